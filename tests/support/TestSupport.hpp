@@ -1,0 +1,28 @@
+#pragma once
+// Helpers shared by Rubble's tests.
+
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "rubble/Mesh.hpp"
+
+namespace rubble::test {
+
+/// The repository root (for assets/ and tests/data/).
+std::filesystem::path sourceDir();
+/// A fresh, empty temporary directory for one test (removed at process exit is not guaranteed).
+std::filesystem::path tempDir(const std::string& name);
+/// The thesis's media folder (../shared/seed/media) when present; tests using it call GTEST_SKIP otherwise.
+std::optional<std::filesystem::path> seedMediaDir();
+/// Writes text to a file, returning its path.
+std::filesystem::path writeFile(const std::filesystem::path& path, const std::string& text);
+
+} // namespace rubble::test
+
+/// Skips the current test when the seed media folder is absent (as in a user's clone).
+#define RUBBLE_REQUIRE_SEED_MEDIA(var)                                                                       \
+    auto var##_opt = ::rubble::test::seedMediaDir();                                                         \
+    if (!var##_opt)                                                                                          \
+        GTEST_SKIP() << "../shared/seed/media is absent";                                                    \
+    const std::filesystem::path var = *var##_opt

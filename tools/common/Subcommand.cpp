@@ -1,0 +1,39 @@
+#include "Subcommand.hpp"
+
+#include <algorithm>
+
+namespace rubble::tools {
+
+std::vector<Subcommand>& registry() {
+    static std::vector<Subcommand> all;
+    return all;
+}
+
+int runMain(const std::string& description, const std::string& version, int argc, char** argv) {
+    CLI::App app{description};
+    app.require_subcommand(1);
+    app.set_version_flag("--version", version);
+    auto& all = registry();
+    std::sort(all.begin(), all.end(),
+              [](const Subcommand& a, const Subcommand& b) { return a.name < b.name; });
+    std::vector<std::function<int()>> runners(all.size());
+    std::vector<CLI::App*> subs;
+    for (std::size_t i = 0; i < all.size(); ++i) {
+        CLI::App* sub = app.add_subcommand(all[i].name, all[i].description);
+        runners[i] = all[i].setup(*sub);
+        subs.push_back(sub);
+    }
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        // Help and version exit 0; usage errors exit 2.
+        const int code = app.exit(e);
+        return code == 0 ? 0 : 2;
+    }
+    for (std::size_t i = 0; i < subs.size(); ++i)
+        if (subs[i]->parsed())
+            return runners[i]();
+    return 2;
+}
+
+} // namespace rubble::tools

@@ -1,0 +1,32 @@
+#pragma once
+// Self-registering subcommands shared by the `rubble` CLI and `rubble-bench`: each *Command.cpp / *Bench.cpp
+// file registers one subcommand at static-initialisation time, so adding one touches no other file.
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+namespace rubble::tools {
+
+/// A subcommand: `setup` adds options to its CLI11 subcommand and returns the function that runs it
+/// (returning the process exit code).
+struct Subcommand {
+    std::string name;
+    std::string description;
+    std::function<std::function<int()>(CLI::App&)> setup;
+};
+
+/// All subcommands registered in this executable.
+std::vector<Subcommand>& registry();
+
+/// Registers a subcommand: `static Registrar r{{"check", "...", setup}};`.
+struct Registrar {
+    explicit Registrar(Subcommand c) { registry().push_back(std::move(c)); }
+};
+
+/// Parses argv, runs the chosen subcommand and returns its exit code (2 for usage errors).
+int runMain(const std::string& description, const std::string& version, int argc, char** argv);
+
+} // namespace rubble::tools
