@@ -1,0 +1,67 @@
+#pragma once
+/// \file ConvexDecomposition.hpp
+/// Approximate convex decomposition for collision shapes, and its incremental update at fracture time.
+
+#include <cstdint>
+#include <filesystem>
+#include <mutex>
+#include <unordered_map>
+#include <vector>
+
+#include "rubble/ConvexPolytope.hpp"
+#include "rubble/Mesh.hpp"
+#include "rubble/Result.hpp"
+
+namespace rubble {
+
+/// Parameters of a decomposition.
+struct DecompositionParams {
+    int maxParts = 24;       ///< at most this many convex parts
+    double concavity = 0.02; ///< stop splitting a part whose concavity is below this fraction of the
+                             ///< mesh's bounding-box diagonal
+    double minPartVolumeFraction = 1e-6; ///< parts below this fraction of the mesh volume are dropped
+};
+
+/// A set of convex parts approximating a closed mesh.
+struct Decomposition {
+    std::vector<ConvexPolytope> parts; ///< convex parts, in the mesh's coordinates
+    double meshVolume = 0;             ///< volume of the mesh
+    double hullVolume = 0;             ///< Σ part volumes
+    /// (Σ hull volume − mesh volume) / mesh volume.
+    double excess() const { return meshVolume > 0 ? (hullVolume - meshVolume) / meshVolume : 0.0; }
+};
+
+/// The convex hull of a point set (Qhull). Fails for fewer than 4 non-coplanar points.
+Result<ConvexPolytope> convexHull(const std::vector<Vec3>& points);
+
+/// Decomposes a closed mesh into at most params.maxParts convex parts; a convex mesh gives exactly one part.
+Result<Decomposition> decompose(const Mesh& mesh, const DecompositionParams& params = {});
+
+/// Incremental update at fracture time: clips the parent's parts by the cells and assigns every fragment to
+/// the piece containing it. parentParts are in the same coordinates as cells and pieces. pieceCells[i] is
+/// Piece::cell of piece i (-1 for remainder islands). Returns one part list per piece; a piece that received
+/// no fragment gets a fresh decomposition. Slivers are dropped and parts merged to respect params.maxParts.
+std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<ConvexPolytope>& parentParts,
+                                                             const std::vector<ConvexPolytope>& cells,
+                                                             const std::vector<Mesh>& pieces,
+                                                             const std::vector<std::int32_t>& pieceCells,
+                                                             const DecompositionParams& params = {});
+
+/// Thread-safe cache of decompositions keyed by Mesh::hash(), optionally persisted in a directory.
+class DecompositionCache {
+public:
+    /// An in-memory cache; with a directory, entries are also read from and written to files there.
+    explicit DecompositionCache(std::filesystem::path directory = {});
+    /// The cached decomposition of mesh, computing and storing it on a miss.
+    Result<Decomposition> get(const Mesh& mesh, const DecompositionParams& params = {});
+    /// Number of lookups answered from the cache (memory or disk).
+    std::size_t hits() const;
+
+private:
+    std::filesystem::path directory_;
+    mutable std::mutex mutex_;
+    std::unordered_map<std::uint64_t, Decomposition> memory_;
+    std::size_t hits_ = 0;
+};
+
+} // namespace rubble

@@ -1,0 +1,139 @@
+#pragma once
+/// \file DestructionWorld.hpp
+/// The engine-agnostic runtime: impacts in, fracture jobs on a JobSystem, versioned results out.
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rubble/ConvexDecomposition.hpp"
+#include "rubble/Fracture.hpp"
+#include "rubble/JobSystem.hpp"
+#include "rubble/Mesh.hpp"
+#include "rubble/Result.hpp"
+
+namespace rubble {
+
+/// Identifies a destructible object in a DestructionWorld (never reused).
+using ObjectId = std::uint32_t;
+
+/// A rigid frame: p_parent = rotation · p_local + translation.
+struct Frame {
+    Mat3 rotation = Mat3::identity(); ///< orientation
+    Vec3 translation;                 ///< position
+};
+
+/// What an object is made of.
+struct ObjectDesc {
+    Mesh mesh;                   ///< closed mesh in the object's local coordinates
+    double density = 1;          ///< mass = density · volume
+    bool destructible = true;    ///< false: never fractured
+    double impulseThreshold = 0; ///< impacts below this impulse are ignored
+    FractureParams fracture;     ///< how it breaks
+    std::vector<ConvexPolytope>
+        convexParts; ///< collision parts in local coordinates; empty = decompose on add
+};
+
+/// A live object as the runtime sees it.
+struct ObjectState {
+    ObjectId id = 0;             ///< its id
+    std::uint32_t version = 0;   ///< bumped whenever its shape is replaced
+    Mesh mesh;                   ///< local mesh (origin at the centre of mass for pieces)
+    MassProperties mass;         ///< mass properties of mesh, density 1
+    double density = 1;          ///< density
+    bool destructible = true;    ///< false when never fractured (also: mesh could not be made valid)
+    double impulseThreshold = 0; ///< minimum impulse that fractures it
+    FractureParams fracture;     ///< how it breaks
+    std::vector<ConvexPolytope> convexParts; ///< collision parts in local coordinates
+    std::string warning;                     ///< why it is indestructible, when it had to be made so
+};
+
+/// Wall-clock timing of one impact from submission to adoption, in milliseconds.
+struct TimingRecord {
+    ObjectId object = 0;        ///< the object that was hit
+    std::uint64_t frame = 0;    ///< frame of submission
+    int impactsMerged = 1;      ///< impacts fractured in this job
+    double queueMs = 0;         ///< waiting for a worker (and for an in-flight job on the same object)
+    double cellMs = 0;          ///< building cells
+    double booleanMs = 0;       ///< booleans
+    double islandsMs = 0;       ///< islands and mass properties
+    double decompositionMs = 0; ///< convex parts of the pieces
+    double adoptionMs = 0;      ///< main-thread adoption
+    double totalMs = 0;         ///< submission → adopted
+    int pieces = 0;             ///< pieces produced
+    bool stale = false;         ///< discarded because the object changed meanwhile
+};
+
+/// A fracture ready to adopt: the parent object is replaced by the pieces.
+struct FractureOutcome {
+    ObjectId parent = 0;             ///< the object that broke (removed from the world by adoption)
+    std::uint32_t parentVersion = 0; ///< its version when the job started
+    std::vector<ObjectId> pieces;    ///< the new objects, already added to the world
+    std::vector<Frame>
+        pieceFrames; ///< piece local frame → parent local frame (centre of mass, principal axes)
+    std::vector<Impact> impacts; ///< the impacts (parent local coordinates) that caused it
+    double droppedVolume = 0;    ///< volume of slivers dropped (for volume bookkeeping)
+};
+
+/// The runtime. All member functions are called from one (main) thread; work runs on the JobSystem.
+class DestructionWorld {
+public:
+    /// Configuration.
+    struct Config {
+        JobSystem* jobs = nullptr;  ///< null: an owned ThreadPool with hardware threads − 1 workers (≥ 1)
+        int workers = -1;           ///< worker count of the owned pool (-1 = automatic)
+        bool deterministic = false; ///< adopt each result exactly delayFrames after its impact
+        int delayFrames = 2;        ///< frame delay in deterministic mode
+        double adoptionBudgetMs =
+            1.0;                ///< main-thread time per frame for adoption (at least one result adopts)
+        std::uint64_t seed = 1; ///< world seed; each job's seed derives from it, the object and version
+        DecompositionParams decomposition; ///< convex parts of pieces
+    };
+
+    /// A world with the given configuration.
+    explicit DestructionWorld(Config config);
+    /// Waits for in-flight jobs to finish (or discards their results); never hangs.
+    ~DestructionWorld();
+    DestructionWorld(const DestructionWorld&) = delete;
+    DestructionWorld& operator=(const DestructionWorld&) = delete;
+
+    /// Adds an object. An open or invalid mesh is repaired when possible, else the object becomes
+    /// indestructible and ObjectState::warning says why. Fails only for an empty mesh.
+    Result<ObjectId> addObject(ObjectDesc desc);
+    /// Removes an object (pending work for it is discarded).
+    void removeObject(ObjectId id);
+    /// The object, or null when it does not exist (any more).
+    const ObjectState* object(ObjectId id) const;
+    /// Ids of all live objects, ascending.
+    std::vector<ObjectId> objects() const;
+
+    /// Submits an impact in the object's local coordinates. Returns false when it is ignored (unknown or
+    /// indestructible object, impulse below threshold). An impact on an object with a job in flight is merged
+    /// into the next job for that object.
+    bool submitImpact(ObjectId id, const Impact& impact);
+
+    /// Advances the frame counter; call once per frame before collect().
+    void beginFrame();
+    /// The current frame number.
+    std::uint64_t frame() const;
+    /// Results ready for adoption this frame (within the adoption budget). Pieces are added to the world and
+    /// the parent removed before this returns; the caller replaces its bodies accordingly.
+    std::vector<FractureOutcome> collect();
+    /// Blocks until no job is in flight or queued (for tools, tests and shutdown).
+    void waitIdle();
+
+    /// Jobs running or waiting.
+    int jobsInFlight() const;
+    /// Timing of every finished impact so far.
+    const std::vector<TimingRecord>& timings() const;
+    /// Writes timings() as CSV.
+    Status writeTimingsCsv(const std::filesystem::path& path) const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+} // namespace rubble

@@ -1,0 +1,119 @@
+#pragma once
+/// \file Fracture.hpp
+/// The fracture kernel: cells around an impact, booleans against them, pieces with mass properties.
+/// Pure functions of their inputs and a seed; no physics engine involved.
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rubble/ConvexPolytope.hpp"
+#include "rubble/MassProperties.hpp"
+#include "rubble/Mesh.hpp"
+#include "rubble/Result.hpp"
+
+namespace rubble {
+
+/// An impact on an object, in the object's mesh coordinates.
+struct Impact {
+    Vec3 point; ///< where the object was hit
+    Vec3 normal{0, 1,
+                0}; ///< surface normal at the hit (pointing out of the object), or the hit direction reversed
+    double impulse = 1; ///< magnitude of the applied impulse (N·s)
+};
+
+/// How the size of the cut region follows the impulse: size = clamp(base + scale · impulse^exponent, min,
+/// max), where size is the edge length of the cubic domain the cell is built in.
+struct CellSizeLaw {
+    double base = 0.5;     ///< size at zero impulse
+    double scale = 0.05;   ///< growth factor
+    double exponent = 0.5; ///< growth exponent
+    double minSize = 0.05; ///< lower clamp
+    double maxSize = 20;   ///< upper clamp
+    /// The domain size for an impulse.
+    double sizeFor(double impulse) const;
+};
+
+/// Which cells an impact cuts.
+enum class CellPattern {
+    SingleCell, ///< the thesis: the Voronoi cell of the impact point among random seeds in a box domain
+    Shatter,    ///< K Voronoi cells around the impact, denser near it, randomly rotated and scaled
+};
+
+/// Which boolean implementation runs.
+enum class BooleanKind {
+    Corefine, ///< CGAL Polygon_mesh_processing corefinement (default)
+    Nef,      ///< CGAL Nef_polyhedron_3 (the thesis's method; reference and cross-check)
+};
+
+/// Parameters of one fracture.
+struct FractureParams {
+    CellPattern pattern = CellPattern::SingleCell; ///< single cell (thesis) or shatter pattern
+    int seedPoints = 15; ///< random Voronoi sites in the domain besides the impact point
+    int cells = 6;       ///< K, the number of cells of a Shatter pattern
+    CellSizeLaw sizeLaw; ///< domain size from impulse
+    BooleanKind backend = BooleanKind::Corefine; ///< boolean implementation
+    double minPieceVolumeFraction = 1e-9; ///< pieces below this fraction of the input volume are dropped
+                                          ///< (their volume is reported in FractureResult::droppedVolume)
+    double uvScale = 1.0;                 ///< texture repeats per unit length on cut faces
+};
+
+/// One output piece: a closed, outward-oriented mesh in the input's coordinates.
+struct Piece {
+    Mesh mesh;              ///< closed mesh; cut faces have material kInteriorMaterial and planar UVs
+    MassProperties mass;    ///< exact mass properties of mesh (density 1)
+    std::int32_t cell = -1; ///< -1: part of the damaged remainder (input − cells); i ≥ 0: debris of cell i
+};
+
+/// Wall-clock durations of the stages of one fracture, in milliseconds.
+struct FractureTimings {
+    double cellMs = 0;    ///< building the cells
+    double booleanMs = 0; ///< difference and intersections
+    double islandsMs = 0; ///< splitting into islands and mass properties
+    double totalMs = 0;   ///< everything
+};
+
+/// Everything one fracture produced.
+struct FractureResult {
+    std::vector<Piece> pieces;         ///< remainder islands first, then debris islands by cell
+    std::vector<ConvexPolytope> cells; ///< the cells that were cut (faces tagged with their plane index)
+    double inputVolume = 0;            ///< volume of the input mesh
+    double droppedVolume = 0;          ///< volume of pieces dropped as too small
+    FractureTimings timings;           ///< stage durations
+};
+
+/// Builds the cutting cells for an impact on a mesh with the given bounds. Deterministic in seed.
+std::vector<ConvexPolytope> generateCells(const Aabb& meshBounds, const Impact& impact,
+                                          const FractureParams& params, std::uint64_t seed);
+
+/// Result of splitting a mesh by disjoint convex cells.
+struct SplitResult {
+    Mesh remainder;           ///< mesh − ∪ cells (may be empty)
+    std::vector<Mesh> inside; ///< inside[i] = mesh ∩ cells[i] (may be empty)
+};
+
+/// A boolean implementation: splits a closed mesh by disjoint convex cells.
+class BooleanBackend {
+public:
+    virtual ~BooleanBackend() = default;
+    /// Short name ("corefine", "nef").
+    virtual std::string name() const = 0;
+    /// remainder = mesh − ∪cells and inside[i] = mesh ∩ cells[i]. Faces created by cell faces carry
+    /// kInteriorMaterial; other faces keep the input's attributes. Errors leave nothing half-done.
+    virtual Result<SplitResult> split(const Mesh& mesh, const std::vector<ConvexPolytope>& cells) const = 0;
+};
+
+/// The backend of the given kind.
+std::unique_ptr<BooleanBackend> makeBooleanBackend(BooleanKind kind);
+
+/// Fractures a closed mesh at an impact: cells, booleans, islands, mass properties, interior UVs.
+/// Returns ErrorCode::NoIntersection when the cells miss the mesh, InvalidInput for an open or invalid mesh.
+Result<FractureResult> fracture(const Mesh& mesh, const Impact& impact, const FractureParams& params,
+                                std::uint64_t seed);
+
+/// Fractures a closed mesh with explicitly given cells (for merged impacts and tests).
+Result<FractureResult> fractureWithCells(const Mesh& mesh, std::vector<ConvexPolytope> cells,
+                                         const FractureParams& params);
+
+} // namespace rubble
