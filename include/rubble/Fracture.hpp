@@ -45,6 +45,9 @@ enum class CellPattern {
 enum class BooleanKind {
     Corefine, ///< CGAL Polygon_mesh_processing corefinement (default)
     Nef,      ///< CGAL Nef_polyhedron_3 (the thesis's method; reference and cross-check)
+    Fast, ///< Rubble's convex-cell clipper: touches only triangles near the cells (~0.7 ms at 10k triangles);
+          ///< implemented by detail::clipByConvexCell (src/fracture/ConvexCellClipper.hpp), applied cell by
+          ///< cell; when it declines a near-degenerate configuration the whole split falls back to Corefine
 };
 
 /// Parameters of one fracture.
