@@ -70,6 +70,10 @@ public:
     const T& value() const& { return std::get<T>(v_); }
     /// The value moved out; only valid when isOk().
     T&& value() && { return std::get<T>(std::move(v_)); }
+    /// The value; only valid when isOk().
+    T& operator*() & { return std::get<T>(v_); }
+    /// The value; only valid when isOk().
+    const T& operator*() const& { return std::get<T>(v_); }
     /// Pointer-like access to the value.
     T* operator->() { return &std::get<T>(v_); }
     /// Pointer-like access to the value.
