@@ -1,0 +1,263 @@
+#include "rubble/MeshCheck.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <unordered_map>
+
+#include "rubble/Islands.hpp"
+#include "rubble/MassProperties.hpp"
+
+namespace rubble {
+
+namespace {
+std::uint64_t edgeKey(std::uint32_t a, std::uint32_t b) {
+    if (a > b)
+        std::swap(a, b);
+    return (static_cast<std::uint64_t>(a) << 32) | b;
+}
+
+std::string num(double v) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.6g", v);
+    return buf;
+}
+
+std::string plural(std::size_t n, const char* one, const char* many) {
+    return std::to_string(n) + " " + (n == 1 ? one : many);
+}
+
+std::string edgeName(std::uint64_t key) {
+    return std::to_string((key >> 32) + 1) + "-" + std::to_string((key & 0xFFFFFFFFu) + 1);
+}
+
+// Appends ", e.g. a, b, c" for the first few examples.
+std::string examples(const std::vector<std::string>& items) {
+    if (items.empty())
+        return {};
+    std::string s = items.size() == 1 ? " (" : " (e.g. ";
+    for (std::size_t i = 0; i < items.size(); ++i)
+        s += (i ? ", " : "") + items[i];
+    return s + ")";
+}
+
+struct EdgeUse {
+    std::uint32_t count = 0;   // incident triangles
+    std::uint32_t forward = 0; // uses as low -> high
+};
+} // namespace
+
+bool MeshReport::valid() const {
+    return triangles > 0 && closed && edgeManifold && oriented && outward && degenerateTriangles == 0 &&
+           duplicateTriangles == 0 && nonFiniteVertices == 0 && badIndices == 0 &&
+           !(selfIntersectionsChecked && selfIntersections > 0);
+}
+
+bool isDegenerateTriangle(const Vec3& a, const Vec3& b, const Vec3& c) {
+    const Vec3 e0 = b - a, e1 = c - a, e2 = c - b;
+    const double longest = std::max({lengthSquared(e0), lengthSquared(e1), lengthSquared(e2)});
+    if (longest == 0)
+        return true;
+    // Zero area relative to the longest edge (the sine of the largest angle's complement is below 1e-12).
+    return lengthSquared(cross(e0, e1)) <= 1e-24 * longest * longest;
+}
+
+MeshReport checkMesh(const Mesh& mesh, const CheckOptions& options) {
+    MeshReport r;
+    r.vertices = mesh.positions.size();
+    r.triangles = mesh.triangles.size();
+    const std::size_t maxListed = options.maxListedPerKind;
+
+    std::vector<std::string> nonFiniteEx, badIndexEx, degenerateEx, duplicateEx;
+    std::vector<bool> finite(mesh.positions.size());
+    for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
+        finite[i] = isFinite(mesh.positions[i]);
+        if (!finite[i]) {
+            ++r.nonFiniteVertices;
+            if (nonFiniteEx.size() < maxListed)
+                nonFiniteEx.push_back("vertex " + std::to_string(i + 1));
+        } else {
+            r.bounds.extend(mesh.positions[i]);
+        }
+    }
+
+    // Triangles usable for topology: in range and three distinct indices.
+    std::vector<bool> usable(mesh.triangles.size(), true);
+    std::unordered_map<std::uint64_t, EdgeUse> edges;
+    edges.reserve(mesh.triangles.size() * 2);
+    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+        const Triangle& tri = mesh.triangles[t];
+        bool inRange = true;
+        for (std::uint32_t v : tri)
+            if (v >= mesh.positions.size()) {
+                inRange = false;
+                ++r.badIndices;
+                if (badIndexEx.size() < maxListed)
+                    badIndexEx.push_back("triangle " + std::to_string(t + 1) + " refers to vertex " +
+                                         std::to_string(std::uint64_t{v} + 1) + " of " +
+                                         std::to_string(mesh.positions.size()));
+            }
+        if (!inRange) {
+            usable[t] = false;
+            continue;
+        }
+        bool degenerate = tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2];
+        if (!degenerate && finite[tri[0]] && finite[tri[1]] && finite[tri[2]])
+            degenerate =
+                isDegenerateTriangle(mesh.positions[tri[0]], mesh.positions[tri[1]], mesh.positions[tri[2]]);
+        if (degenerate) {
+            ++r.degenerateTriangles;
+            if (degenerateEx.size() < maxListed)
+                degenerateEx.push_back("triangle " + std::to_string(t + 1));
+        }
+        if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2]) {
+            usable[t] = false;
+            continue;
+        }
+        for (int c = 0; c < 3; ++c) {
+            const std::uint32_t a = tri[c], b = tri[(c + 1) % 3];
+            EdgeUse& e = edges[edgeKey(a, b)];
+            ++e.count;
+            if (a < b)
+                ++e.forward;
+        }
+    }
+
+    // Duplicate triangles (same vertex set), found by sorting the sorted triples.
+    {
+        std::vector<std::pair<std::array<std::uint32_t, 3>, std::size_t>> keyed;
+        keyed.reserve(mesh.triangles.size());
+        for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
+            if (usable[t]) {
+                std::array<std::uint32_t, 3> s = mesh.triangles[t];
+                std::sort(s.begin(), s.end());
+                keyed.emplace_back(s, t);
+            }
+        std::sort(keyed.begin(), keyed.end());
+        for (std::size_t i = 1; i < keyed.size(); ++i)
+            if (keyed[i].first == keyed[i - 1].first) {
+                ++r.duplicateTriangles;
+                if (duplicateEx.size() < maxListed)
+                    duplicateEx.push_back("triangle " + std::to_string(keyed[i].second + 1) +
+                                          " repeats triangle " + std::to_string(keyed[i - 1].second + 1));
+            }
+    }
+
+    // Edge topology, examples in a deterministic order (smallest edge keys first).
+    std::vector<std::uint64_t> openEx, nonManifoldEx, misorientedEx;
+    std::vector<std::pair<std::uint64_t, EdgeUse>> sortedEdges(edges.begin(), edges.end());
+    std::sort(sortedEdges.begin(), sortedEdges.end(),
+              [](const auto& a, const auto& b) { return a.first < b.first; });
+    std::unordered_map<std::uint64_t, std::uint32_t> nonManifoldCount;
+    for (const auto& [key, use] : sortedEdges) {
+        if (use.count == 1) {
+            ++r.boundaryEdges;
+            if (openEx.size() < maxListed)
+                openEx.push_back(key);
+        } else if (use.count == 2) {
+            if (use.forward != 1) {
+                ++r.misorientedEdges;
+                if (misorientedEx.size() < maxListed)
+                    misorientedEx.push_back(key);
+            }
+        } else {
+            ++r.nonManifoldEdges;
+            if (nonManifoldEx.size() < maxListed) {
+                nonManifoldEx.push_back(key);
+                nonManifoldCount[key] = use.count;
+            }
+        }
+    }
+    r.edgeManifold = r.nonManifoldEdges == 0;
+    r.closed = r.boundaryEdges == 0 && r.nonManifoldEdges == 0 && !edges.empty();
+    r.oriented = r.misorientedEdges == 0 && !edges.empty();
+
+    if (r.badIndices == 0) {
+        std::vector<std::uint32_t> shellOf;
+        r.shells = labelShells(mesh, shellOf);
+    }
+    if (r.badIndices == 0 && r.nonFiniteVertices == 0 && !mesh.triangles.empty()) {
+        const MassProperties mp = computeMassProperties(mesh);
+        r.volume = mp.volume;
+        r.centerOfMass = mp.centerOfMass;
+    }
+    r.outward = r.volume > 0;
+
+    if (options.selfIntersections) {
+        if (r.badIndices == 0 && r.nonFiniteVertices == 0 && r.degenerateTriangles == 0 && r.edgeManifold) {
+            const SelfIntersectionResult si = findSelfIntersections(mesh, options.maxSelfIntersections);
+            r.selfIntersectionsChecked = si.ran;
+            r.selfIntersections = si.pairs;
+            r.selfIntersectionsCapped = si.capped;
+            r.selfIntersectionNote = si.note;
+            if (si.pairs > 0) {
+                std::vector<std::string> ex;
+                for (const auto& [a, b] : si.examples)
+                    if (ex.size() < maxListed)
+                        ex.push_back("triangles " + std::to_string(a + 1) + " and " + std::to_string(b + 1));
+                r.problems.push_back(
+                    (si.capped ? "at least " : "") +
+                    plural(si.pairs, "pair of triangles intersects", "pairs of triangles intersect") +
+                    examples(ex));
+            }
+        } else {
+            r.selfIntersectionNote = r.nonFiniteVertices > 0 ? "skipped: the mesh has non-finite coordinates"
+                                     : r.badIndices > 0
+                                         ? "skipped: a triangle refers to a vertex that does not exist"
+                                     : r.degenerateTriangles ? "skipped: the mesh has degenerate triangles"
+                                                             : "skipped: the mesh has non-manifold edges";
+        }
+    } else {
+        r.selfIntersectionNote = "skipped on request";
+    }
+
+    // Problems, most fundamental first. The self-intersection problem (if any) goes after topology.
+    std::vector<std::string> problems;
+    if (mesh.triangles.empty())
+        problems.push_back("the mesh has no triangles");
+    if (r.nonFiniteVertices > 0)
+        problems.push_back(plural(r.nonFiniteVertices, "vertex has", "vertices have") +
+                           " a non-finite coordinate (NaN or infinity)" + examples(nonFiniteEx));
+    if (r.badIndices > 0)
+        problems.push_back(plural(r.badIndices, "triangle corner refers", "triangle corners refer") +
+                           " to a vertex that does not exist" + examples(badIndexEx));
+    if (r.boundaryEdges > 0) {
+        std::vector<std::string> ex;
+        for (std::uint64_t k : openEx)
+            ex.push_back("edge " + edgeName(k));
+        problems.push_back(
+            "the mesh is not closed (holes): " + plural(r.boundaryEdges, "edge is", "edges are") +
+            " used by only one triangle" + examples(ex));
+    }
+    if (r.nonManifoldEdges > 0) {
+        std::vector<std::string> ex;
+        for (std::uint64_t k : nonManifoldEx)
+            ex.push_back("edge " + edgeName(k) + " has " + std::to_string(nonManifoldCount[k]) +
+                         " triangles");
+        problems.push_back("the mesh is not manifold: " + plural(r.nonManifoldEdges, "edge is", "edges are") +
+                           " shared by three or more triangles" + examples(ex));
+    }
+    if (r.misorientedEdges > 0) {
+        std::vector<std::string> ex;
+        for (std::uint64_t k : misorientedEx)
+            ex.push_back("edge " + edgeName(k));
+        problems.push_back("the mesh is not consistently oriented (flipped triangles): " +
+                           plural(r.misorientedEdges, "edge is", "edges are") +
+                           " used twice in the same direction" + examples(ex));
+    }
+    if (!mesh.triangles.empty() && r.badIndices == 0 && r.nonFiniteVertices == 0 && r.closed && r.oriented &&
+        !r.outward)
+        problems.push_back(r.volume < 0 ? "the mesh is inside out (signed volume " + num(r.volume) + ")"
+                                        : "the mesh encloses no volume");
+    if (r.degenerateTriangles > 0)
+        problems.push_back(plural(r.degenerateTriangles, "triangle is", "triangles are") +
+                           " degenerate (repeated vertex or zero area)" + examples(degenerateEx));
+    if (r.duplicateTriangles > 0)
+        problems.push_back(plural(r.duplicateTriangles, "triangle duplicates", "triangles duplicate") +
+                           " an earlier triangle" + examples(duplicateEx));
+    problems.insert(problems.end(), r.problems.begin(), r.problems.end());
+    r.problems = std::move(problems);
+    return r;
+}
+
+} // namespace rubble

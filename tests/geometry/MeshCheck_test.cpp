@@ -1,0 +1,250 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "rubble/MassProperties.hpp"
+#include "rubble/MeshCheck.hpp"
+#include "rubble/Random.hpp"
+
+using namespace rubble;
+
+namespace {
+bool mentions(const MeshReport& r, const std::string& text) {
+    for (const std::string& p : r.problems)
+        if (p.find(text) != std::string::npos)
+            return true;
+    return false;
+}
+
+std::string problemsOf(const MeshReport& r) {
+    std::string s;
+    for (const std::string& p : r.problems)
+        s += p + "\n";
+    return s;
+}
+
+// Every triangle gets its own three vertices (a "triangle soup", as some exporters write).
+Mesh unwelded(const Mesh& m) {
+    Mesh out;
+    for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+        const auto c = m.corners(t);
+        const auto base = static_cast<std::uint32_t>(out.positions.size());
+        out.positions.insert(out.positions.end(), c.begin(), c.end());
+        out.triangles.push_back({base, base + 1, base + 2});
+    }
+    return out;
+}
+} // namespace
+
+TEST(MeshCheck, ClosedShapesAreValid) {
+    for (const Mesh& m : {makeBox({0, 0, 0}, {1, 2, 3}), makeSubdividedBox({-1, -1, -1}, {1, 1, 1}, 4),
+                          makeSphere({1, 2, 3}, 2, 24, 12), makeTorus({0, 0, 0}, 3, 1, 24, 12)}) {
+        const MeshReport r = checkMesh(m);
+        EXPECT_TRUE(r.valid()) << problemsOf(r);
+        EXPECT_TRUE(r.closed);
+        EXPECT_TRUE(r.edgeManifold);
+        EXPECT_TRUE(r.oriented);
+        EXPECT_TRUE(r.outward);
+        EXPECT_TRUE(r.selfIntersectionsChecked) << r.selfIntersectionNote;
+        EXPECT_EQ(r.selfIntersections, 0u);
+        EXPECT_TRUE(r.problems.empty());
+        EXPECT_EQ(r.vertices, m.vertexCount());
+        EXPECT_EQ(r.triangles, m.triangleCount());
+        EXPECT_EQ(r.shells, 1u);
+        EXPECT_NEAR(r.volume, signedVolume(m), 1e-9 * std::abs(r.volume));
+    }
+}
+
+TEST(MeshCheck, BoxFarFromOriginReportsExactGeometry) {
+    const Mesh m = makeBox({1e6, 1e6, 1e6}, {1e6 + 2, 1e6 + 4, 1e6 + 6});
+    const MeshReport r = checkMesh(m);
+    EXPECT_TRUE(r.valid()) << problemsOf(r);
+    EXPECT_NEAR(r.volume, 48.0, 1e-6);
+    EXPECT_NEAR(r.centerOfMass.x, 1e6 + 1, 1e-6);
+    EXPECT_NEAR(r.centerOfMass.y, 1e6 + 2, 1e-6);
+    EXPECT_NEAR(r.centerOfMass.z, 1e6 + 3, 1e-6);
+    EXPECT_EQ(r.bounds.lo.x, 1e6);
+    EXPECT_EQ(r.bounds.hi.z, 1e6 + 6);
+}
+
+TEST(MeshCheck, OpenCubeIsNotClosed) {
+    Mesh m = makeBox({0, 0, 0}, {1, 1, 1});
+    m.triangles.pop_back();
+    const MeshReport r = checkMesh(m);
+    EXPECT_FALSE(r.valid());
+    EXPECT_FALSE(r.closed);
+    EXPECT_TRUE(r.edgeManifold);
+    EXPECT_TRUE(r.oriented);
+    EXPECT_EQ(r.boundaryEdges, 3u);
+    EXPECT_TRUE(mentions(r, "not closed (holes): 3 edges are used by only one triangle")) << problemsOf(r);
+}
+
+TEST(MeshCheck, OneFlippedFaceIsNotOriented) {
+    Mesh m = makeBox({0, 0, 0}, {1, 1, 1});
+    std::swap(m.triangles[4][1], m.triangles[4][2]);
+    const MeshReport r = checkMesh(m);
+    EXPECT_FALSE(r.valid());
+    EXPECT_TRUE(r.closed);
+    EXPECT_FALSE(r.oriented);
+    EXPECT_EQ(r.misorientedEdges, 3u);
+    EXPECT_TRUE(mentions(r, "not consistently oriented")) << problemsOf(r);
+}
+
+TEST(MeshCheck, InvertedCubeIsInsideOut) {
+    Mesh m = makeBox({0, 0, 0}, {1, 1, 1});
+    for (Triangle& t : m.triangles)
+        std::swap(t[1], t[2]);
+    const MeshReport r = checkMesh(m);
+    EXPECT_FALSE(r.valid());
+    EXPECT_TRUE(r.closed);
+    EXPECT_TRUE(r.oriented);
+    EXPECT_FALSE(r.outward);
+    EXPECT_NEAR(r.volume, -1.0, 1e-12);
+    EXPECT_TRUE(mentions(r, "inside out")) << problemsOf(r);
+}
+
+TEST(MeshCheck, DuplicatedVerticesLeaveEveryEdgeOpen) {
+    const Mesh m = unwelded(makeBox({0, 0, 0}, {1, 1, 1}));
+    const MeshReport r = checkMesh(m);
+    EXPECT_FALSE(r.valid());
+    EXPECT_FALSE(r.closed);
+    EXPECT_EQ(r.boundaryEdges, 36u);
+    EXPECT_EQ(r.shells, 12u);
+    EXPECT_NEAR(r.volume, 1.0, 1e-12); // the volume integral does not need shared vertices
+}
+
+TEST(MeshCheck, ThreeTrianglesOnAnEdgeAreNonManifold) {
+    Mesh m = makeBox({0, 0, 0}, {1, 1, 1});
+    // A fin sticking out of the edge between vertex 0 and the next corner of triangle 0.
+    const Triangle t0 = m.triangles[0];
+    m.positions.push_back({-1, -1, -1});
+    m.triangles.push_back({t0[0], t0[1], static_cast<std::uint32_t>(m.positions.size() - 1)});
+    const MeshReport r = checkMesh(m);
+    EXPECT_FALSE(r.valid());
+    EXPECT_FALSE(r.edgeManifold);
+    EXPECT_FALSE(r.closed);
+    EXPECT_EQ(r.nonManifoldEdges, 1u);
+    EXPECT_FALSE(r.selfIntersectionsChecked);
+    EXPECT_NE(r.selfIntersectionNote.find("non-manifold"), std::string::npos);
+    EXPECT_TRUE(mentions(r, "has 3 triangles")) << problemsOf(r);
+}
+
+TEST(MeshCheck, NonFiniteCoordinatesAreReportedNotComputedWith) {
+    for (double bad : {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+        Mesh m = makeBox({0, 0, 0}, {1, 1, 1});
+        m.positions[3].y = bad;
+        const MeshReport r = checkMesh(m);
+        EXPECT_FALSE(r.valid());
+        EXPECT_EQ(r.nonFiniteVertices, 1u);
+        EXPECT_EQ(r.volume, 0.0);
+        EXPECT_FALSE(r.selfIntersectionsChecked);
+        EXPECT_TRUE(mentions(r, "1 vertex has a non-finite coordinate (NaN or infinity) (vertex 4)"))
+            << problemsOf(r);
+        EXPECT_TRUE(isFinite(r.bounds.lo) && isFinite(r.bounds.hi));
+    }
+}
+
+TEST(MeshCheck, OutOfRangeIndicesAreReportedWithoutCrashing) {
+    Mesh m = makeBox({0, 0, 0}, {1, 1, 1});
+    m.triangles[2][1] = 100;
+    const MeshReport r = checkMesh(m);
+    EXPECT_FALSE(r.valid());
+    EXPECT_EQ(r.badIndices, 1u);
+    EXPECT_TRUE(mentions(r, "triangle 3 refers to vertex 101 of 8")) << problemsOf(r);
+}
+
+TEST(MeshCheck, DegenerateAndDuplicateTriangles) {
+    Mesh m = makeBox({0, 0, 0}, {1, 1, 1});
+    m.triangles.push_back({0, 0, 1}); // repeated index
+    m.positions.push_back({0.5, 0, 0});
+    m.triangles.push_back({0, 1, 8}); // three collinear points? only if 0,1,8 are collinear
+    const Triangle first = m.triangles[0];
+    m.triangles.push_back(first); // exact duplicate
+    const MeshReport r = checkMesh(m);
+    EXPECT_FALSE(r.valid());
+    EXPECT_GE(r.degenerateTriangles, 1u);
+    EXPECT_EQ(r.duplicateTriangles, 1u);
+    EXPECT_TRUE(mentions(r, "degenerate")) << problemsOf(r);
+    EXPECT_TRUE(mentions(r, "duplicates an earlier triangle")) << problemsOf(r);
+}
+
+TEST(MeshCheck, CollinearTriangleIsDegenerate) {
+    EXPECT_TRUE(isDegenerateTriangle({0, 0, 0}, {1, 1, 1}, {2, 2, 2}));
+    EXPECT_TRUE(isDegenerateTriangle({1, 2, 3}, {1, 2, 3}, {1, 2, 3}));
+    EXPECT_FALSE(isDegenerateTriangle({0, 0, 0}, {1, 0, 0}, {0, 1e-6, 0}));
+}
+
+TEST(MeshCheck, OverlappingBoxesSelfIntersect) {
+    Mesh m = makeBox({0, 0, 0}, {2, 2, 2});
+    m.append(makeBox({1, 1, 1}, {3, 3, 3}));
+    const MeshReport r = checkMesh(m);
+    EXPECT_TRUE(r.closed);
+    EXPECT_TRUE(r.oriented);
+    EXPECT_TRUE(r.selfIntersectionsChecked) << r.selfIntersectionNote;
+    EXPECT_GT(r.selfIntersections, 0u);
+    EXPECT_FALSE(r.valid());
+    EXPECT_TRUE(mentions(r, "intersect")) << problemsOf(r);
+
+    CheckOptions skip;
+    skip.selfIntersections = false;
+    const MeshReport fast = checkMesh(m, skip);
+    EXPECT_FALSE(fast.selfIntersectionsChecked);
+    EXPECT_TRUE(fast.valid()); // without the test, two overlapping closed boxes look fine
+}
+
+TEST(MeshCheck, SelfIntersectionCountCanBeCapped) {
+    Mesh m = makeSubdividedBox({0, 0, 0}, {2, 2, 2}, 3);
+    m.append(makeSubdividedBox({1, 1, 1}, {3, 3, 3}, 3));
+    CheckOptions capped;
+    capped.maxSelfIntersections = 2;
+    const MeshReport r = checkMesh(m, capped);
+    EXPECT_TRUE(r.selfIntersectionsCapped);
+    EXPECT_GE(r.selfIntersections, 1u);
+    EXPECT_TRUE(mentions(r, "at least")) << problemsOf(r);
+}
+
+TEST(MeshCheck, SeparateBoxesDoNotIntersect) {
+    Mesh m = makeBox({0, 0, 0}, {1, 1, 1});
+    m.append(makeBox({2, 0, 0}, {3, 1, 1}));
+    const MeshReport r = checkMesh(m);
+    EXPECT_TRUE(r.valid()) << problemsOf(r);
+    EXPECT_EQ(r.shells, 2u);
+    EXPECT_NEAR(r.volume, 2.0, 1e-12);
+}
+
+TEST(MeshCheck, MisorientedMeshStillGetsSelfIntersectionVerdict) {
+    Mesh m = makeBox({0, 0, 0}, {1, 1, 1});
+    std::swap(m.triangles[0][1], m.triangles[0][2]);
+    const MeshReport r = checkMesh(m);
+    EXPECT_TRUE(r.selfIntersectionsChecked) << r.selfIntersectionNote;
+    EXPECT_EQ(r.selfIntersections, 0u);
+}
+
+TEST(MeshCheck, EmptyMeshIsInvalid) {
+    const MeshReport r = checkMesh(Mesh{});
+    EXPECT_FALSE(r.valid());
+    EXPECT_TRUE(mentions(r, "no triangles"));
+    EXPECT_TRUE(r.bounds.empty());
+}
+
+TEST(MeshCheck, RandomIndexSoupsNeverCrash) {
+    Rng rng(42);
+    for (int iter = 0; iter < 200; ++iter) {
+        Mesh m;
+        const std::size_t nv = 1 + rng.below(12), nt = rng.below(20);
+        for (std::size_t i = 0; i < nv; ++i)
+            m.positions.push_back(rng.inBox({-1, -1, -1}, {1, 1, 1}));
+        if (rng.below(4) == 0)
+            m.positions[rng.below(nv)].x = std::numeric_limits<double>::quiet_NaN();
+        for (std::size_t t = 0; t < nt; ++t)
+            m.triangles.push_back({static_cast<std::uint32_t>(rng.below(nv + 1)),
+                                   static_cast<std::uint32_t>(rng.below(nv)),
+                                   static_cast<std::uint32_t>(rng.below(nv))});
+        const MeshReport r = checkMesh(m);
+        EXPECT_EQ(r.triangles, nt);
+        if (nt > 0 && !r.valid()) {
+            EXPECT_FALSE(r.problems.empty());
+        }
+    }
+}

@@ -1,0 +1,248 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "rubble/MassProperties.hpp"
+#include "rubble/MeshRepair.hpp"
+#include "rubble/Random.hpp"
+
+using namespace rubble;
+
+namespace {
+std::string listOf(const std::vector<std::string>& items) {
+    std::string s;
+    for (const std::string& p : items)
+        s += p + "\n";
+    return s;
+}
+
+bool mentions(const std::vector<std::string>& items, const std::string& text) {
+    for (const std::string& p : items)
+        if (p.find(text) != std::string::npos)
+            return true;
+    return false;
+}
+
+// Every triangle gets its own three vertices and per-corner attributes.
+Mesh unweldedWithAttributes(const Mesh& m) {
+    Mesh out;
+    for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+        const auto c = m.corners(t);
+        const auto base = static_cast<std::uint32_t>(out.positions.size());
+        out.positions.insert(out.positions.end(), c.begin(), c.end());
+        out.triangles.push_back({base, base + 1, base + 2});
+        const Vec3 n = normalized(m.triangleNormal(t));
+        for (int k = 0; k < 3; ++k) {
+            out.normals.push_back(n);
+            out.uvs.push_back({c[k].x, c[k].y});
+        }
+        out.materials.push_back(static_cast<std::uint32_t>(t % 3));
+    }
+    out.materialNames = {"a", "b", "c"};
+    return out;
+}
+
+void flip(Mesh& m, std::size_t t) {
+    std::swap(m.triangles[t][1], m.triangles[t][2]);
+    if (m.hasNormals())
+        std::swap(m.normals[3 * t + 1], m.normals[3 * t + 2]);
+    if (m.hasUvs())
+        std::swap(m.uvs[3 * t + 1], m.uvs[3 * t + 2]);
+}
+
+// Normals agree with the faces they belong to.
+void expectNormalsAgreeWithFaces(const Mesh& m) {
+    ASSERT_EQ(m.normals.size(), 3 * m.triangles.size());
+    for (std::size_t t = 0; t < m.triangles.size(); ++t)
+        for (int c = 0; c < 3; ++c)
+            EXPECT_GT(dot(m.normals[3 * t + c], m.triangleNormal(t)), 0) << "triangle " << t;
+}
+} // namespace
+
+TEST(MeshRepair, InvertedCubeBecomesValidWithSameVolume) {
+    Mesh m = makeBox({0, 0, 0}, {2, 3, 4});
+    for (std::size_t t = 0; t < m.triangles.size(); ++t)
+        flip(m, t);
+    const RepairReport r = repairMesh(m);
+    EXPECT_TRUE(r.valid()) << listOf(r.unrepaired);
+    EXPECT_EQ(r.invertedShells, 1u);
+    EXPECT_EQ(r.flippedTriangles, 0u);
+    EXPECT_NEAR(r.after.volume, 24.0, 1e-12);
+    EXPECT_TRUE(mentions(r.fixed, "reversed 1 inside-out shell")) << listOf(r.fixed);
+}
+
+TEST(MeshRepair, OneFlippedFaceIsFlippedBack) {
+    Mesh m = makeBox({0, 0, 0}, {1, 1, 1});
+    flip(m, 7);
+    const RepairReport r = repairMesh(m);
+    EXPECT_TRUE(r.valid()) << listOf(r.unrepaired);
+    EXPECT_EQ(r.flippedTriangles + r.invertedShells, 1u);
+    EXPECT_EQ(m, makeBox({0, 0, 0}, {1, 1, 1}));
+}
+
+TEST(MeshRepair, DuplicatedVerticesAreWeldedAndAttributesFollow) {
+    const Mesh original = makeBox({-1, -1, -1}, {1, 1, 1});
+    Mesh m = unweldedWithAttributes(original);
+    // Also flip two faces and invert nothing else: orientation must be repaired after welding.
+    flip(m, 0);
+    flip(m, 5);
+    const RepairReport r = repairMesh(m);
+    EXPECT_TRUE(r.valid()) << listOf(r.unrepaired);
+    EXPECT_EQ(r.weldedVertices, 36u - 8u);
+    EXPECT_EQ(r.removedUnreferencedVertices, 28u);
+    EXPECT_EQ(m.vertexCount(), 8u);
+    EXPECT_EQ(m.triangleCount(), 12u);
+    EXPECT_NEAR(r.after.volume, 8.0, 1e-12);
+    EXPECT_TRUE(m.validate().isOk()) << m.validate().message();
+    EXPECT_EQ(m.materials.size(), 12u);
+    expectNormalsAgreeWithFaces(m);
+    // UVs travel with their corners: each corner's uv is still (x, y) of its position.
+    for (std::size_t t = 0; t < m.triangles.size(); ++t)
+        for (int c = 0; c < 3; ++c) {
+            EXPECT_EQ(m.uvs[3 * t + c].x, m.positions[m.triangles[t][c]].x);
+            EXPECT_EQ(m.uvs[3 * t + c].y, m.positions[m.triangles[t][c]].y);
+        }
+}
+
+TEST(MeshRepair, InvertedFlippedDuplicatedCubeBecomesValidCube) {
+    Mesh m = unweldedWithAttributes(makeBox({0, 0, 0}, {3, 3, 3}));
+    for (std::size_t t = 0; t < m.triangles.size(); ++t)
+        if (t != 4)
+            flip(m, t); // inverted except one face
+    const RepairReport r = repairMesh(m);
+    EXPECT_TRUE(r.valid()) << listOf(r.unrepaired);
+    EXPECT_NEAR(r.after.volume, 27.0, 1e-12);
+    EXPECT_EQ(m.vertexCount(), 8u);
+    expectNormalsAgreeWithFaces(m);
+}
+
+TEST(MeshRepair, WeldToleranceIsRelativeToTheBoundingBox) {
+    Mesh near = unweldedWithAttributes(makeBox({0, 0, 0}, {1000, 1000, 1000}));
+    near.positions[5].x += 1e-7; // 1e-10 of the diagonal: welded
+    RepairReport r = repairMesh(near);
+    EXPECT_TRUE(r.valid()) << listOf(r.unrepaired);
+
+    Mesh far = unweldedWithAttributes(makeBox({0, 0, 0}, {1000, 1000, 1000}));
+    far.positions[5].x += 1e-3; // 5.8e-7 of the diagonal: kept apart, so the cube stays open
+    r = repairMesh(far);
+    EXPECT_FALSE(r.valid());
+    EXPECT_TRUE(mentions(r.unrepaired, "not closed")) << listOf(r.unrepaired);
+
+    RepairOptions loose;
+    loose.weldTolerance = 1e-5;
+    Mesh far2 = unweldedWithAttributes(makeBox({0, 0, 0}, {1000, 1000, 1000}));
+    far2.positions[5].x += 1e-3;
+    r = repairMesh(far2, loose);
+    EXPECT_TRUE(r.valid()) << listOf(r.unrepaired);
+}
+
+TEST(MeshRepair, DegenerateAndDuplicateTrianglesAreRemoved) {
+    Mesh m = makeBox({0, 0, 0}, {1, 1, 1});
+    m.computeFlatNormals();
+    m.triangles.push_back({1, 1, 2});
+    m.triangles.push_back(m.triangles[3]);
+    m.triangles.push_back({m.triangles[5][0], m.triangles[5][2], m.triangles[5][1]}); // reversed duplicate
+    for (int i = 0; i < 9; ++i)
+        m.normals.push_back({0, 0, 1});
+    const RepairReport r = repairMesh(m);
+    EXPECT_TRUE(r.valid()) << listOf(r.unrepaired);
+    EXPECT_EQ(r.removedDegenerate, 1u);
+    EXPECT_EQ(r.removedDuplicates, 2u);
+    EXPECT_EQ(m.triangleCount(), 12u);
+    EXPECT_EQ(m.normals.size(), 36u);
+}
+
+TEST(MeshRepair, NaNVertexRemovesItsTrianglesAndReportsTheHole) {
+    Mesh m = makeBox({0, 0, 0}, {1, 1, 1});
+    m.positions[0].z = std::numeric_limits<double>::quiet_NaN();
+    const RepairReport r = repairMesh(m);
+    EXPECT_FALSE(r.valid());
+    EXPECT_GT(r.removedNonFiniteTriangles, 0u);
+    EXPECT_EQ(r.after.nonFiniteVertices, 0u);
+    EXPECT_TRUE(mentions(r.fixed, "non-finite")) << listOf(r.fixed);
+    EXPECT_TRUE(mentions(r.unrepaired, "not closed")) << listOf(r.unrepaired);
+    EXPECT_TRUE(m.validate().isOk());
+}
+
+TEST(MeshRepair, OutOfRangeIndicesAreRemoved) {
+    Mesh m = makeBox({0, 0, 0}, {1, 1, 1});
+    m.triangles.push_back({0, 1, 99});
+    const RepairReport r = repairMesh(m);
+    EXPECT_TRUE(r.valid()) << listOf(r.unrepaired);
+    EXPECT_EQ(r.removedBadIndexTriangles, 1u);
+}
+
+TEST(MeshRepair, HolesAndNonManifoldEdgesAreReportedNotHidden) {
+    Mesh open = makeBox({0, 0, 0}, {1, 1, 1});
+    open.triangles.pop_back();
+    RepairReport r = repairMesh(open);
+    EXPECT_FALSE(r.valid());
+    EXPECT_FALSE(r.changed());
+    EXPECT_TRUE(mentions(r.unrepaired, "not closed")) << listOf(r.unrepaired);
+
+    Mesh fin = makeBox({0, 0, 0}, {1, 1, 1});
+    fin.positions.push_back({-1, -1, -1});
+    fin.triangles.push_back({fin.triangles[0][0], fin.triangles[0][1], 8});
+    r = repairMesh(fin);
+    EXPECT_FALSE(r.valid());
+    EXPECT_TRUE(mentions(r.unrepaired, "not manifold")) << listOf(r.unrepaired);
+}
+
+TEST(MeshRepair, SelfIntersectionsAreReportedAsUnrepaired) {
+    Mesh m = makeBox({0, 0, 0}, {2, 2, 2});
+    m.append(makeBox({1, 1, 1}, {3, 3, 3}));
+    const RepairReport r = repairMesh(m);
+    EXPECT_FALSE(r.valid());
+    EXPECT_TRUE(mentions(r.unrepaired, "intersect")) << listOf(r.unrepaired);
+}
+
+TEST(MeshRepair, CavityIsOrientedInwardAndSubtracted) {
+    // Outer box and an inner box, both written outward (a common modelling mistake for a hollow box).
+    Mesh m = makeBox({0, 0, 0}, {4, 4, 4});
+    m.append(makeBox({1, 1, 1}, {2, 2, 2}));
+    const RepairReport r = repairMesh(m);
+    EXPECT_TRUE(r.valid()) << listOf(r.unrepaired);
+    EXPECT_EQ(r.invertedShells, 1u);
+    EXPECT_NEAR(r.after.volume, 64.0 - 1.0, 1e-12);
+
+    // An already correct cavity is left alone.
+    Mesh ok = m;
+    const RepairReport again = repairMesh(ok);
+    EXPECT_FALSE(again.changed()) << listOf(again.fixed);
+    EXPECT_EQ(ok, m);
+}
+
+TEST(MeshRepair, ValidMeshesAreUnchanged) {
+    for (const Mesh& original : {makeSphere({0, 0, 0}, 1, 16, 8), makeTorus({1, 1, 1}, 2, 0.5, 16, 8)}) {
+        Mesh m = original;
+        m.computeFlatNormals();
+        const Mesh before = m;
+        const RepairReport r = repairMesh(m);
+        EXPECT_TRUE(r.valid()) << listOf(r.unrepaired);
+        EXPECT_FALSE(r.changed()) << listOf(r.fixed);
+        EXPECT_EQ(m, before);
+    }
+}
+
+TEST(MeshRepair, RandomFlipsOnASphereAreUndone) {
+    const Mesh sphere = makeSphere({0.5, -2, 3}, 1.5, 20, 10);
+    const double volume = signedVolume(sphere);
+    Rng rng(7);
+    for (int iter = 0; iter < 20; ++iter) {
+        Mesh m = sphere;
+        for (std::size_t t = 0; t < m.triangles.size(); ++t)
+            if (rng.below(3) == 0)
+                flip(m, t);
+        const RepairReport r = repairMesh(m);
+        EXPECT_TRUE(r.valid()) << listOf(r.unrepaired);
+        EXPECT_NEAR(r.after.volume, volume, 1e-9);
+    }
+}
+
+TEST(MeshRepair, EmptyMeshStaysEmptyAndInvalid) {
+    Mesh m;
+    const RepairReport r = repairMesh(m);
+    EXPECT_FALSE(r.valid());
+    EXPECT_TRUE(mentions(r.unrepaired, "no triangles"));
+}
