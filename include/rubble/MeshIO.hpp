@@ -1,0 +1,68 @@
+#pragma once
+/// \file MeshIO.hpp
+/// Reading and writing meshes: Rubble's own OBJ reader and writer, and other formats through Assimp.
+/// Errors name the file and, where known, the line: "cube.obj:17: face refers to vertex 9 but only 8 are
+/// defined". No reader crashes or allocates without bound on malformed input.
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "rubble/Mesh.hpp"
+#include "rubble/Result.hpp"
+
+namespace rubble {
+
+/// Name under which kInteriorMaterial is written to and read from OBJ/MTL files.
+inline constexpr std::string_view kInteriorMaterialName = "interior";
+
+/// One object of a multi-object file (OBJ `o` statements, or `g` groups when a file has no `o`).
+struct NamedMesh {
+    std::string name; ///< the object's name ("" for faces before the first `o`/`g`)
+    Mesh mesh;        ///< its triangles; vertices renumbered to the ones it uses
+};
+
+/// Options of writeObj.
+struct ObjWriteOptions {
+    bool writeNormals = true; ///< write `vn` and v//vn corners when the mesh has normals
+    bool writeUvs = true;     ///< write `vt` corners when the mesh has texture coordinates
+    bool writeMaterials =
+        true;               ///< write `usemtl` and a .mtl file next to the .obj when the mesh has materials
+    std::string objectName; ///< an `o` statement with this name when non-empty
+};
+
+/// Parses OBJ text into one mesh (all objects merged). `displayName` prefixes error messages.
+/// Supports v/vt/vn/f (v, v/vt, v//vn, v/vt/vn, negative indices), o/g, usemtl; quads and convex n-gons
+/// are fanned, concave n-gons ear-clipped on their best-fit plane. Unreferenced vertices are dropped.
+/// Material ids follow the order of first `usemtl` (names in Mesh::materialNames; faces before the first
+/// `usemtl` get a material named "default"); the name "interior" maps to kInteriorMaterial. Corners without
+/// a normal get the flat face normal, corners without a texture coordinate get (0, 0).
+/// Non-finite coordinates ("nan", "inf") are accepted (checkMesh reports them); numbers beyond the double
+/// range are a ParseError.
+Result<Mesh> parseObj(std::string_view text, const std::string& displayName);
+/// Parses OBJ text keeping objects apart (see NamedMesh); objects without faces are dropped.
+Result<std::vector<NamedMesh>> parseObjObjects(std::string_view text, const std::string& displayName);
+
+/// Reads an OBJ file into one mesh (see parseObj). Errors: IoError when the file cannot be read, ParseError
+/// naming file and line when it is malformed or has no triangles.
+Result<Mesh> readObj(const std::filesystem::path& path);
+/// Reads an OBJ file keeping its objects apart (see parseObjObjects).
+Result<std::vector<NamedMesh>> readObjObjects(const std::filesystem::path& path);
+
+/// Writes mesh as OBJ (exact shortest round-trip numbers), with normals and texture coordinates when present,
+/// and, when the mesh has materials, `usemtl` statements and an MTL file (same stem, .mtl) in which
+/// kInteriorMaterial is "interior" with its own colour. Triangles keep their order.
+Status writeObj(const std::filesystem::path& path, const Mesh& mesh, const ObjWriteOptions& options = {});
+
+/// Reads a mesh by extension: .obj with readObj; .off, .stl, .ply, .3ds, .gltf and .glb through Assimp
+/// (triangulated, positions welded exactly, node transforms applied). Size claims in headers (binary STL
+/// triangle count, PLY element counts, OFF counts, 3DS chunk lengths, glTF buffer/accessor lengths) are
+/// checked against the file before Assimp sees it. Errors: Unsupported for other extensions, IoError,
+/// ParseError; every message names the file.
+Result<Mesh> readMesh(const std::filesystem::path& path);
+
+/// The extensions readMesh accepts, lower case with the dot (".obj", ".stl", ...).
+const std::vector<std::string>& supportedMeshExtensions();
+
+} // namespace rubble

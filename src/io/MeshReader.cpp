@@ -1,0 +1,631 @@
+// readMesh: OBJ through Rubble's reader, other formats through Assimp after checking size claims in their
+// headers (Assimp trusts them and may try to allocate what a broken or hostile file claims).
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <charconv>
+#include <cstdio>
+#include <cstring>
+#include <unordered_map>
+
+#include <assimp/Importer.hpp>
+#include <assimp/config.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <nlohmann/json.hpp>
+
+#include "io/FileBytes.hpp"
+#include "io/PolygonTriangulation.hpp"
+#include "rubble/MeshIO.hpp"
+
+namespace rubble {
+
+namespace {
+std::string lower(std::string s) {
+    for (char& c : s)
+        c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return s;
+}
+
+std::uint32_t readU32(const std::string& b, std::size_t at) {
+    const auto* p = reinterpret_cast<const unsigned char*>(b.data() + at);
+    return std::uint32_t{p[0]} | std::uint32_t{p[1]} << 8 | std::uint32_t{p[2]} << 16 |
+           std::uint32_t{p[3]} << 24;
+}
+
+std::uint16_t readU16(const std::string& b, std::size_t at) {
+    const auto* p = reinterpret_cast<const unsigned char*>(b.data() + at);
+    return static_cast<std::uint16_t>(p[0] | p[1] << 8);
+}
+
+std::string bytesText(long double n) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.0Lf", n);
+    return buf;
+}
+
+Error parseError(const std::string& name, const std::string& message) {
+    return makeError(ErrorCode::ParseError, name + ": " + message);
+}
+
+// --- STL --------------------------------------------------------------------------------------------------
+
+// Binary STL files with bytes after the last facet (padding some exporters add) are cut to their real size,
+// because Assimp only recognises a binary STL whose size matches its triangle count exactly.
+Status guardStl(const std::string& b, const std::string& name, std::size_t& truncateTo) {
+    const bool solid = b.size() >= 5 && lower(b.substr(0, 5)) == "solid";
+    if (b.size() < 84) {
+        if (solid)
+            return {};
+        return parseError(name, "too short for a binary STL (" + std::to_string(b.size()) +
+                                    " bytes; a binary STL has an 84-byte header)");
+    }
+    const std::uint32_t count = readU32(b, 80);
+    const long double needed = 84.0L + 50.0L * count;
+    if (needed == static_cast<long double>(b.size()))
+        return {};
+    if (solid) // ASCII STL ("solid ..."), read as text
+        return {};
+    if (needed > static_cast<long double>(b.size()))
+        return parseError(name, "binary STL header claims " + std::to_string(count) + " triangles (" +
+                                    bytesText(needed) + " bytes) but the file has " +
+                                    std::to_string(b.size()) + " bytes");
+    truncateTo = static_cast<std::size_t>(needed);
+    return {};
+}
+
+// --- PLY --------------------------------------------------------------------------------------------------
+
+int plyTypeSize(const std::string& t) {
+    static const std::unordered_map<std::string, int> sizes = {
+        {"char", 1},   {"int8", 1},    {"uchar", 1},  {"uint8", 1},  {"short", 2}, {"int16", 2},
+        {"ushort", 2}, {"uint16", 2},  {"int", 4},    {"int32", 4},  {"uint", 4},  {"uint32", 4},
+        {"float", 4},  {"float32", 4}, {"double", 8}, {"float64", 8}};
+    const auto it = sizes.find(t);
+    return it == sizes.end() ? 0 : it->second;
+}
+
+std::vector<std::string> words(std::string_view s) {
+    std::vector<std::string> out;
+    std::size_t i = 0;
+    while (i < s.size()) {
+        while (i < s.size() && std::isspace(static_cast<unsigned char>(s[i])))
+            ++i;
+        const std::size_t st = i;
+        while (i < s.size() && !std::isspace(static_cast<unsigned char>(s[i])))
+            ++i;
+        if (i > st)
+            out.emplace_back(s.substr(st, i - st));
+    }
+    return out;
+}
+
+bool parseCount(const std::string& s, std::uint64_t& out) {
+    const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
+    return ec == std::errc() && ptr == s.data() + s.size();
+}
+
+Status guardPly(const std::string& b, const std::string& name) {
+    constexpr std::size_t kMaxHeader = 1 << 20;
+    struct Element {
+        std::string name;
+        std::uint64_t count = 0;
+        std::size_t line = 0;
+        long double minBinary = 0; // bytes per element, at least
+        std::size_t properties = 0;
+    };
+    std::vector<Element> elements;
+    std::string format;
+    std::size_t pos = 0, line = 0;
+    bool ended = false;
+    while (pos < b.size() && pos < kMaxHeader) {
+        ++line;
+        std::size_t end = b.find('\n', pos);
+        if (end == std::string::npos)
+            end = b.size();
+        const std::string_view ln(b.data() + pos, end - pos);
+        pos = end + 1;
+        const auto w = words(ln);
+        if (line == 1) {
+            if (w.size() != 1 || w[0] != "ply")
+                return parseError(name, "not a PLY file (the first line is not 'ply')");
+            continue;
+        }
+        if (w.empty() || w[0] == "comment" || w[0] == "obj_info")
+            continue;
+        const std::string where = name + ":" + std::to_string(line) + ": ";
+        if (w[0] == "end_header") {
+            ended = true;
+            break;
+        }
+        if (w[0] == "format") {
+            if (w.size() < 2 ||
+                (w[1] != "ascii" && w[1] != "binary_little_endian" && w[1] != "binary_big_endian"))
+                return makeError(ErrorCode::ParseError,
+                                 where + "unknown PLY format '" + (w.size() > 1 ? w[1] : "") + "'");
+            format = w[1];
+        } else if (w[0] == "element") {
+            Element e;
+            e.line = line;
+            if (w.size() != 3 || !parseCount(w[2], e.count))
+                return makeError(ErrorCode::ParseError, where + "expected 'element <name> <count>'");
+            e.name = w[1];
+            elements.push_back(e);
+        } else if (w[0] == "property") {
+            if (elements.empty())
+                return makeError(ErrorCode::ParseError, where + "property before any element");
+            Element& e = elements.back();
+            if (w.size() >= 2 && w[1] == "list") {
+                if (w.size() != 5 || plyTypeSize(w[2]) == 0 || plyTypeSize(w[3]) == 0)
+                    return makeError(ErrorCode::ParseError,
+                                     where + "expected 'property list <count type> <item type> <name>'");
+                e.minBinary += plyTypeSize(w[2]);
+            } else {
+                if (w.size() != 3 || plyTypeSize(w[1]) == 0)
+                    return makeError(ErrorCode::ParseError, where + "expected 'property <type> <name>'");
+                e.minBinary += plyTypeSize(w[1]);
+            }
+            ++e.properties;
+        } else {
+            return makeError(ErrorCode::ParseError, where + "unknown header keyword '" + w[0] + "'");
+        }
+    }
+    if (!ended)
+        return parseError(name, "PLY header has no 'end_header' line");
+    if (format.empty())
+        return parseError(name, "PLY header has no 'format' line");
+    const long double body = pos >= b.size() ? 0.0L : static_cast<long double>(b.size() - pos);
+    long double total = 0;
+    for (const Element& e : elements) {
+        const long double per = format == "ascii" ? std::max<long double>(1, 2.0L * e.properties)
+                                                  : std::max<long double>(1, e.minBinary);
+        total += per * static_cast<long double>(e.count);
+        if (total > body + 1)
+            return makeError(ErrorCode::ParseError, name + ":" + std::to_string(e.line) + ": header claims " +
+                                                        std::to_string(e.count) + " '" + e.name +
+                                                        "' elements (at least " + bytesText(total) +
+                                                        " bytes of data) but only " + bytesText(body) +
+                                                        " bytes follow the header");
+    }
+    return {};
+}
+
+// --- OFF --------------------------------------------------------------------------------------------------
+
+Status guardOff(const std::string& b, const std::string& name) {
+    // Tokens with their line numbers, comments skipped; only the first few are needed.
+    std::vector<std::pair<std::string, std::size_t>> tok;
+    std::size_t line = 1;
+    for (std::size_t i = 0; i < b.size() && tok.size() < 6;) {
+        const char c = b[i];
+        if (c == '\n') {
+            ++line;
+            ++i;
+        } else if (c == '#') {
+            while (i < b.size() && b[i] != '\n')
+                ++i;
+        } else if (std::isspace(static_cast<unsigned char>(c))) {
+            ++i;
+        } else {
+            const std::size_t st = i;
+            while (i < b.size() && !std::isspace(static_cast<unsigned char>(b[i])) && b[i] != '#')
+                ++i;
+            tok.emplace_back(b.substr(st, std::min<std::size_t>(i - st, 64)), line);
+        }
+    }
+    if (tok.empty() || tok[0].first.find("OFF") == std::string::npos)
+        return parseError(name, "not an OFF file (it does not start with 'OFF')");
+    std::size_t k = 1;
+    if (tok[0].first.front() == 'n' || tok[0].first.find("nOFF") != std::string::npos)
+        ++k; // dimension
+    if (k < tok.size() && lower(tok[k].first) == "binary")
+        return makeError(ErrorCode::Unsupported, name + ": binary OFF files are not supported");
+    std::uint64_t nv = 0, nf = 0;
+    if (k + 1 >= tok.size() || !parseCount(tok[k].first, nv) || !parseCount(tok[k + 1].first, nf))
+        return makeError(ErrorCode::ParseError, name + ":" +
+                                                    std::to_string(k < tok.size() ? tok[k].second : line) +
+                                                    ": expected the vertex and face counts after 'OFF'");
+    const long double needed = 6.0L * nv + 2.0L * nf; // "0 0 0\n" per vertex, "0\n" per face at least
+    if (needed > static_cast<long double>(b.size()))
+        return makeError(ErrorCode::ParseError,
+                         name + ":" + std::to_string(tok[k].second) + ": header claims " +
+                             std::to_string(nv) + " vertices and " + std::to_string(nf) +
+                             " faces (at least " + bytesText(needed) + " bytes) but the file has " +
+                             std::to_string(b.size()) + " bytes");
+    return {};
+}
+
+// --- 3DS --------------------------------------------------------------------------------------------------
+
+Status guard3dsChunks(const std::string& b, const std::string& name, std::size_t begin, std::size_t end,
+                      int depth) {
+    std::size_t at = begin;
+    while (at + 6 <= end) {
+        const std::uint16_t id = readU16(b, at);
+        const std::uint32_t len = readU32(b, at + 2);
+        if (len < 6 || len > end - at) {
+            char buf[160];
+            std::snprintf(buf, sizeof buf, "3DS chunk 0x%04X at byte %zu claims %u bytes but only %zu remain",
+                          id, at, len, end - at);
+            return parseError(name, buf);
+        }
+        // Descend into the containers that lead to the mesh data.
+        if (depth < 4 && (id == 0x3D3D || id == 0x4100 || id == 0xB000))
+            if (Status s = guard3dsChunks(b, name, at + 6, at + len, depth + 1); !s)
+                return s;
+        if (id == 0x4000 && depth < 4) { // named object: a 0-terminated name, then sub-chunks
+            std::size_t p = at + 6;
+            while (p < at + len && b[p] != '\0')
+                ++p;
+            if (Status s =
+                    guard3dsChunks(b, name, std::min<std::size_t>(p + 1, at + len), at + len, depth + 1);
+                !s)
+                return s;
+        }
+        if ((id == 0x4110 || id == 0x4120 || id == 0x4140) && len >= 8) {
+            const std::uint16_t n = readU16(b, at + 6);
+            const std::size_t item = id == 0x4110 ? 12 : id == 0x4120 ? 8 : 8;
+            if (8 + std::size_t{n} * item > len) {
+                char buf[160];
+                std::snprintf(buf, sizeof buf,
+                              "3DS chunk 0x%04X at byte %zu claims %u items but holds only %u bytes", id, at,
+                              unsigned{n}, len);
+                return parseError(name, buf);
+            }
+        }
+        at += len;
+    }
+    return {};
+}
+
+Status guard3ds(const std::string& b, const std::string& name) {
+    if (b.size() < 6)
+        return parseError(name, "too short for a 3DS file (" + std::to_string(b.size()) + " bytes)");
+    const std::uint16_t id = readU16(b, 0);
+    if (id != 0x4D4D) {
+        char buf[96];
+        std::snprintf(buf, sizeof buf, "not a 3DS file (first chunk 0x%04X, expected 0x4D4D)", id);
+        return parseError(name, buf);
+    }
+    const std::uint32_t len = readU32(b, 2);
+    if (len < 6 || len > b.size())
+        return parseError(name, "3DS main chunk claims " + std::to_string(len) + " bytes but the file has " +
+                                    std::to_string(b.size()) + " bytes");
+    return guard3dsChunks(b, name, 6, len, 0);
+}
+
+// --- glTF / GLB -------------------------------------------------------------------------------------------
+
+long double base64Bytes(const std::string& uri) {
+    const std::size_t comma = uri.find(',');
+    if (comma == std::string::npos)
+        return 0;
+    std::size_t n = uri.size() - comma - 1, pad = 0;
+    while (pad < 2 && n > pad && uri[uri.size() - 1 - pad] == '=')
+        ++pad;
+    return static_cast<long double>(n / 4 * 3) - static_cast<long double>(pad);
+}
+
+Status guardGltfJson(const nlohmann::json& j, const std::filesystem::path& path, const std::string& name,
+                     long double glbBinBytes) {
+    using nlohmann::json;
+    auto count = [](const json& v, const char* key) -> long double {
+        const auto it = v.find(key);
+        if (it == v.end() || !it->is_number())
+            return 0;
+        return it->get<long double>();
+    };
+    std::vector<long double> bufferLen;
+    if (j.contains("buffers") && j["buffers"].is_array())
+        for (std::size_t i = 0; i < j["buffers"].size(); ++i) {
+            const json& buf = j["buffers"][i];
+            const long double claimed = count(buf, "byteLength");
+            long double available = 0;
+            if (buf.contains("uri") && buf["uri"].is_string()) {
+                const std::string uri = buf["uri"].get<std::string>();
+                if (uri.rfind("data:", 0) == 0) {
+                    available = base64Bytes(uri);
+                } else {
+                    std::error_code ec;
+                    const auto file = path.parent_path() / uri;
+                    const auto size = std::filesystem::file_size(file, ec);
+                    if (ec)
+                        return parseError(name, "buffer " + std::to_string(i) + " refers to '" + uri +
+                                                    "', which cannot be read");
+                    available = static_cast<long double>(size);
+                }
+            } else {
+                available = i == 0 ? glbBinBytes : 0;
+            }
+            if (claimed > available)
+                return parseError(name, "buffer " + std::to_string(i) + " claims " + bytesText(claimed) +
+                                            " bytes but only " + bytesText(available) + " are available");
+            bufferLen.push_back(claimed);
+        }
+    std::vector<long double> viewLen;
+    if (j.contains("bufferViews") && j["bufferViews"].is_array())
+        for (std::size_t i = 0; i < j["bufferViews"].size(); ++i) {
+            const json& v = j["bufferViews"][i];
+            const long double b = count(v, "buffer");
+            const long double end = count(v, "byteOffset") + count(v, "byteLength");
+            if (b < 0 || b >= static_cast<long double>(bufferLen.size()) ||
+                end > bufferLen[static_cast<std::size_t>(b)])
+                return parseError(name, "buffer view " + std::to_string(i) + " lies outside its buffer");
+            viewLen.push_back(count(v, "byteLength"));
+        }
+    if (j.contains("accessors") && j["accessors"].is_array())
+        for (std::size_t i = 0; i < j["accessors"].size(); ++i) {
+            const json& a = j["accessors"][i];
+            const long double n = count(a, "count");
+            const int ct = static_cast<int>(count(a, "componentType"));
+            const int cs = ct == 5120 || ct == 5121 ? 1 : ct == 5122 || ct == 5123 ? 2 : 4;
+            static const std::unordered_map<std::string, int> comps = {
+                {"SCALAR", 1}, {"VEC2", 2}, {"VEC3", 3}, {"VEC4", 4}, {"MAT2", 4}, {"MAT3", 9}, {"MAT4", 16}};
+            int nc = 1;
+            if (a.contains("type") && a["type"].is_string()) {
+                const auto it = comps.find(a["type"].get<std::string>());
+                nc = it == comps.end() ? 1 : it->second;
+            }
+            const long double elem = static_cast<long double>(cs) * nc;
+            if (!a.contains("bufferView")) {
+                if (n * elem > 256.0L * 1024 * 1024)
+                    return parseError(name, "accessor " + std::to_string(i) + " claims " + bytesText(n) +
+                                                " elements without any data");
+                continue;
+            }
+            const long double vi = count(a, "bufferView");
+            if (vi < 0 || vi >= static_cast<long double>(viewLen.size()))
+                return parseError(name, "accessor " + std::to_string(i) + " refers to a missing buffer view");
+            long double stride = elem;
+            const json& view = j["bufferViews"][static_cast<std::size_t>(vi)];
+            if (count(view, "byteStride") > 0)
+                stride = count(view, "byteStride");
+            const long double needed = n > 0 ? count(a, "byteOffset") + stride * (n - 1) + elem : 0;
+            if (needed > viewLen[static_cast<std::size_t>(vi)])
+                return parseError(name, "accessor " + std::to_string(i) + " claims " + bytesText(n) +
+                                            " elements (" + bytesText(needed) +
+                                            " bytes) but its buffer view has " +
+                                            bytesText(viewLen[static_cast<std::size_t>(vi)]) + " bytes");
+        }
+    return {};
+}
+
+Status guardGltf(const std::string& b, const std::filesystem::path& path, const std::string& name, bool glb) {
+    std::string jsonText;
+    long double binBytes = 0;
+    if (glb) {
+        if (b.size() < 20 || b.compare(0, 4, "glTF") != 0)
+            return parseError(name, "not a GLB file (missing the 'glTF' magic)");
+        const std::uint32_t total = readU32(b, 8);
+        if (total > b.size())
+            return parseError(name, "GLB header claims " + std::to_string(total) +
+                                        " bytes but the file has " + std::to_string(b.size()) + " bytes");
+        std::size_t at = 12;
+        while (at + 8 <= total) {
+            const std::uint32_t len = readU32(b, at), type = readU32(b, at + 4);
+            if (len > total - at - 8)
+                return parseError(name, "GLB chunk at byte " + std::to_string(at) + " claims " +
+                                            std::to_string(len) + " bytes but only " +
+                                            std::to_string(total - at - 8) + " remain");
+            if (type == 0x4E4F534Au && jsonText.empty())
+                jsonText = b.substr(at + 8, len);
+            else if (type == 0x004E4942u && binBytes == 0)
+                binBytes = len;
+            at += 8 + len;
+        }
+        if (jsonText.empty())
+            return parseError(name, "GLB file has no JSON chunk");
+    } else {
+        jsonText = b;
+    }
+    const nlohmann::json j = nlohmann::json::parse(jsonText, nullptr, false);
+    if (j.is_discarded() || !j.is_object())
+        return parseError(name, "not a glTF file (its JSON is malformed)");
+    try {
+        return guardGltfJson(j, path, name, binBytes);
+    } catch (const std::exception& e) {
+        return parseError(name, std::string("malformed glTF: ") + e.what());
+    }
+}
+
+// --- Assimp -----------------------------------------------------------------------------------------------
+
+struct PosKey {
+    std::array<std::uint64_t, 3> bits;
+    bool operator==(const PosKey&) const = default;
+};
+struct PosKeyHash {
+    std::size_t operator()(const PosKey& k) const {
+        return static_cast<std::size_t>(k.bits[0] * 0x9E3779B97F4A7C15ull ^
+                                        k.bits[1] * 0xC2B2AE3D27D4EB4Full ^
+                                        k.bits[2] * 0x165667B19E3779F9ull);
+    }
+};
+
+PosKey keyOf(const Vec3& p) {
+    PosKey k;
+    const double c[3] = {p.x + 0.0, p.y + 0.0, p.z + 0.0};
+    for (int i = 0; i < 3; ++i)
+        std::memcpy(&k.bits[i], &c[i], sizeof(double));
+    return k;
+}
+
+Result<Mesh> readWithAssimp(const std::filesystem::path& path, const std::string& name,
+                            const std::string* memory = nullptr, const char* hint = "") {
+    Assimp::Importer importer;
+    importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+    const aiScene* scene = nullptr;
+    try {
+        // Polygons are triangulated below, not by aiProcess_Triangulate: Debian's Assimp is built with its
+        // assertions on, and TriangulateProcess aborts the process on some malformed polygons.
+        const unsigned flags = aiProcess_ValidateDataStructure | aiProcess_JoinIdenticalVertices;
+        scene = memory ? importer.ReadFileFromMemory(memory->data(), memory->size(), flags, hint)
+                       : importer.ReadFile(path.string(), flags);
+    } catch (const std::exception& e) {
+        return parseError(name, e.what());
+    }
+    if (!scene) {
+        std::string why = importer.GetErrorString();
+        while (!why.empty() && (why.back() == '\n' || why.back() == ' ' || why.back() == '.'))
+            why.pop_back();
+        return parseError(name, why.empty() ? "Assimp could not read the file" : why);
+    }
+    if (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE || !scene->mRootNode)
+        return parseError(name, "the file describes an incomplete scene (no mesh data)");
+
+    bool anyNormals = false, anyUvs = false;
+    for (unsigned i = 0; i < scene->mNumMeshes; ++i) {
+        anyNormals = anyNormals || scene->mMeshes[i]->HasNormals();
+        anyUvs = anyUvs || scene->mMeshes[i]->HasTextureCoords(0);
+    }
+    bool useMaterials = false;
+    std::vector<std::string> materialNames;
+    for (unsigned i = 0; i < scene->mNumMaterials; ++i) {
+        aiString s;
+        scene->mMaterials[i]->Get(AI_MATKEY_NAME, s);
+        materialNames.emplace_back(s.C_Str());
+        useMaterials =
+            useMaterials || (materialNames.back() != AI_DEFAULT_MATERIAL_NAME && scene->mNumMaterials > 0);
+    }
+    useMaterials = useMaterials && scene->mNumMaterials > 1;
+
+    Mesh m;
+    std::unordered_map<PosKey, std::uint32_t, PosKeyHash> index;
+    std::vector<std::pair<const aiNode*, aiMatrix4x4>> stack{
+        {scene->mRootNode, scene->mRootNode->mTransformation}};
+    while (!stack.empty()) {
+        const auto [node, xf] = stack.back();
+        stack.pop_back();
+        for (unsigned c = 0; c < node->mNumChildren; ++c)
+            stack.emplace_back(node->mChildren[c], xf * node->mChildren[c]->mTransformation);
+        aiMatrix3x3 normalXf(xf);
+        normalXf.Inverse().Transpose();
+        const bool mirrored = aiMatrix3x3(xf).Determinant() < 0;
+        for (unsigned k = 0; k < node->mNumMeshes; ++k) {
+            if (node->mMeshes[k] >= scene->mNumMeshes)
+                continue;
+            const aiMesh* am = scene->mMeshes[node->mMeshes[k]];
+            std::vector<std::array<unsigned, 3>> corners;
+            for (unsigned f = 0; f < am->mNumFaces; ++f) {
+                const aiFace& face = am->mFaces[f];
+                if (face.mNumIndices < 3 || !face.mIndices)
+                    continue; // points and lines
+                bool inRange = true;
+                for (unsigned c = 0; c < face.mNumIndices; ++c)
+                    inRange = inRange && face.mIndices[c] < am->mNumVertices;
+                if (!inRange)
+                    continue;
+                if (face.mNumIndices == 3) {
+                    corners.push_back({face.mIndices[0], face.mIndices[1], face.mIndices[2]});
+                    continue;
+                }
+                std::vector<Vec3> pts;
+                for (unsigned c = 0; c < face.mNumIndices; ++c) {
+                    const aiVector3D& p = am->mVertices[face.mIndices[c]];
+                    pts.push_back({p.x, p.y, p.z});
+                }
+                for (const auto& t : io::triangulatePolygon(pts))
+                    corners.push_back({face.mIndices[t[0]], face.mIndices[t[1]], face.mIndices[t[2]]});
+            }
+            for (std::array<unsigned, 3> ids : corners) {
+                if (mirrored)
+                    std::swap(ids[1], ids[2]);
+                Triangle tri;
+                bool ok = true;
+                for (int c = 0; c < 3; ++c) {
+                    if (ids[c] >= am->mNumVertices) {
+                        ok = false;
+                        break;
+                    }
+                    const aiVector3D p = xf * am->mVertices[ids[c]];
+                    const Vec3 v{p.x, p.y, p.z};
+                    auto [it, inserted] =
+                        index.emplace(keyOf(v), static_cast<std::uint32_t>(m.positions.size()));
+                    if (inserted)
+                        m.positions.push_back(v);
+                    tri[c] = it->second;
+                }
+                if (!ok)
+                    continue;
+                m.triangles.push_back(tri);
+                if (anyNormals) {
+                    for (int c = 0; c < 3; ++c) {
+                        if (am->HasNormals()) {
+                            const aiVector3D n = normalXf * am->mNormals[ids[c]];
+                            m.normals.push_back(normalized(Vec3{n.x, n.y, n.z}));
+                        } else {
+                            m.normals.push_back(normalized(m.triangleNormal(m.triangles.size() - 1)));
+                        }
+                    }
+                }
+                if (anyUvs)
+                    for (int c = 0; c < 3; ++c) {
+                        if (am->HasTextureCoords(0)) {
+                            const aiVector3D t = am->mTextureCoords[0][ids[c]];
+                            m.uvs.push_back({t.x, t.y});
+                        } else {
+                            m.uvs.push_back({});
+                        }
+                    }
+                if (useMaterials)
+                    m.materials.push_back(am->mMaterialIndex);
+            }
+        }
+    }
+    if (m.triangles.empty())
+        return parseError(name, "no triangles");
+    if (useMaterials)
+        m.materialNames = std::move(materialNames);
+    return m;
+}
+} // namespace
+
+const std::vector<std::string>& supportedMeshExtensions() {
+    static const std::vector<std::string> ext = {".obj", ".off", ".stl", ".ply", ".3ds", ".gltf", ".glb"};
+    return ext;
+}
+
+Result<Mesh> readMesh(const std::filesystem::path& path) {
+    const std::string name = io::displayName(path);
+    const std::string ext = lower(path.extension().string());
+    if (ext == ".obj")
+        return readObj(path);
+    const auto& all = supportedMeshExtensions();
+    if (std::find(all.begin(), all.end(), ext) == all.end()) {
+        std::string list;
+        for (const auto& e : all)
+            list += (list.empty() ? "" : ", ") + e;
+        return makeError(ErrorCode::Unsupported,
+                         name + ": unsupported mesh format '" + ext + "' (supported: " + list + ")");
+    }
+    Status guard;
+    std::string truncated; // a binary STL cut to its real size, read from memory
+    {
+        auto bytes = io::readFileBytes(path);
+        if (!bytes)
+            return bytes.error();
+        const std::string& b = bytes.value();
+        if (b.empty())
+            return parseError(name, "no triangles (the file is empty)");
+        std::size_t truncateTo = 0;
+        if (ext == ".stl") {
+            guard = guardStl(b, name, truncateTo);
+            if (guard && truncateTo > 0 && truncateTo < b.size())
+                truncated = b.substr(0, truncateTo);
+        } else if (ext == ".ply")
+            guard = guardPly(b, name);
+        else if (ext == ".off")
+            guard = guardOff(b, name);
+        else if (ext == ".3ds")
+            guard = guard3ds(b, name);
+        else
+            guard = guardGltf(b, path, name, ext == ".glb");
+    }
+    if (!guard)
+        return guard.error();
+    if (!truncated.empty())
+        return readWithAssimp(path, name, &truncated, "stl");
+    return readWithAssimp(path, name);
+}
+
+} // namespace rubble

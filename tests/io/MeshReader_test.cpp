@@ -1,0 +1,285 @@
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <fstream>
+#include <iterator>
+
+#include "TestSupport.hpp"
+#include "rubble/MeshCheck.hpp"
+#include "rubble/MeshIO.hpp"
+#include "rubble/Random.hpp"
+
+using namespace rubble;
+
+namespace {
+const std::filesystem::path kData = test::sourceDir() / "tests/data/meshes";
+
+std::string problemsOf(const MeshReport& r) {
+    std::string s;
+    for (const std::string& p : r.problems)
+        s += p + "\n";
+    return s;
+}
+
+std::string base64(const std::string& bytes) {
+    static const char* tbl = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string out;
+    std::size_t i = 0;
+    for (; i + 2 < bytes.size(); i += 3) {
+        const auto n = static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[i]) << 16 |
+                                                  static_cast<unsigned char>(bytes[i + 1]) << 8 |
+                                                  static_cast<unsigned char>(bytes[i + 2]));
+        for (int k = 3; k >= 0; --k)
+            out += tbl[(n >> (6 * k)) & 63];
+    }
+    if (i + 1 == bytes.size()) {
+        const std::uint32_t n = static_cast<unsigned char>(bytes[i]) << 16;
+        out += std::string{tbl[n >> 18 & 63], tbl[n >> 12 & 63], '=', '='};
+    } else if (i + 2 == bytes.size()) {
+        const std::uint32_t n =
+            static_cast<unsigned char>(bytes[i]) << 16 | static_cast<unsigned char>(bytes[i + 1]) << 8;
+        out += std::string{tbl[n >> 18 & 63], tbl[n >> 12 & 63], tbl[n >> 6 & 63], '='};
+    }
+    return out;
+}
+
+template <class T>
+void put(std::string& s, T v) {
+    char b[sizeof(T)];
+    std::memcpy(b, &v, sizeof(T));
+    s.append(b, sizeof(T));
+}
+
+// A tetrahedron as glTF buffer data: 4 float3 positions then 12 uint16 indices.
+std::string tetraBuffer() {
+    std::string b;
+    const float p[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    for (const auto& v : p)
+        for (float c : v)
+            put(b, c);
+    const std::uint16_t idx[12] = {0, 2, 1, 0, 1, 3, 1, 2, 3, 2, 0, 3};
+    for (std::uint16_t i : idx)
+        put(b, i);
+    return b;
+}
+
+std::string gltfJson(const std::string& bufferEntry, unsigned positionCount = 4) {
+    return R"({"asset":{"version":"2.0"},"scenes":[{"nodes":[0]}],"scene":0,"nodes":[{"mesh":0}],)"
+           R"("meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1}]}],)"
+           R"("buffers":[)" +
+           bufferEntry +
+           R"(],"bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":48},{"buffer":0,"byteOffset":48,"byteLength":24}],)"
+           R"("accessors":[{"bufferView":0,"componentType":5126,"count":)" +
+           std::to_string(positionCount) +
+           R"(,"type":"VEC3","min":[0,0,0],"max":[1,1,1]},{"bufferView":1,"componentType":5123,"count":12,"type":"SCALAR"}]})";
+}
+
+void expectValidTetra(const Result<Mesh>& r) {
+    ASSERT_TRUE(r.isOk()) << r.error().message;
+    EXPECT_EQ(r->vertexCount(), 4u);
+    EXPECT_EQ(r->triangleCount(), 4u);
+    const MeshReport rep = checkMesh(r.value());
+    EXPECT_TRUE(rep.valid()) << problemsOf(rep);
+    EXPECT_NEAR(rep.volume, 1.0 / 6.0, 1e-7);
+}
+
+Error errorOf(const std::filesystem::path& p) {
+    const auto r = readMesh(p);
+    EXPECT_FALSE(r.isOk()) << p;
+    return r.isOk() ? Error{} : r.error();
+}
+} // namespace
+
+TEST(MeshReader, ObjStlPlyOffFixturesAreValidSolids) {
+    expectValidTetra(readMesh(kData / "tetra.obj"));
+    expectValidTetra(readMesh(kData / "tetra.stl")); // STL repeats corners per facet: welded exactly
+    expectValidTetra(readMesh(kData / "tetra.3ds"));
+    for (const char* name : {"cube.obj", "cube.ply", "cube_binary.ply", "cube.off"}) {
+        const auto r = readMesh(kData / name);
+        ASSERT_TRUE(r.isOk()) << name << ": " << r.error().message;
+        EXPECT_EQ(r->vertexCount(), 8u) << name;
+        EXPECT_EQ(r->triangleCount(), 12u) << name;
+        const MeshReport rep = checkMesh(r.value());
+        EXPECT_TRUE(rep.valid()) << name << "\n" << problemsOf(rep);
+        EXPECT_NEAR(rep.volume, 1.0, 1e-12) << name;
+    }
+}
+
+TEST(MeshReader, GltfWithDataUriAndGlbAreRead) {
+    const auto dir = test::tempDir("MeshReader_gltf");
+    const std::string buf = tetraBuffer();
+    const std::string entry =
+        R"({"byteLength":72,"uri":"data:application/octet-stream;base64,)" + base64(buf) + R"("})";
+    test::writeFile(dir / "tetra.gltf", gltfJson(entry));
+    expectValidTetra(readMesh(dir / "tetra.gltf"));
+
+    // The same as an external .bin buffer.
+    test::writeFile(dir / "tetra.bin", buf);
+    test::writeFile(dir / "external.gltf", gltfJson(R"({"byteLength":72,"uri":"tetra.bin"})"));
+    expectValidTetra(readMesh(dir / "external.gltf"));
+
+    // GLB: header, JSON chunk (padded with spaces), BIN chunk.
+    std::string json = gltfJson(R"({"byteLength":72})");
+    while (json.size() % 4)
+        json += ' ';
+    std::string glb = "glTF";
+    put(glb, std::uint32_t{2});
+    put(glb, static_cast<std::uint32_t>(12 + 8 + json.size() + 8 + buf.size()));
+    put(glb, static_cast<std::uint32_t>(json.size()));
+    put(glb, std::uint32_t{0x4E4F534A});
+    glb += json;
+    put(glb, static_cast<std::uint32_t>(buf.size()));
+    put(glb, std::uint32_t{0x004E4942});
+    glb += buf;
+    test::writeFile(dir / "tetra.glb", glb);
+    expectValidTetra(readMesh(dir / "tetra.glb"));
+}
+
+TEST(MeshReader, HugeSizeClaimsAreRejectedBeforeAssimp) {
+    Error e = errorOf(kData / "huge_claim.stl");
+    EXPECT_EQ(e.code, ErrorCode::ParseError);
+    EXPECT_NE(
+        e.message.find("huge_claim.stl: binary STL header claims 2000000000 triangles (100000000084 bytes) "
+                       "but the file has 134 bytes"),
+        std::string::npos)
+        << e.message;
+    e = errorOf(kData / "huge_claim.ply");
+    EXPECT_EQ(e.code, ErrorCode::ParseError);
+    EXPECT_NE(e.message.find("huge_claim.ply:4: header claims 2000000000 'vertex' elements"),
+              std::string::npos)
+        << e.message;
+    e = errorOf(kData / "huge_claim.off");
+    EXPECT_NE(e.message.find("huge_claim.off:2: header claims 2000000000 vertices"), std::string::npos)
+        << e.message;
+
+    const auto dir = test::tempDir("MeshReader_claims");
+    // ASCII PLY claiming more faces than it could hold.
+    test::writeFile(dir / "ascii.ply",
+                    "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                    "property float z\nelement face 4000000000\nproperty list uchar int "
+                    "vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+    e = errorOf(dir / "ascii.ply");
+    EXPECT_NE(e.message.find("ascii.ply:7: header claims 4000000000 'face' elements"), std::string::npos)
+        << e.message;
+    // glTF accessor claiming two billion positions in a 48-byte view.
+    const std::string entry =
+        R"({"byteLength":72,"uri":"data:application/octet-stream;base64,)" + base64(tetraBuffer()) + R"("})";
+    test::writeFile(dir / "huge.gltf", gltfJson(entry, 2000000000u));
+    e = errorOf(dir / "huge.gltf");
+    EXPECT_NE(e.message.find("huge.gltf: accessor 0 claims 2000000000 elements"), std::string::npos)
+        << e.message;
+    // glTF buffer longer than its data.
+    test::writeFile(dir / "short.gltf", gltfJson(R"({"byteLength":7200000000,"uri":"data:;base64,AAAA"})"));
+    e = errorOf(dir / "short.gltf");
+    EXPECT_NE(e.message.find("short.gltf: buffer 0 claims 7200000000 bytes but only 3 are available"),
+              std::string::npos)
+        << e.message;
+    // GLB whose header claims more bytes than the file has.
+    std::string glb = "glTF";
+    put(glb, std::uint32_t{2});
+    put(glb, std::uint32_t{2000000000});
+    put(glb, std::uint32_t{0});
+    put(glb, std::uint32_t{0x4E4F534A});
+    test::writeFile(dir / "huge.glb", glb);
+    e = errorOf(dir / "huge.glb");
+    EXPECT_NE(e.message.find("huge.glb: GLB header claims 2000000000 bytes but the file has 20 bytes"),
+              std::string::npos)
+        << e.message;
+    // 3DS main chunk claiming 2 GB.
+    std::string tds;
+    put(tds, std::uint16_t{0x4D4D});
+    put(tds, std::uint32_t{2000000000});
+    tds += std::string(32, '\0');
+    test::writeFile(dir / "huge.3ds", tds);
+    e = errorOf(dir / "huge.3ds");
+    EXPECT_NE(e.message.find("huge.3ds: 3DS main chunk claims 2000000000 bytes but the file has 38 bytes"),
+              std::string::npos)
+        << e.message;
+}
+
+TEST(MeshReader, UnknownExtensionMissingAndEmptyFiles) {
+    const auto dir = test::tempDir("MeshReader_misc");
+    test::writeFile(dir / "model.xyz", "whatever");
+    Error e = errorOf(dir / "model.xyz");
+    EXPECT_EQ(e.code, ErrorCode::Unsupported);
+    EXPECT_NE(
+        e.message.find("model.xyz: unsupported mesh format '.xyz' (supported: .obj, .off, .stl, .ply, .3ds, "
+                       ".gltf, .glb)"),
+        std::string::npos)
+        << e.message;
+    e = errorOf(dir / "missing.stl");
+    EXPECT_EQ(e.code, ErrorCode::IoError);
+    EXPECT_NE(e.message.find("missing.stl: cannot open"), std::string::npos) << e.message;
+    for (const char* name :
+         {"empty.obj", "empty.stl", "empty.ply", "empty.off", "empty.3ds", "empty.gltf", "empty.glb"}) {
+        test::writeFile(dir / name, "");
+        e = errorOf(dir / name);
+        EXPECT_EQ(e.code, ErrorCode::ParseError) << name;
+        EXPECT_NE(e.message.find(std::string(name) + ": no triangles"), std::string::npos) << e.message;
+    }
+    // Upper-case extensions are accepted.
+    std::filesystem::copy_file(kData / "tetra.stl", dir / "TETRA.STL");
+    expectValidTetra(readMesh(dir / "TETRA.STL"));
+}
+
+TEST(MeshReader, RandomBytesInEveryFormatGiveErrorsNotCrashes) {
+    const auto dir = test::tempDir("MeshReader_random");
+    Rng rng(77);
+    int errors = 0;
+    for (const std::string ext : {".obj", ".stl", ".ply", ".off", ".3ds", ".gltf", ".glb"}) {
+        for (int i = 0; i < 25; ++i) {
+            std::string bytes(1 + rng.below(2000), '\0');
+            for (char& c : bytes)
+                c = static_cast<char>(rng.below(256));
+            if (i % 5 == 1 && ext == ".ply")
+                bytes =
+                    "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nend_header\n" +
+                    bytes;
+            if (i % 5 == 2 && ext == ".stl")
+                bytes = "solid " + bytes;
+            if (i % 5 == 3 && ext == ".off")
+                bytes = "OFF\n3 1 0\n" + bytes;
+            if (i % 5 == 4 && ext == ".3ds") {
+                std::string h;
+                put(h, std::uint16_t{0x4D4D});
+                put(h, static_cast<std::uint32_t>(bytes.size() + 6));
+                bytes = h + bytes;
+            }
+            const auto path = dir / ("random" + std::to_string(i) + ext);
+            test::writeFile(path, bytes);
+            const auto r = readMesh(path);
+            if (!r.isOk()) {
+                ++errors;
+                EXPECT_NE(r.error().message.find(path.filename().string()), std::string::npos)
+                    << r.error().message;
+            } else {
+                (void)checkMesh(r.value());
+            }
+        }
+    }
+    EXPECT_GT(errors, 150);
+}
+
+TEST(MeshReader, BinaryStlWithTrailingBytesAndAsciiStl) {
+    const auto dir = test::tempDir("MeshReader_stl");
+    std::string bin;
+    {
+        std::ifstream in(kData / "tetra.stl", std::ios::binary);
+        bin.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    }
+    test::writeFile(dir / "padded.stl", bin + std::string(10, '\0'));
+    expectValidTetra(readMesh(dir / "padded.stl"));
+    std::string ascii = "solid tetra\n";
+    const float p[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    const int f[4][3] = {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {2, 0, 3}};
+    for (const auto& tri : f) {
+        ascii += "facet normal 0 0 0\nouter loop\n";
+        for (int k : tri)
+            ascii += "vertex " + std::to_string(p[k][0]) + " " + std::to_string(p[k][1]) + " " +
+                     std::to_string(p[k][2]) + "\n";
+        ascii += "endloop\nendfacet\n";
+    }
+    ascii += "endsolid tetra\n";
+    test::writeFile(dir / "ascii.stl", ascii);
+    expectValidTetra(readMesh(dir / "ascii.stl"));
+}

@@ -1,0 +1,117 @@
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "TestSupport.hpp"
+#include "rubble/MassProperties.hpp"
+#include "rubble/MeshCheck.hpp"
+#include "rubble/MeshIO.hpp"
+#include "rubble/Random.hpp"
+
+using namespace rubble;
+
+namespace {
+std::string slurp(const std::filesystem::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+} // namespace
+
+TEST(ObjWriter, RoundTripKeepsGeometryExactly) {
+    const auto dir = test::tempDir("ObjWriter_roundtrip");
+    Rng rng(1);
+    Mesh m = makeSphere({0.1, -7.3, 1e3}, 2.5, 24, 12).transformed(rng.rotation(), {1, 2, 0.5}, {3, 4, 5});
+    const auto path = dir / "sphere.obj";
+    ASSERT_TRUE(writeObj(path, m).isOk());
+    const auto r = readObj(path);
+    ASSERT_TRUE(r.isOk()) << r.error().message;
+    EXPECT_EQ(r->triangleCount(), m.triangleCount());
+    EXPECT_EQ(r.value(), m); // shortest round-trip numbers: bit-identical positions
+    EXPECT_EQ(signedVolume(r.value()), signedVolume(m));
+    EXPECT_FALSE(std::filesystem::exists(dir / "sphere.mtl")); // no materials, no MTL
+}
+
+TEST(ObjWriter, RoundTripKeepsNormalsUvsAndMaterialNames) {
+    const auto dir = test::tempDir("ObjWriter_attributes");
+    Mesh m = makeBox({-1, -1, -1}, {1, 1, 1});
+    m.computeFlatNormals();
+    for (std::size_t t = 0; t < m.triangleCount(); ++t)
+        for (int c = 0; c < 3; ++c) {
+            const Vec3 p = m.positions[m.triangles[t][c]];
+            m.uvs.push_back({p.x * 0.5 + 0.5, p.y * 0.25 + 0.125});
+        }
+    m.materialNames = {"stone", "moss"};
+    for (std::size_t t = 0; t < m.triangleCount(); ++t)
+        m.materials.push_back(t < 4 ? 0u : t < 8 ? kInteriorMaterial : 1u);
+    const auto path = dir / "box.obj";
+    ASSERT_TRUE(writeObj(path, m).isOk());
+    const auto r = readObj(path);
+    ASSERT_TRUE(r.isOk()) << r.error().message;
+    EXPECT_EQ(r->positions, m.positions);
+    EXPECT_EQ(r->triangles, m.triangles);
+    EXPECT_EQ(r->normals, m.normals);
+    EXPECT_EQ(r->uvs, m.uvs);
+    ASSERT_EQ(r->materials.size(), m.materials.size());
+    for (std::size_t t = 0; t < m.triangleCount(); ++t) {
+        const std::uint32_t a = m.materials[t], b = r->materials[t];
+        if (a == kInteriorMaterial)
+            EXPECT_EQ(b, kInteriorMaterial);
+        else
+            EXPECT_EQ(r->materialNames.at(b), m.materialNames.at(a));
+    }
+    const std::string mtl = slurp(dir / "box.mtl");
+    EXPECT_NE(mtl.find("newmtl interior"), std::string::npos);
+    EXPECT_NE(mtl.find("newmtl stone"), std::string::npos);
+    EXPECT_NE(mtl.find("newmtl moss"), std::string::npos);
+    EXPECT_NE(slurp(path).find("mtllib box.mtl"), std::string::npos);
+    EXPECT_TRUE(checkMesh(r.value()).valid());
+}
+
+TEST(ObjWriter, OptionsLeaveOutAttributesAndNameTheObject) {
+    const auto dir = test::tempDir("ObjWriter_options");
+    Mesh m = makeBox({0, 0, 0}, {1, 1, 1});
+    m.computeFlatNormals();
+    m.materials.assign(m.triangleCount(), 0);
+    ObjWriteOptions o;
+    o.writeNormals = false;
+    o.writeMaterials = false;
+    o.objectName = "my box";
+    ASSERT_TRUE(writeObj(dir / "plain.obj", m, o).isOk());
+    const std::string text = slurp(dir / "plain.obj");
+    EXPECT_EQ(text.find("vn "), std::string::npos);
+    EXPECT_EQ(text.find("usemtl"), std::string::npos);
+    EXPECT_NE(text.find("o my_box\n"), std::string::npos);
+    const auto objects = readObjObjects(dir / "plain.obj");
+    ASSERT_TRUE(objects.isOk());
+    ASSERT_EQ(objects->size(), 1u);
+    EXPECT_EQ((*objects)[0].name, "my_box");
+}
+
+TEST(ObjWriter, RoundTripOfTheSubdividedCubeKeepsVolumeAndCount) {
+    const auto dir = test::tempDir("ObjWriter_cube");
+    const Mesh m =
+        makeSubdividedBox({-1, 0.033073, -1}, {1, 2.033073, 1}, 29); // 10092 triangles like the seed
+    ASSERT_EQ(m.triangleCount(), 10092u);
+    ASSERT_TRUE(writeObj(dir / "cube.obj", m).isOk());
+    const auto r = readObj(dir / "cube.obj");
+    ASSERT_TRUE(r.isOk()) << r.error().message;
+    EXPECT_EQ(r->triangleCount(), 10092u);
+    EXPECT_EQ(signedVolume(r.value()), signedVolume(m));
+    EXPECT_NEAR(signedVolume(r.value()), 8.0, 1e-9);
+}
+
+TEST(ObjWriter, ErrorsNameTheFile) {
+    const Mesh m = makeBox({0, 0, 0}, {1, 1, 1});
+    const Status s = writeObj("/nonexistent-dir/x.obj", m);
+    ASSERT_FALSE(s.isOk());
+    EXPECT_EQ(s.error().code, ErrorCode::IoError);
+    EXPECT_EQ(s.message().rfind("/nonexistent-dir/x.obj: cannot open for writing", 0), 0u) << s.message();
+    Mesh broken = m;
+    broken.triangles[0][0] = 50;
+    const Status b = writeObj(test::tempDir("ObjWriter_err") / "b.obj", broken);
+    ASSERT_FALSE(b.isOk());
+    EXPECT_EQ(b.error().code, ErrorCode::InvalidInput);
+}
