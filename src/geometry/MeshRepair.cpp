@@ -157,6 +157,13 @@ bool insideByRay(const Mesh& m, const std::vector<std::size_t>& tris, const Vec3
     return crossings % 2 == 1;
 }
 
+// True when box inner lies inside box outer (a shell can only be a cavity of a shell whose box holds it;
+// this keeps overlapping, self-intersecting shells from being mistaken for cavities).
+bool encloses(const Aabb& outer, const Aabb& inner) {
+    return outer.contains(inner.lo) && outer.contains(inner.hi) &&
+           !(outer.lo == inner.lo && outer.hi == inner.hi);
+}
+
 struct OrientStats {
     std::size_t flipped = 0, inverted = 0, nonOrientable = 0;
 };
@@ -241,7 +248,7 @@ OrientStats orientShells(Mesh& m) {
         if (compClosed[i]) {
             const Vec3 probe = m.positions[m.triangles[comps[i][0]][0]];
             for (std::size_t j = 0; j < k; ++j)
-                if (j != i && compClosed[j] && box[j].contains(probe) && insideByRay(m, comps[j], probe))
+                if (j != i && compClosed[j] && encloses(box[j], box[i]) && insideByRay(m, comps[j], probe))
                     ++depth;
         }
         const bool wantPositive = depth % 2 == 0;

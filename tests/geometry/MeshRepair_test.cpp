@@ -246,3 +246,11 @@ TEST(MeshRepair, EmptyMeshStaysEmptyAndInvalid) {
     EXPECT_FALSE(r.valid());
     EXPECT_TRUE(mentions(r.unrepaired, "no triangles"));
 }
+
+TEST(MeshRepair, OverlappingShellsAreNotMistakenForCavities) {
+    Mesh m = makeBox({0, 0, 0}, {2, 2, 2});
+    m.append(makeBox({1, 1, 1}, {3, 3, 3}));
+    const RepairReport r = repairMesh(m);
+    EXPECT_EQ(r.invertedShells, 0u);
+    EXPECT_NEAR(r.after.volume, 16.0, 1e-12);
+}

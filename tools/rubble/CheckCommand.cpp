@@ -61,8 +61,8 @@ void printStats(std::ostream& out, const rubble::MeshReport& r) {
         out << " (" << r.nonManifoldEdges << " non-manifold " << (r.nonManifoldEdges == 1 ? "edge" : "edges")
             << ")";
     out << "\n  oriented            " << yesNo(r.oriented);
-    if (r.oriented)
-        out << (r.outward ? " (outward)" : " (inward)");
+    if (r.oriented && r.closed && r.volume != 0)
+        out << (r.volume > 0 ? " (outward)" : " (inside out)");
     out << "\n  self-intersections  " << selfIntersectionText(r) << "\n";
     out << "  volume              " << num(r.volume) << "\n";
     out << "  centre of mass      " << vec(r.centerOfMass) << "\n";
