@@ -1,0 +1,811 @@
+#include "Renderer.hpp"
+
+#include <stb_image.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+
+namespace demo {
+
+namespace {
+
+constexpr int kFloatsPerVertex = 10; // pos3 normal3 uv2 slot interior
+constexpr int kTexelsPerSlot = 6;    // mat4 columns, (heat, fade), tint
+
+const char* kMeshVs = R"(#version 330 core
+layout(location=0) in vec3 aPos;
+layout(location=1) in vec3 aNormal;
+layout(location=2) in vec2 aUv;
+layout(location=3) in float aSlot;
+layout(location=4) in float aInterior;
+uniform samplerBuffer uSlots;
+uniform mat4 uViewProj;
+uniform mat4 uLightVP;
+out vec3 vWorld; out vec3 vNormal; out vec2 vUv; out float vInterior; out vec2 vHeatFade; out vec3 vTint;
+out vec4 vLight;
+void main() {
+    int b = int(aSlot + 0.5) * 6;
+    mat4 M = mat4(texelFetch(uSlots, b), texelFetch(uSlots, b + 1), texelFetch(uSlots, b + 2), texelFetch(uSlots, b + 3));
+    vHeatFade = texelFetch(uSlots, b + 4).xy;
+    vTint = texelFetch(uSlots, b + 5).rgb;
+    vec4 w = M * vec4(aPos, 1.0);
+    vWorld = w.xyz;
+    vNormal = mat3(M) * aNormal;
+    vUv = aUv;
+    vInterior = aInterior;
+    vLight = uLightVP * w;
+    gl_Position = uViewProj * w;
+})";
+
+const char* kMeshFs = R"(#version 330 core
+in vec3 vWorld; in vec3 vNormal; in vec2 vUv; in float vInterior; in vec2 vHeatFade; in vec3 vTint; in vec4 vLight;
+uniform sampler2D uTex;
+uniform sampler2D uInterior;
+uniform sampler2DShadow uShadow;
+uniform int uUseShadow;
+uniform vec3 uSunDir;
+uniform vec3 uCamPos;
+uniform vec3 uFogColor;
+out vec4 oColor;
+float shadowAt() {
+    if (uUseShadow == 0) return 1.0;
+    vec3 p = vLight.xyz / vLight.w * 0.5 + 0.5;
+    if (p.x <= 0.0 || p.x >= 1.0 || p.y <= 0.0 || p.y >= 1.0 || p.z >= 1.0) return 1.0;
+    return texture(uShadow, vec3(p.xy, p.z - 0.002));
+}
+void main() {
+    vec3 n = normalize(vNormal);
+    if (!gl_FrontFacing) n = -n;
+    vec3 albedo;
+    if (vInterior > 0.5) { vec3 t = texture(uInterior, vUv).rgb; albedo = t * t * vec3(0.85, 0.78, 0.70); }
+    else { vec3 t = texture(uTex, vUv).rgb; albedo = t * t * vTint; }
+    vec3 L = -uSunDir;
+    float ndl = max(dot(n, L), 0.0);
+    float sh = ndl > 0.0 ? shadowAt() : 0.0;
+    vec3 amb = mix(vec3(0.11, 0.094, 0.077), vec3(0.20, 0.25, 0.34), n.y * 0.5 + 0.5);
+    vec3 V = normalize(uCamPos - vWorld);
+    vec3 H = normalize(V + L);
+    float s2 = max(dot(n, H), 0.0);
+    s2 *= s2; s2 *= s2; s2 *= s2; s2 *= s2; s2 *= s2;
+    vec3 sun = vec3(1.6, 1.49, 1.31);
+    vec3 c = albedo * (amb + sun * (ndl * sh)) + sun * (s2 * 0.2 * ndl * sh);
+    float heat = vHeatFade.x * vInterior;
+    c += heat * heat * vec3(2.2, 0.75, 0.18);
+    vec3 dv = uCamPos - vWorld;
+    float fog = 1.0 - exp(-dot(dv, dv) * 2.5e-6);
+    c = mix(c, uFogColor * uFogColor, fog);
+    c = c / (1.0 + c * 0.15);
+    oColor = vec4(sqrt(c), vHeatFade.y);
+})";
+
+const char* kDepthVs = R"(#version 330 core
+layout(location=0) in vec3 aPos;
+layout(location=3) in float aSlot;
+uniform samplerBuffer uSlots;
+uniform mat4 uViewProj;
+void main() {
+    int b = int(aSlot + 0.5) * 6;
+    mat4 M = mat4(texelFetch(uSlots, b), texelFetch(uSlots, b + 1), texelFetch(uSlots, b + 2), texelFetch(uSlots, b + 3));
+    gl_Position = uViewProj * M * vec4(aPos, 1.0);
+})";
+
+const char* kDepthFs = R"(#version 330 core
+void main() {})";
+
+const char* kSkyVs = R"(#version 330 core
+layout(location=0) in vec3 aDir;
+layout(location=1) in vec3 aColor;
+uniform mat4 uViewProj;
+out vec3 vDir; out vec3 vColor;
+void main() {
+    vDir = aDir;
+    vColor = aColor;
+    gl_Position = (uViewProj * vec4(aDir, 1.0)).xyww;
+})";
+
+const char* kSkyFs = R"(#version 330 core
+in vec3 vDir; in vec3 vColor;
+uniform samplerCube uCube;
+uniform int uHasCube;
+out vec4 oColor;
+void main() {
+    oColor = vec4(uHasCube == 1 ? texture(uCube, vec3(vDir.xy, -vDir.z)).rgb : vColor, 1.0);
+})";
+
+const char* kParticleVs = R"(#version 330 core
+layout(location=0) in vec2 aCorner;
+layout(location=1) in vec4 aPosSize;
+layout(location=2) in vec4 aColor;
+uniform mat4 uViewProj;
+uniform vec3 uRight;
+uniform vec3 uUp;
+out vec2 vCorner; out vec4 vColor;
+void main() {
+    vec3 p = aPosSize.xyz + (uRight * aCorner.x + uUp * aCorner.y) * aPosSize.w;
+    vCorner = aCorner * 2.0;
+    vColor = aColor;
+    gl_Position = uViewProj * vec4(p, 1.0);
+})";
+
+const char* kParticleFs = R"(#version 330 core
+in vec2 vCorner; in vec4 vColor;
+uniform int uAdditive;
+out vec4 oColor;
+void main() {
+    float r2 = dot(vCorner, vCorner);
+    if (r2 > 1.0) discard;
+    float f = uAdditive == 1 ? pow(1.0 - r2, 1.5) : (1.0 - r2 * 0.6);
+    oColor = vec4(vColor.rgb, vColor.a * f);
+})";
+
+const char* kLineVs = R"(#version 330 core
+layout(location=0) in vec3 aPos;
+layout(location=1) in vec3 aColor;
+uniform mat4 uViewProj;
+out vec3 vColor;
+void main() { vColor = aColor; gl_Position = uViewProj * vec4(aPos, 1.0); })";
+
+const char* kLineFs = R"(#version 330 core
+in vec3 vColor; out vec4 oColor;
+void main() { oColor = vec4(vColor, 1.0); })";
+
+GLuint compile(GLenum type, const char* src, std::string& error) {
+    GLuint s = glCreateShader(type);
+    glShaderSource(s, 1, &src, nullptr);
+    glCompileShader(s);
+    GLint ok = 0;
+    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
+    if (!ok) {
+        char log[2048];
+        glGetShaderInfoLog(s, sizeof log, nullptr, log);
+        error += log;
+        glDeleteShader(s);
+        return 0;
+    }
+    return s;
+}
+
+GLuint program(const char* vs, const char* fs, std::string& error) {
+    GLuint v = compile(GL_VERTEX_SHADER, vs, error);
+    GLuint f = compile(GL_FRAGMENT_SHADER, fs, error);
+    if (!v || !f)
+        return 0;
+    GLuint p = glCreateProgram();
+    glAttachShader(p, v);
+    glAttachShader(p, f);
+    glLinkProgram(p);
+    glDeleteShader(v);
+    glDeleteShader(f);
+    GLint ok = 0;
+    glGetProgramiv(p, GL_LINK_STATUS, &ok);
+    if (!ok) {
+        char log[2048];
+        glGetProgramInfoLog(p, sizeof log, nullptr, log);
+        error += log;
+        return 0;
+    }
+    return p;
+}
+
+GLint loc(GLuint p, const char* name) {
+    return glGetUniformLocation(p, name);
+}
+
+float hashNoise(int x, int y, int seed) {
+    std::uint32_t h = static_cast<std::uint32_t>(x) * 374761393u +
+                      static_cast<std::uint32_t>(y) * 668265263u +
+                      static_cast<std::uint32_t>(seed) * 2246822519u;
+    h = (h ^ (h >> 13)) * 1274126177u;
+    return static_cast<float>((h ^ (h >> 16)) & 0xFFFF) / 65535.0f;
+}
+
+float valueNoise(float x, float y, int period, int seed) {
+    const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
+    const float fx = x - static_cast<float>(x0), fy = y - static_cast<float>(y0);
+    auto h = [&](int a, int b) {
+        return hashNoise(((a % period) + period) % period, ((b % period) + period) % period, seed);
+    };
+    const float sx = fx * fx * (3 - 2 * fx), sy = fy * fy * (3 - 2 * fy);
+    const float a = h(x0, y0) + (h(x0 + 1, y0) - h(x0, y0)) * sx;
+    const float b = h(x0, y0 + 1) + (h(x0 + 1, y0 + 1) - h(x0, y0 + 1)) * sx;
+    return a + (b - a) * sy;
+}
+
+float fbm(float x, float y, int period, int seed) {
+    float s = 0, amp = 0.5f;
+    for (int o = 0; o < 5; ++o) {
+        s += amp * valueNoise(x, y, period, seed + o);
+        x *= 2;
+        y *= 2;
+        period *= 2;
+        amp *= 0.5f;
+    }
+    return s;
+}
+
+GLuint uploadRgba(const unsigned char* data, int w, int h) {
+    GLuint t = 0;
+    glGenTextures(1, &t);
+    glBindTexture(GL_TEXTURE_2D, t);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, w, h, 0, GL_RGBA, GL_UNSIGNED_BYTE, data);
+    glGenerateMipmap(GL_TEXTURE_2D);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+    return t;
+}
+
+} // namespace
+
+bool Renderer::init(std::string& error) {
+    meshProg_ = program(kMeshVs, kMeshFs, error);
+    depthProg_ = program(kDepthVs, kDepthFs, error);
+    skyProg_ = program(kSkyVs, kSkyFs, error);
+    particleProg_ = program(kParticleVs, kParticleFs, error);
+    lineProg_ = program(kLineVs, kLineFs, error);
+    if (!meshProg_ || !depthProg_ || !skyProg_ || !particleProg_ || !lineProg_)
+        return false;
+
+    glGenBuffers(1, &slotBuf_);
+    glGenTextures(1, &slotTex_);
+    glGenVertexArrays(1, &emptyVao_);
+
+    glGenVertexArrays(1, &particleVao_);
+    glBindVertexArray(particleVao_);
+    const float quad[] = {-0.5f, -0.5f, 0.5f, -0.5f, -0.5f, 0.5f, 0.5f, 0.5f};
+    glGenBuffers(1, &particleQuad_);
+    glBindBuffer(GL_ARRAY_BUFFER, particleQuad_);
+    glBufferData(GL_ARRAY_BUFFER, sizeof quad, quad, GL_STATIC_DRAW);
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, 0, nullptr);
+    glGenBuffers(1, &particleInst_);
+    glBindBuffer(GL_ARRAY_BUFFER, particleInst_);
+    glEnableVertexAttribArray(1);
+    glVertexAttribPointer(1, 4, GL_FLOAT, GL_FALSE, 8 * sizeof(float), nullptr);
+    glVertexAttribDivisor(1, 1);
+    glEnableVertexAttribArray(2);
+    glVertexAttribPointer(2, 4, GL_FLOAT, GL_FALSE, 8 * sizeof(float),
+                          reinterpret_cast<void*>(4 * sizeof(float)));
+    glVertexAttribDivisor(2, 1);
+
+    glGenVertexArrays(1, &lineVao_);
+    glBindVertexArray(lineVao_);
+    glGenBuffers(1, &lineVbo_);
+    glBindBuffer(GL_ARRAY_BUFFER, lineVbo_);
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), nullptr);
+    glEnableVertexAttribArray(1);
+    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float),
+                          reinterpret_cast<void*>(3 * sizeof(float)));
+    glBindVertexArray(0);
+
+    glGenFramebuffers(1, &shadowFbo_);
+    glGenTextures(1, &shadowTex_);
+    glBindTexture(GL_TEXTURE_2D, shadowTex_);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT24, shadowSize_, shadowSize_, 0, GL_DEPTH_COMPONENT,
+                 GL_FLOAT, nullptr);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+    glBindFramebuffer(GL_FRAMEBUFFER, shadowFbo_);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, shadowTex_, 0);
+    glDrawBuffer(GL_NONE);
+    glReadBuffer(GL_NONE);
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+        shadows = false;
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+
+    interiorTex_ = proceduralTexture("interior");
+    return true;
+}
+
+void Renderer::shutdown() {
+    for (auto& b : batches_) {
+        glDeleteBuffers(1, &b.vbo);
+        glDeleteVertexArrays(1, &b.vao);
+    }
+    batches_.clear();
+    for (GLuint t : textures_)
+        glDeleteTextures(1, &t);
+    textures_.clear();
+    GLuint progs[] = {meshProg_, depthProg_, skyProg_, particleProg_, lineProg_};
+    for (GLuint p : progs)
+        if (p)
+            glDeleteProgram(p);
+}
+
+int Renderer::proceduralTexture(const std::string& kind) {
+    const int n = 256;
+    std::vector<unsigned char> px(static_cast<size_t>(n) * n * 4);
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+            const float fx = static_cast<float>(x) / n * 8, fy = static_cast<float>(y) / n * 8;
+            float r = 0.5f, g = 0.5f, b = 0.5f;
+            const float nz = fbm(fx, fy, 8, 7);
+            if (kind == "grid") {
+                const bool line = (x % 64) < 2 || (y % 64) < 2;
+                const bool fine = (x % 16) == 0 || (y % 16) == 0;
+                const float base = 0.36f + 0.12f * nz;
+                r = base * 0.9f;
+                g = base * 1.0f;
+                b = base * 0.85f;
+                if (fine) {
+                    r *= 0.85f;
+                    g *= 0.85f;
+                    b *= 0.85f;
+                }
+                if (line) {
+                    r = 0.85f;
+                    g = 0.75f;
+                    b = 0.35f;
+                }
+            } else if (kind == "interior") {
+                const float grain = fbm(fx * 2, fy * 2, 16, 31);
+                const float speck = hashNoise(x, y, 5) > 0.93f ? 0.12f : 0.0f;
+                r = 0.55f + 0.25f * grain - speck;
+                g = 0.50f + 0.22f * grain - speck;
+                b = 0.45f + 0.18f * grain - speck;
+            } else if (kind == "metal") {
+                const bool panel = (x % 64) < 2 || (y % 128) < 2;
+                r = 0.55f + 0.1f * nz;
+                g = 0.58f + 0.1f * nz;
+                b = 0.62f + 0.1f * nz;
+                if (panel) {
+                    r *= 0.6f;
+                    g *= 0.6f;
+                    b *= 0.6f;
+                }
+            } else { // concrete / facade
+                const bool mortar = (y % 32) < 2 || ((x + ((y / 32) % 2) * 32) % 64) < 2;
+                const bool window = (x % 64) > 16 && (x % 64) < 48 && (y % 64) > 20 && (y % 64) < 50;
+                r = 0.66f + 0.18f * nz;
+                g = 0.62f + 0.16f * nz;
+                b = 0.56f + 0.14f * nz;
+                if (window) {
+                    r = 0.16f + 0.1f * nz;
+                    g = 0.22f + 0.1f * nz;
+                    b = 0.30f + 0.12f * nz;
+                } else if (mortar) {
+                    r *= 0.8f;
+                    g *= 0.8f;
+                    b *= 0.8f;
+                }
+            }
+            unsigned char* p = &px[(static_cast<size_t>(y) * n + x) * 4];
+            p[0] = static_cast<unsigned char>(std::clamp(r, 0.0f, 1.0f) * 255);
+            p[1] = static_cast<unsigned char>(std::clamp(g, 0.0f, 1.0f) * 255);
+            p[2] = static_cast<unsigned char>(std::clamp(b, 0.0f, 1.0f) * 255);
+            p[3] = 255;
+        }
+    textures_.push_back(uploadRgba(px.data(), n, n));
+    texturePaths_.push_back("procedural:" + kind);
+    return static_cast<int>(textures_.size()) - 1;
+}
+
+int Renderer::loadTexture(const std::filesystem::path& path, const std::string& kind,
+                          std::vector<std::string>& warnings) {
+    for (size_t i = 0; i < texturePaths_.size(); ++i)
+        if (texturePaths_[i] == path.string())
+            return static_cast<int>(i);
+    int w = 0, h = 0, c = 0;
+    unsigned char* data = stbi_load(path.string().c_str(), &w, &h, &c, 4);
+    if (!data) {
+        warnings.push_back(path.string() + ": texture could not be loaded (" +
+                           (stbi_failure_reason() ? stbi_failure_reason() : "?") + "); using a procedural '" +
+                           kind + "' texture");
+        for (size_t i = 0; i < texturePaths_.size(); ++i)
+            if (texturePaths_[i] == "procedural:" + kind)
+                return static_cast<int>(i);
+        return proceduralTexture(kind);
+    }
+    textures_.push_back(uploadRgba(data, w, h));
+    texturePaths_.push_back(path.string());
+    stbi_image_free(data);
+    return static_cast<int>(textures_.size()) - 1;
+}
+
+void Renderer::setSkybox(const std::array<std::filesystem::path, 6>& faces,
+                         std::vector<std::string>& warnings) {
+    // world.cfg order: top, bottom, left, right, front, back → GL faces +Y, -Y, -X, +X, +Z, -Z (cube maps
+    // are left-handed: the shader samples with z mirrored so that 'front' lies ahead, toward -Z).
+    const GLenum target[6] = {GL_TEXTURE_CUBE_MAP_POSITIVE_Y, GL_TEXTURE_CUBE_MAP_NEGATIVE_Y,
+                              GL_TEXTURE_CUBE_MAP_NEGATIVE_X, GL_TEXTURE_CUBE_MAP_POSITIVE_X,
+                              GL_TEXTURE_CUBE_MAP_POSITIVE_Z, GL_TEXTURE_CUBE_MAP_NEGATIVE_Z};
+    std::vector<unsigned char*> data(6, nullptr);
+    int w[6], h[6];
+    bool ok = true;
+    for (int i = 0; i < 6; ++i) {
+        int c = 0;
+        if (!faces[i].empty())
+            data[i] = stbi_load(faces[i].string().c_str(), &w[i], &h[i], &c, 4);
+        if (!data[i]) {
+            warnings.push_back((faces[i].empty() ? std::string("<none>") : faces[i].string()) +
+                               ": skybox image could not be loaded; using the procedural sky");
+            ok = false;
+            break;
+        }
+        if (w[i] != w[0] || h[i] != w[0]) {
+            // Cube faces must be square and equal: resample (nearest) to the first face's size.
+            const int n = w[0];
+            auto* fixed = static_cast<unsigned char*>(std::malloc(static_cast<size_t>(n) * n * 4));
+            for (int y = 0; y < n; ++y)
+                for (int x = 0; x < n; ++x) {
+                    const int sx = x * w[i] / n, sy = y * h[i] / n;
+                    std::memcpy(fixed + (static_cast<size_t>(y) * n + x) * 4,
+                                data[i] + (static_cast<size_t>(sy) * w[i] + sx) * 4, 4);
+                }
+            stbi_image_free(data[i]);
+            data[i] = fixed;
+            w[i] = h[i] = n;
+        }
+    }
+    if (ok) {
+        glGenTextures(1, &skyCube_);
+        glBindTexture(GL_TEXTURE_CUBE_MAP, skyCube_);
+        for (int i = 0; i < 6; ++i)
+            glTexImage2D(target[i], 0, GL_RGBA8, w[i], h[i], 0, GL_RGBA, GL_UNSIGNED_BYTE, data[i]);
+        glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+        glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+        glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+    }
+    for (auto* d : data)
+        if (d)
+            stbi_image_free(d);
+}
+
+void Renderer::bakeProceduralSky() {
+    // A sky dome with per-vertex colours (gradient, sun glow, hazy horizon): almost free per pixel.
+    const V3 sun = norm(sunDir) * -1.0f;
+    const V3 fog{0.70f, 0.77f, 0.85f};
+    const int slices = 48, stacks = 32;
+    auto colour = [&](const V3& d) {
+        const float t = d.y;
+        const V3 zenith{0.22f, 0.42f, 0.75f}, horizon{0.78f, 0.84f, 0.90f};
+        V3 c = lerp(horizon, zenith, std::pow(std::max(t, 0.0f), 0.55f));
+        if (t < 0)
+            c = lerp(horizon, V3{0.45f, 0.45f, 0.47f}, std::min(-t * 4.0f, 1.0f));
+        const float sd = std::max(dot(d, sun), 0.0f);
+        c += V3{1.0f, 0.85f, 0.6f} * (std::pow(sd, 12.0f) * 0.3f + std::pow(sd, 80.0f) * 0.6f);
+        const float h = std::clamp(t * 6.0f, 0.0f, 1.0f);
+        return lerp(fog, c, 0.25f + 0.75f * h);
+    };
+    std::vector<float> v;
+    auto dir = [&](int i, int j) {
+        const float th = 3.14159265f * static_cast<float>(j) / stacks;
+        const float ph = 2 * 3.14159265f * static_cast<float>(i) / slices;
+        return V3{std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph)};
+    };
+    auto push = [&](const V3& d) {
+        const V3 c = colour(d);
+        const float f[6] = {d.x, d.y, d.z, c.x, c.y, c.z};
+        v.insert(v.end(), f, f + 6);
+    };
+    for (int j = 0; j < stacks; ++j)
+        for (int i = 0; i < slices; ++i) {
+            const V3 a = dir(i, j), b = dir(i + 1, j), c = dir(i + 1, j + 1), d = dir(i, j + 1);
+            push(a), push(b), push(c), push(a), push(c), push(d);
+        }
+    skyVertices_ = static_cast<int>(v.size() / 6);
+    glGenVertexArrays(1, &skyVao_);
+    glBindVertexArray(skyVao_);
+    glGenBuffers(1, &skyVbo_);
+    glBindBuffer(GL_ARRAY_BUFFER, skyVbo_);
+    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(v.size() * sizeof(float)), v.data(),
+                 GL_STATIC_DRAW);
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), nullptr);
+    glEnableVertexAttribArray(1);
+    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float),
+                          reinterpret_cast<void*>(3 * sizeof(float)));
+    glBindVertexArray(0);
+}
+
+int Renderer::batchFor(int texture) {
+    for (size_t i = 0; i < batches_.size(); ++i)
+        if (batches_[i].texture == texture)
+            return static_cast<int>(i);
+    Batch b;
+    b.texture = texture;
+    glGenVertexArrays(1, &b.vao);
+    glGenBuffers(1, &b.vbo);
+    glBindVertexArray(b.vao);
+    glBindBuffer(GL_ARRAY_BUFFER, b.vbo);
+    const GLsizei stride = kFloatsPerVertex * sizeof(float);
+    const int sizes[] = {3, 3, 2, 1, 1};
+    size_t off = 0;
+    for (int a = 0; a < 5; ++a) {
+        glEnableVertexAttribArray(static_cast<GLuint>(a));
+        glVertexAttribPointer(static_cast<GLuint>(a), sizes[a], GL_FLOAT, GL_FALSE, stride,
+                              reinterpret_cast<void*>(off * sizeof(float)));
+        off += static_cast<size_t>(sizes[a]);
+    }
+    glBindVertexArray(0);
+    batches_.push_back(std::move(b));
+    return static_cast<int>(batches_.size()) - 1;
+}
+
+int Renderer::addMesh(const rubble::Mesh& mesh, int texture, float r, float g, float b) {
+    int id;
+    if (!freeIds_.empty()) {
+        id = freeIds_.back();
+        freeIds_.pop_back();
+    } else {
+        id = static_cast<int>(meshes_.size());
+        meshes_.emplace_back();
+    }
+    const int bi = batchFor(texture);
+    Batch& batch = batches_[bi];
+    MeshRec& rec = meshes_[id];
+    rec.batch = bi;
+    rec.first = static_cast<int>(batch.cpu.size() / kFloatsPerVertex);
+    rec.count = static_cast<int>(mesh.triangles.size() * 3);
+    rec.alive = true;
+    batch.cpu.reserve(batch.cpu.size() + static_cast<size_t>(rec.count) * kFloatsPerVertex);
+    for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+        const rubble::Vec3 fn = rubble::normalized(mesh.triangleNormal(t));
+        const bool interior = mesh.material(t) == rubble::kInteriorMaterial;
+        for (int c = 0; c < 3; ++c) {
+            const rubble::Vec3& p = mesh.positions[mesh.triangles[t][static_cast<size_t>(c)]];
+            const rubble::Vec3 n = mesh.hasNormals() ? mesh.normals[3 * t + static_cast<size_t>(c)] : fn;
+            const rubble::Vec2 uv = mesh.hasUvs() ? mesh.uvs[3 * t + static_cast<size_t>(c)] : rubble::Vec2{};
+            const float v[kFloatsPerVertex] = {static_cast<float>(p.x),  static_cast<float>(p.y),
+                                               static_cast<float>(p.z),  static_cast<float>(n.x),
+                                               static_cast<float>(n.y),  static_cast<float>(n.z),
+                                               static_cast<float>(uv.x), static_cast<float>(uv.y),
+                                               static_cast<float>(id),   interior ? 1.0f : 0.0f};
+            batch.cpu.insert(batch.cpu.end(), v, v + kFloatsPerVertex);
+        }
+    }
+    batch.dirty = true;
+    ++liveMeshes_;
+    const size_t need = static_cast<size_t>(id + 1) * kTexelsPerSlot * 4;
+    if (slotData_.size() < need)
+        slotData_.resize(need, 0.0f);
+    float* s = &slotData_[static_cast<size_t>(id) * kTexelsPerSlot * 4];
+    s[20] = r;
+    s[21] = g;
+    s[22] = b;
+    return id;
+}
+
+void Renderer::removeMesh(int id) {
+    if (id < 0 || id >= static_cast<int>(meshes_.size()) || !meshes_[id].alive)
+        return;
+    MeshRec& rec = meshes_[id];
+    rec.alive = false;
+    Batch& b = batches_[rec.batch];
+    b.dead += rec.count;
+    freeIds_.push_back(id);
+    --liveMeshes_;
+    if (b.dead > 30000 && b.dead * 2 > static_cast<int>(b.cpu.size() / kFloatsPerVertex))
+        compact(b, rec.batch);
+}
+
+void Renderer::compact(Batch& b, int batchIndex) {
+    std::vector<float> fresh;
+    fresh.reserve(b.cpu.size() / 2);
+    for (auto& rec : meshes_) {
+        if (!rec.alive || rec.batch != batchIndex)
+            continue;
+        const int first = static_cast<int>(fresh.size() / kFloatsPerVertex);
+        fresh.insert(fresh.end(), b.cpu.begin() + static_cast<long>(rec.first) * kFloatsPerVertex,
+                     b.cpu.begin() + static_cast<long>(rec.first + rec.count) * kFloatsPerVertex);
+        rec.first = first;
+    }
+    b.cpu.swap(fresh);
+    b.dead = 0;
+    b.dirty = true;
+    b.gpuCapacity = 0;
+}
+
+void Renderer::uploadBatch(Batch& b) {
+    glBindBuffer(GL_ARRAY_BUFFER, b.vbo);
+    const size_t bytes = b.cpu.size() * sizeof(float);
+    if (bytes > b.gpuCapacity) {
+        b.gpuCapacity = std::max(bytes * 3 / 2, static_cast<size_t>(1 << 16));
+        glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(b.gpuCapacity), nullptr, GL_DYNAMIC_DRAW);
+    }
+    glBufferSubData(GL_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(bytes), b.cpu.data());
+    b.dirty = false;
+}
+
+void Renderer::beginFrame() {
+    for (auto& b : batches_) {
+        b.firsts.clear();
+        b.counts.clear();
+    }
+    dust_.clear();
+    sparks_.clear();
+    lines_.clear();
+    maxSlotUsed_ = 0;
+}
+
+void Renderer::drawMesh(int id, const M4& model, float heat, float fade) {
+    if (id < 0 || id >= static_cast<int>(meshes_.size()) || !meshes_[id].alive)
+        return;
+    const MeshRec& rec = meshes_[id];
+    Batch& b = batches_[rec.batch];
+    b.firsts.push_back(rec.first);
+    b.counts.push_back(rec.count);
+    float* s = &slotData_[static_cast<size_t>(id) * kTexelsPerSlot * 4];
+    std::copy(model.m, model.m + 16, s);
+    s[16] = heat;
+    s[17] = fade;
+    maxSlotUsed_ = std::max(maxSlotUsed_, id + 1);
+}
+
+void Renderer::addParticle(const Particle& p, bool additive) {
+    auto& v = additive ? sparks_ : dust_;
+    const float d[8] = {p.pos.x, p.pos.y, p.pos.z, p.size, p.r, p.g, p.b, p.a};
+    v.insert(v.end(), d, d + 8);
+}
+
+void Renderer::addLine(const V3& a, const V3& b, float r, float g, float bl) {
+    const float d[12] = {a.x, a.y, a.z, r, g, bl, b.x, b.y, b.z, r, g, bl};
+    lines_.insert(lines_.end(), d, d + 12);
+}
+
+void Renderer::drawBatches(bool depthOnly) {
+    for (auto& b : batches_) {
+        if (b.firsts.empty())
+            continue;
+        if (!depthOnly) {
+            glActiveTexture(GL_TEXTURE0);
+            glBindTexture(GL_TEXTURE_2D, textures_[static_cast<size_t>(b.texture)]);
+        }
+        glBindVertexArray(b.vao);
+        glMultiDrawArrays(GL_TRIANGLES, b.firsts.data(), b.counts.data(),
+                          static_cast<GLsizei>(b.firsts.size()));
+        ++drawCalls_;
+        if (!depthOnly)
+            for (GLsizei c : b.counts)
+                triangles_ += c / 3;
+    }
+}
+
+void Renderer::render(const FrameView& fv) {
+    static const char* skipEnv = std::getenv("RUBBLE_DEMO_SKIP");
+    const std::string skip = skipEnv ? skipEnv : "";
+    drawCalls_ = 0;
+    triangles_ = 0;
+    for (auto& b : batches_)
+        if (b.dirty)
+            uploadBatch(b);
+
+    // Per-object transforms → buffer texture.
+    const size_t floats = static_cast<size_t>(std::max(maxSlotUsed_, 1)) * kTexelsPerSlot * 4;
+    if (slotData_.size() < floats)
+        slotData_.resize(floats, 0.0f);
+    glBindBuffer(GL_TEXTURE_BUFFER, slotBuf_);
+    if (floats * sizeof(float) > slotCapacity_) {
+        slotCapacity_ = floats * sizeof(float) * 2;
+        glBufferData(GL_TEXTURE_BUFFER, static_cast<GLsizeiptr>(slotCapacity_), nullptr, GL_STREAM_DRAW);
+    }
+    glBufferSubData(GL_TEXTURE_BUFFER, 0, static_cast<GLsizeiptr>(floats * sizeof(float)), slotData_.data());
+    glActiveTexture(GL_TEXTURE3);
+    glBindTexture(GL_TEXTURE_BUFFER, slotTex_);
+    glTexBuffer(GL_TEXTURE_BUFFER, GL_RGBA32F, slotBuf_);
+
+    // Shadow map: orthographic from the sun around the focus point.
+    const V3 sun = norm(sunDir);
+    const float extent = 140.0f;
+    const V3 lightEye = fv.focus - sun * 400.0f;
+    const M4 lightView = lookAt(lightEye, fv.focus, std::fabs(sun.y) > 0.99f ? V3{0, 0, 1} : V3{0, 1, 0});
+    const M4 lightVP = ortho(-extent, extent, -extent, extent, 1.0f, 900.0f) * lightView;
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LEQUAL);
+    glDisable(GL_BLEND);
+    if (shadows && skip.find("shadow") == std::string::npos) {
+        glBindFramebuffer(GL_FRAMEBUFFER, shadowFbo_);
+        glViewport(0, 0, shadowSize_, shadowSize_);
+        glClear(GL_DEPTH_BUFFER_BIT);
+        glDisable(GL_CULL_FACE);
+        glEnable(GL_POLYGON_OFFSET_FILL);
+        glPolygonOffset(2.0f, 4.0f);
+        glUseProgram(depthProg_);
+        glUniform1i(loc(depthProg_, "uSlots"), 3);
+        glUniformMatrix4fv(loc(depthProg_, "uViewProj"), 1, GL_FALSE, lightVP.m);
+        drawBatches(true);
+        glDisable(GL_POLYGON_OFFSET_FILL);
+    }
+
+    glBindFramebuffer(GL_FRAMEBUFFER, fv.fbo);
+    glViewport(0, 0, fv.width, fv.height);
+    const V3 fog{0.70f, 0.77f, 0.85f};
+    glClearColor(fog.x, fog.y, fog.z, 1);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    const M4 viewProj = fv.proj * fv.view;
+
+    glUseProgram(meshProg_);
+    glUniform1i(loc(meshProg_, "uSlots"), 3);
+    glUniform1i(loc(meshProg_, "uTex"), 0);
+    glUniform1i(loc(meshProg_, "uInterior"), 1);
+    glUniform1i(loc(meshProg_, "uShadow"), 2);
+    glUniform1i(loc(meshProg_, "uUseShadow"), shadows ? 1 : 0);
+    glUniformMatrix4fv(loc(meshProg_, "uViewProj"), 1, GL_FALSE, viewProj.m);
+    glUniformMatrix4fv(loc(meshProg_, "uLightVP"), 1, GL_FALSE, lightVP.m);
+    glUniform3f(loc(meshProg_, "uSunDir"), sun.x, sun.y, sun.z);
+    glUniform3f(loc(meshProg_, "uCamPos"), fv.eye.x, fv.eye.y, fv.eye.z);
+    glUniform3f(loc(meshProg_, "uFogColor"), fog.x, fog.y, fog.z);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, textures_[static_cast<size_t>(interiorTex_)]);
+    glActiveTexture(GL_TEXTURE2);
+    glBindTexture(GL_TEXTURE_2D, shadowTex_);
+    glEnable(GL_CULL_FACE);
+    glCullFace(GL_BACK);
+    if (skip.find("mesh") == std::string::npos)
+        drawBatches(false);
+    glDisable(GL_CULL_FACE);
+
+    // Sky behind everything (drawn last among opaque passes so early depth rejects covered pixels).
+    M4 viewNoT = fv.view;
+    viewNoT.m[12] = viewNoT.m[13] = viewNoT.m[14] = 0;
+    const M4 vp = fv.proj * viewNoT;
+    if (!skyVao_)
+        bakeProceduralSky();
+    glUseProgram(skyProg_);
+    glUniformMatrix4fv(loc(skyProg_, "uViewProj"), 1, GL_FALSE, vp.m);
+    glUniform1i(loc(skyProg_, "uHasCube"), skyCube_ ? 1 : 0);
+    glUniform1i(loc(skyProg_, "uCube"), 4);
+    glActiveTexture(GL_TEXTURE4);
+    glBindTexture(GL_TEXTURE_CUBE_MAP, skyCube_);
+    glDepthMask(GL_FALSE);
+    glBindVertexArray(skyVao_);
+    if (skip.find("sky") == std::string::npos)
+        glDrawArrays(GL_TRIANGLES, 0, skyVertices_);
+    ++drawCalls_;
+    glDepthMask(GL_TRUE);
+
+    // Debug lines.
+    if (!lines_.empty()) {
+        glUseProgram(lineProg_);
+        glUniformMatrix4fv(loc(lineProg_, "uViewProj"), 1, GL_FALSE, viewProj.m);
+        glBindVertexArray(lineVao_);
+        glBindBuffer(GL_ARRAY_BUFFER, lineVbo_);
+        glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(lines_.size() * sizeof(float)), lines_.data(),
+                     GL_STREAM_DRAW);
+        glDrawArrays(GL_LINES, 0, static_cast<GLsizei>(lines_.size() / 6));
+        ++drawCalls_;
+    }
+
+    // Particles: dust (alpha), then sparks (additive); depth test on, no depth writes.
+    glUseProgram(particleProg_);
+    glUniformMatrix4fv(loc(particleProg_, "uViewProj"), 1, GL_FALSE, viewProj.m);
+    const V3 right{fv.view.m[0], fv.view.m[4], fv.view.m[8]};
+    const V3 up{fv.view.m[1], fv.view.m[5], fv.view.m[9]};
+    glUniform3f(loc(particleProg_, "uRight"), right.x, right.y, right.z);
+    glUniform3f(loc(particleProg_, "uUp"), up.x, up.y, up.z);
+    glBindVertexArray(particleVao_);
+    glEnable(GL_BLEND);
+    glDepthMask(GL_FALSE);
+    for (int pass = 0; pass < 2; ++pass) {
+        const auto& v = pass == 0 ? dust_ : sparks_;
+        if (v.empty())
+            continue;
+        if (pass == 0)
+            glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+        else
+            glBlendFunc(GL_SRC_ALPHA, GL_ONE);
+        glUniform1i(loc(particleProg_, "uAdditive"), pass);
+        glBindBuffer(GL_ARRAY_BUFFER, particleInst_);
+        glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(v.size() * sizeof(float)), v.data(),
+                     GL_STREAM_DRAW);
+        glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, static_cast<GLsizei>(v.size() / 8));
+        ++drawCalls_;
+    }
+    glDepthMask(GL_TRUE);
+    glDisable(GL_BLEND);
+    glBindVertexArray(0);
+    glUseProgram(0);
+}
+
+} // namespace demo

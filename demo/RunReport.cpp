@@ -1,0 +1,78 @@
+#include "RunReport.hpp"
+
+#include <stb_image_write.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+namespace demo {
+
+double quantile(std::vector<double> v, double q) {
+    if (v.empty())
+        return 0;
+    std::sort(v.begin(), v.end());
+    const size_t i = static_cast<size_t>(std::ceil(q * static_cast<double>(v.size()))) - 1;
+    return v[std::min(i, v.size() - 1)];
+}
+
+bool writePng(const std::filesystem::path& path, const std::string& rgb, int w, int h) {
+    return stbi_write_png(path.string().c_str(), w, h, 3, rgb.data(), w * 3) != 0;
+}
+
+bool RunReport::write(const std::filesystem::path& dir, const std::string& scene, const std::string& renderer,
+                      const std::vector<double>& latencies, int screenshots, std::string& summary) const {
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    std::ofstream csv(dir / "frames.csv");
+    if (!csv)
+        return false;
+    csv << "frame,sim_time_s,frame_ms,step_ms,draw_calls,bodies,pieces,jobs,shots,impacts,fractures\n";
+    std::vector<double> ms;
+    for (const auto& f : frames_) {
+        csv << f.frame << ',' << f.simTime << ',' << f.frameMs << ',' << f.stepMs << ',' << f.drawCalls << ','
+            << f.counters.bodies << ',' << f.counters.pieces << ',' << f.counters.jobs << ','
+            << f.counters.shots << ',' << f.counters.impacts << ',' << f.counters.fractures << '\n';
+        ms.push_back(f.frameMs);
+    }
+    // Skip the first frames (shader compilation, first uploads) for the summary.
+    std::vector<double> steady(ms.begin() + static_cast<long>(std::min<size_t>(ms.size(), 10)), ms.end());
+    if (steady.empty())
+        steady = ms;
+    const double p50 = quantile(steady, 0.5), p99 = quantile(steady, 0.99);
+    const GameCounters last = frames_.empty() ? GameCounters{} : frames_.back().counters;
+    nlohmann::json j;
+    j["scene"] = scene;
+    j["renderer"] = renderer;
+    j["frames"] = frames_.size();
+    j["sim_seconds"] = frames_.empty() ? 0.0 : frames_.back().simTime;
+    j["frame_ms"] = {{"p50", p50}, {"p99", p99}, {"max", quantile(steady, 1.0)}};
+    j["fps"] = {{"p50", p50 > 0 ? 1000.0 / p50 : 0.0}, {"p99", p99 > 0 ? 1000.0 / p99 : 0.0}};
+    j["shots"] = last.shots;
+    j["impacts"] = last.impacts;
+    j["impacts_submitted"] = last.submitted;
+    j["fractures"] = last.fractures;
+    j["pieces_created"] = last.piecesCreated;
+    j["pieces_retired_to_particles"] = last.retired;
+    j["latency_ms"] = {{"count", latencies.size()},
+                       {"p50", quantile(latencies, 0.5)},
+                       {"p99", quantile(latencies, 0.99)},
+                       {"max", quantile(latencies, 1.0)}};
+    j["screenshots"] = screenshots;
+    j["fracture_runtime"] = Game::fractureAvailable();
+    std::ofstream js(dir / "report.json");
+    js << j.dump(2) << '\n';
+    std::ostringstream s;
+    s.precision(3);
+    s << "frames " << frames_.size() << ", fps p50 " << (p50 > 0 ? 1000.0 / p50 : 0.0) << " / p99 "
+      << (p99 > 0 ? 1000.0 / p99 : 0.0) << " (frame ms p50 " << p50 << ", p99 " << p99 << "), shots "
+      << last.shots << ", impacts " << last.impacts << ", fractures " << last.fractures << ", latency ms p50 "
+      << quantile(latencies, 0.5) << " p99 " << quantile(latencies, 0.99);
+    summary = s.str();
+    return static_cast<bool>(js);
+}
+
+} // namespace demo

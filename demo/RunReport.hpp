@@ -1,0 +1,44 @@
+#pragma once
+/// \file RunReport.hpp
+/// Per-frame timing records of a run, written as CSV and summarised as JSON; PNG screenshots.
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "Game.hpp"
+
+namespace demo {
+
+/// Collects frame records and writes the report files.
+class RunReport {
+public:
+    /// One frame.
+    struct Frame {
+        std::uint64_t frame = 0; ///< simulation frame
+        double simTime = 0;      ///< seconds of simulated time
+        double frameMs = 0;      ///< wall-clock time of the whole frame
+        double stepMs = 0;       ///< wall-clock time of the simulation step
+        GameCounters counters;   ///< counters after the frame
+        int drawCalls = 0;       ///< draw calls
+    };
+    /// Adds a frame.
+    void add(const Frame& f) { frames_.push_back(f); }
+    /// Number of frames recorded.
+    std::size_t size() const { return frames_.size(); }
+    /// Writes frames.csv and report.json into dir; latencies are impact → adopted in ms.
+    bool write(const std::filesystem::path& dir, const std::string& scene, const std::string& renderer,
+               const std::vector<double>& latencies, int screenshots, std::string& summary) const;
+
+private:
+    std::vector<Frame> frames_;
+};
+
+/// Writes tightly packed RGB rows (top first) as PNG.
+bool writePng(const std::filesystem::path& path, const std::string& rgb, int w, int h);
+
+/// The q-quantile (0..1) of values (nearest rank); 0 for an empty set.
+double quantile(std::vector<double> values, double q);
+
+} // namespace demo

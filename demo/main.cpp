@@ -1,0 +1,419 @@
+// rubble-demo: fly, shoot, watch things break. GLFW + OpenGL 3.3 (libepoxy) + Dear ImGui; headless via EGL.
+#include <epoxy/gl.h>
+
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+#include <imgui_impl_glfw.h>
+#include <imgui_impl_opengl3.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "Autopilot.hpp"
+#include "Game.hpp"
+#include "GlContext.hpp"
+#include "Panel.hpp"
+#include "Renderer.hpp"
+#include "RunReport.hpp"
+#include "rubble/SceneConfig.hpp"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+/// Built-in scene used when the default world.cfg is missing (models missing → box stand-ins).
+const char* kFallbackScene =
+    "sky_top.png;sky_bottom.png;sky_left.png;sky_right.png;sky_front.png;sky_back.png\n"
+    ";ground.png;0;-15;0;1000;10;1000;0\n"
+    "vehicle.obj;;0;20;0;1;1;1;100\n"
+    "tower.obj;;-20;5;-60;8;15;8;500\n"
+    "tower.obj;;30;0;-120;10;10;10;0\n"
+    "tower.obj;;-60;15;-160;6;25;6;800\n"
+    "tower.obj;;70;-2;-40;6;8;6;300\n";
+
+struct Options {
+    std::string scene;
+    bool debug = false;
+    double autopilot = 0;
+    double screenshotEvery = 0;
+    std::string out;
+    bool stats = false;
+    int statsEvery = 30;
+    int width = 1280;
+    int height = 720;
+    bool headless = false;
+    bool window = false;
+    int workers = -1;
+    std::string pattern = "single";
+    int cells = 6;
+    bool noPanel = false;
+    bool deterministic = false;
+    bool noShadows = false;
+};
+
+struct App {
+    Options opt;
+    std::unique_ptr<demo::GlContext> gl;
+    demo::Renderer renderer;
+    demo::Game game;
+    demo::Panel panel;
+    demo::GameSettings pending;
+    rubble::SceneConfig scene;
+    std::string sceneName;
+    bool paused = false;
+    bool quit = false;
+    bool screenshotRequested = false;
+    int screenshots = 0;
+    bool imguiGlfw = false;
+};
+
+App* gApp = nullptr;
+
+void keyCallback(GLFWwindow* w, int key, int, int action, int) {
+    if (action != GLFW_PRESS || !gApp)
+        return;
+    if (ImGui::GetCurrentContext() && ImGui::GetIO().WantTextInput)
+        return;
+    App& a = *gApp;
+    switch (key) {
+    case GLFW_KEY_ESCAPE:
+        a.quit = true;
+        glfwSetWindowShouldClose(w, GLFW_TRUE);
+        break;
+    case GLFW_KEY_P:
+        a.paused = !a.paused;
+        break;
+    case GLFW_KEY_SPACE:
+        if (a.paused)
+            a.paused = false;
+        break;
+    case GLFW_KEY_F1:
+        a.panel.visible = !a.panel.visible;
+        break;
+    case GLFW_KEY_F2:
+        a.screenshotRequested = true;
+        break;
+    case GLFW_KEY_F3: {
+        auto& s = a.game.settings();
+        const bool on = !(s.debugShapes || s.debugAabbs || s.debugImpacts);
+        s.debugShapes = s.debugAabbs = s.debugImpacts = on;
+        break;
+    }
+    default:
+        break;
+    }
+}
+
+demo::ControlInput readKeys(GLFWwindow* w, bool& spaceHeld) {
+    demo::ControlInput in;
+    auto down = [w](int k) { return glfwGetKey(w, k) == GLFW_PRESS; };
+    in.pitch = (down(GLFW_KEY_W) ? 1.0f : 0.0f) - (down(GLFW_KEY_S) ? 1.0f : 0.0f);
+    in.roll = (down(GLFW_KEY_A) ? 1.0f : 0.0f) - (down(GLFW_KEY_D) ? 1.0f : 0.0f);
+    in.yaw = (down(GLFW_KEY_Q) ? 1.0f : 0.0f) - (down(GLFW_KEY_E) ? 1.0f : 0.0f);
+    in.throttle = (down(GLFW_KEY_Z) ? 1.0f : 0.0f) - (down(GLFW_KEY_X) ? 1.0f : 0.0f);
+    spaceHeld = down(GLFW_KEY_SPACE);
+    in.fire = spaceHeld;
+    return in;
+}
+
+bool loadScene(App& a, std::string& error) {
+    std::vector<std::string> warnings;
+    a.renderer.shutdown();
+    a.renderer = demo::Renderer();
+    std::string rerr;
+    if (!a.renderer.init(rerr)) {
+        error = "renderer: " + rerr;
+        return false;
+    }
+    bool skyOk = true;
+    for (const auto& p : a.scene.skyboxPaths)
+        skyOk = skyOk && !p.empty() && std::filesystem::exists(p);
+    if (skyOk)
+        a.renderer.setSkybox(a.scene.skyboxPaths, warnings);
+    if (!a.game.load(a.scene, a.renderer, a.pending, warnings, error))
+        return false;
+    for (const auto& w : warnings)
+        std::fprintf(stderr, "warning: %s\n", w.c_str());
+    if (!skyOk)
+        std::fprintf(stderr, "warning: skybox images missing; drawing the procedural sky\n");
+    return true;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    App app;
+    gApp = &app;
+    Options& o = app.opt;
+    CLI::App cli{"rubble-demo: fly a vehicle through a world.cfg scene and shoot destructible objects.\n"
+                 "Keys: W/S pitch, A/D roll, Q/E yaw, Z/X speed, Space fire/unpause, P pause, Esc quit,\n"
+                 "F1 panel, F2 screenshot, F3 debug overlay."};
+    cli.add_option("--scene", o.scene, "world.cfg scene (thesis format); default assets/scenes/world.cfg");
+    cli.add_flag("-d,--debug", o.debug, "draw collision shapes, AABBs and impact points");
+    cli.add_option("--autopilot", o.autopilot, "fly and shoot by script for SECONDS (fixed 1/60 s steps)");
+    cli.add_option("--screenshot-every", o.screenshotEvery,
+                   "write a PNG every S simulated seconds (needs --out)");
+    cli.add_option("--out", o.out, "output folder for screenshots and the timing report");
+    cli.add_flag("--stats", o.stats, "print a stats line to stdout every --stats-every frames");
+    cli.add_option("--stats-every", o.statsEvery, "frames between stats lines (default 30)");
+    cli.add_option("--width", o.width, "framebuffer width");
+    cli.add_option("--height", o.height, "framebuffer height");
+    cli.add_flag("--headless", o.headless, "render offscreen with EGL (default when DISPLAY is unset)");
+    cli.add_flag("--window", o.window, "open a window even for --autopilot");
+    cli.add_option("--workers", o.workers, "fracture worker threads (-1 automatic)");
+    cli.add_option("--pattern", o.pattern, "fracture pattern: single or shatter")
+        ->check(CLI::IsMember({"single", "shatter"}));
+    cli.add_option("--cells", o.cells, "cells K of the shatter pattern");
+    cli.add_flag("--no-panel", o.noPanel, "hide the ImGui panel (F1 toggles it)");
+    cli.add_flag("--deterministic", o.deterministic, "adopt fractures a fixed number of frames after impact");
+    cli.add_flag("--no-shadows", o.noShadows, "disable shadow mapping");
+    CLI11_PARSE(cli, argc, argv);
+
+    const bool haveDisplay = std::getenv("DISPLAY") && *std::getenv("DISPLAY");
+    const bool autopilot = o.autopilot > 0;
+    bool headless = o.headless || !haveDisplay;
+    if (o.window)
+        headless = false;
+    if (autopilot && !o.window && !haveDisplay)
+        headless = true;
+    if (!autopilot && headless && !o.headless) {
+        std::fprintf(stderr,
+                     "rubble-demo: no DISPLAY. Run with --autopilot SECONDS --out DIR for a headless run, "
+                     "or under xvfb-run.\n");
+        return 2;
+    }
+
+    // Scene.
+    std::filesystem::path scenePath =
+        o.scene.empty() ? std::filesystem::path(RUBBLE_SOURCE_DIR) / "assets/scenes/world.cfg"
+                        : std::filesystem::path(o.scene);
+    if (o.scene.empty() && !std::filesystem::exists(scenePath)) {
+        std::fprintf(stderr, "warning: %s not found; using the built-in fallback scene\n",
+                     scenePath.string().c_str());
+        auto r = rubble::parseSceneConfigText(kFallbackScene, "builtin.cfg",
+                                              std::filesystem::path(RUBBLE_SOURCE_DIR) / "assets");
+        if (!r) {
+            std::fprintf(stderr, "error: %s\n", r.error().message.c_str());
+            return 1;
+        }
+        app.scene = r.value();
+        app.sceneName = "built-in scene";
+    } else {
+        auto r = rubble::parseSceneConfig(scenePath);
+        if (!r) {
+            std::fprintf(stderr, "error: %s\n", r.error().message.c_str());
+            return 1;
+        }
+        app.scene = r.value();
+        app.sceneName = scenePath.filename().string();
+    }
+
+    app.pending.workers = o.workers;
+    app.pending.deterministic = o.deterministic || autopilot;
+    app.pending.fracture.pattern =
+        o.pattern == "shatter" ? rubble::CellPattern::Shatter : rubble::CellPattern::SingleCell;
+    app.pending.fracture.cells = o.cells;
+    app.pending.fracture.sizeLaw.base = 3.0;
+    app.pending.fracture.sizeLaw.scale = 0.35;
+    app.pending.fracture.sizeLaw.exponent = 0.5;
+    app.pending.fracture.sizeLaw.maxSize = 30;
+    app.pending.fracture.uvScale = 0.25;
+    app.pending.shadows = !o.noShadows;
+    app.pending.debugShapes = app.pending.debugAabbs = app.pending.debugImpacts = o.debug;
+
+    std::string error;
+    app.gl = demo::GlContext::create(o.width, o.height, headless, error);
+    if (!app.gl) {
+        std::fprintf(stderr, "error: %s\n", error.c_str());
+        return 1;
+    }
+    if (!loadScene(app, error)) {
+        std::fprintf(stderr, "error: %s\n", error.c_str());
+        return 1;
+    }
+
+    IMGUI_CHECKVERSION();
+    ImGui::CreateContext();
+    ImGuiIO& io = ImGui::GetIO();
+    io.IniFilename = nullptr;
+    ImGui::StyleColorsDark();
+    ImGui::GetStyle().WindowRounding = 6.0f;
+    ImGui::GetStyle().FrameRounding = 3.0f;
+    if (app.gl->window()) {
+        glfwSetWindowUserPointer(app.gl->window(), &app);
+        glfwSetKeyCallback(app.gl->window(), keyCallback);
+        ImGui_ImplGlfw_InitForOpenGL(app.gl->window(), true);
+        app.imguiGlfw = true;
+    }
+    ImGui_ImplOpenGL3_Init("#version 330 core");
+    app.panel.visible = !o.noPanel;
+
+    if (!o.out.empty()) {
+        std::error_code ec;
+        std::filesystem::create_directories(o.out, ec);
+    }
+    const std::string rendererName = app.gl->renderer();
+    std::fprintf(stderr, "rubble-demo: %s, %dx%d, %s, fracture runtime %s\n",
+                 headless ? "EGL offscreen" : "window", app.gl->width(), app.gl->height(),
+                 rendererName.c_str(),
+                 demo::Game::fractureAvailable() ? "linked" : "NOT linked (impacts only)");
+
+    demo::Autopilot pilot;
+    demo::RunReport report;
+    const float fixedDt = 1.0f / 60.0f;
+    const long totalFrames = autopilot ? std::lround(o.autopilot * 60.0) : -1;
+    const long shotEvery = o.screenshotEvery > 0 ? std::max(1L, std::lround(o.screenshotEvery * 60.0)) : 0;
+    long renderFrame = 0;
+    double accumulator = 0;
+    auto last = Clock::now();
+
+    while (!app.quit) {
+        const auto frameStart = Clock::now();
+        double realDt = std::chrono::duration<double>(frameStart - last).count();
+        last = frameStart;
+        if (app.gl->window()) {
+            glfwPollEvents();
+            if (glfwWindowShouldClose(app.gl->window()))
+                app.quit = true;
+        }
+
+        // Simulation.
+        const auto stepStart = Clock::now();
+        demo::GameSettings& live = app.game.settings();
+        if (autopilot) {
+            const demo::ControlInput in = pilot.update(app.game, fixedDt);
+            app.game.step(in, fixedDt, app.renderer);
+        } else if (!app.paused) {
+            bool space = false;
+            demo::ControlInput in;
+            if (app.gl->window() && !ImGui::GetIO().WantCaptureKeyboard)
+                in = readKeys(app.gl->window(), space);
+            accumulator += std::min(realDt, 0.1);
+            int steps = 0;
+            while (accumulator >= fixedDt && steps < 4) {
+                app.game.step(in, fixedDt * live.timeScale, app.renderer);
+                accumulator -= fixedDt;
+                ++steps;
+            }
+            if (steps == 4)
+                accumulator = 0;
+        } else {
+            accumulator = 0;
+        }
+        const double stepMs = std::chrono::duration<double, std::milli>(Clock::now() - stepStart).count();
+
+        // Scene.
+        const int w = app.gl->width(), h = app.gl->height();
+        app.renderer.beginFrame();
+        app.game.draw(app.renderer, autopilot ? fixedDt : static_cast<float>(std::min(realDt, 0.1)));
+        demo::FrameView fv;
+        fv.width = w;
+        fv.height = h;
+        fv.fbo = app.gl->framebuffer();
+        fv.eye = app.game.camera().eye;
+        fv.view = app.game.camera().view();
+        fv.proj = demo::perspective(1.05f, static_cast<float>(w) / static_cast<float>(std::max(h, 1)), 0.5f,
+                                    3000.0f);
+        demo::V3 vpos, vfwd, vup;
+        app.game.vehicleFrame(vpos, vfwd, vup);
+        fv.focus = vpos + vfwd * 60.0f;
+        app.renderer.render(fv);
+
+        // UI.
+        io.DisplaySize = ImVec2(static_cast<float>(w), static_cast<float>(h));
+        io.DeltaTime = autopilot || realDt <= 0 ? fixedDt : static_cast<float>(realDt);
+        ImGui_ImplOpenGL3_NewFrame();
+        if (app.imguiGlfw)
+            ImGui_ImplGlfw_NewFrame();
+        if (autopilot) {
+            io.DeltaTime = fixedDt;
+        }
+        ImGui::NewFrame();
+        app.panel.pushLatencies(app.game.takeNewLatencies());
+        if (app.panel.draw(app.game, app.pending, app.paused, app.sceneName, rendererName,
+                           app.renderer.drawCalls(), app.renderer.triangles())) {
+            app.pending.timeScale = live.timeScale;
+            app.pending.debugShapes = live.debugShapes;
+            app.pending.debugAabbs = live.debugAabbs;
+            app.pending.debugImpacts = live.debugImpacts;
+            app.pending.shadows = live.shadows;
+            if (!loadScene(app, error)) {
+                std::fprintf(stderr, "error: %s\n", error.c_str());
+                break;
+            }
+        }
+        app.panel.drawHud(app.game, app.paused, w, h);
+        ImGui::Render();
+        glBindFramebuffer(GL_FRAMEBUFFER, app.gl->framebuffer());
+        glViewport(0, 0, w, h);
+        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+
+        ++renderFrame;
+        const std::uint64_t simFrame = app.game.counters().frame;
+        const bool lastFrame = autopilot && static_cast<long>(simFrame) >= totalFrames;
+        const bool timedShot =
+            shotEvery > 0 && (autopilot ? (static_cast<long>(simFrame) % shotEvery == 0 || lastFrame)
+                                        : renderFrame % shotEvery == 0);
+        if ((timedShot || app.screenshotRequested) && !o.out.empty()) {
+            std::string rgb;
+            int sw = 0, sh = 0;
+            app.gl->readPixels(rgb, sw, sh);
+            char name[64];
+            std::snprintf(name, sizeof name, "shot_%04d.png", ++app.screenshots);
+            const auto path = std::filesystem::path(o.out) / name;
+            if (demo::writePng(path, rgb, sw, sh))
+                std::printf("screenshot %s frame=%llu\n", path.string().c_str(),
+                            static_cast<unsigned long long>(simFrame));
+            std::fflush(stdout);
+            app.screenshotRequested = false;
+        }
+        app.gl->present();
+
+        const double frameMs = std::chrono::duration<double, std::milli>(Clock::now() - frameStart).count();
+        app.panel.pushFrameMs(static_cast<float>(frameMs));
+        const demo::GameCounters& c = app.game.counters();
+        report.add(
+            {simFrame, static_cast<double>(simFrame) / 60.0, frameMs, stepMs, c, app.renderer.drawCalls()});
+        if (o.stats && renderFrame % std::max(1, o.statsEvery) == 0) {
+            std::printf(
+                "stats render=%ld frame=%llu paused=%d shots=%d impacts=%d fractures=%d bodies=%d pieces=%d "
+                "jobs=%d frame_ms=%.2f\n",
+                renderFrame, static_cast<unsigned long long>(c.frame), app.paused ? 1 : 0, c.shots, c.impacts,
+                c.fractures, c.bodies, c.pieces, c.jobs, frameMs);
+            std::fflush(stdout);
+        }
+        if (lastFrame)
+            break;
+    }
+
+    if (!o.out.empty()) {
+        std::string summary;
+        const auto outDir = std::filesystem::path(o.out);
+        if (report.write(outDir, app.scene.baseDir.string() + "/" + app.sceneName, rendererName,
+                         app.game.latencies(), app.screenshots, summary)) {
+            app.game.writeTimings((outDir / "latency.csv").string());
+            std::printf("report: %s\n", summary.c_str());
+            std::printf("wrote %s/report.json, %s/frames.csv and %d screenshots\n", o.out.c_str(),
+                        o.out.c_str(), app.screenshots);
+        } else {
+            std::fprintf(stderr, "error: cannot write the report into %s\n", o.out.c_str());
+        }
+    }
+    std::fflush(stdout);
+
+    ImGui_ImplOpenGL3_Shutdown();
+    if (app.imguiGlfw)
+        ImGui_ImplGlfw_Shutdown();
+    ImGui::DestroyContext();
+    app.game.clear(app.renderer);
+    app.renderer.shutdown();
+    app.gl.reset();
+    return 0;
+}
