@@ -5,6 +5,7 @@
 // {"meshes":[{"file","vertices","triangles","closed","manifold","oriented","self_intersections","volume",
 // "center_of_mass":[x,y,z],"bbox":[[lo],[hi]]}]}, where self_intersections is the number of intersecting
 // triangle pairs or null when the test did not run; an unreadable file appears as {"file","error"}.
+// With --repair the entries describe the repaired meshes, "file" being the path written.
 // Problems and repair notes go to stderr in --json mode.
 #include <algorithm>
 #include <cstdio>
@@ -204,6 +205,10 @@ const rubble::tools::Registrar registrar{
     {"check", "Check meshes: closed, manifold, oriented, self-intersections, volume; optionally repair",
      [](CLI::App& app) {
          auto args = std::make_shared<CheckArgs>();
+         app.footer(
+             "Exit codes: 0 every mesh is a valid solid, 1 a mesh is readable but invalid, 2 a file is "
+             "unreadable or the command line is wrong.\nIn --json, self_intersections is the number of "
+             "intersecting triangle pairs, or null when the test did not run.");
          app.add_option("meshes", args->files, "mesh files (.obj, .off, .stl, .ply, .3ds, .gltf, .glb)")
              ->required();
          app.add_flag("--json", args->json, "print a JSON document instead of text");
