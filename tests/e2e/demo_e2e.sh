@@ -1,0 +1,130 @@
+#!/usr/bin/env bash
+# End-to-end test of rubble-demo under Xvfb: real window, real key events (xdotool), assertions on the
+# demo's --stats output and on its screenshots.
+#   Space fires and impacts follow; P freezes the frame counter and Space resumes it; Esc exits with 0;
+#   a screenshot is not blank and differs before and after a hit.
+# Usage: demo_e2e.sh PATH/TO/rubble-demo      Exit 77 = skipped (Xvfb or xdotool missing).
+set -uo pipefail
+demo=${1:?usage: demo_e2e.sh PATH/TO/rubble-demo}
+here=$(cd "$(dirname "$0")" && pwd)
+for tool in Xvfb xdotool python3; do
+    if ! command -v "$tool" >/dev/null; then
+        echo "SKIP: $tool is not installed (apt-get install xvfb xdotool python3)"
+        exit 77
+    fi
+done
+
+work=$(mktemp -d /tmp/rubble-e2e.XXXXXX)
+xvfb_pid=""
+demo_pid=""
+cleanup() {
+    [ -n "$demo_pid" ] && kill "$demo_pid" 2>/dev/null
+    [ -n "$xvfb_pid" ] && kill "$xvfb_pid" 2>/dev/null
+    wait 2>/dev/null
+    rm -rf "$work"
+}
+trap cleanup EXIT
+fail() {
+    echo "FAIL: $*"
+    echo "--- demo output (last 30 lines) ---"
+    tail -n 30 "$work/log" 2>/dev/null
+    exit 1
+}
+
+# A free display number.
+disp=""
+for n in $(seq 91 140); do
+    if [ ! -e "/tmp/.X11-unix/X$n" ] && [ ! -e "/tmp/.X$n-lock" ]; then
+        disp=":$n"
+        break
+    fi
+done
+[ -n "$disp" ] || fail "no free X display number"
+Xvfb "$disp" -screen 0 1280x720x24 -r -nolisten tcp >"$work/xvfb.log" 2>&1 &
+xvfb_pid=$!
+for _ in $(seq 1 100); do
+    [ -e "/tmp/.X11-unix/X${disp#:}" ] && break
+    sleep 0.1
+done
+[ -e "/tmp/.X11-unix/X${disp#:}" ] || fail "Xvfb did not start on $disp"
+export DISPLAY=$disp
+
+"$demo" --scene "$here/e2e.cfg" --stats --stats-every 5 --out "$work/out" --no-panel >"$work/log" 2>&1 &
+demo_pid=$!
+
+# Last value of a field (frame, shots, impacts, paused, ...) in the stats lines.
+field() { grep '^stats ' "$work/log" | tail -n 1 | tr ' ' '\n' | grep "^$1=" | cut -d= -f2; }
+wait_for() { # wait_for SECONDS COMMAND...: polls until COMMAND succeeds
+    local limit=$1
+    shift
+    for _ in $(seq 1 $((limit * 10))); do
+        if "$@"; then return 0; fi
+        kill -0 "$demo_pid" 2>/dev/null || fail "rubble-demo exited early"
+        sleep 0.1
+    done
+    return 1
+}
+have_stats() { grep -q '^stats ' "$work/log"; }
+wait_for 60 have_stats || fail "no stats line within 60 s"
+
+win=$(xdotool search --sync --onlyvisible --name "Rubble" 2>/dev/null | head -n 1)
+[ -n "$win" ] || fail "demo window not found"
+xdotool windowfocus --sync "$win" 2>/dev/null || xdotool windowfocus "$win"
+sleep 0.5
+key() { xdotool key --clearmodifiers "$@"; }
+
+# Screenshot before any hit.
+shots_taken() { [ "$(ls "$work/out"/shot_*.png 2>/dev/null | wc -l)" -ge "$1" ]; }
+key F2
+wait_for 20 shots_taken 1 || fail "F2 did not write a screenshot"
+
+# Space fires; impacts follow.
+s0=$(field shots)
+xdotool keydown space
+sleep 1.2
+xdotool keyup space
+fired() { [ "$(field shots)" -gt "$s0" ]; }
+wait_for 20 fired || fail "Space did not fire (shots stayed at $s0)"
+hit() { [ "$(field impacts)" -gt 0 ]; }
+wait_for 30 hit || fail "shots fired ($(field shots)) but no impact followed"
+echo "ok: Space fired $(field shots) shots, $(field impacts) impacts"
+sleep 0.3
+key F2
+wait_for 20 shots_taken 2 || fail "second screenshot missing"
+
+# P pauses: the frame counter stops while stats lines keep coming.
+key p
+is_paused() { [ "$(field paused)" = "1" ]; }
+wait_for 20 is_paused || fail "P did not pause"
+f1=$(field frame)
+sleep 2
+f2=$(field frame)
+[ "$f1" = "$f2" ] || fail "frame counter moved while paused ($f1 -> $f2)"
+[ "$(field paused)" = "1" ] || fail "paused flag dropped"
+echo "ok: P froze the frame counter at $f1"
+key space
+resumed() { [ "$(field paused)" = "0" ] && [ "$(field frame)" -gt "$f2" ]; }
+wait_for 20 resumed || fail "Space did not unpause"
+echo "ok: Space resumed (frame $(field frame))"
+
+# Screenshots: not blank, and different before and after the hit.
+stats=$(python3 "$here/png_stats.py" "$work/out/shot_0001.png" "$work/out/shot_0002.png") || fail "png_stats failed"
+echo "screenshots: $stats"
+var=$(echo "$stats" | sed -n 's/.*var=\([0-9.]*\).*/\1/p')
+diff=$(echo "$stats" | sed -n 's/.*diff=\([0-9.]*\).*/\1/p')
+python3 -c "import sys; sys.exit(0 if float('$var') > 50 else 1)" || fail "screenshot looks blank (variance $var)"
+python3 -c "import sys; sys.exit(0 if float('$diff') > 0.05 else 1)" || fail "screenshots before/after the hit are the same (diff $diff)"
+
+# Esc quits with status 0.
+key Escape
+for _ in $(seq 1 200); do
+    kill -0 "$demo_pid" 2>/dev/null || break
+    sleep 0.1
+done
+if kill -0 "$demo_pid" 2>/dev/null; then fail "Esc did not quit within 20 s"; fi
+wait "$demo_pid"
+rc=$?
+demo_pid=""
+[ "$rc" -eq 0 ] || fail "rubble-demo exited with $rc after Esc"
+echo "ok: Esc exited with 0"
+echo "PASS"
