@@ -32,11 +32,15 @@ struct MeshReport {
 
     bool closed = false;       ///< every edge has exactly two incident triangles
     bool edgeManifold = false; ///< no edge has more than two incident triangles
-    bool oriented = false;     ///< every edge shared by two triangles is used once in each direction
-    bool outward = false;      ///< total signed volume is positive
+    /// Every vertex's triangles form one fan (no two solids touching at a single vertex); only examined when
+    /// the mesh is edge-manifold and its indices are in range.
+    bool vertexManifold = false;
+    bool oriented = false; ///< every edge shared by two triangles is used once in each direction
+    bool outward = false;  ///< total signed volume is positive
 
     std::size_t boundaryEdges = 0;       ///< edges with exactly one incident triangle (holes)
     std::size_t nonManifoldEdges = 0;    ///< edges with three or more incident triangles
+    std::size_t nonManifoldVertices = 0; ///< vertices whose triangles form two or more separate fans
     std::size_t misorientedEdges = 0;    ///< edges used twice in the same direction
     std::size_t degenerateTriangles = 0; ///< triangles with a repeated index or zero area
     std::size_t duplicateTriangles = 0;  ///< triangles with the same three vertices as an earlier one
@@ -60,6 +64,9 @@ struct MeshReport {
 
     /// Human-readable problems, one sentence each, most important first; empty for a valid mesh.
     std::vector<std::string> problems;
+
+    /// True when both edges and vertices are manifold.
+    bool manifold() const { return edgeManifold && vertexManifold; }
 
     /// True when the mesh is a valid solid: non-empty, closed, manifold, oriented outward, finite, without
     /// degenerate triangles and (when checked) without self-intersections.

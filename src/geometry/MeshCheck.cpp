@@ -48,8 +48,8 @@ struct EdgeUse {
 } // namespace
 
 bool MeshReport::valid() const {
-    return triangles > 0 && closed && edgeManifold && oriented && outward && degenerateTriangles == 0 &&
-           duplicateTriangles == 0 && nonFiniteVertices == 0 && badIndices == 0 &&
+    return triangles > 0 && closed && edgeManifold && vertexManifold && oriented && outward &&
+           degenerateTriangles == 0 && duplicateTriangles == 0 && nonFiniteVertices == 0 && badIndices == 0 &&
            !(selfIntersectionsChecked && selfIntersections > 0);
 }
 
@@ -172,6 +172,53 @@ MeshReport checkMesh(const Mesh& mesh, const CheckOptions& options) {
     r.closed = r.boundaryEdges == 0 && r.nonManifoldEdges == 0 && !edges.empty();
     r.oriented = r.misorientedEdges == 0 && !edges.empty();
 
+    // Vertex manifoldness: the link of each vertex (the edges opposite it) must be connected.
+    std::vector<std::string> pinchedEx;
+    if (r.badIndices == 0 && r.edgeManifold && !edges.empty()) {
+        std::unordered_map<std::uint64_t, std::uint32_t> linkId; // (vertex, neighbour) -> union-find node
+        linkId.reserve(mesh.triangles.size() * 6);
+        std::vector<std::uint32_t> parent;
+        auto node = [&](std::uint32_t v, std::uint32_t w) {
+            const auto [it, inserted] =
+                linkId.emplace((std::uint64_t{v} << 32) | w, static_cast<std::uint32_t>(parent.size()));
+            if (inserted)
+                parent.push_back(it->second);
+            return it->second;
+        };
+        auto find = [&](std::uint32_t x) {
+            while (parent[x] != x)
+                x = parent[x] = parent[parent[x]];
+            return x;
+        };
+        for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+            if (!usable[t])
+                continue;
+            const Triangle& tri = mesh.triangles[t];
+            for (int c = 0; c < 3; ++c) {
+                const std::uint32_t v = tri[c], a = tri[(c + 1) % 3], b = tri[(c + 2) % 3];
+                const std::uint32_t x = find(node(v, a)), y = find(node(v, b));
+                if (x != y)
+                    parent[std::max(x, y)] = std::min(x, y);
+            }
+        }
+        std::unordered_map<std::uint32_t, std::uint32_t> firstRoot; // vertex -> a root of its link
+        std::vector<std::uint32_t> pinched;
+        for (const auto& [key, id] : linkId) {
+            const auto v = static_cast<std::uint32_t>(key >> 32);
+            const std::uint32_t root = find(id);
+            const auto [it, inserted] = firstRoot.emplace(v, root);
+            if (!inserted && it->second != root && it->second != UINT32_MAX) {
+                it->second = UINT32_MAX; // counted once
+                pinched.push_back(v);
+            }
+        }
+        std::sort(pinched.begin(), pinched.end());
+        r.nonManifoldVertices = pinched.size();
+        for (std::size_t i = 0; i < pinched.size() && i < maxListed; ++i)
+            pinchedEx.push_back("vertex " + std::to_string(std::uint64_t{pinched[i]} + 1));
+    }
+    r.vertexManifold = r.badIndices == 0 && r.edgeManifold && r.nonManifoldVertices == 0;
+
     if (r.badIndices == 0) {
         std::vector<std::uint32_t> shellOf;
         r.shells = labelShells(mesh, shellOf);
@@ -184,7 +231,8 @@ MeshReport checkMesh(const Mesh& mesh, const CheckOptions& options) {
     r.outward = r.volume > 0;
 
     if (options.selfIntersections) {
-        if (r.badIndices == 0 && r.nonFiniteVertices == 0 && r.degenerateTriangles == 0 && r.edgeManifold) {
+        if (r.badIndices == 0 && r.nonFiniteVertices == 0 && r.degenerateTriangles == 0 && r.edgeManifold &&
+            r.nonManifoldVertices == 0) {
             const SelfIntersectionResult si = findSelfIntersections(mesh, options.maxSelfIntersections);
             r.selfIntersectionsChecked = si.ran;
             r.selfIntersections = si.pairs;
@@ -204,8 +252,9 @@ MeshReport checkMesh(const Mesh& mesh, const CheckOptions& options) {
             r.selfIntersectionNote = r.nonFiniteVertices > 0 ? "skipped: the mesh has non-finite coordinates"
                                      : r.badIndices > 0
                                          ? "skipped: a triangle refers to a vertex that does not exist"
-                                     : r.degenerateTriangles ? "skipped: the mesh has degenerate triangles"
-                                                             : "skipped: the mesh has non-manifold edges";
+                                     : r.degenerateTriangles  ? "skipped: the mesh has degenerate triangles"
+                                     : r.nonManifoldEdges > 0 ? "skipped: the mesh has non-manifold edges"
+                                                              : "skipped: the mesh has non-manifold vertices";
         }
     } else {
         r.selfIntersectionNote = "skipped on request";
@@ -237,6 +286,10 @@ MeshReport checkMesh(const Mesh& mesh, const CheckOptions& options) {
         problems.push_back("the mesh is not manifold: " + plural(r.nonManifoldEdges, "edge is", "edges are") +
                            " shared by three or more triangles" + examples(ex));
     }
+    if (r.nonManifoldVertices > 0)
+        problems.push_back(
+            "the mesh is not manifold: " + plural(r.nonManifoldVertices, "vertex joins", "vertices join") +
+            " parts that share no edge there (pinched)" + examples(pinchedEx));
     if (r.misorientedEdges > 0) {
         std::vector<std::string> ex;
         for (std::uint64_t k : misorientedEx)

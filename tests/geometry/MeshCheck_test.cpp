@@ -248,3 +248,29 @@ TEST(MeshCheck, RandomIndexSoupsNeverCrash) {
         }
     }
 }
+
+TEST(MeshCheck, SolidsTouchingAtOneVertexAreNotManifold) {
+    // Two tetrahedra sharing only vertex 0 (by index): every edge has two triangles, but vertex 0 is pinched.
+    Mesh m;
+    m.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {-1, 0, 0}, {0, -1, 0}, {0, 0, -1}};
+    m.triangles = {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {2, 0, 3}, {0, 4, 5}, {0, 6, 4}, {4, 6, 5}, {5, 6, 0}};
+    ASSERT_GT(signedVolume(m), 0);
+    const MeshReport r = checkMesh(m);
+    EXPECT_TRUE(r.closed);
+    EXPECT_TRUE(r.edgeManifold);
+    EXPECT_TRUE(r.oriented);
+    EXPECT_FALSE(r.vertexManifold);
+    EXPECT_FALSE(r.manifold());
+    EXPECT_EQ(r.nonManifoldVertices, 1u);
+    EXPECT_FALSE(r.valid());
+    EXPECT_FALSE(r.selfIntersectionsChecked);
+    EXPECT_EQ(r.selfIntersectionNote, "skipped: the mesh has non-manifold vertices");
+    EXPECT_TRUE(mentions(r, "1 vertex joins parts that share no edge there (pinched) (vertex 1)"))
+        << problemsOf(r);
+
+    // Valid meshes have manifold vertices, including open ones with one boundary fan per vertex.
+    EXPECT_TRUE(checkMesh(makeTorus({0, 0, 0}, 2, 1, 12, 8)).vertexManifold);
+    Mesh open = makeBox({0, 0, 0}, {1, 1, 1});
+    open.triangles.pop_back();
+    EXPECT_TRUE(checkMesh(open).vertexManifold);
+}

@@ -57,10 +57,13 @@ void printStats(std::ostream& out, const rubble::MeshReport& r) {
     out << "  closed              " << yesNo(r.closed);
     if (r.boundaryEdges > 0)
         out << " (" << r.boundaryEdges << " open " << (r.boundaryEdges == 1 ? "edge" : "edges") << ")";
-    out << "\n  manifold            " << yesNo(r.edgeManifold);
+    out << "\n  manifold            " << yesNo(r.manifold());
     if (r.nonManifoldEdges > 0)
         out << " (" << r.nonManifoldEdges << " non-manifold " << (r.nonManifoldEdges == 1 ? "edge" : "edges")
             << ")";
+    else if (r.nonManifoldVertices > 0)
+        out << " (" << r.nonManifoldVertices << " non-manifold "
+            << (r.nonManifoldVertices == 1 ? "vertex" : "vertices") << ")";
     out << "\n  oriented            " << yesNo(r.oriented);
     if (r.oriented && r.closed && r.volume != 0)
         out << (r.volume > 0 ? " (outward)" : " (inside out)");
@@ -87,7 +90,7 @@ nlohmann::json jsonOf(const std::string& file, const rubble::MeshReport& r) {
     j["vertices"] = r.vertices;
     j["triangles"] = r.triangles;
     j["closed"] = r.closed;
-    j["manifold"] = r.edgeManifold;
+    j["manifold"] = r.manifold();
     j["oriented"] = r.oriented;
     if (r.selfIntersectionsChecked)
         j["self_intersections"] = r.selfIntersections;
