@@ -31,11 +31,11 @@ std::string edgeName(std::uint64_t key) {
     return std::to_string((key >> 32) + 1) + "-" + std::to_string((key & 0xFFFFFFFFu) + 1);
 }
 
-// Appends ", e.g. a, b, c" for the first few examples.
-std::string examples(const std::vector<std::string>& items) {
+// " (a, b)" when the items are all there are, " (e.g. a, b, c)" when there are more than listed.
+std::string examples(const std::vector<std::string>& items, std::size_t total) {
     if (items.empty())
         return {};
-    std::string s = items.size() == 1 ? " (" : " (e.g. ";
+    std::string s = items.size() >= total ? " (" : " (e.g. ";
     for (std::size_t i = 0; i < items.size(); ++i)
         s += (i ? ", " : "") + items[i];
     return s + ")";
@@ -246,7 +246,7 @@ MeshReport checkMesh(const Mesh& mesh, const CheckOptions& options) {
                 r.problems.push_back(
                     (si.capped ? "at least " : "") +
                     plural(si.pairs, "pair of triangles intersects", "pairs of triangles intersect") +
-                    examples(ex));
+                    examples(ex, si.capped ? si.pairs + 1 : si.pairs));
             }
         } else {
             r.selfIntersectionNote = r.nonFiniteVertices > 0 ? "skipped: the mesh has non-finite coordinates"
@@ -266,17 +266,18 @@ MeshReport checkMesh(const Mesh& mesh, const CheckOptions& options) {
         problems.push_back("the mesh has no triangles");
     if (r.nonFiniteVertices > 0)
         problems.push_back(plural(r.nonFiniteVertices, "vertex has", "vertices have") +
-                           " a non-finite coordinate (NaN or infinity)" + examples(nonFiniteEx));
+                           " a non-finite coordinate (NaN or infinity)" +
+                           examples(nonFiniteEx, r.nonFiniteVertices));
     if (r.badIndices > 0)
         problems.push_back(plural(r.badIndices, "triangle corner refers", "triangle corners refer") +
-                           " to a vertex that does not exist" + examples(badIndexEx));
+                           " to a vertex that does not exist" + examples(badIndexEx, r.badIndices));
     if (r.boundaryEdges > 0) {
         std::vector<std::string> ex;
         for (std::uint64_t k : openEx)
             ex.push_back("edge " + edgeName(k));
         problems.push_back(
             "the mesh is not closed (holes): " + plural(r.boundaryEdges, "edge is", "edges are") +
-            " used by only one triangle" + examples(ex));
+            " used by only one triangle" + examples(ex, r.boundaryEdges));
     }
     if (r.nonManifoldEdges > 0) {
         std::vector<std::string> ex;
@@ -284,19 +285,19 @@ MeshReport checkMesh(const Mesh& mesh, const CheckOptions& options) {
             ex.push_back("edge " + edgeName(k) + " has " + std::to_string(nonManifoldCount[k]) +
                          " triangles");
         problems.push_back("the mesh is not manifold: " + plural(r.nonManifoldEdges, "edge is", "edges are") +
-                           " shared by three or more triangles" + examples(ex));
+                           " shared by three or more triangles" + examples(ex, r.nonManifoldEdges));
     }
     if (r.nonManifoldVertices > 0)
         problems.push_back(
             "the mesh is not manifold: " + plural(r.nonManifoldVertices, "vertex joins", "vertices join") +
-            " parts that share no edge there (pinched)" + examples(pinchedEx));
+            " parts that share no edge there (pinched)" + examples(pinchedEx, r.nonManifoldVertices));
     if (r.misorientedEdges > 0) {
         std::vector<std::string> ex;
         for (std::uint64_t k : misorientedEx)
             ex.push_back("edge " + edgeName(k));
         problems.push_back("the mesh is not consistently oriented (flipped triangles): " +
                            plural(r.misorientedEdges, "edge is", "edges are") +
-                           " used twice in the same direction" + examples(ex));
+                           " used twice in the same direction" + examples(ex, r.misorientedEdges));
     }
     if (!mesh.triangles.empty() && r.badIndices == 0 && r.nonFiniteVertices == 0 && r.closed && r.oriented &&
         !r.outward)
@@ -304,10 +305,11 @@ MeshReport checkMesh(const Mesh& mesh, const CheckOptions& options) {
                                         : "the mesh encloses no volume");
     if (r.degenerateTriangles > 0)
         problems.push_back(plural(r.degenerateTriangles, "triangle is", "triangles are") +
-                           " degenerate (repeated vertex or zero area)" + examples(degenerateEx));
+                           " degenerate (repeated vertex or zero area)" +
+                           examples(degenerateEx, r.degenerateTriangles));
     if (r.duplicateTriangles > 0)
         problems.push_back(plural(r.duplicateTriangles, "triangle duplicates", "triangles duplicate") +
-                           " an earlier triangle" + examples(duplicateEx));
+                           " an earlier triangle" + examples(duplicateEx, r.duplicateTriangles));
     problems.insert(problems.end(), r.problems.begin(), r.problems.end());
     r.problems = std::move(problems);
     return r;
