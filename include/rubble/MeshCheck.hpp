@@ -47,6 +47,7 @@ struct MeshReport {
     std::size_t nonFiniteVertices = 0;   ///< vertices with a NaN or infinite coordinate
     std::size_t badIndices = 0;          ///< triangle corners referring to a vertex that does not exist
     std::size_t shells = 0;              ///< edge-connected components of triangles
+    std::size_t badAttributeArrays = 0;  ///< normals/uvs/materials present with the wrong number of entries
 
     /// True when the self-intersection test ran (see CheckOptions::selfIntersections).
     bool selfIntersectionsChecked = false;
@@ -68,8 +69,9 @@ struct MeshReport {
     /// True when both edges and vertices are manifold.
     bool manifold() const { return edgeManifold && vertexManifold; }
 
-    /// True when the mesh is a valid solid: non-empty, closed, manifold, oriented outward, finite, without
-    /// degenerate triangles and (when checked) without self-intersections.
+    /// True when the mesh is a valid solid: non-empty, closed, manifold, oriented outward, finite, with
+    /// attribute arrays of the right sizes, without degenerate triangles and (when checked) without
+    /// self-intersections.
     bool valid() const;
 };
 

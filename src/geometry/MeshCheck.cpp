@@ -50,7 +50,7 @@ struct EdgeUse {
 bool MeshReport::valid() const {
     return triangles > 0 && closed && edgeManifold && vertexManifold && oriented && outward &&
            degenerateTriangles == 0 && duplicateTriangles == 0 && nonFiniteVertices == 0 && badIndices == 0 &&
-           !(selfIntersectionsChecked && selfIntersections > 0);
+           badAttributeArrays == 0 && !(selfIntersectionsChecked && selfIntersections > 0);
 }
 
 bool isDegenerateTriangle(const Vec3& a, const Vec3& b, const Vec3& c) {
@@ -271,6 +271,18 @@ MeshReport checkMesh(const Mesh& mesh, const CheckOptions& options) {
     if (r.badIndices > 0)
         problems.push_back(plural(r.badIndices, "triangle corner refers", "triangle corners refer") +
                            " to a vertex that does not exist" + examples(badIndexEx, r.badIndices));
+    auto attribute = [&](std::size_t have, std::size_t perTriangle, const char* what) {
+        const std::size_t want = perTriangle * mesh.triangles.size();
+        if (have == 0 || have == want)
+            return;
+        ++r.badAttributeArrays;
+        problems.push_back(std::string(what) + " have " + std::to_string(have) + " entries but " +
+                           std::to_string(want) + " are needed (" + std::to_string(perTriangle) +
+                           " per triangle)");
+    };
+    attribute(mesh.normals.size(), 3, "normals");
+    attribute(mesh.uvs.size(), 3, "texture coordinates");
+    attribute(mesh.materials.size(), 1, "material ids");
     if (r.boundaryEdges > 0) {
         std::vector<std::string> ex;
         for (std::uint64_t k : openEx)

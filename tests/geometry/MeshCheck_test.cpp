@@ -274,3 +274,15 @@ TEST(MeshCheck, SolidsTouchingAtOneVertexAreNotManifold) {
     open.triangles.pop_back();
     EXPECT_TRUE(checkMesh(open).vertexManifold);
 }
+
+TEST(MeshCheck, AttributeArraysOfTheWrongSizeAreReported) {
+    Mesh m = makeBox({0, 0, 0}, {1, 1, 1});
+    m.normals.assign(5, Vec3{0, 0, 1});
+    m.materials.assign(3, 0);
+    const MeshReport r = checkMesh(m);
+    EXPECT_FALSE(r.valid());
+    EXPECT_EQ(r.badAttributeArrays, 2u);
+    EXPECT_TRUE(mentions(r, "normals have 5 entries but 36 are needed (3 per triangle)")) << problemsOf(r);
+    EXPECT_TRUE(mentions(r, "material ids have 3 entries but 12 are needed (1 per triangle)"))
+        << problemsOf(r);
+}

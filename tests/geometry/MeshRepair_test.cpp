@@ -254,3 +254,13 @@ TEST(MeshRepair, OverlappingShellsAreNotMistakenForCavities) {
     EXPECT_EQ(r.invertedShells, 0u);
     EXPECT_NEAR(r.after.volume, 16.0, 1e-12);
 }
+
+TEST(MeshRepair, AttributeArraysOfTheWrongSizeAreDropped) {
+    Mesh m = makeBox({0, 0, 0}, {1, 1, 1});
+    m.uvs.assign(7, Vec2{});
+    const RepairReport r = repairMesh(m);
+    EXPECT_TRUE(r.valid()) << listOf(r.unrepaired);
+    EXPECT_FALSE(m.hasUvs());
+    EXPECT_TRUE(mentions(r.fixed, "dropped texture coordinates")) << listOf(r.fixed);
+    EXPECT_TRUE(m.validate().isOk());
+}
