@@ -99,6 +99,8 @@ struct Game::Body {
     float heat = 0;
     float age = 0;
     float volume = 0;
+    double density = 1;
+    rubble::Mesh localMesh; // used by the stand-in fracture
     bool dead = false;
 };
 
@@ -343,6 +345,11 @@ bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const Game
 #endif
         if (parts.empty())
             parts.push_back(renderMesh.positions);
+        b->density = density;
+#if !RUBBLE_DEMO_HAS_RUNTIME
+        b->object = nextLocalId_++;
+        b->localMesh = renderMesh;
+#endif
         auto compound = std::make_unique<btCompoundShape>();
         for (const auto& pts : parts) {
             auto hull = std::make_unique<btConvexHullShape>();
@@ -492,7 +499,19 @@ void Game::processContacts(Renderer& renderer) {
                         ++counters_.submitted;
                 }
 #else
-                (void)impulse;
+                if (other->object && impulse >= settings_.impulseThreshold && other->volume > 0.2f &&
+                    !local_.busy(other->object)) {
+                    const btTransform inv = other->rb->getWorldTransform().inverse();
+                    const btVector3 lp = inv * pt;
+                    const btVector3 ln = inv.getBasis() * nrm;
+                    const auto& law = settings_.fracture.sizeLaw;
+                    const double size = std::clamp(law.base + law.scale * std::pow(impulse, law.exponent),
+                                                   law.minSize, law.maxSize);
+                    local_.submit(other->object, other->localMesh, {lp.x(), lp.y(), lp.z()},
+                                  {ln.x(), ln.y(), ln.z()}, size,
+                                  1000003ull * counters_.frame + other->object, counters_.frame);
+                    ++counters_.submitted;
+                }
 #endif
             } else if (other->kind == Body::Kind::Ground) {
                 particles_.impactBurst(toV3(pt), toV3(nrm), 0.3f, burstSeed_++);
@@ -524,91 +543,124 @@ void Game::processContacts(Renderer& renderer) {
     }
 }
 
+void Game::spawnPiece(const Body& parent, const rubble::Mesh& mesh, const rubble::Mat3& rotation,
+                      const rubble::Vec3& offset, double volume, const rubble::Vec3& inertiaDiag,
+                      double density, std::uint32_t object,
+                      const std::vector<std::vector<rubble::Vec3>>& partsIn, Renderer& renderer) {
+    const btTransform T = parent.rb->getWorldTransform();
+    const btVector3 v = parent.rb->getLinearVelocity();
+    const btVector3 w = parent.rb->getAngularVelocity();
+    btMatrix3x3 basis;
+    for (int r = 0; r < 3; ++r)
+        basis[r] = btVector3(static_cast<btScalar>(rotation.m[r][0]), static_cast<btScalar>(rotation.m[r][1]),
+                             static_cast<btScalar>(rotation.m[r][2]));
+    const btTransform Tp = T * btTransform(basis, toBt(offset));
+    const btVector3 r = Tp.getOrigin() - T.getOrigin();
+    const btVector3 pv = v + w.cross(r);
+    if (volume < settings_.minPieceVolume) {
+        particles_.debrisPuff(toV3(Tp.getOrigin()), toV3(pv) + toV3(r.normalized()) * 2.0f,
+                              static_cast<float>(std::cbrt(volume)), burstSeed_++);
+        ++counters_.retired;
+        return;
+    }
+    auto b = std::make_unique<Body>();
+    b->kind = Body::Kind::Piece;
+    b->object = object;
+    b->volume = static_cast<float>(volume);
+    b->density = density;
+    b->texture = parent.texture;
+    b->tint = parent.tint;
+    b->heat = 1.0f;
+#if !RUBBLE_DEMO_HAS_RUNTIME
+    b->localMesh = mesh;
+#endif
+    auto compound = std::make_unique<btCompoundShape>();
+    std::vector<std::vector<rubble::Vec3>> parts = partsIn;
+    if (parts.empty())
+        parts.push_back(mesh.positions);
+    for (const auto& pts : parts) {
+        auto hull = std::make_unique<btConvexHullShape>();
+        for (const auto& p : pts)
+            hull->addPoint(toBt(p), false);
+        hull->recalcLocalAabb();
+        hull->setMargin(0.01f);
+        btTransform id;
+        id.setIdentity();
+        compound->addChildShape(id, hull.get());
+        b->children.push_back(std::move(hull));
+    }
+    b->shape = std::move(compound);
+    const bool staysStatic = parent.rb->getInvMass() == 0 && volume > 0.25 * parent.volume;
+    const float mass = staysStatic ? 0.0f : static_cast<float>(density * volume);
+    btVector3 inertia(0, 0, 0);
+    if (mass > 0)
+        inertia = btVector3(static_cast<btScalar>(std::max(1e-6, inertiaDiag.x * density)),
+                            static_cast<btScalar>(std::max(1e-6, inertiaDiag.y * density)),
+                            static_cast<btScalar>(std::max(1e-6, inertiaDiag.z * density)));
+    b->rb = std::make_unique<btRigidBody>(
+        btRigidBody::btRigidBodyConstructionInfo(mass, nullptr, b->shape.get(), inertia));
+    b->rb->setWorldTransform(Tp);
+    b->rb->setFriction(0.8f);
+    b->rb->setDamping(0.05f, 0.2f);
+    if (mass > 0) {
+        b->rb->setLinearVelocity(pv);
+        b->rb->setAngularVelocity(w);
+    }
+    b->mesh = renderer.addMesh(mesh, b->texture, b->tint.x, b->tint.y, b->tint.z);
+    addBody(std::move(b));
+    ++counters_.piecesCreated;
+}
+
 void Game::adoptFractures(Renderer& renderer) {
+#if !RUBBLE_DEMO_HAS_RUNTIME
+    local_.deterministic = settings_.deterministic;
+    for (auto& res : local_.collect(counters_.frame)) {
+        Body* parent = nullptr;
+        for (auto& b : bodies_)
+            if (b->object == res.key && !b->dead && b->kind != Body::Kind::Projectile)
+                parent = b.get();
+        if (!parent || res.pieces.empty())
+            continue;
+        for (auto& piece : res.pieces) {
+            const std::uint32_t id = piece.volume >= settings_.minPieceVolume ? nextLocalId_++ : 0;
+            spawnPiece(*parent, piece.mesh, rubble::Mat3::identity(), piece.offset, piece.volume,
+                       piece.inertia, parent->density, id, {}, renderer);
+        }
+        latencies_.push_back(res.latencyMs);
+        parent->dead = true;
+        removeBody(parent, renderer);
+        ++counters_.fractures;
+    }
+    counters_.jobs = local_.inFlight();
+#endif
 #if RUBBLE_DEMO_HAS_RUNTIME
     destruction_->beginFrame();
     auto outcomes = destruction_->collect();
     for (auto& o : outcomes) {
         Body* parent = nullptr;
         for (auto& b : bodies_)
-            if (b->object == o.parent && !b->dead)
+            if (b->object == o.parent && !b->dead && b->kind != Body::Kind::Projectile)
                 parent = b.get();
         if (!parent) {
             for (auto id : o.pieces)
                 destruction_->removeObject(id);
             continue;
         }
-        const btTransform T = parent->rb->getWorldTransform();
-        const btVector3 v = parent->rb->getLinearVelocity();
-        const btVector3 w = parent->rb->getAngularVelocity();
-        const bool parentStatic = parent->rb->getInvMass() == 0;
-        const float parentVolume = parent->volume;
-        for (size_t i = 0; i < o.pieces.size(); ++i) {
+        for (size_t i = 0; i < o.pieces.size() && i < o.pieceFrames.size(); ++i) {
             const rubble::ObjectState* st = destruction_->object(o.pieces[i]);
-            if (!st || i >= o.pieceFrames.size())
+            if (!st)
                 continue;
-            const rubble::Frame& f = o.pieceFrames[i];
-            btMatrix3x3 basis;
-            for (int r = 0; r < 3; ++r)
-                basis[r] = btVector3(static_cast<btScalar>(f.rotation.m[r][0]),
-                                     static_cast<btScalar>(f.rotation.m[r][1]),
-                                     static_cast<btScalar>(f.rotation.m[r][2]));
-            const btTransform Tp = T * btTransform(basis, toBt(f.translation));
-            const btVector3 r = Tp.getOrigin() - T.getOrigin();
-            const btVector3 pv = v + w.cross(r);
             const double vol = std::fabs(st->mass.volume);
-            if (vol < settings_.minPieceVolume) {
-                particles_.debrisPuff(toV3(Tp.getOrigin()), toV3(pv) + toV3(r.normalized()) * 2.0f,
-                                      static_cast<float>(std::cbrt(vol)), burstSeed_++);
-                destruction_->removeObject(o.pieces[i]);
-                ++counters_.retired;
-                continue;
-            }
-            auto b = std::make_unique<Body>();
-            b->kind = Body::Kind::Piece;
-            b->object = o.pieces[i];
-            b->volume = static_cast<float>(vol);
-            b->texture = parent->texture;
-            b->tint = parent->tint;
-            b->heat = 1.0f;
-            auto compound = std::make_unique<btCompoundShape>();
             std::vector<std::vector<rubble::Vec3>> parts;
             for (const auto& part : st->convexParts)
                 parts.push_back(part.vertices());
-            if (parts.empty())
-                parts.push_back(st->mesh.positions);
-            for (const auto& pts : parts) {
-                auto hull = std::make_unique<btConvexHullShape>();
-                for (const auto& p : pts)
-                    hull->addPoint(toBt(p), false);
-                hull->recalcLocalAabb();
-                hull->setMargin(0.01f);
-                btTransform id;
-                id.setIdentity();
-                compound->addChildShape(id, hull.get());
-                b->children.push_back(std::move(hull));
-            }
-            b->shape = std::move(compound);
-            const bool staysStatic = parentStatic && vol > 0.25 * parentVolume;
-            const float mass = staysStatic ? 0.0f : static_cast<float>(st->density * vol);
-            btVector3 inertia(0, 0, 0);
-            if (mass > 0)
-                inertia =
-                    btVector3(static_cast<btScalar>(std::max(1e-6, st->mass.inertia.m[0][0] * st->density)),
-                              static_cast<btScalar>(std::max(1e-6, st->mass.inertia.m[1][1] * st->density)),
-                              static_cast<btScalar>(std::max(1e-6, st->mass.inertia.m[2][2] * st->density)));
-            b->rb = std::make_unique<btRigidBody>(
-                btRigidBody::btRigidBodyConstructionInfo(mass, nullptr, b->shape.get(), inertia));
-            b->rb->setWorldTransform(Tp);
-            b->rb->setFriction(0.8f);
-            b->rb->setDamping(0.05f, 0.2f);
-            if (mass > 0) {
-                b->rb->setLinearVelocity(pv);
-                b->rb->setAngularVelocity(w);
-            }
-            b->mesh = renderer.addMesh(st->mesh, b->texture, b->tint.x, b->tint.y, b->tint.z);
-            addBody(std::move(b));
-            ++counters_.piecesCreated;
+            const rubble::Vec3 inertia{st->mass.inertia.m[0][0], st->mass.inertia.m[1][1],
+                                       st->mass.inertia.m[2][2]};
+            if (vol < settings_.minPieceVolume)
+                destruction_->removeObject(o.pieces[i]);
+            spawnPiece(*parent, st->mesh, o.pieceFrames[i].rotation, o.pieceFrames[i].translation, vol,
+                       inertia, st->density, vol < settings_.minPieceVolume ? 0 : o.pieces[i], parts,
+                       renderer);
         }
         parent->dead = true;
         removeBody(parent, renderer);

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "ChaseCamera.hpp"
+#include "LocalFracture.hpp"
 #include "Math.hpp"
 #include "ParticleSystem.hpp"
 #include "Renderer.hpp"
@@ -131,6 +132,10 @@ private:
     void adoptFractures(Renderer& renderer);
     void retireExcessPieces(Renderer& renderer);
     void controlVehicle(const ControlInput& input, float dt);
+    void spawnPiece(const Body& parent, const rubble::Mesh& mesh, const rubble::Mat3& rotation,
+                    const rubble::Vec3& offset, double volume, const rubble::Vec3& inertia, double density,
+                    std::uint32_t object, const std::vector<std::vector<rubble::Vec3>>& parts,
+                    Renderer& renderer);
 
     GameSettings settings_;
     GameCounters counters_;
@@ -144,6 +149,8 @@ private:
     std::shared_ptr<rubble::DestructionWorld>
         destruction_; ///< shared_ptr: no destructor reference without the runtime
     std::vector<std::unique_ptr<Body>> bodies_;
+    LocalFracture local_; ///< stand-in fracture while the runtime is not linked
+    std::uint32_t nextLocalId_ = 1;
     Body* vehicle_ = nullptr;
     float speed_ = 30;
     float fireCooldown_ = 0;

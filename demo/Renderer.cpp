@@ -108,11 +108,29 @@ void main() {
 
 const char* kSkyFs = R"(#version 330 core
 in vec3 vDir; in vec3 vColor;
-uniform samplerCube uCube;
+uniform sampler2DArray uFaces; // world.cfg order: top, bottom, left, right, front, back
 uniform int uHasCube;
 out vec4 oColor;
 void main() {
-    oColor = vec4(uHasCube == 1 ? texture(uCube, vec3(vDir.xy, -vDir.z)).rgb : vColor, 1.0);
+    if (uHasCube == 0) { oColor = vec4(vColor, 1.0); return; }
+    // Face selection and UVs exactly as Irrlicht's CSkyBoxSceneNode maps the six images.
+    vec3 d = vDir;
+    vec3 a = abs(d);
+    vec2 uv; float layer;
+    if (a.y >= a.x && a.y >= a.z) {
+        vec3 p = d / a.y;
+        if (d.y > 0.0) { uv = vec2(1.0 - p.z, 1.0 + p.x) * 0.5; layer = 0.0; }
+        else { uv = vec2(1.0 - p.z, 1.0 - p.x) * 0.5; layer = 1.0; }
+    } else if (a.x >= a.z) {
+        vec3 p = d / a.x;
+        if (d.x > 0.0) { uv = vec2(1.0 - p.z, 1.0 - p.y) * 0.5; layer = 2.0; }
+        else { uv = vec2(1.0 + p.z, 1.0 - p.y) * 0.5; layer = 3.0; }
+    } else {
+        vec3 p = d / a.z;
+        if (d.z < 0.0) { uv = vec2(1.0 - p.x, 1.0 - p.y) * 0.5; layer = 4.0; }
+        else { uv = vec2(1.0 + p.x, 1.0 - p.y) * 0.5; layer = 5.0; }
+    }
+    oColor = vec4(texture(uFaces, vec3(uv, layer)).rgb, 1.0);
 })";
 
 const char* kParticleVs = R"(#version 330 core
@@ -413,11 +431,8 @@ int Renderer::loadTexture(const std::filesystem::path& path, const std::string& 
 
 void Renderer::setSkybox(const std::array<std::filesystem::path, 6>& faces,
                          std::vector<std::string>& warnings) {
-    // world.cfg order: top, bottom, left, right, front, back → GL faces +Y, -Y, -X, +X, +Z, -Z (cube maps
-    // are left-handed: the shader samples with z mirrored so that 'front' lies ahead, toward -Z).
-    const GLenum target[6] = {GL_TEXTURE_CUBE_MAP_POSITIVE_Y, GL_TEXTURE_CUBE_MAP_NEGATIVE_Y,
-                              GL_TEXTURE_CUBE_MAP_NEGATIVE_X, GL_TEXTURE_CUBE_MAP_POSITIVE_X,
-                              GL_TEXTURE_CUBE_MAP_POSITIVE_Z, GL_TEXTURE_CUBE_MAP_NEGATIVE_Z};
+    // world.cfg order: top, bottom, left, right, front, back; one layer each of a 2D array texture, sampled
+    // with Irrlicht's face mapping (see kSkyFs) so the thesis's images meet without seams.
     std::vector<unsigned char*> data(6, nullptr);
     int w[6], h[6];
     bool ok = true;
@@ -448,14 +463,15 @@ void Renderer::setSkybox(const std::array<std::filesystem::path, 6>& faces,
     }
     if (ok) {
         glGenTextures(1, &skyCube_);
-        glBindTexture(GL_TEXTURE_CUBE_MAP, skyCube_);
+        glBindTexture(GL_TEXTURE_2D_ARRAY, skyCube_);
+        glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_RGBA8, w[0], w[0], 6, 0, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
         for (int i = 0; i < 6; ++i)
-            glTexImage2D(target[i], 0, GL_RGBA8, w[i], h[i], 0, GL_RGBA, GL_UNSIGNED_BYTE, data[i]);
-        glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-        glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-        glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-        glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-        glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+            glTexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, 0, 0, i, w[0], w[0], 1, GL_RGBA, GL_UNSIGNED_BYTE,
+                            data[i]);
+        glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+        glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
     }
     for (auto* d : data)
         if (d)
@@ -755,9 +771,9 @@ void Renderer::render(const FrameView& fv) {
     glUseProgram(skyProg_);
     glUniformMatrix4fv(loc(skyProg_, "uViewProj"), 1, GL_FALSE, vp.m);
     glUniform1i(loc(skyProg_, "uHasCube"), skyCube_ ? 1 : 0);
-    glUniform1i(loc(skyProg_, "uCube"), 4);
+    glUniform1i(loc(skyProg_, "uFaces"), 4);
     glActiveTexture(GL_TEXTURE4);
-    glBindTexture(GL_TEXTURE_CUBE_MAP, skyCube_);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, skyCube_);
     glDepthMask(GL_FALSE);
     glBindVertexArray(skyVao_);
     if (skip.find("sky") == std::string::npos)
