@@ -11,9 +11,9 @@ namespace demo {
 /// Follows a target frame (position, forward, up) with exponential smoothing; never rolls with the target.
 class ChaseCamera {
 public:
-    float distance = 16;  ///< metres behind the target
-    float height = 4.5f;  ///< metres above the target
-    float lookAhead = 25; ///< metres ahead of the target the camera looks at
+    float distance = 19;  ///< metres behind the target
+    float height = 5.5f;  ///< metres above the target
+    float lookAhead = 30; ///< metres ahead of the target the camera looks at
     V3 eye{0, 30, 20};    ///< current position
     V3 target;            ///< current look-at point
 

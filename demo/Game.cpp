@@ -51,15 +51,29 @@ void ensureUvs(rubble::Mesh& m, double metresPerRepeat) {
     }
 }
 
+/// A closed triangular prism: triangle (a, b, c) extruded by e, outward oriented.
+rubble::Mesh prism(const rubble::Vec3& a, const rubble::Vec3& b, const rubble::Vec3& c,
+                   const rubble::Vec3& e) {
+    rubble::Mesh m;
+    m.positions = {a - e * 0.5, b - e * 0.5, c - e * 0.5, a + e * 0.5, b + e * 0.5, c + e * 0.5};
+    m.triangles = {{0, 2, 1}, {3, 4, 5}, {0, 1, 4}, {0, 4, 3}, {1, 2, 5}, {1, 5, 4}, {2, 0, 3}, {2, 3, 5}};
+    if (rubble::signedVolume(m) < 0)
+        for (auto& t : m.triangles)
+            std::swap(t[1], t[2]);
+    return m;
+}
+
 rubble::Mesh standInJet() {
-    rubble::Mesh jet = rubble::makeSphere({0, 0, 0}, 1.0, 14, 8);
-    jet = jet.transformed(rubble::Mat3::identity(), {0.9, 0.7, 3.6}, {0, 0, 0});
-    rubble::Mesh wing = rubble::makeBox({-4.6, -0.12, -0.4}, {4.6, 0.12, 1.6});
-    rubble::Mesh tail = rubble::makeBox({-0.1, 0.2, 1.8}, {0.1, 2.0, 3.4});
-    rubble::Mesh stab = rubble::makeBox({-1.8, -0.08, 2.4}, {1.8, 0.08, 3.4});
-    jet.append(wing);
-    jet.append(tail);
-    jet.append(stab);
+    rubble::Mesh jet = rubble::makeSphere({0, 0, 0}, 1.0, 16, 10);
+    jet = jet.transformed(rubble::Mat3::identity(), {0.75, 0.62, 3.6}, {0, 0, 0});
+    rubble::Mesh canopy = rubble::makeSphere({0, 0, 0}, 1.0, 12, 8);
+    jet.append(canopy.transformed(rubble::Mat3::identity(), {0.42, 0.38, 1.2}, {0, 0.48, -1.0}));
+    const rubble::Vec3 up{0, 0.16, 0};
+    jet.append(prism({0.4, -0.1, -1.4}, {4.6, -0.1, 1.7}, {0.4, -0.1, 2.0}, up));
+    jet.append(prism({-0.4, -0.1, -1.4}, {-4.6, -0.1, 1.7}, {-0.4, -0.1, 2.0}, up));
+    jet.append(prism({0.3, 0.0, 2.2}, {1.9, 0.0, 3.6}, {0.3, 0.0, 3.6}, up * 0.7));
+    jet.append(prism({-0.3, 0.0, 2.2}, {-1.9, 0.0, 3.6}, {-0.3, 0.0, 3.6}, up * 0.7));
+    jet.append(prism({0, 0.3, 1.6}, {0, 2.1, 3.5}, {0, 0.3, 3.5}, {0.12, 0, 0}));
     jet.normals.clear();
     return jet;
 }

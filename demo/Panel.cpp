@@ -34,6 +34,8 @@ bool Panel::draw(Game& game, GameSettings& pending, bool paused, const std::stri
     const GameCounters& c = game.counters();
     ImGui::Text("%s", sceneName.c_str());
     ImGui::TextDisabled("%s", rendererName.c_str());
+    ImGui::TextDisabled("fracture: %s", Game::fractureAvailable() ? "DestructionWorld runtime"
+                                                                  : "demo stand-in (convex-cell clipper)");
 
     // Frame time plot.
     std::vector<float> ordered;
@@ -50,8 +52,7 @@ bool Panel::draw(Game& game, GameSettings& pending, bool paused, const std::stri
     ImGui::PlotLines("frame", ordered.data(), static_cast<int>(ordered.size()), 0, label, 0.0f, 50.0f,
                      ImVec2(230, 50));
     if (latency_.empty()) {
-        ImGui::TextDisabled(Game::fractureAvailable() ? "impact -> adopted: no fracture yet"
-                                                      : "impact -> adopted: fracture runtime not linked");
+        ImGui::TextDisabled("impact -> adopted: no fracture yet");
     } else {
         std::vector<double> d(latency_.begin(), latency_.end());
         std::snprintf(label, sizeof label, "p50 %.1f ms  p99 %.1f", quantile(d, 0.5), quantile(d, 0.99));

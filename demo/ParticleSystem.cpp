@@ -53,7 +53,7 @@ void ParticleSystem::impactBurst(const V3& point, const V3& normal, float streng
         V3 d{rnd(s) * 2 - 1, rnd(s) * 2 - 1, rnd(s) * 2 - 1};
         d = norm(d + n * 1.5f);
         const float grey = 0.35f + 0.2f * rnd(s);
-        emit(Kind::Chunk, point, d * (6 + 10 * rnd(s)), 2.5f + 2 * rnd(s), 0.18f + 0.22f * rnd(s), grey,
+        emit(Kind::Chunk, point, d * (6 + 10 * rnd(s)), 2.5f + 2 * rnd(s), 0.1f + 0.18f * rnd(s), grey,
              grey * 0.92f, grey * 0.85f);
     }
 }
@@ -63,8 +63,8 @@ void ParticleSystem::debrisPuff(const V3& center, const V3& vel, float radius, s
     for (int i = 0; i < 6; ++i) {
         V3 d{rnd(s) * 2 - 1, rnd(s) * 2 - 1, rnd(s) * 2 - 1};
         const float grey = 0.4f + 0.2f * rnd(s);
-        emit(Kind::Chunk, center + d * radius, vel + d * 3.0f, 2 + 2 * rnd(s), std::max(0.12f, radius * 0.6f),
-             grey, grey * 0.9f, grey * 0.85f);
+        emit(Kind::Chunk, center + d * radius, vel + d * 3.0f, 2 + 2 * rnd(s),
+             std::clamp(radius * 0.5f, 0.1f, 0.35f), grey, grey * 0.9f, grey * 0.85f);
     }
     for (int i = 0; i < 3; ++i) {
         V3 d{rnd(s) * 2 - 1, rnd(s), rnd(s) * 2 - 1};

@@ -73,7 +73,7 @@ void main() {
     vec3 sun = vec3(1.6, 1.49, 1.31);
     vec3 c = albedo * (amb + sun * (ndl * sh)) + sun * (s2 * 0.2 * ndl * sh);
     float heat = vHeatFade.x * vInterior;
-    c += heat * heat * vec3(2.2, 0.75, 0.18);
+    c += heat * heat * vec3(1.5, 0.5, 0.12);
     vec3 dv = uCamPos - vWorld;
     float fog = 1.0 - exp(-dot(dv, dv) * 2.5e-6);
     c = mix(c, uFogColor * uFogColor, fog);
