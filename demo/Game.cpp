@@ -821,6 +821,7 @@ void Game::draw(Renderer& renderer, float dt) {
     V3 pos, fwd, up;
     vehicleFrame(pos, fwd, up);
     camera_.update(pos, fwd, up, dt);
+    camera_.eye.y = std::max(camera_.eye.y, groundTop_ + 1.5f);
 }
 
 std::vector<double> Game::takeNewLatencies() {
@@ -832,7 +833,9 @@ std::vector<double> Game::takeNewLatencies() {
 std::vector<V3> Game::targets() const {
     std::vector<V3> out;
     for (const auto& b : bodies_)
-        if ((b->kind == Body::Kind::Object || (b->kind == Body::Kind::Piece && b->volume > 20)) && !b->dead)
+        if (!b->dead &&
+            (b->kind == Body::Kind::Object || (b->kind == Body::Kind::Piece && b->volume > 150 &&
+                                               b->rb->getCenterOfMassPosition().y() > groundTop_ + 15)))
             out.push_back(toV3(b->rb->getCenterOfMassPosition()));
     return out;
 }
