@@ -1,0 +1,53 @@
+#pragma once
+/// \file CollisionShape.hpp
+/// A Bullet compound of convex hulls built from Rubble's convex parts, owning every child shape, with the
+/// edges of its parts kept for debug drawing.
+
+#include <array>
+#include <memory>
+#include <vector>
+
+#include <btBulletCollisionCommon.h>
+
+#include "rubble/ConvexPolytope.hpp"
+#include "rubble/DestructionWorld.hpp"
+
+namespace rubble::bullet {
+
+/// Owns a btCompoundShape and its children. Child hulls are given in the body's frame (centre of mass,
+/// principal axes). Each hull is eroded by its collision margin, so that hull + margin matches the part and
+/// neighbouring pieces do not start out overlapping.
+class CollisionShape {
+public:
+    /// Compound of the convex parts (object coordinates); objectToBody maps body → object coordinates
+    /// (p_object = rotation · p_body + translation). When parts is empty (or no part is usable) the convex
+    /// hull of fallbackPoints (object coordinates, reduced to at most 42 points) is used; returns null when
+    /// nothing usable remains.
+    static std::unique_ptr<CollisionShape> fromParts(const std::vector<ConvexPolytope>& parts,
+                                                     const std::vector<Vec3>& fallbackPoints,
+                                                     const Frame& objectToBody, double margin);
+    /// A box of the given half extents centred on the body's origin.
+    static std::unique_ptr<CollisionShape> box(const Vec3& halfExtents);
+    /// A sphere of the given radius centred on the body's origin.
+    static std::unique_ptr<CollisionShape> sphere(double radius);
+
+    ~CollisionShape();
+    CollisionShape(const CollisionShape&) = delete;
+    CollisionShape& operator=(const CollisionShape&) = delete;
+
+    /// The shape to give a btRigidBody.
+    btCollisionShape* shape() const { return root_; }
+    /// Number of compound children (0 for a plain box or sphere).
+    int childCount() const;
+    /// Edges of the parts in body coordinates (for debug drawing).
+    const std::vector<std::array<Vec3, 2>>& edges() const { return edges_; }
+
+private:
+    CollisionShape() = default;
+    btCollisionShape* root_ = nullptr;
+    std::unique_ptr<btCompoundShape> compound_;
+    std::vector<std::unique_ptr<btCollisionShape>> children_;
+    std::vector<std::array<Vec3, 2>> edges_;
+};
+
+} // namespace rubble::bullet

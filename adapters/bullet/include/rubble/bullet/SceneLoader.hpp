@@ -1,0 +1,40 @@
+#pragma once
+/// \file SceneLoader.hpp
+/// Builds bodies from a parsed world.cfg scene (SceneConfig): ground box, vehicle, destructible objects.
+
+#include <string>
+#include <vector>
+
+#include "rubble/DestructionWorld.hpp"
+#include "rubble/SceneConfig.hpp"
+#include "rubble/bullet/DestructionBridge.hpp"
+
+namespace rubble::bullet {
+
+/// How scene objects are made.
+struct SceneLoadOptions {
+    bool loadVehicle = true;      ///< create the vehicle's body (headless scenes may skip it)
+    double staticDensity = 200;   ///< density (kg/m³) of static objects, used by their moving pieces
+    double impulseThreshold = 50; ///< ObjectDesc::impulseThreshold of every object
+    FractureParams fracture;      ///< ObjectDesc::fracture of every object
+};
+
+/// What loading produced.
+struct LoadedScene {
+    Body* ground = nullptr;            ///< the ground box (null when the scene has none)
+    Body* vehicle = nullptr;           ///< the vehicle (null when not loaded)
+    double groundTop = 0;              ///< height of the ground's top face
+    std::vector<ObjectId> objects;     ///< objects in file order (stand-ins included)
+    std::vector<std::string> warnings; ///< missing files, stand-ins, meshes made indestructible
+    double initialVolume = 0;          ///< Σ object volumes at load
+};
+
+/// Loads a scene. The ground line gives a static box of full size (sx, sy, sz) centred at (x, y, z); the
+/// vehicle line a dynamic convex body; every object line readMesh(model) scaled by (sx, sy, sz) and placed at
+/// (x, y, z), mass 0 = static but destructible. A missing or unreadable model becomes a stand-in box (a cube
+/// of edge 1 scaled by (sx, sy, sz)) with a warning; a mesh that cannot be made valid stays intact and
+/// indestructible with one warning. Never fails on a parsed scene.
+LoadedScene loadScene(const SceneConfig& scene, DestructionBridge& bridge,
+                      const SceneLoadOptions& options = {});
+
+} // namespace rubble::bullet

@@ -1,0 +1,161 @@
+#include "rubble/bullet/CollisionShape.hpp"
+
+#include <algorithm>
+
+#include <BulletCollision/CollisionShapes/btShapeHull.h>
+
+#include "rubble/bullet/Convert.hpp"
+
+namespace rubble::bullet {
+namespace {
+
+// body coordinates of an object-coordinate point
+Vec3 toBody(const Frame& objectToBody, const Vec3& p) {
+    return objectToBody.rotation.transposed() * (p - objectToBody.translation);
+}
+
+bool lexLess(const Vec3& a, const Vec3& b) {
+    if (a.x != b.x)
+        return a.x < b.x;
+    if (a.y != b.y)
+        return a.y < b.y;
+    return a.z < b.z;
+}
+
+// The part shrunk by margin along every face plane (empty when it is thinner than 2·margin).
+ConvexPolytope eroded(const ConvexPolytope& part, double margin) {
+    ConvexPolytope out = part;
+    for (const PolytopeFace& f : part.faces()) {
+        out = out.clipped(Plane{f.plane.normal, f.plane.offset - margin}, f.tag);
+        if (out.empty())
+            break;
+    }
+    return out;
+}
+
+} // namespace
+
+CollisionShape::~CollisionShape() = default;
+
+int CollisionShape::childCount() const {
+    return compound_ ? compound_->getNumChildShapes() : 0;
+}
+
+std::unique_ptr<CollisionShape> CollisionShape::fromParts(const std::vector<ConvexPolytope>& parts,
+                                                          const std::vector<Vec3>& fallbackPoints,
+                                                          const Frame& objectToBody, double margin) {
+    std::unique_ptr<CollisionShape> s(new CollisionShape());
+    s->compound_ = std::make_unique<btCompoundShape>(true, static_cast<int>(parts.size()));
+    btTransform identity;
+    identity.setIdentity();
+    for (const ConvexPolytope& part : parts) {
+        if (part.empty())
+            continue;
+        const Aabb b = part.bounds();
+        const Vec3 size = b.size();
+        double m = std::min(margin, 0.2 * std::min({size.x, size.y, size.z}));
+        ConvexPolytope core = m > 0 ? eroded(part, m) : part;
+        for (int attempt = 0; attempt < 4 && core.empty() && m > 0; ++attempt) {
+            m *= 0.25;
+            core = eroded(part, m);
+        }
+        if (core.empty()) {
+            core = part;
+            m = 0;
+        }
+        const std::vector<Vec3> verts = core.vertices();
+        if (verts.size() < 4)
+            continue;
+        auto hull = std::make_unique<btConvexHullShape>();
+        for (const Vec3& v : verts)
+            hull->addPoint(toBt(toBody(objectToBody, v)), false);
+        hull->setMargin(static_cast<btScalar>(std::max(m, 1e-4)));
+        hull->recalcLocalAabb();
+        s->compound_->addChildShape(identity, hull.get());
+        s->children_.push_back(std::move(hull));
+        for (const PolytopeFace& f : part.faces())
+            for (std::size_t i = 0; i < f.corners.size(); ++i) {
+                const Vec3& a = f.corners[i];
+                const Vec3& c = f.corners[(i + 1) % f.corners.size()];
+                if (lexLess(a, c))
+                    s->edges_.push_back({toBody(objectToBody, a), toBody(objectToBody, c)});
+            }
+    }
+    if (s->children_.empty()) {
+        if (fallbackPoints.size() < 4)
+            return nullptr;
+        btConvexHullShape raw;
+        for (const Vec3& p : fallbackPoints)
+            raw.addPoint(toBt(toBody(objectToBody, p)), false);
+        raw.recalcLocalAabb();
+        btShapeHull reducer(&raw);
+        reducer.buildHull(raw.getMargin());
+        auto hull = std::make_unique<btConvexHullShape>();
+        const int n = reducer.numVertices();
+        for (int i = 0; i < n; ++i)
+            hull->addPoint(reducer.getVertexPointer()[i], false);
+        if (n < 4)
+            for (int i = 0; i < raw.getNumPoints(); ++i)
+                hull->addPoint(raw.getUnscaledPoints()[i], false);
+        hull->setMargin(static_cast<btScalar>(std::min(margin, 0.01)));
+        hull->recalcLocalAabb();
+        const unsigned int* idx = reducer.getIndexPointer();
+        for (int t = 0; t + 2 < reducer.numIndices(); t += 3)
+            for (int e = 0; e < 3; ++e) {
+                const btVector3& a = reducer.getVertexPointer()[idx[t + e]];
+                const btVector3& c = reducer.getVertexPointer()[idx[t + (e + 1) % 3]];
+                s->edges_.push_back({fromBt(a), fromBt(c)});
+            }
+        s->compound_->addChildShape(identity, hull.get());
+        s->children_.push_back(std::move(hull));
+    }
+    s->root_ = s->compound_.get();
+    return s;
+}
+
+std::unique_ptr<CollisionShape> CollisionShape::box(const Vec3& halfExtents) {
+    std::unique_ptr<CollisionShape> s(new CollisionShape());
+    auto box = std::make_unique<btBoxShape>(toBt(halfExtents));
+    s->root_ = box.get();
+    s->children_.push_back(std::move(box));
+    const Vec3 h = halfExtents;
+    for (int axis = 0; axis < 3; ++axis)
+        for (int i = 0; i < 4; ++i) {
+            Vec3 lo, hi;
+            const double u = (i & 1) ? 1 : -1, v = (i & 2) ? 1 : -1;
+            if (axis == 0) {
+                lo = {-h.x, u * h.y, v * h.z};
+                hi = {h.x, u * h.y, v * h.z};
+            } else if (axis == 1) {
+                lo = {u * h.x, -h.y, v * h.z};
+                hi = {u * h.x, h.y, v * h.z};
+            } else {
+                lo = {u * h.x, v * h.y, -h.z};
+                hi = {u * h.x, v * h.y, h.z};
+            }
+            s->edges_.push_back({lo, hi});
+        }
+    return s;
+}
+
+std::unique_ptr<CollisionShape> CollisionShape::sphere(double radius) {
+    std::unique_ptr<CollisionShape> s(new CollisionShape());
+    auto sph = std::make_unique<btSphereShape>(static_cast<btScalar>(radius));
+    s->root_ = sph.get();
+    s->children_.push_back(std::move(sph));
+    const int n = 12;
+    for (int axis = 0; axis < 3; ++axis)
+        for (int i = 0; i < n; ++i) {
+            const double a0 = 2 * 3.14159265358979 * i / n, a1 = 2 * 3.14159265358979 * (i + 1) / n;
+            auto pt = [&](double a) {
+                Vec3 p;
+                p[(axis + 1) % 3] = radius * std::cos(a);
+                p[(axis + 2) % 3] = radius * std::sin(a);
+                return p;
+            };
+            s->edges_.push_back({pt(a0), pt(a1)});
+        }
+    return s;
+}
+
+} // namespace rubble::bullet

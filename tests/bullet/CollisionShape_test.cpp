@@ -1,0 +1,100 @@
+// Bullet-only parts of the adapter: shapes from convex parts, fixed stepping, bodies placed at their centre
+// of mass.
+#include <gtest/gtest.h>
+
+#include "rubble/ConvexPolytope.hpp"
+#include "rubble/MassProperties.hpp"
+#include "rubble/bullet/CollisionShape.hpp"
+#include "rubble/bullet/Convert.hpp"
+#include "rubble/bullet/PhysicsWorld.hpp"
+
+using namespace rubble;
+using namespace rubble::bullet;
+
+TEST(CollisionShape, ErodedHullPlusMarginMatchesThePart) {
+    const ConvexPolytope part = ConvexPolytope::fromAabb(Aabb{{0, 0, 0}, {2, 1, 4}});
+    const Frame objectToBody{Mat3::identity(), {1, 0.5, 2}};
+    auto shape = CollisionShape::fromParts({part}, {}, objectToBody, 0.05);
+    ASSERT_TRUE(shape);
+    EXPECT_EQ(shape->childCount(), 1);
+    // hull points + margin hug the part's box (centred on the body)
+    auto* compound = static_cast<btCompoundShape*>(shape->shape());
+    auto* hull = static_cast<btConvexHullShape*>(compound->getChildShape(0));
+    const double m = hull->getMargin();
+    EXPECT_NEAR(m, 0.05, 1e-6);
+    btVector3 lo(1e9f, 1e9f, 1e9f), hi(-1e9f, -1e9f, -1e9f);
+    for (int i = 0; i < hull->getNumPoints(); ++i) {
+        lo.setMin(hull->getUnscaledPoints()[i]);
+        hi.setMax(hull->getUnscaledPoints()[i]);
+    }
+    EXPECT_NEAR(lo.x() - m, -1.0, 1e-5);
+    EXPECT_NEAR(hi.y() + m, 0.5, 1e-5);
+    EXPECT_NEAR(hi.z() + m, 2.0, 1e-5);
+    EXPECT_EQ(shape->edges().size(), 12u);
+}
+
+TEST(CollisionShape, ThinPartsStillGetAHull) {
+    const ConvexPolytope sliver = ConvexPolytope::fromAabb(Aabb{{0, 0, 0}, {1, 1, 0.001}});
+    auto shape = CollisionShape::fromParts({sliver}, {}, Frame{}, 0.05);
+    ASSERT_TRUE(shape);
+    EXPECT_EQ(shape->childCount(), 1);
+}
+
+TEST(CollisionShape, FallsBackToTheHullOfPointsWithoutParts) {
+    const Mesh sphere = makeSphere({0, 0, 0}, 1, 24, 12);
+    auto shape = CollisionShape::fromParts({}, sphere.positions, Frame{}, 0.02);
+    ASSERT_TRUE(shape);
+    EXPECT_EQ(shape->childCount(), 1);
+    EXPECT_FALSE(CollisionShape::fromParts({}, {{0, 0, 0}, {1, 0, 0}}, Frame{}, 0.02));
+}
+
+TEST(PhysicsWorld, StepsInFixedSubSteps) {
+    PhysicsWorld::Config c;
+    c.maxSubSteps = 3;
+    PhysicsWorld world(c);
+    int post = 0;
+    world.setPostTickCallback([&](double) { ++post; });
+    EXPECT_EQ(world.step(1.0 / 60), 1);
+    EXPECT_EQ(post, 1);
+    EXPECT_EQ(world.step(1.0), 3);
+    EXPECT_EQ(post, 4);
+    EXPECT_EQ(world.ticks(), 4);
+}
+
+// An L-shaped solid of two boxes, built with its body at the true centre of mass, rests on the ground with
+// its centre of mass where the geometry says (the thesis placed bodies at the bounding-box centre instead).
+TEST(PhysicsWorld, BodyAtCentreOfMassRestsCorrectly) {
+    PhysicsWorld world;
+    auto groundShape = CollisionShape::box({50, 0.5, 50});
+    btRigidBody::btRigidBodyConstructionInfo gi(0, nullptr, groundShape->shape());
+    gi.m_startWorldTransform.setIdentity();
+    gi.m_startWorldTransform.setOrigin({0, -0.5f, 0});
+    btRigidBody ground(gi);
+    world.world().addRigidBody(&ground);
+
+    const std::vector<ConvexPolytope> parts{ConvexPolytope::fromAabb(Aabb{{0, 0, 0}, {3, 1, 1}}),
+                                            ConvexPolytope::fromAabb(Aabb{{0, 1, 0}, {1, 3, 1}})};
+    Mesh mesh = parts[0].toMesh();
+    mesh.append(parts[1].toMesh());
+    const MassProperties mp = computeMassProperties(mesh);
+    const Frame objectToBody{mp.principalAxes, mp.centerOfMass};
+    auto shape = CollisionShape::fromParts(parts, {}, objectToBody, 0.02);
+    ASSERT_TRUE(shape);
+    const double density = 2;
+    const btVector3 inertia = toBt(mp.principalMoments * density);
+    btRigidBody::btRigidBodyConstructionInfo info(static_cast<btScalar>(density * mp.volume), nullptr,
+                                                  shape->shape(), inertia);
+    info.m_startWorldTransform = toBt(Frame{Mat3::identity(), {0, 0.01, 0}}) * toBt(objectToBody);
+    btRigidBody body(info);
+    world.world().addRigidBody(&body);
+    for (int i = 0; i < 120; ++i)
+        world.step(1.0 / 60);
+    // resting upright: the centre of mass is where the mesh says, the L did not tip over
+    const Vec3 com = fromBt(body.getCenterOfMassPosition());
+    EXPECT_NEAR(com.x, mp.centerOfMass.x, 0.05);
+    EXPECT_NEAR(com.y, mp.centerOfMass.y, 0.05);
+    EXPECT_NEAR(com.z, mp.centerOfMass.z, 0.05);
+    EXPECT_LT(body.getLinearVelocity().length(), 0.05f);
+    world.world().removeRigidBody(&body);
+    world.world().removeRigidBody(&ground);
+}
