@@ -1096,6 +1096,42 @@ def scenes():
     return out
 
 
+def check_scene(path):
+    """Checks a written scene against appendix A.3: field counts, numbers, and that every file exists."""
+    problems = []
+    base = os.path.dirname(path)
+    with open(path) as f:
+        lines = [ln.rstrip("\n") for ln in f if ln.strip()]
+    if len(lines) < 3:
+        return ["fewer than three lines"]
+    sky = lines[0].split(";")
+    if len(sky) != 6:
+        problems.append("line 1: expected 6 sky-box images, got %d" % len(sky))
+    for name in sky:
+        if not os.path.isfile(os.path.join(base, name)):
+            problems.append("line 1: missing %s" % name)
+    for k, ln in enumerate(lines[1:], start=2):
+        fields = ln.split(";")
+        if len(fields) != 9:
+            problems.append("line %d: expected 9 fields, got %d" % (k, len(fields)))
+            continue
+        try:
+            nums = [float(x) for x in fields[2:]]
+        except ValueError:
+            problems.append("line %d: a number does not parse" % k)
+            continue
+        if k == 2 and (fields[0] or nums[6] != 0):
+            problems.append("line 2: the ground has no model and mass 0")
+        if k > 2 and not fields[0]:
+            problems.append("line %d: model missing" % k)
+        for name in fields[:2]:
+            if name and not os.path.isfile(os.path.join(base, name)):
+                problems.append("line %d: missing %s" % (k, name))
+        if any(x <= 0 for x in nums[3:6]) or nums[6] < 0:
+            problems.append("line %d: scale must be positive and mass non-negative" % k)
+    return problems
+
+
 # ----------------------------------------------------------------------------------------------------------
 
 
@@ -1133,11 +1169,16 @@ def main():
         for name, lines in scenes().items():
             with open(os.path.join(SCENES, name), "w", newline="\n") as f:
                 f.write("\n".join(lines) + "\n")
-            print("scene", name)
+    for name in sorted(os.listdir(SCENES)):
+        if name.endswith(".cfg"):
+            problems = check_scene(os.path.join(SCENES, name))
+            ok = ok and not problems
+            print("scene %-22s %s" % (name, "OK" if not problems else "FAIL: " + "; ".join(problems)))
     if not ok:
-        print("make-assets: some models are INVALID", file=sys.stderr)
+        print("make-assets: some models or scenes are INVALID", file=sys.stderr)
         return 1
-    print("make-assets: all %d models closed, 2-manifold, outward-oriented, no self-intersections" % len(report))
+    print("make-assets: all %d models closed, 2-manifold, outward-oriented, no self-intersections; "
+          "scenes complete" % len(report))
     return 0
 
 
