@@ -49,7 +49,7 @@ ControlInput Autopilot::update(const Game& game, float dt) {
             in.yaw = x < 0 ? 1.0f : -1.0f;
         }
         const float dist = len(target_ - pos);
-        in.fire = z > 0.985f && dist < 300;
+        in.fire = (z > 0.985f && dist < 300) || (z > 0.96f && dist < 150);
         if (dist < 55) {
             evade_ = 2.2f;
             evadeYaw_ = x < 0 ? -1.0f : 1.0f;

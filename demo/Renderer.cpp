@@ -407,6 +407,18 @@ int Renderer::proceduralTexture(const std::string& kind) {
     return static_cast<int>(textures_.size()) - 1;
 }
 
+bool Renderer::setInteriorTexture(const std::filesystem::path& path) {
+    std::vector<std::string> ignored;
+    const size_t before = textures_.size();
+    const int id = loadTexture(path, "interior", ignored);
+    if (textures_.size() == before && texturePaths_[static_cast<size_t>(id)] != path.string())
+        return false;
+    if (!ignored.empty())
+        return false;
+    interiorTex_ = id;
+    return true;
+}
+
 int Renderer::loadTexture(const std::filesystem::path& path, const std::string& kind,
                           std::vector<std::string>& warnings) {
     for (size_t i = 0; i < texturePaths_.size(); ++i)

@@ -47,6 +47,8 @@ public:
     /// given kind ("grid", "concrete", "metal", "interior"). Cached by path.
     int loadTexture(const std::filesystem::path& path, const std::string& kind,
                     std::vector<std::string>& warnings);
+    /// Uses the image at path for cut faces (kInteriorMaterial); false (procedural kept) when unreadable.
+    bool setInteriorTexture(const std::filesystem::path& path);
     /// A procedural texture of the given kind.
     int proceduralTexture(const std::string& kind);
     /// Sets the skybox from six images (top, bottom, left, right, front, back). Missing images: procedural

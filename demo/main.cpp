@@ -33,10 +33,11 @@ const char* kFallbackScene =
     "sky_top.png;sky_bottom.png;sky_left.png;sky_right.png;sky_front.png;sky_back.png\n"
     ";ground.png;0;-15;0;1000;10;1000;0\n"
     "vehicle.obj;;0;20;0;1;1;1;100\n"
-    "tower.obj;;-20;5;-60;8;15;8;500\n"
-    "tower.obj;;30;0;-120;10;10;10;0\n"
-    "tower.obj;;-60;15;-160;6;25;6;800\n"
-    "tower.obj;;70;-2;-40;6;8;6;300\n";
+    "tower.obj;;-15;20;-150;8;30;8;0\n"
+    "tower.obj;;25;10;-210;10;20;10;0\n"
+    "tower.obj;;-45;25;-260;7;35;7;0\n"
+    "tower.obj;;60;5;-300;12;15;12;0\n"
+    "tower.obj;;0;-5;-120;4;5;4;300\n";
 
 struct Options {
     std::string scene;
@@ -132,6 +133,12 @@ bool loadScene(App& a, std::string& error) {
         error = "renderer: " + rerr;
         return false;
     }
+    // Interior material of cut faces: interior.png next to the scene, in ../textures, or in assets/textures.
+    for (const auto& candidate :
+         {a.scene.baseDir / "interior.png", a.scene.baseDir / "../textures/interior.png",
+          std::filesystem::path(RUBBLE_SOURCE_DIR) / "assets/textures/interior.png"})
+        if (std::filesystem::exists(candidate) && a.renderer.setInteriorTexture(candidate))
+            break;
     bool skyOk = true;
     for (const auto& p : a.scene.skyboxPaths)
         skyOk = skyOk && !p.empty() && std::filesystem::exists(p);
@@ -247,6 +254,7 @@ int main(int argc, char** argv) {
     ImGui::GetStyle().WindowRounding = 6.0f;
     ImGui::GetStyle().FrameRounding = 3.0f;
     if (app.gl->window()) {
+        glfwSwapInterval(autopilot ? 0 : 1); // play at the display's rate; scripted runs as fast as possible
         glfwSetWindowUserPointer(app.gl->window(), &app);
         glfwSetKeyCallback(app.gl->window(), keyCallback);
         ImGui_ImplGlfw_InitForOpenGL(app.gl->window(), true);
