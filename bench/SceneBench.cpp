@@ -1,0 +1,236 @@
+// `rubble-bench scene FILE.cfg [--seconds T] [--shots-per-second R] [--workers
+// W] [--seed S]
+// [--deterministic]
+//  [--json] [--csv FILE]`
+//
+// Headless destruction run of a world.cfg scene through the Bullet adapter:
+// seeded projectiles at the destructible objects (target chosen with
+// probability ∝ volume, aim point uniform in the central 80% of its bounding
+// box), fixed 1/60 s frames as fast as possible, no rendering. Frame time =
+// wall time of the main-thread frame (shooting + physics + impact gathering +
+// adoption). Reports frames, frame_ms, impacts, fractures, latency_ms (impact →
+// adopted, from DestructionWorld timings), pieces_alive, volume_error
+// (|live + retired + dropped − start| / start), state_hash (of the final sorted
+// piece set), peak_rss_mb.
+#include "Subcommand.hpp"
+
+#if defined(RUBBLE_HAVE_BULLET) && defined(RUBBLE_HAVE_RUNTIME)
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "rubble/DestructionWorld.hpp"
+#include "rubble/Random.hpp"
+#include "rubble/SceneConfig.hpp"
+#include "rubble/bullet/Convert.hpp"
+#include "rubble/bullet/DestructionBridge.hpp"
+#include "rubble/bullet/PhysicsWorld.hpp"
+#include "rubble/bullet/SceneLoader.hpp"
+
+namespace {
+
+struct SceneArgs {
+    std::string file;
+    double seconds = 60;
+    double shotsPerSecond = 10;
+    int workers = -1;
+    std::uint64_t seed = 1;
+    bool deterministic = false;
+    bool json = false;
+    std::string csv;
+    int maxPieces = 400;
+    double projectileSpeed = 120;
+    double projectileMass = 2;
+    double projectileRadius = 0.25;
+};
+
+double percentile(std::vector<double> v, double q) {
+    if (v.empty())
+        return 0;
+    std::sort(v.begin(), v.end());
+    const double pos = q * static_cast<double>(v.size() - 1);
+    const std::size_t i = static_cast<std::size_t>(pos);
+    const double f = pos - static_cast<double>(i);
+    return i + 1 < v.size() ? v[i] * (1 - f) + v[i + 1] * f : v[i];
+}
+
+double peakRssMb() {
+    std::ifstream in("/proc/self/status");
+    std::string line;
+    while (std::getline(in, line))
+        if (line.rfind("VmHWM:", 0) == 0)
+            return std::stod(line.substr(6)) / 1024.0;
+    return 0;
+}
+
+// One projectile at a destructible body chosen with probability ∝ volume.
+void shoot(rubble::bullet::DestructionBridge& bridge, rubble::Rng& rng, const SceneArgs& a) {
+    using namespace rubble::bullet;
+    std::vector<Body*> targets;
+    double total = 0;
+    for (Body* b : bridge.bodies()) {
+        if (!b->hasObject || (b->kind != BodyKind::Object && b->kind != BodyKind::Piece))
+            continue;
+        const rubble::ObjectState* st = bridge.destruction().object(b->object);
+        if (!st || !st->destructible)
+            continue;
+        targets.push_back(b);
+        total += b->volume;
+    }
+    if (targets.empty() || total <= 0)
+        return;
+    double pick = rng.uniform(0, total);
+    Body* target = targets.back();
+    for (Body* b : targets) {
+        if (pick < b->volume) {
+            target = b;
+            break;
+        }
+        pick -= b->volume;
+    }
+    btVector3 lo, hi;
+    target->rigid->getAabb(lo, hi);
+    const rubble::Vec3 l = fromBt(lo), h = fromBt(hi), c = (l + h) * 0.5;
+    const rubble::Vec3 aim =
+        c + rubble::Vec3{rng.uniform(-0.4, 0.4) * (h.x - l.x), rng.uniform(-0.4, 0.4) * (h.y - l.y),
+                         rng.uniform(-0.4, 0.4) * (h.z - l.z)};
+    const double phi = rng.uniform(0, 2 * 3.14159265358979);
+    const double y = rng.uniform(0.05, 0.6);
+    const double r = std::sqrt(1 - y * y);
+    const rubble::Vec3 dir{r * std::cos(phi), y, r * std::sin(phi)};
+    const double distance = 30 + 0.5 * rubble::length(h - l);
+    bridge.fireProjectile(aim + dir * distance, dir * -a.projectileSpeed, a.projectileMass,
+                          a.projectileRadius);
+}
+
+int runScene(const SceneArgs& a) {
+    using namespace rubble;
+    using namespace rubble::bullet;
+    Result<SceneConfig> scene = parseSceneConfig(a.file);
+    if (!scene) {
+        std::cerr << "rubble-bench scene: " << scene.error().message << "\n";
+        return 2;
+    }
+    DestructionWorld::Config dc;
+    dc.workers = a.workers;
+    dc.deterministic = a.deterministic;
+    dc.seed = a.seed;
+    DestructionWorld destruction(dc);
+    PhysicsWorld physics;
+    DestructionBridge::Config bc;
+    bc.maxLivePieces = a.maxPieces;
+    DestructionBridge bridge(physics, destruction, bc);
+    SceneLoadOptions lo;
+    lo.loadVehicle = false;
+    const auto tLoad = std::chrono::steady_clock::now();
+    const LoadedScene loaded = loadScene(*scene, bridge, lo);
+    const double loadMs =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tLoad).count();
+    for (const std::string& w : loaded.warnings)
+        std::cerr << "warning: " << w << "\n";
+    const double startVolume = bridge.totalVolume();
+
+    Rng rng(mixSeed(a.seed, 0x5CE7E));
+    const double dt = 1.0 / 60;
+    const long frames = std::max(1L, std::lround(a.seconds * 60));
+    std::vector<double> frameMs;
+    frameMs.reserve(static_cast<std::size_t>(frames));
+    long shots = 0;
+    for (long f = 0; f < frames; ++f) {
+        const auto t0 = std::chrono::steady_clock::now();
+        const long due = static_cast<long>(std::floor(static_cast<double>(f) * a.shotsPerSecond / 60.0));
+        while (shots < due) {
+            shoot(bridge, rng, a);
+            ++shots;
+        }
+        bridge.stepFrame(dt);
+        frameMs.push_back(
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    }
+    std::vector<double> latency;
+    for (const TimingRecord& t : destruction.timings())
+        if (!t.stale)
+            latency.push_back(t.totalMs);
+    const double volumeError =
+        startVolume > 0 ? std::abs(bridge.totalVolume() - startVolume) / startVolume : 0;
+    const std::uint64_t hash = bridge.stateHash();
+    char hashText[32];
+    std::snprintf(hashText, sizeof hashText, "%016llx", static_cast<unsigned long long>(hash));
+    const BridgeCounters& c = bridge.counters();
+    const double rss = peakRssMb();
+
+    if (!a.csv.empty()) {
+        if (Status s = destruction.writeTimingsCsv(a.csv); !s)
+            std::cerr << "rubble-bench scene: " << s.message() << "\n";
+    }
+    if (a.json) {
+        nlohmann::json j;
+        j["scene"] = a.file;
+        j["frames"] = frames;
+        j["shots"] = shots;
+        j["frame_ms"] = {{"p50", percentile(frameMs, 0.5)},
+                         {"p99", percentile(frameMs, 0.99)},
+                         {"max", percentile(frameMs, 1.0)}};
+        j["impacts"] = c.impacts;
+        j["fractures"] = c.fractures;
+        j["latency_ms"] = {{"p50", percentile(latency, 0.5)},
+                           {"p99", percentile(latency, 0.99)},
+                           {"max", percentile(latency, 1.0)}};
+        j["pieces_alive"] = bridge.livePieces();
+        j["pieces_retired"] = c.piecesRetired;
+        j["volume_error"] = volumeError;
+        j["state_hash"] = hashText;
+        j["peak_rss_mb"] = rss;
+        j["load_ms"] = loadMs;
+        j["warnings"] = loaded.warnings;
+        std::cout << j.dump(2) << "\n";
+        return 0;
+    }
+    std::printf("scene %s: %ld frames (%.1f s at 1/60 s), %ld shots, workers "
+                "%d%s, seed %llu, load %.1f ms\n",
+                a.file.c_str(), frames, a.seconds, shots, a.workers,
+                a.deterministic ? " (deterministic)" : "", static_cast<unsigned long long>(a.seed), loadMs);
+    std::printf("%-28s %10s %10s %10s\n", "", "p50", "p99", "max");
+    std::printf("%-28s %10.3f %10.3f %10.3f\n", "frame (ms)", percentile(frameMs, 0.5),
+                percentile(frameMs, 0.99), percentile(frameMs, 1.0));
+    std::printf("%-28s %10.3f %10.3f %10.3f\n", "impact -> adopted (ms)", percentile(latency, 0.5),
+                percentile(latency, 0.99), percentile(latency, 1.0));
+    std::printf("%-28s %10lld\n", "impacts", c.impacts);
+    std::printf("%-28s %10lld\n", "fractures", c.fractures);
+    std::printf("%-28s %10d\n", "pieces alive", bridge.livePieces());
+    std::printf("%-28s %10lld\n", "pieces retired", c.piecesRetired);
+    std::printf("%-28s %10.3g\n", "volume error", volumeError);
+    std::printf("%-28s %10s\n", "state hash", hashText);
+    std::printf("%-28s %10.1f\n", "peak RSS (MB)", rss);
+    return 0;
+}
+
+rubble::tools::Registrar registrar{
+    {"scene", "headless destruction run of a world.cfg scene (Bullet + runtime)", [](CLI::App& app) {
+         auto args = std::make_shared<SceneArgs>();
+         app.add_option("file", args->file, "scene file (world.cfg format)")->required();
+         app.add_option("--seconds", args->seconds, "simulated seconds");
+         app.add_option("--shots-per-second", args->shotsPerSecond, "projectiles per simulated second");
+         app.add_option("--workers", args->workers, "fracture worker threads (-1 automatic)");
+         app.add_option("--seed", args->seed, "random seed");
+         app.add_flag("--deterministic", args->deterministic,
+                      "adopt results a fixed number of frames after impact");
+         app.add_flag("--json", args->json, "JSON on stdout");
+         app.add_option("--csv", args->csv, "write impact timings as CSV");
+         app.add_option("--max-pieces", args->maxPieces, "live piece body cap");
+         app.add_option("--projectile-speed", args->projectileSpeed, "m/s");
+         app.add_option("--projectile-mass", args->projectileMass, "kg");
+         return [args] { return runScene(*args); };
+     }}};
+
+} // namespace
+
+#endif

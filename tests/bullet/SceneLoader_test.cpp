@@ -1,0 +1,98 @@
+// Scene loading through the Bullet adapter: ground, objects, stand-ins for missing models, static objects.
+#include <gtest/gtest.h>
+
+#if RUBBLE_HAVE_RUNTIME
+
+#include <algorithm>
+
+#include "TestSupport.hpp"
+#include "rubble/SceneConfig.hpp"
+#include "rubble/bullet/Convert.hpp"
+#include "rubble/bullet/SceneLoader.hpp"
+
+using namespace rubble;
+using namespace rubble::bullet;
+
+namespace {
+
+struct World {
+    World() {
+        DestructionWorld::Config dc;
+        dc.workers = 1;
+        destruction = std::make_unique<DestructionWorld>(dc);
+        physics = std::make_unique<PhysicsWorld>();
+        bridge = std::make_unique<DestructionBridge>(*physics, *destruction, DestructionBridge::Config{});
+    }
+    ~World() {
+        bridge.reset();
+        destruction.reset();
+    }
+    std::unique_ptr<DestructionWorld> destruction;
+    std::unique_ptr<PhysicsWorld> physics;
+    std::unique_ptr<DestructionBridge> bridge;
+};
+
+bool anyContains(const std::vector<std::string>& v, const std::string& s) {
+    return std::any_of(v.begin(), v.end(),
+                       [&](const std::string& w) { return w.find(s) != std::string::npos; });
+}
+
+} // namespace
+
+TEST(SceneLoader, MissingModelGivesAWarningAndAStandInBox) {
+    const std::string text = "a.jpg;b.jpg;c.jpg;d.jpg;e.jpg;f.jpg\n"
+                             ";grid.jpg;0;-15;0;1000;10;1000;0\n"
+                             "nothing.3ds;;0;20;0;0.5;0.5;0.5;100\n"
+                             "no_such_model.obj;;3;-8;1;2;4;6;50\n"
+                             "cube_12.obj;;-5;-9;0;1;1;1;0\n";
+    Result<SceneConfig> scene =
+        parseSceneConfigText(text, "test.cfg", test::sourceDir() / "assets" / "models");
+    ASSERT_TRUE(scene) << scene.error().message;
+    World w;
+    const LoadedScene loaded = loadScene(*scene, *w.bridge);
+    ASSERT_EQ(loaded.objects.size(), 2u);
+    EXPECT_TRUE(anyContains(loaded.warnings, "no_such_model.obj"));
+    EXPECT_TRUE(anyContains(loaded.warnings, "stand-in"));
+    ASSERT_NE(loaded.ground, nullptr);
+    EXPECT_NEAR(loaded.groundTop, -10, 1e-9);
+    ASSERT_NE(loaded.vehicle, nullptr); // a stand-in too
+    // the stand-in is a 2 × 4 × 6 box at (3, -8, 1) with mass 50
+    Body* standIn = w.bridge->bodyOf(loaded.objects[0]);
+    ASSERT_NE(standIn, nullptr);
+    EXPECT_NEAR(standIn->volume, 48, 1e-6);
+    EXPECT_NEAR(standIn->mass, 50, 1e-6);
+    const Vec3 c = fromBt(standIn->rigid->getCenterOfMassPosition());
+    EXPECT_NEAR(c.x, 3, 1e-5);
+    EXPECT_NEAR(c.y, -8, 1e-5);
+    EXPECT_NEAR(c.z, 1, 1e-5);
+    // the model that exists: a static, destructible object
+    Body* cube = w.bridge->bodyOf(loaded.objects[1]);
+    ASSERT_NE(cube, nullptr);
+    EXPECT_TRUE(cube->isStatic);
+    EXPECT_NEAR(cube->volume, 8, 1e-6);
+    EXPECT_NEAR(loaded.initialVolume, 56, 1e-6);
+    for (int i = 0; i < 30; ++i)
+        w.bridge->stepFrame();
+}
+
+TEST(SceneLoader, LoadsTheProjectsScenes) {
+    for (const char* name : {"cube_test.cfg", "performance_test.cfg"}) {
+        const auto path = test::sourceDir() / "assets" / "scenes" / name;
+        if (!std::filesystem::exists(path))
+            continue;
+        Result<SceneConfig> scene = parseSceneConfig(path);
+        ASSERT_TRUE(scene) << scene.error().message;
+        World w;
+        SceneLoadOptions options;
+        options.loadVehicle = false;
+        const LoadedScene loaded = loadScene(*scene, *w.bridge, options);
+        EXPECT_EQ(loaded.objects.size(), scene->objects.size()) << name;
+        EXPECT_GT(loaded.initialVolume, 0) << name;
+    }
+}
+
+#else
+TEST(SceneLoader, NeedsTheRuntime) {
+    GTEST_SKIP() << "src/runtime has no implementation yet";
+}
+#endif
