@@ -1,0 +1,38 @@
+#pragma once
+// Private helpers of the collision module: polygon clipping, point-in-mesh, and the convex hull of the part
+// of a closed mesh inside a convex region.
+
+#include <vector>
+
+#include "rubble/ConvexPolytope.hpp"
+#include "rubble/Mesh.hpp"
+#include "rubble/Result.hpp"
+
+namespace rubble::detail {
+
+/// A planar convex polygon (a clipped mesh triangle).
+using Polygon = std::vector<Vec3>;
+
+/// Splits a convex polygon by a plane into its inner (signed distance <= 0) and outer parts; either may come
+/// out with fewer than 3 corners (nothing on that side).
+void splitPolygon(const Polygon& poly, const Plane& plane, Polygon& inside, Polygon& outside);
+
+/// The generalized winding number of p with respect to a closed mesh (1 inside, 0 outside).
+double windingNumber(const Mesh& mesh, const Vec3& p);
+
+/// True when p lies inside the closed mesh (winding number above 1/2).
+inline bool insideMesh(const Mesh& mesh, const Vec3& p) {
+    return windingNumber(mesh, p) > 0.5;
+}
+
+/// The mesh's triangles clipped to a convex region (triangles whose bounds miss the region are skipped).
+std::vector<Polygon> clipTrianglesToRegion(const Mesh& mesh, const ConvexPolytope& region);
+
+/// The hull of (solid of mesh) ∩ region: hull of the clipped surface polygons' corners and the region's
+/// corners that lie inside the mesh. Fails when that set is empty or flat.
+Result<ConvexPolytope> hullOfMeshInRegion(const Mesh& mesh, const ConvexPolytope& region);
+
+/// Hull of polygons' corners plus extra points.
+Result<ConvexPolytope> hullOfPolygons(const std::vector<Polygon>& polys, const std::vector<Vec3>& extra);
+
+} // namespace rubble::detail

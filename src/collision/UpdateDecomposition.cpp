@@ -1,0 +1,194 @@
+// Incremental update of a decomposition at fracture time (Mueller et al. 2013): the parent's convex parts are
+// clipped by the cells' planes, and every fragment goes to the piece that contains it.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "collision/MeshRegion.hpp"
+#include "rubble/ConvexDecomposition.hpp"
+#include "rubble/MassProperties.hpp"
+
+namespace rubble {
+
+namespace {
+
+struct Fragment {
+    ConvexPolytope shape;
+    std::int32_t cell = -1; // -1: outside every cell
+};
+
+/// part − cell as at most one fragment per cell plane: outside plane j and inside planes < j.
+void subtractCell(const ConvexPolytope& part, const ConvexPolytope& cell, std::vector<ConvexPolytope>& out) {
+    if (!part.bounds().overlaps(cell.bounds())) {
+        out.push_back(part);
+        return;
+    }
+    ConvexPolytope rest = part;
+    for (const PolytopeFace& f : cell.faces()) {
+        ConvexPolytope outside = rest.clippedOutside(f.plane);
+        if (!outside.empty())
+            out.push_back(std::move(outside));
+        rest = rest.clipped(f.plane);
+        if (rest.empty())
+            return;
+    }
+}
+
+double distanceToBox(const Aabb& b, const Vec3& p) {
+    const Vec3 d = max(max(b.lo - p, p - b.hi), Vec3{});
+    return length(d);
+}
+
+/// Merges parts whose joint hull adds the least volume until at most maxParts remain.
+void mergeToBudget(std::vector<ConvexPolytope>& parts, int maxParts) {
+    while (static_cast<int>(parts.size()) > std::max(1, maxParts)) {
+        double bestCost = std::numeric_limits<double>::infinity();
+        std::size_t bi = 0, bj = 1;
+        ConvexPolytope bestHull;
+        // Only touching neighbours are candidates (fall back to all pairs when none touch).
+        for (int pass = 0; pass < 2 && !std::isfinite(bestCost); ++pass)
+            for (std::size_t i = 0; i < parts.size(); ++i)
+                for (std::size_t j = i + 1; j < parts.size(); ++j) {
+                    const Aabb a = parts[i].bounds(), b = parts[j].bounds();
+                    if (pass == 0 && !a.overlaps(b, 1e-9 * (a.diagonal() + b.diagonal())))
+                        continue;
+                    std::vector<Vec3> pts = parts[i].vertices();
+                    const std::vector<Vec3> pj = parts[j].vertices();
+                    pts.insert(pts.end(), pj.begin(), pj.end());
+                    auto h = convexHull(pts);
+                    if (!h)
+                        continue;
+                    const double cost = h->volume() - parts[i].volume() - parts[j].volume();
+                    if (cost < bestCost) {
+                        bestCost = cost;
+                        bi = i;
+                        bj = j;
+                        bestHull = std::move(h.value());
+                    }
+                }
+        if (!std::isfinite(bestCost)) {
+            parts.resize(static_cast<std::size_t>(std::max(1, maxParts)));
+            return;
+        }
+        parts[bi] = std::move(bestHull);
+        parts.erase(parts.begin() + static_cast<std::ptrdiff_t>(bj));
+    }
+}
+
+} // namespace
+
+std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<ConvexPolytope>& parentParts,
+                                                             const std::vector<ConvexPolytope>& cells,
+                                                             const std::vector<Mesh>& pieces,
+                                                             const std::vector<std::int32_t>& pieceCells,
+                                                             const DecompositionParams& params) {
+    std::vector<std::vector<ConvexPolytope>> result(pieces.size());
+    if (pieces.empty())
+        return result;
+
+    // 1. Fragments: part ∩ cell_i, and what is left outside every cell.
+    double parentVolume = 0;
+    std::vector<Fragment> fragments;
+    for (const ConvexPolytope& part : parentParts) {
+        parentVolume += part.volume();
+        const Aabb pb = part.bounds();
+        for (std::size_t c = 0; c < cells.size(); ++c) {
+            if (!pb.overlaps(cells[c].bounds()))
+                continue;
+            ConvexPolytope inside = part;
+            for (const PolytopeFace& f : cells[c].faces()) {
+                inside = inside.clipped(f.plane);
+                if (inside.empty())
+                    break;
+            }
+            if (!inside.empty())
+                fragments.push_back({std::move(inside), static_cast<std::int32_t>(c)});
+        }
+        std::vector<ConvexPolytope> rest{part}, next;
+        for (const ConvexPolytope& cell : cells) {
+            next.clear();
+            for (const ConvexPolytope& r : rest)
+                subtractCell(r, cell, next);
+            rest.swap(next);
+        }
+        for (ConvexPolytope& r : rest)
+            fragments.push_back({std::move(r), -1});
+    }
+
+    // 2. Drop slivers.
+    const double sliver = std::max(params.minPartVolumeFraction, 1e-12) * parentVolume;
+    // 3. Assign every fragment to the piece containing it.
+    std::vector<Aabb> pieceBounds(pieces.size());
+    for (std::size_t i = 0; i < pieces.size(); ++i)
+        pieceBounds[i] = pieces[i].bounds();
+    for (Fragment& frag : fragments) {
+        if (frag.shape.volume() <= sliver)
+            continue;
+        const Aabb fb = frag.shape.bounds();
+        const double tol = 1e-9 * (fb.diagonal() + 1);
+        std::vector<std::size_t> candidates;
+        for (std::size_t i = 0; i < pieces.size(); ++i) {
+            const std::int32_t cell = i < pieceCells.size() ? pieceCells[i] : -1;
+            if (cell == frag.cell && pieceBounds[i].overlaps(fb, tol))
+                candidates.push_back(i);
+        }
+        if (candidates.size() == 1) {
+            result[candidates[0]].push_back(std::move(frag.shape));
+            continue;
+        }
+        if (candidates.size() > 1) {
+            // Several islands may share this fragment: give each the hull of its own part inside it.
+            for (std::size_t i : candidates) {
+                auto h = detail::hullOfMeshInRegion(pieces[i], frag.shape);
+                if (h && h->volume() > sliver)
+                    result[i].push_back(std::move(h.value()));
+            }
+            continue;
+        }
+        // No piece of the matching class overlaps: nearest piece by bounds.
+        const Vec3 c = frag.shape.centroid();
+        std::size_t best = 0;
+        double bestDist = std::numeric_limits<double>::infinity();
+        for (std::size_t i = 0; i < pieces.size(); ++i) {
+            const double d = distanceToBox(pieceBounds[i], c);
+            if (d < bestDist) {
+                bestDist = d;
+                best = i;
+            }
+        }
+        // A fragment lying in empty space away from every piece is dropped.
+        if (bestDist <= 1e-6 * (pieceBounds[best].diagonal() + fb.diagonal()))
+            result[best].push_back(std::move(frag.shape));
+    }
+
+    // 4. Per piece: one hull when the fragments fill it, else merge to the budget; fresh decomposition when
+    //    nothing arrived.
+    for (std::size_t i = 0; i < pieces.size(); ++i) {
+        std::vector<ConvexPolytope>& parts = result[i];
+        if (parts.empty()) {
+            auto d = decompose(pieces[i], params);
+            if (d)
+                parts = std::move(d->parts);
+            continue;
+        }
+        if (parts.size() > 1) {
+            double sum = 0;
+            std::vector<Vec3> pts;
+            for (const ConvexPolytope& p : parts) {
+                sum += p.volume();
+                const auto v = p.vertices();
+                pts.insert(pts.end(), v.begin(), v.end());
+            }
+            auto h = convexHull(pts);
+            if (h && h->volume() <= sum * (1 + 1e-6)) {
+                parts.clear();
+                parts.push_back(std::move(h.value()));
+                continue;
+            }
+        }
+        mergeToBudget(parts, params.maxParts);
+    }
+    return result;
+}
+
+} // namespace rubble

@@ -1,0 +1,351 @@
+// Convex hulls, decomposition, incremental update and the decomposition cache.
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "TestSupport.hpp"
+#include "rubble/ConvexDecomposition.hpp"
+#include "rubble/MassProperties.hpp"
+#include "rubble/MeshIO.hpp"
+#include "rubble/Random.hpp"
+
+namespace rubble {
+namespace {
+
+/// An extruded L (reflex corner at (1,1)) from z = 0 to z = h.
+Mesh makeLPrism(double h = 1) {
+    const Vec2 l[6] = {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
+    Mesh m;
+    for (int z = 0; z < 2; ++z)
+        for (const Vec2& p : l)
+            m.positions.push_back({p.x, p.y, z * h});
+    const int fan[4][3] = {{3, 4, 5}, {3, 5, 0}, {3, 0, 1}, {3, 1, 2}};
+    for (const auto& t : fan) {
+        m.triangles.push_back({std::uint32_t(t[0]), std::uint32_t(t[2]), std::uint32_t(t[1])});
+        m.triangles.push_back({std::uint32_t(t[0] + 6), std::uint32_t(t[1] + 6), std::uint32_t(t[2] + 6)});
+    }
+    for (std::uint32_t i = 0; i < 6; ++i) {
+        const std::uint32_t j = (i + 1) % 6;
+        m.triangles.push_back({i, j, j + 6});
+        m.triangles.push_back({i, j + 6, i + 6});
+    }
+    return m;
+}
+
+double diag(const Mesh& m) {
+    return m.bounds().diagonal();
+}
+
+/// Every vertex of mesh lies in (or within eps of) some part; no part leaves the mesh's bounds by more
+/// than eps.
+void expectCovers(const Mesh& mesh, const std::vector<ConvexPolytope>& parts, double eps) {
+    ASSERT_FALSE(parts.empty());
+    std::size_t uncovered = 0;
+    double worst = 0;
+    for (const Vec3& v : mesh.positions) {
+        bool in = false;
+        double nearest = std::numeric_limits<double>::infinity();
+        for (const ConvexPolytope& p : parts) {
+            in |= p.contains(v, eps);
+            double out = 0;
+            for (const PolytopeFace& f : p.faces())
+                out = std::max(out, f.plane.signedDistance(v));
+            nearest = std::min(nearest, out);
+        }
+        uncovered += in ? 0 : 1;
+        worst = std::max(worst, nearest);
+    }
+    EXPECT_EQ(uncovered, 0u) << "of " << mesh.positions.size() << " vertices; farthest " << worst
+                             << " outside";
+    const Aabb b = mesh.bounds();
+    for (const ConvexPolytope& p : parts) {
+        const Aabb pb = p.bounds();
+        EXPECT_TRUE(b.contains(pb.lo, eps) && b.contains(pb.hi, eps));
+        EXPECT_GT(p.volume(), 0);
+    }
+}
+
+TEST(ConvexHull, CubePointsGiveSixMergedFaces) {
+    std::vector<Vec3> pts;
+    for (int i = 0; i < 8; ++i)
+        pts.push_back({double(i & 1), double((i >> 1) & 1), double((i >> 2) & 1)});
+    pts.push_back({0.5, 0.5, 0.5}); // interior point
+    auto h = convexHull(pts);
+    ASSERT_TRUE(h) << h.error().message;
+    EXPECT_EQ(h->faces().size(), 6u);
+    EXPECT_NEAR(h->volume(), 1.0, 1e-12);
+    EXPECT_EQ(h->vertices().size(), 8u);
+    for (const Vec3& p : pts)
+        EXPECT_TRUE(h->contains(p, 1e-12));
+    EXPECT_FALSE(h->contains({1.1, 0.5, 0.5}, 1e-12));
+    // Outward planes and counter-clockwise corners: each face's corner winding agrees with its normal.
+    for (const PolytopeFace& f : h->faces()) {
+        const Vec3 n = cross(f.corners[1] - f.corners[0], f.corners[2] - f.corners[0]);
+        EXPECT_GT(dot(n, f.plane.normal), 0);
+    }
+}
+
+TEST(ConvexHull, RandomPointsAreContainedAndMeshIsClosed) {
+    Rng rng(7);
+    std::vector<Vec3> pts;
+    for (int i = 0; i < 500; ++i)
+        pts.push_back(rng.unitVector() * rng.uniform(0.2, 3.0) + Vec3{10, -5, 2});
+    auto h = convexHull(pts);
+    ASSERT_TRUE(h) << h.error().message;
+    for (const Vec3& p : pts)
+        EXPECT_TRUE(h->contains(p, 1e-9));
+    EXPECT_NEAR(signedVolume(h->toMesh()), h->volume(), 1e-9 * h->volume());
+}
+
+TEST(ConvexHull, DegenerateInputIsAnErrorNotACrash) {
+    EXPECT_FALSE(convexHull({}));
+    EXPECT_FALSE(convexHull({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}));
+    std::vector<Vec3> flat;
+    for (int i = 0; i < 20; ++i)
+        flat.push_back({double(i % 5), double(i / 5), 2.0});
+    auto r = convexHull(flat);
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().code, ErrorCode::InvalidInput);
+    std::vector<Vec3> line{{0, 0, 0}, {1, 1, 1}, {2, 2, 2}, {3, 3, 3}, {4, 4, 4}};
+    EXPECT_FALSE(convexHull(line));
+    std::vector<Vec3> same(10, Vec3{1, 2, 3});
+    EXPECT_FALSE(convexHull(same));
+    std::vector<Vec3> nan{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, std::nan("")}};
+    EXPECT_FALSE(convexHull(nan));
+}
+
+TEST(Decompose, ConvexInputGivesExactlyOnePart) {
+    for (const Mesh& m : {makeBox({0, 0, 0}, {1, 2, 3}), makeSubdividedBox({-1, -1, -1}, {1, 1, 1}, 7),
+                          makeSphere({1, 2, 3}, 2, 24, 12)}) {
+        auto d = decompose(m);
+        ASSERT_TRUE(d) << d.error().message;
+        EXPECT_EQ(d->parts.size(), 1u);
+        EXPECT_LT(d->excess(), 1e-9 + (m.triangles.size() > 500 ? 0.0 : 0.0) + 1e-6);
+        expectCovers(m, d->parts, 1e-9 * diag(m));
+    }
+}
+
+TEST(Decompose, LPrismSplitsAtTheReflexCorner) {
+    const Mesh m = makeLPrism();
+    auto d = decompose(m);
+    ASSERT_TRUE(d) << d.error().message;
+    EXPECT_GE(d->parts.size(), 2u);
+    EXPECT_LE(d->parts.size(), 3u);
+    EXPECT_LT(d->excess(), 1e-6);
+    EXPECT_NEAR(d->meshVolume, 3.0, 1e-12);
+    expectCovers(m, d->parts, 1e-9);
+}
+
+TEST(Decompose, TorusAndRespectsMaxParts) {
+    const Mesh m = makeTorus({0, 0, 0}, 2, 0.5, 32, 12);
+    auto d = decompose(m);
+    ASSERT_TRUE(d) << d.error().message;
+    EXPECT_LE(d->parts.size(), 24u);
+    EXPECT_GE(d->parts.size(), 4u);
+    EXPECT_LT(d->excess(), 0.6) << "parts " << d->parts.size();
+    expectCovers(m, d->parts, 1e-9 * diag(m));
+    DecompositionParams few;
+    few.maxParts = 3;
+    auto d3 = decompose(m, few);
+    ASSERT_TRUE(d3);
+    EXPECT_LE(d3->parts.size(), 3u);
+    expectCovers(m, d3->parts, 1e-9 * diag(m));
+}
+
+TEST(Decompose, OpenOrEmptyMeshIsAnError) {
+    EXPECT_FALSE(decompose(Mesh{}));
+    Mesh open = makeBox({0, 0, 0}, {1, 1, 1});
+    open.triangles.resize(6);
+    auto r = decompose(open);
+    EXPECT_TRUE(!r || !r->parts.empty()); // never a crash; an open mesh may still give a hull
+    Mesh inverted = makeBox({0, 0, 0}, {1, 1, 1});
+    for (Triangle& t : inverted.triangles)
+        std::swap(t[1], t[2]);
+    EXPECT_FALSE(decompose(inverted));
+}
+
+TEST(Decompose, SeedModels) {
+    RUBBLE_REQUIRE_SEED_MEDIA(media);
+    for (const char* name : {"building.obj", "missile.obj", "ship.obj", "empty.obj", "cube_12.obj",
+                             "cube_588.obj", "cube_10092.obj"}) {
+        auto mesh = readMesh(media / name);
+        ASSERT_TRUE(mesh) << mesh.error().message;
+        const auto t0 = std::chrono::steady_clock::now();
+        auto d = decompose(*mesh);
+        const double ms =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        ASSERT_TRUE(d) << name << ": " << d.error().message;
+        std::printf("%-16s %6zu triangles: %2zu parts, excess %.4f, %.2f ms\n", name, mesh->triangles.size(),
+                    d->parts.size(), d->excess(), ms);
+        EXPECT_LT(d->excess(), 0.35) << name;
+        expectCovers(*mesh, d->parts, 1e-7 * diag(*mesh));
+        if (std::string(name).starts_with("cube")) {
+            EXPECT_EQ(d->parts.size(), 1u) << name;
+        }
+    }
+}
+
+/// Voronoi cells of sites inside a box (each the box clipped by bisector planes), tagged by plane index.
+std::vector<ConvexPolytope> voronoiCells(const Aabb& box, const std::vector<Vec3>& sites) {
+    std::vector<ConvexPolytope> cells;
+    for (std::size_t i = 0; i < sites.size(); ++i) {
+        ConvexPolytope c = ConvexPolytope::fromAabb(box);
+        for (std::size_t j = 0; j < sites.size(); ++j)
+            if (j != i)
+                c = c.clipped(Plane::fromPointNormal((sites[i] + sites[j]) * 0.5, sites[j] - sites[i]),
+                              static_cast<std::int32_t>(j));
+        cells.push_back(c);
+    }
+    return cells;
+}
+
+TEST(UpdateDecomposition, ChainedUpdatesOfConvexPiecesStillCoverThem) {
+    // A convex object cut by the cells of a Voronoi partition: every piece is convex (object ∩ cell).
+    // The first cells are "cut" cells (debris), the rest form the remainder, given as one mesh made of
+    // the remaining convex pieces.
+    Rng rng(42);
+    ConvexPolytope object = ConvexPolytope::fromAabb({{-1, -1, -1}, {1, 1, 1}});
+    auto d0 = decompose(object.toMesh());
+    ASSERT_TRUE(d0);
+    std::vector<ConvexPolytope> parts = d0->parts;
+    for (int round = 0; round < 10; ++round) {
+        const Aabb box = object.bounds();
+        Aabb big = box;
+        big.lo -= Vec3{1, 1, 1};
+        big.hi += Vec3{1, 1, 1};
+        std::vector<Vec3> sites;
+        for (int i = 0; i < 6; ++i)
+            sites.push_back(rng.inBox(box.lo, box.hi));
+        std::vector<ConvexPolytope> all = voronoiCells(big, sites);
+        std::vector<ConvexPolytope> cells(all.begin(), all.begin() + 2);
+        std::vector<Mesh> pieces;
+        std::vector<std::int32_t> pieceCells;
+        std::vector<ConvexPolytope> pieceShapes;
+        Mesh remainder;
+        ConvexPolytope nextObject;
+        for (std::size_t c = 0; c < all.size(); ++c) {
+            ConvexPolytope piece = object;
+            for (const PolytopeFace& f : all[c].faces())
+                piece = piece.clipped(f.plane);
+            if (piece.empty())
+                continue;
+            if (c < 2) {
+                pieces.push_back(piece.toMesh());
+                pieceCells.push_back(static_cast<std::int32_t>(c));
+            } else {
+                remainder.append(piece.toMesh());
+            }
+            if (nextObject.empty() || piece.volume() > nextObject.volume())
+                nextObject = piece;
+        }
+        if (!remainder.empty()) {
+            pieces.push_back(remainder);
+            pieceCells.push_back(-1);
+        }
+        auto updated = updateDecomposition(parts, cells, pieces, pieceCells);
+        ASSERT_EQ(updated.size(), pieces.size());
+        for (std::size_t i = 0; i < pieces.size(); ++i) {
+            SCOPED_TRACE("round " + std::to_string(round) + " piece " + std::to_string(i));
+            expectCovers(pieces[i], updated[i], 1e-7);
+            EXPECT_LE(updated[i].size(), 24u);
+            double v = 0;
+            for (const ConvexPolytope& p : updated[i])
+                v += p.volume();
+            EXPECT_NEAR(v, signedVolume(pieces[i]), 1e-6 * (1 + v));
+        }
+        // Continue with the biggest convex piece and its parts.
+        for (std::size_t i = 0; i < pieces.size(); ++i)
+            if (pieceCells[i] >= 0 && std::abs(signedVolume(pieces[i]) - nextObject.volume()) < 1e-12) {
+                object = nextObject;
+                parts = updated[i];
+            }
+        if (parts.empty() || object.empty()) {
+            object = nextObject;
+            parts = {nextObject};
+        }
+    }
+}
+
+TEST(UpdateDecomposition, PieceWithoutFragmentsGetsAFreshDecomposition) {
+    const Mesh l = makeLPrism();
+    auto updated = updateDecomposition({}, {}, {l}, {-1});
+    ASSERT_EQ(updated.size(), 1u);
+    EXPECT_GE(updated[0].size(), 2u);
+    expectCovers(l, updated[0], 1e-9);
+}
+
+TEST(UpdateDecomposition, PartBudgetIsKept) {
+    // A box cut by many small cells leaves many fragments in the remainder.
+    const Mesh box = makeBox({-1, -1, -1}, {1, 1, 1});
+    std::vector<ConvexPolytope> cells;
+    for (int i = 0; i < 4; ++i) {
+        const double x = -0.8 + 0.45 * i;
+        cells.push_back(ConvexPolytope::fromAabb({{x, -0.2, 0.8}, {x + 0.2, 0.2, 1.5}}));
+    }
+    std::vector<Mesh> pieces{box};
+    std::vector<std::int32_t> pieceCells{-1};
+    DecompositionParams params;
+    params.maxParts = 6;
+    auto updated = updateDecomposition({ConvexPolytope::fromAabb({{-1, -1, -1}, {1, 1, 1}})}, cells, pieces,
+                                       pieceCells, params);
+    ASSERT_EQ(updated.size(), 1u);
+    EXPECT_LE(updated[0].size(), 6u);
+    expectCovers(box, updated[0], 1e-9);
+}
+
+TEST(DecompositionCache, MemoryAndDiskHitsAndCorruptFiles) {
+    const std::filesystem::path dir = test::tempDir("decomposition_cache");
+    const Mesh l = makeLPrism();
+    {
+        DecompositionCache cache(dir);
+        auto a = cache.get(l);
+        ASSERT_TRUE(a);
+        EXPECT_EQ(cache.hits(), 0u);
+        auto b = cache.get(l);
+        ASSERT_TRUE(b);
+        EXPECT_EQ(cache.hits(), 1u);
+        EXPECT_EQ(a->parts.size(), b->parts.size());
+    }
+    std::vector<std::filesystem::path> files;
+    for (const auto& e : std::filesystem::directory_iterator(dir))
+        files.push_back(e.path());
+    ASSERT_EQ(files.size(), 1u);
+    {
+        DecompositionCache cache(dir);
+        auto c = cache.get(l);
+        ASSERT_TRUE(c);
+        EXPECT_EQ(cache.hits(), 1u); // from disk
+        EXPECT_NEAR(c->hullVolume, 3.0, 1e-9);
+        expectCovers(l, c->parts, 1e-9);
+    }
+    // Truncated and garbage files are ignored (recomputed), never a crash.
+    const auto size = std::filesystem::file_size(files[0]);
+    for (std::uintmax_t cut : {std::uintmax_t(0), std::uintmax_t(5), size / 2, size - 1}) {
+        std::filesystem::resize_file(files[0], cut);
+        DecompositionCache cache(dir);
+        auto c = cache.get(l);
+        ASSERT_TRUE(c);
+        EXPECT_EQ(cache.hits(), 0u);
+        EXPECT_NEAR(c->hullVolume, 3.0, 1e-9);
+    }
+    {
+        std::fstream f(files[0], std::ios::in | std::ios::out | std::ios::binary);
+        f.seekp(40);
+        f.put('\x7f');
+    }
+    DecompositionCache cache(dir);
+    auto c = cache.get(l);
+    ASSERT_TRUE(c);
+    EXPECT_EQ(cache.hits(), 0u);
+    // Different parameters are a different entry.
+    DecompositionParams one;
+    one.maxParts = 1;
+    auto single = cache.get(l, one);
+    ASSERT_TRUE(single);
+    EXPECT_EQ(single->parts.size(), 1u);
+}
+
+} // namespace
+} // namespace rubble
