@@ -176,6 +176,25 @@ TEST(DestructionBridge, RestingBoxNeverFracturesButAProjectileHitDoes) {
     EXPECT_EQ(rig.bridge->bodyOf(id), nullptr);
 }
 
+TEST(DestructionBridge, DebugDrawHasShapesAabbsAndImpactCrosses) {
+    Rig rig(true);
+    rig.bridge->addGround({0, -0.5, 0}, {50, 0.5, 50});
+    rig.addBox({0.5, 0.5, 0.5}, Frame{Mat3::identity(), {0, 0.5, 0}}, 100);
+    DebugDrawOptions o;
+    o.aabbs = false;
+    const std::size_t shapes = rig.bridge->debugDraw(o).lines.size();
+    EXPECT_GE(shapes, 24u); // two boxes' edges
+    o.aabbs = true;
+    EXPECT_EQ(rig.bridge->debugDraw(o).lines.size(), shapes + 24u);
+    rig.bridge->fireProjectile({-10, 0.5, 0}, {100, 0, 0}, 1, 0.1);
+    for (int i = 0; i < 30 && rig.bridge->recentImpacts().empty(); ++i)
+        rig.bridge->stepFrame();
+    ASSERT_EQ(rig.bridge->recentImpacts().size(), 1u);
+    EXPECT_NEAR(rig.bridge->recentImpacts().front().point.x, -0.5, 0.1);
+    o.shapes = o.aabbs = false;
+    EXPECT_EQ(rig.bridge->debugDraw(o).lines.size(), 4u); // a cross and its normal
+}
+
 namespace {
 
 // A small seeded shooting scene; returns the final state hash and volume error.

@@ -49,9 +49,10 @@ LoadedScene loadScene(const SceneConfig& scene, DestructionBridge& bridge, const
             out.warnings.push_back(std::move(w));
         Result<Body*> body = bridge.addConvexBody(
             mesh.positions, Frame{Mat3::identity(), scene.vehicle.position}, scene.vehicle.mass);
-        if (body)
+        if (body) {
             out.vehicle = *body;
-        else
+            out.vehicle->rigid->setActivationState(DISABLE_DEACTIVATION); // the player steers it
+        } else
             out.warnings.push_back(where(scene, scene.vehicle) + ": vehicle skipped (" +
                                    body.error().message + ")");
     }
