@@ -1,0 +1,64 @@
+#!/usr/bin/env bash
+# `rubble decompose`: JSON fields, convex input gives one part, --max-parts, exit codes.
+set -eu
+data="$(cd "$(dirname "$0")/../data/meshes" && pwd)"
+tmp="$(mktemp -d)"
+trap 'rm -rf "$tmp"' EXIT
+fail() { echo "decompose.t.sh: $*"; exit 1; }
+
+"$RUBBLE" decompose --json "$data/cube.obj" >"$tmp/cube.json" || fail "cube should exit 0"
+python3 - "$tmp/cube.json" <<'PY' || fail "cube JSON: $(cat "$tmp/cube.json")"
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert set(d) == {"parts", "mesh_volume", "hull_volume", "excess", "ms"}, d
+assert d["parts"] == 1 and abs(d["mesh_volume"] - 1) < 1e-12 and abs(d["excess"]) < 1e-9 and d["ms"] >= 0, d
+PY
+"$RUBBLE" decompose "$data/cube.obj" | grep -q "1 convex part" || fail "text output"
+
+# A non-convex mesh (two cubes joined in an L) gives several parts, at most --max-parts.
+cat >"$tmp/l.obj" <<'OBJ'
+v 0 0 0
+v 2 0 0
+v 2 1 0
+v 1 1 0
+v 1 2 0
+v 0 2 0
+v 0 0 1
+v 2 0 1
+v 2 1 1
+v 1 1 1
+v 1 2 1
+v 0 2 1
+f 4 6 5
+f 4 1 6
+f 4 2 1
+f 4 3 2
+f 10 11 12
+f 10 12 7
+f 10 7 8
+f 10 8 9
+f 1 2 8 7
+f 2 3 9 8
+f 3 4 10 9
+f 4 5 11 10
+f 5 6 12 11
+f 6 1 7 12
+OBJ
+"$RUBBLE" decompose --json "$tmp/l.obj" >"$tmp/l.json" || fail "L should exit 0"
+python3 -c "import json,sys; d=json.load(open(sys.argv[1])); assert d['parts']>=2 and d['excess']<1e-6, d" \
+    "$tmp/l.json" || fail "L JSON: $(cat "$tmp/l.json")"
+"$RUBBLE" decompose --json --max-parts 1 "$tmp/l.obj" | grep -qF '"parts":1' || fail "--max-parts 1"
+
+# Unreadable input: exit 2 with the file named.
+set +e
+"$RUBBLE" decompose "$tmp/missing.obj" >"$tmp/err.txt" 2>&1; code=$?
+set -e
+[ "$code" -eq 2 ] || fail "missing file should exit 2, got $code"
+grep -q "missing.obj" "$tmp/err.txt" || fail "error does not name the file: $(cat "$tmp/err.txt")"
+set +e
+"$RUBBLE" decompose "$data/garbage.obj" >/dev/null 2>&1; code=$?
+"$RUBBLE" decompose --max-parts 0 "$data/cube.obj" >/dev/null 2>&1; code2=$?
+set -e
+[ "$code" -eq 2 ] || fail "garbage should exit 2, got $code"
+[ "$code2" -eq 2 ] || fail "--max-parts 0 should exit 2, got $code2"
+exit 0
