@@ -24,7 +24,7 @@ public:
     }
     /// Moves toward the ideal position over dt seconds.
     void update(const V3& pos, const V3& forward, const V3& up, float dt) {
-        const float k = 1.0f - std::exp(-6.0f * dt);
+        const float k = 1.0f - std::exp(-8.0f * dt);
         eye = lerp(eye, ideal(pos, forward, up), k);
         target = lerp(target, pos + forward * lookAhead, 1.0f - std::exp(-10.0f * dt));
     }
