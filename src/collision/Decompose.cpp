@@ -287,7 +287,7 @@ public:
             const Part& part = parts[best];
             std::optional<Split> chosen;
             for (const Vec3& n : candidateNormals(part)) {
-                for (const Vec3& through : {part.pocket, part.pocket - part.pocketDir * (0.5 * part.depth)}) {
+                for (const Vec3& through : {part.pocket}) {
                     auto s = trySplit(part, Plane::fromPointNormal(through, n));
                     if (s && (!chosen || s->score < chosen->score))
                         chosen = std::move(s);
