@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "rubble/ConvexDecomposition.hpp"
 #include "rubble/DestructionWorld.hpp"
 #include "rubble/MassProperties.hpp"
 #include "rubble/MeshIO.hpp"
@@ -355,6 +356,16 @@ bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const Game
             } else {
                 warnings.push_back("scene line " + std::to_string(o.line) + ": " + id.error().message);
             }
+        }
+#endif
+#if !RUBBLE_DEMO_HAS_RUNTIME
+        // Concave objects (arches, walls, stepped towers) get a convex decomposition, cached by mesh hash.
+        if (parts.empty()) {
+            static rubble::DecompositionCache cache;
+            auto dec = cache.get(renderMesh);
+            if (dec && !dec->parts.empty())
+                for (const auto& part : dec->parts)
+                    parts.push_back(part.vertices());
         }
 #endif
         if (parts.empty())
