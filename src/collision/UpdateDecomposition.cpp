@@ -39,40 +39,77 @@ double distanceToBox(const Aabb& b, const Vec3& p) {
     return length(d);
 }
 
-/// Merges parts whose joint hull adds the least volume until at most maxParts remain.
+/// Merges parts whose joint hull adds the least volume until at most maxParts remain. Only touching parts
+/// are candidates; pair costs are computed once and refreshed only for the part that changed.
 void mergeToBudget(std::vector<ConvexPolytope>& parts, int maxParts) {
-    while (static_cast<int>(parts.size()) > std::max(1, maxParts)) {
-        double bestCost = std::numeric_limits<double>::infinity();
-        std::size_t bi = 0, bj = 1;
-        ConvexPolytope bestHull;
-        // Only touching neighbours are candidates (fall back to all pairs when none touch).
-        for (int pass = 0; pass < 2 && !std::isfinite(bestCost); ++pass)
-            for (std::size_t i = 0; i < parts.size(); ++i)
-                for (std::size_t j = i + 1; j < parts.size(); ++j) {
-                    const Aabb a = parts[i].bounds(), b = parts[j].bounds();
-                    if (pass == 0 && !a.overlaps(b, 1e-9 * (a.diagonal() + b.diagonal())))
-                        continue;
-                    std::vector<Vec3> pts = parts[i].vertices();
-                    const std::vector<Vec3> pj = parts[j].vertices();
-                    pts.insert(pts.end(), pj.begin(), pj.end());
-                    auto h = convexHull(pts);
-                    if (!h)
-                        continue;
-                    const double cost = h->volume() - parts[i].volume() - parts[j].volume();
-                    if (cost < bestCost) {
-                        bestCost = cost;
-                        bi = i;
-                        bj = j;
-                        bestHull = std::move(h.value());
-                    }
-                }
-        if (!std::isfinite(bestCost)) {
-            parts.resize(static_cast<std::size_t>(std::max(1, maxParts)));
-            return;
-        }
-        parts[bi] = std::move(bestHull);
-        parts.erase(parts.begin() + static_cast<std::ptrdiff_t>(bj));
+    const std::size_t budget = static_cast<std::size_t>(std::max(1, maxParts));
+    if (parts.size() <= budget)
+        return;
+    struct Candidate {
+        double cost;
+        std::size_t i, j;
+        std::uint32_t vi, vj; // versions of i and j when computed
+        bool operator>(const Candidate& o) const { return cost > o.cost; }
+    };
+    std::vector<std::uint32_t> version(parts.size(), 0);
+    std::vector<bool> alive(parts.size(), true);
+    std::vector<Aabb> bounds(parts.size());
+    std::vector<double> volumes(parts.size());
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+        bounds[i] = parts[i].bounds();
+        volumes[i] = parts[i].volume();
     }
+    std::vector<Candidate> heap;
+    auto consider = [&](std::size_t i, std::size_t j) {
+        const double tol = 1e-9 * (bounds[i].diagonal() + bounds[j].diagonal());
+        if (!bounds[i].overlaps(bounds[j], tol))
+            return;
+        std::vector<Vec3> pts = parts[i].vertices();
+        const std::vector<Vec3> pj = parts[j].vertices();
+        pts.insert(pts.end(), pj.begin(), pj.end());
+        auto h = convexHull(pts);
+        if (!h)
+            return;
+        heap.push_back({h->volume() - volumes[i] - volumes[j], i, j, version[i], version[j]});
+        std::push_heap(heap.begin(), heap.end(), std::greater<>());
+    };
+    for (std::size_t i = 0; i < parts.size(); ++i)
+        for (std::size_t j = i + 1; j < parts.size(); ++j)
+            consider(i, j);
+    std::size_t count = parts.size();
+    while (count > budget && !heap.empty()) {
+        std::pop_heap(heap.begin(), heap.end(), std::greater<>());
+        const Candidate c = heap.back();
+        heap.pop_back();
+        if (!alive[c.i] || !alive[c.j] || version[c.i] != c.vi || version[c.j] != c.vj)
+            continue;
+        std::vector<Vec3> pts = parts[c.i].vertices();
+        const std::vector<Vec3> pj = parts[c.j].vertices();
+        pts.insert(pts.end(), pj.begin(), pj.end());
+        auto h = convexHull(pts);
+        if (!h)
+            continue;
+        parts[c.i] = std::move(h.value());
+        bounds[c.i] = parts[c.i].bounds();
+        volumes[c.i] = parts[c.i].volume();
+        ++version[c.i];
+        alive[c.j] = false;
+        --count;
+        for (std::size_t k = 0; k < parts.size(); ++k)
+            if (k != c.i && alive[k])
+                consider(std::min(k, c.i), std::max(k, c.i));
+    }
+    std::vector<ConvexPolytope> kept;
+    for (std::size_t i = 0; i < parts.size(); ++i)
+        if (alive[i])
+            kept.push_back(std::move(parts[i]));
+    // Parts that touch nothing are kept whole; if still over budget, the smallest go.
+    if (kept.size() > budget) {
+        std::sort(kept.begin(), kept.end(),
+                  [](const ConvexPolytope& a, const ConvexPolytope& b) { return a.volume() > b.volume(); });
+        kept.resize(budget);
+    }
+    parts = std::move(kept);
 }
 
 } // namespace

@@ -1,0 +1,240 @@
+// `rubble-bench decomposition [--quick] [--runs N] [--out DIR]`
+//
+// Convex decomposition cost per subdivided cube (12 .. 10,092 triangles, like the thesis's Table 3.2) and per
+// seed model when ../shared/seed/media is present: the initial decomposition of the whole object and the
+// incremental update at fracture time (parent parts clipped by one Voronoi cell at (0.99, 0, 0), fragments
+// assigned to the pieces). Reference columns: the thesis's HACD decomposition times (Table 3.2) and the
+// thesis's program measured on this machine, with the speed-up of the incremental update against them.
+// Table on stdout, CSV in DIR/decomposition.csv, plot in DIR/decomposition.png (gnuplot).
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <optional>
+
+#include "Subcommand.hpp"
+#include "rubble/ConvexDecomposition.hpp"
+#include "rubble/Fracture.hpp"
+#include "rubble/MeshIO.hpp"
+#include "rubble/Random.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+struct BenchArgs {
+    bool quick = false;
+    int runs = 15;
+    std::string out = RUBBLE_SOURCE_DIR "/bench/results";
+};
+
+struct Stats {
+    double median = 0, min = 0, max = 0;
+};
+
+Stats stats(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return {v[v.size() / 2], v.front(), v.back()};
+}
+
+template <class F>
+Stats timeIt(int runs, F&& f) {
+    std::vector<double> ms;
+    for (int i = 0; i < runs; ++i) {
+        const auto t0 = Clock::now();
+        f();
+        ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+    }
+    return stats(ms);
+}
+
+/// The Voronoi cell of `site` among 15 random sites in a cube of edge `size` around it.
+rubble::ConvexPolytope voronoiCell(const rubble::Vec3& site, double size, std::uint64_t seed) {
+    rubble::Rng rng(seed);
+    const rubble::Vec3 h{size / 2, size / 2, size / 2};
+    rubble::ConvexPolytope cell = rubble::ConvexPolytope::fromAabb({site - h, site + h});
+    for (int i = 0; i < 15; ++i) {
+        const rubble::Vec3 other = rng.inBox(site - h, site + h);
+        cell = cell.clipped(rubble::Plane::fromPointNormal((site + other) * 0.5, other - site), i);
+    }
+    return cell;
+}
+
+struct Row {
+    std::string name;
+    std::size_t triangles = 0;
+    std::size_t parts = 0;
+    double excess = 0;
+    Stats initial, update;
+    std::size_t updatedParts = 0;
+    std::string pieces; // how pieces were made
+    double thesisS = -1, seedS = -1;
+};
+
+Row measure(const std::string& name, const rubble::Mesh& mesh, const rubble::Vec3& impact, int runs) {
+    Row row;
+    row.name = name;
+    row.triangles = mesh.triangles.size();
+    std::optional<rubble::Decomposition> d;
+    row.initial = timeIt(runs, [&] { d = rubble::decompose(mesh).value(); });
+    row.parts = d->parts.size();
+    row.excess = d->excess();
+    // Pieces of one fracture by a cell at the impact.
+    const double size = 0.5 * mesh.bounds().size().x + 1e-9;
+    std::vector<rubble::ConvexPolytope> cells{voronoiCell(impact, size, 1)};
+    std::vector<rubble::Mesh> pieces;
+    std::vector<std::int32_t> pieceCells;
+    rubble::FractureParams fp;
+    fp.backend = rubble::BooleanKind::Fast;
+    auto fr = rubble::fractureWithCells(mesh, cells, fp);
+    if (fr) {
+        for (const rubble::Piece& p : fr->pieces) {
+            pieces.push_back(p.mesh);
+            pieceCells.push_back(p.cell);
+        }
+        row.pieces = "fracture";
+    } else {
+        // Stand-in pieces: the input as the remainder, the clipped cell as the debris.
+        rubble::ConvexPolytope debris = rubble::ConvexPolytope::fromAabb(mesh.bounds());
+        for (const rubble::PolytopeFace& f : cells[0].faces())
+            debris = debris.clipped(f.plane);
+        pieces = {mesh, debris.toMesh()};
+        pieceCells = {-1, 0};
+        row.pieces = "stand-in (" + fr.error().message.substr(0, 40) + ")";
+    }
+    std::vector<std::vector<rubble::ConvexPolytope>> updated;
+    row.update =
+        timeIt(runs, [&] { updated = rubble::updateDecomposition(d->parts, cells, pieces, pieceCells); });
+    for (const auto& u : updated)
+        row.updatedParts += u.size();
+    return row;
+}
+
+int runBench(const BenchArgs& args) {
+    const int runs = args.quick ? 1 : std::max(1, args.runs);
+    // Thesis Table 3.2 (HACD, seconds) and the thesis's program measured here (seconds).
+    const std::vector<int> grid = args.quick ? std::vector<int>{1, 3} : std::vector<int>{1, 3, 7, 15, 29};
+    const std::map<std::size_t, std::pair<double, double>> reference = {{12, {0.118, 0.191}},
+                                                                        {108, {0.135, 0.210}},
+                                                                        {588, {0.261, 0.223}},
+                                                                        {2700, {2.362, 1.120}},
+                                                                        {10092, {12.007, 5.099}}};
+    std::vector<Row> rows;
+    for (int n : grid) {
+        const rubble::Mesh cube = rubble::makeSubdividedBox({-1, -1, -1}, {1, 1, 1}, n);
+        Row r = measure("cube_" + std::to_string(cube.triangles.size()), cube, {0.99, 0, 0}, runs);
+        if (auto it = reference.find(r.triangles); it != reference.end()) {
+            r.thesisS = it->second.first;
+            r.seedS = it->second.second;
+        }
+        rows.push_back(r);
+    }
+    const fs::path media = fs::path(RUBBLE_SOURCE_DIR) / ".." / "shared" / "seed" / "media";
+    if (!args.quick && fs::is_directory(media)) {
+        for (const char* name : {"building.obj", "missile.obj", "ship.obj", "empty.obj"}) {
+            auto mesh = rubble::readMesh(media / name);
+            if (!mesh) {
+                std::cerr << "decomposition: skipping " << name << ": " << mesh.error().message << "\n";
+                continue;
+            }
+            const rubble::Aabb b = mesh->bounds();
+            const rubble::Vec3 impact{b.hi.x - 0.01 * b.size().x, b.center().y, b.center().z};
+            rows.push_back(measure(name, mesh.value(), impact, runs));
+        }
+    } else if (!args.quick) {
+        std::cout << "(seed media not found at " << media.string() << ": seed models skipped)\n";
+    }
+
+    std::printf("%-14s %6s %5s %7s | %-24s | %-24s | %9s %9s %8s %8s\n", "model", "tris", "parts", "excess",
+                "initial ms (med/min/max)", "update ms (med/min/max)", "thesis s", "seed s", "x thesis",
+                "x seed");
+    for (const Row& r : rows) {
+        char ref[96] = "";
+        if (r.thesisS > 0)
+            std::snprintf(ref, sizeof ref, "%9.3f %9.3f %8.0f %8.0f", r.thesisS, r.seedS,
+                          r.thesisS * 1000 / r.update.median, r.seedS * 1000 / r.update.median);
+        std::printf("%-14s %6zu %5zu %7.4f | %7.3f %7.3f %8.3f | %7.3f %7.3f %8.3f | %s\n", r.name.c_str(),
+                    r.triangles, r.parts, r.excess, r.initial.median, r.initial.min, r.initial.max,
+                    r.update.median, r.update.min, r.update.max, ref);
+    }
+    std::printf(
+        "runs per case: %d; update = parent parts clipped by one cell, fragments assigned to %s pieces\n",
+        runs, rows.empty() ? "" : rows[0].pieces.c_str());
+
+    std::error_code ec;
+    fs::create_directories(args.out, ec);
+    const fs::path csv = fs::path(args.out) / "decomposition.csv";
+    std::ofstream out(csv);
+    if (!out) {
+        std::cerr << "decomposition: cannot write " << csv.string() << "\n";
+        return 1;
+    }
+    out << "model,triangles,parts,excess,runs,initial_median_ms,initial_min_ms,initial_max_ms,update_median_"
+           "ms,"
+           "update_min_ms,update_max_ms,updated_parts,pieces,thesis_hacd_s,seed_program_s,speedup_vs_thesis,"
+           "speedup_vs_seed\n";
+    for (const Row& r : rows) {
+        out << r.name << "," << r.triangles << "," << r.parts << "," << r.excess << "," << runs << ","
+            << r.initial.median << "," << r.initial.min << "," << r.initial.max << "," << r.update.median
+            << "," << r.update.min << "," << r.update.max << "," << r.updatedParts << ",\"" << r.pieces
+            << "\",";
+        if (r.thesisS > 0)
+            out << r.thesisS << "," << r.seedS << "," << r.thesisS * 1000 / r.update.median << ","
+                << r.seedS * 1000 / r.update.median;
+        else
+            out << ",,,";
+        out << "\n";
+    }
+    out.close();
+    std::cout << "CSV: " << csv.string() << "\n";
+
+    if (std::system("command -v gnuplot >/dev/null 2>&1") != 0) {
+        std::cout << "gnuplot not found: plot skipped\n";
+        return 0;
+    }
+    const fs::path dat = fs::path(args.out) / "decomposition_cubes.dat";
+    {
+        std::ofstream d(dat);
+        for (const Row& r : rows)
+            if (r.thesisS > 0)
+                d << r.triangles << " " << r.initial.median << " " << r.update.median << " "
+                  << r.thesisS * 1000 << " " << r.seedS * 1000 << "\n";
+    }
+    const fs::path png = fs::path(args.out) / "decomposition.png";
+    const fs::path gp = fs::path(args.out) / "decomposition.gp";
+    {
+        std::ofstream g(gp);
+        g << "set terminal pngcairo size 900,600\nset output '" << png.string() << "'\n"
+          << "set logscale xy\nset xlabel 'cube triangles'\nset ylabel 'time (ms)'\nset grid\n"
+          << "set key top left\nset title 'Convex decomposition: Rubble vs the thesis (HACD)'\n"
+          << "plot '" << dat.string() << "' u 1:4 w lp t 'thesis Table 3.2 (HACD)', '' u 1:5 w lp t "
+          << "'thesis program measured here', '' u 1:2 w lp t 'Rubble initial decomposition', '' u 1:3 w lp "
+             "t "
+          << "'Rubble incremental update'\n";
+    }
+    if (std::system(("gnuplot '" + gp.string() + "' 2>/dev/null").c_str()) == 0)
+        std::cout << "plot: " << png.string() << "\n";
+    else
+        std::cout << "gnuplot failed: plot skipped\n";
+    fs::remove(gp, ec);
+    fs::remove(dat, ec);
+    return 0;
+}
+
+const rubble::tools::Registrar registrar{
+    {"decomposition", "Convex decomposition: initial and incremental update per cube size and seed model",
+     [](CLI::App& app) {
+         auto args = std::make_shared<BenchArgs>();
+         app.add_flag("--quick", args->quick, "one repetition, small cubes only (CI smoke run)");
+         app.add_option("--runs", args->runs, "repetitions per case")->check(CLI::Range(1, 10000));
+         app.add_option("--out", args->out, "folder for decomposition.csv and decomposition.png");
+         return [args] { return runBench(*args); };
+     }}};
+
+} // namespace
