@@ -143,6 +143,7 @@ int runScene(const SceneArgs& a) {
     const long frames = std::max(1L, std::lround(a.seconds * 60));
     std::vector<double> frameMs;
     frameMs.reserve(static_cast<std::size_t>(frames));
+    std::vector<double> physicsMs, adoptMs;
     long shots = 0;
     for (long f = 0; f < frames; ++f) {
         const auto t0 = std::chrono::steady_clock::now();
@@ -151,7 +152,9 @@ int runScene(const SceneArgs& a) {
             shoot(bridge, rng, a);
             ++shots;
         }
-        bridge.stepFrame(dt);
+        const FrameStats fs = bridge.stepFrame(dt);
+        physicsMs.push_back(fs.physicsMs);
+        adoptMs.push_back(fs.adoptMs);
         frameMs.push_back(
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     }
@@ -179,6 +182,12 @@ int runScene(const SceneArgs& a) {
         j["frame_ms"] = {{"p50", percentile(frameMs, 0.5)},
                          {"p99", percentile(frameMs, 0.99)},
                          {"max", percentile(frameMs, 1.0)}};
+        j["physics_ms"] = {{"p50", percentile(physicsMs, 0.5)},
+                           {"p99", percentile(physicsMs, 0.99)},
+                           {"max", percentile(physicsMs, 1.0)}};
+        j["adopt_ms"] = {{"p50", percentile(adoptMs, 0.5)},
+                         {"p99", percentile(adoptMs, 0.99)},
+                         {"max", percentile(adoptMs, 1.0)}};
         j["impacts"] = c.impacts;
         j["fractures"] = c.fractures;
         j["latency_ms"] = {{"p50", percentile(latency, 0.5)},
@@ -201,6 +210,10 @@ int runScene(const SceneArgs& a) {
     std::printf("%-28s %10s %10s %10s\n", "", "p50", "p99", "max");
     std::printf("%-28s %10.3f %10.3f %10.3f\n", "frame (ms)", percentile(frameMs, 0.5),
                 percentile(frameMs, 0.99), percentile(frameMs, 1.0));
+    std::printf("%-28s %10.3f %10.3f %10.3f\n", "  physics step (ms)", percentile(physicsMs, 0.5),
+                percentile(physicsMs, 0.99), percentile(physicsMs, 1.0));
+    std::printf("%-28s %10.3f %10.3f %10.3f\n", "  impacts + adoption (ms)", percentile(adoptMs, 0.5),
+                percentile(adoptMs, 0.99), percentile(adoptMs, 1.0));
     std::printf("%-28s %10.3f %10.3f %10.3f\n", "impact -> adopted (ms)", percentile(latency, 0.5),
                 percentile(latency, 0.99), percentile(latency, 1.0));
     std::printf("%-28s %10lld\n", "impacts", c.impacts);
