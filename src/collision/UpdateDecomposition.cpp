@@ -152,15 +152,23 @@ std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<C
             fragments.push_back({std::move(r), -1});
     }
 
-    // 2. Drop slivers.
-    const double sliver = std::max(params.minPartVolumeFraction, 1e-12) * parentVolume;
+    // 2. Drop slivers: numerical leftovers always; small fragments only when they are flat (a small but
+    //    chunky fragment may hold a piece's corner and is merged into a neighbour instead).
+    const double sliver = 1e-12 * parentVolume;
+    const double small = params.minPartVolumeFraction * parentVolume;
     // 3. Assign every fragment to the piece containing it.
     std::vector<Aabb> pieceBounds(pieces.size());
     for (std::size_t i = 0; i < pieces.size(); ++i)
         pieceBounds[i] = pieces[i].bounds();
     for (Fragment& frag : fragments) {
-        if (frag.shape.volume() <= sliver)
+        const double fragVolume = frag.shape.volume();
+        if (fragVolume <= sliver)
             continue;
+        if (fragVolume <= small) {
+            const double d = frag.shape.bounds().diagonal();
+            if (fragVolume < 1e-3 * d * d * d)
+                continue; // flat: its thickness is far below its size
+        }
         const Aabb fb = frag.shape.bounds();
         const double tol = 1e-9 * (fb.diagonal() + 1);
         std::vector<std::size_t> candidates;

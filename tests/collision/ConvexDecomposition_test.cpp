@@ -7,6 +7,7 @@
 
 #include "TestSupport.hpp"
 #include "rubble/ConvexDecomposition.hpp"
+#include "rubble/Fracture.hpp"
 #include "rubble/MassProperties.hpp"
 #include "rubble/MeshIO.hpp"
 #include "rubble/Random.hpp"
@@ -264,6 +265,47 @@ TEST(UpdateDecomposition, ChainedUpdatesOfConvexPiecesStillCoverThem) {
         if (parts.empty() || object.empty()) {
             object = nextObject;
             parts = {nextObject};
+        }
+    }
+}
+
+TEST(UpdateDecomposition, RealFracturePiecesChained) {
+    // Pieces from rubble::fracture: parts are updated through 6 chained fractures of the biggest piece.
+    for (const Mesh& start : {makeSubdividedBox({-1, -1, -1}, {1, 1, 1}, 3), makeLPrism(2)}) {
+        Mesh mesh = start;
+        auto d = decompose(mesh);
+        ASSERT_TRUE(d);
+        std::vector<ConvexPolytope> parts = d->parts;
+        Rng rng(3);
+        for (int round = 0; round < 6; ++round) {
+            const Aabb b = mesh.bounds();
+            Impact impact;
+            impact.point = rng.inBox(b.lo, b.hi);
+            impact.impulse = 5;
+            FractureParams fp;
+            fp.sizeLaw.base = 0.4 * b.size().x;
+            fp.sizeLaw.scale = 0;
+            auto fr = fracture(mesh, impact, fp, 100 + round);
+            if (!fr)
+                continue; // e.g. the cell missed the mesh
+            std::vector<Mesh> pieces;
+            std::vector<std::int32_t> pieceCells;
+            for (const Piece& p : fr->pieces) {
+                pieces.push_back(p.mesh);
+                pieceCells.push_back(p.cell);
+            }
+            auto updated = updateDecomposition(parts, fr->cells, pieces, pieceCells);
+            ASSERT_EQ(updated.size(), pieces.size());
+            std::size_t biggest = 0;
+            for (std::size_t i = 0; i < pieces.size(); ++i) {
+                SCOPED_TRACE("round " + std::to_string(round) + " piece " + std::to_string(i));
+                expectCovers(pieces[i], updated[i], 1e-6 * diag(start));
+                EXPECT_LE(updated[i].size(), 24u);
+                if (fr->pieces[i].mass.volume > fr->pieces[biggest].mass.volume)
+                    biggest = i;
+            }
+            mesh = pieces[biggest];
+            parts = updated[biggest];
         }
     }
 }
