@@ -137,8 +137,16 @@ Body* DestructionBridge::makeObjectBody(ObjectId id, const btTransform& bodyWorl
     b->isStatic = isStatic;
     b->objectToBody = principalFrame(st->mass);
     b->volume = std::abs(st->mass.volume);
-    b->shape = CollisionShape::fromParts(st->convexParts, st->mesh.positions, b->objectToBody,
-                                         config_.collisionMargin);
+    if (kind == BodyKind::Piece && st->convexParts.size() > 1 && b->volume < config_.singleHullVolume) {
+        std::vector<Vec3> points;
+        for (const ConvexPolytope& part : st->convexParts)
+            for (const Vec3& p : part.vertices())
+                points.push_back(p);
+        b->shape = CollisionShape::fromParts({}, points, b->objectToBody, config_.collisionMargin);
+    }
+    if (!b->shape)
+        b->shape = CollisionShape::fromParts(st->convexParts, st->mesh.positions, b->objectToBody,
+                                             config_.collisionMargin);
     if (!b->shape) {
         const Aabb box = st->mesh.bounds();
         b->shape = CollisionShape::box(box.empty() ? Vec3{0.1, 0.1, 0.1} : box.size() * 0.5);

@@ -59,18 +59,20 @@ public:
         double collisionImpulseThreshold = 2500; ///< non-projectile contacts fracture only above this total
                                                  ///< impulse per contact pair and step (and the object's own
                                                  ///< threshold)
-        double minApproachSpeed = 2.0;   ///< non-projectile contacts also need this approach speed (m/s)
-        int graceFrames = 30;            ///< new pieces ignore non-projectile contacts for this many frames
-        double minPieceVolume = 1e-3;    ///< pieces below this volume (m³) become debris particles at once
-        double minFractureVolume = 0;    ///< impacts on objects below this volume are ignored
-        int maxLivePieces = 400;         ///< beyond this many piece bodies the smallest retire to particles
-        double debrisLifetime = 3.0;     ///< seconds a debris particle is drawn
-        double collisionMargin = 0.02;   ///< convex hull margin (hulls are eroded by it)
-        double linearSleep = 0.8;        ///< sleeping threshold (m/s)
-        double angularSleep = 1.0;       ///< sleeping threshold (rad/s)
-        double killBelowY = -500;        ///< pieces falling below this height retire
-        bool keepStaticRemainder = true; ///< the largest remainder piece of a static object stays static
-        double projectileLifetime = 6;   ///< seconds before a projectile is removed
+        double minApproachSpeed = 2.0;  ///< non-projectile contacts also need this approach speed (m/s)
+        int graceFrames = 30;           ///< new pieces ignore non-projectile contacts for this many frames
+        double minPieceVolume = 1e-3;   ///< pieces below this volume (m³) become debris particles at once
+        double minFractureVolume = 0;   ///< impacts on objects below this volume are ignored
+        int maxLivePieces = 400;        ///< beyond this many piece bodies the smallest retire to particles
+        double debrisLifetime = 3.0;    ///< seconds a debris particle is drawn
+        double singleHullVolume = 0.25; ///< pieces below this volume (m³) collide as one convex hull of their
+                                        ///< parts (cheaper contacts for small debris)
+        double collisionMargin = 0.02;        ///< convex hull margin (hulls are eroded by it)
+        double linearSleep = 0.8;             ///< sleeping threshold (m/s)
+        double angularSleep = 1.0;            ///< sleeping threshold (rad/s)
+        double killBelowY = -500;             ///< pieces falling below this height retire
+        bool keepStaticRemainder = true;      ///< the largest remainder piece of a static object stays static
+        double projectileLifetime = 6;        ///< seconds before a projectile is removed
         double spentProjectileLifetime = 0.5; ///< seconds a projectile lives after its hit
         int maxImpactMarks = 64;              ///< recent impacts kept for debug drawing
     };
