@@ -34,6 +34,20 @@ void subtractCell(const ConvexPolytope& part, const ConvexPolytope& cell, std::v
     }
 }
 
+/// The polytope clipped to an axis-aligned box (only by the box planes it crosses).
+ConvexPolytope clippedToBox(ConvexPolytope p, const Aabb& box) {
+    const Aabb b = p.bounds();
+    for (int a = 0; a < 3 && !p.empty(); ++a) {
+        Vec3 n;
+        n[a] = 1;
+        if (b.hi[a] > box.hi[a])
+            p = p.clipped({n, box.hi[a]});
+        if (!p.empty() && b.lo[a] < box.lo[a])
+            p = p.clipped({-n, -box.lo[a]});
+    }
+    return p;
+}
+
 double distanceToBox(const Aabb& b, const Vec3& p) {
     const Vec3 d = max(max(b.lo - p, p - b.hi), Vec3{});
     return length(d);
@@ -166,8 +180,8 @@ std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<C
             continue;
         if (fragVolume <= small) {
             const double d = frag.shape.bounds().diagonal();
-            if (fragVolume < 1e-3 * d * d * d)
-                continue; // flat: its thickness is far below its size
+            if (fragVolume < 1e-7 * d * d * d)
+                continue; // flat: thinner than about 1e-7 of its size
         }
         const Aabb fb = frag.shape.bounds();
         const double tol = 1e-9 * (fb.diagonal() + 1);
@@ -178,7 +192,10 @@ std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<C
                 candidates.push_back(i);
         }
         if (candidates.size() == 1) {
-            result[candidates[0]].push_back(std::move(frag.shape));
+            // Parent parts may reach into empty space: keep the fragment inside the piece's bounds.
+            ConvexPolytope clipped = clippedToBox(std::move(frag.shape), pieceBounds[candidates[0]]);
+            if (!clipped.empty())
+                result[candidates[0]].push_back(std::move(clipped));
             continue;
         }
         if (candidates.size() > 1) {
@@ -202,8 +219,11 @@ std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<C
             }
         }
         // A fragment lying in empty space away from every piece is dropped.
-        if (bestDist <= 1e-6 * (pieceBounds[best].diagonal() + fb.diagonal()))
-            result[best].push_back(std::move(frag.shape));
+        if (bestDist <= 1e-6 * (pieceBounds[best].diagonal() + fb.diagonal())) {
+            ConvexPolytope clipped = clippedToBox(std::move(frag.shape), pieceBounds[best]);
+            if (!clipped.empty())
+                result[best].push_back(std::move(clipped));
+        }
     }
 
     // 4. Per piece: one hull when the fragments fill it, else merge to the budget; fresh decomposition when
