@@ -1,0 +1,39 @@
+#pragma once
+// Private to rubble_fracture: the boolean backends and the helpers they share.
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "rubble/ConvexPolytope.hpp"
+#include "rubble/Fracture.hpp"
+#include "rubble/Mesh.hpp"
+
+namespace rubble::detail {
+
+/// CGAL Polygon_mesh_processing corefinement backend (exact constructions; see CorefineBackend.cpp).
+std::unique_ptr<BooleanBackend> makeCorefineBackend();
+/// CGAL Nef_polyhedron_3 backend (the thesis's method).
+std::unique_ptr<BooleanBackend> makeNefBackend();
+/// Convex-cell clipper backend with a Corefine fallback.
+std::unique_ptr<BooleanBackend> makeFastBackend();
+
+/// Source of an output triangle: >= 0 an input triangle, kCutFace a cell face, kUnknownSource not known
+/// (found geometrically by assembleMesh).
+inline constexpr std::int64_t kCutFace = -1;
+/// See kCutFace.
+inline constexpr std::int64_t kUnknownSource = -2;
+
+/// Builds an output mesh from positions, triangles and per-triangle sources: triangles from the input keep
+/// its material and get its per-corner normals/uvs interpolated barycentrically; cut faces get
+/// kInteriorMaterial, their geometric normal (when the input has normals) and zero uvs (filled later by
+/// the fracture pipeline). Unknown sources are resolved geometrically (nearest input triangle when the
+/// triangle lies on the input surface, a cut face otherwise). Always produces uvs and materials.
+Mesh assembleMesh(const Mesh& input, std::vector<Vec3> positions, const std::vector<Triangle>& triangles,
+                  std::vector<std::int64_t> sources);
+
+/// Closed, edge-manifold and consistently oriented at Mesh level: every directed edge appears exactly once
+/// and its reverse exactly once.
+bool isClosedOriented(const Mesh& mesh);
+
+} // namespace rubble::detail

@@ -1,0 +1,213 @@
+// The fracture pipeline: validate, cells, booleans, interior attributes, islands, mass properties.
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "BooleanBackends.hpp"
+#include "rubble/Fracture.hpp"
+#include "rubble/Islands.hpp"
+
+namespace rubble {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double msSince(Clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+Status validateInput(const Mesh& mesh) {
+    if (mesh.empty())
+        return makeError(ErrorCode::InvalidInput, "fracture: the mesh has no triangles");
+    if (Status s = mesh.validate(); !s)
+        return makeError(ErrorCode::InvalidInput, "fracture: invalid mesh: " + s.message());
+    if (!detail::isClosedOriented(mesh))
+        return makeError(
+            ErrorCode::InvalidInput,
+            "fracture: the mesh is not closed and consistently oriented (every edge must be shared "
+            "by exactly two triangles in opposite directions); repair it first");
+    if (!(signedVolume(mesh) > 0))
+        return makeError(ErrorCode::InvalidInput, "fracture: the mesh does not enclose a positive volume");
+    return {};
+}
+
+/// An orthonormal basis (u, v) of the plane with normal n, the same for n and -n (so both sides of a cut
+/// get continuous texture coordinates).
+void cutBasis(Vec3 n, Vec3& u, Vec3& v) {
+    int big = 0;
+    for (int a = 1; a < 3; ++a)
+        if (std::abs(n[a]) > std::abs(n[big]))
+            big = a;
+    if (n[big] < 0)
+        n = -n;
+    int small = 0;
+    for (int a = 1; a < 3; ++a)
+        if (std::abs(n[a]) < std::abs(n[small]))
+            small = a;
+    Vec3 axis;
+    axis[small] = 1;
+    u = normalized(cross(axis, n));
+    v = cross(n, u);
+}
+
+/// Cut faces: planar UVs (projection onto the cut plane, scaled by uvScale) and the plane's normal.
+void finishCutFaces(Mesh& m, const std::vector<ConvexPolytope>& cells, double uvScale) {
+    if (!m.hasMaterials())
+        return;
+    if (m.uvs.size() != 3 * m.triangles.size())
+        m.uvs.assign(3 * m.triangles.size(), Vec2{});
+    for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+        if (m.materials[t] != kInteriorMaterial)
+            continue;
+        const auto c = m.corners(t);
+        const Vec3 tn = cross(c[1] - c[0], c[2] - c[0]);
+        // The cell face the triangle lies on: the plane nearest to its corners with a matching normal.
+        const Plane* best = nullptr;
+        double bestErr = std::numeric_limits<double>::infinity();
+        for (const ConvexPolytope& cell : cells)
+            for (const PolytopeFace& f : cell.faces()) {
+                if (std::abs(dot(f.plane.normal, tn)) < 0.5 * length(tn))
+                    continue;
+                const double e =
+                    std::max({std::abs(f.plane.signedDistance(c[0])), std::abs(f.plane.signedDistance(c[1])),
+                              std::abs(f.plane.signedDistance(c[2]))});
+                if (e < bestErr) {
+                    bestErr = e;
+                    best = &f.plane;
+                }
+            }
+        Vec3 n = best ? best->normal : normalized(tn);
+        if (dot(n, tn) < 0)
+            n = -n;
+        Vec3 u, v;
+        cutBasis(n, u, v);
+        for (int k = 0; k < 3; ++k) {
+            const Vec3& p = c[static_cast<std::size_t>(k)];
+            m.uvs[3 * t + static_cast<std::size_t>(k)] = {dot(p, u) * uvScale, dot(p, v) * uvScale};
+            if (m.hasNormals())
+                m.normals[3 * t + static_cast<std::size_t>(k)] = n;
+        }
+    }
+}
+
+void addPieces(const Mesh& m, std::int32_t cell, double minVolume, FractureResult& out) {
+    if (m.empty())
+        return;
+    for (Mesh& island : splitIntoIslands(m)) {
+        MassProperties mp = computeMassProperties(island);
+        if (!(mp.volume > minVolume)) {
+            out.droppedVolume += mp.volume;
+            continue;
+        }
+        out.pieces.push_back({std::move(island), mp, cell});
+    }
+}
+
+} // namespace
+
+std::unique_ptr<BooleanBackend> makeBooleanBackend(BooleanKind kind) {
+    switch (kind) {
+    case BooleanKind::Nef:
+        return detail::makeNefBackend();
+    case BooleanKind::Fast:
+        return detail::makeFastBackend();
+    case BooleanKind::Corefine:
+        break;
+    }
+    return detail::makeCorefineBackend();
+}
+
+namespace {
+
+Result<FractureResult> fractureValidated(const Mesh& mesh, std::vector<ConvexPolytope> cells,
+                                         const FractureParams& params, double inputVolume) {
+    const auto t0 = Clock::now();
+    FractureResult res;
+    res.inputVolume = inputVolume;
+    Aabb meshBox = mesh.bounds();
+    bool any = false;
+    for (const ConvexPolytope& c : cells)
+        any |= !c.empty() && c.bounds().overlaps(meshBox);
+    if (!any)
+        return makeError(ErrorCode::NoIntersection, "fracture: the impact's cells do not touch the mesh");
+
+    auto backend = makeBooleanBackend(params.backend);
+    auto split = backend->split(mesh, cells);
+    // The result must close up and conserve volume; a failed Fast split is redone exactly.
+    auto acceptable = [&](const SplitResult& s) {
+        double v = s.remainder.empty() ? 0.0 : signedVolume(s.remainder);
+        if (!s.remainder.empty() && !detail::isClosedOriented(s.remainder))
+            return false;
+        for (const Mesh& m : s.inside) {
+            if (m.empty())
+                continue;
+            if (!detail::isClosedOriented(m))
+                return false;
+            v += signedVolume(m);
+        }
+        return std::abs(v - inputVolume) <= 1e-7 * inputVolume;
+    };
+    if (split && !acceptable(*split) && params.backend == BooleanKind::Fast)
+        split = detail::makeCorefineBackend()->split(mesh, cells);
+    if (!split)
+        return split.error();
+    if (!acceptable(*split))
+        return makeError(ErrorCode::GeometryFailure,
+                         "fracture: the " + backend->name() +
+                             " backend produced pieces that are not closed or do not conserve volume");
+    bool hit = false;
+    for (const Mesh& m : split->inside)
+        hit |= !m.empty();
+    if (!hit)
+        return makeError(
+            ErrorCode::NoIntersection,
+            "fracture: the impact's cells do not intersect the mesh (is the impact outside it?)");
+    res.timings.booleanMs = msSince(t0);
+
+    const auto t1 = Clock::now();
+    finishCutFaces(split->remainder, cells, params.uvScale);
+    for (Mesh& m : split->inside)
+        finishCutFaces(m, cells, params.uvScale);
+    const double minVolume = std::max(0.0, params.minPieceVolumeFraction) * inputVolume;
+    addPieces(split->remainder, -1, minVolume, res);
+    for (std::size_t i = 0; i < split->inside.size(); ++i)
+        addPieces(split->inside[i], static_cast<std::int32_t>(i), minVolume, res);
+    res.timings.islandsMs = msSince(t1);
+    res.cells = std::move(cells);
+    res.timings.totalMs = msSince(t0);
+    return res;
+}
+
+} // namespace
+
+Result<FractureResult> fractureWithCells(const Mesh& mesh, std::vector<ConvexPolytope> cells,
+                                         const FractureParams& params) {
+    if (Status s = validateInput(mesh); !s)
+        return s.error();
+    return fractureValidated(mesh, std::move(cells), params, signedVolume(mesh));
+}
+
+Result<FractureResult> fracture(const Mesh& mesh, const Impact& impact, const FractureParams& params,
+                                std::uint64_t seed) {
+    const auto t0 = Clock::now();
+    if (Status s = validateInput(mesh); !s)
+        return s.error();
+    if (!isFinite(impact.point) || !std::isfinite(impact.impulse))
+        return makeError(ErrorCode::InvalidInput, "fracture: the impact point or impulse is not finite");
+    const auto tc = Clock::now();
+    std::vector<ConvexPolytope> cells = generateCells(mesh.bounds(), impact, params, seed);
+    const double cellMs = msSince(tc);
+    if (cells.empty())
+        return makeError(ErrorCode::NoIntersection, "fracture: no cell could be built around the impact");
+    auto r = fractureValidated(mesh, std::move(cells), params, signedVolume(mesh));
+    if (!r)
+        return r;
+    r->timings.cellMs = cellMs;
+    r->timings.totalMs = msSince(t0);
+    return r;
+}
+
+} // namespace rubble

@@ -1,0 +1,148 @@
+// Cell generators: the thesis's single Voronoi cell and the shatter pattern.
+
+#include <gtest/gtest.h>
+
+#include <map>
+
+#include "rubble/Fracture.hpp"
+#include "rubble/MassProperties.hpp"
+#include "rubble/Random.hpp"
+
+using namespace rubble;
+
+namespace {
+
+::testing::AssertionResult closedAndOriented(const Mesh& m) {
+    std::map<std::pair<std::uint32_t, std::uint32_t>, int> directed;
+    for (const Triangle& t : m.triangles)
+        for (int c = 0; c < 3; ++c)
+            ++directed[{t[c], t[(c + 1) % 3]}];
+    for (const auto& [e, count] : directed)
+        if (count != 1 || !directed.count({e.second, e.first}))
+            return ::testing::AssertionFailure() << "bad edge " << e.first << "-" << e.second;
+    return ::testing::AssertionSuccess();
+}
+
+// Every face is planar, counter-clockwise seen from outside, and every vertex is inside every plane.
+void checkConvexCell(const ConvexPolytope& cell, double size) {
+    ASSERT_FALSE(cell.empty());
+    const auto verts = cell.vertices();
+    for (std::size_t i = 0; i < cell.faces().size(); ++i) {
+        const PolytopeFace& f = cell.faces()[i];
+        EXPECT_EQ(f.tag, static_cast<std::int32_t>(i));
+        EXPECT_NEAR(length(f.plane.normal), 1.0, 1e-12);
+        Vec3 n;
+        for (std::size_t k = 0; k < f.corners.size(); ++k)
+            n += cross(f.corners[k], f.corners[(k + 1) % f.corners.size()]);
+        EXPECT_GT(dot(n, f.plane.normal), 0) << "face " << i << " is not counter-clockwise from outside";
+        for (const Vec3& c : f.corners)
+            EXPECT_NEAR(f.plane.signedDistance(c), 0, 1e-9 * size);
+        for (const Vec3& v : verts)
+            EXPECT_LE(f.plane.signedDistance(v), 1e-9 * size);
+    }
+    const Mesh m = cell.toMesh();
+    EXPECT_TRUE(closedAndOriented(m));
+    EXPECT_GT(signedVolume(m), 0);
+    EXPECT_NEAR(signedVolume(m), cell.volume(), 1e-9 * size * size * size);
+}
+
+} // namespace
+
+TEST(CellSizeLaw, ClampsAndGrows) {
+    CellSizeLaw law;
+    EXPECT_DOUBLE_EQ(law.sizeFor(0), 0.5);
+    EXPECT_GT(law.sizeFor(100), law.sizeFor(1));
+    EXPECT_DOUBLE_EQ(law.sizeFor(1e300), law.maxSize);
+    EXPECT_DOUBLE_EQ(law.sizeFor(-5), 0.5);
+    EXPECT_DOUBLE_EQ(law.sizeFor(std::nan("")), 0.5);
+}
+
+TEST(CellGenerator, SingleCellIsTheImpactsConvexVoronoiCell) {
+    Rng rng(3);
+    for (int i = 0; i < 300; ++i) {
+        FractureParams params;
+        params.seedPoints = static_cast<int>(rng.below(30));
+        const Vec3 impact = rng.inBox({-10, -10, -10}, {10, 10, 10});
+        const double size = params.sizeLaw.sizeFor(rng.uniform(0, 500));
+        const auto cells = generateCells({}, {impact, {0, 1, 0}, 0}, params, rng.next());
+        (void)size;
+        ASSERT_EQ(cells.size(), 1u);
+        const ConvexPolytope& c = cells[0];
+        const double s = params.sizeLaw.sizeFor(0) * 50;
+        checkConvexCell(c, s);
+        EXPECT_TRUE(c.contains(impact, 1e-12));
+        // The cell lies in the rotated cubic domain: within half a space diagonal of the impact.
+        for (const Vec3& v : c.vertices())
+            EXPECT_LE(length(v - impact), params.sizeLaw.maxSize);
+    }
+}
+
+TEST(CellGenerator, SingleCellVolumeBoundedByDomainAndShrinksWithMoreSeeds) {
+    FractureParams params;
+    params.sizeLaw.base = 2;
+    params.sizeLaw.scale = 0;
+    double few = 0, many = 0;
+    for (std::uint64_t seed = 0; seed < 50; ++seed) {
+        params.seedPoints = 0;
+        const auto whole = generateCells({}, {{1, 2, 3}, {0, 1, 0}, 1}, params, seed);
+        ASSERT_EQ(whole.size(), 1u);
+        EXPECT_NEAR(whole[0].volume(), 8.0, 1e-9); // no other site: the whole (rotated) domain
+        params.seedPoints = 3;
+        few += generateCells({}, {{1, 2, 3}, {0, 1, 0}, 1}, params, seed)[0].volume();
+        params.seedPoints = 40;
+        many += generateCells({}, {{1, 2, 3}, {0, 1, 0}, 1}, params, seed)[0].volume();
+    }
+    EXPECT_LT(many, few);
+    EXPECT_LT(few, 50 * 8.0);
+}
+
+TEST(CellGenerator, DeterministicInSeed) {
+    FractureParams params;
+    for (CellPattern pattern : {CellPattern::SingleCell, CellPattern::Shatter}) {
+        params.pattern = pattern;
+        const auto a = generateCells({}, {{0, 0, 0}, {0, 1, 0}, 3}, params, 42);
+        const auto b = generateCells({}, {{0, 0, 0}, {0, 1, 0}, 3}, params, 42);
+        const auto c = generateCells({}, {{0, 0, 0}, {0, 1, 0}, 3}, params, 43);
+        ASSERT_EQ(a.size(), b.size());
+        for (std::size_t i = 0; i < a.size(); ++i)
+            EXPECT_EQ(a[i].toMesh(), b[i].toMesh());
+        EXPECT_FALSE(a[0].toMesh() == c[0].toMesh());
+    }
+}
+
+TEST(CellGenerator, ShatterCellsAreDisjointConvexAndAroundTheImpact) {
+    Rng rng(5);
+    for (int i = 0; i < 60; ++i) {
+        FractureParams params;
+        params.pattern = CellPattern::Shatter;
+        params.cells = 1 + static_cast<int>(rng.below(8));
+        params.sizeLaw.base = 1;
+        params.sizeLaw.scale = 0;
+        const Vec3 impact = rng.inBox({-5, -5, -5}, {5, 5, 5});
+        const auto cells = generateCells({}, {impact, {0, 1, 0}, 1}, params, rng.next());
+        ASSERT_EQ(cells.size(), static_cast<std::size_t>(params.cells));
+        EXPECT_TRUE(cells[0].contains(impact, 1e-12));
+        double total = 0;
+        for (const ConvexPolytope& c : cells) {
+            checkConvexCell(c, 1);
+            total += c.volume();
+        }
+        EXPECT_LE(total, 1.25 * 1.25 * 1.25 + 1e-9);
+        // Interiors are disjoint: each cell's centroid is strictly outside every other cell.
+        for (std::size_t a = 0; a < cells.size(); ++a)
+            for (std::size_t b = 0; b < cells.size(); ++b)
+                if (a != b) {
+                    EXPECT_FALSE(cells[b].contains(cells[a].centroid(), -1e-9));
+                }
+        // Shared corners are bit-identical across neighbouring cells (welded): no near-duplicates remain.
+        std::vector<Vec3> all;
+        for (const ConvexPolytope& c : cells)
+            for (const Vec3& v : c.vertices())
+                all.push_back(v);
+        for (std::size_t a = 0; a < all.size(); ++a)
+            for (std::size_t b = a + 1; b < all.size(); ++b)
+                if (!(all[a] == all[b])) {
+                    EXPECT_GT(length(all[a] - all[b]), 1e-9);
+                }
+    }
+}
