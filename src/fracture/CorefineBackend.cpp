@@ -14,6 +14,7 @@
 #include <array>
 #include <map>
 #include <memory>
+#include <optional>
 
 // GCC's -Wmaybe-uninitialized fires inside CGAL's templates instantiated here (false positives).
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
@@ -191,6 +192,109 @@ public:
 
 private:
     static SplitResult run(const Mesh& mesh, const std::vector<ConvexPolytope>& cells) {
+        std::vector<std::size_t> touching;
+        const Aabb box = mesh.bounds();
+        for (std::size_t i = 0; i < cells.size(); ++i)
+            if (!cells[i].empty() && cells[i].bounds().overlaps(box))
+                touching.push_back(i);
+        if (touching.size() > 1)
+            if (auto r = runIndependent(mesh, cells, touching))
+                return std::move(*r);
+        return runSequential(mesh, cells);
+    }
+
+    /// Several cells: inside[i] = mesh ∩ cell_i each from the input, remainder = mesh − U with U the union
+    /// of the cells as one closed surface (faces shared by two welded cells cancel). Cutting the cells one
+    /// after the other from the remainder would make CGAL meet faces that coincide exactly (the shared
+    /// faces), where its box intersection breaks ties by memory address: the output would not be
+    /// bit-identical from run to run. Returns nothing when the union is not a manifold surface.
+    static std::optional<SplitResult> runIndependent(const Mesh& mesh,
+                                                     const std::vector<ConvexPolytope>& cells,
+                                                     const std::vector<std::size_t>& touching) {
+        SourceTable table;
+        SplitResult out;
+        out.inside.resize(cells.size());
+        std::vector<std::unique_ptr<SM>> insides(cells.size());
+        // The union's triangles: every cell's canonical fan triangles, minus pairs of opposite ones.
+        std::map<std::tuple<double, double, double>, std::uint32_t> index;
+        std::vector<Vec3> points;
+        std::map<std::array<std::uint32_t, 3>, int> tris;
+        auto canonical = [](std::array<std::uint32_t, 3> t) {
+            std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
+            return t;
+        };
+        for (std::size_t i : touching) {
+            std::unique_ptr<SM> cell = cellToSm(cells[i], table);
+            std::vector<std::uint32_t> id(cell->num_vertices());
+            for (SM::Vertex_index v : cell->vertices()) {
+                const K::Point_3& p = cell->point(v);
+                const Vec3 q{toDouble(p.x()), toDouble(p.y()), toDouble(p.z())};
+                auto [it, inserted] =
+                    index.emplace(std::make_tuple(q.x, q.y, q.z), static_cast<std::uint32_t>(points.size()));
+                if (inserted)
+                    points.push_back(q);
+                id[static_cast<std::size_t>(v)] = it->second;
+            }
+            for (SM::Face_index f : cell->faces()) {
+                std::array<std::uint32_t, 3> t{};
+                int c = 0;
+                for (SM::Vertex_index v : CGAL::vertices_around_face(cell->halfedge(f), *cell))
+                    t[static_cast<std::size_t>(c++ % 3)] = id[static_cast<std::size_t>(v)];
+                const auto key = canonical(t);
+                const auto twin = canonical({t[0], t[2], t[1]});
+                if (auto it = tris.find(twin); it != tris.end() && it->second > 0)
+                    --it->second;
+                else
+                    ++tris[key];
+            }
+            std::unique_ptr<SM> m = meshToSm(mesh, table);
+            auto inter = std::make_unique<SM>();
+            std::array<boost::optional<SM*>, 4> outputs;
+            outputs[PMP::Corefinement::INTERSECTION] = inter.get();
+            SourceVisitor visitor;
+            visitor.table = &table;
+            const std::array<bool, 4> ok = PMP::corefine_and_compute_boolean_operations(
+                *m, *cell, outputs, PMP::parameters::visitor(visitor));
+            if (!ok[PMP::Corefinement::INTERSECTION])
+                throw Failure{"the result of cell " + std::to_string(i) + " would not be a manifold surface"};
+            table.of.erase(m.get());
+            table.of.erase(cell.get());
+            insides[i] = std::move(inter);
+        }
+        auto uni = std::make_unique<SM>();
+        for (const Vec3& p : points)
+            uni->add_vertex(K::Point_3(p.x, p.y, p.z));
+        for (const auto& [t, count] : tris) {
+            if (count <= 0)
+                continue;
+            if (count > 1)
+                return std::nullopt;
+            const SM::Face_index f =
+                uni->add_face(SM::Vertex_index(t[0]), SM::Vertex_index(t[1]), SM::Vertex_index(t[2]));
+            if (f == SM::null_face())
+                return std::nullopt;
+            table.set(*uni, f, kCutFace);
+        }
+        if (!CGAL::is_closed(*uni))
+            return std::nullopt;
+        std::unique_ptr<SM> m = meshToSm(mesh, table);
+        auto diff = std::make_unique<SM>();
+        std::array<boost::optional<SM*>, 4> outputs;
+        outputs[PMP::Corefinement::TM1_MINUS_TM2] = diff.get();
+        SourceVisitor visitor;
+        visitor.table = &table;
+        const std::array<bool, 4> ok = PMP::corefine_and_compute_boolean_operations(
+            *m, *uni, outputs, PMP::parameters::visitor(visitor));
+        if (!ok[PMP::Corefinement::TM1_MINUS_TM2])
+            return std::nullopt;
+        for (std::size_t i = 0; i < cells.size(); ++i)
+            if (insides[i])
+                out.inside[i] = smToMesh(*insides[i], table, mesh);
+        out.remainder = smToMesh(*diff, table, mesh);
+        return out;
+    }
+
+    static SplitResult runSequential(const Mesh& mesh, const std::vector<ConvexPolytope>& cells) {
         SourceTable table;
         std::unique_ptr<SM> rem = meshToSm(mesh, table);
         SplitResult out;
