@@ -58,7 +58,10 @@ TEST(ThreadPool, ShutdownWithQueuedJobsDoesNotHang) {
         std::thread releaser;
         {
             ThreadPool pool(1);
-            pool.submit([gate, &ran] {
+            std::promise<void> startedPromise;
+            auto started = startedPromise.get_future();
+            pool.submit([gate, &ran, &startedPromise] {
+                startedPromise.set_value();
                 gate.wait();
                 ran.fetch_add(1);
             });
@@ -67,6 +70,7 @@ TEST(ThreadPool, ShutdownWithQueuedJobsDoesNotHang) {
                     std::this_thread::sleep_for(std::chrono::milliseconds(1));
                     ran.fetch_add(1);
                 });
+            started.wait(); // the first job is in flight before shutdown begins
             releaser = std::thread([&] {
                 std::this_thread::sleep_for(std::chrono::milliseconds(20));
                 release.set_value();
