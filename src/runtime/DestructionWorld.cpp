@@ -1,0 +1,419 @@
+#include "rubble/DestructionWorld.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <condition_variable>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <mutex>
+
+#include "rubble/MassProperties.hpp"
+#include "rubble/MeshCheck.hpp"
+#include "rubble/Random.hpp"
+#include "rubble/ThreadPool.hpp"
+
+namespace rubble {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double msBetween(Clock::time_point a, Clock::time_point b) {
+    return std::chrono::duration<double, std::milli>(b - a).count();
+}
+
+struct PendingImpact {
+    Impact impact;
+    std::uint64_t frame = 0;
+    Clock::time_point time;
+};
+
+// Shared between the world and its jobs; outlives the world when a foreign JobSystem still holds jobs.
+struct Sync {
+    std::mutex mutex;
+    std::condition_variable done;
+    int outstanding = 0;
+    bool cancelled = false;
+};
+
+struct Job {
+    // inputs (immutable once submitted)
+    ObjectId id = 0;
+    std::uint32_t version = 0;
+    std::vector<PendingImpact> impacts;
+    Mesh mesh;
+    std::vector<ConvexPolytope> parts;
+    FractureParams params;
+    DecompositionParams decomposition;
+    std::uint64_t seed = 0;
+    std::uint64_t frame = 0;
+    Clock::time_point submitted;
+    // outputs (written by the worker, read by the main thread after `finished` under Sync::mutex)
+    bool finished = false;
+    bool ok = false;
+    std::string error;
+    FractureResult result;
+    std::vector<Frame> frames;
+    std::vector<Mesh> localMeshes;
+    std::vector<std::vector<ConvexPolytope>> localParts;
+    double queueMs = 0;
+    double decompositionMs = 0;
+};
+
+ConvexPolytope toLocal(const ConvexPolytope& p, const Frame& f) {
+    const Mat3 rt = f.rotation.transposed();
+    std::vector<PolytopeFace> faces;
+    faces.reserve(p.faces().size());
+    for (const auto& face : p.faces()) {
+        PolytopeFace out;
+        out.tag = face.tag;
+        for (const auto& c : face.corners)
+            out.corners.push_back(rt * (c - f.translation));
+        const Vec3 n = rt * face.plane.normal;
+        out.plane = out.corners.empty() ? Plane{n, 0} : Plane::fromPointNormal(out.corners.front(), n);
+        faces.push_back(std::move(out));
+    }
+    return ConvexPolytope::fromFaces(std::move(faces));
+}
+
+void runJob(Job& job) {
+    std::vector<ConvexPolytope> cells;
+    Result<FractureResult> r = Error{ErrorCode::NoIntersection, "no cells"};
+    if (job.impacts.size() == 1) {
+        r = fracture(job.mesh, job.impacts.front().impact, job.params, mixSeed(job.seed, 0));
+    } else {
+        // Union of the cells of every merged impact; a cell overlapping an accepted one is skipped so that
+        // the cells stay disjoint (the overlapping region is already cut by the earlier impact's cells).
+        const Aabb bounds = job.mesh.bounds();
+        for (std::size_t i = 0; i < job.impacts.size(); ++i) {
+            const std::size_t earlier = cells.size(); // only cells of earlier impacts are compared
+            for (auto& c : generateCells(bounds, job.impacts[i].impact, job.params, mixSeed(job.seed, i))) {
+                const Aabb cb = c.bounds();
+                bool overlaps = false;
+                for (std::size_t a = 0; a < earlier; ++a)
+                    overlaps = overlaps || cells[a].bounds().overlaps(cb);
+                if (!overlaps)
+                    cells.push_back(std::move(c));
+            }
+        }
+        r = fractureWithCells(job.mesh, cells, job.params);
+    }
+    if (!r) {
+        job.error = r.error().message;
+        return;
+    }
+    job.result = std::move(r).value();
+    const auto t0 = Clock::now();
+    std::vector<Mesh> meshes;
+    std::vector<std::int32_t> pieceCells;
+    for (const auto& p : job.result.pieces) {
+        meshes.push_back(p.mesh);
+        pieceCells.push_back(p.cell);
+    }
+    auto parts = updateDecomposition(job.parts, job.result.cells, meshes, pieceCells, job.decomposition);
+    job.decompositionMs = msBetween(t0, Clock::now());
+    for (std::size_t i = 0; i < job.result.pieces.size(); ++i) {
+        const auto& m = job.result.pieces[i].mass;
+        Frame f{m.principalAxes, m.centerOfMass};
+        const Mat3 rt = f.rotation.transposed();
+        job.localMeshes.push_back(meshes[i].transformed(rt, Vec3{1, 1, 1}, rt * (-1.0 * f.translation)));
+        std::vector<ConvexPolytope> lp;
+        if (i < parts.size())
+            for (const auto& p : parts[i])
+                lp.push_back(toLocal(p, f));
+        job.localParts.push_back(std::move(lp));
+        job.frames.push_back(f);
+    }
+    job.ok = true;
+}
+
+} // namespace
+
+struct DestructionWorld::Impl {
+    Config config;
+    std::unique_ptr<ThreadPool> ownedPool;
+    JobSystem* jobs = nullptr;
+    std::shared_ptr<Sync> sync = std::make_shared<Sync>();
+    std::map<ObjectId, ObjectState> objects;
+    ObjectId nextId = 1;
+    std::uint64_t frame = 0;
+    DecompositionCache cache;
+    std::map<ObjectId, std::vector<PendingImpact>> waiting; // impacts waiting for an in-flight job
+    std::vector<std::shared_ptr<Job>> inflight;             // in submission order
+    std::vector<TimingRecord> timings;
+
+    bool busy(ObjectId id) const {
+        return std::any_of(inflight.begin(), inflight.end(), [&](const auto& j) { return j->id == id; });
+    }
+
+    void launch(ObjectId id, std::vector<PendingImpact> impacts) {
+        const ObjectState& o = objects.at(id);
+        auto job = std::make_shared<Job>();
+        job->id = id;
+        job->version = o.version;
+        job->impacts = std::move(impacts);
+        job->mesh = o.mesh;
+        job->parts = o.convexParts;
+        job->params = o.fracture;
+        job->decomposition = config.decomposition;
+        job->seed = mixSeed(mixSeed(config.seed, id), o.version);
+        job->frame = job->impacts.front().frame;
+        job->submitted = Clock::now();
+        inflight.push_back(job);
+        {
+            std::lock_guard lock(sync->mutex);
+            ++sync->outstanding;
+        }
+        auto s = sync;
+        jobs->submit([s, job] {
+            {
+                std::lock_guard lock(s->mutex);
+                if (s->cancelled) {
+                    --s->outstanding;
+                    job->finished = true;
+                    s->done.notify_all();
+                    return;
+                }
+            }
+            job->queueMs = msBetween(job->impacts.front().time, Clock::now());
+            runJob(*job);
+            std::lock_guard lock(s->mutex);
+            job->finished = true;
+            --s->outstanding;
+            s->done.notify_all();
+        });
+    }
+
+    bool isFinished(const Job& j) {
+        std::lock_guard lock(sync->mutex);
+        return j.finished;
+    }
+    void waitFor(const Job& j) {
+        std::unique_lock lock(sync->mutex);
+        sync->done.wait(lock, [&] { return j.finished; });
+    }
+};
+
+DestructionWorld::DestructionWorld(Config config) : impl_(std::make_unique<Impl>()) {
+    impl_->config = config;
+    if (config.jobs) {
+        impl_->jobs = config.jobs;
+    } else {
+        impl_->ownedPool = std::make_unique<ThreadPool>(config.workers);
+        impl_->jobs = impl_->ownedPool.get();
+    }
+}
+
+DestructionWorld::~DestructionWorld() {
+    {
+        std::lock_guard lock(impl_->sync->mutex);
+        impl_->sync->cancelled = true; // queued jobs return at once; results of running ones are discarded
+    }
+    impl_->ownedPool.reset(); // finishes running jobs, drops queued ones (they only hold shared state)
+}
+
+Result<ObjectId> DestructionWorld::addObject(ObjectDesc desc) {
+    if (desc.mesh.triangles.empty() || desc.mesh.positions.empty())
+        return Error{ErrorCode::InvalidInput, "addObject: empty mesh"};
+    ObjectState s;
+    s.id = impl_->nextId++;
+    s.density = desc.density;
+    s.destructible = desc.destructible;
+    s.impulseThreshold = desc.impulseThreshold;
+    s.fracture = desc.fracture;
+    CheckOptions opts;
+    const MeshReport report = checkMesh(desc.mesh, opts);
+    if (!report.valid()) {
+        s.destructible = false;
+        s.warning = "mesh is not a valid closed solid";
+        if (!report.problems.empty())
+            s.warning += ": " + report.problems.front();
+        std::fprintf(stderr, "rubble: warning: object %u is indestructible: %s\n", s.id, s.warning.c_str());
+    }
+    s.mass = computeMassProperties(desc.mesh);
+    s.convexParts = std::move(desc.convexParts);
+    if (s.convexParts.empty() && report.valid()) {
+        auto d = impl_->cache.get(desc.mesh, impl_->config.decomposition);
+        if (d)
+            s.convexParts = d.value().parts;
+    }
+    s.mesh = std::move(desc.mesh);
+    const ObjectId id = s.id;
+    impl_->objects.emplace(id, std::move(s));
+    return id;
+}
+
+void DestructionWorld::removeObject(ObjectId id) {
+    impl_->objects.erase(id);
+    impl_->waiting.erase(id);
+}
+
+const ObjectState* DestructionWorld::object(ObjectId id) const {
+    auto it = impl_->objects.find(id);
+    return it == impl_->objects.end() ? nullptr : &it->second;
+}
+
+std::vector<ObjectId> DestructionWorld::objects() const {
+    std::vector<ObjectId> ids;
+    for (const auto& [id, o] : impl_->objects)
+        ids.push_back(id);
+    return ids;
+}
+
+bool DestructionWorld::submitImpact(ObjectId id, const Impact& impact) {
+    auto it = impl_->objects.find(id);
+    if (it == impl_->objects.end() || !it->second.destructible)
+        return false;
+    if (impact.impulse < it->second.impulseThreshold)
+        return false;
+    PendingImpact p{impact, impl_->frame, Clock::now()};
+    if (impl_->busy(id)) {
+        impl_->waiting[id].push_back(p);
+    } else {
+        impl_->launch(id, {p});
+    }
+    return true;
+}
+
+void DestructionWorld::beginFrame() {
+    ++impl_->frame;
+}
+
+std::uint64_t DestructionWorld::frame() const {
+    return impl_->frame;
+}
+
+std::vector<FractureOutcome> DestructionWorld::collect() {
+    std::vector<FractureOutcome> out;
+    const auto start = Clock::now();
+    Impl& im = *impl_;
+    for (std::size_t k = 0; k < im.inflight.size();) {
+        auto job = im.inflight[k];
+        if (im.config.deterministic) {
+            if (job->frame + static_cast<std::uint64_t>(std::max(0, im.config.delayFrames)) > im.frame) {
+                ++k;
+                continue;
+            }
+            im.waitFor(*job);
+        } else {
+            if (!im.isFinished(*job)) {
+                ++k;
+                continue;
+            }
+            if (!out.empty() && msBetween(start, Clock::now()) > im.config.adoptionBudgetMs)
+                break;
+        }
+        im.inflight.erase(im.inflight.begin() + static_cast<std::ptrdiff_t>(k));
+        const auto a0 = Clock::now();
+        TimingRecord rec;
+        rec.object = job->id;
+        rec.frame = job->frame;
+        rec.impactsMerged = static_cast<int>(job->impacts.size());
+        rec.queueMs = job->queueMs;
+        rec.cellMs = job->result.timings.cellMs;
+        rec.booleanMs = job->result.timings.booleanMs;
+        rec.islandsMs = job->result.timings.islandsMs;
+        rec.decompositionMs = job->decompositionMs;
+        auto it = im.objects.find(job->id);
+        std::vector<PendingImpact> later;
+        if (auto w = im.waiting.find(job->id); w != im.waiting.end()) {
+            later = std::move(w->second);
+            im.waiting.erase(w);
+        }
+        if (it == im.objects.end() || it->second.version != job->version) {
+            rec.stale = true; // the object was removed or replaced meanwhile: the result is discarded
+        } else if (job->ok) {
+            ObjectState parent = std::move(it->second);
+            im.objects.erase(it);
+            FractureOutcome o;
+            o.parent = job->id;
+            o.parentVersion = job->version;
+            for (const auto& p : job->impacts)
+                o.impacts.push_back(p.impact);
+            o.droppedVolume = job->result.droppedVolume;
+            for (std::size_t i = 0; i < job->localMeshes.size(); ++i) {
+                ObjectState s;
+                s.id = im.nextId++;
+                s.version = 0;
+                s.mesh = std::move(job->localMeshes[i]);
+                s.mass = computeMassProperties(s.mesh);
+                s.density = parent.density;
+                s.destructible = parent.destructible;
+                s.impulseThreshold = parent.impulseThreshold;
+                s.fracture = parent.fracture;
+                s.convexParts = std::move(job->localParts[i]);
+                o.pieces.push_back(s.id);
+                o.pieceFrames.push_back(job->frames[i]);
+                im.objects.emplace(s.id, std::move(s));
+            }
+            // Impacts that arrived while this job ran go to the piece nearest to their point.
+            for (auto& p : later) {
+                double best = 1e300;
+                std::size_t bi = 0;
+                for (std::size_t i = 0; i < o.pieces.size(); ++i) {
+                    const Frame& f = o.pieceFrames[i];
+                    const Aabb b = im.objects.at(o.pieces[i]).mesh.bounds();
+                    const Vec3 q = f.rotation.transposed() * (p.impact.point - f.translation);
+                    const Vec3 c = b.center();
+                    const double d = length(q - c);
+                    if (d < best)
+                        best = d, bi = i;
+                }
+                if (o.pieces.empty())
+                    break;
+                const Frame& f = o.pieceFrames[bi];
+                PendingImpact q = p;
+                q.impact.point = f.rotation.transposed() * (p.impact.point - f.translation);
+                q.impact.normal = f.rotation.transposed() * p.impact.normal;
+                const ObjectId pid = o.pieces[bi];
+                if (im.busy(pid))
+                    im.waiting[pid].push_back(q);
+                else
+                    im.launch(pid, {q});
+            }
+            later.clear();
+            rec.pieces = static_cast<int>(o.pieces.size());
+            out.push_back(std::move(o));
+        }
+        // A failed or stale job: impacts that waited on it run now on the (unchanged) object if it still
+        // exists.
+        if (!later.empty() && im.objects.count(job->id))
+            im.launch(job->id, std::move(later));
+        const auto a1 = Clock::now();
+        rec.adoptionMs = msBetween(a0, a1);
+        rec.totalMs = msBetween(job->impacts.front().time, a1);
+        im.timings.push_back(rec);
+    }
+    return out;
+}
+
+void DestructionWorld::waitIdle() {
+    std::unique_lock lock(impl_->sync->mutex);
+    impl_->sync->done.wait(lock, [&] { return impl_->sync->outstanding == 0; });
+}
+
+int DestructionWorld::jobsInFlight() const {
+    return static_cast<int>(impl_->inflight.size());
+}
+
+const std::vector<TimingRecord>& DestructionWorld::timings() const {
+    return impl_->timings;
+}
+
+Status DestructionWorld::writeTimingsCsv(const std::filesystem::path& path) const {
+    std::ofstream f(path);
+    if (!f)
+        return Error{ErrorCode::IoError, "cannot write " + path.string()};
+    f << "object,frame,impacts_merged,queue_ms,cell_ms,boolean_ms,islands_ms,decomposition_ms,adoption_ms,"
+         "total_"
+         "ms,pieces,stale\n";
+    for (const auto& r : impl_->timings)
+        f << r.object << ',' << r.frame << ',' << r.impactsMerged << ',' << r.queueMs << ',' << r.cellMs
+          << ',' << r.booleanMs << ',' << r.islandsMs << ',' << r.decompositionMs << ',' << r.adoptionMs
+          << ',' << r.totalMs << ',' << r.pieces << ',' << (r.stale ? 1 : 0) << '\n';
+    if (!f)
+        return Error{ErrorCode::IoError, "write failed: " + path.string()};
+    return Status::ok();
+}
+
+} // namespace rubble

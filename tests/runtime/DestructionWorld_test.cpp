@@ -1,0 +1,183 @@
+#include "rubble/DestructionWorld.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "TestSupport.hpp"
+#include "rubble/MassProperties.hpp"
+#include "rubble/ThreadPool.hpp"
+
+namespace rubble {
+namespace {
+
+/// Runs jobs only when the test says so (deterministic interleavings).
+class HeldJobs final : public JobSystem {
+public:
+    void submit(std::function<void()> job) override { held.push_back(std::move(job)); }
+    int workerCount() const override { return 1; }
+    void runAll() {
+        auto jobs = std::move(held);
+        held.clear();
+        for (auto& j : jobs)
+            j();
+    }
+    std::vector<std::function<void()>> held;
+};
+
+DestructionWorld::Config heldConfig(HeldJobs& jobs) {
+    DestructionWorld::Config c;
+    c.jobs = &jobs;
+    return c;
+}
+
+ObjectDesc boxDesc() {
+    ObjectDesc d;
+    d.mesh = makeSubdividedBox({-1, -1, -1}, {1, 1, 1}, 3);
+    d.density = 2;
+    d.impulseThreshold = 1;
+    return d;
+}
+
+Impact centreHit() {
+    Impact i;
+    i.point = {0, 0, 1};
+    i.normal = {0, 0, 1};
+    i.impulse = 10;
+    return i;
+}
+
+TEST(DestructionWorld, ImpactBelowThresholdIgnored) {
+    HeldJobs jobs;
+    DestructionWorld w(heldConfig(jobs));
+    auto id = w.addObject(boxDesc());
+    ASSERT_TRUE(id);
+    Impact i = centreHit();
+    i.impulse = 0.5;
+    EXPECT_FALSE(w.submitImpact(id.value(), i));
+    EXPECT_EQ(w.jobsInFlight(), 0);
+}
+
+TEST(DestructionWorld, OpenMeshIsIndestructible) {
+    HeldJobs jobs;
+    DestructionWorld w(heldConfig(jobs));
+    ObjectDesc d = boxDesc();
+    d.mesh.triangles.pop_back();
+    auto id = w.addObject(d);
+    ASSERT_TRUE(id);
+    ASSERT_NE(w.object(id.value()), nullptr);
+    EXPECT_FALSE(w.object(id.value())->destructible);
+    EXPECT_FALSE(w.object(id.value())->warning.empty());
+    EXPECT_FALSE(w.submitImpact(id.value(), centreHit()));
+}
+
+TEST(DestructionWorld, ImpactConservesVolumeAndMass) {
+    HeldJobs jobs;
+    DestructionWorld w(heldConfig(jobs));
+    auto id = w.addObject(boxDesc()).value();
+    const double v0 = w.object(id)->mass.volume;
+    ASSERT_TRUE(w.submitImpact(id, centreHit()));
+    jobs.runAll();
+    w.beginFrame();
+    auto out = w.collect();
+    ASSERT_EQ(out.size(), 1u);
+    EXPECT_EQ(w.object(id), nullptr);
+    double v = out[0].droppedVolume;
+    for (ObjectId p : out[0].pieces) {
+        ASSERT_NE(w.object(p), nullptr);
+        v += w.object(p)->mass.volume;
+        EXPECT_NEAR(length(w.object(p)->mass.centerOfMass), 0, 1e-9);
+        EXPECT_EQ(w.object(p)->density, 2);
+    }
+    EXPECT_NEAR(v, v0, 1e-6 * v0);
+    ASSERT_EQ(w.timings().size(), 1u);
+}
+
+TEST(DestructionWorld, ImpactsDuringJobAreMergedNotLost) {
+    HeldJobs jobs;
+    DestructionWorld w(heldConfig(jobs));
+    auto id = w.addObject(boxDesc()).value();
+    ASSERT_TRUE(w.submitImpact(id, centreHit()));
+    Impact j = centreHit();
+    j.point = {1, 0, 0};
+    j.normal = {1, 0, 0};
+    ASSERT_TRUE(w.submitImpact(id, j));
+    Impact k = j;
+    k.point = {-1, 0, 0};
+    k.normal = {-1, 0, 0};
+    ASSERT_TRUE(w.submitImpact(id, k));
+    jobs.runAll();
+    w.beginFrame();
+    ASSERT_EQ(w.collect().size(), 1u);
+    // The two waiting impacts were forwarded to pieces: a job is in flight for them.
+    EXPECT_GE(w.jobsInFlight(), 1);
+    for (int round = 0; round < 4 && w.jobsInFlight() > 0; ++round) {
+        jobs.runAll();
+        w.beginFrame();
+        w.collect();
+    }
+    int handled = 0;
+    for (const auto& r : w.timings())
+        handled += r.impactsMerged;
+    EXPECT_EQ(handled, 3);
+}
+
+TEST(DestructionWorld, StaleResultDiscarded) {
+    HeldJobs jobs;
+    DestructionWorld w(heldConfig(jobs));
+    auto id = w.addObject(boxDesc()).value();
+    ASSERT_TRUE(w.submitImpact(id, centreHit()));
+    w.removeObject(id);
+    jobs.runAll();
+    w.beginFrame();
+    EXPECT_TRUE(w.collect().empty());
+    ASSERT_EQ(w.timings().size(), 1u);
+    EXPECT_TRUE(w.timings()[0].stale);
+}
+
+std::vector<std::uint64_t> pieceHashes(DestructionWorld::Config cfg) {
+    DestructionWorld w(cfg);
+    auto id = w.addObject(boxDesc()).value();
+    EXPECT_TRUE(w.submitImpact(id, centreHit()));
+    w.waitIdle();
+    std::vector<std::uint64_t> h;
+    for (int f = 0; f < 5; ++f) {
+        w.beginFrame();
+        for (const auto& o : w.collect())
+            for (ObjectId p : o.pieces)
+                h.push_back(w.object(p)->mesh.hash());
+    }
+    std::sort(h.begin(), h.end());
+    return h;
+}
+
+TEST(DestructionWorld, DeterministicAcrossWorkerCounts) {
+    DestructionWorld::Config one;
+    one.workers = 1;
+    DestructionWorld::Config two;
+    two.workers = 2;
+    DestructionWorld::Config det;
+    det.workers = 2;
+    det.deterministic = true;
+    const auto a = pieceHashes(one);
+    EXPECT_FALSE(a.empty());
+    EXPECT_EQ(a, pieceHashes(two));
+    EXPECT_EQ(a, pieceHashes(det));
+}
+
+TEST(DestructionWorld, DestroyWithJobsInFlight) {
+    {
+        DestructionWorld::Config cfg;
+        cfg.workers = 1;
+        DestructionWorld w(cfg);
+        for (int i = 0; i < 3; ++i) {
+            auto id = w.addObject(boxDesc()).value();
+            w.submitImpact(id, centreHit());
+        }
+    }
+    SUCCEED();
+}
+
+} // namespace
+} // namespace rubble
