@@ -10,6 +10,7 @@
 
 #include "rubble/MassProperties.hpp"
 #include "rubble/MeshCheck.hpp"
+#include "rubble/MeshRepair.hpp"
 #include "rubble/Random.hpp"
 #include "rubble/ThreadPool.hpp"
 
@@ -222,7 +223,19 @@ Result<ObjectId> DestructionWorld::addObject(ObjectDesc desc) {
     s.impulseThreshold = desc.impulseThreshold;
     s.fracture = desc.fracture;
     CheckOptions opts;
-    const MeshReport report = checkMesh(desc.mesh, opts);
+    MeshReport report = checkMesh(desc.mesh, opts);
+    if (!report.valid()) {
+        Mesh repaired = desc.mesh;
+        repairMesh(repaired);
+        MeshReport again = checkMesh(repaired, opts);
+        if (again.valid()) {
+            s.warning = "mesh was repaired: " +
+                        (report.problems.empty() ? std::string("invalid") : report.problems.front());
+            std::fprintf(stderr, "rubble: warning: object %u: %s\n", s.id, s.warning.c_str());
+            desc.mesh = std::move(repaired);
+            report = std::move(again);
+        }
+    }
     if (!report.valid()) {
         s.destructible = false;
         s.warning = "mesh is not a valid closed solid";
