@@ -123,6 +123,39 @@ TEST(DestructionWorld, ImpactsDuringJobAreMergedNotLost) {
     EXPECT_EQ(handled, 3);
 }
 
+TEST(DestructionWorld, ImpactsWaitingOnAFailedJobAreMergedIntoOneJob) {
+    HeldJobs jobs;
+    DestructionWorld w(heldConfig(jobs));
+    auto id = w.addObject(boxDesc()).value();
+    Impact miss = centreHit();
+    miss.point = {50, 50, 50}; // the cells miss the mesh: the job fails and the object stays
+    ASSERT_TRUE(w.submitImpact(id, miss));
+    Impact j = centreHit();
+    j.point = {1, 0, 0};
+    j.normal = {1, 0, 0};
+    Impact k = j;
+    k.point = {-1, 0, 0};
+    k.normal = {-1, 0, 0};
+    ASSERT_TRUE(w.submitImpact(id, j));
+    ASSERT_TRUE(w.submitImpact(id, k));
+    jobs.runAll();
+    w.beginFrame();
+    EXPECT_TRUE(w.collect().empty());
+    ASSERT_NE(w.object(id), nullptr);
+    ASSERT_EQ(w.jobsInFlight(), 1);
+    jobs.runAll();
+    w.beginFrame();
+    const auto out = w.collect();
+    ASSERT_EQ(out.size(), 1u);
+    EXPECT_EQ(out[0].impacts.size(), 2u);
+    ASSERT_EQ(w.timings().size(), 2u);
+    EXPECT_EQ(w.timings()[1].impactsMerged, 2);
+    double v = out[0].droppedVolume;
+    for (ObjectId p : out[0].pieces)
+        v += w.object(p)->mass.volume;
+    EXPECT_NEAR(v, 8.0, 8e-6);
+}
+
 TEST(DestructionWorld, StaleResultDiscarded) {
     HeldJobs jobs;
     DestructionWorld w(heldConfig(jobs));
