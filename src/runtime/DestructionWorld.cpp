@@ -47,7 +47,8 @@ struct Job {
     FractureParams params;
     DecompositionParams decomposition;
     std::uint64_t seed = 0;
-    std::uint64_t frame = 0;
+    std::uint64_t frame = 0;      // frame of the first impact (timing records)
+    std::uint64_t readyFrame = 0; // deterministic mode: adopted at this frame
     Clock::time_point submitted;
     // outputs (written by the worker, read by the main thread after `finished` under Sync::mutex)
     bool finished = false;
@@ -143,6 +144,20 @@ struct DestructionWorld::Impl {
     std::vector<std::shared_ptr<Job>> inflight;             // in submission order
     std::vector<TimingRecord> timings;
 
+    // Impacts that can no longer run (their object is gone) still leave a stale timing record, so that every
+    // accepted impact is accounted for in exactly one record.
+    void recordDropped(ObjectId id, const std::vector<PendingImpact>& impacts) {
+        if (impacts.empty())
+            return;
+        TimingRecord rec;
+        rec.object = id;
+        rec.frame = impacts.front().frame;
+        rec.impactsMerged = static_cast<int>(impacts.size());
+        rec.stale = true;
+        rec.totalMs = msBetween(impacts.front().time, Clock::now());
+        timings.push_back(rec);
+    }
+
     bool busy(ObjectId id) const {
         return std::any_of(inflight.begin(), inflight.end(), [&](const auto& j) { return j->id == id; });
     }
@@ -159,6 +174,9 @@ struct DestructionWorld::Impl {
         job->decomposition = config.decomposition;
         job->seed = mixSeed(mixSeed(config.seed, id), o.version);
         job->frame = job->impacts.front().frame;
+        // Adopted delayFrames after the launch (not after the first impact: impacts forwarded to pieces or
+        // re-run after a failed job would otherwise be due at once and block the main thread).
+        job->readyFrame = frame + static_cast<std::uint64_t>(std::max(0, config.delayFrames));
         job->submitted = Clock::now();
         inflight.push_back(job);
         {
@@ -258,7 +276,10 @@ Result<ObjectId> DestructionWorld::addObject(ObjectDesc desc) {
 
 void DestructionWorld::removeObject(ObjectId id) {
     impl_->objects.erase(id);
-    impl_->waiting.erase(id);
+    if (auto w = impl_->waiting.find(id); w != impl_->waiting.end()) {
+        impl_->recordDropped(id, w->second);
+        impl_->waiting.erase(w);
+    }
 }
 
 const ObjectState* DestructionWorld::object(ObjectId id) const {
@@ -303,7 +324,7 @@ std::vector<FractureOutcome> DestructionWorld::collect() {
     for (std::size_t k = 0; k < im.inflight.size();) {
         auto job = im.inflight[k];
         if (im.config.deterministic) {
-            if (job->frame + static_cast<std::uint64_t>(std::max(0, im.config.delayFrames)) > im.frame) {
+            if (job->readyFrame > im.frame) {
                 ++k;
                 continue;
             }
@@ -360,7 +381,9 @@ std::vector<FractureOutcome> DestructionWorld::collect() {
                 im.objects.emplace(s.id, std::move(s));
             }
             // Impacts that arrived while this job ran go to the piece nearest to their point.
-            for (auto& p : later) {
+            if (o.pieces.empty())
+                im.recordDropped(job->id, later);
+            for (auto& p : o.pieces.empty() ? std::vector<PendingImpact>{} : later) {
                 double best = 1e300;
                 std::size_t bi = 0;
                 for (std::size_t i = 0; i < o.pieces.size(); ++i) {
@@ -372,8 +395,6 @@ std::vector<FractureOutcome> DestructionWorld::collect() {
                     if (d < best)
                         best = d, bi = i;
                 }
-                if (o.pieces.empty())
-                    break;
                 const Frame& f = o.pieceFrames[bi];
                 PendingImpact q = p;
                 q.impact.point = f.rotation.transposed() * (p.impact.point - f.translation);
@@ -390,12 +411,15 @@ std::vector<FractureOutcome> DestructionWorld::collect() {
         }
         // A failed or stale job: impacts that waited on it run now on the (unchanged) object if it still
         // exists.
-        if (!later.empty() && im.objects.count(job->id))
+        const bool relaunch = !later.empty() && im.objects.count(job->id) > 0;
+        if (relaunch)
             im.launch(job->id, std::move(later));
         const auto a1 = Clock::now();
         rec.adoptionMs = msBetween(a0, a1);
         rec.totalMs = msBetween(job->impacts.front().time, a1);
         im.timings.push_back(rec);
+        if (!relaunch)
+            im.recordDropped(job->id, later);
     }
     return out;
 }

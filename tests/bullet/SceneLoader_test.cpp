@@ -91,6 +91,54 @@ TEST(SceneLoader, LoadsTheProjectsScenes) {
     }
 }
 
+TEST(SceneLoader, SeedScenesLoadAsTheyAreWithWarningsForMissingFiles) {
+    RUBBLE_REQUIRE_SEED_MEDIA(media);
+    for (const char* name : {"world.cfg", "cube_test.cfg", "performance_test.cfg"}) {
+        Result<SceneConfig> scene = parseSceneConfig(media / name);
+        ASSERT_TRUE(scene) << name << ": " << scene.error().message;
+        World w;
+        const LoadedScene loaded = loadScene(*scene, *w.bridge);
+        EXPECT_EQ(loaded.objects.size(), scene->objects.size()) << name;
+        // the missing vehicle model and ground texture are named with file and line
+        EXPECT_TRUE(anyContains(loaded.warnings, std::string(name) + ":3")) << name;
+        EXPECT_TRUE(anyContains(loaded.warnings, "fighter.3ds")) << name;
+        EXPECT_TRUE(anyContains(loaded.warnings, "grid.jpg")) << name;
+        EXPECT_NE(loaded.vehicle, nullptr) << name; // a stand-in
+        for (int i = 0; i < 10; ++i)
+            w.bridge->stepFrame();
+    }
+}
+
+TEST(SceneLoader, PrepareMeshHookSeesEveryObjectAndIndicesMapToTheScene) {
+    const std::string text = "a.jpg;b.jpg;c.jpg;d.jpg;e.jpg;f.jpg\n"
+                             ";grid.jpg;0;-15;0;1000;10;1000;0\n"
+                             "nothing.3ds;;0;20;0;0.5;0.5;0.5;100\n"
+                             "cube_12.obj;;-5;-9;0;1;1;1;0\n"
+                             "no_such_model.obj;;3;-8;1;2;4;6;50\n";
+    Result<SceneConfig> scene =
+        parseSceneConfigText(text, "test.cfg", test::sourceDir() / "assets" / "models");
+    ASSERT_TRUE(scene) << scene.error().message;
+    World w;
+    SceneLoadOptions options;
+    int calls = 0;
+    options.prepareMesh = [&](Mesh& m) {
+        ++calls;
+        m.uvs.assign(m.triangles.size() * 3, Vec2{0.25, 0.5});
+    };
+    const LoadedScene loaded = loadScene(*scene, *w.bridge, options);
+    EXPECT_EQ(calls, 2);
+    ASSERT_EQ(loaded.sceneIndex.size(), loaded.objects.size());
+    ASSERT_EQ(loaded.objects.size(), 2u);
+    EXPECT_EQ(loaded.sceneIndex[0], 0u);
+    EXPECT_EQ(loaded.sceneIndex[1], 1u);
+    for (ObjectId id : loaded.objects) {
+        const ObjectState* st = w.destruction->object(id);
+        ASSERT_NE(st, nullptr);
+        ASSERT_FALSE(st->mesh.uvs.empty());
+        EXPECT_EQ(st->mesh.uvs.front().x, 0.25);
+    }
+}
+
 #else
 TEST(SceneLoader, NeedsTheRuntime) {
     GTEST_SKIP() << "src/runtime has no implementation yet";

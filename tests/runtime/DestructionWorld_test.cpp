@@ -7,6 +7,7 @@
 
 #include "TestSupport.hpp"
 #include "rubble/MassProperties.hpp"
+#include "rubble/Random.hpp"
 #include "rubble/ThreadPool.hpp"
 
 namespace rubble {
@@ -210,6 +211,111 @@ TEST(DestructionWorld, DestroyWithJobsInFlight) {
         }
     }
     SUCCEED();
+}
+
+TEST(DestructionWorld, RemoveObjectRecordsItsWaitingImpacts) {
+    HeldJobs jobs;
+    DestructionWorld w(heldConfig(jobs));
+    auto id = w.addObject(boxDesc()).value();
+    ASSERT_TRUE(w.submitImpact(id, centreHit())); // runs
+    Impact j = centreHit();
+    j.point = {1, 0, 0};
+    ASSERT_TRUE(w.submitImpact(id, j)); // waits
+    ASSERT_TRUE(w.submitImpact(id, j)); // waits
+    w.removeObject(id);
+    ASSERT_EQ(w.timings().size(), 1u); // the two waiting impacts, recorded at once
+    EXPECT_TRUE(w.timings()[0].stale);
+    EXPECT_EQ(w.timings()[0].impactsMerged, 2);
+    EXPECT_EQ(w.timings()[0].object, id);
+    jobs.runAll();
+    w.beginFrame();
+    EXPECT_TRUE(w.collect().empty());
+    EXPECT_EQ(w.jobsInFlight(), 0);
+    ASSERT_EQ(w.timings().size(), 2u); // and the running job, discarded as stale
+    EXPECT_TRUE(w.timings()[1].stale);
+    EXPECT_EQ(w.timings()[1].impactsMerged, 1);
+}
+
+TEST(DestructionWorld, DeterministicModeAdoptsExactlyDelayFramesAfterLaunch) {
+    DestructionWorld::Config cfg;
+    cfg.workers = 2;
+    cfg.deterministic = true;
+    cfg.delayFrames = 3;
+    DestructionWorld w(cfg);
+    auto id = w.addObject(boxDesc()).value();
+    ASSERT_TRUE(w.submitImpact(id, centreHit())); // frame 0
+    Impact j = centreHit();
+    j.point = {1, 0.2, 0.1};
+    j.normal = {1, 0, 0};
+    ASSERT_TRUE(w.submitImpact(id, j)); // waits for the first job
+    w.waitIdle();                       // ready long before it is due
+    std::vector<std::uint64_t> adoptedAt;
+    for (int f = 0; f < 12; ++f) {
+        w.beginFrame();
+        for (const auto& o : w.collect()) {
+            (void)o;
+            adoptedAt.push_back(w.frame());
+        }
+        w.waitIdle();
+    }
+    // the first at frame 3; the waiting impact is forwarded to a piece at frame 3 and adopted 3 frames later
+    ASSERT_EQ(adoptedAt.size(), 2u);
+    EXPECT_EQ(adoptedAt[0], 3u);
+    EXPECT_EQ(adoptedAt[1], 6u);
+}
+
+TEST(DestructionWorld, JobsOutlivingTheWorldAreHarmless) {
+    HeldJobs jobs; // a foreign job system that runs the jobs after the world is gone
+    {
+        DestructionWorld w(heldConfig(jobs));
+        for (int i = 0; i < 3; ++i) {
+            auto id = w.addObject(boxDesc()).value();
+            ASSERT_TRUE(w.submitImpact(id, centreHit()));
+        }
+        ASSERT_EQ(jobs.held.size(), 3u);
+    }
+    jobs.runAll(); // must neither crash nor touch freed memory (checked under ASan/TSan)
+    SUCCEED();
+}
+
+TEST(DestructionWorld, EveryAcceptedImpactEndsInExactlyOneRecord) {
+    // Random submissions and removals on a real pool: after draining, the records account for every accepted
+    // impact (adopted, merged, forwarded to pieces, stale or dropped with its object).
+    DestructionWorld::Config cfg;
+    cfg.workers = 2;
+    DestructionWorld w(cfg);
+    Rng rng(5);
+    for (int i = 0; i < 3; ++i)
+        ASSERT_TRUE(w.addObject(boxDesc()));
+    int accepted = 0;
+    for (int f = 0; f < 40; ++f) {
+        const auto ids = w.objects();
+        if (ids.empty())
+            break;
+        const ObjectId id = ids[rng.below(ids.size())];
+        const Aabb b = w.object(id)->mesh.bounds();
+        Impact im;
+        im.point = b.center();
+        im.normal = {0, 0, 1};
+        im.impulse = 10;
+        if (w.submitImpact(id, im))
+            ++accepted;
+        if (rng.uniform(0, 1) < 0.15)
+            w.removeObject(ids.front());
+        w.beginFrame();
+        w.collect();
+    }
+    for (int round = 0; round < 50 && w.jobsInFlight() > 0; ++round) {
+        w.waitIdle();
+        w.beginFrame();
+        w.collect();
+    }
+    EXPECT_EQ(w.jobsInFlight(), 0);
+    int recorded = 0;
+    for (const auto& r : w.timings())
+        recorded += r.impactsMerged;
+    EXPECT_GT(accepted, 10);
+    EXPECT_EQ(recorded, accepted);
 }
 
 } // namespace

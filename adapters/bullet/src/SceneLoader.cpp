@@ -56,8 +56,11 @@ LoadedScene loadScene(const SceneConfig& scene, DestructionBridge& bridge, const
             out.warnings.push_back(where(scene, scene.vehicle) + ": vehicle skipped (" +
                                    body.error().message + ")");
     }
-    for (const SceneObject& o : scene.objects) {
+    for (std::size_t index = 0; index < scene.objects.size(); ++index) {
+        const SceneObject& o = scene.objects[index];
         Mesh mesh = modelOrStandIn(scene, o, out.warnings);
+        if (options.prepareMesh)
+            options.prepareMesh(mesh);
         const double volume = std::abs(signedVolume(mesh));
         ObjectDesc desc;
         desc.density = o.isStatic() || volume <= 0 ? options.staticDensity : o.mass / volume;
@@ -72,6 +75,8 @@ LoadedScene loadScene(const SceneConfig& scene, DestructionBridge& bridge, const
             const Vec3 h = o.scale * 0.5;
             ObjectDesc box;
             box.mesh = makeBox(-h, h);
+            if (options.prepareMesh)
+                options.prepareMesh(box.mesh);
             box.destructible = false;
             box.density = o.isStatic() ? options.staticDensity : o.mass / std::max(1e-9, 8 * h.x * h.y * h.z);
             id = bridge.addObject(std::move(box), Frame{Mat3::identity(), o.position}, o.isStatic());
@@ -83,6 +88,7 @@ LoadedScene loadScene(const SceneConfig& scene, DestructionBridge& bridge, const
         if (Body* b = bridge.bodyOf(*id))
             out.initialVolume += b->volume;
         out.objects.push_back(*id);
+        out.sceneIndex.push_back(index);
     }
     return out;
 }

@@ -2,6 +2,8 @@
 /// \file SceneLoader.hpp
 /// Builds bodies from a parsed world.cfg scene (SceneConfig): ground box, vehicle, destructible objects.
 
+#include <cstddef>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -17,16 +19,20 @@ struct SceneLoadOptions {
     double staticDensity = 200;   ///< density (kg/m³) of static objects, used by their moving pieces
     double impulseThreshold = 50; ///< ObjectDesc::impulseThreshold of every object
     FractureParams fracture;      ///< ObjectDesc::fracture of every object
+    std::function<void(Mesh&)>
+        prepareMesh; ///< called on every object mesh (scaled, object coordinates) before it is added, e.g.
+                     ///< to generate texture coordinates; may be empty
 };
 
 /// What loading produced.
 struct LoadedScene {
-    Body* ground = nullptr;            ///< the ground box (null when the scene has none)
-    Body* vehicle = nullptr;           ///< the vehicle (null when not loaded)
-    double groundTop = 0;              ///< height of the ground's top face
-    std::vector<ObjectId> objects;     ///< objects in file order (stand-ins included)
-    std::vector<std::string> warnings; ///< missing files, stand-ins, meshes made indestructible
-    double initialVolume = 0;          ///< Σ object volumes at load
+    Body* ground = nullptr;              ///< the ground box (null when the scene has none)
+    Body* vehicle = nullptr;             ///< the vehicle (null when not loaded)
+    double groundTop = 0;                ///< height of the ground's top face
+    std::vector<ObjectId> objects;       ///< objects in file order (stand-ins included)
+    std::vector<std::size_t> sceneIndex; ///< for each of objects: its index in SceneConfig::objects
+    std::vector<std::string> warnings;   ///< missing files, stand-ins, meshes made indestructible
+    double initialVolume = 0;            ///< Σ object volumes at load
 };
 
 /// Loads a scene. The ground line gives a static box of full size (sx, sy, sz) centred at (x, y, z); the
