@@ -55,6 +55,23 @@ Result<std::vector<NamedMesh>> readObjObjects(const std::filesystem::path& path)
 /// kInteriorMaterial is "interior" with its own colour. Triangles keep their order.
 Status writeObj(const std::filesystem::path& path, const Mesh& mesh, const ObjWriteOptions& options = {});
 
+/// One node of a glTF scene written by writeGltf.
+struct GltfNode {
+    std::string name; ///< node and mesh name (e.g. "piece_000")
+    Mesh mesh;        ///< closed or open triangles in scene coordinates; must not be empty
+    Vec3 origin;      ///< where the node is placed (e.g. the piece's centre of mass); the mesh is stored
+                      ///< relative to it, so that a node's translation is `origin`
+};
+
+/// Writes a self-contained glTF 2.0 file (one embedded base64 buffer): one node per GltfNode, translated to
+/// its origin, each with a mesh of up to two primitives, one per material: "surface" (every material id but
+/// kInteriorMaterial) and "interior" (kInteriorMaterial, i.e. cut faces). Every primitive has POSITION
+/// (float, relative to the origin), NORMAL (unit; flat face normals when the mesh has none), TEXCOORD_0
+/// (V flipped to glTF's top-left origin; (0, 0) when the mesh has none) and uint32 indices; corners with
+/// equal position, normal and UV share a vertex. Output is byte-identical for identical input. Errors:
+/// InvalidInput for an empty or invalid mesh, IoError naming the file.
+Status writeGltf(const std::filesystem::path& path, const std::vector<GltfNode>& nodes);
+
 /// Reads a mesh by extension: .obj with readObj; .off, .stl, .ply, .3ds, .gltf and .glb through Assimp
 /// (triangulated, positions welded exactly, node transforms applied). Size claims in headers (binary STL
 /// triangle count, PLY element counts, OFF counts, 3DS chunk lengths, glTF buffer/accessor lengths) are
