@@ -2,25 +2,11 @@
 // degenerate ones (planes through vertices, axis-aligned faces, tiny and huge cells). Whenever the clipper
 // accepts a configuration, both outputs must be closed, consistently oriented and conserve volume.
 #include <cstdint>
-#include <map>
 
+#include "FuzzChecks.hpp"
 #include "FuzzInput.hpp"
 #include "fracture/ConvexCellClipper.hpp"
 #include "rubble/MassProperties.hpp"
-
-namespace {
-bool closedAndOriented(const rubble::Mesh& m) {
-    std::map<std::pair<std::uint32_t, std::uint32_t>, int> directed;
-    for (const rubble::Triangle& t : m.triangles)
-        for (int c = 0; c < 3; ++c)
-            if (++directed[{t[c], t[(c + 1) % 3]}] > 1)
-                return false;
-    for (const auto& [e, count] : directed)
-        if (!directed.count({e.second, e.first}))
-            return false;
-    return true;
-}
-} // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     using namespace rubble;
@@ -66,7 +52,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const double vo = split->outside.empty() ? 0.0 : signedVolume(split->outside);
     if (std::abs(vi + vo - v) > 1e-9 * v || vi < 0 || vo < 0)
         __builtin_trap();
-    if (!closedAndOriented(split->inside) || !closedAndOriented(split->outside))
+    if (!fuzz::closedAndOriented(split->inside) || !fuzz::closedAndOriented(split->outside))
         __builtin_trap();
     return 0;
 }
