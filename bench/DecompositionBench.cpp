@@ -7,16 +7,14 @@
 // thesis's program measured on this machine, with the speed-up of the incremental update against them.
 // Table on stdout, CSV in DIR/decomposition.csv, plot in DIR/decomposition.png (gnuplot).
 #include <algorithm>
-#include <chrono>
-#include <cstdio>
-#include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <map>
 #include <memory>
 #include <optional>
+#include <sstream>
 
+#include "BenchUtil.hpp"
 #include "Subcommand.hpp"
 #include "rubble/ConvexDecomposition.hpp"
 #include "rubble/Fracture.hpp"
@@ -26,33 +24,15 @@
 namespace {
 
 namespace fs = std::filesystem;
-using Clock = std::chrono::steady_clock;
+using rubble::bench::fixed;
+using rubble::bench::Stats;
+using rubble::bench::timeIt;
 
 struct BenchArgs {
     bool quick = false;
     int runs = 15;
-    std::string out = RUBBLE_SOURCE_DIR "/bench/results";
+    std::string out = rubble::bench::kResultsDir;
 };
-
-struct Stats {
-    double median = 0, min = 0, max = 0;
-};
-
-Stats stats(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return {v[v.size() / 2], v.front(), v.back()};
-}
-
-template <class F>
-Stats timeIt(int runs, F&& f) {
-    std::vector<double> ms;
-    for (int i = 0; i < runs; ++i) {
-        const auto t0 = Clock::now();
-        f();
-        ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
-    }
-    return stats(ms);
-}
 
 /// The Voronoi cell of `site` among 15 random sites in a cube of edge `size` around it.
 rubble::ConvexPolytope voronoiCell(const rubble::Vec3& site, double size, std::uint64_t seed) {
@@ -151,79 +131,50 @@ int runBench(const BenchArgs& args) {
         std::cout << "(seed media not found at " << media.string() << ": seed models skipped)\n";
     }
 
-    std::printf("%-14s %6s %5s %7s | %-24s | %-24s | %9s %9s %8s %8s\n", "model", "tris", "parts", "excess",
-                "initial ms (med/min/max)", "update ms (med/min/max)", "thesis s", "seed s", "x thesis",
-                "x seed");
+    rubble::bench::Table table{{"model", "tris", "parts", "excess", "initial med ms", "min", "max",
+                                "update med ms", "min", "max", "thesis s", "seed s", "x thesis", "x seed"},
+                               {}};
+    rubble::bench::Table csv{{"model", "triangles", "parts", "excess", "runs", "initial_median_ms",
+                              "initial_min_ms", "initial_max_ms", "update_median_ms", "update_min_ms",
+                              "update_max_ms", "updated_parts", "pieces", "thesis_hacd_s", "seed_program_s",
+                              "speedup_vs_thesis", "speedup_vs_seed"},
+                             {}};
+    auto str = [](auto v) {
+        std::ostringstream o;
+        o << v;
+        return o.str();
+    };
+    std::ostringstream data;
     for (const Row& r : rows) {
-        char ref[96] = "";
-        if (r.thesisS > 0)
-            std::snprintf(ref, sizeof ref, "%9.3f %9.3f %8.0f %8.0f", r.thesisS, r.seedS,
-                          r.thesisS * 1000 / r.update.median, r.seedS * 1000 / r.update.median);
-        std::printf("%-14s %6zu %5zu %7.4f | %7.3f %7.3f %8.3f | %7.3f %7.3f %8.3f | %s\n", r.name.c_str(),
-                    r.triangles, r.parts, r.excess, r.initial.median, r.initial.min, r.initial.max,
-                    r.update.median, r.update.min, r.update.max, ref);
+        const bool ref = r.thesisS > 0;
+        const double xThesis = ref ? r.thesisS * 1000 / r.update.median : -1;
+        const double xSeed = ref ? r.seedS * 1000 / r.update.median : -1;
+        table.rows.push_back({r.name, str(r.triangles), str(r.parts), fixed(r.excess, 4),
+                              fixed(r.initial.median), fixed(r.initial.min), fixed(r.initial.max),
+                              fixed(r.update.median), fixed(r.update.min), fixed(r.update.max),
+                              ref ? fixed(r.thesisS) : "", ref ? fixed(r.seedS) : "", fixed(xThesis, 0),
+                              fixed(xSeed, 0)});
+        csv.rows.push_back({r.name, str(r.triangles), str(r.parts), str(r.excess), str(runs),
+                            str(r.initial.median), str(r.initial.min), str(r.initial.max),
+                            str(r.update.median), str(r.update.min), str(r.update.max), str(r.updatedParts),
+                            r.pieces, ref ? str(r.thesisS) : "", ref ? str(r.seedS) : "",
+                            ref ? str(xThesis) : "", ref ? str(xSeed) : ""});
+        if (ref)
+            data << r.triangles << " " << r.initial.median << " " << r.update.median << " "
+                 << r.thesisS * 1000 << " " << r.seedS * 1000 << "\n";
     }
-    std::printf(
-        "runs per case: %d; update = parent parts clipped by one cell, fragments assigned to %s pieces\n",
-        runs, rows.empty() ? "" : rows[0].pieces.c_str());
-
-    std::error_code ec;
-    fs::create_directories(args.out, ec);
-    const fs::path csv = fs::path(args.out) / "decomposition.csv";
-    std::ofstream out(csv);
-    if (!out) {
-        std::cerr << "decomposition: cannot write " << csv.string() << "\n";
+    rubble::bench::printTable(table);
+    std::cout << "runs per case: " << runs
+              << "; update = parent parts clipped by one cell, fragments assigned to "
+              << (rows.empty() ? "" : rows[0].pieces) << " pieces\n";
+    if (!rubble::bench::writeCsv(fs::path(args.out) / "decomposition.csv", csv))
         return 1;
-    }
-    out << "model,triangles,parts,excess,runs,initial_median_ms,initial_min_ms,initial_max_ms,update_median_"
-           "ms,"
-           "update_min_ms,update_max_ms,updated_parts,pieces,thesis_hacd_s,seed_program_s,speedup_vs_thesis,"
-           "speedup_vs_seed\n";
-    for (const Row& r : rows) {
-        out << r.name << "," << r.triangles << "," << r.parts << "," << r.excess << "," << runs << ","
-            << r.initial.median << "," << r.initial.min << "," << r.initial.max << "," << r.update.median
-            << "," << r.update.min << "," << r.update.max << "," << r.updatedParts << ",\"" << r.pieces
-            << "\",";
-        if (r.thesisS > 0)
-            out << r.thesisS << "," << r.seedS << "," << r.thesisS * 1000 / r.update.median << ","
-                << r.seedS * 1000 / r.update.median;
-        else
-            out << ",,,";
-        out << "\n";
-    }
-    out.close();
-    std::cout << "CSV: " << csv.string() << "\n";
-
-    if (std::system("command -v gnuplot >/dev/null 2>&1") != 0) {
-        std::cout << "gnuplot not found: plot skipped\n";
-        return 0;
-    }
-    const fs::path dat = fs::path(args.out) / "decomposition_cubes.dat";
-    {
-        std::ofstream d(dat);
-        for (const Row& r : rows)
-            if (r.thesisS > 0)
-                d << r.triangles << " " << r.initial.median << " " << r.update.median << " "
-                  << r.thesisS * 1000 << " " << r.seedS * 1000 << "\n";
-    }
-    const fs::path png = fs::path(args.out) / "decomposition.png";
-    const fs::path gp = fs::path(args.out) / "decomposition.gp";
-    {
-        std::ofstream g(gp);
-        g << "set terminal pngcairo size 900,600\nset output '" << png.string() << "'\n"
-          << "set logscale xy\nset xlabel 'cube triangles'\nset ylabel 'time (ms)'\nset grid\n"
-          << "set key top left\nset title 'Convex decomposition: Rubble vs the thesis (HACD)'\n"
-          << "plot '" << dat.string() << "' u 1:4 w lp t 'thesis Table 3.2 (HACD)', '' u 1:5 w lp t "
-          << "'thesis program measured here', '' u 1:2 w lp t 'Rubble initial decomposition', '' u 1:3 w lp "
-             "t "
-          << "'Rubble incremental update'\n";
-    }
-    if (std::system(("gnuplot '" + gp.string() + "' 2>/dev/null").c_str()) == 0)
-        std::cout << "plot: " << png.string() << "\n";
-    else
-        std::cout << "gnuplot failed: plot skipped\n";
-    fs::remove(gp, ec);
-    fs::remove(dat, ec);
+    rubble::bench::plotPng(args.out, "decomposition", data.str(),
+                           "set logscale xy\nset xlabel 'cube triangles'\nset ylabel 'time (ms)'\nset grid\n"
+                           "set key top left\nset title 'Convex decomposition: Rubble vs the thesis (HACD)'\n"
+                           "plot $DATA u 1:4 w lp t 'thesis Table 3.2 (HACD)', '' u 1:5 w lp t "
+                           "'thesis program measured here', '' u 1:2 w lp t 'Rubble initial decomposition', "
+                           "'' u 1:3 w lp t 'Rubble incremental update'");
     return 0;
 }
 

@@ -1,0 +1,121 @@
+#include "BenchUtil.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+
+namespace rubble::bench {
+
+namespace fs = std::filesystem;
+
+Stats stats(std::vector<double> samples) {
+    if (samples.empty())
+        return {};
+    std::sort(samples.begin(), samples.end());
+    return {samples[samples.size() / 2], samples.front(), samples.back()};
+}
+
+double msSince(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+std::string fixed(double v, int digits) {
+    if (v < 0)
+        return "";
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.*f", digits, v);
+    return buf;
+}
+
+void printTable(const Table& table) {
+    std::vector<std::size_t> width(table.header.size(), 0);
+    auto measure = [&](const std::vector<std::string>& row) {
+        for (std::size_t c = 0; c < row.size() && c < width.size(); ++c)
+            width[c] = std::max(width[c], row[c].size());
+    };
+    measure(table.header);
+    for (const auto& row : table.rows)
+        measure(row);
+    auto print = [&](const std::vector<std::string>& row) {
+        std::string line;
+        for (std::size_t c = 0; c < row.size() && c < width.size(); ++c) {
+            const std::string pad(width[c] - row[c].size(), ' ');
+            line += c == 0 ? row[c] + pad : "  " + pad + row[c];
+        }
+        std::cout << line << "\n";
+    };
+    print(table.header);
+    std::size_t total = 0;
+    for (std::size_t w : width)
+        total += w + 2;
+    std::cout << std::string(total > 2 ? total - 2 : 0, '-') << "\n";
+    for (const auto& row : table.rows)
+        print(row);
+}
+
+namespace {
+std::string csvField(const std::string& s) {
+    if (s.find_first_of(",\"\n") == std::string::npos)
+        return s;
+    std::string q = "\"";
+    for (char c : s)
+        q += c == '"' ? std::string("\"\"") : std::string(1, c);
+    return q + "\"";
+}
+} // namespace
+
+bool writeCsv(const fs::path& path, const Table& table) {
+    std::error_code ec;
+    if (path.has_parent_path())
+        fs::create_directories(path.parent_path(), ec);
+    std::ofstream out(path);
+    auto line = [&](const std::vector<std::string>& row) {
+        for (std::size_t c = 0; c < row.size(); ++c)
+            out << (c ? "," : "") << csvField(row[c]);
+        out << "\n";
+    };
+    line(table.header);
+    for (const auto& row : table.rows)
+        line(row);
+    out.close();
+    if (!out) {
+        std::cerr << "cannot write " << path.string() << "\n";
+        return false;
+    }
+    std::cout << "CSV: " << path.string() << "\n";
+    return true;
+}
+
+void plotPng(const fs::path& dir, const std::string& stem, const std::string& data, const std::string& plot) {
+    if (std::system("command -v gnuplot >/dev/null 2>&1") != 0) {
+        std::cout << "gnuplot not found: plot skipped\n";
+        return;
+    }
+    const fs::path dat = dir / (stem + ".dat");
+    const fs::path gp = dir / (stem + ".gp");
+    const fs::path png = dir / (stem + ".png");
+    {
+        std::ofstream d(dat);
+        d << data;
+    }
+    {
+        std::ofstream g(gp);
+        g << "set terminal pngcairo size 900,600\nset output '" << png.string() << "'\nDATA = '"
+          << dat.string() << "'\n";
+        std::string script = plot;
+        for (std::size_t at = script.find("$DATA"); at != std::string::npos; at = script.find("$DATA", at))
+            script.replace(at, 5, "DATA");
+        g << script << "\n";
+    }
+    if (std::system(("gnuplot '" + gp.string() + "' 2>/dev/null").c_str()) == 0)
+        std::cout << "plot: " << png.string() << "\n";
+    else
+        std::cout << "gnuplot failed: plot skipped\n";
+    std::error_code ec;
+    fs::remove(gp, ec);
+    fs::remove(dat, ec);
+}
+
+} // namespace rubble::bench

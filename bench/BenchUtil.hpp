@@ -1,0 +1,62 @@
+#pragma once
+// Helpers shared by the rubble-bench suites: timing statistics, aligned tables on stdout, CSV files and
+// gnuplot PNGs in the results folder.
+
+#include <chrono>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace rubble::bench {
+
+/// The default results folder (bench/results in the source tree).
+inline constexpr const char* kResultsDir = RUBBLE_SOURCE_DIR "/bench/results";
+
+/// Median, minimum and maximum of a set of samples (milliseconds).
+struct Stats {
+    double median = 0; ///< middle sample (upper middle for an even count)
+    double min = 0;    ///< smallest sample
+    double max = 0;    ///< largest sample
+};
+
+/// Statistics of samples; all zero for no samples.
+Stats stats(std::vector<double> samples);
+
+/// Milliseconds since t0 on the steady clock.
+double msSince(std::chrono::steady_clock::time_point t0);
+
+/// Runs f `runs` times and returns the statistics of its wall-clock durations in milliseconds.
+template <class F>
+Stats timeIt(int runs, F&& f) {
+    std::vector<double> ms;
+    for (int i = 0; i < runs; ++i) {
+        const auto t0 = std::chrono::steady_clock::now();
+        f();
+        ms.push_back(msSince(t0));
+    }
+    return stats(ms);
+}
+
+/// A number with `digits` digits after the point ("" for a negative value, meaning "no value").
+std::string fixed(double v, int digits = 3);
+
+/// A table of text cells: printed with aligned columns on stdout, or written as CSV.
+struct Table {
+    std::vector<std::string> header;            ///< column names
+    std::vector<std::vector<std::string>> rows; ///< cells, one vector per row (same length as header)
+};
+
+/// Prints the table with right-aligned columns (first column left-aligned) to stdout.
+void printTable(const Table& table);
+
+/// Writes the table as CSV (fields with commas or quotes are quoted), creating the folder; prints the path.
+/// Returns false (after printing why) when the file cannot be written.
+bool writeCsv(const std::filesystem::path& path, const Table& table);
+
+/// Draws DIR/<stem>.png with gnuplot (pngcairo, 900x600): `data` is written to a temporary data file and
+/// `plot` is a gnuplot script in which $DATA names that file (e.g. "set logscale y\nplot $DATA u 1:2 w lp").
+/// Prints where the plot is, or why it was skipped (no gnuplot, gnuplot failed); temporary files are removed.
+void plotPng(const std::filesystem::path& dir, const std::string& stem, const std::string& data,
+             const std::string& plot);
+
+} // namespace rubble::bench

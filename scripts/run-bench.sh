@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Runs the benchmark suites of a built tree and writes their results into bench/results/ (CSV + PNG).
+# Usage: scripts/run-bench.sh BUILD_DIR   (called by `make bench` with the Release tree)
+# Extra arguments after BUILD_DIR are passed to the decomposition and booleans suites (e.g. --runs 5).
+set -euo pipefail
+root="$(cd "$(dirname "$0")/.." && pwd)"
+build="${1:?usage: scripts/run-bench.sh BUILD_DIR [suite options]}"
+shift
+bench="$build/bin/rubble-bench"
+[ -x "$bench" ] || { echo "run-bench: $bench not found (build the tree first: make release)" >&2; exit 1; }
+results="$root/bench/results"
+mkdir -p "$results"
+
+status=0
+echo "== decomposition"
+"$bench" decomposition --out "$results" "$@" || status=1
+echo
+echo "== booleans"
+"$bench" booleans --out "$results" "$@" || status=1
+if "$bench" --help 2>/dev/null | grep -qE '^ +scene( |$)'; then
+    echo
+    echo "== scene (assets/scenes/cube_test.cfg)"
+    "$bench" scene "$root/assets/scenes/cube_test.cfg" --json >"$results/scene_cube_test.json" || status=1
+    cat "$results/scene_cube_test.json"
+else
+    echo "(rubble-bench has no scene suite in this build: skipped)"
+fi
+echo
+echo "results: $results"
+ls -1 "$results"
+exit $status
