@@ -42,8 +42,9 @@ grep -q "^newmtl interior" "$tmp/a/piece_000.mtl" || fail "piece_000.mtl has no 
 grep -q "^usemtl interior" "$tmp/a/piece_000.obj" || fail "piece_000.obj uses no interior material"
 "$RUBBLE" check "$tmp/a"/piece_*.obj >"$tmp/check.txt" || fail "rubble check rejects the pieces: $(cat "$tmp/check.txt")"
 
-# Same seed: byte-identical files; another seed: different pieces.
-"$RUBBLE" fracture "$models/cube_588.obj" --impact 0.9,0.2,-0.1 --impulse 400 --seed 7 -o "$tmp/b" >/dev/null \
+# Same seed: byte-identical files (also through an output path with a trailing slash); another seed: different
+# pieces.
+"$RUBBLE" fracture "$models/cube_588.obj" --impact 0.9,0.2,-0.1 --impulse 400 --seed 7 -o "$tmp/b/" >/dev/null \
     || fail "second run should exit 0"
 diff -r "$tmp/a" "$tmp/b" >/dev/null || fail "same seed gave different files"
 "$RUBBLE" fracture "$models/cube_588.obj" --impact 0.9,0.2,-0.1 --impulse 400 --seed 8 -o "$tmp/c" >/dev/null \

@@ -2,12 +2,11 @@
 
 #include <cmath>
 #include <cstring>
-#include <fstream>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
 #include "TestSupport.hpp"
+#include "io/FileBytes.hpp"
 #include "rubble/MassProperties.hpp"
 #include "rubble/MeshIO.hpp"
 
@@ -16,10 +15,7 @@ using namespace rubble;
 namespace {
 
 std::string slurp(const std::filesystem::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
+    return io::readFileBytes(p).value();
 }
 
 std::string decodeBase64(const std::string& text) {

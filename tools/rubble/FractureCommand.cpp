@@ -299,7 +299,11 @@ int runFracture(const FractureArgs& args) {
     const auto point = parsePoint(args.impact);
     if (!point)
         return usage("--impact '" + args.impact + "' is not three finite numbers X,Y,Z");
-    const fs::path dir(args.output);
+    fs::path dir = fs::path(args.output).lexically_normal();
+    if (!dir.has_filename() && dir.has_parent_path()) // "out/" names the folder "out"
+        dir = dir.parent_path();
+    if (dir.empty() || dir.filename() == "." || dir.filename() == "..")
+        return usage("-o '" + args.output + "' does not name a folder to create");
     std::error_code ec;
     if (fs::exists(dir, ec) && (!fs::is_directory(dir, ec) || !fs::is_empty(dir, ec)))
         return usage("the output folder '" + args.output +
