@@ -13,10 +13,12 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <map>
 #include <memory>
 #include <sstream>
+#include <thread>
 
 #include "BenchUtil.hpp"
 #include "Subcommand.hpp"
@@ -67,6 +69,7 @@ struct Row {
     std::size_t triangles = 0;
     std::size_t cellPlanes = 0;
     Stats ms[kBackends];
+    double loadAverage = -1;      // 1-minute load average when the case was measured (the machine is shared)
     std::string check[kBackends]; // "ok" or what is wrong
     Reference ref;
 };
@@ -151,6 +154,7 @@ Row measure(const Case& c, int runs, std::uint64_t seed) {
         }
     for (std::size_t b = 0; b < kBackends; ++b)
         row.ms[b] = rubble::bench::stats(samples[b]);
+    std::ifstream("/proc/loadavg") >> row.loadAverage;
     return row;
 }
 
@@ -203,7 +207,8 @@ int runBench(const BenchArgs& args) {
     }
     for (const char* h : {"thesis T3.2", "nef proto", "seed prog", "checks"})
         table.header.push_back(h);
-    for (const char* h : {"thesis_table_3_2_ms", "nef_prototype_here_ms", "seed_program_here_ms", "checks"})
+    for (const char* h : {"thesis_table_3_2_ms", "nef_prototype_here_ms", "seed_program_here_ms", "checks",
+                          "load_average_1m"})
         csv.header.push_back(h);
 
     auto str = [](auto v) {
@@ -237,6 +242,7 @@ int runBench(const BenchArgs& args) {
         }
         t.push_back(checks);
         c.push_back(checks);
+        c.push_back(r.loadAverage >= 0 ? str(r.loadAverage) : "");
         table.rows.push_back(t);
         csv.rows.push_back(c);
         std::ostringstream& d = r.cube ? cubeData : modelData;
@@ -247,6 +253,12 @@ int runBench(const BenchArgs& args) {
         d << "\n";
     }
     rubble::bench::printTable(table);
+    double load = 0;
+    for (const Row& r : rows)
+        load = std::max(load, r.loadAverage);
+    std::cout << "load average (1 min) up to " << fixed(load, 2) << " on "
+              << std::thread::hardware_concurrency()
+              << " hardware threads: absolute times grow with it, ratios between backends much less\n";
     std::cout << "ms per split (difference + intersection with one seeded thesis cell), " << runs
               << (runs == 1 ? " run" : " runs")
               << " per backend, interleaved; reference columns in ms: thesis Table 3.2 (subtraction), "

@@ -1,14 +1,15 @@
 #!/usr/bin/env bash
 # Runs the benchmark suites of a built tree and writes their results into bench/results/ (CSV + PNG).
 # Usage: scripts/run-bench.sh BUILD_DIR   (called by `make bench` with the Release tree)
-# Extra arguments after BUILD_DIR are passed to the decomposition and booleans suites (e.g. --runs 5).
+# Extra arguments after BUILD_DIR are passed to the decomposition and booleans suites (e.g. --runs 5, --quick);
+# RUBBLE_BENCH_RESULTS=DIR writes somewhere else than bench/results/ (e.g. for a trial run).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="${1:?usage: scripts/run-bench.sh BUILD_DIR [suite options]}"
 shift
 bench="$build/bin/rubble-bench"
 [ -x "$bench" ] || { echo "run-bench: $bench not found (build the tree first: make release)" >&2; exit 1; }
-results="$root/bench/results"
+results="${RUBBLE_BENCH_RESULTS:-$root/bench/results}"
 mkdir -p "$results"
 
 status=0
