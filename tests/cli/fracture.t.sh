@@ -84,6 +84,11 @@ mkdir "$tmp/full" && touch "$tmp/full/keep"
 expect_2 "non-empty output folder" "$models/cube_12.obj" --impact 0.99,0,0 -o "$tmp/full"
 [ "$(ls "$tmp/full")" = keep ] || fail "non-empty output folder was changed"
 
+mkdir "$tmp/empty"
+"$RUBBLE" fracture "$models/cube_12.obj" --impact 0.99,0,0 --backend fast -o "$tmp/empty" >/dev/null \
+    || fail "an existing empty output folder should be used"
+[ -s "$tmp/empty/piece_000.obj" ] || fail "nothing written into the existing empty folder"
+
 # Impact outside the mesh: exit 3, said plainly, no pieces, nothing written.
 set +e
 "$RUBBLE" fracture "$models/cube_12.obj" --impact 50,50,50 -o "$tmp/out" --json >"$tmp/out.json" 2>"$tmp/out.txt"
