@@ -249,7 +249,8 @@ int runBench(const BenchArgs& args) {
         d << r.triangles << " " << r.ms[0].median << " " << r.ms[1].median << " " << r.ms[2].median;
         if (r.cube)
             d << " " << (r.ref.thesisMs > 0 ? str(r.ref.thesisMs) : "NaN") << " "
-              << (r.ref.seedMs > 0 ? str(r.ref.seedMs) : "NaN");
+              << (r.ref.seedMs > 0 ? str(r.ref.seedMs) : "NaN") << " "
+              << (r.ref.prototypeMs > 0 ? str(r.ref.prototypeMs) : "NaN");
         d << "\n";
     }
     rubble::bench::printTable(table);
@@ -270,12 +271,16 @@ int runBench(const BenchArgs& args) {
         "set logscale xy\nset xlabel 'triangles'\nset ylabel 'boolean stage (ms)'\nset grid\n"
         "set key top left\nset title 'Mesh booleans (one thesis cell): Rubble backends vs "
         "the thesis'\n"
-        "plot $DATA index 0 u 1:5 w lp t 'thesis Table 3.2 (subtraction)', "
-        "'' index 0 u 1:6 w lp t 'thesis program measured here', "
-        "'' index 0 u 1:2 w lp t 'Nef (cubes)', '' index 0 u 1:3 w lp t 'Corefine (cubes)', "
-        "'' index 0 u 1:4 w lp t 'Fast (cubes)', '' index 1 u 1:2 w p pt 4 t 'Nef (models)', "
-        "'' index 1 u 1:3 w p pt 6 t 'Corefine (models)', "
-        "'' index 1 u 1:4 w p pt 8 t 'Fast (models)'");
+        "nef = '#1f77b4'; core = '#ff7f0e'; fast = '#2ca02c'\n"
+        "plot $DATA index 0 u 1:5 w lp lc rgb '#7f7f7f' t 'thesis Table 3.2 (subtraction)', "
+        "'' index 0 u 1:6 w lp lc rgb '#9467bd' t 'thesis program measured here', "
+        "'' index 0 u 1:7 w lp dt 2 lc rgb nef t 'Nef prototype measured here', "
+        "'' index 0 u 1:2 w lp pt 5 lc rgb nef t 'Nef (cubes)', "
+        "'' index 0 u 1:3 w lp pt 7 lc rgb core t 'Corefine (cubes)', "
+        "'' index 0 u 1:4 w lp pt 9 lc rgb fast t 'Fast (cubes)', "
+        "'' index 1 u 1:2 w p pt 4 lc rgb nef t 'Nef (models)', "
+        "'' index 1 u 1:3 w p pt 6 lc rgb core t 'Corefine (models)', "
+        "'' index 1 u 1:4 w p pt 8 lc rgb fast t 'Fast (models)'");
     bool allOk = true;
     for (const Row& r : rows)
         for (const std::string& c : r.check)
