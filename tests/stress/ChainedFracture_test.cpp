@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <filesystem>
 #include <map>
 #include <string>
 #include <vector>
@@ -69,6 +70,22 @@ std::uint64_t hashPieces(const FractureResult& r) {
     return h;
 }
 
+void dumpInput(const char* dir, const Mesh& parent, const Impact& impact, const FractureParams& params,
+               std::uint64_t seed, const std::string& what) {
+    (void)writeObj(std::filesystem::path(dir) / "last.obj", parent); // shortest round-trip numbers: exact
+    if (std::FILE* f = std::fopen((std::filesystem::path(dir) / "last.txt").c_str(), "w")) {
+        std::fprintf(
+            f,
+            "%s\nimpact %.17g %.17g %.17g impulse %.17g\npattern %d cells %d seedPoints %d backend %d\n"
+            "base %.17g scale %.17g seed %llu\n",
+            what.c_str(), impact.point.x, impact.point.y, impact.point.z, impact.impulse,
+            static_cast<int>(params.pattern), params.cells, params.seedPoints,
+            static_cast<int>(params.backend), params.sizeLaw.base, params.sizeLaw.scale,
+            static_cast<unsigned long long>(seed));
+        std::fclose(f);
+    }
+}
+
 int impactCount() {
     const char* env = std::getenv("RUBBLE_STRESS_IMPACTS");
     const int n = env ? std::atoi(env) : 2000;
@@ -82,6 +99,7 @@ TEST(ChainedFractureStress, RandomImpactsOnRandomPiecesStayValid) {
     ASSERT_GE(shapes.size(), 6u);
     const int total = impactCount();
     constexpr int kGenerations = 20;
+    const char* dumpDir = std::getenv("RUBBLE_STRESS_DUMP");
     std::map<std::string, int> failures; // error code -> count (errors are allowed: the piece stays whole)
     int fractures = 0, impacts = 0, pieces = 0, invalid = 0, exceptions = 0, nondeterministic = 0;
     double worstPerFracture = 0, worstChain = 0;
@@ -109,6 +127,8 @@ TEST(ChainedFractureStress, RandomImpactsOnRandomPiecesStayValid) {
             const std::uint64_t seed = rng.next();
             const std::string what =
                 shape.name + " chain " + std::to_string(chain) + " generation " + std::to_string(g);
+            if (dumpDir) // the last input, to reproduce a crash: RUBBLE_STRESS_DUMP=DIR
+                dumpInput(dumpDir, parent, impact, params, seed, what);
             Result<FractureResult> r = makeError(ErrorCode::Cancelled, "not run");
             try {
                 r = fracture(parent, impact, params, seed);
