@@ -1,17 +1,16 @@
-// `rubble-bench scene FILE.cfg [--seconds T] [--shots-per-second R] [--workers
-// W] [--seed S]
-// [--deterministic]
-//  [--json] [--csv FILE]`
+// `rubble-bench scene FILE.cfg [--seconds T | --frames N] [--shots-per-second R] [--workers W] [--seed S]
+//  [--deterministic] [--unpaced] [--json] [--timings-csv FILE] [--frames-csv FILE] [--append-csv FILE]`
 //
-// Headless destruction run of a world.cfg scene through the Bullet adapter:
-// seeded projectiles at the destructible objects (target chosen with
-// probability ∝ volume, aim point uniform in the central 80% of its bounding
-// box), fixed 1/60 s frames as fast as possible, no rendering. Frame time =
-// wall time of the main-thread frame (shooting + physics + impact gathering +
-// adoption). Reports frames, frame_ms, impacts, fractures, latency_ms (impact →
-// adopted, from DestructionWorld timings), pieces_alive, volume_error
-// (|live + retired + dropped − start| / start), state_hash (of the final sorted
-// piece set), peak_rss_mb.
+// Headless destruction run of a world.cfg scene through the Bullet adapter: seeded projectiles at the
+// destructible objects (target chosen with probability ∝ volume, aim point uniform in the central 80% of its
+// bounding box), fixed 1/60 s frames paced at 60 Hz wall clock like a game (--unpaced: back to back), no
+// rendering. Frame time = wall time of the main-thread frame (shooting + physics + impact gathering +
+// adoption). Reports frames, frame_ms, impacts, fractures, latency_ms (impact → adopted, wall clock, from
+// DestructionWorld timings), pieces_alive, volume_error (|live + retired + dropped − start| / start),
+// state_hash (of the final sorted piece set; reproducible in --deterministic mode) and peak_rss_mb. --json
+// prints exactly those keys; the table adds the physics and adoption shares of the frame and the fracture
+// stages. --append-csv adds one summary row to a CSV (header when the file is new), e.g.
+// bench/results/scene.csv.
 #include "Subcommand.hpp"
 
 #if defined(RUBBLE_HAVE_BULLET) && defined(RUBBLE_HAVE_RUNTIME)
@@ -20,9 +19,11 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -30,6 +31,7 @@
 #include "rubble/DestructionWorld.hpp"
 #include "rubble/Random.hpp"
 #include "rubble/SceneConfig.hpp"
+#include "rubble/ThreadPool.hpp"
 #include "rubble/bullet/Convert.hpp"
 #include "rubble/bullet/DestructionBridge.hpp"
 #include "rubble/bullet/PhysicsWorld.hpp"
@@ -44,8 +46,12 @@ struct SceneArgs {
     int workers = -1;
     std::uint64_t seed = 1;
     bool deterministic = false;
+    long frames = 0;      // > 0: overrides seconds
+    bool unpaced = false; // run frames back to back instead of at 60 Hz wall clock
     bool json = false;
-    std::string csv;
+    std::string timingsCsv;
+    std::string framesCsv;
+    std::string appendCsv;
     int maxPieces = 400;
     double projectileSpeed = 120;
     double projectileMass = 2;
@@ -140,12 +146,25 @@ int runScene(const SceneArgs& a) {
 
     Rng rng(mixSeed(a.seed, 0x5CE7E));
     const double dt = 1.0 / 60;
-    const long frames = std::max(1L, std::lround(a.seconds * 60));
-    std::vector<double> frameMs;
+    const long frames = a.frames > 0 ? a.frames : std::max(1L, std::lround(a.seconds * 60));
+    std::vector<double> frameMs, physicsMs, adoptMs;
     frameMs.reserve(static_cast<std::size_t>(frames));
-    std::vector<double> physicsMs, adoptMs;
+    std::ofstream framesOut;
+    if (!a.framesCsv.empty()) {
+        framesOut.open(a.framesCsv);
+        if (!framesOut)
+            std::cerr << "rubble-bench scene: cannot write " << a.framesCsv << "\n";
+        framesOut << "frame,frame_ms,physics_ms,adopt_ms,bodies,pieces_alive,jobs_in_flight,fractures\n";
+    }
     long shots = 0;
+    int maxPieces = 0;
+    const auto runStart = std::chrono::steady_clock::now();
+    const auto period =
+        std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(dt));
     for (long f = 0; f < frames; ++f) {
+        // like a game: one frame per 1/60 s of wall time (fracture jobs run in the idle part of the frame)
+        if (!a.unpaced)
+            std::this_thread::sleep_until(runStart + period * f);
         const auto t0 = std::chrono::steady_clock::now();
         const long due = static_cast<long>(std::floor(static_cast<double>(f) * a.shotsPerSecond / 60.0));
         while (shots < due) {
@@ -153,15 +172,31 @@ int runScene(const SceneArgs& a) {
             ++shots;
         }
         const FrameStats fs = bridge.stepFrame(dt);
+        const double ms =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         physicsMs.push_back(fs.physicsMs);
         adoptMs.push_back(fs.adoptMs);
-        frameMs.push_back(
-            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+        frameMs.push_back(ms);
+        maxPieces = std::max(maxPieces, bridge.livePieces());
+        if (framesOut)
+            framesOut << f << ',' << ms << ',' << fs.physicsMs << ',' << fs.adoptMs << ','
+                      << bridge.bodyCount() << ',' << bridge.livePieces() << ',' << destruction.jobsInFlight()
+                      << ',' << bridge.counters().fractures << '\n';
     }
-    std::vector<double> latency;
-    for (const TimingRecord& t : destruction.timings())
-        if (!t.stale)
-            latency.push_back(t.totalMs);
+    std::vector<double> latency, queue, cell, boolean, islands, decomposition;
+    int stale = 0;
+    for (const TimingRecord& t : destruction.timings()) {
+        if (t.stale) {
+            ++stale;
+            continue;
+        }
+        latency.push_back(t.totalMs);
+        queue.push_back(t.queueMs);
+        cell.push_back(t.cellMs);
+        boolean.push_back(t.booleanMs);
+        islands.push_back(t.islandsMs);
+        decomposition.push_back(t.decompositionMs);
+    }
     const double volumeError =
         startVolume > 0 ? std::abs(bridge.totalVolume() - startVolume) / startVolume : 0;
     const std::uint64_t hash = bridge.stateHash();
@@ -169,56 +204,74 @@ int runScene(const SceneArgs& a) {
     std::snprintf(hashText, sizeof hashText, "%016llx", static_cast<unsigned long long>(hash));
     const BridgeCounters& c = bridge.counters();
     const double rss = peakRssMb();
+    const int workers = a.workers > 0 ? a.workers : rubble::ThreadPool::defaultWorkerCount();
 
-    if (!a.csv.empty()) {
-        if (Status s = destruction.writeTimingsCsv(a.csv); !s)
+    if (!a.timingsCsv.empty()) {
+        if (Status s = destruction.writeTimingsCsv(a.timingsCsv); !s)
             std::cerr << "rubble-bench scene: " << s.message() << "\n";
+    }
+    if (!a.appendCsv.empty()) {
+        const bool fresh =
+            !std::filesystem::exists(a.appendCsv) || std::filesystem::file_size(a.appendCsv) == 0;
+        std::ofstream out(a.appendCsv, std::ios::app);
+        if (!out)
+            std::cerr << "rubble-bench scene: cannot write " << a.appendCsv << "\n";
+        if (fresh)
+            out << "scene,workers,deterministic,seed,shots_per_second,frames,shots,frame_p50_ms,frame_p99_ms,"
+                   "frame_max_ms,physics_p50_ms,physics_p99_ms,adopt_p99_ms,impacts,fractures,stale,"
+                   "latency_p50_ms,latency_p99_ms,latency_max_ms,queue_p50_ms,boolean_p50_ms,"
+                   "decomposition_p50_ms,pieces_alive,pieces_max,pieces_retired,volume_error,state_hash,"
+                   "peak_rss_mb\n";
+        out << std::filesystem::path(a.file).filename().string() << ',' << workers << ','
+            << (a.deterministic ? 1 : 0) << ',' << a.seed << ',' << a.shotsPerSecond << ',' << frames << ','
+            << shots << ',' << percentile(frameMs, 0.5) << ',' << percentile(frameMs, 0.99) << ','
+            << percentile(frameMs, 1.0) << ',' << percentile(physicsMs, 0.5) << ','
+            << percentile(physicsMs, 0.99) << ',' << percentile(adoptMs, 0.99) << ',' << c.impacts << ','
+            << c.fractures << ',' << stale << ',' << percentile(latency, 0.5) << ','
+            << percentile(latency, 0.99) << ',' << percentile(latency, 1.0) << ',' << percentile(queue, 0.5)
+            << ',' << percentile(boolean, 0.5) << ',' << percentile(decomposition, 0.5) << ','
+            << bridge.livePieces() << ',' << maxPieces << ',' << c.piecesRetired << ',' << volumeError << ','
+            << hashText << ',' << rss << '\n';
     }
     if (a.json) {
         nlohmann::json j;
-        j["scene"] = a.file;
         j["frames"] = frames;
-        j["shots"] = shots;
         j["frame_ms"] = {{"p50", percentile(frameMs, 0.5)},
                          {"p99", percentile(frameMs, 0.99)},
                          {"max", percentile(frameMs, 1.0)}};
-        j["physics_ms"] = {{"p50", percentile(physicsMs, 0.5)},
-                           {"p99", percentile(physicsMs, 0.99)},
-                           {"max", percentile(physicsMs, 1.0)}};
-        j["adopt_ms"] = {{"p50", percentile(adoptMs, 0.5)},
-                         {"p99", percentile(adoptMs, 0.99)},
-                         {"max", percentile(adoptMs, 1.0)}};
         j["impacts"] = c.impacts;
         j["fractures"] = c.fractures;
         j["latency_ms"] = {{"p50", percentile(latency, 0.5)},
                            {"p99", percentile(latency, 0.99)},
                            {"max", percentile(latency, 1.0)}};
         j["pieces_alive"] = bridge.livePieces();
-        j["pieces_retired"] = c.piecesRetired;
         j["volume_error"] = volumeError;
         j["state_hash"] = hashText;
         j["peak_rss_mb"] = rss;
-        j["load_ms"] = loadMs;
-        j["warnings"] = loaded.warnings;
         std::cout << j.dump(2) << "\n";
         return 0;
     }
-    std::printf("scene %s: %ld frames (%.1f s at 1/60 s), %ld shots, workers "
-                "%d%s, seed %llu, load %.1f ms\n",
-                a.file.c_str(), frames, a.seconds, shots, a.workers,
+    std::printf("scene %s: %ld frames (%.1f s at 1/60 s), %ld shots, %d workers%s, seed %llu, load %.1f ms\n",
+                a.file.c_str(), frames, static_cast<double>(frames) / 60.0, shots, workers,
                 a.deterministic ? " (deterministic)" : "", static_cast<unsigned long long>(a.seed), loadMs);
     std::printf("%-28s %10s %10s %10s\n", "", "p50", "p99", "max");
-    std::printf("%-28s %10.3f %10.3f %10.3f\n", "frame (ms)", percentile(frameMs, 0.5),
-                percentile(frameMs, 0.99), percentile(frameMs, 1.0));
-    std::printf("%-28s %10.3f %10.3f %10.3f\n", "  physics step (ms)", percentile(physicsMs, 0.5),
-                percentile(physicsMs, 0.99), percentile(physicsMs, 1.0));
-    std::printf("%-28s %10.3f %10.3f %10.3f\n", "  impacts + adoption (ms)", percentile(adoptMs, 0.5),
-                percentile(adoptMs, 0.99), percentile(adoptMs, 1.0));
-    std::printf("%-28s %10.3f %10.3f %10.3f\n", "impact -> adopted (ms)", percentile(latency, 0.5),
-                percentile(latency, 0.99), percentile(latency, 1.0));
+    auto row = [](const char* name, const std::vector<double>& v) {
+        std::printf("%-28s %10.3f %10.3f %10.3f\n", name, percentile(v, 0.5), percentile(v, 0.99),
+                    percentile(v, 1.0));
+    };
+    row("frame (ms)", frameMs);
+    row("  physics step (ms)", physicsMs);
+    row("  impacts + adoption (ms)", adoptMs);
+    row("impact -> adopted (ms)", latency);
+    row("  queue wait (ms)", queue);
+    row("  cells (ms)", cell);
+    row("  booleans (ms)", boolean);
+    row("  islands + mass (ms)", islands);
+    row("  decomposition (ms)", decomposition);
     std::printf("%-28s %10lld\n", "impacts", c.impacts);
     std::printf("%-28s %10lld\n", "fractures", c.fractures);
-    std::printf("%-28s %10d\n", "pieces alive", bridge.livePieces());
+    std::printf("%-28s %10d\n", "stale results", stale);
+    std::printf("%-28s %10d (max %d)\n", "pieces alive", bridge.livePieces(), maxPieces);
     std::printf("%-28s %10lld\n", "pieces retired", c.piecesRetired);
     std::printf("%-28s %10.3g\n", "volume error", volumeError);
     std::printf("%-28s %10s\n", "state hash", hashText);
@@ -237,7 +290,13 @@ rubble::tools::Registrar registrar{
          app.add_flag("--deterministic", args->deterministic,
                       "adopt results a fixed number of frames after impact");
          app.add_flag("--json", args->json, "JSON on stdout");
-         app.add_option("--csv", args->csv, "write impact timings as CSV");
+         app.add_flag("--unpaced", args->unpaced,
+                      "run frames back to back (default: paced at 60 Hz wall clock, like a game)");
+         app.add_option("--frames", args->frames, "frames to run (overrides --seconds; for soak runs)");
+         app.add_option("--timings-csv", args->timingsCsv, "write the per-impact timing records as CSV");
+         app.add_option("--frames-csv", args->framesCsv, "write per-frame times and counts as CSV");
+         app.add_option("--append-csv", args->appendCsv,
+                        "append a summary row to this CSV (e.g. bench/results/scene.csv)");
          app.add_option("--max-pieces", args->maxPieces, "live piece body cap");
          app.add_option("--projectile-speed", args->projectileSpeed, "m/s");
          app.add_option("--projectile-mass", args->projectileMass, "kg");

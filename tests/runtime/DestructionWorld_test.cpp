@@ -157,6 +157,26 @@ TEST(DestructionWorld, ImpactsWaitingOnAFailedJobAreMergedIntoOneJob) {
     EXPECT_NEAR(v, 8.0, 8e-6);
 }
 
+TEST(DestructionWorld, ImpactReportedOffTheSurfaceStillFractures) {
+    // A predictive CCD contact reports the projectile's centre, a radius away from the surface: the cells are
+    // centred on the nearest surface point. Without that, this cell domain (edge ~0.66) would miss the box.
+    HeldJobs jobs;
+    DestructionWorld w(heldConfig(jobs));
+    auto id = w.addObject(boxDesc()).value();
+    Impact i = centreHit();
+    i.point = {0.1, 0.2, 1.4};
+    ASSERT_TRUE(w.submitImpact(id, i));
+    jobs.runAll();
+    w.beginFrame();
+    const auto out = w.collect();
+    ASSERT_EQ(out.size(), 1u);
+    EXPECT_GE(out[0].pieces.size(), 2u);
+    double v = out[0].droppedVolume;
+    for (ObjectId p : out[0].pieces)
+        v += w.object(p)->mass.volume;
+    EXPECT_NEAR(v, 8.0, 8e-6);
+}
+
 TEST(DestructionWorld, StaleResultDiscarded) {
     HeldJobs jobs;
     DestructionWorld w(heldConfig(jobs));
