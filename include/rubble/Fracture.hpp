@@ -43,23 +43,24 @@ enum class CellPattern {
 
 /// Which boolean implementation runs.
 enum class BooleanKind {
-    Corefine, ///< CGAL Polygon_mesh_processing corefinement (default)
+    Corefine, ///< CGAL Polygon_mesh_processing corefinement (exact; the fallback of Fast)
     Nef,      ///< CGAL Nef_polyhedron_3 (the thesis's method; reference and cross-check)
-    Fast, ///< Rubble's convex-cell clipper: touches only triangles near the cells (~0.7 ms at 10k triangles);
-          ///< implemented by detail::clipByConvexCell (src/fracture/ConvexCellClipper.hpp), applied cell by
-          ///< cell; when it declines a near-degenerate configuration the whole split falls back to Corefine
+    Fast, ///< default: Rubble's convex-cell clipper, touching only triangles near the cells; implemented by
+          ///< detail::clipByConvexCell (src/fracture/ConvexCellClipper.hpp), applied cell by cell; when it
+          ///< declines a near-degenerate configuration, or its split fails verification, the whole split is
+          ///< redone by Corefine (FractureResult::exactFallback). Same seed, same bytes, like the others.
 };
 
 /// Parameters of one fracture.
 struct FractureParams {
     CellPattern pattern = CellPattern::SingleCell; ///< single cell (thesis) or shatter pattern
-    int seedPoints = 15; ///< random Voronoi sites in the domain besides the impact point
-    int cells = 6;       ///< K, the number of cells of a Shatter pattern
-    CellSizeLaw sizeLaw; ///< domain size from impulse
-    BooleanKind backend = BooleanKind::Corefine; ///< boolean implementation
-    double minPieceVolumeFraction = 1e-9; ///< pieces below this fraction of the input volume are dropped
-                                          ///< (their volume is reported in FractureResult::droppedVolume)
-    double uvScale = 1.0;                 ///< texture repeats per unit length on cut faces
+    int seedPoints = 15;                     ///< random Voronoi sites in the domain besides the impact point
+    int cells = 6;                           ///< K, the number of cells of a Shatter pattern
+    CellSizeLaw sizeLaw;                     ///< domain size from impulse
+    BooleanKind backend = BooleanKind::Fast; ///< boolean implementation
+    double minPieceVolumeFraction = 1e-9;    ///< pieces below this fraction of the input volume are dropped
+                                             ///< (their volume is reported in FractureResult::droppedVolume)
+    double uvScale = 1.0;                    ///< texture repeats per unit length on cut faces
 };
 
 /// One output piece: a closed, outward-oriented mesh in the input's coordinates.
@@ -73,7 +74,8 @@ struct Piece {
 struct FractureTimings {
     double cellMs = 0;    ///< building the cells
     double booleanMs = 0; ///< difference and intersections
-    double islandsMs = 0; ///< splitting into islands and mass properties
+    double islandsMs = 0; ///< splitting into islands and mass properties (includes massMs)
+    double massMs = 0;    ///< of islandsMs: mass properties of the pieces and interior UVs
     double totalMs = 0;   ///< everything
 };
 
@@ -83,6 +85,7 @@ struct FractureResult {
     std::vector<ConvexPolytope> cells; ///< the cells that were cut (faces tagged with their plane index)
     double inputVolume = 0;            ///< volume of the input mesh
     double droppedVolume = 0;          ///< volume of pieces dropped as too small
+    bool exactFallback = false;        ///< Fast declined or failed verification; Corefine made the split
     FractureTimings timings;           ///< stage durations
 };
 
@@ -92,8 +95,9 @@ std::vector<ConvexPolytope> generateCells(const Aabb& meshBounds, const Impact& 
 
 /// Result of splitting a mesh by disjoint convex cells.
 struct SplitResult {
-    Mesh remainder;           ///< mesh − ∪ cells (may be empty)
-    std::vector<Mesh> inside; ///< inside[i] = mesh ∩ cells[i] (may be empty)
+    Mesh remainder;             ///< mesh − ∪ cells (may be empty)
+    std::vector<Mesh> inside;   ///< inside[i] = mesh ∩ cells[i] (may be empty)
+    bool exactFallback = false; ///< a fast backend declined and an exact backend made this split
 };
 
 /// A boolean implementation: splits a closed mesh by disjoint convex cells.

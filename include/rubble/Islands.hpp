@@ -17,4 +17,12 @@ std::size_t labelShells(const Mesh& mesh, std::vector<std::uint32_t>& triangleSh
 /// unreferenced vertices dropped. Islands come out in a deterministic order (by lowest triangle index).
 std::vector<Mesh> splitIntoIslands(const Mesh& mesh);
 
+/// As splitIntoIslands(const Mesh&), but a mesh that is one island is moved into the result, not copied.
+std::vector<Mesh> splitIntoIslands(Mesh&& mesh);
+
+/// As splitIntoIslands(Mesh&&) with the shell labels already known (triangleShell and shells as returned by
+/// labelShells for this mesh).
+std::vector<Mesh> splitIntoIslands(Mesh&& mesh, const std::vector<std::uint32_t>& triangleShell,
+                                   std::size_t shells);
+
 } // namespace rubble

@@ -15,6 +15,7 @@ namespace {
 struct Fragment {
     ConvexPolytope shape;
     std::int32_t cell = -1; // -1: outside every cell
+    std::uint32_t part = 0; // index of the parent part it was cut from
 };
 
 /// part − cell as at most one fragment per cell plane: outside plane j and inside planes < j.
@@ -54,8 +55,12 @@ double distanceToBox(const Aabb& b, const Vec3& p) {
 }
 
 /// Merges parts whose joint hull adds the least volume until at most maxParts remain. Only touching parts
-/// are candidates; pair costs are computed once and refreshed only for the part that changed.
-void mergeToBudget(std::vector<ConvexPolytope>& parts, int maxParts) {
+/// are candidates; pair costs are computed once and refreshed only for the part that changed. Siblings
+/// (fragments of the same parent part, origin[i] == origin[j]) are merged first: they tile their parent
+/// part minus the cells, and there are far fewer sibling pairs than pairs (each cost is a Qhull call). Only
+/// when that does not reach the budget are all touching pairs considered.
+void mergeToBudget(std::vector<ConvexPolytope>& parts, const std::vector<std::uint32_t>& origin,
+                   int maxParts) {
     const std::size_t budget = static_cast<std::size_t>(std::max(1, maxParts));
     if (parts.size() <= budget)
         return;
@@ -74,7 +79,10 @@ void mergeToBudget(std::vector<ConvexPolytope>& parts, int maxParts) {
         volumes[i] = parts[i].volume();
     }
     std::vector<Candidate> heap;
+    bool siblingsOnly = true;
     auto consider = [&](std::size_t i, std::size_t j) {
+        if (siblingsOnly && origin[i] != origin[j])
+            return;
         const double tol = 1e-9 * (bounds[i].diagonal() + bounds[j].diagonal());
         if (!bounds[i].overlaps(bounds[j], tol))
             return;
@@ -91,7 +99,17 @@ void mergeToBudget(std::vector<ConvexPolytope>& parts, int maxParts) {
         for (std::size_t j = i + 1; j < parts.size(); ++j)
             consider(i, j);
     std::size_t count = parts.size();
-    while (count > budget && !heap.empty()) {
+    while (count > budget) {
+        if (heap.empty()) {
+            if (!siblingsOnly)
+                break;
+            siblingsOnly = false; // siblings were not enough: every touching pair
+            for (std::size_t i = 0; i < parts.size(); ++i)
+                for (std::size_t j = i + 1; j < parts.size(); ++j)
+                    if (alive[i] && alive[j] && origin[i] != origin[j])
+                        consider(i, j);
+            continue;
+        }
         std::pop_heap(heap.begin(), heap.end(), std::greater<>());
         const Candidate c = heap.back();
         heap.pop_back();
@@ -140,7 +158,8 @@ std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<C
     // 1. Fragments: part ∩ cell_i, and what is left outside every cell.
     double parentVolume = 0;
     std::vector<Fragment> fragments;
-    for (const ConvexPolytope& part : parentParts) {
+    for (std::uint32_t partIndex = 0; partIndex < parentParts.size(); ++partIndex) {
+        const ConvexPolytope& part = parentParts[partIndex];
         parentVolume += part.volume();
         const Aabb pb = part.bounds();
         for (std::size_t c = 0; c < cells.size(); ++c) {
@@ -153,7 +172,7 @@ std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<C
                     break;
             }
             if (!inside.empty())
-                fragments.push_back({std::move(inside), static_cast<std::int32_t>(c)});
+                fragments.push_back({std::move(inside), static_cast<std::int32_t>(c), partIndex});
         }
         std::vector<ConvexPolytope> rest{part}, next;
         for (const ConvexPolytope& cell : cells) {
@@ -163,7 +182,7 @@ std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<C
             rest.swap(next);
         }
         for (ConvexPolytope& r : rest)
-            fragments.push_back({std::move(r), -1});
+            fragments.push_back({std::move(r), -1, partIndex});
     }
 
     // 2. Drop slivers: numerical leftovers always; small fragments only when they are flat (a small but
@@ -171,6 +190,11 @@ std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<C
     const double sliver = 1e-12 * parentVolume;
     const double small = params.minPartVolumeFraction * parentVolume;
     // 3. Assign every fragment to the piece containing it.
+    std::vector<std::vector<std::uint32_t>> origins(pieces.size()); // parent part of each result part
+    auto give = [&](std::size_t piece, ConvexPolytope part, std::uint32_t origin) {
+        result[piece].push_back(std::move(part));
+        origins[piece].push_back(origin);
+    };
     std::vector<Aabb> pieceBounds(pieces.size());
     for (std::size_t i = 0; i < pieces.size(); ++i)
         pieceBounds[i] = pieces[i].bounds();
@@ -195,7 +219,7 @@ std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<C
             // Parent parts may reach into empty space: keep the fragment inside the piece's bounds.
             ConvexPolytope clipped = clippedToBox(std::move(frag.shape), pieceBounds[candidates[0]]);
             if (!clipped.empty())
-                result[candidates[0]].push_back(std::move(clipped));
+                give(candidates[0], std::move(clipped), frag.part);
             continue;
         }
         if (candidates.size() > 1) {
@@ -203,7 +227,7 @@ std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<C
             for (std::size_t i : candidates) {
                 auto h = detail::hullOfMeshInRegion(pieces[i], frag.shape);
                 if (h && h->volume() > sliver)
-                    result[i].push_back(std::move(h.value()));
+                    give(i, std::move(h.value()), frag.part);
             }
             continue;
         }
@@ -222,7 +246,7 @@ std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<C
         if (bestDist <= 1e-6 * (pieceBounds[best].diagonal() + fb.diagonal())) {
             ConvexPolytope clipped = clippedToBox(std::move(frag.shape), pieceBounds[best]);
             if (!clipped.empty())
-                result[best].push_back(std::move(clipped));
+                give(best, std::move(clipped), frag.part);
         }
     }
 
@@ -251,7 +275,7 @@ std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<C
                 continue;
             }
         }
-        mergeToBudget(parts, params.maxParts);
+        mergeToBudget(parts, origins[i], params.maxParts);
     }
     return result;
 }

@@ -585,7 +585,13 @@ Mesh Clipper::assemble(const std::vector<std::uint32_t>& untouched, const std::v
         return local[g];
     };
     const bool hasN = mesh_.hasNormals(), hasUv = mesh_.hasUvs();
-    m.triangles.reserve(untouched.size() + tris.size());
+    const std::size_t total = untouched.size() + tris.size();
+    m.positions.reserve(std::min<std::size_t>(nV_ + extra_.size(), 3 * total));
+    m.triangles.reserve(total);
+    m.materials.reserve(total);
+    m.uvs.reserve(3 * total);
+    if (hasN)
+        m.normals.reserve(3 * total);
     for (std::uint32_t t : untouched) {
         const Triangle& tri = mesh_.triangles[t];
         m.triangles.push_back({id(tri[0]), id(tri[1]), id(tri[2])});
@@ -594,10 +600,10 @@ Mesh Clipper::assemble(const std::vector<std::uint32_t>& untouched, const std::v
                              mesh_.normals.begin() + 3 * t + 3);
         if (hasUv)
             m.uvs.insert(m.uvs.end(), mesh_.uvs.begin() + 3 * t, mesh_.uvs.begin() + 3 * t + 3);
-        else
-            m.uvs.insert(m.uvs.end(), 3, Vec2{});
         m.materials.push_back(mesh_.material(t));
     }
+    if (!hasUv)
+        m.uvs.resize(3 * m.triangles.size()); // zeros, in one go
     for (const OutTri& o : tris) {
         m.triangles.push_back({id(o.v[0]), id(o.v[1]), id(o.v[2])});
         if (o.source == kNone) {

@@ -16,22 +16,29 @@ public:
     Result<SplitResult> split(const Mesh& mesh, const std::vector<ConvexPolytope>& cells) const override {
         SplitResult out;
         out.inside.resize(cells.size());
-        Mesh rem = mesh;
-        // The clipper always emits uvs and materials; keep the layout identical when nothing is cut.
-        if (rem.uvs.empty())
-            rem.uvs.assign(3 * rem.triangles.size(), Vec2{});
-        if (rem.materials.empty())
-            rem.materials.assign(rem.triangles.size(), 0u);
+        // The remainder is the input until the first cell cuts it (no copy of the whole mesh up front).
+        const Mesh* rem = &mesh;
+        Mesh cut;
         for (std::size_t i = 0; i < cells.size(); ++i) {
-            if (cells[i].empty() || rem.empty() || !cells[i].bounds().overlaps(rem.bounds()))
+            if (cells[i].empty() || rem->empty() || !cells[i].bounds().overlaps(rem->bounds()))
                 continue;
-            auto r = clipByConvexCell(rem, cells[i]);
-            if (!r)
-                return makeCorefineBackend()->split(mesh, cells);
+            auto r = clipByConvexCell(*rem, cells[i]);
+            if (!r) {
+                auto exact = makeCorefineBackend()->split(mesh, cells);
+                if (exact)
+                    exact->exactFallback = true;
+                return exact;
+            }
             out.inside[i] = std::move(r->inside);
-            rem = std::move(r->outside);
+            cut = std::move(r->outside);
+            rem = &cut;
         }
-        out.remainder = std::move(rem);
+        out.remainder = rem == &mesh ? mesh : std::move(cut);
+        // The clipper always emits uvs and materials; keep the layout identical when nothing is cut.
+        if (out.remainder.uvs.empty())
+            out.remainder.uvs.assign(3 * out.remainder.triangles.size(), Vec2{});
+        if (out.remainder.materials.empty())
+            out.remainder.materials.assign(out.remainder.triangles.size(), 0u);
         return out;
     }
 };

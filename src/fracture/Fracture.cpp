@@ -6,6 +6,8 @@
 #include <limits>
 
 #include "BooleanBackends.hpp"
+#include "FracturePipeline.hpp"
+#include "geometry/OrientedShells.hpp"
 #include "rubble/Fracture.hpp"
 #include "rubble/Islands.hpp"
 
@@ -19,7 +21,8 @@ double msSince(Clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
-Status validateInput(const Mesh& mesh) {
+/// Checks that mesh is a valid closed, oriented solid; its volume out.
+Status validateInput(const Mesh& mesh, double& volume) {
     if (mesh.empty())
         return makeError(ErrorCode::InvalidInput, "fracture: the mesh has no triangles");
     if (Status s = mesh.validate(); !s)
@@ -29,7 +32,8 @@ Status validateInput(const Mesh& mesh) {
             ErrorCode::InvalidInput,
             "fracture: the mesh is not closed and consistently oriented (every edge must be shared "
             "by exactly two triangles in opposite directions); repair it first");
-    if (!(signedVolume(mesh) > 0))
+    volume = signedVolume(mesh);
+    if (!(volume > 0))
         return makeError(ErrorCode::InvalidInput, "fracture: the mesh does not enclose a positive volume");
     return {};
 }
@@ -93,11 +97,14 @@ void finishCutFaces(Mesh& m, const std::vector<ConvexPolytope>& cells, double uv
     }
 }
 
-void addPieces(const Mesh& m, std::int32_t cell, double minVolume, FractureResult& out) {
+void addPieces(Mesh&& m, const detail::OutputShells& shells, std::int32_t cell, double minVolume,
+               FractureResult& out) {
     if (m.empty())
         return;
-    for (Mesh& island : splitIntoIslands(m)) {
+    for (Mesh& island : splitIntoIslands(std::move(m), shells.triangleShell, shells.count)) {
+        const auto tm = Clock::now();
         MassProperties mp = computeMassProperties(island);
+        out.timings.massMs += msSince(tm);
         if (!(mp.volume > minVolume)) {
             out.droppedVolume += mp.volume;
             continue;
@@ -120,43 +127,70 @@ std::unique_ptr<BooleanBackend> makeBooleanBackend(BooleanKind kind) {
     return detail::makeCorefineBackend();
 }
 
+namespace detail {
+
+bool splitIsSound(const SplitResult& s, double inputVolume, std::vector<OutputShells>* shells) {
+    double v = 0;
+    if (shells)
+        shells->assign(1 + s.inside.size(), {});
+    std::size_t index = 0;
+    auto sound = [&](const Mesh& m) {
+        OutputShells* out = shells ? &(*shells)[index++] : nullptr;
+        if (m.empty())
+            return true;
+        if (!m.validate())
+            return false;
+        const std::int64_t count = closedOrientedShells(m, out ? &out->triangleShell : nullptr);
+        if (count < 0)
+            return false;
+        if (out)
+            out->count = static_cast<std::size_t>(count);
+        const double mv = signedVolume(m);
+        v += mv;
+        return mv > 0;
+    };
+    if (!sound(s.remainder))
+        return false;
+    for (const Mesh& m : s.inside)
+        if (!sound(m))
+            return false;
+    return std::abs(v - inputVolume) <= 1e-7 * inputVolume;
+}
+
+} // namespace detail
+
 namespace {
 
-Result<FractureResult> fractureValidated(const Mesh& mesh, std::vector<ConvexPolytope> cells,
-                                         const FractureParams& params, double inputVolume) {
+/// The pipeline after input validation.
+Result<FractureResult> runPipeline(const Mesh& mesh, std::vector<ConvexPolytope> cells,
+                                   const FractureParams& params, const BooleanBackend& backend,
+                                   bool exactRedo, double inputVolume) {
     const auto t0 = Clock::now();
     FractureResult res;
     res.inputVolume = inputVolume;
-    Aabb meshBox = mesh.bounds();
+    const Aabb meshBox = mesh.bounds();
     bool any = false;
     for (const ConvexPolytope& c : cells)
         any |= !c.empty() && c.bounds().overlaps(meshBox);
     if (!any)
         return makeError(ErrorCode::NoIntersection, "fracture: the impact's cells do not touch the mesh");
 
-    auto backend = makeBooleanBackend(params.backend);
-    auto split = backend->split(mesh, cells);
-    // The result must close up and conserve volume; a failed Fast split is redone exactly.
-    auto acceptable = [&](const SplitResult& s) {
-        double v = s.remainder.empty() ? 0.0 : signedVolume(s.remainder);
-        if (!s.remainder.empty() && !detail::isClosedOriented(s.remainder))
-            return false;
-        for (const Mesh& m : s.inside) {
-            if (m.empty())
-                continue;
-            if (!detail::isClosedOriented(m))
-                return false;
-            v += signedVolume(m);
-        }
-        return std::abs(v - inputVolume) <= 1e-7 * inputVolume;
-    };
-    if (split && !acceptable(*split) && params.backend == BooleanKind::Fast)
+    auto split = backend.split(mesh, cells);
+    // The result must close up and conserve volume; a failed fast split is redone exactly. The check labels
+    // the shells of every output on the way; the islands below reuse them.
+    std::vector<detail::OutputShells> shells;
+    bool sound = split && detail::splitIsSound(*split, inputVolume, &shells);
+    if (split && !sound && exactRedo) {
         split = detail::makeCorefineBackend()->split(mesh, cells);
+        if (split)
+            split->exactFallback = true;
+        sound = split && detail::splitIsSound(*split, inputVolume, &shells);
+    }
     if (!split)
         return split.error();
-    if (!acceptable(*split))
+    if (!sound)
         return makeError(ErrorCode::GeometryFailure,
-                         "fracture: the " + backend->name() +
+                         "fracture: the " + backend.name() +
                              " backend produced pieces that are not closed or do not conserve volume");
     bool hit = false;
     for (const Mesh& m : split->inside)
@@ -165,16 +199,18 @@ Result<FractureResult> fractureValidated(const Mesh& mesh, std::vector<ConvexPol
         return makeError(
             ErrorCode::NoIntersection,
             "fracture: the impact's cells do not intersect the mesh (is the impact outside it?)");
+    res.exactFallback = split->exactFallback;
     res.timings.booleanMs = msSince(t0);
 
     const auto t1 = Clock::now();
     finishCutFaces(split->remainder, cells, params.uvScale);
     for (Mesh& m : split->inside)
         finishCutFaces(m, cells, params.uvScale);
+    res.timings.massMs = msSince(t1);
     const double minVolume = std::max(0.0, params.minPieceVolumeFraction) * inputVolume;
-    addPieces(split->remainder, -1, minVolume, res);
+    addPieces(std::move(split->remainder), shells[0], -1, minVolume, res);
     for (std::size_t i = 0; i < split->inside.size(); ++i)
-        addPieces(split->inside[i], static_cast<std::int32_t>(i), minVolume, res);
+        addPieces(std::move(split->inside[i]), shells[i + 1], static_cast<std::int32_t>(i), minVolume, res);
     res.timings.islandsMs = msSince(t1);
     res.cells = std::move(cells);
     res.timings.totalMs = msSince(t0);
@@ -183,17 +219,30 @@ Result<FractureResult> fractureValidated(const Mesh& mesh, std::vector<ConvexPol
 
 } // namespace
 
+namespace detail {
+
+Result<FractureResult> fractureWithBackend(const Mesh& mesh, std::vector<ConvexPolytope> cells,
+                                           const FractureParams& params, const BooleanBackend& backend,
+                                           bool exactRedo) {
+    double volume = 0;
+    if (Status s = validateInput(mesh, volume); !s)
+        return s.error();
+    return runPipeline(mesh, std::move(cells), params, backend, exactRedo, volume);
+}
+
+} // namespace detail
+
 Result<FractureResult> fractureWithCells(const Mesh& mesh, std::vector<ConvexPolytope> cells,
                                          const FractureParams& params) {
-    if (Status s = validateInput(mesh); !s)
-        return s.error();
-    return fractureValidated(mesh, std::move(cells), params, signedVolume(mesh));
+    return detail::fractureWithBackend(mesh, std::move(cells), params, *makeBooleanBackend(params.backend),
+                                       params.backend == BooleanKind::Fast);
 }
 
 Result<FractureResult> fracture(const Mesh& mesh, const Impact& impact, const FractureParams& params,
                                 std::uint64_t seed) {
     const auto t0 = Clock::now();
-    if (Status s = validateInput(mesh); !s)
+    double volume = 0;
+    if (Status s = validateInput(mesh, volume); !s)
         return s.error();
     if (!isFinite(impact.point) || !std::isfinite(impact.impulse))
         return makeError(ErrorCode::InvalidInput, "fracture: the impact point or impulse is not finite");
@@ -202,7 +251,8 @@ Result<FractureResult> fracture(const Mesh& mesh, const Impact& impact, const Fr
     const double cellMs = msSince(tc);
     if (cells.empty())
         return makeError(ErrorCode::NoIntersection, "fracture: no cell could be built around the impact");
-    auto r = fractureValidated(mesh, std::move(cells), params, signedVolume(mesh));
+    auto r = runPipeline(mesh, std::move(cells), params, *makeBooleanBackend(params.backend),
+                         params.backend == BooleanKind::Fast, volume);
     if (!r)
         return r;
     r->timings.cellMs = cellMs;

@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <unordered_set>
 
 #include "BooleanBackends.hpp"
+#include "geometry/OrientedShells.hpp"
 
 namespace rubble::detail {
 
@@ -186,18 +186,7 @@ Mesh assembleMesh(const Mesh& input, std::vector<Vec3> positions, const std::vec
 }
 
 bool isClosedOriented(const Mesh& mesh) {
-    std::unordered_set<std::uint64_t> directed;
-    directed.reserve(mesh.triangles.size() * 3);
-    for (const Triangle& t : mesh.triangles)
-        for (int c = 0; c < 3; ++c) {
-            const std::uint32_t a = t[c], b = t[(c + 1) % 3];
-            if (a == b || !directed.insert((std::uint64_t(a) << 32) | b).second)
-                return false;
-        }
-    for (const std::uint64_t e : directed)
-        if (!directed.count((e << 32) | (e >> 32)))
-            return false;
-    return true;
+    return closedOrientedShells(mesh, nullptr) >= 0;
 }
 
 } // namespace rubble::detail

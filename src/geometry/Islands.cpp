@@ -1,9 +1,11 @@
 #include "rubble/Islands.hpp"
 
 #include <algorithm>
+#include <cstdint>
 #include <numeric>
-#include <unordered_map>
 
+#include "geometry/OrientedShells.hpp"
+#include "geometry/VertexStar.hpp"
 #include "rubble/MassProperties.hpp"
 
 namespace rubble {
@@ -24,12 +26,6 @@ struct UnionFind {
             parent[std::max(a, b)] = std::min(a, b); // smaller index wins: deterministic labels
     }
 };
-
-std::uint64_t edgeKey(std::uint32_t a, std::uint32_t b) {
-    if (a > b)
-        std::swap(a, b);
-    return (static_cast<std::uint64_t>(a) << 32) | b;
-}
 
 // Parity of crossings of a ray from p along a fixed, slightly irrational direction.
 bool insideByRay(const Mesh& m, const std::vector<std::size_t>& tris, const Vec3& p) {
@@ -58,18 +54,11 @@ bool insideByRay(const Mesh& m, const std::vector<std::size_t>& tris, const Vec3
 }
 } // namespace
 
-std::size_t labelShells(const Mesh& mesh, std::vector<std::uint32_t>& triangleShell) {
-    const std::size_t n = mesh.triangles.size();
-    UnionFind uf(n);
-    std::unordered_map<std::uint64_t, std::uint32_t> firstOwner;
-    firstOwner.reserve(n * 3);
-    for (std::uint32_t t = 0; t < n; ++t)
-        for (int c = 0; c < 3; ++c) {
-            const auto key = edgeKey(mesh.triangles[t][c], mesh.triangles[t][(c + 1) % 3]);
-            auto [it, inserted] = firstOwner.emplace(key, t);
-            if (!inserted)
-                uf.unite(it->second, t);
-        }
+namespace {
+
+/// Labels by the smallest triangle index of each union-find class, numbered in order of first appearance.
+std::size_t labelsFrom(UnionFind& uf, std::vector<std::uint32_t>& triangleShell) {
+    const std::size_t n = uf.parent.size();
     triangleShell.assign(n, 0);
     std::vector<std::uint32_t> rootToLabel(n, UINT32_MAX);
     std::uint32_t count = 0;
@@ -82,12 +71,96 @@ std::size_t labelShells(const Mesh& mesh, std::vector<std::uint32_t>& triangleSh
     return count;
 }
 
-std::vector<Mesh> splitIntoIslands(const Mesh& mesh) {
-    std::vector<std::uint32_t> shellOf;
-    const std::size_t shells = labelShells(mesh, shellOf);
-    if (shells <= 1)
-        return shells == 0 ? std::vector<Mesh>{} : std::vector<Mesh>{mesh};
+/// Insertion sort of a short range (a vertex's neighbours).
+void sortShort(std::uint64_t* first, std::uint64_t* last) {
+    for (std::uint64_t* i = first + 1; i < last; ++i) {
+        const std::uint64_t key = *i;
+        std::uint64_t* j = i;
+        for (; j > first && j[-1] > key; --j)
+            *j = j[-1];
+        *j = key;
+    }
+}
 
+} // namespace
+
+namespace detail {
+
+std::int64_t closedOrientedShells(const Mesh& mesh, std::vector<std::uint32_t>* triangleShell) {
+    const std::size_t nv = mesh.positions.size(), nt = mesh.triangles.size();
+    // Per vertex: outgoing (neighbour << 32 | triangle) and incoming (neighbour << 32 | triangle) entries.
+    std::vector<std::uint32_t> outFirst(nv + 1, 0), inFirst(nv + 1, 0);
+    for (const Triangle& t : mesh.triangles)
+        for (int c = 0; c < 3; ++c) {
+            if (t[c] >= nv)
+                return -1;
+            ++outFirst[t[c] + 1];
+            ++inFirst[t[(c + 1) % 3] + 1];
+        }
+    for (std::size_t v = 0; v < nv; ++v) {
+        outFirst[v + 1] += outFirst[v];
+        inFirst[v + 1] += inFirst[v];
+    }
+    std::vector<std::uint64_t> out(3 * nt), in(3 * nt);
+    {
+        std::vector<std::uint32_t> o(outFirst.begin(), outFirst.end() - 1),
+            i(inFirst.begin(), inFirst.end() - 1);
+        for (std::uint32_t t = 0; t < nt; ++t)
+            for (int c = 0; c < 3; ++c) {
+                const std::uint32_t a = mesh.triangles[t][c], b = mesh.triangles[t][(c + 1) % 3];
+                out[o[a]++] = std::uint64_t(b) << 32 | t;
+                in[i[b]++] = std::uint64_t(a) << 32 | t;
+            }
+    }
+    UnionFind uf(triangleShell ? nt : 0);
+    for (std::size_t v = 0; v < nv; ++v) {
+        const std::uint32_t o0 = outFirst[v], o1 = outFirst[v + 1], i0 = inFirst[v];
+        if (o1 - o0 != inFirst[v + 1] - i0)
+            return -1;
+        sortShort(out.data() + o0, out.data() + o1);
+        sortShort(in.data() + i0, in.data() + i0 + (o1 - o0));
+        for (std::uint32_t k = 0; k < o1 - o0; ++k) {
+            const std::uint64_t e = out[o0 + k], r = in[i0 + k];
+            const std::uint32_t to = static_cast<std::uint32_t>(e >> 32);
+            // (v, to) must not be a loop or repeated, and its twin (to, v) must be the matching incoming
+            // entry.
+            if (to == v || (k > 0 && (out[o0 + k - 1] >> 32) == to) || (r >> 32) != to)
+                return -1;
+            if (triangleShell)
+                uf.unite(static_cast<std::uint32_t>(e), static_cast<std::uint32_t>(r));
+        }
+    }
+    if (!triangleShell)
+        return 0;
+    return static_cast<std::int64_t>(labelsFrom(uf, *triangleShell));
+}
+
+} // namespace detail
+
+std::size_t labelShells(const Mesh& mesh, std::vector<std::uint32_t>& triangleShell) {
+    const std::size_t n = mesh.triangles.size();
+    UnionFind uf(n);
+    // Triangles sharing an edge (either direction, also non-manifold) are united; each vertex's star is
+    // scanned instead of hashing every edge.
+    const detail::VertexStar star(mesh);
+    for (std::uint32_t a = 0; a < star.vertexCount(); ++a)
+        for (std::uint32_t i = star.begin(a); i < star.end(a); ++i) {
+            const std::uint32_t b = star.target(i), t = star.halfEdge(i) / 3;
+            for (std::uint32_t j = star.begin(a); j < i; ++j)
+                if (star.target(j) == b)
+                    uf.unite(star.halfEdge(j) / 3, t);
+            if (a < b)
+                for (std::uint32_t j = star.begin(b); j < star.end(b); ++j)
+                    if (star.target(j) == a)
+                        uf.unite(star.halfEdge(j) / 3, t);
+        }
+    return labelsFrom(uf, triangleShell);
+}
+
+namespace {
+
+std::vector<Mesh> splitShells(const Mesh& mesh, const std::vector<std::uint32_t>& shellOf,
+                              std::size_t shells) {
     std::vector<std::vector<std::size_t>> trisOf(shells);
     for (std::size_t t = 0; t < shellOf.size(); ++t)
         trisOf[shellOf[t]].push_back(t);
@@ -125,13 +198,28 @@ std::vector<Mesh> splitIntoIslands(const Mesh& mesh) {
         }
         islandOf[s] = islandOf[o];
     }
-    for (Mesh& m : out) {
-        m.positions = mesh.positions;
+    // Vertices are numbered per island in order of first use (as removeUnreferencedVertices does); a vertex
+    // shared by two islands (touching at a point) is copied into both.
+    std::vector<std::uint32_t> local(mesh.positions.size(), UINT32_MAX);
+    std::vector<std::size_t> localOwner(mesh.positions.size(), SIZE_MAX);
+    for (Mesh& m : out)
         m.materialNames = mesh.materialNames;
-    }
     for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
-        Mesh& m = out[static_cast<std::size_t>(islandOf[shellOf[t]])];
-        m.triangles.push_back(mesh.triangles[t]);
+        const auto island = static_cast<std::size_t>(islandOf[shellOf[t]]);
+        Mesh& m = out[island];
+        Triangle tri = mesh.triangles[t];
+        for (std::uint32_t& v : tri) {
+            if (localOwner[v] != island) {
+                localOwner[v] = island;
+                local[v] = UINT32_MAX;
+            }
+            if (local[v] == UINT32_MAX) {
+                local[v] = static_cast<std::uint32_t>(m.positions.size());
+                m.positions.push_back(mesh.positions[v]);
+            }
+            v = local[v];
+        }
+        m.triangles.push_back(tri);
         if (mesh.hasNormals())
             m.normals.insert(m.normals.end(), mesh.normals.begin() + 3 * t, mesh.normals.begin() + 3 * t + 3);
         if (mesh.hasUvs())
@@ -139,9 +227,33 @@ std::vector<Mesh> splitIntoIslands(const Mesh& mesh) {
         if (mesh.hasMaterials())
             m.materials.push_back(mesh.materials[t]);
     }
-    for (Mesh& m : out)
-        m.removeUnreferencedVertices();
     return out;
+}
+
+} // namespace
+
+std::vector<Mesh> splitIntoIslands(const Mesh& mesh) {
+    std::vector<std::uint32_t> shellOf;
+    const std::size_t shells = labelShells(mesh, shellOf);
+    if (shells <= 1)
+        return shells == 0 ? std::vector<Mesh>{} : std::vector<Mesh>{mesh};
+    return splitShells(mesh, shellOf, shells);
+}
+
+std::vector<Mesh> splitIntoIslands(Mesh&& mesh, const std::vector<std::uint32_t>& triangleShell,
+                                   std::size_t shells) {
+    std::vector<Mesh> out;
+    if (shells == 1)
+        out.push_back(std::move(mesh));
+    else if (shells > 1)
+        out = splitShells(mesh, triangleShell, shells);
+    return out;
+}
+
+std::vector<Mesh> splitIntoIslands(Mesh&& mesh) {
+    std::vector<std::uint32_t> shellOf;
+    const std::size_t shells = labelShells(mesh, shellOf);
+    return splitIntoIslands(std::move(mesh), shellOf, shells);
 }
 
 } // namespace rubble

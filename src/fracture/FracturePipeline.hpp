@@ -1,0 +1,31 @@
+#pragma once
+// Private to rubble_fracture (and its tests): the verification every split passes and the pipeline with an
+// explicit backend, so that tests can inject faulty splits.
+
+#include <cstdint>
+#include <vector>
+
+#include "rubble/ConvexPolytope.hpp"
+#include "rubble/Fracture.hpp"
+#include "rubble/Mesh.hpp"
+
+namespace rubble::detail {
+
+/// Shell labels of one split output, as labelShells gives them.
+struct OutputShells {
+    std::vector<std::uint32_t> triangleShell; ///< shell of each triangle
+    std::size_t count = 0;                    ///< number of shells
+};
+
+/// The verification every split passes before it becomes pieces: each non-empty output valid, closed,
+/// consistently oriented with positive volume, and the volumes summing to inputVolume (relative 1e-7).
+/// With shells, also the shell labels of the remainder and then of each inside mesh (found in the same pass).
+bool splitIsSound(const SplitResult& split, double inputVolume, std::vector<OutputShells>* shells = nullptr);
+
+/// fractureWithCells with an explicit backend (tests inject faulty ones). A split that fails splitIsSound
+/// is redone by Corefine when exactRedo is set (then FractureResult::exactFallback), else it is an error.
+Result<FractureResult> fractureWithBackend(const Mesh& mesh, std::vector<ConvexPolytope> cells,
+                                           const FractureParams& params, const BooleanBackend& backend,
+                                           bool exactRedo);
+
+} // namespace rubble::detail

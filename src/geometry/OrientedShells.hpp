@@ -1,0 +1,19 @@
+#pragma once
+// Private to the core: one linear pass that both verifies that a mesh is closed and consistently oriented
+// and labels its shells. The fracture pipeline runs it on every split output and reuses the labels for the
+// islands, instead of verifying and labelling separately.
+
+#include <cstdint>
+#include <vector>
+
+#include "rubble/Mesh.hpp"
+
+namespace rubble::detail {
+
+/// When every triangle index is in range, no edge is a loop, and every directed edge appears exactly once
+/// with its reverse exactly once: labels the shells exactly as labelShells does (when triangleShell is not
+/// null) and returns their number. Otherwise returns -1. No hashing: per vertex, the sorted outgoing and
+/// incoming neighbour lists must be equal and free of repeats, which pairs every half-edge with its twin.
+std::int64_t closedOrientedShells(const Mesh& mesh, std::vector<std::uint32_t>* triangleShell);
+
+} // namespace rubble::detail
