@@ -52,15 +52,11 @@ std::vector<Shape> stressShapes() {
     return shapes;
 }
 
+// A uniformly distributed point of a random triangle (square-root barycentric sampling).
 Vec3 surfacePoint(const Mesh& m, Rng& rng) {
-    const auto t = static_cast<std::size_t>(rng.below(m.triangleCount()));
-    double a = rng.uniform(), b = rng.uniform();
-    if (a + b > 1) {
-        a = 1 - a;
-        b = 1 - b;
-    }
-    const auto c = m.corners(t);
-    return c[0] + (c[1] - c[0]) * a + (c[2] - c[0]) * b;
+    const auto corners = m.corners(static_cast<std::size_t>(rng.below(m.triangleCount())));
+    const double r = std::sqrt(rng.uniform()), s = rng.uniform();
+    return corners[0] * (1 - r) + corners[1] * (r * (1 - s)) + corners[2] * (r * s);
 }
 
 std::uint64_t hashPieces(const FractureResult& r) {
@@ -100,7 +96,8 @@ TEST(ChainedFractureStress, RandomImpactsOnRandomPiecesStayValid) {
     const int total = impactCount();
     constexpr int kGenerations = 20;
     const char* dumpDir = std::getenv("RUBBLE_STRESS_DUMP");
-    std::map<std::string, int> failures; // error code -> count (errors are allowed: the piece stays whole)
+    // error code -> count and first message (errors are allowed: the piece stays whole)
+    std::map<std::string, std::pair<int, std::string>> failures;
     int fractures = 0, impacts = 0, pieces = 0, invalid = 0, exceptions = 0, nondeterministic = 0;
     double worstPerFracture = 0, worstChain = 0;
 
@@ -140,7 +137,9 @@ TEST(ChainedFractureStress, RandomImpactsOnRandomPiecesStayValid) {
             if (!r) {
                 // A piece made by fracture is always a valid input; other errors leave the piece whole.
                 EXPECT_NE(r.error().code, ErrorCode::InvalidInput) << what << ": " << r.error().message;
-                ++failures[toString(r.error().code)];
+                auto& [count, first] = failures[toString(r.error().code)];
+                if (count++ == 0)
+                    first = what + ": " + r.error().message;
                 previous.assign(1, rng.below(pool.size()));
                 continue;
             }
@@ -195,12 +194,42 @@ TEST(ChainedFractureStress, RandomImpactsOnRandomPiecesStayValid) {
     std::printf(
         "impacts %d, fractures %d, pieces %d, invalid pieces %d, exceptions %d, nondeterministic %d\n",
         impacts, fractures, pieces, invalid, exceptions, nondeterministic);
-    for (const auto& [code, n] : failures)
-        std::printf("  left whole (%s): %d\n", code.c_str(), n);
+    for (const auto& [code, failure] : failures)
+        std::printf("  left whole (%s): %d, first: %s\n", code.c_str(), failure.first,
+                    failure.second.c_str());
     std::printf("worst volume error: per fracture %.3g, per chain %.3g (relative)\n", worstPerFracture,
                 worstChain);
     EXPECT_EQ(invalid, 0);
     EXPECT_EQ(exceptions, 0);
     // Impacts are on the surface of the piece, so almost all of them must fracture it.
     EXPECT_GE(fractures, impacts * 98 / 100);
+}
+
+// Regression: this piece of cube_588 (chain 41, generation 4 of an earlier version of the test above) cut by
+// a 7-cell shatter pattern made CGAL 5.5's corefinement segfault when the Corefine backend cut adjacent cells
+// one after the other. Both backends must now fracture it into valid, volume-conserving pieces.
+TEST(ChainedFractureStress, CoincidentCellFacesDoNotCrashCorefinement) {
+    auto mesh = readObj(test::sourceDir() / "tests" / "stress" / "data" / "corefine_coincident_cells.obj");
+    ASSERT_TRUE(mesh.isOk()) << mesh.error().message;
+    const Impact impact{{-0.2422785180446681, 1, -0.31723650370051987}, {0, 1, 0}, 28.564805487537036};
+    FractureParams params;
+    params.pattern = CellPattern::Shatter;
+    params.cells = 7;
+    params.seedPoints = 9;
+    params.sizeLaw.base = 0.016936262688734393;
+    params.sizeLaw.scale = 0.0034441181204336604;
+    const double v0 = signedVolume(*mesh);
+    for (BooleanKind backend : {BooleanKind::Corefine, BooleanKind::Fast}) {
+        params.backend = backend;
+        auto r = fracture(*mesh, impact, params, 7640487810275784266ull);
+        ASSERT_TRUE(r.isOk()) << r.error().message;
+        double sum = r->droppedVolume;
+        for (const Piece& p : r->pieces) {
+            EXPECT_GT(p.mass.volume, 0);
+            EXPECT_TRUE(fuzz::closedAndOriented(p.mesh));
+            sum += p.mass.volume;
+        }
+        EXPECT_GT(r->pieces.size(), 1u);
+        EXPECT_NEAR(sum, v0, 1e-6 * v0);
+    }
 }
