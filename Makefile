@@ -3,6 +3,12 @@
 #   make test    install, build, check formatting and layering, run all tests
 #   make bench   install, build Release, run the benchmarks (CSV + PNG in bench/results/)
 #   make build   install and build (RelWithDebInfo) into build/
+#   make sanitize    clang ASan+UBSan build of the whole test suite (build-asan/) and TSan build of the runtime
+#                    and threading tests (build-tsan/), both run by CTest (scripts/sanitize.sh)
+#   make sanitize-ci the part of both that CI runs after make test (geometry + io under ASan+UBSan, 3 fuzzers)
+#   make fuzz-smoke  every libFuzzer target for FUZZ_SECONDS (default 45) each, built into build-asan/
+#   make stress      the chained-fracture stress test with STRESS_IMPACTS (default 10000) impacts
+#   make soak        rubble-bench scene with continuous fire for SOAK_FRAMES (default 100000) frames
 
 BUILD_DIR  ?= build
 BUILD_TYPE ?= RelWithDebInfo
@@ -10,7 +16,12 @@ RELEASE_DIR ?= build-release
 JOBS       ?= $(shell nproc)
 CMAKE_ARGS ?=
 
-.PHONY: all deps build release test demo bench format format-check lint clean
+FUZZ_SECONDS ?= 45
+STRESS_IMPACTS ?= 10000
+SOAK_FRAMES ?= 100000
+
+.PHONY: all deps build release test demo bench format format-check lint clean deps-clang sanitize sanitize-ci fuzz-smoke \
+	stress soak
 
 all: build
 
@@ -40,6 +51,25 @@ demo: build
 
 bench: release
 	@bash scripts/run-bench.sh $(RELEASE_DIR)
+
+deps-clang:
+	@bash scripts/install-deps.sh all
+
+sanitize: deps-clang
+	@bash scripts/sanitize.sh all
+
+sanitize-ci: deps-clang
+	@bash scripts/sanitize.sh ci
+
+fuzz-smoke: deps-clang
+	@bash scripts/fuzz.sh $(FUZZ_SECONDS)
+
+stress: build
+	RUBBLE_STRESS_IMPACTS=$(STRESS_IMPACTS) ctest --test-dir $(BUILD_DIR) --output-on-failure -L stress -V \
+	    --timeout 7200
+
+soak: release
+	@bash scripts/soak.sh $(RELEASE_DIR) $(SOAK_FRAMES)
 
 format:
 	@git ls-files '*.cpp' '*.hpp' | xargs clang-format -i

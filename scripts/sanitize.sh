@@ -1,0 +1,90 @@
+#!/usr/bin/env bash
+# Sanitizer runs (clang). Usage: scripts/sanitize.sh [all|asan|tsan|ci|configure-asan|configure-tsan]
+#   asan: the whole test suite (all labels but e2e) built with ASan + UBSan into build-asan/ and run by CTest;
+#         every finding is fatal (-fno-sanitize-recover=all, halt_on_error). The libFuzzer targets are built
+#         into the same tree (scripts/fuzz.sh uses it), so one tree serves both.
+#   tsan: only the runtime and threading tests (tests/runtime, tests/bullet) built with TSan into build-tsan/.
+#   ci:   the subset .ci/run can afford on a cold cache (see docs/robustness.md, section 7): the geometry and io
+#         modules and their tests under ASan + UBSan, then the obj, scene and mesh_repair fuzzers for
+#         FUZZ_SECONDS (default 30) each, in build-asan/. The CGAL-heavy fracture backends are left to
+#         `make sanitize` / `make fuzz-smoke`: compiling them under ASan alone takes longer than CI's budget.
+# Environment: JOBS (default nproc), RUBBLE_STRESS_IMPACTS (default 300 here: ASan is ~10x slower).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+what=${1:-all}
+jobs=${JOBS:-$(nproc)}
+common=(-G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRUBBLE_BUILD_DEMO=OFF -DRUBBLE_BUILD_BENCH=OFF
+    -DRUBBLE_WERROR=OFF) # warnings are enforced by the gcc build; clang only has to compile
+
+configure() { # dir, sanitizers, extra cmake args...
+    local dir=$1 san=$2
+    shift 2
+    [ -f "$dir/build.ninja" ] && return 0
+    CC=clang CXX=clang++ cmake -S . -B "$dir" "${common[@]}" -DRUBBLE_SANITIZE="$san" "$@" >/dev/null
+}
+
+elapsed() { echo "$(($(date +%s) - $1)) s"; }
+
+asan() {
+    local t0
+    t0=$(date +%s)
+    configure build-asan address,undefined -DRUBBLE_BUILD_FUZZERS=ON
+    cmake --build build-asan -j "$jobs"
+    echo "sanitize: ASan+UBSan build took $(elapsed "$t0")"
+    t0=$(date +%s)
+    # Leak checking is on (ASan's default on Linux); the suppressions file names only third-party leaks.
+    ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1 \
+        UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+        RUBBLE_STRESS_IMPACTS=${RUBBLE_STRESS_IMPACTS:-300} \
+        ctest --test-dir build-asan --output-on-failure -j "$jobs" --timeout 1200 -LE e2e
+    echo "sanitize: ASan+UBSan tests took $(elapsed "$t0")"
+}
+
+tsan() {
+    local t0
+    t0=$(date +%s)
+    configure build-tsan thread
+    # Only the threaded code: the runtime's tests and the Bullet bridge (which drives DestructionWorld).
+    local targets
+    targets=$(ninja -C build-tsan -t targets all | sed -n 's#^tests/\(\(runtime\|bullet\)_[A-Za-z]*_test\):.*#\1#p')
+    # shellcheck disable=SC2086
+    cmake --build build-tsan -j "$jobs" --target $targets
+    echo "sanitize: TSan build took $(elapsed "$t0")"
+    t0=$(date +%s)
+    # Clang 14's TSan cannot map its shadow with the larger ASLR entropy of recent kernels: run without ASLR.
+    local norand=()
+    if [ "$(cat /proc/sys/vm/mmap_rnd_bits 2>/dev/null || echo 28)" -gt 28 ]; then norand=(setarch "$(uname -m)" -R); fi
+    TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1 \
+        "${norand[@]}" ctest --test-dir build-tsan --output-on-failure -j "$jobs" --timeout 1200 -L 'runtime|bullet'
+    echo "sanitize: TSan tests took $(elapsed "$t0")"
+}
+
+ci() {
+    local t0
+    t0=$(date +%s)
+    configure build-asan address,undefined -DRUBBLE_BUILD_FUZZERS=ON
+    local targets
+    targets=$(ninja -C build-asan -t targets all | sed -n 's#^tests/\(\(geometry\|io\)_[A-Za-z]*_test\):.*#\1#p')
+    # shellcheck disable=SC2086
+    cmake --build build-asan -j "$jobs" --target $targets fuzz_replay_obj fuzz_replay_scene fuzz_replay_mesh_repair
+    echo "sanitize: ASan+UBSan build (geometry, io) took $(elapsed "$t0")"
+    t0=$(date +%s)
+    export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:strict_string_checks=1
+    export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+    ctest --test-dir build-asan --output-on-failure -j "$jobs" --timeout 1200 -L 'geometry|io'
+    ctest --test-dir build-asan --output-on-failure -R '^fuzz_replay_(obj|scene|mesh_repair)$'
+    echo "sanitize: ASan+UBSan tests (geometry, io) took $(elapsed "$t0")"
+    t0=$(date +%s)
+    bash scripts/fuzz.sh "${FUZZ_SECONDS:-30}" obj scene mesh_repair
+    echo "sanitize: fuzzing took $(elapsed "$t0")"
+}
+
+case "$what" in
+    all) asan && tsan ;;
+    asan) asan ;;
+    tsan) tsan ;;
+    ci) ci ;;
+    configure-asan) configure build-asan address,undefined -DRUBBLE_BUILD_FUZZERS=ON ;;
+    configure-tsan) configure build-tsan thread ;;
+    *) echo "usage: scripts/sanitize.sh [all|asan|tsan|ci|configure-asan|configure-tsan]" >&2; exit 2 ;;
+esac
