@@ -80,12 +80,23 @@ void mergeToBudget(std::vector<ConvexPolytope>& parts, const std::vector<std::ui
     }
     std::vector<Candidate> heap;
     bool siblingsOnly = true;
+    // Many fragments (a shatter pattern cuts each part into hundreds): rank pairs by the volume their joint
+    // bounding box adds instead of one Qhull call per pair; merges still build true hulls.
+    const bool boxCosts = parts.size() > 2 * budget;
     auto consider = [&](std::size_t i, std::size_t j) {
         if (siblingsOnly && origin[i] != origin[j])
             return;
         const double tol = 1e-9 * (bounds[i].diagonal() + bounds[j].diagonal());
         if (!bounds[i].overlaps(bounds[j], tol))
             return;
+        if (boxCosts) {
+            Aabb joint = bounds[i];
+            joint.extend(bounds[j]);
+            const Vec3 e = joint.size();
+            heap.push_back({e.x * e.y * e.z - volumes[i] - volumes[j], i, j, version[i], version[j]});
+            std::push_heap(heap.begin(), heap.end(), std::greater<>());
+            return;
+        }
         std::vector<Vec3> pts = parts[i].vertices();
         const std::vector<Vec3> pj = parts[j].vertices();
         pts.insert(pts.end(), pj.begin(), pj.end());
