@@ -310,6 +310,45 @@ TEST(UpdateDecomposition, RealFracturePiecesChained) {
     }
 }
 
+TEST(UpdateDecomposition, ShatterPatternsKeepCoverageAndBudget) {
+    // Six adjacent cells cut each parent part into many fragments (more than twice the budget), which takes
+    // the bounding-box-ranked merge; siblings of several parent parts (the L prism has two) merge first.
+    for (const Mesh& start : {makeSubdividedBox({-1, -1, -1}, {1, 1, 1}, 3), makeLPrism(2)}) {
+        auto d = decompose(start);
+        ASSERT_TRUE(d);
+        const Aabb b = start.bounds();
+        for (std::uint64_t seed = 0; seed < 4; ++seed) {
+            SCOPED_TRACE("seed " + std::to_string(seed));
+            FractureParams fp;
+            fp.pattern = CellPattern::Shatter;
+            fp.cells = 6;
+            fp.sizeLaw.base = 0.6 * b.size().x;
+            fp.sizeLaw.scale = 0;
+            auto fr = fracture(start, {b.center() + Vec3{0.1, 0.05, 0.02}, {1, 0, 0}, 1}, fp, seed);
+            ASSERT_TRUE(fr) << fr.error().message;
+            std::vector<Mesh> pieces;
+            std::vector<std::int32_t> pieceCells;
+            for (const Piece& p : fr->pieces) {
+                pieces.push_back(p.mesh);
+                pieceCells.push_back(p.cell);
+            }
+            DecompositionParams params;
+            params.maxParts = 8;
+            auto updated = updateDecomposition(d->parts, fr->cells, pieces, pieceCells, params);
+            ASSERT_EQ(updated.size(), pieces.size());
+            for (std::size_t i = 0; i < pieces.size(); ++i) {
+                expectCovers(pieces[i], updated[i], 1e-6 * diag(start));
+                EXPECT_LE(updated[i].size(), 8u);
+                for (const ConvexPolytope& part : updated[i]) {
+                    const Aabb pb = part.bounds();
+                    EXPECT_TRUE(b.contains(pb.lo, 1e-6 * diag(start)) &&
+                                b.contains(pb.hi, 1e-6 * diag(start)));
+                }
+            }
+        }
+    }
+}
+
 TEST(UpdateDecomposition, PieceWithoutFragmentsGetsAFreshDecomposition) {
     const Mesh l = makeLPrism();
     auto updated = updateDecomposition({}, {}, {l}, {-1});
