@@ -222,16 +222,15 @@ int runScene(const SceneArgs& a) {
                    "latency_p50_ms,latency_p99_ms,latency_max_ms,queue_p50_ms,boolean_p50_ms,"
                    "decomposition_p50_ms,pieces_alive,pieces_max,pieces_retired,volume_error,state_hash,"
                    "peak_rss_mb\n";
-        out << std::filesystem::path(a.file).filename().string() << ',' << workers << ','
-            << (a.deterministic ? 1 : 0) << ',' << a.seed << ',' << a.shotsPerSecond << ',' << frames << ','
-            << shots << ',' << percentile(frameMs, 0.5) << ',' << percentile(frameMs, 0.99) << ','
-            << percentile(frameMs, 1.0) << ',' << percentile(physicsMs, 0.5) << ','
-            << percentile(physicsMs, 0.99) << ',' << percentile(adoptMs, 0.99) << ',' << c.impacts << ','
-            << c.fractures << ',' << stale << ',' << percentile(latency, 0.5) << ','
-            << percentile(latency, 0.99) << ',' << percentile(latency, 1.0) << ',' << percentile(queue, 0.5)
-            << ',' << percentile(boolean, 0.5) << ',' << percentile(decomposition, 0.5) << ','
-            << bridge.livePieces() << ',' << maxPieces << ',' << c.piecesRetired << ',' << volumeError << ','
-            << hashText << ',' << rss << '\n';
+        out << a.file << ',' << workers << ',' << (a.deterministic ? 1 : 0) << ',' << a.seed << ','
+            << a.shotsPerSecond << ',' << frames << ',' << shots << ',' << percentile(frameMs, 0.5) << ','
+            << percentile(frameMs, 0.99) << ',' << percentile(frameMs, 1.0) << ','
+            << percentile(physicsMs, 0.5) << ',' << percentile(physicsMs, 0.99) << ','
+            << percentile(adoptMs, 0.99) << ',' << c.impacts << ',' << c.fractures << ',' << stale << ','
+            << percentile(latency, 0.5) << ',' << percentile(latency, 0.99) << ',' << percentile(latency, 1.0)
+            << ',' << percentile(queue, 0.5) << ',' << percentile(boolean, 0.5) << ','
+            << percentile(decomposition, 0.5) << ',' << bridge.livePieces() << ',' << maxPieces << ','
+            << c.piecesRetired << ',' << volumeError << ',' << hashText << ',' << rss << '\n';
     }
     if (a.json) {
         nlohmann::json j;

@@ -9,6 +9,7 @@
 #include <map>
 #include <mutex>
 
+#include "geometry/ClosestPoint.hpp"
 #include "rubble/MassProperties.hpp"
 #include "rubble/MeshCheck.hpp"
 #include "rubble/MeshRepair.hpp"
@@ -79,33 +80,6 @@ ConvexPolytope toLocal(const ConvexPolytope& p, const Frame& f) {
     return ConvexPolytope::fromFaces(std::move(faces));
 }
 
-// Closest point to p on triangle (a, b, c) (Ericson, Real-Time Collision Detection, 5.1.5).
-Vec3 closestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
-    const Vec3 ab = b - a, ac = c - a, ap = p - a;
-    const double d1 = dot(ab, ap), d2 = dot(ac, ap);
-    if (d1 <= 0 && d2 <= 0)
-        return a;
-    const Vec3 bp = p - b;
-    const double d3 = dot(ab, bp), d4 = dot(ac, bp);
-    if (d3 >= 0 && d4 <= d3)
-        return b;
-    const double vc = d1 * d4 - d3 * d2;
-    if (vc <= 0 && d1 >= 0 && d3 <= 0)
-        return a + ab * (d1 / (d1 - d3));
-    const Vec3 cp = p - c;
-    const double d5 = dot(ab, cp), d6 = dot(ac, cp);
-    if (d6 >= 0 && d5 <= d6)
-        return c;
-    const double vb = d5 * d2 - d1 * d6;
-    if (vb <= 0 && d2 >= 0 && d6 <= 0)
-        return a + ac * (d2 / (d2 - d6));
-    const double va = d3 * d6 - d5 * d4;
-    if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
-        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
-    const double denom = 1 / (va + vb + vc);
-    return a + ab * (vb * denom) + ac * (vc * denom);
-}
-
 // Physics engines report contact points off the surface (a predictive CCD contact gives the projectile's
 // centre at the time of impact, a margin adds a few centimetres): the cells are centred on the nearest
 // surface point so that they always cut the mesh. A point farther away than the impact's cell domain is
@@ -114,8 +88,8 @@ Impact onSurface(const Mesh& mesh, Impact impact, const FractureParams& params) 
     double best = std::numeric_limits<double>::infinity();
     Vec3 closest = impact.point;
     for (const auto& t : mesh.triangles) {
-        const Vec3 q =
-            closestOnTriangle(impact.point, mesh.positions[t[0]], mesh.positions[t[1]], mesh.positions[t[2]]);
+        const Vec3 q = detail::closestOnTriangle(impact.point, mesh.positions[t[0]], mesh.positions[t[1]],
+                                                 mesh.positions[t[2]]);
         const double d = lengthSquared(q - impact.point);
         if (d < best) {
             best = d;
