@@ -13,13 +13,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <map>
 #include <memory>
 
+#include "BenchUtil.hpp"
 #include "Subcommand.hpp"
 #include "rubble/ConvexDecomposition.hpp"
 #include "rubble/Fracture.hpp"
@@ -35,23 +34,11 @@ struct BenchArgs {
     int runs = 15;
     std::string only; // run only the cases whose name contains this
     std::vector<std::string> backends{"corefine", "fast", "nef"}; // which backends run
-    std::string out = RUBBLE_SOURCE_DIR "/bench/results";
+    std::string out = rubble::bench::kResultsDir;
 };
 
-struct Stats {
-    double median = 0, min = 0, max = 0;
-};
-
-Stats stats(std::vector<double> v) {
-    if (v.empty())
-        return {};
-    std::sort(v.begin(), v.end());
-    return {v[v.size() / 2], v.front(), v.back()};
-}
-
-double msBetween(Clock::time_point a, Clock::time_point b) {
-    return std::chrono::duration<double, std::milli>(b - a).count();
-}
+using rubble::bench::msSince;
+using rubble::bench::stats;
 
 const char* backendName(rubble::BooleanKind k) {
     switch (k) {
@@ -112,13 +99,15 @@ void runOnce(Case& c, rubble::BooleanKind kind, std::uint64_t seed) {
     const auto parts = rubble::updateDecomposition(c.parentParts, r->cells, meshes, pieceCells);
     const auto t3 = Clock::now();
     // The copies of the piece meshes are the caller's choice (the runtime makes them too) and not timed.
-    s.pieces.push_back(msBetween(t0, t1));
-    s.withParts.push_back(msBetween(t0, t1) + msBetween(t2, t3));
+    const double piecesMs = std::chrono::duration<double, std::milli>(t1 - t0).count();
+    const double partsMs = std::chrono::duration<double, std::milli>(t3 - t2).count();
+    s.pieces.push_back(piecesMs);
+    s.withParts.push_back(piecesMs + partsMs);
     s.cell.push_back(r->timings.cellMs);
     s.boolean.push_back(r->timings.booleanMs);
     s.islands.push_back(r->timings.islandsMs - r->timings.massMs);
     s.mass.push_back(r->timings.massMs);
-    s.decomposition.push_back(msBetween(t2, t3));
+    s.decomposition.push_back(partsMs);
     s.fallbacks += r->exactFallback ? 1 : 0;
     s.pieceCount = r->pieces.size();
     s.partCount = 0;
@@ -197,7 +186,7 @@ int runBench(const BenchArgs& args) {
     for (Case& c : cases) {
         const auto t0 = Clock::now();
         auto d = rubble::decompose(c.mesh);
-        c.decomposeMs = msBetween(t0, Clock::now());
+        c.decomposeMs = msSince(t0);
         if (d)
             c.parentParts = std::move(d->parts);
     }
@@ -213,121 +202,94 @@ int runBench(const BenchArgs& args) {
             }
         }
 
-    std::printf("%-19s %6s %-8s | %-26s | %-26s | %6s %7s %7s %7s %7s | %6s %5s %5s | %8s %9s\n", "model",
-                "tris", "backend", "pieces ms (med/min/max)", "+convex parts ms (med/min/max)", "cell",
-                "boolean", "islands", "mass/uv", "decomp", "fallbk", "pcs", "parts", "thesis s", "x thesis");
-    struct CsvRow {
-        const Case* c;
-        rubble::BooleanKind kind;
-        Stats pieces, withParts;
-        double cell, boolean, islands, mass, decomposition;
-        const Samples* s;
-    };
-    std::vector<CsvRow> rows;
+    using rubble::bench::fixed;
+    rubble::bench::Table table;
+    table.header = {"model",
+                    "triangles",
+                    "backend",
+                    "runs",
+                    "failures",
+                    "fallbacks",
+                    "pieces",
+                    "convex_parts",
+                    "pieces_median_ms",
+                    "pieces_min_ms",
+                    "pieces_max_ms",
+                    "with_parts_median_ms",
+                    "with_parts_min_ms",
+                    "with_parts_max_ms",
+                    "cell_ms",
+                    "boolean_ms",
+                    "islands_ms",
+                    "mass_uv_ms",
+                    "decomposition_ms",
+                    "initial_decomposition_ms",
+                    "thesis_s",
+                    "speedup_vs_thesis"};
+    std::string failures;
     for (const Case& c : cases)
         for (const auto& [kind, s] : c.samples) {
-            CsvRow row{&c,
-                       kind,
-                       stats(s.pieces),
-                       stats(s.withParts),
-                       stats(s.cell).median,
-                       stats(s.boolean).median,
-                       stats(s.islands).median,
-                       stats(s.mass).median,
-                       stats(s.decomposition).median,
-                       &s};
-            rows.push_back(row);
-            const int ok = static_cast<int>(s.pieces.size());
-            char ref[64] = "";
-            if (c.thesisS > 0 && ok > 0)
-                std::snprintf(ref, sizeof ref, "%8.3f %9.0f", c.thesisS,
-                              c.thesisS * 1000 / row.withParts.median);
-            char fb[16];
-            std::snprintf(fb, sizeof fb, "%d/%d", s.fallbacks, ok);
-            std::printf(
-                "%-19s %6zu %-8s | %8.3f %8.3f %8.3f | %8.3f %8.3f %8.3f | %6.3f %7.3f %7.3f %7.3f %7.3f | "
-                "%6s %5zu %5zu | %s\n",
-                c.name.c_str(), c.mesh.triangleCount(), backendName(kind), row.pieces.median, row.pieces.min,
-                row.pieces.max, row.withParts.median, row.withParts.min, row.withParts.max, row.cell,
-                row.boolean, row.islands, row.mass, row.decomposition, fb, s.pieceCount, s.partCount, ref);
+            const rubble::bench::Stats pieces = stats(s.pieces), withParts = stats(s.withParts);
+            const bool reference = c.thesisS > 0 && withParts.median > 0;
+            table.rows.push_back({c.name,
+                                  std::to_string(c.mesh.triangleCount()),
+                                  backendName(kind),
+                                  std::to_string(runs),
+                                  std::to_string(s.failures),
+                                  std::to_string(s.fallbacks),
+                                  std::to_string(s.pieceCount),
+                                  std::to_string(s.partCount),
+                                  fixed(pieces.median),
+                                  fixed(pieces.min),
+                                  fixed(pieces.max),
+                                  fixed(withParts.median),
+                                  fixed(withParts.min),
+                                  fixed(withParts.max),
+                                  fixed(stats(s.cell).median),
+                                  fixed(stats(s.boolean).median),
+                                  fixed(stats(s.islands).median),
+                                  fixed(stats(s.mass).median),
+                                  fixed(stats(s.decomposition).median),
+                                  fixed(c.decomposeMs),
+                                  reference ? fixed(c.thesisS) : "",
+                                  reference ? fixed(c.thesisS * 1000 / withParts.median, 0) : ""});
             if (s.failures > 0)
-                std::printf("  %d of %d runs failed: %s\n", s.failures, runs, s.error.c_str());
+                failures += c.name + " " + backendName(kind) + ": " + std::to_string(s.failures) + " of " +
+                            std::to_string(runs) + " runs failed: " + s.error + "\n";
         }
-    std::printf("runs per case: %d, interleaved; stage columns are medians in ms; fallbk = runs where Fast "
-                "declined and Corefine made the split; parent decomposition cached before the impact\n",
-                runs);
-
-    std::error_code ec;
-    fs::create_directories(args.out, ec);
-    const fs::path csv = fs::path(args.out) / "impact.csv";
-    std::ofstream out(csv);
-    if (!out) {
-        std::cerr << "impact: cannot write " << csv.string() << "\n";
+    rubble::bench::printTable(table);
+    std::printf(
+        "%sruns per case: %d, interleaved (run i uses seed 1000+i for every backend); stage columns are "
+        "medians in ms; fallbacks = runs where Fast declined and Corefine made the split; the parent's "
+        "decomposition is cached before the impact (initial_decomposition_ms)\n",
+        failures.c_str(), runs);
+    if (!rubble::bench::writeCsv(fs::path(args.out) / "impact.csv", table))
         return 1;
-    }
-    out << "model,triangles,backend,runs,failures,fallbacks,pieces,convex_parts,pieces_median_ms,pieces_min_"
-           "ms,"
-           "pieces_max_ms,with_parts_median_ms,with_parts_min_ms,with_parts_max_ms,cell_ms,boolean_ms,"
-           "islands_ms,mass_uv_ms,decomposition_ms,initial_decomposition_ms,thesis_s,speedup_vs_thesis\n";
-    for (const CsvRow& r : rows) {
-        out << r.c->name << "," << r.c->mesh.triangleCount() << "," << backendName(r.kind) << "," << runs
-            << "," << r.s->failures << "," << r.s->fallbacks << "," << r.s->pieceCount << ","
-            << r.s->partCount << "," << r.pieces.median << "," << r.pieces.min << "," << r.pieces.max << ","
-            << r.withParts.median << "," << r.withParts.min << "," << r.withParts.max << "," << r.cell << ","
-            << r.boolean << "," << r.islands << "," << r.mass << "," << r.decomposition << ","
-            << r.c->decomposeMs << ",";
-        if (r.c->thesisS > 0 && r.withParts.median > 0)
-            out << r.c->thesisS << "," << r.c->thesisS * 1000 / r.withParts.median;
-        else
-            out << ",";
-        out << "\n";
-    }
-    out.close();
-    std::cout << "CSV: " << csv.string() << "\n";
 
-    if (std::system("command -v gnuplot >/dev/null 2>&1") != 0) {
-        std::cout << "gnuplot not found: plot skipped\n";
-        return 0;
-    }
-    const fs::path dat = fs::path(args.out) / "impact_cubes.dat";
-    {
-        // One line per cube: triangles, thesis ms, then pieces+parts medians of corefine, fast, nef ("?" =
-        // none).
-        std::ofstream d(dat);
-        for (const Case& c : cases) {
-            if (c.thesisS <= 0)
-                continue;
-            d << c.mesh.triangleCount() << " " << c.thesisS * 1000;
-            for (rubble::BooleanKind k :
-                 {rubble::BooleanKind::Corefine, rubble::BooleanKind::Fast, rubble::BooleanKind::Nef}) {
-                auto it = c.samples.find(k);
-                if (it == c.samples.end() || it->second.withParts.empty())
-                    d << " ?";
-                else
-                    d << " " << stats(it->second.withParts).median;
-            }
-            d << "\n";
+    // One line per cube: triangles, thesis ms, then pieces+parts medians of corefine, fast, nef ("?" = none).
+    std::string data;
+    for (const Case& c : cases) {
+        if (c.thesisS <= 0)
+            continue;
+        data += std::to_string(c.mesh.triangleCount()) + " " + fixed(c.thesisS * 1000);
+        for (rubble::BooleanKind k :
+             {rubble::BooleanKind::Corefine, rubble::BooleanKind::Fast, rubble::BooleanKind::Nef}) {
+            auto it = c.samples.find(k);
+            const bool has = it != c.samples.end() && !it->second.withParts.empty();
+            data += " " + (has ? fixed(stats(it->second.withParts).median) : std::string("?"));
         }
+        data += "\n";
     }
-    const fs::path png = fs::path(args.out) / "impact.png";
-    const fs::path gp = fs::path(args.out) / "impact.gp";
-    {
-        std::ofstream g(gp);
-        g << "set terminal pngcairo size 900,600\nset output '" << png.string() << "'\n"
-          << "set datafile missing '?'\nset logscale xy\nset xrange [8:15000]\nset xlabel 'cube triangles'\n"
-          << "set ylabel 'impact -> pieces + convex parts (ms)'\nset grid\nset key top left\n"
-          << "set title 'Impact to final collision shapes: Rubble vs the thesis program (same machine)'\n"
-          << "plot '" << dat.string() << "' u 1:2 w lp t 'thesis program (Nef + HACD)', '' u 1:3 w lp t "
-          << "'Rubble, corefine', '' u 1:4 w lp t 'Rubble, fast', '' u 1:5 w lp t 'Rubble, nef', 16.7 w l dt "
-             "2 "
-          << "t '60 Hz frame'\n";
-    }
-    if (std::system(("gnuplot '" + gp.string() + "' 2>/dev/null").c_str()) == 0)
-        std::cout << "plot: " << png.string() << "\n";
-    else
-        std::cout << "gnuplot failed: plot skipped\n";
-    fs::remove(gp, ec);
-    fs::remove(dat, ec);
+    rubble::bench::plotPng(
+        args.out, "impact", data,
+        "set datafile missing '?'\nset logscale xy\nset xrange [8:15000]\n"
+        "set xlabel 'cube triangles'\nset ylabel 'impact -> pieces + convex parts (ms)'\n"
+        "set grid\nset key top left\n"
+        "set title 'Impact to final collision shapes: Rubble vs the thesis program (same "
+        "machine)'\n"
+        "plot $DATA u 1:2 w lp t 'thesis program (Nef + HACD)', '' u 1:3 w lp t 'Rubble, "
+        "corefine', '' u 1:4 w lp t 'Rubble, fast', '' u 1:5 w lp t 'Rubble, nef', 16.7 w l "
+        "dt 2 t '60 Hz frame'");
     return 0;
 }
 
