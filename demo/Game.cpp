@@ -1,27 +1,27 @@
 #include "Game.hpp"
 
-#include <BulletCollision/CollisionShapes/btShapeHull.h>
 #include <btBulletDynamicsCommon.h>
 
 #include <algorithm>
 #include <cmath>
 
-#include "rubble/ConvexDecomposition.hpp"
-#include "rubble/DestructionWorld.hpp"
 #include "rubble/MassProperties.hpp"
 #include "rubble/MeshIO.hpp"
+#include "rubble/bullet/Convert.hpp"
+#include "rubble/bullet/SceneLoader.hpp"
 
 namespace demo {
 
 namespace {
 
-enum Group : int { kStatic = 1, kVehicle = 2, kProjectile = 4, kDebris = 8, kAll = 0xFFFF };
+using rubble::bullet::Body;
+using rubble::bullet::BodyKind;
 
 V3 toV3(const btVector3& v) {
     return {v.x(), v.y(), v.z()};
 }
-btVector3 toBt(const rubble::Vec3& v) {
-    return {static_cast<btScalar>(v.x), static_cast<btScalar>(v.y), static_cast<btScalar>(v.z)};
+V3 toV3(const rubble::Vec3& v) {
+    return {static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z)};
 }
 
 /// Box-projected UVs (metres per repeat) for meshes that have none.
@@ -79,116 +79,47 @@ rubble::Mesh standInJet() {
     return jet;
 }
 
-class DebugLines : public btIDebugDraw {
-public:
-    explicit DebugLines(Renderer& r) : r_(r) {}
-    void drawLine(const btVector3& a, const btVector3& b, const btVector3& c) override {
-        r_.addLine(toV3(a), toV3(b), c.x(), c.y(), c.z());
-    }
-    void drawContactPoint(const btVector3& p, const btVector3& n, btScalar, int,
-                          const btVector3& c) override {
-        drawLine(p, p + n * 1.0f, c);
-    }
-    void reportErrorWarning(const char*) override {}
-    void draw3dText(const btVector3&, const char*) override {}
-    void setDebugMode(int m) override { mode_ = m; }
-    int getDebugMode() const override { return mode_; }
-
-private:
-    Renderer& r_;
-    int mode_ = 0;
-};
-
 } // namespace
-
-struct Game::Body {
-    enum class Kind { Ground, Vehicle, Object, Piece, Projectile };
-    Kind kind = Kind::Object;
-    std::unique_ptr<btRigidBody> rb;
-    std::unique_ptr<btCollisionShape> shape;
-    std::vector<std::unique_ptr<btCollisionShape>> children;
-    int mesh = -1;
-    int texture = 0;
-    V3 tint{1, 1, 1};
-    std::uint32_t object = 0;
-    float heat = 0;
-    float age = 0;
-    float volume = 0;
-    double density = 1;
-    rubble::Mesh localMesh; // used by the stand-in fracture
-    bool dead = false;
-};
 
 Game::Game() = default;
 
 Game::~Game() {
-    if (world_)
-        for (auto& b : bodies_)
-            world_->removeRigidBody(b->rb.get());
-}
-
-bool Game::fractureAvailable() {
-#if RUBBLE_DEMO_HAS_RUNTIME
-    return true;
-#else
-    return false;
-#endif
-}
-
-Game::Body* Game::addBody(std::unique_ptr<Body> b) {
-    b->rb->setUserPointer(b.get());
-    int group = kStatic, mask = kAll;
-    switch (b->kind) {
-    case Body::Kind::Vehicle:
-        group = kVehicle;
-        mask = kAll & ~kProjectile;
-        break;
-    case Body::Kind::Projectile:
-        group = kProjectile;
-        mask = kAll & ~kVehicle & ~kProjectile;
-        break;
-    case Body::Kind::Piece:
-        group = kDebris;
-        break;
-    default:
-        break;
+    if (bridge_) {
+        bridge_->setOnRemoved({});
+        bridge_->setOnAdopted({});
     }
-    world_->addRigidBody(b->rb.get(), group, mask);
-    bodies_.push_back(std::move(b));
-    return bodies_.back().get();
-}
-
-void Game::removeBody(Body* b, Renderer& renderer) {
-    world_->removeRigidBody(b->rb.get());
-    if (b->mesh >= 0 && b->kind != Body::Kind::Projectile)
-        renderer.removeMesh(b->mesh);
-    auto it = std::find_if(bodies_.begin(), bodies_.end(), [b](const auto& p) { return p.get() == b; });
-    if (it != bodies_.end())
-        bodies_.erase(it);
+    bridge_.reset();
+    physics_.reset();
+    destruction_.reset();
 }
 
 void Game::clear(Renderer& renderer) {
-    if (world_)
-        for (auto& b : bodies_) {
-            world_->removeRigidBody(b->rb.get());
-            if (b->mesh >= 0)
-                renderer.removeMesh(b->mesh);
-        }
-    bodies_.clear();
+    if (bridge_) {
+        bridge_->setOnAdopted({});
+        bridge_->setOnRemoved({});
+    }
+    for (const auto& [body, v] : visuals_)
+        if (v.mesh >= 0)
+            renderer.removeMesh(v.mesh);
+    visuals_.clear();
+    looks_.clear();
     vehicle_ = nullptr;
-    world_.reset();
-    solver_.reset();
-    broadphase_.reset();
-    dispatcher_.reset();
-    collisionConfig_.reset();
-#if RUBBLE_DEMO_HAS_RUNTIME
+    bridge_.reset();
+    physics_.reset();
     destruction_.reset();
-#endif
     particles_.clear();
-    marks_.clear();
     counters_ = {};
     latencies_.clear();
     latencyCursor_ = timingCursor_ = 0;
+}
+
+void Game::addVisual(const Body& body, const rubble::Mesh& mesh, const Look& look, float heat,
+                     Renderer& renderer) {
+    Visual v;
+    v.mesh = renderer.addMesh(mesh, look.texture, look.tint.x, look.tint.y, look.tint.z);
+    v.heat = heat;
+    v.tint = look.tint;
+    visuals_[&body] = v;
 }
 
 bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const GameSettings& settings,
@@ -196,63 +127,75 @@ bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const Game
     clear(renderer);
     settings_ = settings;
     renderer.shadows = settings.shadows;
-    collisionConfig_ = std::make_unique<btDefaultCollisionConfiguration>();
-    dispatcher_ = std::make_unique<btCollisionDispatcher>(collisionConfig_.get());
-    broadphase_ = std::make_unique<btDbvtBroadphase>();
-    solver_ = std::make_unique<btSequentialImpulseConstraintSolver>();
-    world_ = std::make_unique<btDiscreteDynamicsWorld>(dispatcher_.get(), broadphase_.get(), solver_.get(),
-                                                       collisionConfig_.get());
-    world_->setGravity({0, -9.81f, 0});
-#if RUBBLE_DEMO_HAS_RUNTIME
-    rubble::DestructionWorld::Config cfg;
-    cfg.workers = settings.workers;
-    cfg.deterministic = settings.deterministic;
-    cfg.seed = 20260522;
-    destruction_ = std::make_shared<rubble::DestructionWorld>(cfg);
-#endif
-    for (const auto& w : scene.warnings)
-        warnings.push_back(w.message);
+    rubble::DestructionWorld::Config dc;
+    dc.workers = settings.workers;
+    dc.deterministic = settings.deterministic;
+    dc.seed = 20260522;
+    destruction_ = std::make_unique<rubble::DestructionWorld>(dc);
+    physics_ = std::make_unique<rubble::bullet::PhysicsWorld>();
+    rubble::bullet::DestructionBridge::Config bc;
+    bc.collisionImpulseThreshold = settings.collisionImpulse;
+    bc.minPieceVolume = settings.minPieceVolume;
+    bc.maxLivePieces = settings.maxPieces;
+    bc.projectileLifetime = 3;
+    bc.spentProjectileLifetime = 0;
+    bridge_ = std::make_unique<rubble::bullet::DestructionBridge>(*physics_, *destruction_, bc);
+    bridge_->setOnRemoved([this, &renderer](Body& b) {
+        auto it = visuals_.find(&b);
+        if (it == visuals_.end())
+            return;
+        if (it->second.mesh >= 0)
+            renderer.removeMesh(it->second.mesh);
+        visuals_.erase(it);
+    });
+    bridge_->setOnAdopted([this, &renderer](const rubble::FractureOutcome& o) { onAdopted(o, renderer); });
+
+    rubble::bullet::SceneLoadOptions lo;
+    lo.loadVehicle = false; // the demo builds its own (stand-in jet, steering assist)
+    lo.staticDensity = 400;
+    lo.impulseThreshold = settings.impulseThreshold;
+    lo.fracture = settings.fracture;
+    lo.prepareMesh = [](rubble::Mesh& m) {
+        m.normals.clear();
+        ensureUvs(m, 4.0);
+    };
+    const rubble::bullet::LoadedScene loaded = rubble::bullet::loadScene(scene, *bridge_, lo);
+    for (const auto& w : loaded.warnings)
+        warnings.push_back(w);
 
     // Ground: a solid unit cube scaled (thesis: "generated as a solid cube with 1x1x1 size").
-    {
+    if (loaded.ground) {
         const auto& g = scene.ground;
-        const V3 half{static_cast<float>(g.scale.x * 0.5), static_cast<float>(g.scale.y * 0.5),
-                      static_cast<float>(g.scale.z * 0.5)};
-        rubble::Mesh box = rubble::makeBox({-half.x, -half.y, -half.z}, {half.x, half.y, half.z});
-        box.uvs.clear();
-        box.uvs.resize(box.triangles.size() * 3);
+        const rubble::Vec3 half{std::abs(g.scale.x) * 0.5, std::abs(g.scale.y) * 0.5,
+                                std::abs(g.scale.z) * 0.5};
+        rubble::Mesh box = rubble::makeBox(-half, half);
+        box.uvs.assign(box.triangles.size() * 3, {});
         for (size_t t = 0; t < box.triangles.size(); ++t)
             for (int c = 0; c < 3; ++c) {
                 const auto& p = box.positions[box.triangles[t][static_cast<size_t>(c)]];
                 box.uvs[3 * t + static_cast<size_t>(c)] = {(p.x + g.position.x) / 16.0,
                                                            (p.z + g.position.z) / 16.0};
             }
-        auto b = std::make_unique<Body>();
-        b->kind = Body::Kind::Ground;
-        b->shape = std::make_unique<btBoxShape>(btVector3(half.x, half.y, half.z));
-        btTransform t;
-        t.setIdentity();
-        t.setOrigin(toBt(g.position));
-        b->rb = std::make_unique<btRigidBody>(0.0f, nullptr, b->shape.get());
-        b->rb->setWorldTransform(t);
-        b->rb->setFriction(0.9f);
-        b->texture = g.textureFound ? renderer.loadTexture(g.texturePath, "grid", warnings)
-                                    : renderer.proceduralTexture("grid");
-        b->mesh = renderer.addMesh(box, b->texture, 0.95f, 1.0f, 0.92f);
-        groundTop_ = static_cast<float>(g.position.y + half.y);
-        addBody(std::move(b));
+        loaded.ground->rigid->setFriction(0.9f);
+        Look look;
+        look.texture = g.textureFound ? renderer.loadTexture(g.texturePath, "grid", warnings)
+                                      : renderer.proceduralTexture("grid");
+        look.tint = {0.95f, 1.0f, 0.92f};
+        addVisual(*loaded.ground, box, look, 0, renderer);
+        groundTop_ = static_cast<float>(loaded.groundTop);
     }
+    bridge_->config().killBelowY = groundTop_ - 60.0;
 
-    // Vehicle.
-    {
+    // Vehicle: the scene's model, or the built-in jet; an indestructible convex body steered by
+    // controlVehicle.
+    if (scene.vehicle.line != 0) {
         const auto& v = scene.vehicle;
         rubble::Mesh mesh;
         bool standIn = true;
         if (v.modelFound) {
             auto r = rubble::readMesh(v.modelPath);
             if (r && !r->empty()) {
-                mesh = r.value();
-                mesh = mesh.transformed(rubble::Mat3::identity(), v.scale, {0, 0, 0});
+                mesh = r.value().transformed(rubble::Mat3::identity(), v.scale, {0, 0, 0});
                 standIn = false;
             } else {
                 warnings.push_back(scene.baseDir.string() + ":" + std::to_string(v.line) +
@@ -267,145 +210,43 @@ bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const Game
         mesh = mesh.translated(rubble::Vec3{} - bb.center());
         const rubble::Vec3 he = bb.size() * 0.5;
         noseOffset_ = static_cast<float>(std::max(he.z, std::max(he.x, he.y))) + 2.0f;
-        auto b = std::make_unique<Body>();
-        b->kind = Body::Kind::Vehicle;
-        b->shape = std::make_unique<btBoxShape>(btVector3(static_cast<btScalar>(he.x * 0.6),
-                                                          static_cast<btScalar>(he.y * 0.8),
-                                                          static_cast<btScalar>(he.z * 0.9)));
-        const float mass = std::max(static_cast<float>(v.mass), 1.0f);
-        btVector3 inertia;
-        b->shape->calculateLocalInertia(mass, inertia);
-        btTransform t;
-        t.setIdentity();
-        t.setOrigin(toBt(v.position));
-        b->rb = std::make_unique<btRigidBody>(
-            btRigidBody::btRigidBodyConstructionInfo(mass, nullptr, b->shape.get(), inertia));
-        b->rb->setWorldTransform(t);
-        b->rb->setFlags(b->rb->getFlags() | BT_DISABLE_WORLD_GRAVITY);
-        b->rb->setActivationState(DISABLE_DEACTIVATION);
-        b->rb->setDamping(0.05f, 0.6f);
-        b->texture = v.textureFound ? renderer.loadTexture(v.texturePath, "metal", warnings)
-                                    : renderer.proceduralTexture("metal");
-        vehicleTexture_ = b->texture;
-        b->tint = {0.85f, 0.9f, 1.0f};
-        b->mesh = renderer.addMesh(mesh, b->texture, 0.85f, 0.9f, 1.0f);
-        speed_ = v.mass > 0 ? 30.0f : 0.0f;
-        vehicle_ = addBody(std::move(b));
-        vehicle_->rb->setLinearVelocity(btVector3(0, 0, -speed_));
+        auto body = bridge_->addConvexBody(
+            mesh.positions, rubble::Frame{rubble::Mat3::identity(), v.position}, std::max(v.mass, 1.0));
+        if (body) {
+            vehicle_ = *body;
+            btRigidBody* rb = vehicle_->rigid.get();
+            rb->setFlags(rb->getFlags() | BT_DISABLE_WORLD_GRAVITY);
+            rb->setGravity(btVector3(0, 0, 0));
+            rb->setActivationState(DISABLE_DEACTIVATION);
+            rb->setDamping(0.05f, 0.6f);
+            Look look;
+            look.texture = v.textureFound ? renderer.loadTexture(v.texturePath, "metal", warnings)
+                                          : renderer.proceduralTexture("metal");
+            look.tint = {0.85f, 0.9f, 1.0f};
+            addVisual(*vehicle_, mesh, look, 0, renderer);
+            speed_ = v.mass > 0 ? 30.0f : 0.0f;
+            rb->setLinearVelocity(btVector3(0, 0, -speed_));
+        } else {
+            warnings.push_back(scene.baseDir.string() + ":" + std::to_string(v.line) + ": vehicle skipped (" +
+                               body.error().message + ")");
+        }
     }
 
-    // Objects.
-    for (const auto& o : scene.objects) {
-        rubble::Mesh mesh;
-        bool ok = false;
-        if (o.modelFound) {
-            auto r = rubble::readMesh(o.modelPath);
-            if (r && !r->empty()) {
-                mesh = r.value();
-                ok = true;
-            } else {
-                warnings.push_back(o.modelPath.string() + " (scene line " + std::to_string(o.line) +
-                                   "): unreadable (" + (r ? "empty" : r.error().message) +
-                                   "); using a box stand-in");
-            }
-        }
-        if (!ok)
-            mesh = rubble::makeBox({-1, -1, -1}, {1, 1, 1});
-        mesh = mesh.transformed(rubble::Mat3::identity(), o.scale, {0, 0, 0});
-        mesh.normals.clear();
-        ensureUvs(mesh, 4.0);
-        rubble::MassProperties mp = rubble::computeMassProperties(mesh);
-        double volume = mp.volume;
-        rubble::Vec3 com = mp.centerOfMass;
-        if (!(volume > 1e-9)) {
-            warnings.push_back(o.modelPath.string() + " (scene line " + std::to_string(o.line) +
-                               "): mesh is not a closed outward solid (volume " + std::to_string(volume) +
-                               "); centred on its bounding box");
-            const rubble::Aabb bb = mesh.bounds();
-            com = bb.center();
-            const rubble::Vec3 s = bb.size();
-            volume = std::max(1e-3, s.x * s.y * s.z);
-        }
-        mesh = mesh.translated(rubble::Vec3{} - com);
-        const bool isStatic = o.mass <= 0;
-        const double density = isStatic ? 400.0 : o.mass / volume;
-
-        auto b = std::make_unique<Body>();
-        b->kind = Body::Kind::Object;
-        b->volume = static_cast<float>(volume);
-        std::vector<std::vector<rubble::Vec3>> parts;
-        rubble::Mesh renderMesh = mesh;
-#if RUBBLE_DEMO_HAS_RUNTIME
-        {
-            rubble::ObjectDesc desc;
-            desc.mesh = mesh;
-            desc.density = density;
-            desc.impulseThreshold = settings.impulseThreshold;
-            desc.fracture = settings.fracture;
-            auto id = destruction_->addObject(std::move(desc));
-            if (id) {
-                b->object = id.value();
-                if (const rubble::ObjectState* st = destruction_->object(b->object)) {
-                    if (!st->warning.empty())
-                        warnings.push_back(o.modelPath.string() + " (scene line " + std::to_string(o.line) +
-                                           "): " + st->warning);
-                    renderMesh = st->mesh;
-                    for (const auto& part : st->convexParts)
-                        parts.push_back(part.vertices());
-                }
-            } else {
-                warnings.push_back("scene line " + std::to_string(o.line) + ": " + id.error().message);
-            }
-        }
-#endif
-#if !RUBBLE_DEMO_HAS_RUNTIME
-        // Concave objects (arches, walls, stepped towers) get a convex decomposition, cached by mesh hash.
-        if (parts.empty()) {
-            static rubble::DecompositionCache cache;
-            auto dec = cache.get(renderMesh);
-            if (dec && !dec->parts.empty())
-                for (const auto& part : dec->parts)
-                    parts.push_back(part.vertices());
-        }
-#endif
-        if (parts.empty())
-            parts.push_back(renderMesh.positions);
-        b->density = density;
-#if !RUBBLE_DEMO_HAS_RUNTIME
-        b->object = nextLocalId_++;
-        b->localMesh = renderMesh;
-#endif
-        auto compound = std::make_unique<btCompoundShape>();
-        for (const auto& pts : parts) {
-            auto hull = std::make_unique<btConvexHullShape>();
-            for (const auto& p : pts)
-                hull->addPoint(toBt(p), false);
-            hull->recalcLocalAabb();
-            hull->setMargin(0.02f);
-            btTransform id;
-            id.setIdentity();
-            compound->addChildShape(id, hull.get());
-            b->children.push_back(std::move(hull));
-        }
-        b->shape = std::move(compound);
-        const float mass = isStatic ? 0.0f : static_cast<float>(o.mass);
-        btVector3 inertia(0, 0, 0);
-        if (mass > 0)
-            inertia = btVector3(static_cast<btScalar>(std::max(1e-6, mp.inertia.m[0][0] * density)),
-                                static_cast<btScalar>(std::max(1e-6, mp.inertia.m[1][1] * density)),
-                                static_cast<btScalar>(std::max(1e-6, mp.inertia.m[2][2] * density)));
-        btTransform t;
-        t.setIdentity();
-        t.setOrigin(toBt(o.position + com));
-        b->rb = std::make_unique<btRigidBody>(
-            btRigidBody::btRigidBodyConstructionInfo(mass, nullptr, b->shape.get(), inertia));
-        b->rb->setWorldTransform(t);
-        b->rb->setFriction(0.8f);
-        b->rb->setDamping(0.02f, 0.1f);
-        b->texture = o.textureFound ? renderer.loadTexture(o.texturePath, "concrete", warnings)
-                                    : renderer.proceduralTexture("concrete");
-        b->mesh = renderer.addMesh(renderMesh, b->texture);
-        addBody(std::move(b));
+    // Objects: render meshes in object coordinates (the runtime's mesh, UVs included).
+    for (size_t i = 0; i < loaded.objects.size(); ++i) {
+        const rubble::ObjectId id = loaded.objects[i];
+        const auto& o = scene.objects[loaded.sceneIndex[i]];
+        Body* body = bridge_->bodyOf(id);
+        const rubble::ObjectState* st = destruction_->object(id);
+        if (!body || !st)
+            continue;
+        body->rigid->setFriction(0.8f);
+        body->rigid->setDamping(0.02f, 0.1f);
+        Look look;
+        look.texture = o.textureFound ? renderer.loadTexture(o.texturePath, "concrete", warnings)
+                                      : renderer.proceduralTexture("concrete");
+        looks_[id] = look;
+        addVisual(*body, st->mesh, look, 0, renderer);
     }
     counters_.warnings = static_cast<int>(warnings.size());
     V3 pos, fwd, up;
@@ -415,6 +256,24 @@ bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const Game
     return true;
 }
 
+void Game::onAdopted(const rubble::FractureOutcome& o, Renderer& renderer) {
+    Look look;
+    if (auto it = looks_.find(o.parent); it != looks_.end()) {
+        look = it->second;
+        looks_.erase(it);
+    }
+    for (rubble::ObjectId pid : o.pieces) {
+        Body* b = bridge_->bodyOf(pid);
+        const rubble::ObjectState* st = destruction_->object(pid);
+        if (!b || !st)
+            continue; // retired at once into a debris particle
+        b->rigid->setFriction(0.8f);
+        b->rigid->setDamping(0.05f, 0.2f);
+        looks_[pid] = look;
+        addVisual(*b, st->mesh, look, 1.0f, renderer);
+    }
+}
+
 void Game::vehicleFrame(V3& pos, V3& forward, V3& up) const {
     if (!vehicle_) {
         pos = {};
@@ -422,7 +281,7 @@ void Game::vehicleFrame(V3& pos, V3& forward, V3& up) const {
         up = {0, 1, 0};
         return;
     }
-    const btTransform& t = vehicle_->rb->getWorldTransform();
+    const btTransform& t = vehicle_->rigid->getWorldTransform();
     pos = toV3(t.getOrigin());
     forward = toV3(t.getBasis() * btVector3(0, 0, -1));
     up = toV3(t.getBasis() * btVector3(0, 1, 0));
@@ -431,7 +290,7 @@ void Game::vehicleFrame(V3& pos, V3& forward, V3& up) const {
 void Game::controlVehicle(const ControlInput& in, float dt) {
     if (!vehicle_)
         return;
-    btRigidBody* rb = vehicle_->rb.get();
+    btRigidBody* rb = vehicle_->rigid.get();
     const btMatrix3x3& R = rb->getWorldTransform().getBasis();
     speed_ = std::clamp(speed_ + in.throttle * 25.0f * dt, 0.0f, 90.0f);
     const btVector3 right = R * btVector3(1, 0, 0);
@@ -450,337 +309,92 @@ void Game::controlVehicle(const ControlInput& in, float dt) {
     rb->activate(true);
 }
 
-void Game::fire(Renderer& renderer) {
-    (void)renderer;
-    const btTransform& vt = vehicle_->rb->getWorldTransform();
+void Game::fire() {
+    const btTransform& vt = vehicle_->rigid->getWorldTransform();
     const btVector3 fwd = vt.getBasis() * btVector3(0, 0, -1);
-    auto b = std::make_unique<Body>();
-    b->kind = Body::Kind::Projectile;
-    b->shape = std::make_unique<btSphereShape>(0.35f);
-    const float m = settings_.projectileMass;
-    btVector3 inertia;
-    b->shape->calculateLocalInertia(m, inertia);
-    btTransform t;
-    t.setIdentity();
-    t.setOrigin(vt.getOrigin() + fwd * noseOffset_);
-    b->rb = std::make_unique<btRigidBody>(
-        btRigidBody::btRigidBodyConstructionInfo(m, nullptr, b->shape.get(), inertia));
-    b->rb->setWorldTransform(t);
-    b->rb->setLinearVelocity(vehicle_->rb->getLinearVelocity() + fwd * settings_.projectileSpeed);
-    b->rb->setCcdMotionThreshold(0.2f);
-    b->rb->setCcdSweptSphereRadius(0.3f);
-    b->rb->setGravity(btVector3(0, -2.0f, 0));
-    b->rb->setFlags(b->rb->getFlags() | BT_DISABLE_WORLD_GRAVITY);
-    addBody(std::move(b));
-    bodies_.back()->rb->setGravity(btVector3(0, -2.0f, 0));
+    const btVector3 from = vt.getOrigin() + fwd * noseOffset_;
+    const btVector3 vel = vehicle_->rigid->getLinearVelocity() + fwd * settings_.projectileSpeed;
+    Body& p = bridge_->fireProjectile(rubble::bullet::fromBt(from), rubble::bullet::fromBt(vel),
+                                      settings_.projectileMass, 0.35);
+    p.rigid->setFlags(p.rigid->getFlags() | BT_DISABLE_WORLD_GRAVITY);
+    p.rigid->setGravity(btVector3(0, -2.0f, 0));
     ++counters_.shots;
 }
 
-void Game::processContacts(Renderer& renderer) {
-    (void)renderer;
-    const int n = dispatcher_->getNumManifolds();
-    for (int i = 0; i < n; ++i) {
-        btPersistentManifold* m = dispatcher_->getManifoldByIndexInternal(i);
-        if (m->getNumContacts() == 0)
-            continue;
-        auto* a = static_cast<Body*>(m->getBody0()->getUserPointer());
-        auto* b = static_cast<Body*>(m->getBody1()->getUserPointer());
-        if (!a || !b)
-            continue;
-        const bool aProj = a->kind == Body::Kind::Projectile, bProj = b->kind == Body::Kind::Projectile;
-        int best = 0;
-        for (int c = 1; c < m->getNumContacts(); ++c)
-            if (m->getContactPoint(c).getDistance() < m->getContactPoint(best).getDistance())
-                best = c;
-        const btManifoldPoint& cp = m->getContactPoint(best);
-        if (aProj || bProj) {
-            Body* proj = aProj ? a : b;
-            Body* other = aProj ? b : a;
-            if (proj->dead || other->kind == Body::Kind::Projectile)
-                continue;
-            const btVector3 pt = aProj ? cp.getPositionWorldOnB() : cp.getPositionWorldOnA();
-            const btVector3 nrm = aProj ? cp.m_normalWorldOnB : -cp.m_normalWorldOnB;
-            proj->dead = true;
-            const btVector3 rel =
-                proj->rb->getLinearVelocity() -
-                other->rb->getVelocityInLocalPoint(pt - other->rb->getCenterOfMassPosition());
-            const double impulse = static_cast<double>(settings_.projectileMass) * rel.length();
-            if (other->kind == Body::Kind::Object || other->kind == Body::Kind::Piece) {
-                ++counters_.impacts;
-                marks_.push_back({toV3(pt), toV3(nrm), 0});
-                if (marks_.size() > 64)
-                    marks_.pop_front();
-                particles_.impactBurst(toV3(pt), toV3(nrm), 1.0f, burstSeed_++);
-#if RUBBLE_DEMO_HAS_RUNTIME
-                if (other->object) {
-                    const btTransform inv = other->rb->getWorldTransform().inverse();
-                    const btVector3 lp = inv * pt;
-                    const btVector3 ln = inv.getBasis() * nrm;
-                    rubble::Impact imp;
-                    imp.point = {lp.x(), lp.y(), lp.z()};
-                    imp.normal = {ln.x(), ln.y(), ln.z()};
-                    imp.impulse = impulse;
-                    if (destruction_->submitImpact(other->object, imp))
-                        ++counters_.submitted;
-                }
-#else
-                if (other->object && impulse >= settings_.impulseThreshold && other->volume > 0.2f &&
-                    !local_.busy(other->object)) {
-                    const btTransform inv = other->rb->getWorldTransform().inverse();
-                    const btVector3 lp = inv * pt;
-                    const btVector3 ln = inv.getBasis() * nrm;
-                    const auto& law = settings_.fracture.sizeLaw;
-                    const double size = std::clamp(law.base + law.scale * std::pow(impulse, law.exponent),
-                                                   law.minSize, law.maxSize);
-                    local_.submit(other->object, other->localMesh, {lp.x(), lp.y(), lp.z()},
-                                  {ln.x(), ln.y(), ln.z()}, size,
-                                  1000003ull * counters_.frame + other->object, counters_.frame);
-                    ++counters_.submitted;
-                }
-#endif
-            } else if (other->kind == Body::Kind::Ground) {
-                particles_.impactBurst(toV3(pt), toV3(nrm), 0.3f, burstSeed_++);
-            }
-            continue;
-        }
-#if RUBBLE_DEMO_HAS_RUNTIME
-        // Heavy collisions (the vehicle ramming a building, a falling slab) fracture too.
-        float maxImpulse = 0;
-        for (int c = 0; c < m->getNumContacts(); ++c)
-            maxImpulse = std::max(maxImpulse, m->getContactPoint(c).getAppliedImpulse());
-        if (maxImpulse > settings_.collisionImpulse) {
-            for (Body* target : {a, b}) {
-                if (!target->object || target->dead)
-                    continue;
-                const btVector3 pt = target == a ? cp.getPositionWorldOnA() : cp.getPositionWorldOnB();
-                const btVector3 nrm = target == a ? -cp.m_normalWorldOnB : cp.m_normalWorldOnB;
-                const btTransform inv = target->rb->getWorldTransform().inverse();
-                const btVector3 lp = inv * pt;
-                const btVector3 ln = inv.getBasis() * nrm;
-                rubble::Impact imp{{lp.x(), lp.y(), lp.z()}, {ln.x(), ln.y(), ln.z()}, maxImpulse};
-                if (destruction_->submitImpact(target->object, imp)) {
-                    ++counters_.submitted;
-                    marks_.push_back({toV3(pt), toV3(nrm), 0});
-                }
-            }
-        }
-#endif
+void Game::emitEffects(long long impactsBefore, long long retiredBefore) {
+    // sparks and dust at the impacts of this frame (the newest marks)
+    const auto& marks = bridge_->recentImpacts();
+    const long long fresh = std::min<long long>(bridge_->counters().impacts - impactsBefore,
+                                                static_cast<long long>(marks.size()));
+    for (long long k = 0; k < fresh; ++k) {
+        const auto& m = marks[marks.size() - 1 - static_cast<size_t>(k)];
+        particles_.impactBurst(toV3(m.point), toV3(m.normal), 1.0f, burstSeed_++);
     }
-}
-
-void Game::spawnPiece(const Body& parent, const rubble::Mesh& mesh, const rubble::Mat3& rotation,
-                      const rubble::Vec3& offset, double volume, const rubble::Vec3& inertiaDiag,
-                      double density, std::uint32_t object,
-                      const std::vector<std::vector<rubble::Vec3>>& partsIn, Renderer& renderer) {
-    const btTransform T = parent.rb->getWorldTransform();
-    const btVector3 v = parent.rb->getLinearVelocity();
-    const btVector3 w = parent.rb->getAngularVelocity();
-    btMatrix3x3 basis;
-    for (int r = 0; r < 3; ++r)
-        basis[r] = btVector3(static_cast<btScalar>(rotation.m[r][0]), static_cast<btScalar>(rotation.m[r][1]),
-                             static_cast<btScalar>(rotation.m[r][2]));
-    const btTransform Tp = T * btTransform(basis, toBt(offset));
-    const btVector3 r = Tp.getOrigin() - T.getOrigin();
-    const btVector3 pv = v + w.cross(r);
-    if (volume < settings_.minPieceVolume) {
-        particles_.debrisPuff(toV3(Tp.getOrigin()), toV3(pv) + toV3(r.normalized()) * 2.0f,
-                              static_cast<float>(std::cbrt(volume)), burstSeed_++);
-        ++counters_.retired;
-        return;
-    }
-    auto b = std::make_unique<Body>();
-    b->kind = Body::Kind::Piece;
-    b->object = object;
-    b->volume = static_cast<float>(volume);
-    b->density = density;
-    b->texture = parent.texture;
-    b->tint = parent.tint;
-    b->heat = 1.0f;
-#if !RUBBLE_DEMO_HAS_RUNTIME
-    b->localMesh = mesh;
-#endif
-    auto compound = std::make_unique<btCompoundShape>();
-    std::vector<std::vector<rubble::Vec3>> parts = partsIn;
-    if (parts.empty())
-        parts.push_back(mesh.positions);
-    for (const auto& pts : parts) {
-        auto hull = std::make_unique<btConvexHullShape>();
-        for (const auto& p : pts)
-            hull->addPoint(toBt(p), false);
-        hull->recalcLocalAabb();
-        hull->setMargin(0.01f);
-        btTransform id;
-        id.setIdentity();
-        compound->addChildShape(id, hull.get());
-        b->children.push_back(std::move(hull));
-    }
-    b->shape = std::move(compound);
-    const bool staysStatic = parent.rb->getInvMass() == 0 && volume > 0.25 * parent.volume;
-    const float mass = staysStatic ? 0.0f : static_cast<float>(density * volume);
-    btVector3 inertia(0, 0, 0);
-    if (mass > 0)
-        inertia = btVector3(static_cast<btScalar>(std::max(1e-6, inertiaDiag.x * density)),
-                            static_cast<btScalar>(std::max(1e-6, inertiaDiag.y * density)),
-                            static_cast<btScalar>(std::max(1e-6, inertiaDiag.z * density)));
-    b->rb = std::make_unique<btRigidBody>(
-        btRigidBody::btRigidBodyConstructionInfo(mass, nullptr, b->shape.get(), inertia));
-    b->rb->setWorldTransform(Tp);
-    b->rb->setFriction(0.8f);
-    b->rb->setDamping(0.05f, 0.2f);
-    if (mass > 0) {
-        b->rb->setLinearVelocity(pv);
-        b->rb->setAngularVelocity(w);
-    }
-    b->mesh = renderer.addMesh(mesh, b->texture, b->tint.x, b->tint.y, b->tint.z);
-    addBody(std::move(b));
-    ++counters_.piecesCreated;
-}
-
-void Game::adoptFractures(Renderer& renderer) {
-#if !RUBBLE_DEMO_HAS_RUNTIME
-    local_.deterministic = settings_.deterministic;
-    for (auto& res : local_.collect(counters_.frame)) {
-        Body* parent = nullptr;
-        for (auto& b : bodies_)
-            if (b->object == res.key && !b->dead && b->kind != Body::Kind::Projectile)
-                parent = b.get();
-        if (!parent || res.pieces.empty())
-            continue;
-        for (auto& piece : res.pieces) {
-            const std::uint32_t id = piece.volume >= settings_.minPieceVolume ? nextLocalId_++ : 0;
-            spawnPiece(*parent, piece.mesh, rubble::Mat3::identity(), piece.offset, piece.volume,
-                       piece.inertia, parent->density, id, {}, renderer);
-        }
-        latencies_.push_back(res.latencyMs);
-        parent->dead = true;
-        removeBody(parent, renderer);
-        ++counters_.fractures;
-    }
-    counters_.jobs = local_.inFlight();
-#endif
-#if RUBBLE_DEMO_HAS_RUNTIME
-    destruction_->beginFrame();
-    auto outcomes = destruction_->collect();
-    for (auto& o : outcomes) {
-        Body* parent = nullptr;
-        for (auto& b : bodies_)
-            if (b->object == o.parent && !b->dead && b->kind != Body::Kind::Projectile)
-                parent = b.get();
-        if (!parent) {
-            for (auto id : o.pieces)
-                destruction_->removeObject(id);
-            continue;
-        }
-        for (size_t i = 0; i < o.pieces.size() && i < o.pieceFrames.size(); ++i) {
-            const rubble::ObjectState* st = destruction_->object(o.pieces[i]);
-            if (!st)
-                continue;
-            const double vol = std::fabs(st->mass.volume);
-            std::vector<std::vector<rubble::Vec3>> parts;
-            for (const auto& part : st->convexParts)
-                parts.push_back(part.vertices());
-            const rubble::Vec3 inertia{st->mass.inertia.m[0][0], st->mass.inertia.m[1][1],
-                                       st->mass.inertia.m[2][2]};
-            if (vol < settings_.minPieceVolume)
-                destruction_->removeObject(o.pieces[i]);
-            spawnPiece(*parent, st->mesh, o.pieceFrames[i].rotation, o.pieceFrames[i].translation, vol,
-                       inertia, st->density, vol < settings_.minPieceVolume ? 0 : o.pieces[i], parts,
-                       renderer);
-        }
-        parent->dead = true;
-        removeBody(parent, renderer);
-        ++counters_.fractures;
-    }
-    const auto& timings = destruction_->timings();
-    for (; timingCursor_ < timings.size(); ++timingCursor_)
-        if (!timings[timingCursor_].stale)
-            latencies_.push_back(timings[timingCursor_].totalMs);
-    counters_.jobs = destruction_->jobsInFlight();
-#else
-    (void)renderer;
-#endif
-}
-
-void Game::retireExcessPieces(Renderer& renderer) {
-    std::vector<Body*> pieces;
-    for (auto& b : bodies_)
-        if (b->kind == Body::Kind::Piece)
-            pieces.push_back(b.get());
-    counters_.pieces = static_cast<int>(pieces.size());
-    if (static_cast<int>(pieces.size()) <= settings_.maxPieces)
-        return;
-    std::sort(pieces.begin(), pieces.end(), [](Body* x, Body* y) { return x->volume < y->volume; });
-    const size_t excess = pieces.size() - static_cast<size_t>(settings_.maxPieces);
-    for (size_t i = 0; i < excess && i < pieces.size(); ++i) {
-        Body* p = pieces[i];
-        if (p->age < 1.0f || p->rb->getInvMass() == 0)
-            continue;
-        particles_.debrisPuff(toV3(p->rb->getCenterOfMassPosition()), toV3(p->rb->getLinearVelocity()),
-                              std::cbrt(p->volume), burstSeed_++);
-#if RUBBLE_DEMO_HAS_RUNTIME
-        destruction_->removeObject(p->object);
-#endif
-        removeBody(p, renderer);
-        ++counters_.retired;
+    // a puff of dust for every piece retired into a debris particle this frame (the newest particles)
+    const auto& debris = bridge_->particles();
+    const long long retired = std::min<long long>(bridge_->counters().piecesRetired - retiredBefore,
+                                                  static_cast<long long>(debris.size()));
+    for (long long k = 0; k < retired; ++k) {
+        const auto& d = debris[debris.size() - 1 - static_cast<size_t>(k)];
+        particles_.debrisPuff(toV3(d.position), toV3(d.velocity), static_cast<float>(d.size), burstSeed_++);
     }
 }
 
 void Game::step(const ControlInput& input, float dt, Renderer& renderer) {
-    if (!world_)
+    (void)renderer; // meshes follow the bridge's callbacks
+    if (!bridge_)
         return;
-    time_ += dt;
     ++counters_.frame;
     controlVehicle(input, dt);
     fireCooldown_ -= dt;
     if (input.fire && vehicle_ && (!fireWasDown_ || fireCooldown_ <= 0)) {
-        fire(renderer);
+        fire();
         fireCooldown_ = settings_.fireInterval;
     }
     fireWasDown_ = input.fire;
 
-    world_->stepSimulation(dt, 0);
-    processContacts(renderer);
+    // live-tunable adapter settings
+    auto& bc = bridge_->config();
+    bc.minPieceVolume = settings_.minPieceVolume;
+    bc.maxLivePieces = settings_.maxPieces;
+    bc.collisionImpulseThreshold = settings_.collisionImpulse;
 
-    // Projectiles: trails, lifetime; dead ones removed.
-    std::vector<Body*> doomed;
-    for (auto& b : bodies_) {
-        b->age += dt;
-        b->heat = std::max(0.0f, b->heat - dt * 0.6f);
-        if (b->kind == Body::Kind::Projectile) {
-            const V3 p = toV3(b->rb->getCenterOfMassPosition());
-            particles_.emit(ParticleSystem::Kind::Trail, p, V3{}, 0.18f, 0.5f, 1.0f, 0.7f, 0.3f);
-            if (b->dead || b->age > 3.0f || p.y < groundTop_ - 5)
-                doomed.push_back(b.get());
-        } else if (b->kind == Body::Kind::Piece && b->rb->getCenterOfMassPosition().y() < groundTop_ - 60) {
-            doomed.push_back(b.get());
-        }
-    }
-    for (Body* b : doomed) {
-#if RUBBLE_DEMO_HAS_RUNTIME
-        if (b->kind == Body::Kind::Piece)
-            destruction_->removeObject(b->object);
-#endif
-        removeBody(b, renderer);
-    }
+    const long long impactsBefore = bridge_->counters().impacts;
+    const long long retiredBefore = bridge_->counters().piecesRetired;
+    bridge_->stepFrame(dt);
+    emitEffects(impactsBefore, retiredBefore);
 
-    adoptFractures(renderer);
-    retireExcessPieces(renderer);
+    for (const Body* b : bridge_->bodies())
+        if (b->kind == BodyKind::Projectile)
+            particles_.emit(ParticleSystem::Kind::Trail, toV3(b->rigid->getCenterOfMassPosition()), V3{},
+                            0.18f, 0.5f, 1.0f, 0.7f, 0.3f);
+    for (auto& [body, v] : visuals_)
+        v.heat = std::max(0.0f, v.heat - dt * 0.6f);
     particles_.step(dt, groundTop_);
-    for (auto& m : marks_)
-        m.age += dt;
-    while (!marks_.empty() && marks_.front().age > 4.0f)
-        marks_.pop_front();
-    counters_.bodies = static_cast<int>(bodies_.size());
+
+    const auto& timings = destruction_->timings();
+    for (; timingCursor_ < timings.size(); ++timingCursor_)
+        if (!timings[timingCursor_].stale)
+            latencies_.push_back(timings[timingCursor_].totalMs);
+    const auto& c = bridge_->counters();
+    counters_.impacts = static_cast<int>(c.projectileHits);
+    counters_.submitted = static_cast<int>(c.impacts);
+    counters_.fractures = static_cast<int>(c.fractures);
+    counters_.piecesCreated = static_cast<int>(c.piecesCreated);
+    counters_.retired = static_cast<int>(c.piecesRetired);
+    counters_.bodies = static_cast<int>(bridge_->bodyCount());
+    counters_.pieces = bridge_->livePieces();
+    counters_.jobs = destruction_->jobsInFlight();
 }
 
 void Game::draw(Renderer& renderer, float dt) {
-    if (!world_)
+    if (!bridge_)
         return;
     renderer.shadows = settings_.shadows;
-    for (auto& b : bodies_) {
-        if (b->kind == Body::Kind::Projectile) {
+    for (const Body* b : bridge_->bodies()) {
+        if (b->kind == BodyKind::Projectile) {
             Particle p;
-            p.pos = toV3(b->rb->getCenterOfMassPosition());
+            p.pos = toV3(b->rigid->getCenterOfMassPosition());
             p.size = 1.4f;
             p.r = 1.0f;
             p.g = 0.85f;
@@ -788,15 +402,17 @@ void Game::draw(Renderer& renderer, float dt) {
             renderer.addParticle(p, true);
             continue;
         }
-        if (b->mesh < 0)
+        auto it = visuals_.find(b);
+        if (it == visuals_.end() || it->second.mesh < 0)
             continue;
         M4 m;
-        b->rb->getWorldTransform().getOpenGLMatrix(m.m);
-        renderer.drawMesh(b->mesh, m, b->heat);
+        // render meshes are in object coordinates; the body sits at the centre of mass
+        b->objectTransform().getOpenGLMatrix(m.m);
+        renderer.drawMesh(it->second.mesh, m, it->second.heat);
     }
     if (vehicle_) {
         // Engine glow at the tail.
-        const btTransform& t = vehicle_->rb->getWorldTransform();
+        const btTransform& t = vehicle_->rigid->getWorldTransform();
         Particle p;
         p.pos = toV3(t * btVector3(0, 0, noseOffset_ - 2.2f));
         p.size = 1.1f + 0.02f * speed_;
@@ -806,28 +422,28 @@ void Game::draw(Renderer& renderer, float dt) {
         p.a = 0.9f;
         renderer.addParticle(p, true);
     }
+    // retired pieces still flying: small dark chunks
+    for (const auto& d : bridge_->particles()) {
+        Particle p;
+        p.pos = toV3(d.position);
+        p.size = std::clamp(static_cast<float>(d.size), 0.05f, 1.5f);
+        p.r = p.g = p.b = 0.45f;
+        p.a = std::min(1.0f, static_cast<float>(d.lifetime));
+        renderer.addParticle(p, false);
+    }
     particles_.draw(renderer);
 
-    if (settings_.debugShapes || settings_.debugAabbs) {
-        DebugLines dl(renderer);
-        int mode = 0;
-        if (settings_.debugShapes)
-            mode |= btIDebugDraw::DBG_DrawWireframe;
-        if (settings_.debugAabbs)
-            mode |= btIDebugDraw::DBG_DrawAabb;
-        dl.setDebugMode(mode);
-        world_->setDebugDrawer(&dl);
-        world_->debugDrawWorld();
-        world_->setDebugDrawer(nullptr);
+    if (settings_.debugShapes || settings_.debugAabbs || settings_.debugImpacts) {
+        rubble::bullet::DebugDrawOptions o;
+        o.shapes = settings_.debugShapes;
+        o.aabbs = settings_.debugAabbs;
+        o.impacts = settings_.debugImpacts;
+        o.impactCrossSize = 1.5;
+        for (const auto& l : bridge_->debugDraw(o).lines)
+            renderer.addLine(toV3(l.from), toV3(l.to), static_cast<float>((l.rgba >> 24) & 0xFF) / 255.0f,
+                             static_cast<float>((l.rgba >> 16) & 0xFF) / 255.0f,
+                             static_cast<float>((l.rgba >> 8) & 0xFF) / 255.0f);
     }
-    if (settings_.debugImpacts)
-        for (const auto& m : marks_) {
-            const float s = 1.5f;
-            renderer.addLine(m.point - V3{s, 0, 0}, m.point + V3{s, 0, 0}, 1, 0.1f, 0.1f);
-            renderer.addLine(m.point - V3{0, s, 0}, m.point + V3{0, s, 0}, 1, 0.1f, 0.1f);
-            renderer.addLine(m.point - V3{0, 0, s}, m.point + V3{0, 0, s}, 1, 0.1f, 0.1f);
-            renderer.addLine(m.point, m.point + m.normal * 3.0f, 1, 1, 0.2f);
-        }
 
     V3 pos, fwd, up;
     vehicleFrame(pos, fwd, up);
@@ -843,21 +459,18 @@ std::vector<double> Game::takeNewLatencies() {
 
 std::vector<V3> Game::targets() const {
     std::vector<V3> out;
-    for (const auto& b : bodies_)
-        if (!b->dead &&
-            (b->kind == Body::Kind::Object || (b->kind == Body::Kind::Piece && b->volume > 150 &&
-                                               b->rb->getCenterOfMassPosition().y() > groundTop_ + 15)))
-            out.push_back(toV3(b->rb->getCenterOfMassPosition()));
+    if (!bridge_)
+        return out;
+    for (const Body* b : bridge_->bodies())
+        if (b->kind == BodyKind::Object || (b->kind == BodyKind::Piece && b->volume > 150 &&
+                                            b->rigid->getCenterOfMassPosition().y() > groundTop_ + 15))
+            out.push_back(toV3(b->rigid->getCenterOfMassPosition()));
     return out;
 }
 
 void Game::writeTimings(const std::string& path) const {
-#if RUBBLE_DEMO_HAS_RUNTIME
     if (destruction_)
         (void)destruction_->writeTimingsCsv(path);
-#else
-    (void)path;
-#endif
 }
 
 } // namespace demo

@@ -1,33 +1,26 @@
 #pragma once
 /// \file Game.hpp
-/// The game: a Bullet world built from a world.cfg scene, the flying vehicle with a stabilising assist,
-/// projectiles from its nose, impacts handed to Rubble's DestructionWorld and pieces adopted back.
+/// The game: a world.cfg scene loaded through Rubble's Bullet adapter (PhysicsWorld, DestructionBridge,
+/// SceneLoader) on the DestructionWorld runtime, the flying vehicle with a stabilising assist, projectiles
+/// from its nose, and the renderer's meshes kept in step with the adapter's bodies.
 
 #include <cstdint>
 #include <deque>
+#include <map>
 #include <memory>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "ChaseCamera.hpp"
-#include "LocalFracture.hpp"
 #include "Math.hpp"
 #include "ParticleSystem.hpp"
 #include "Renderer.hpp"
+#include "rubble/DestructionWorld.hpp"
 #include "rubble/Fracture.hpp"
 #include "rubble/SceneConfig.hpp"
-
-class btRigidBody;
-class btCollisionShape;
-class btDiscreteDynamicsWorld;
-class btDefaultCollisionConfiguration;
-class btCollisionDispatcher;
-class btBroadphaseInterface;
-class btSequentialImpulseConstraintSolver;
-
-namespace rubble {
-class DestructionWorld;
-}
+#include "rubble/bullet/DestructionBridge.hpp"
+#include "rubble/bullet/PhysicsWorld.hpp"
 
 namespace demo {
 
@@ -63,7 +56,7 @@ struct GameSettings {
 struct GameCounters {
     std::uint64_t frame = 0; ///< simulation frames (frozen while paused)
     int shots = 0;           ///< projectiles fired
-    int impacts = 0;         ///< projectile hits on objects
+    int impacts = 0;         ///< projectile hits (on objects or the ground)
     int submitted = 0;       ///< impacts accepted by the DestructionWorld
     int fractures = 0;       ///< fracture results adopted
     int piecesCreated = 0;   ///< piece bodies created
@@ -72,13 +65,6 @@ struct GameCounters {
     int pieces = 0;          ///< live piece bodies
     int jobs = 0;            ///< fracture jobs queued or running
     int warnings = 0;        ///< scene warnings
-};
-
-/// One recent impact for the debug overlay.
-struct ImpactMark {
-    V3 point;      ///< world position
-    V3 normal;     ///< world normal
-    float age = 0; ///< seconds since the impact
 };
 
 /// The game world.
@@ -118,52 +104,50 @@ public:
     std::vector<V3> targets() const;
     /// Height of the ground surface.
     float groundY() const { return groundTop_; }
-    /// True when Rubble's fracture runtime is linked in.
-    static bool fractureAvailable();
-    /// Writes the runtime's timing records as CSV (no-op without the runtime).
+    /// True: fracture runs on Rubble's DestructionWorld runtime (kept for the panel and the run report).
+    static bool fractureAvailable() { return true; }
+    /// Writes the runtime's timing records as CSV.
     void writeTimings(const std::string& path) const;
 
 private:
-    struct Body;
-    Body* addBody(std::unique_ptr<Body> b);
-    void removeBody(Body* b, Renderer& renderer);
-    void fire(Renderer& renderer);
-    void processContacts(Renderer& renderer);
-    void adoptFractures(Renderer& renderer);
-    void retireExcessPieces(Renderer& renderer);
+    /// How a body with a render mesh looks.
+    struct Visual {
+        int mesh = -1;    ///< renderer mesh (object coordinates)
+        float heat = 0;   ///< glow of fresh cut faces
+        V3 tint{1, 1, 1}; ///< colour multiplier
+    };
+    /// Texture and tint an object passes on to its pieces.
+    struct Look {
+        int texture = 0;  ///< renderer texture
+        V3 tint{1, 1, 1}; ///< colour multiplier
+    };
+    void fire();
+    void onAdopted(const rubble::FractureOutcome& outcome, Renderer& renderer);
+    void addVisual(const rubble::bullet::Body& body, const rubble::Mesh& mesh, const Look& look, float heat,
+                   Renderer& renderer);
     void controlVehicle(const ControlInput& input, float dt);
-    void spawnPiece(const Body& parent, const rubble::Mesh& mesh, const rubble::Mat3& rotation,
-                    const rubble::Vec3& offset, double volume, const rubble::Vec3& inertia, double density,
-                    std::uint32_t object, const std::vector<std::vector<rubble::Vec3>>& parts,
-                    Renderer& renderer);
+    void emitEffects(long long impactsBefore, long long retiredBefore);
 
     GameSettings settings_;
     GameCounters counters_;
     ChaseCamera camera_;
     ParticleSystem particles_;
-    std::unique_ptr<btDefaultCollisionConfiguration> collisionConfig_;
-    std::unique_ptr<btCollisionDispatcher> dispatcher_;
-    std::unique_ptr<btBroadphaseInterface> broadphase_;
-    std::unique_ptr<btSequentialImpulseConstraintSolver> solver_;
-    std::unique_ptr<btDiscreteDynamicsWorld> world_;
-    std::shared_ptr<rubble::DestructionWorld>
-        destruction_; ///< shared_ptr: no destructor reference without the runtime
-    std::vector<std::unique_ptr<Body>> bodies_;
-    LocalFracture local_; ///< stand-in fracture while the runtime is not linked
-    std::uint32_t nextLocalId_ = 1;
-    Body* vehicle_ = nullptr;
+    // destroyed in reverse order: the bridge before the worlds it refers to
+    std::unique_ptr<rubble::DestructionWorld> destruction_;
+    std::unique_ptr<rubble::bullet::PhysicsWorld> physics_;
+    std::unique_ptr<rubble::bullet::DestructionBridge> bridge_;
+    std::unordered_map<const rubble::bullet::Body*, Visual> visuals_;
+    std::map<rubble::ObjectId, Look> looks_;
+    rubble::bullet::Body* vehicle_ = nullptr;
     float speed_ = 30;
     float fireCooldown_ = 0;
     bool fireWasDown_ = false;
     float groundTop_ = -10;
-    float time_ = 0;
-    std::deque<ImpactMark> marks_;
     std::vector<double> latencies_;
     size_t latencyCursor_ = 0;
     size_t timingCursor_ = 0;
     std::uint32_t burstSeed_ = 1;
     float noseOffset_ = 3;
-    int vehicleTexture_ = 0;
 };
 
 } // namespace demo

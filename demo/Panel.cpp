@@ -34,8 +34,7 @@ bool Panel::draw(Game& game, GameSettings& pending, bool paused, const std::stri
     const GameCounters& c = game.counters();
     ImGui::Text("%s", sceneName.c_str());
     ImGui::TextDisabled("%s", rendererName.c_str());
-    ImGui::TextDisabled("fracture: %s", Game::fractureAvailable() ? "DestructionWorld runtime"
-                                                                  : "demo stand-in (convex-cell clipper)");
+    ImGui::TextDisabled("fracture: DestructionWorld runtime + Bullet adapter");
 
     // Frame time plot.
     std::vector<float> ordered;

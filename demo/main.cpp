@@ -268,9 +268,9 @@ int main(int argc, char** argv) {
         std::filesystem::create_directories(o.out, ec);
     }
     const std::string rendererName = app.gl->renderer();
-    std::fprintf(stderr, "rubble-demo: %s, %dx%d, %s, fracture %s\n", headless ? "EGL offscreen" : "window",
-                 app.gl->width(), app.gl->height(), rendererName.c_str(),
-                 demo::Game::fractureAvailable() ? "DestructionWorld" : "demo stand-in (runtime not linked)");
+    std::fprintf(stderr, "rubble-demo: %s, %dx%d, %s, fracture DestructionWorld + rubble_bullet\n",
+                 headless ? "EGL offscreen" : "window", app.gl->width(), app.gl->height(),
+                 rendererName.c_str());
 
     demo::Autopilot pilot;
     demo::RunReport report;
