@@ -1,5 +1,6 @@
-// HelloWorld: see docs/hello.md. Breaks a cube twice: once with the fracture kernel directly, once through the
-// engine-agnostic runtime a game uses (impacts in, pieces with collision parts out, work off the main thread).
+// HelloWorld: see docs/hello.md. Breaks a cube twice: once with the fracture kernel directly, once through
+// the engine-agnostic runtime a game uses (impacts in, pieces with collision parts out, work off the main
+// thread).
 #include <cstdio>
 
 #include "rubble/DestructionWorld.hpp"
@@ -49,7 +50,8 @@ int main() {
         std::printf("object %u broke into %zu pieces:\n", outcome.parent, outcome.pieces.size());
         for (std::size_t i = 0; i < outcome.pieces.size(); ++i) {
             const rubble::ObjectState* piece = world.object(outcome.pieces[i]);
-            const rubble::Vec3 at = outcome.pieceFrames[i].translation; // where its body goes (centre of mass)
+            const rubble::Vec3 at =
+                outcome.pieceFrames[i].translation; // where its body goes (centre of mass)
             std::printf("  id %u: volume %.4f, %zu convex parts, body at (%.3f, %.3f, %.3f)\n", piece->id,
                         piece->mass.volume, piece->convexParts.size(), at.x, at.y, at.z);
         }
