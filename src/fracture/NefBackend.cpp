@@ -3,7 +3,9 @@
 // lost: output faces are matched geometrically to the input (assembleMesh), and attributes of a merged face
 // are interpolated from one input triangle of its plane.
 
+#include <algorithm>
 #include <map>
+#include <tuple>
 
 // GCC's -Wmaybe-uninitialized fires inside CGAL's templates instantiated here (false positives).
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
@@ -100,6 +102,30 @@ Mesh nefToMesh(const Nef& nef, const Mesh& input) {
             throw Failure{"a degenerate face in the output"};
         tris.push_back(tri);
     }
+    // Nef's output order follows its internal (address-dependent) storage: number the vertices by their
+    // coordinates and sort the triangles (each rotated to start at its smallest vertex, keeping its
+    // orientation) so that the same input gives the same bytes on every run.
+    std::vector<std::uint32_t> order(positions.size());
+    for (std::uint32_t i = 0; i < order.size(); ++i)
+        order[i] = i;
+    std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+        const Vec3 &p = positions[a], &q = positions[b];
+        return std::tie(p.x, p.y, p.z) < std::tie(q.x, q.y, q.z);
+    });
+    std::vector<std::uint32_t> rank(positions.size());
+    std::vector<Vec3> sorted(positions.size());
+    for (std::uint32_t i = 0; i < order.size(); ++i) {
+        rank[order[i]] = i;
+        sorted[i] = positions[order[i]];
+    }
+    positions = std::move(sorted);
+    for (Triangle& t : tris) {
+        for (std::uint32_t& v : t)
+            v = rank[v];
+        while (t[0] > t[1] || t[0] > t[2])
+            std::rotate(t.begin(), t.begin() + 1, t.end());
+    }
+    std::sort(tris.begin(), tris.end());
     std::vector<std::int64_t> sources(tris.size(), kUnknownSource);
     return assembleMesh(input, std::move(positions), tris, std::move(sources));
 }
