@@ -32,6 +32,7 @@
 #include "rubble/Random.hpp"
 #include "rubble/SceneConfig.hpp"
 #include "rubble/ThreadPool.hpp"
+#include "rubble/TimingReport.hpp"
 #include "rubble/bullet/Convert.hpp"
 #include "rubble/bullet/DestructionBridge.hpp"
 #include "rubble/bullet/PhysicsWorld.hpp"
@@ -52,7 +53,7 @@ struct SceneArgs {
     std::string timingsCsv;
     std::string framesCsv;
     std::string appendCsv;
-    int maxPieces = 400;
+    int maxPieces = 250;
     double projectileSpeed = 120;
     double projectileMass = 2;
     double projectileRadius = 0.25;
@@ -183,20 +184,8 @@ int runScene(const SceneArgs& a) {
                       << bridge.bodyCount() << ',' << bridge.livePieces() << ',' << destruction.jobsInFlight()
                       << ',' << bridge.counters().fractures << '\n';
     }
-    std::vector<double> latency, queue, cell, boolean, islands, decomposition;
-    int stale = 0;
-    for (const TimingRecord& t : destruction.timings()) {
-        if (t.stale) {
-            ++stale;
-            continue;
-        }
-        latency.push_back(t.totalMs);
-        queue.push_back(t.queueMs);
-        cell.push_back(t.cellMs);
-        boolean.push_back(t.booleanMs);
-        islands.push_back(t.islandsMs);
-        decomposition.push_back(t.decompositionMs);
-    }
+    // per-impact stages: the runtime's own summary (nearest-rank percentiles, stale records excluded)
+    const TimingSummary ts = summarizeTimings(destruction.timings());
     const double volumeError =
         startVolume > 0 ? std::abs(bridge.totalVolume() - startVolume) / startVolume : 0;
     const std::uint64_t hash = bridge.stateHash();
@@ -226,11 +215,10 @@ int runScene(const SceneArgs& a) {
             << a.shotsPerSecond << ',' << frames << ',' << shots << ',' << percentile(frameMs, 0.5) << ','
             << percentile(frameMs, 0.99) << ',' << percentile(frameMs, 1.0) << ','
             << percentile(physicsMs, 0.5) << ',' << percentile(physicsMs, 0.99) << ','
-            << percentile(adoptMs, 0.99) << ',' << c.impacts << ',' << c.fractures << ',' << stale << ','
-            << percentile(latency, 0.5) << ',' << percentile(latency, 0.99) << ',' << percentile(latency, 1.0)
-            << ',' << percentile(queue, 0.5) << ',' << percentile(boolean, 0.5) << ','
-            << percentile(decomposition, 0.5) << ',' << bridge.livePieces() << ',' << maxPieces << ','
-            << c.piecesRetired << ',' << volumeError << ',' << hashText << ',' << rss << '\n';
+            << percentile(adoptMs, 0.99) << ',' << c.impacts << ',' << c.fractures << ',' << ts.stale << ','
+            << ts.total.p50 << ',' << ts.total.p99 << ',' << ts.total.max << ',' << ts.queue.p50 << ','
+            << ts.boolean.p50 << ',' << ts.decomposition.p50 << ',' << bridge.livePieces() << ',' << maxPieces
+            << ',' << c.piecesRetired << ',' << volumeError << ',' << hashText << ',' << rss << '\n';
     }
     if (a.json) {
         nlohmann::json j;
@@ -240,9 +228,7 @@ int runScene(const SceneArgs& a) {
                          {"max", percentile(frameMs, 1.0)}};
         j["impacts"] = c.impacts;
         j["fractures"] = c.fractures;
-        j["latency_ms"] = {{"p50", percentile(latency, 0.5)},
-                           {"p99", percentile(latency, 0.99)},
-                           {"max", percentile(latency, 1.0)}};
+        j["latency_ms"] = {{"p50", ts.total.p50}, {"p99", ts.total.p99}, {"max", ts.total.max}};
         j["pieces_alive"] = bridge.livePieces();
         j["volume_error"] = volumeError;
         j["state_hash"] = hashText;
@@ -261,15 +247,19 @@ int runScene(const SceneArgs& a) {
     row("frame (ms)", frameMs);
     row("  physics step (ms)", physicsMs);
     row("  impacts + adoption (ms)", adoptMs);
-    row("impact -> adopted (ms)", latency);
-    row("  queue wait (ms)", queue);
-    row("  cells (ms)", cell);
-    row("  booleans (ms)", boolean);
-    row("  islands + mass (ms)", islands);
-    row("  decomposition (ms)", decomposition);
+    auto stage = [](const char* name, const StageSummary& st) {
+        std::printf("%-28s %10.3f %10.3f %10.3f\n", name, st.p50, st.p99, st.max);
+    };
+    stage("impact -> adopted (ms)", ts.total);
+    stage("  queue wait (ms)", ts.queue);
+    stage("  cells (ms)", ts.cell);
+    stage("  booleans (ms)", ts.boolean);
+    stage("  islands + mass (ms)", ts.islands);
+    stage("  decomposition (ms)", ts.decomposition);
+    stage("  adoption (ms)", ts.adoption);
     std::printf("%-28s %10lld\n", "impacts", c.impacts);
     std::printf("%-28s %10lld\n", "fractures", c.fractures);
-    std::printf("%-28s %10d\n", "stale results", stale);
+    std::printf("%-28s %10d\n", "stale results", ts.stale);
     std::printf("%-28s %10d (max %d)\n", "pieces alive", bridge.livePieces(), maxPieces);
     std::printf("%-28s %10lld\n", "pieces retired", c.piecesRetired);
     std::printf("%-28s %10.3g\n", "volume error", volumeError);

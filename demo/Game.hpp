@@ -45,7 +45,7 @@ struct GameSettings {
     float projectileMass = 4;        ///< kg
     float fireInterval = 0.14f;      ///< s between shots while Space is held
     float minPieceVolume = 0.02f;    ///< m^3: smaller pieces become debris particles
-    int maxPieces = 600;             ///< beyond this, the smallest old pieces retire to particles
+    int maxPieces = 250;             ///< beyond this, the smallest old pieces retire to particles
     bool debugShapes = false;        ///< draw collision shapes
     bool debugAabbs = false;         ///< draw AABBs
     bool debugImpacts = false;       ///< draw impact points

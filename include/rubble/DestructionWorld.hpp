@@ -64,6 +64,8 @@ struct TimingRecord {
     double totalMs = 0;         ///< submission → adopted
     int pieces = 0;             ///< pieces produced
     bool stale = false;         ///< discarded because the object changed meanwhile
+    bool failed = false;        ///< the fracture failed (e.g. its cells missed the mesh): the object stays
+                                ///< and impacts that waited on the job are retried
 };
 
 /// A fracture ready to adopt: the parent object is replaced by the pieces.

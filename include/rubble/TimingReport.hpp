@@ -16,10 +16,12 @@ struct StageSummary {
     double max = 0; ///< maximum
 };
 
-/// Summary of a set of timing records (stale records are counted but excluded from the statistics).
+/// Summary of a set of timing records (stale and failed records are counted but excluded from the
+/// statistics: these describe impacts that were adopted).
 struct TimingSummary {
     int records = 0;            ///< non-stale records summarised
     int stale = 0;              ///< stale records
+    int failed = 0;             ///< failed records
     StageSummary queue;         ///< TimingRecord::queueMs
     StageSummary cell;          ///< TimingRecord::cellMs
     StageSummary boolean;       ///< TimingRecord::booleanMs

@@ -440,6 +440,8 @@ std::vector<FractureOutcome> DestructionWorld::collect() {
             later.clear();
             rec.pieces = static_cast<int>(o.pieces.size());
             out.push_back(std::move(o));
+        } else {
+            rec.failed = true;
         }
         // A failed or stale job: impacts that waited on it run now on the (unchanged) object if it still
         // exists.
@@ -474,12 +476,13 @@ Status DestructionWorld::writeTimingsCsv(const std::filesystem::path& path) cons
     if (!f)
         return Error{ErrorCode::IoError, "cannot write " + path.string()};
     f << "object,frame,impacts_merged,queue_ms,cell_ms,boolean_ms,islands_ms,decomposition_ms,adoption_ms,"
-         "total_"
-         "ms,pieces,stale\n";
+         "total_ms,"
+         "pieces,stale,failed\n";
     for (const auto& r : impl_->timings)
         f << r.object << ',' << r.frame << ',' << r.impactsMerged << ',' << r.queueMs << ',' << r.cellMs
           << ',' << r.booleanMs << ',' << r.islandsMs << ',' << r.decompositionMs << ',' << r.adoptionMs
-          << ',' << r.totalMs << ',' << r.pieces << ',' << (r.stale ? 1 : 0) << '\n';
+          << ',' << r.totalMs << ',' << r.pieces << ',' << (r.stale ? 1 : 0) << ',' << (r.failed ? 1 : 0)
+          << '\n';
     if (!f)
         return Error{ErrorCode::IoError, "write failed: " + path.string()};
     return Status::ok();

@@ -32,6 +32,10 @@ TimingSummary summarizeTimings(const std::vector<TimingRecord>& records) {
             ++out.stale;
             continue;
         }
+        if (r.failed) {
+            ++out.failed;
+            continue;
+        }
         ++out.records;
         q.push_back(r.queueMs);
         c.push_back(r.cellMs);
@@ -59,7 +63,7 @@ std::string formatTimingSummary(const TimingSummary& s) {
                       st.max);
         out += line;
     };
-    std::snprintf(line, sizeof line, "%d records, %d stale\n", s.records, s.stale);
+    std::snprintf(line, sizeof line, "%d records, %d stale, %d failed\n", s.records, s.stale, s.failed);
     out += line;
     add("queue", s.queue);
     add("cell", s.cell);

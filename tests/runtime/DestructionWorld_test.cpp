@@ -150,6 +150,8 @@ TEST(DestructionWorld, ImpactsWaitingOnAFailedJobAreMergedIntoOneJob) {
     ASSERT_EQ(out.size(), 1u);
     EXPECT_EQ(out[0].impacts.size(), 2u);
     ASSERT_EQ(w.timings().size(), 2u);
+    EXPECT_TRUE(w.timings()[0].failed);
+    EXPECT_FALSE(w.timings()[1].failed);
     EXPECT_EQ(w.timings()[1].impactsMerged, 2);
     double v = out[0].droppedVolume;
     for (ObjectId p : out[0].pieces)

@@ -13,9 +13,14 @@ TEST(TimingReport, PercentilesAndStale) {
     st.stale = true;
     st.totalMs = 1e6;
     r.push_back(st);
+    TimingRecord failed;
+    failed.failed = true;
+    failed.totalMs = 2e6;
+    r.push_back(failed);
     const auto s = summarizeTimings(r);
     EXPECT_EQ(s.records, 100);
     EXPECT_EQ(s.stale, 1);
+    EXPECT_EQ(s.failed, 1);
     EXPECT_DOUBLE_EQ(s.total.p50, 50);
     EXPECT_DOUBLE_EQ(s.total.p99, 99);
     EXPECT_DOUBLE_EQ(s.total.max, 100);
