@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <ranges>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -11,6 +12,7 @@
 #include <CGAL/Triangulation_face_base_with_info_2.h>
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
 
+#include "geometry/RayParity.hpp"
 #include "rubble/MassProperties.hpp"
 
 namespace rubble::detail {
@@ -430,28 +432,7 @@ void Clipper::cutTriangle(std::uint32_t t) {
 }
 
 bool Clipper::pointInsideMesh(const Vec3& p) const {
-    const Vec3 d = normalized(Vec3{0.5773502691896258, 0.5772502691896258, 0.5774502691896258});
-    int crossings = 0;
-    for (std::size_t t = 0; t < mesh_.triangles.size(); ++t) {
-        const auto c = mesh_.corners(t);
-        const Vec3 e1 = c[1] - c[0], e2 = c[2] - c[0];
-        const Vec3 h = cross(d, e2);
-        const double a = dot(e1, h);
-        if (a == 0)
-            continue;
-        const double f = 1.0 / a;
-        const Vec3 s = p - c[0];
-        const double uu = f * dot(s, h);
-        if (uu < 0 || uu > 1)
-            continue;
-        const Vec3 q = cross(s, e1);
-        const double vv = f * dot(d, q);
-        if (vv < 0 || uu + vv > 1)
-            continue;
-        if (f * dot(e2, q) > 0)
-            ++crossings;
-    }
-    return crossings % 2 == 1;
+    return insideByRayParity(mesh_, std::views::iota(std::size_t{0}, mesh_.triangles.size()), p);
 }
 
 void Clipper::buildCaps() {

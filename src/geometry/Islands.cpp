@@ -5,6 +5,7 @@
 #include <numeric>
 
 #include "geometry/OrientedShells.hpp"
+#include "geometry/RayParity.hpp"
 #include "geometry/VertexStar.hpp"
 #include "rubble/MassProperties.hpp"
 
@@ -27,31 +28,6 @@ struct UnionFind {
     }
 };
 
-// Parity of crossings of a ray from p along a fixed, slightly irrational direction.
-bool insideByRay(const Mesh& m, const std::vector<std::size_t>& tris, const Vec3& p) {
-    const Vec3 d = normalized(Vec3{0.5773502691896258, 0.5772502691896258, 0.5774502691896258});
-    int crossings = 0;
-    for (std::size_t t : tris) {
-        const auto c = m.corners(t);
-        const Vec3 e1 = c[1] - c[0], e2 = c[2] - c[0];
-        const Vec3 h = cross(d, e2);
-        const double a = dot(e1, h);
-        if (a == 0)
-            continue;
-        const double f = 1.0 / a;
-        const Vec3 s = p - c[0];
-        const double u = f * dot(s, h);
-        if (u < 0 || u > 1)
-            continue;
-        const Vec3 q = cross(s, e1);
-        const double v = f * dot(d, q);
-        if (v < 0 || u + v > 1)
-            continue;
-        if (f * dot(e2, q) > 0)
-            ++crossings;
-    }
-    return crossings % 2 == 1;
-}
 } // namespace
 
 namespace {
@@ -182,7 +158,8 @@ std::vector<Mesh> splitShells(const Mesh& mesh, const std::vector<std::uint32_t>
         const Vec3 probe = mesh.positions[mesh.triangles[trisOf[s][0]][0]];
         double best = 0;
         for (std::size_t o = 0; o < shells; ++o)
-            if (vol[o] > 0 && (best == 0 || vol[o] < best) && insideByRay(mesh, trisOf[o], probe)) {
+            if (vol[o] > 0 && (best == 0 || vol[o] < best) &&
+                detail::insideByRayParity(mesh, trisOf[o], probe)) {
                 best = vol[o];
                 owner[s] = static_cast<std::uint32_t>(o);
             }

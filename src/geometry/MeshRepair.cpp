@@ -7,6 +7,8 @@
 #include <limits>
 #include <unordered_map>
 
+#include "geometry/RayParity.hpp"
+
 namespace rubble {
 
 namespace {
@@ -131,32 +133,6 @@ std::vector<std::uint32_t> weldVertices(const Mesh& m, double tol) {
     return rep;
 }
 
-// Parity of crossings of a ray from p with the given triangles (true = inside a closed shell).
-bool insideByRay(const Mesh& m, const std::vector<std::size_t>& tris, const Vec3& p) {
-    const Vec3 d = normalized(Vec3{0.5773502691896258, 0.5772502691896258, 0.5774502691896258});
-    int crossings = 0;
-    for (std::size_t t : tris) {
-        const auto c = m.corners(t);
-        const Vec3 e1 = c[1] - c[0], e2 = c[2] - c[0];
-        const Vec3 h = cross(d, e2);
-        const double a = dot(e1, h);
-        if (a == 0)
-            continue;
-        const double f = 1.0 / a;
-        const Vec3 s = p - c[0];
-        const double u = f * dot(s, h);
-        if (u < 0 || u > 1)
-            continue;
-        const Vec3 q = cross(s, e1);
-        const double v = f * dot(d, q);
-        if (v < 0 || u + v > 1)
-            continue;
-        if (f * dot(e2, q) > 0)
-            ++crossings;
-    }
-    return crossings % 2 == 1;
-}
-
 // True when box inner lies inside box outer (a shell can only be a cavity of a shell whose box holds it;
 // this keeps overlapping, self-intersecting shells from being mistaken for cavities).
 bool encloses(const Aabb& outer, const Aabb& inner) {
@@ -248,7 +224,8 @@ OrientStats orientShells(Mesh& m) {
         if (compClosed[i]) {
             const Vec3 probe = m.positions[m.triangles[comps[i][0]][0]];
             for (std::size_t j = 0; j < k; ++j)
-                if (j != i && compClosed[j] && encloses(box[j], box[i]) && insideByRay(m, comps[j], probe))
+                if (j != i && compClosed[j] && encloses(box[j], box[i]) &&
+                    detail::insideByRayParity(m, comps[j], probe))
                     ++depth;
         }
         const bool wantPositive = depth % 2 == 0;
