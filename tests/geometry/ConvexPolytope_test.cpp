@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "TestSupport.hpp"
 #include "rubble/ConvexPolytope.hpp"
 #include "rubble/MassProperties.hpp"
 #include "rubble/MeshCheck.hpp"
@@ -10,13 +11,6 @@
 using namespace rubble;
 
 namespace {
-std::string problemsOf(const MeshReport& r) {
-    std::string s;
-    for (const std::string& p : r.problems)
-        s += p + "\n";
-    return s;
-}
-
 // A random plane through a point inside the box lo..hi.
 Plane randomPlane(Rng& rng, const Vec3& lo, const Vec3& hi) {
     return Plane::fromPointNormal(rng.inBox(lo, hi), rng.unitVector());
@@ -36,7 +30,7 @@ TEST(ConvexPolytope, BoxHasExactVolumeCentroidAndMesh) {
     EXPECT_FALSE(p.contains({0, 1.5, 3}));
     const Mesh m = p.toMesh();
     const MeshReport r = checkMesh(m);
-    EXPECT_TRUE(r.valid()) << problemsOf(r);
+    EXPECT_TRUE(r.valid()) << test::joinLines(r.problems);
     EXPECT_NEAR(r.volume, 12, 1e-12);
 }
 
@@ -55,8 +49,8 @@ TEST(ConvexPolytope, ClippingByRandomPlanesConservesVolume) {
                 continue;
             const Mesh m = part->toMesh();
             const MeshReport r = checkMesh(m);
-            EXPECT_TRUE(r.closed) << "plane " << i << "\n" << problemsOf(r);
-            EXPECT_TRUE(r.oriented) << "plane " << i << "\n" << problemsOf(r);
+            EXPECT_TRUE(r.closed) << "plane " << i << "\n" << test::joinLines(r.problems);
+            EXPECT_TRUE(r.oriented) << "plane " << i << "\n" << test::joinLines(r.problems);
             EXPECT_TRUE(r.outward) << "plane " << i;
             EXPECT_NEAR(r.volume, part->volume(), 1e-9 * whole) << "plane " << i;
         }
@@ -87,7 +81,7 @@ TEST(ConvexPolytope, RepeatedClippingMakesClosedCellsThatTileTheBox) {
     for (const auto& c : cells) {
         total += c.volume();
         const MeshReport r = checkMesh(c.toMesh());
-        EXPECT_TRUE(r.closed && r.oriented && r.outward) << problemsOf(r);
+        EXPECT_TRUE(r.closed && r.oriented && r.outward) << test::joinLines(r.problems);
         EXPECT_EQ(r.nonManifoldEdges, 0u);
     }
     EXPECT_GT(cells.size(), 5u);

@@ -3,45 +3,18 @@
 #include <cmath>
 #include <limits>
 
+#include "TestSupport.hpp"
 #include "rubble/MassProperties.hpp"
 #include "rubble/MeshCheck.hpp"
 #include "rubble/Random.hpp"
 
 using namespace rubble;
 
-namespace {
-bool mentions(const MeshReport& r, const std::string& text) {
-    for (const std::string& p : r.problems)
-        if (p.find(text) != std::string::npos)
-            return true;
-    return false;
-}
-
-std::string problemsOf(const MeshReport& r) {
-    std::string s;
-    for (const std::string& p : r.problems)
-        s += p + "\n";
-    return s;
-}
-
-// Every triangle gets its own three vertices (a "triangle soup", as some exporters write).
-Mesh unwelded(const Mesh& m) {
-    Mesh out;
-    for (std::size_t t = 0; t < m.triangles.size(); ++t) {
-        const auto c = m.corners(t);
-        const auto base = static_cast<std::uint32_t>(out.positions.size());
-        out.positions.insert(out.positions.end(), c.begin(), c.end());
-        out.triangles.push_back({base, base + 1, base + 2});
-    }
-    return out;
-}
-} // namespace
-
 TEST(MeshCheck, ClosedShapesAreValid) {
     for (const Mesh& m : {makeBox({0, 0, 0}, {1, 2, 3}), makeSubdividedBox({-1, -1, -1}, {1, 1, 1}, 4),
                           makeSphere({1, 2, 3}, 2, 24, 12), makeTorus({0, 0, 0}, 3, 1, 24, 12)}) {
         const MeshReport r = checkMesh(m);
-        EXPECT_TRUE(r.valid()) << problemsOf(r);
+        EXPECT_TRUE(r.valid()) << test::joinLines(r.problems);
         EXPECT_TRUE(r.closed);
         EXPECT_TRUE(r.edgeManifold);
         EXPECT_TRUE(r.oriented);
@@ -59,7 +32,7 @@ TEST(MeshCheck, ClosedShapesAreValid) {
 TEST(MeshCheck, BoxFarFromOriginReportsExactGeometry) {
     const Mesh m = makeBox({1e6, 1e6, 1e6}, {1e6 + 2, 1e6 + 4, 1e6 + 6});
     const MeshReport r = checkMesh(m);
-    EXPECT_TRUE(r.valid()) << problemsOf(r);
+    EXPECT_TRUE(r.valid()) << test::joinLines(r.problems);
     EXPECT_NEAR(r.volume, 48.0, 1e-6);
     EXPECT_NEAR(r.centerOfMass.x, 1e6 + 1, 1e-6);
     EXPECT_NEAR(r.centerOfMass.y, 1e6 + 2, 1e-6);
@@ -77,7 +50,8 @@ TEST(MeshCheck, OpenCubeIsNotClosed) {
     EXPECT_TRUE(r.edgeManifold);
     EXPECT_TRUE(r.oriented);
     EXPECT_EQ(r.boundaryEdges, 3u);
-    EXPECT_TRUE(mentions(r, "not closed (holes): 3 edges are used by only one triangle")) << problemsOf(r);
+    EXPECT_TRUE(test::mentions(r.problems, "not closed (holes): 3 edges are used by only one triangle"))
+        << test::joinLines(r.problems);
 }
 
 TEST(MeshCheck, OneFlippedFaceIsNotOriented) {
@@ -88,7 +62,7 @@ TEST(MeshCheck, OneFlippedFaceIsNotOriented) {
     EXPECT_TRUE(r.closed);
     EXPECT_FALSE(r.oriented);
     EXPECT_EQ(r.misorientedEdges, 3u);
-    EXPECT_TRUE(mentions(r, "not consistently oriented")) << problemsOf(r);
+    EXPECT_TRUE(test::mentions(r.problems, "not consistently oriented")) << test::joinLines(r.problems);
 }
 
 TEST(MeshCheck, InvertedCubeIsInsideOut) {
@@ -101,11 +75,11 @@ TEST(MeshCheck, InvertedCubeIsInsideOut) {
     EXPECT_TRUE(r.oriented);
     EXPECT_FALSE(r.outward);
     EXPECT_NEAR(r.volume, -1.0, 1e-12);
-    EXPECT_TRUE(mentions(r, "inside out")) << problemsOf(r);
+    EXPECT_TRUE(test::mentions(r.problems, "inside out")) << test::joinLines(r.problems);
 }
 
 TEST(MeshCheck, DuplicatedVerticesLeaveEveryEdgeOpen) {
-    const Mesh m = unwelded(makeBox({0, 0, 0}, {1, 1, 1}));
+    const Mesh m = test::unwelded(makeBox({0, 0, 0}, {1, 1, 1}));
     const MeshReport r = checkMesh(m);
     EXPECT_FALSE(r.valid());
     EXPECT_FALSE(r.closed);
@@ -127,7 +101,7 @@ TEST(MeshCheck, ThreeTrianglesOnAnEdgeAreNonManifold) {
     EXPECT_EQ(r.nonManifoldEdges, 1u);
     EXPECT_FALSE(r.selfIntersectionsChecked);
     EXPECT_NE(r.selfIntersectionNote.find("non-manifold"), std::string::npos);
-    EXPECT_TRUE(mentions(r, "has 3 triangles")) << problemsOf(r);
+    EXPECT_TRUE(test::mentions(r.problems, "has 3 triangles")) << test::joinLines(r.problems);
 }
 
 TEST(MeshCheck, NonFiniteCoordinatesAreReportedNotComputedWith) {
@@ -139,8 +113,9 @@ TEST(MeshCheck, NonFiniteCoordinatesAreReportedNotComputedWith) {
         EXPECT_EQ(r.nonFiniteVertices, 1u);
         EXPECT_EQ(r.volume, 0.0);
         EXPECT_FALSE(r.selfIntersectionsChecked);
-        EXPECT_TRUE(mentions(r, "1 vertex has a non-finite coordinate (NaN or infinity) (vertex 4)"))
-            << problemsOf(r);
+        EXPECT_TRUE(
+            test::mentions(r.problems, "1 vertex has a non-finite coordinate (NaN or infinity) (vertex 4)"))
+            << test::joinLines(r.problems);
         EXPECT_TRUE(isFinite(r.bounds.lo) && isFinite(r.bounds.hi));
     }
 }
@@ -151,7 +126,8 @@ TEST(MeshCheck, OutOfRangeIndicesAreReportedWithoutCrashing) {
     const MeshReport r = checkMesh(m);
     EXPECT_FALSE(r.valid());
     EXPECT_EQ(r.badIndices, 1u);
-    EXPECT_TRUE(mentions(r, "triangle 3 refers to vertex 101 of 8")) << problemsOf(r);
+    EXPECT_TRUE(test::mentions(r.problems, "triangle 3 refers to vertex 101 of 8"))
+        << test::joinLines(r.problems);
 }
 
 TEST(MeshCheck, DegenerateAndDuplicateTriangles) {
@@ -165,8 +141,8 @@ TEST(MeshCheck, DegenerateAndDuplicateTriangles) {
     EXPECT_FALSE(r.valid());
     EXPECT_GE(r.degenerateTriangles, 1u);
     EXPECT_EQ(r.duplicateTriangles, 1u);
-    EXPECT_TRUE(mentions(r, "degenerate")) << problemsOf(r);
-    EXPECT_TRUE(mentions(r, "duplicates an earlier triangle")) << problemsOf(r);
+    EXPECT_TRUE(test::mentions(r.problems, "degenerate")) << test::joinLines(r.problems);
+    EXPECT_TRUE(test::mentions(r.problems, "duplicates an earlier triangle")) << test::joinLines(r.problems);
 }
 
 TEST(MeshCheck, CollinearTriangleIsDegenerate) {
@@ -184,7 +160,7 @@ TEST(MeshCheck, OverlappingBoxesSelfIntersect) {
     EXPECT_TRUE(r.selfIntersectionsChecked) << r.selfIntersectionNote;
     EXPECT_GT(r.selfIntersections, 0u);
     EXPECT_FALSE(r.valid());
-    EXPECT_TRUE(mentions(r, "intersect")) << problemsOf(r);
+    EXPECT_TRUE(test::mentions(r.problems, "intersect")) << test::joinLines(r.problems);
 
     CheckOptions skip;
     skip.selfIntersections = false;
@@ -201,14 +177,14 @@ TEST(MeshCheck, SelfIntersectionCountCanBeCapped) {
     const MeshReport r = checkMesh(m, capped);
     EXPECT_TRUE(r.selfIntersectionsCapped);
     EXPECT_GE(r.selfIntersections, 1u);
-    EXPECT_TRUE(mentions(r, "at least")) << problemsOf(r);
+    EXPECT_TRUE(test::mentions(r.problems, "at least")) << test::joinLines(r.problems);
 }
 
 TEST(MeshCheck, SeparateBoxesDoNotIntersect) {
     Mesh m = makeBox({0, 0, 0}, {1, 1, 1});
     m.append(makeBox({2, 0, 0}, {3, 1, 1}));
     const MeshReport r = checkMesh(m);
-    EXPECT_TRUE(r.valid()) << problemsOf(r);
+    EXPECT_TRUE(r.valid()) << test::joinLines(r.problems);
     EXPECT_EQ(r.shells, 2u);
     EXPECT_NEAR(r.volume, 2.0, 1e-12);
 }
@@ -224,7 +200,7 @@ TEST(MeshCheck, MisorientedMeshStillGetsSelfIntersectionVerdict) {
 TEST(MeshCheck, EmptyMeshIsInvalid) {
     const MeshReport r = checkMesh(Mesh{});
     EXPECT_FALSE(r.valid());
-    EXPECT_TRUE(mentions(r, "no triangles"));
+    EXPECT_TRUE(test::mentions(r.problems, "no triangles"));
     EXPECT_TRUE(r.bounds.empty());
 }
 
@@ -265,8 +241,9 @@ TEST(MeshCheck, SolidsTouchingAtOneVertexAreNotManifold) {
     EXPECT_FALSE(r.valid());
     EXPECT_FALSE(r.selfIntersectionsChecked);
     EXPECT_EQ(r.selfIntersectionNote, "skipped: the mesh has non-manifold vertices");
-    EXPECT_TRUE(mentions(r, "1 vertex joins parts that share no edge there (pinched) (vertex 1)"))
-        << problemsOf(r);
+    EXPECT_TRUE(
+        test::mentions(r.problems, "1 vertex joins parts that share no edge there (pinched) (vertex 1)"))
+        << test::joinLines(r.problems);
 
     // Valid meshes have manifold vertices, including open ones with one boundary fan per vertex.
     EXPECT_TRUE(checkMesh(makeTorus({0, 0, 0}, 2, 1, 12, 8)).vertexManifold);
@@ -282,7 +259,8 @@ TEST(MeshCheck, AttributeArraysOfTheWrongSizeAreReported) {
     const MeshReport r = checkMesh(m);
     EXPECT_FALSE(r.valid());
     EXPECT_EQ(r.badAttributeArrays, 2u);
-    EXPECT_TRUE(mentions(r, "normals have 5 entries but 36 are needed (3 per triangle)")) << problemsOf(r);
-    EXPECT_TRUE(mentions(r, "material ids have 3 entries but 12 are needed (1 per triangle)"))
-        << problemsOf(r);
+    EXPECT_TRUE(test::mentions(r.problems, "normals have 5 entries but 36 are needed (3 per triangle)"))
+        << test::joinLines(r.problems);
+    EXPECT_TRUE(test::mentions(r.problems, "material ids have 3 entries but 12 are needed (1 per triangle)"))
+        << test::joinLines(r.problems);
 }

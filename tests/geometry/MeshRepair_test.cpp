@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 
+#include "TestSupport.hpp"
 #include "rubble/MassProperties.hpp"
 #include "rubble/MeshRepair.hpp"
 #include "rubble/Random.hpp"
@@ -10,39 +11,6 @@
 using namespace rubble;
 
 namespace {
-std::string listOf(const std::vector<std::string>& items) {
-    std::string s;
-    for (const std::string& p : items)
-        s += p + "\n";
-    return s;
-}
-
-bool mentions(const std::vector<std::string>& items, const std::string& text) {
-    for (const std::string& p : items)
-        if (p.find(text) != std::string::npos)
-            return true;
-    return false;
-}
-
-// Every triangle gets its own three vertices and per-corner attributes.
-Mesh unweldedWithAttributes(const Mesh& m) {
-    Mesh out;
-    for (std::size_t t = 0; t < m.triangles.size(); ++t) {
-        const auto c = m.corners(t);
-        const auto base = static_cast<std::uint32_t>(out.positions.size());
-        out.positions.insert(out.positions.end(), c.begin(), c.end());
-        out.triangles.push_back({base, base + 1, base + 2});
-        const Vec3 n = normalized(m.triangleNormal(t));
-        for (int k = 0; k < 3; ++k) {
-            out.normals.push_back(n);
-            out.uvs.push_back({c[k].x, c[k].y});
-        }
-        out.materials.push_back(static_cast<std::uint32_t>(t % 3));
-    }
-    out.materialNames = {"a", "b", "c"};
-    return out;
-}
-
 void flip(Mesh& m, std::size_t t) {
     std::swap(m.triangles[t][1], m.triangles[t][2]);
     if (m.hasNormals())
@@ -65,30 +33,30 @@ TEST(MeshRepair, InvertedCubeBecomesValidWithSameVolume) {
     for (std::size_t t = 0; t < m.triangles.size(); ++t)
         flip(m, t);
     const RepairReport r = repairMesh(m);
-    EXPECT_TRUE(r.valid()) << listOf(r.unrepaired);
+    EXPECT_TRUE(r.valid()) << test::joinLines(r.unrepaired);
     EXPECT_EQ(r.invertedShells, 1u);
     EXPECT_EQ(r.flippedTriangles, 0u);
     EXPECT_NEAR(r.after.volume, 24.0, 1e-12);
-    EXPECT_TRUE(mentions(r.fixed, "reversed 1 inside-out shell")) << listOf(r.fixed);
+    EXPECT_TRUE(test::mentions(r.fixed, "reversed 1 inside-out shell")) << test::joinLines(r.fixed);
 }
 
 TEST(MeshRepair, OneFlippedFaceIsFlippedBack) {
     Mesh m = makeBox({0, 0, 0}, {1, 1, 1});
     flip(m, 7);
     const RepairReport r = repairMesh(m);
-    EXPECT_TRUE(r.valid()) << listOf(r.unrepaired);
+    EXPECT_TRUE(r.valid()) << test::joinLines(r.unrepaired);
     EXPECT_EQ(r.flippedTriangles + r.invertedShells, 1u);
     EXPECT_EQ(m, makeBox({0, 0, 0}, {1, 1, 1}));
 }
 
 TEST(MeshRepair, DuplicatedVerticesAreWeldedAndAttributesFollow) {
     const Mesh original = makeBox({-1, -1, -1}, {1, 1, 1});
-    Mesh m = unweldedWithAttributes(original);
+    Mesh m = test::unwelded(original, true);
     // Also flip two faces and invert nothing else: orientation must be repaired after welding.
     flip(m, 0);
     flip(m, 5);
     const RepairReport r = repairMesh(m);
-    EXPECT_TRUE(r.valid()) << listOf(r.unrepaired);
+    EXPECT_TRUE(r.valid()) << test::joinLines(r.unrepaired);
     EXPECT_EQ(r.weldedVertices, 36u - 8u);
     EXPECT_EQ(r.removedUnreferencedVertices, 28u);
     EXPECT_EQ(m.vertexCount(), 8u);
@@ -106,35 +74,35 @@ TEST(MeshRepair, DuplicatedVerticesAreWeldedAndAttributesFollow) {
 }
 
 TEST(MeshRepair, InvertedFlippedDuplicatedCubeBecomesValidCube) {
-    Mesh m = unweldedWithAttributes(makeBox({0, 0, 0}, {3, 3, 3}));
+    Mesh m = test::unwelded(makeBox({0, 0, 0}, {3, 3, 3}), true);
     for (std::size_t t = 0; t < m.triangles.size(); ++t)
         if (t != 4)
             flip(m, t); // inverted except one face
     const RepairReport r = repairMesh(m);
-    EXPECT_TRUE(r.valid()) << listOf(r.unrepaired);
+    EXPECT_TRUE(r.valid()) << test::joinLines(r.unrepaired);
     EXPECT_NEAR(r.after.volume, 27.0, 1e-12);
     EXPECT_EQ(m.vertexCount(), 8u);
     expectNormalsAgreeWithFaces(m);
 }
 
 TEST(MeshRepair, WeldToleranceIsRelativeToTheBoundingBox) {
-    Mesh near = unweldedWithAttributes(makeBox({0, 0, 0}, {1000, 1000, 1000}));
+    Mesh near = test::unwelded(makeBox({0, 0, 0}, {1000, 1000, 1000}), true);
     near.positions[5].x += 1e-7; // 1e-10 of the diagonal: welded
     RepairReport r = repairMesh(near);
-    EXPECT_TRUE(r.valid()) << listOf(r.unrepaired);
+    EXPECT_TRUE(r.valid()) << test::joinLines(r.unrepaired);
 
-    Mesh far = unweldedWithAttributes(makeBox({0, 0, 0}, {1000, 1000, 1000}));
+    Mesh far = test::unwelded(makeBox({0, 0, 0}, {1000, 1000, 1000}), true);
     far.positions[5].x += 1e-3; // 5.8e-7 of the diagonal: kept apart, so the cube stays open
     r = repairMesh(far);
     EXPECT_FALSE(r.valid());
-    EXPECT_TRUE(mentions(r.unrepaired, "not closed")) << listOf(r.unrepaired);
+    EXPECT_TRUE(test::mentions(r.unrepaired, "not closed")) << test::joinLines(r.unrepaired);
 
     RepairOptions loose;
     loose.weldTolerance = 1e-5;
-    Mesh far2 = unweldedWithAttributes(makeBox({0, 0, 0}, {1000, 1000, 1000}));
+    Mesh far2 = test::unwelded(makeBox({0, 0, 0}, {1000, 1000, 1000}), true);
     far2.positions[5].x += 1e-3;
     r = repairMesh(far2, loose);
-    EXPECT_TRUE(r.valid()) << listOf(r.unrepaired);
+    EXPECT_TRUE(r.valid()) << test::joinLines(r.unrepaired);
 }
 
 TEST(MeshRepair, DegenerateAndDuplicateTrianglesAreRemoved) {
@@ -146,7 +114,7 @@ TEST(MeshRepair, DegenerateAndDuplicateTrianglesAreRemoved) {
     for (int i = 0; i < 9; ++i)
         m.normals.push_back({0, 0, 1});
     const RepairReport r = repairMesh(m);
-    EXPECT_TRUE(r.valid()) << listOf(r.unrepaired);
+    EXPECT_TRUE(r.valid()) << test::joinLines(r.unrepaired);
     EXPECT_EQ(r.removedDegenerate, 1u);
     EXPECT_EQ(r.removedDuplicates, 2u);
     EXPECT_EQ(m.triangleCount(), 12u);
@@ -160,8 +128,8 @@ TEST(MeshRepair, NaNVertexRemovesItsTrianglesAndReportsTheHole) {
     EXPECT_FALSE(r.valid());
     EXPECT_GT(r.removedNonFiniteTriangles, 0u);
     EXPECT_EQ(r.after.nonFiniteVertices, 0u);
-    EXPECT_TRUE(mentions(r.fixed, "non-finite")) << listOf(r.fixed);
-    EXPECT_TRUE(mentions(r.unrepaired, "not closed")) << listOf(r.unrepaired);
+    EXPECT_TRUE(test::mentions(r.fixed, "non-finite")) << test::joinLines(r.fixed);
+    EXPECT_TRUE(test::mentions(r.unrepaired, "not closed")) << test::joinLines(r.unrepaired);
     EXPECT_TRUE(m.validate().isOk());
 }
 
@@ -169,7 +137,7 @@ TEST(MeshRepair, OutOfRangeIndicesAreRemoved) {
     Mesh m = makeBox({0, 0, 0}, {1, 1, 1});
     m.triangles.push_back({0, 1, 99});
     const RepairReport r = repairMesh(m);
-    EXPECT_TRUE(r.valid()) << listOf(r.unrepaired);
+    EXPECT_TRUE(r.valid()) << test::joinLines(r.unrepaired);
     EXPECT_EQ(r.removedBadIndexTriangles, 1u);
 }
 
@@ -179,14 +147,14 @@ TEST(MeshRepair, HolesAndNonManifoldEdgesAreReportedNotHidden) {
     RepairReport r = repairMesh(open);
     EXPECT_FALSE(r.valid());
     EXPECT_FALSE(r.changed());
-    EXPECT_TRUE(mentions(r.unrepaired, "not closed")) << listOf(r.unrepaired);
+    EXPECT_TRUE(test::mentions(r.unrepaired, "not closed")) << test::joinLines(r.unrepaired);
 
     Mesh fin = makeBox({0, 0, 0}, {1, 1, 1});
     fin.positions.push_back({-1, -1, -1});
     fin.triangles.push_back({fin.triangles[0][0], fin.triangles[0][1], 8});
     r = repairMesh(fin);
     EXPECT_FALSE(r.valid());
-    EXPECT_TRUE(mentions(r.unrepaired, "not manifold")) << listOf(r.unrepaired);
+    EXPECT_TRUE(test::mentions(r.unrepaired, "not manifold")) << test::joinLines(r.unrepaired);
 }
 
 TEST(MeshRepair, SelfIntersectionsAreReportedAsUnrepaired) {
@@ -194,7 +162,7 @@ TEST(MeshRepair, SelfIntersectionsAreReportedAsUnrepaired) {
     m.append(makeBox({1, 1, 1}, {3, 3, 3}));
     const RepairReport r = repairMesh(m);
     EXPECT_FALSE(r.valid());
-    EXPECT_TRUE(mentions(r.unrepaired, "intersect")) << listOf(r.unrepaired);
+    EXPECT_TRUE(test::mentions(r.unrepaired, "intersect")) << test::joinLines(r.unrepaired);
 }
 
 TEST(MeshRepair, CavityIsOrientedInwardAndSubtracted) {
@@ -202,14 +170,14 @@ TEST(MeshRepair, CavityIsOrientedInwardAndSubtracted) {
     Mesh m = makeBox({0, 0, 0}, {4, 4, 4});
     m.append(makeBox({1, 1, 1}, {2, 2, 2}));
     const RepairReport r = repairMesh(m);
-    EXPECT_TRUE(r.valid()) << listOf(r.unrepaired);
+    EXPECT_TRUE(r.valid()) << test::joinLines(r.unrepaired);
     EXPECT_EQ(r.invertedShells, 1u);
     EXPECT_NEAR(r.after.volume, 64.0 - 1.0, 1e-12);
 
     // An already correct cavity is left alone.
     Mesh ok = m;
     const RepairReport again = repairMesh(ok);
-    EXPECT_FALSE(again.changed()) << listOf(again.fixed);
+    EXPECT_FALSE(again.changed()) << test::joinLines(again.fixed);
     EXPECT_EQ(ok, m);
 }
 
@@ -219,8 +187,8 @@ TEST(MeshRepair, ValidMeshesAreUnchanged) {
         m.computeFlatNormals();
         const Mesh before = m;
         const RepairReport r = repairMesh(m);
-        EXPECT_TRUE(r.valid()) << listOf(r.unrepaired);
-        EXPECT_FALSE(r.changed()) << listOf(r.fixed);
+        EXPECT_TRUE(r.valid()) << test::joinLines(r.unrepaired);
+        EXPECT_FALSE(r.changed()) << test::joinLines(r.fixed);
         EXPECT_EQ(m, before);
     }
 }
@@ -235,7 +203,7 @@ TEST(MeshRepair, RandomFlipsOnASphereAreUndone) {
             if (rng.below(3) == 0)
                 flip(m, t);
         const RepairReport r = repairMesh(m);
-        EXPECT_TRUE(r.valid()) << listOf(r.unrepaired);
+        EXPECT_TRUE(r.valid()) << test::joinLines(r.unrepaired);
         EXPECT_NEAR(r.after.volume, volume, 1e-9);
     }
 }
@@ -244,7 +212,7 @@ TEST(MeshRepair, EmptyMeshStaysEmptyAndInvalid) {
     Mesh m;
     const RepairReport r = repairMesh(m);
     EXPECT_FALSE(r.valid());
-    EXPECT_TRUE(mentions(r.unrepaired, "no triangles"));
+    EXPECT_TRUE(test::mentions(r.unrepaired, "no triangles"));
 }
 
 TEST(MeshRepair, OverlappingShellsAreNotMistakenForCavities) {
@@ -259,8 +227,8 @@ TEST(MeshRepair, AttributeArraysOfTheWrongSizeAreDropped) {
     Mesh m = makeBox({0, 0, 0}, {1, 1, 1});
     m.uvs.assign(7, Vec2{});
     const RepairReport r = repairMesh(m);
-    EXPECT_TRUE(r.valid()) << listOf(r.unrepaired);
+    EXPECT_TRUE(r.valid()) << test::joinLines(r.unrepaired);
     EXPECT_FALSE(m.hasUvs());
-    EXPECT_TRUE(mentions(r.fixed, "dropped texture coordinates")) << listOf(r.fixed);
+    EXPECT_TRUE(test::mentions(r.fixed, "dropped texture coordinates")) << test::joinLines(r.fixed);
     EXPECT_TRUE(m.validate().isOk());
 }

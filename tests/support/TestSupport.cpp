@@ -34,4 +34,39 @@ std::filesystem::path writeFile(const std::filesystem::path& path, const std::st
     return path;
 }
 
+std::string joinLines(const std::vector<std::string>& lines) {
+    std::string s;
+    for (const std::string& line : lines)
+        s += line + "\n";
+    return s;
+}
+
+bool mentions(const std::vector<std::string>& lines, const std::string& text) {
+    for (const std::string& line : lines)
+        if (line.find(text) != std::string::npos)
+            return true;
+    return false;
+}
+
+Mesh unwelded(const Mesh& m, bool withAttributes) {
+    Mesh out;
+    for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+        const auto c = m.corners(t);
+        const auto base = static_cast<std::uint32_t>(out.positions.size());
+        out.positions.insert(out.positions.end(), c.begin(), c.end());
+        out.triangles.push_back({base, base + 1, base + 2});
+        if (!withAttributes)
+            continue;
+        const Vec3 n = normalized(m.triangleNormal(t));
+        for (int k = 0; k < 3; ++k) {
+            out.normals.push_back(n);
+            out.uvs.push_back({c[k].x, c[k].y});
+        }
+        out.materials.push_back(static_cast<std::uint32_t>(t % 3));
+    }
+    if (withAttributes)
+        out.materialNames = {"a", "b", "c"};
+    return out;
+}
+
 } // namespace rubble::test

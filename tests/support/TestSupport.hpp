@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "rubble/Mesh.hpp"
 
@@ -17,6 +18,13 @@ std::filesystem::path tempDir(const std::string& name);
 std::optional<std::filesystem::path> seedMediaDir();
 /// Writes text to a file, returning its path.
 std::filesystem::path writeFile(const std::filesystem::path& path, const std::string& text);
+/// The lines joined with newlines (for failure messages listing problems).
+std::string joinLines(const std::vector<std::string>& lines);
+/// True when some line contains text.
+bool mentions(const std::vector<std::string>& lines, const std::string& text);
+/// Every triangle gets its own three vertices (a "triangle soup", as some exporters write); with attributes,
+/// also per-corner normals (the face normal), UVs (x, y) and three materials "a", "b", "c" in turn.
+Mesh unwelded(const Mesh& m, bool withAttributes = false);
 
 } // namespace rubble::test
 
