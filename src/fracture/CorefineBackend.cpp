@@ -175,6 +175,14 @@ Aabb smBounds(const SM& sm) {
     return b;
 }
 
+/// Named parameters for the mesh side of a corefinement. A self-intersecting (e.g. self-touching) input
+/// violates corefinement's precondition and made CGAL 5.5 segfault in its constrained triangulation (found by
+/// FractureFuzz: two boxes sharing a face); CGAL then checks the triangles near the intersection and throws
+/// instead.
+auto meshParameters(SourceVisitor& visitor) {
+    return PMP::parameters::visitor(visitor).throw_on_self_intersection(true);
+}
+
 class CorefineBackend final : public BooleanBackend {
 public:
     std::string name() const override { return "corefine"; }
@@ -263,8 +271,8 @@ private:
             outputs[PMP::Corefinement::INTERSECTION] = inter.get();
             SourceVisitor visitor;
             visitor.table = &table;
-            const std::array<bool, 4> ok = PMP::corefine_and_compute_boolean_operations(
-                *m, *cell, outputs, PMP::parameters::visitor(visitor));
+            const std::array<bool, 4> ok =
+                PMP::corefine_and_compute_boolean_operations(*m, *cell, outputs, meshParameters(visitor));
             if (!ok[PMP::Corefinement::INTERSECTION])
                 throw Failure{"the result of cell " + std::to_string(i) + " would not be a manifold surface"};
             table.of.erase(m.get());
@@ -293,8 +301,8 @@ private:
         outputs[PMP::Corefinement::TM1_MINUS_TM2] = diff.get();
         SourceVisitor visitor;
         visitor.table = &table;
-        const std::array<bool, 4> ok = PMP::corefine_and_compute_boolean_operations(
-            *m, *uni, outputs, PMP::parameters::visitor(visitor));
+        const std::array<bool, 4> ok =
+            PMP::corefine_and_compute_boolean_operations(*m, *uni, outputs, meshParameters(visitor));
         if (!ok[PMP::Corefinement::TM1_MINUS_TM2])
             return std::nullopt;
         for (std::size_t i = 0; i < cells.size(); ++i)
@@ -322,8 +330,8 @@ private:
             outputs[PMP::Corefinement::TM1_MINUS_TM2] = diff.get();
             SourceVisitor visitor;
             visitor.table = &table;
-            const std::array<bool, 4> ok = PMP::corefine_and_compute_boolean_operations(
-                *rem, *cell, outputs, PMP::parameters::visitor(visitor));
+            const std::array<bool, 4> ok =
+                PMP::corefine_and_compute_boolean_operations(*rem, *cell, outputs, meshParameters(visitor));
             if (!ok[PMP::Corefinement::INTERSECTION] || !ok[PMP::Corefinement::TM1_MINUS_TM2])
                 throw Failure{"the result of cell " + std::to_string(i) + " would not be a manifold surface"};
             table.of.erase(rem.get());
