@@ -37,9 +37,11 @@ std::uint64_t pairKey(std::uint32_t a, std::uint32_t b) {
     return (std::uint64_t(a) << 32) | b;
 }
 
-/// Key of a created point: which mesh edge / triangle and which cell planes it lies on.
+/// Key of a created point: which mesh edge / triangle and which cell planes or complex edge it lies on.
 struct PointKey {
-    std::uint32_t kind; // 1: mesh edge (a<b) ∩ plane c; 2: triangle a ∩ planes b<c; 3: cell vertex a
+    // 1: mesh edge (a<b) ∩ face c; 2: triangle a ∩ complex edge (b<c); 3: complex vertex a;
+    // 4: triangle a ∩ faces b<c that share no edge (never a corner of an output)
+    std::uint32_t kind;
     std::uint32_t a, b, c;
     bool operator==(const PointKey&) const = default;
 };
@@ -55,7 +57,7 @@ struct PointKeyHash {
 
 /// What an edge of a clipped polygon lies on.
 struct Support {
-    bool onMeshEdge; // true: the mesh edge (a,b) with a<b; false: the cut line of plane a
+    bool onMeshEdge; // true: the mesh edge (a,b) with a<b; false: the cut line of complex face a
     std::uint32_t a, b;
 };
 
@@ -65,45 +67,121 @@ struct Corner {
     Support next;
 };
 
-/// Convex cell as vertices, CCW face loops and planes.
-struct CellTopology {
+/// The cells as one complex: welded vertices, and faces shared by two cells stored once. A face's plane is
+/// outward for its `back` cell; `front` is the cell on the other side, or the outside region (index K).
+struct CellComplex {
+    struct Face {
+        std::vector<std::uint32_t> loop; // counter-clockwise seen from the back cell's outside
+        Plane plane;
+        std::uint32_t back = 0, front = 0;
+    };
+    struct Cell {
+        std::vector<std::uint32_t> faces; // complex faces
+        std::vector<bool> flipped;        // true where the cell is the face's front
+        std::unordered_map<std::uint64_t, std::uint64_t> edgeOfFaces; // face pair (f<g) -> complex edge (a<b)
+        Aabb box;
+    };
     std::vector<Vec3> vertices;
-    std::vector<std::vector<std::uint32_t>> loops;
-    std::vector<Plane> planes;
-    std::unordered_map<std::uint64_t, std::uint32_t> faceOfDirectedEdge;
+    std::vector<Face> faces;
+    std::vector<Cell> cells;
 };
 
-CellTopology buildTopology(const ConvexPolytope& cell) {
-    CellTopology t;
+/// The loop rotated to start at its smallest id (identifies a face whatever corner it starts from).
+std::vector<std::uint32_t> canonicalLoop(std::vector<std::uint32_t> loop) {
+    std::rotate(loop.begin(), std::min_element(loop.begin(), loop.end()), loop.end());
+    return loop;
+}
+
+CellComplex buildComplex(const std::vector<ConvexPolytope>& polytopes, double eps) {
+    CellComplex cx;
+    const auto outside = static_cast<std::uint32_t>(polytopes.size());
     std::map<std::tuple<double, double, double>, std::uint32_t> index;
-    for (const PolytopeFace& f : cell.faces()) {
-        std::vector<std::uint32_t> loop;
-        for (const Vec3& c : f.corners) {
-            auto [it, inserted] =
-                index.emplace(std::make_tuple(c.x, c.y, c.z), static_cast<std::uint32_t>(t.vertices.size()));
-            if (inserted)
-                t.vertices.push_back(c);
-            if (loop.empty() || loop.back() != it->second)
-                loop.push_back(it->second);
+    std::map<std::vector<std::uint32_t>, std::uint32_t> faceByLoop;
+    for (std::uint32_t c = 0; c < polytopes.size(); ++c) {
+        CellComplex::Cell cell;
+        cell.box = polytopes[c].bounds();
+        std::unordered_map<std::uint64_t, std::uint32_t> localFaceOfEdge;
+        std::vector<std::vector<std::uint32_t>> loops;
+        for (const PolytopeFace& f : polytopes[c].faces()) {
+            std::vector<std::uint32_t> loop;
+            for (const Vec3& p : f.corners) {
+                auto [it, inserted] = index.emplace(std::make_tuple(p.x, p.y, p.z),
+                                                    static_cast<std::uint32_t>(cx.vertices.size()));
+                if (inserted)
+                    cx.vertices.push_back(p);
+                if (loop.empty() || loop.back() != it->second)
+                    loop.push_back(it->second);
+            }
+            while (loop.size() > 1 && loop.front() == loop.back())
+                loop.pop_back();
+            if (loop.size() < 3)
+                continue;
+            const auto local = static_cast<std::uint32_t>(loops.size());
+            for (std::size_t i = 0; i < loop.size(); ++i)
+                if (!localFaceOfEdge.emplace(pairKey(loop[i], loop[(i + 1) % loop.size()]), local).second)
+                    throw Degenerate{"cell edge used twice"};
+            // A face another cell already has, reversed, is shared; the same face with the same orientation
+            // means the cells overlap.
+            std::vector<std::uint32_t> key = canonicalLoop(loop);
+            auto shared =
+                faceByLoop.find(canonicalLoop(std::vector<std::uint32_t>(loop.rbegin(), loop.rend())));
+            if (shared != faceByLoop.end() && cx.faces[shared->second].front == outside) {
+                cx.faces[shared->second].front = c;
+                cell.faces.push_back(shared->second);
+                cell.flipped.push_back(true);
+            } else {
+                const auto id = static_cast<std::uint32_t>(cx.faces.size());
+                if (!faceByLoop.emplace(std::move(key), id).second)
+                    throw Degenerate{"cells overlap"};
+                cx.faces.push_back({loop, f.plane, c, outside});
+                cell.faces.push_back(id);
+                cell.flipped.push_back(false);
+            }
+            loops.push_back(std::move(loop));
         }
-        while (loop.size() > 1 && loop.front() == loop.back())
-            loop.pop_back();
-        if (loop.size() < 3)
-            continue;
-        const auto face = static_cast<std::uint32_t>(t.loops.size());
-        for (std::size_t i = 0; i < loop.size(); ++i)
-            if (!t.faceOfDirectedEdge.emplace(pairKey(loop[i], loop[(i + 1) % loop.size()]), face).second)
-                throw Degenerate{"cell edge used twice"};
-        t.loops.push_back(std::move(loop));
-        t.planes.push_back(f.plane);
+        for (const auto& [key, face] : localFaceOfEdge) {
+            const auto a = static_cast<std::uint32_t>(key >> 32),
+                       b = static_cast<std::uint32_t>(key & 0xFFFFFFFFu);
+            auto twin = localFaceOfEdge.find(pairKey(b, a));
+            if (twin == localFaceOfEdge.end())
+                throw Degenerate{"cell is not closed"};
+            const std::uint32_t f = cell.faces[face], g = cell.faces[twin->second];
+            cell.edgeOfFaces[pairKey(std::min(f, g), std::max(f, g))] =
+                pairKey(std::min(a, b), std::max(a, b));
+        }
+        if (loops.size() < 4)
+            throw Degenerate{"cell has fewer than 4 faces"};
+        cx.cells.push_back(std::move(cell));
     }
-    for (const auto& [key, face] : t.faceOfDirectedEdge)
-        if (!t.faceOfDirectedEdge.count(pairKey(static_cast<std::uint32_t>(key & 0xFFFFFFFFu),
-                                                static_cast<std::uint32_t>(key >> 32))))
-            throw Degenerate{"cell is not closed"};
-    if (t.loops.size() < 4)
-        throw Degenerate{"cell has fewer than 4 faces"};
-    return t;
+    // The union's boundary (faces with the outside in front) must close up: every directed edge once and its
+    // reverse once. Faces of neighbouring cells that overlap without being the same face break this.
+    std::unordered_map<std::uint64_t, int> directed;
+    for (const CellComplex::Face& f : cx.faces)
+        if (f.front == outside)
+            for (std::size_t i = 0; i < f.loop.size(); ++i)
+                if (++directed[pairKey(f.loop[i], f.loop[(i + 1) % f.loop.size()])] > 1)
+                    throw Degenerate{"cells do not form a complex"};
+    for (const auto& [key, count] : directed)
+        if (!directed.count(pairKey(static_cast<std::uint32_t>(key & 0xFFFFFFFFu),
+                                    static_cast<std::uint32_t>(key >> 32))))
+            throw Degenerate{"cells do not form a complex"};
+    // Disjoint interiors: every pair of nearby cells is separated by a face plane of one of them.
+    for (std::uint32_t c = 0; c < polytopes.size(); ++c)
+        for (std::uint32_t d = c + 1; d < polytopes.size(); ++d) {
+            if (!cx.cells[c].box.overlaps(cx.cells[d].box, eps))
+                continue;
+            auto separates = [&](std::uint32_t a, std::uint32_t b) {
+                const std::vector<Vec3> others = polytopes[b].vertices();
+                for (const PolytopeFace& f : polytopes[a].faces())
+                    if (std::all_of(others.begin(), others.end(),
+                                    [&](const Vec3& p) { return f.plane.signedDistance(p) >= -eps; }))
+                        return true;
+                return false;
+            };
+            if (!separates(c, d) && !separates(d, c))
+                throw Degenerate{"cells overlap"};
+        }
+    return cx;
 }
 
 /// An orthonormal basis (u, v) of a plane with normal n such that u × v = n.
@@ -112,109 +190,147 @@ void planeBasis(const Vec3& n, Vec3& u, Vec3& v) {
     v = cross(n, u);
 }
 
+/// Splits a mesh by a complex of convex cells in one pass: every point is computed once, from the input
+/// mesh and the complex, and shared by every region that uses it.
 class Clipper {
 public:
-    Clipper(const Mesh& mesh, const ConvexPolytope& cell) : mesh_(mesh), topo_(buildTopology(cell)) {
+    Clipper(const Mesh& mesh, const std::vector<ConvexPolytope>& cells) : mesh_(mesh) {
         nV_ = static_cast<std::uint32_t>(mesh.positions.size());
-        k_ = static_cast<std::uint32_t>(topo_.planes.size());
-        cellBox_ = cell.bounds();
+        k_ = static_cast<std::uint32_t>(cells.size());
+        for (const ConvexPolytope& c : cells)
+            box_.extend(c.bounds());
         double maxAbs = 0;
         for (int a = 0; a < 3; ++a)
-            maxAbs = std::max({maxAbs, std::abs(cellBox_.lo[a]), std::abs(cellBox_.hi[a])});
-        eps_ = std::max(1e-10 * cellBox_.diagonal(), 1e-14 * maxAbs);
-        cutEdges_.resize(k_);
+            maxAbs = std::max({maxAbs, std::abs(box_.lo[a]), std::abs(box_.hi[a])});
+        eps_ = std::max(1e-10 * box_.diagonal(), 1e-14 * maxAbs);
+        cx_ = buildComplex(cells, eps_);
+        nF_ = static_cast<std::uint32_t>(cx_.faces.size());
+        cutEdges_.resize(nF_);
+        untouched_.resize(k_ + 1);
+        tris_.resize(k_ + 1);
     }
 
-    CellSplit run();
+    /// Region k < K: mesh ∩ cell k; region K: the rest.
+    std::vector<Mesh> run();
 
 private:
     const Mesh& mesh_;
-    CellTopology topo_;
-    std::uint32_t nV_ = 0, k_ = 0;
-    Aabb cellBox_;
+    CellComplex cx_;
+    std::uint32_t nV_ = 0, k_ = 0, nF_ = 0;
+    Aabb box_;
     double eps_ = 0;
 
-    std::vector<Vec3> extra_; // created points, ids nV_ + i
+    std::vector<Vec3> extra_;   // created points, ids nV_ + i
+    std::vector<bool> offEdge_; // per created point: kind 4 (may not end up in an output)
     std::unordered_map<PointKey, std::uint32_t, PointKeyHash> keyed_;
     std::vector<std::int32_t> distSlot_; // per mesh vertex: offset into dist_ or -1
-    std::vector<double> dist_;
+    std::vector<double> dist_;           // distances to every complex face plane
 
-    // Per plane: the directed cut edges of the inside polygons on that plane.
+    // Per complex face: the directed cut edges of its back cell's polygons on that face.
     std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>> cutEdges_;
-    // Per cell edge (i<j): points where it pierces the mesh surface.
+    // Per complex edge (a<b): points where it pierces the mesh surface.
     std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> pierce_;
 
-    // Output triangles by point id, with the source triangle (kNone for cap faces) and cap plane.
+    // Output triangles by point id, with the source triangle (kNone for cap faces) and cap face.
     struct OutTri {
         std::uint32_t v[3];
         std::uint32_t source; // mesh triangle it lies in, or kNone for a cap
-        std::uint32_t plane;  // cap plane when source == kNone
+        std::uint32_t face;   // complex face of a cap
+        bool flipped;         // cap seen from the face's front
     };
-    std::vector<OutTri> inTris_, outTris_;
-    std::vector<std::uint32_t> untouchedIn_, untouchedOut_;
+    std::vector<std::vector<OutTri>> tris_;             // per region
+    std::vector<std::vector<std::uint32_t>> untouched_; // per region: input triangles kept whole
 
     const Vec3& pos(std::uint32_t id) const { return id < nV_ ? mesh_.positions[id] : extra_[id - nV_]; }
 
-    double dist(std::uint32_t id, std::uint32_t plane) const {
+    /// Signed distance to complex face f's plane (positive in front).
+    double dist(std::uint32_t id, std::uint32_t f) const {
         if (id < nV_)
-            return dist_[static_cast<std::size_t>(distSlot_[id]) + plane];
-        return topo_.planes[plane].signedDistance(extra_[id - nV_]);
+            return dist_[static_cast<std::size_t>(distSlot_[id]) + f];
+        return cx_.faces[f].plane.signedDistance(extra_[id - nV_]);
+    }
+    /// Signed distance to the l-th plane of cell c (positive outside the cell).
+    double cellDist(std::uint32_t id, std::uint32_t c, std::size_t l) const {
+        const double d = dist(id, cx_.cells[c].faces[l]);
+        return cx_.cells[c].flipped[l] ? -d : d;
     }
 
     void ensureDistances(std::uint32_t v) {
         if (distSlot_[v] >= 0)
             return;
         distSlot_[v] = static_cast<std::int32_t>(dist_.size());
-        for (std::uint32_t i = 0; i < k_; ++i)
-            dist_.push_back(topo_.planes[i].signedDistance(mesh_.positions[v]));
+        for (const CellComplex::Face& f : cx_.faces)
+            dist_.push_back(f.plane.signedDistance(mesh_.positions[v]));
     }
 
-    std::uint32_t addPoint(const PointKey& key, const Vec3& p) {
+    std::uint32_t addPoint(const PointKey& key, const Vec3& p, bool offEdge = false) {
         auto [it, inserted] = keyed_.emplace(key, nV_ + static_cast<std::uint32_t>(extra_.size()));
-        if (inserted)
+        if (inserted) {
             extra_.push_back(p);
+            offEdge_.push_back(offEdge);
+        }
         return it->second;
     }
 
-    std::uint32_t crossing(std::uint32_t tri, const Support& s, std::uint32_t plane, std::uint32_t from,
-                           std::uint32_t to, double dFrom, double dTo);
-    std::vector<Corner> clipTriangle(std::uint32_t t);
-    void cutTriangle(std::uint32_t t);
-    void emitConvex(const std::vector<std::uint32_t>& poly, const Vec3& normal, std::uint32_t source);
+    std::uint32_t crossing(std::uint32_t tri, std::uint32_t cell, const Support& s, std::uint32_t face,
+                           std::uint32_t from, std::uint32_t to, double dFrom, double dTo);
+    std::vector<Corner> clipTriangle(std::uint32_t t, std::uint32_t cell);
+    void cutTriangle(std::uint32_t t, const std::vector<std::uint32_t>& cells);
+    void emitConvex(const std::vector<std::uint32_t>& poly, const Vec3& normal, std::uint32_t source,
+                    std::vector<OutTri>& out);
     void triangulateRegion(const std::vector<std::pair<std::uint32_t, std::uint32_t>>& edges,
                            std::size_t boundaryEdges, const Vec3& normal, std::uint32_t source,
-                           std::uint32_t plane, std::vector<OutTri>& out);
+                           std::uint32_t face, std::vector<OutTri>& out);
     void buildCaps();
     bool pointInsideMesh(const Vec3& p) const;
-    Mesh assemble(const std::vector<std::uint32_t>& untouched, const std::vector<OutTri>& tris,
-                  bool reverseCaps) const;
+    Mesh assemble(std::uint32_t region) const;
 };
 
-std::uint32_t Clipper::crossing(std::uint32_t tri, const Support& s, std::uint32_t plane, std::uint32_t from,
-                                std::uint32_t to, double dFrom, double dTo) {
+std::uint32_t Clipper::crossing(std::uint32_t tri, std::uint32_t cell, const Support& s, std::uint32_t face,
+                                std::uint32_t from, std::uint32_t to, double dFrom, double dTo) {
     if (s.onMeshEdge) {
-        const PointKey key{1, s.a, s.b, plane};
+        const PointKey key{1, s.a, s.b, face};
         if (auto it = keyed_.find(key); it != keyed_.end())
             return it->second;
-        // Canonical: from the lower vertex index to the higher, with their own distances.
-        const double da = dist(s.a, plane), db = dist(s.b, plane);
+        // Canonical: from the lower vertex index to the higher, with their own distances (the same for both
+        // cells of a shared face: the ratio does not depend on the sign).
+        const double da = dist(s.a, face), db = dist(s.b, face);
         if (!((da < 0 && db > 0) || (da > 0 && db < 0)))
             throw Degenerate{"edge crossing without sign change"};
         const Vec3& pa = mesh_.positions[s.a];
         const Vec3& pb = mesh_.positions[s.b];
         return addPoint(key, pa + (pb - pa) * (da / (da - db)));
     }
-    const std::uint32_t i = std::min(s.a, plane), j = std::max(s.a, plane);
-    const PointKey key{2, tri, i, j};
-    if (auto it = keyed_.find(key); it != keyed_.end())
-        return it->second;
+    const std::uint32_t f = std::min(s.a, face), g = std::max(s.a, face);
     const Vec3& p = pos(from);
     const Vec3& q = pos(to);
-    return addPoint(key, p + (q - p) * (dFrom / (dFrom - dTo)));
+    const Vec3 along = p + (q - p) * (dFrom / (dFrom - dTo));
+    const auto& edges = cx_.cells[cell].edgeOfFaces;
+    const auto edge = edges.find(pairKey(f, g));
+    if (edge == edges.end()) // the faces meet at most in a vertex: this point cannot survive clipping
+        return addPoint({4, tri, f, g}, along, true);
+    // Where the triangle meets a complex edge: every cell around the edge gets the same point, computed
+    // from the edge's (welded) end points and the triangle's plane.
+    const auto a = static_cast<std::uint32_t>(edge->second >> 32);
+    const auto b = static_cast<std::uint32_t>(edge->second & 0xFFFFFFFFu);
+    const PointKey key{2, tri, a, b};
+    if (auto it = keyed_.find(key); it != keyed_.end())
+        return it->second;
+    const auto c = mesh_.corners(tri);
+    const Vec3 n = cross(c[1] - c[0], c[2] - c[0]);
+    const Vec3 &pa = cx_.vertices[a], &pb = cx_.vertices[b];
+    const double da = dot(n, pa - c[0]), db = dot(n, pb - c[0]);
+    if (!(std::abs(da - db) > 1e-9 * length(n) * length(pb - pa)))
+        throw Degenerate{"triangle parallel to a cell edge"};
+    const Vec3 x = pa + (pb - pa) * (da / (da - db));
+    if (length(x - along) > 10 * eps_)
+        throw Degenerate{"ill-conditioned cell edge crossing"};
+    return addPoint(key, x);
 }
 
-// Sutherland–Hodgman clipping of triangle t by all cell planes; corners carry the support of their next edge.
-std::vector<Corner> Clipper::clipTriangle(std::uint32_t t) {
+// Sutherland–Hodgman clipping of triangle t by all planes of a cell; corners carry the support of their
+// next edge.
+std::vector<Corner> Clipper::clipTriangle(std::uint32_t t, std::uint32_t cell) {
     const Triangle& tri = mesh_.triangles[t];
     std::vector<Corner> poly;
     for (int c = 0; c < 3; ++c) {
@@ -223,11 +339,12 @@ std::vector<Corner> Clipper::clipTriangle(std::uint32_t t) {
     }
     std::vector<Corner> next;
     std::vector<double> d;
-    for (std::uint32_t i = 0; i < k_ && !poly.empty(); ++i) {
+    const std::vector<std::uint32_t>& faces = cx_.cells[cell].faces;
+    for (std::size_t l = 0; l < faces.size() && !poly.empty(); ++l) {
         d.resize(poly.size());
         bool anyOut = false, anyIn = false;
         for (std::size_t c = 0; c < poly.size(); ++c) {
-            d[c] = dist(poly[c].id, i);
+            d[c] = cellDist(poly[c].id, cell, l);
             if (std::abs(d[c]) <= eps_) {
                 throw Degenerate{"point on a cell plane"};
             }
@@ -249,11 +366,13 @@ std::vector<Corner> Clipper::clipTriangle(std::uint32_t t) {
             if (curIn) {
                 next.push_back(cur);
                 if (!nxtIn) {
-                    const std::uint32_t x = crossing(t, cur.next, i, cur.id, nxt.id, d[c], d[(c + 1) % n]);
-                    next.push_back({x, {false, i, 0}});
+                    const std::uint32_t x =
+                        crossing(t, cell, cur.next, faces[l], cur.id, nxt.id, d[c], d[(c + 1) % n]);
+                    next.push_back({x, {false, faces[l], 0}});
                 }
             } else if (nxtIn) {
-                const std::uint32_t y = crossing(t, cur.next, i, cur.id, nxt.id, d[c], d[(c + 1) % n]);
+                const std::uint32_t y =
+                    crossing(t, cell, cur.next, faces[l], cur.id, nxt.id, d[c], d[(c + 1) % n]);
                 next.push_back({y, cur.next});
             }
         }
@@ -263,7 +382,8 @@ std::vector<Corner> Clipper::clipTriangle(std::uint32_t t) {
 }
 
 // Triangulates a convex polygon (possibly with collinear corners) by clipping strictly convex ears.
-void Clipper::emitConvex(const std::vector<std::uint32_t>& polyIn, const Vec3& normal, std::uint32_t source) {
+void Clipper::emitConvex(const std::vector<std::uint32_t>& polyIn, const Vec3& normal, std::uint32_t source,
+                         std::vector<OutTri>& out) {
     std::vector<std::uint32_t> poly = polyIn;
     auto strictlyConvex = [&](std::size_t c) {
         const std::size_t n = poly.size();
@@ -283,20 +403,20 @@ void Clipper::emitConvex(const std::vector<std::uint32_t>& polyIn, const Vec3& n
         if (ear == poly.size())
             throw Degenerate{"flat polygon"};
         const std::size_t n = poly.size();
-        inTris_.push_back({{poly[(ear + n - 1) % n], poly[ear], poly[(ear + 1) % n]}, source, kNone});
+        out.push_back({{poly[(ear + n - 1) % n], poly[ear], poly[(ear + 1) % n]}, source, kNone, false});
         poly.erase(poly.begin() + static_cast<std::ptrdiff_t>(ear));
     }
-    inTris_.push_back({{poly[0], poly[1], poly[2]}, source, kNone});
+    out.push_back({{poly[0], poly[1], poly[2]}, source, kNone, false});
 }
 
 // Triangulates (with a constrained Delaunay triangulation) the planar region bounded by the first
-// `boundaryEdges` directed edges (counter-clockwise seen along normal), minus the polygon whose edges are the
-// remaining ones (the hole). Inside and outside are found topologically: walking from the unbounded face,
-// every crossed boundary edge toggles "inside the region" and every crossed hole edge toggles "inside the
-// hole".
+// `boundaryEdges` directed edges (counter-clockwise seen along normal), minus the polygons whose edges are
+// the remaining ones (the holes). Inside and outside are found topologically: walking from the unbounded
+// face, every crossed boundary edge toggles "inside the region" and every crossed hole edge toggles "inside
+// the hole".
 void Clipper::triangulateRegion(const std::vector<std::pair<std::uint32_t, std::uint32_t>>& edges,
                                 std::size_t boundaryEdges, const Vec3& normal, std::uint32_t source,
-                                std::uint32_t plane, std::vector<OutTri>& out) {
+                                std::uint32_t face, std::vector<OutTri>& out) {
     Vec3 u, v;
     planeBasis(normalized(normal), u, v);
     auto to2 = [&](std::uint32_t id) {
@@ -361,52 +481,68 @@ void Clipper::triangulateRegion(const std::vector<std::pair<std::uint32_t, std::
         if (CGAL::orientation(f->vertex(0)->point(), f->vertex(1)->point(), f->vertex(2)->point()) !=
             CGAL::LEFT_TURN)
             throw Degenerate{"flat triangle in a cut face"};
-        out.push_back({{f->vertex(0)->info(), f->vertex(1)->info(), f->vertex(2)->info()}, source, plane});
+        out.push_back(
+            {{f->vertex(0)->info(), f->vertex(1)->info(), f->vertex(2)->info()}, source, face, false});
     }
 }
 
-void Clipper::cutTriangle(std::uint32_t t) {
-    const std::vector<Corner> poly = clipTriangle(t);
+void Clipper::cutTriangle(std::uint32_t t, const std::vector<std::uint32_t>& cells) {
     const Triangle& tri = mesh_.triangles[t];
-    if (poly.empty()) {
-        untouchedOut_.push_back(t);
-        return;
+    std::vector<std::pair<std::uint32_t, std::vector<Corner>>> polys;
+    for (std::uint32_t c : cells) {
+        std::vector<Corner> poly = clipTriangle(t, c);
+        if (poly.empty())
+            continue;
+        bool created = false;
+        for (const Corner& k : poly) {
+            created |= k.id >= nV_;
+            if (k.id >= nV_ && offEdge_[k.id - nV_])
+                throw Degenerate{"triangle through a cell vertex"};
+        }
+        if (!created) { // wholly inside this cell (its distances said otherwise only within rounding)
+            if (!polys.empty() || cells.size() > 1)
+                throw Degenerate{"triangle inside a cell and cut by another"};
+            untouched_[c].push_back(t);
+            return;
+        }
+        polys.emplace_back(c, std::move(poly));
     }
-    bool created = false;
-    for (const Corner& c : poly)
-        created |= c.id >= nV_;
-    if (!created) { // wholly inside
-        untouchedIn_.push_back(t);
+    if (polys.empty()) {
+        untouched_[k_].push_back(t);
         return;
     }
     const Vec3 normal = mesh_.triangleNormal(t);
-    std::vector<std::uint32_t> ids;
-    for (const Corner& c : poly)
-        ids.push_back(c.id);
-    emitConvex(ids, normal, t);
-
-    // Record cut edges and pierce points for the caps; contact points on the triangle's edges.
+    // Each cell's part; cut edges (on faces whose back is that cell) and pierce points for the caps; contact
+    // points on the triangle's edges.
     std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> contacts; // by mesh edge (a<b)
-    for (std::size_t c = 0; c < poly.size(); ++c) {
-        const Corner& cur = poly[c];
-        const Corner& nxt = poly[(c + 1) % poly.size()];
-        if (!cur.next.onMeshEdge) {
-            cutEdges_[cur.next.a].emplace_back(cur.id, nxt.id);
-        }
-        if (cur.id >= nV_) {
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> holes;
+    for (const auto& [cell, poly] : polys) {
+        std::vector<std::uint32_t> ids;
+        for (const Corner& k : poly)
+            ids.push_back(k.id);
+        emitConvex(ids, normal, t, tris_[cell]);
+        for (std::size_t c = 0; c < poly.size(); ++c) {
+            const Corner& cur = poly[c];
+            const Corner& nxt = poly[(c + 1) % poly.size()];
+            holes.emplace_back(cur.id, nxt.id);
+            if (!cur.next.onMeshEdge && cx_.faces[cur.next.a].back == cell)
+                cutEdges_[cur.next.a].emplace_back(cur.id, nxt.id);
+            if (cur.id < nV_)
+                continue;
             // Which key made it: look at its supports.
             const Support& in = poly[(c + poly.size() - 1) % poly.size()].next;
             const Support& out = cur.next;
             if (!in.onMeshEdge && !out.onMeshEdge) {
-                const std::uint32_t i = std::min(in.a, out.a), j = std::max(in.a, out.a);
-                pierce_[pairKey(i, j)].push_back(cur.id);
+                const std::uint32_t f = std::min(in.a, out.a), g = std::max(in.a, out.a);
+                pierce_[cx_.cells[cell].edgeOfFaces.at(pairKey(f, g))].push_back(cur.id);
             } else {
                 const Support& edge = in.onMeshEdge ? in : out;
                 contacts[pairKey(edge.a, edge.b)].push_back(cur.id);
             }
         }
     }
-    // Remainder: the triangle minus the convex inside polygon, as a constrained triangulation.
+    // The rest: the triangle minus the cells' convex polygons (edges two neighbouring polygons share cancel),
+    // as a constrained triangulation.
     std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
     for (int c = 0; c < 3; ++c) {
         const std::uint32_t a = tri[c], b = tri[(c + 1) % 3];
@@ -426,9 +562,8 @@ void Clipper::cutTriangle(std::uint32_t t) {
         edges.emplace_back(prev, b);
     }
     const std::size_t boundary = edges.size();
-    for (std::size_t c = 0; c < ids.size(); ++c)
-        edges.emplace_back(ids[c], ids[(c + 1) % ids.size()]);
-    triangulateRegion(edges, boundary, normal, t, kNone, outTris_);
+    edges.insert(edges.end(), holes.begin(), holes.end());
+    triangulateRegion(edges, boundary, normal, t, kNone, tris_[k_]);
 }
 
 bool Clipper::pointInsideMesh(const Vec3& p) const {
@@ -436,46 +571,47 @@ bool Clipper::pointInsideMesh(const Vec3& p) const {
 }
 
 void Clipper::buildCaps() {
-    // Map: per plane, point -> whether the inside polygon's cut edge leaves it (true) or arrives at it
+    // Map: per face, point -> whether the back cell's polygon cut edge leaves it (true) or arrives at it
     // (false).
-    std::vector<std::unordered_map<std::uint32_t, bool>> leaves(k_);
-    for (std::uint32_t i = 0; i < k_; ++i)
-        for (const auto& [a, b] : cutEdges_[i]) {
-            leaves[i][b] = true;
-            leaves[i][a] = false;
+    std::vector<std::unordered_map<std::uint32_t, bool>> leaves(nF_);
+    for (std::uint32_t f = 0; f < nF_; ++f)
+        for (const auto& [a, b] : cutEdges_[f]) {
+            leaves[f][b] = true;
+            leaves[f][a] = false;
         }
-    const std::size_t nCellVerts = topo_.vertices.size();
+    for (auto& [edge, points] : pierce_) { // every cell around a complex edge reports its pierce points
+        std::sort(points.begin(), points.end());
+        points.erase(std::unique(points.begin(), points.end()), points.end());
+    }
+    const std::size_t nCellVerts = cx_.vertices.size();
     std::vector<int> vertexInside(nCellVerts, -1);
     auto setStatus = [&](std::uint32_t v, int s) {
         if (vertexInside[v] >= 0 && vertexInside[v] != s)
             throw Degenerate{"inconsistent cell vertex status"};
         vertexInside[v] = s;
     };
-    // Per directed cell edge of face i: sorted pierce points and the inside status of each sub-edge.
+    // Per directed edge of face f: sorted pierce points and the inside status of each sub-edge.
     struct EdgeSplit {
         std::vector<std::uint32_t> points;
         std::vector<int> inside; // points.size() + 1 entries
     };
-    std::vector<std::vector<EdgeSplit>> splits(k_);
-    for (std::uint32_t i = 0; i < k_; ++i) {
-        const auto& loop = topo_.loops[i];
-        splits[i].resize(loop.size());
+    std::vector<std::vector<EdgeSplit>> splits(nF_);
+    for (std::uint32_t f = 0; f < nF_; ++f) {
+        const auto& loop = cx_.faces[f].loop;
+        splits[f].resize(loop.size());
         for (std::size_t e = 0; e < loop.size(); ++e) {
             const std::uint32_t A = loop[e], B = loop[(e + 1) % loop.size()];
-            const std::uint32_t j = topo_.faceOfDirectedEdge.at(pairKey(B, A));
-            EdgeSplit& s = splits[i][e];
-            if (auto it = pierce_.find(pairKey(std::min(i, j), std::max(i, j))); it != pierce_.end())
+            EdgeSplit& s = splits[f][e];
+            if (auto it = pierce_.find(pairKey(std::min(A, B), std::max(A, B))); it != pierce_.end())
                 s.points = it->second;
-            const Vec3 pa = topo_.vertices[A], dir = topo_.vertices[B] - pa;
+            const Vec3 pa = cx_.vertices[A], dir = cx_.vertices[B] - pa;
             std::sort(s.points.begin(), s.points.end(), [&](std::uint32_t x, std::uint32_t y) {
                 return dot(pos(x) - pa, dir) < dot(pos(y) - pa, dir);
             });
-            if (std::adjacent_find(s.points.begin(), s.points.end()) != s.points.end())
-                throw Degenerate{"duplicate pierce point"};
             s.inside.assign(s.points.size() + 1, -1);
             for (std::size_t q = 0; q < s.points.size(); ++q) {
-                auto it = leaves[i].find(s.points[q]);
-                if (it == leaves[i].end())
+                auto it = leaves[f].find(s.points[q]);
+                if (it == leaves[f].end())
                     throw Degenerate{"pierce point without cut edge"};
                 const int before =
                     it->second ? 1 : 0; // cap edge leaves the point: the sub-edge before is inside
@@ -491,14 +627,14 @@ void Clipper::buildCaps() {
             }
         }
     }
-    // Propagate vertex status along unpierced cell edges; with no information at all, cast a ray.
+    // Propagate vertex status along unpierced complex edges; with no information at all, cast a ray.
     bool changed = true;
     while (changed) {
         changed = false;
-        for (std::uint32_t i = 0; i < k_; ++i) {
-            const auto& loop = topo_.loops[i];
+        for (std::uint32_t f = 0; f < nF_; ++f) {
+            const auto& loop = cx_.faces[f].loop;
             for (std::size_t e = 0; e < loop.size(); ++e) {
-                if (!splits[i][e].points.empty())
+                if (!splits[f][e].points.empty())
                     continue;
                 const std::uint32_t A = loop[e], B = loop[(e + 1) % loop.size()];
                 if (vertexInside[A] >= 0 && vertexInside[B] < 0) {
@@ -514,22 +650,22 @@ void Clipper::buildCaps() {
         }
         if (!changed && std::find(vertexInside.begin(), vertexInside.end(), -1) != vertexInside.end()) {
             const auto it = std::find(vertexInside.begin(), vertexInside.end(), -1);
-            *it =
-                pointInsideMesh(topo_.vertices[static_cast<std::size_t>(it - vertexInside.begin())]) ? 1 : 0;
+            *it = pointInsideMesh(cx_.vertices[static_cast<std::size_t>(it - vertexInside.begin())]) ? 1 : 0;
             changed = true;
         }
     }
-    // Cell vertices become points (created lazily when a cap uses them).
-    auto cellPoint = [&](std::uint32_t v) { return addPoint({3, v, 0, 0}, topo_.vertices[v]); };
+    // Complex vertices become points (created lazily when a cap uses them). A cap goes to the face's back
+    // cell as it is and to the region in front reversed.
+    auto cellPoint = [&](std::uint32_t v) { return addPoint({3, v, 0, 0}, cx_.vertices[v]); };
     std::vector<OutTri> caps;
-    for (std::uint32_t i = 0; i < k_; ++i) {
+    for (std::uint32_t f = 0; f < nF_; ++f) {
         std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
-        for (const auto& [a, b] : cutEdges_[i])
+        for (const auto& [a, b] : cutEdges_[f])
             edges.emplace_back(b, a);
-        const auto& loop = topo_.loops[i];
+        const auto& loop = cx_.faces[f].loop;
         for (std::size_t e = 0; e < loop.size(); ++e) {
             const std::uint32_t A = loop[e], B = loop[(e + 1) % loop.size()];
-            const EdgeSplit& s = splits[i][e];
+            const EdgeSplit& s = splits[f][e];
             if (s.points.empty()) {
                 if (vertexInside[A] == 1)
                     edges.emplace_back(cellPoint(A), cellPoint(B));
@@ -545,16 +681,18 @@ void Clipper::buildCaps() {
         }
         if (edges.empty())
             continue;
-        triangulateRegion(edges, edges.size(), topo_.planes[i].normal, kNone, i, caps);
-    }
-    for (const OutTri& c : caps) {
-        inTris_.push_back(c);
-        outTris_.push_back({{c.v[0], c.v[2], c.v[1]}, kNone, c.plane});
+        caps.clear();
+        triangulateRegion(edges, edges.size(), cx_.faces[f].plane.normal, kNone, f, caps);
+        for (const OutTri& c : caps) {
+            tris_[cx_.faces[f].back].push_back(c);
+            tris_[cx_.faces[f].front].push_back({{c.v[0], c.v[2], c.v[1]}, kNone, f, true});
+        }
     }
 }
 
-Mesh Clipper::assemble(const std::vector<std::uint32_t>& untouched, const std::vector<OutTri>& tris,
-                       bool reverseCaps) const {
+Mesh Clipper::assemble(std::uint32_t region) const {
+    const std::vector<std::uint32_t>& untouched = untouched_[region];
+    const std::vector<OutTri>& tris = tris_[region];
     Mesh m;
     m.materialNames = mesh_.materialNames;
     std::vector<std::uint32_t> local(nV_ + extra_.size(), kNone);
@@ -588,7 +726,8 @@ Mesh Clipper::assemble(const std::vector<std::uint32_t>& untouched, const std::v
     for (const OutTri& o : tris) {
         m.triangles.push_back({id(o.v[0]), id(o.v[1]), id(o.v[2])});
         if (o.source == kNone) {
-            const Vec3 n = reverseCaps ? -topo_.planes[o.plane].normal : topo_.planes[o.plane].normal;
+            const Vec3& normal = cx_.faces[o.face].plane.normal;
+            const Vec3 n = o.flipped ? -normal : normal;
             if (hasN)
                 m.normals.insert(m.normals.end(), 3, n);
             m.uvs.insert(m.uvs.end(), 3, Vec2{}); // interior UVs are generated by the fracture pipeline
@@ -637,57 +776,70 @@ void checkNewEdgesClosed(const std::vector<std::array<std::uint32_t, 3>>& tris, 
         }
 }
 
-CellSplit Clipper::run() {
+std::vector<Mesh> Clipper::run() {
     distSlot_.assign(nV_, -1);
     const std::size_t nT = mesh_.triangles.size();
-    std::vector<std::uint32_t> cut;
+    std::vector<std::pair<std::uint32_t, std::vector<std::uint32_t>>> cut; // triangle, cells it may cross
+    std::vector<std::uint32_t> candidates;
     for (std::uint32_t t = 0; t < nT; ++t) {
         const Triangle& tri = mesh_.triangles[t];
         Aabb box;
         for (std::uint32_t v : tri)
             box.extend(mesh_.positions[v]);
-        if (!box.overlaps(cellBox_, eps_)) {
-            untouchedOut_.push_back(t);
+        if (!box.overlaps(box_, eps_)) {
+            untouched_[k_].push_back(t);
             continue;
         }
-        for (std::uint32_t v : tri)
-            ensureDistances(v);
-        bool outside = false, inside = true;
-        for (std::uint32_t i = 0; i < k_ && !outside; ++i) {
-            int positive = 0;
+        candidates.clear();
+        std::uint32_t insideOf = kNone;
+        for (std::uint32_t c = 0; c < k_; ++c) {
+            if (!box.overlaps(cx_.cells[c].box, eps_))
+                continue;
             for (std::uint32_t v : tri)
-                positive += dist(v, i) > 0;
-            outside = positive == 3;
-            inside &= positive == 0;
+                ensureDistances(v);
+            bool outside = false, inside = true;
+            for (std::size_t l = 0; l < cx_.cells[c].faces.size() && !outside; ++l) {
+                int positive = 0;
+                for (std::uint32_t v : tri)
+                    positive += cellDist(v, c, l) > 0;
+                outside = positive == 3;
+                inside &= positive == 0;
+            }
+            if (outside)
+                continue;
+            candidates.push_back(c);
+            if (inside)
+                insideOf = c;
         }
-        if (outside)
-            untouchedOut_.push_back(t);
-        else if (inside)
-            untouchedIn_.push_back(t);
+        if (candidates.empty())
+            untouched_[k_].push_back(t);
+        else if (insideOf != kNone && candidates.size() == 1)
+            untouched_[insideOf].push_back(t);
         else
-            cut.push_back(t);
+            cut.emplace_back(t, candidates);
     }
-    for (std::uint32_t t : cut)
-        cutTriangle(t);
+    for (const auto& [t, cells] : cut)
+        cutTriangle(t, cells);
     buildCaps();
 
-    CellSplit result;
-    result.inside = assemble(untouchedIn_, inTris_, false);
-    result.outside = assemble(untouchedOut_, outTris_, true);
+    std::vector<Mesh> result;
+    for (std::uint32_t r = 0; r <= k_; ++r)
+        result.push_back(assemble(r));
     // Verify: the new faces close up, and no volume is created or lost.
-    std::vector<std::array<std::uint32_t, 3>> newIn, newOut;
-    for (const OutTri& o : inTris_) {
-        newIn.push_back({o.v[0], o.v[1], o.v[2]});
+    double sum = 0;
+    for (std::uint32_t r = 0; r <= k_; ++r) {
+        std::vector<std::array<std::uint32_t, 3>> created;
+        created.reserve(tris_[r].size());
+        for (const OutTri& o : tris_[r])
+            created.push_back({o.v[0], o.v[1], o.v[2]});
+        checkNewEdgesClosed(created, nV_);
+        const double v = result[r].empty() ? 0.0 : signedVolume(result[r]);
+        if (v < 0)
+            throw Degenerate{"negative volume"};
+        sum += v;
     }
-    for (const OutTri& o : outTris_) {
-        newOut.push_back({o.v[0], o.v[1], o.v[2]});
-    }
-    checkNewEdgesClosed(newIn, nV_);
-    checkNewEdgesClosed(newOut, nV_);
     const double v0 = signedVolume(mesh_);
-    const double vi = result.inside.empty() ? 0.0 : signedVolume(result.inside);
-    const double vo = result.outside.empty() ? 0.0 : signedVolume(result.outside);
-    if (vi < 0 || vo < 0 || std::abs(vi + vo - v0) > 1e-9 * std::abs(v0))
+    if (std::abs(sum - v0) > 1e-9 * std::abs(v0))
         throw Degenerate{"volume not conserved"};
     return result;
 }
@@ -697,9 +849,24 @@ CellSplit Clipper::run() {
 Result<CellSplit> clipByConvexCell(const Mesh& mesh, const ConvexPolytope& cell) {
     if (cell.empty())
         return makeError(ErrorCode::InvalidInput, "empty cell");
+    auto split = clipByConvexCells(mesh, {cell});
+    if (!split)
+        return split.error();
+    return CellSplit{std::move(split->outside), std::move(split->inside.front())};
+}
+
+Result<MultiCellSplit> clipByConvexCells(const Mesh& mesh, const std::vector<ConvexPolytope>& cells) {
+    if (cells.empty() ||
+        std::any_of(cells.begin(), cells.end(), [](const ConvexPolytope& c) { return c.empty(); }))
+        return makeError(ErrorCode::InvalidInput, "no cells, or an empty cell");
     try {
-        Clipper clipper(mesh, cell);
-        return clipper.run();
+        Clipper clipper(mesh, cells);
+        std::vector<Mesh> regions = clipper.run();
+        MultiCellSplit out;
+        out.outside = std::move(regions.back());
+        regions.pop_back();
+        out.inside = std::move(regions);
+        return out;
     } catch (const Degenerate& d) {
         return makeError(ErrorCode::GeometryFailure, std::string("fast clip declined: ") + d.why);
     } catch (const std::exception& e) {

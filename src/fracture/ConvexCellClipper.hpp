@@ -1,16 +1,22 @@
 #pragma once
-// Fast split of a closed triangle mesh by ONE convex cell, touching only the triangles near the cell.
+// Fast split of a closed triangle mesh by one convex cell, or by several convex cells with disjoint interiors
+// (a shatter pattern), touching only the triangles near the cells.
 //
 // Exactness model: decisions are made with floating-point signed distances, but every point is computed once
 // from a canonical key (the mesh edge it lies on, or the triangle and cell edge it lies on) and shared by all
-// faces that use it, so the outputs are closed by construction. Any near-degenerate configuration (a vertex
-// within tolerance of a cell plane, an ill-conditioned intersection, an inconsistent boundary) is reported as
-// an error, and the caller falls back to an exact CGAL backend. Outputs are verified (closedness of all new
-// faces, volume conservation) before they are returned.
+// faces that use it, so the outputs are closed by construction. Several cells are split in one pass as a
+// complex: their welded vertices and the faces two cells share are stored once, a point on a shared face or
+// on an edge where cells meet is the same keyed point for every cell around it, and a cap on a shared face
+// goes to both cells (one reversed), so neighbouring pieces match exactly. Any near-degenerate configuration
+// (a vertex within tolerance of a cell plane, an ill-conditioned intersection, an inconsistent boundary) is
+// reported as an error, and the caller falls back to an exact CGAL backend. Outputs are verified (closedness
+// of all new faces, volume conservation) before they are returned.
 
 #include "rubble/ConvexPolytope.hpp"
 #include "rubble/Mesh.hpp"
 #include "rubble/Result.hpp"
+
+#include <vector>
 
 namespace rubble::detail {
 
@@ -23,5 +29,17 @@ struct CellSplit {
 /// Splits a closed, consistently oriented mesh by a convex cell. Cut faces get kInteriorMaterial.
 /// Returns ErrorCode::GeometryFailure for configurations it does not handle robustly (use an exact backend).
 Result<CellSplit> clipByConvexCell(const Mesh& mesh, const ConvexPolytope& cell);
+
+/// The parts of a mesh split by several convex cells.
+struct MultiCellSplit {
+    Mesh outside;             ///< mesh − ∪ cells
+    std::vector<Mesh> inside; ///< mesh ∩ cell k, in the order of the cells
+};
+
+/// Splits a closed, consistently oriented mesh by non-empty convex cells with disjoint interiors whose shared
+/// faces have the same (bit-identical) corners, e.g. welded Voronoi cells. Cut faces get kInteriorMaterial.
+/// Returns ErrorCode::GeometryFailure when the cells overlap, do not form a complex, or for configurations it
+/// does not handle robustly (use an exact backend).
+Result<MultiCellSplit> clipByConvexCells(const Mesh& mesh, const std::vector<ConvexPolytope>& cells);
 
 } // namespace rubble::detail

@@ -1,6 +1,7 @@
-// Boolean backend on Rubble's convex-cell clipper (ConvexCellClipper): cells are cut one after the other
-// from the remainder, touching only the triangles near each cell. When the clipper declines a
-// near-degenerate configuration, the whole split is redone by the exact Corefine backend.
+// Boolean backend on Rubble's convex-cell clipper (ConvexCellClipper): all cells that reach the mesh are cut
+// in one pass as a complex (adjacent shatter cells share faces exactly), touching only the triangles near
+// them. When the clipper declines a near-degenerate configuration, the whole split is redone by the exact
+// Corefine backend.
 
 #include "BooleanBackends.hpp"
 #include "ConvexCellClipper.hpp"
@@ -16,24 +17,29 @@ public:
     Result<SplitResult> split(const Mesh& mesh, const std::vector<ConvexPolytope>& cells) const override {
         SplitResult out;
         out.inside.resize(cells.size());
-        // The remainder is the input until the first cell cuts it (no copy of the whole mesh up front).
-        const Mesh* rem = &mesh;
-        Mesh cut;
-        for (std::size_t i = 0; i < cells.size(); ++i) {
-            if (cells[i].empty() || rem->empty() || !cells[i].bounds().overlaps(rem->bounds()))
-                continue;
-            auto r = clipByConvexCell(*rem, cells[i]);
+        // Only the cells that can reach the mesh take part (the others get nothing).
+        std::vector<ConvexPolytope> used;
+        std::vector<std::size_t> index;
+        const Aabb box = mesh.bounds();
+        for (std::size_t i = 0; i < cells.size(); ++i)
+            if (!cells[i].empty() && !mesh.empty() && cells[i].bounds().overlaps(box)) {
+                used.push_back(cells[i]);
+                index.push_back(i);
+            }
+        if (used.empty()) {
+            out.remainder = mesh;
+        } else {
+            auto r = clipByConvexCells(mesh, used);
             if (!r) {
                 auto exact = makeCorefineBackend()->split(mesh, cells);
                 if (exact)
                     exact->exactFallback = true;
                 return exact;
             }
-            out.inside[i] = std::move(r->inside);
-            cut = std::move(r->outside);
-            rem = &cut;
+            for (std::size_t k = 0; k < index.size(); ++k)
+                out.inside[index[k]] = std::move(r->inside[k]);
+            out.remainder = std::move(r->outside);
         }
-        out.remainder = rem == &mesh ? mesh : std::move(cut);
         // The clipper always emits uvs and materials; keep the layout identical when nothing is cut.
         if (out.remainder.uvs.empty())
             out.remainder.uvs.assign(3 * out.remainder.triangles.size(), Vec2{});

@@ -3,6 +3,7 @@
 #include <map>
 
 #include "fracture/ConvexCellClipper.hpp"
+#include "rubble/Fracture.hpp"
 #include "rubble/MassProperties.hpp"
 #include "rubble/Random.hpp"
 
@@ -185,4 +186,163 @@ TEST(ConvexCellClipper, FarFromOrigin) {
         checkSplit(cube, randomCell(rng, far + Vec3{1, rng.uniform(-0.8, 0.8), rng.uniform(-0.8, 0.8)}, 0.4),
                    stats);
     EXPECT_LT(stats.declined, stats.runs / 5);
+}
+
+namespace {
+
+Vec3 randomSurfacePoint(const Mesh& m, Rng& rng) {
+    const auto c = m.corners(static_cast<std::size_t>(rng.below(m.triangleCount())));
+    double a = rng.uniform(), b = rng.uniform();
+    if (a + b > 1) {
+        a = 1 - a;
+        b = 1 - b;
+    }
+    return c[0] + (c[1] - c[0]) * a + (c[2] - c[0]) * b;
+}
+
+using CornerKey = std::array<double, 9>;
+
+// A triangle by its corner positions, rotated to start at its smallest corner (so the same triangle from
+// another mesh, whatever its vertex ids, gets the same key); reversed for the twin with opposite orientation.
+CornerKey cornerKey(const Mesh& m, std::size_t t, bool reversed) {
+    auto c = m.corners(t);
+    if (reversed)
+        std::swap(c[1], c[2]);
+    auto less = [](const Vec3& a, const Vec3& b) {
+        return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
+    };
+    const std::size_t s = less(c[1], c[0]) ? (less(c[2], c[1]) ? 2 : 1) : (less(c[2], c[0]) ? 2 : 0);
+    CornerKey k{};
+    for (std::size_t i = 0; i < 3; ++i) {
+        const Vec3& p = c[(s + i) % 3];
+        k[3 * i] = p.x;
+        k[3 * i + 1] = p.y;
+        k[3 * i + 2] = p.z;
+    }
+    return k;
+}
+
+// Every interior (cut) face of every output has a twin, the same triangle reversed, in another output: the
+// pieces of neighbouring cells and the remainder meet without gaps or overlaps, bit for bit.
+::testing::AssertionResult interiorFacesPairUp(const std::vector<const Mesh*>& outputs) {
+    std::map<CornerKey, std::vector<std::size_t>> owners;
+    for (std::size_t o = 0; o < outputs.size(); ++o)
+        for (std::size_t t = 0; t < outputs[o]->triangles.size(); ++t)
+            if (outputs[o]->material(t) == kInteriorMaterial)
+                owners[cornerKey(*outputs[o], t, false)].push_back(o);
+    for (std::size_t o = 0; o < outputs.size(); ++o)
+        for (std::size_t t = 0; t < outputs[o]->triangles.size(); ++t) {
+            if (outputs[o]->material(t) != kInteriorMaterial)
+                continue;
+            auto twin = owners.find(cornerKey(*outputs[o], t, true));
+            if (twin == owners.end() || twin->second.size() != 1 || twin->second.front() == o)
+                return ::testing::AssertionFailure() << "interior triangle " << t << " of output " << o
+                                                     << " has no single twin in another output";
+        }
+    return ::testing::AssertionSuccess();
+}
+
+} // namespace
+
+// Shatter patterns (adjacent Voronoi cells sharing faces) are split in one pass: every output closed and
+// oriented, volume conserved, each cell's piece the same as when that cell alone cuts the mesh, shared faces
+// matching exactly, and the same input gives the same bytes.
+TEST(ConvexCellClipper, ShatterCellsSplitInOnePass) {
+    Rng rng(2024);
+    const std::vector<Mesh> shapes = {
+        makeSubdividedBox({-1, -1, -1}, {1, 1, 1}, 7), makeSphere({0.1, 0, 0}, 1.0, 24, 12),
+        makeTorus({0, 0, 0}, 1.0, 0.35, 32, 16), makeBox({-3, -0.05, -2}, {3, 0.05, 2}),
+        makeSubdividedBox({-1, -1, -1}, {1, 1, 1}, 29)};
+    int runs = 0, declined = 0, cellsCut = 0;
+    for (const Mesh& mesh : shapes) {
+        const double v0 = signedVolume(mesh);
+        for (int i = 0; i < 30; ++i) {
+            FractureParams params;
+            params.pattern = CellPattern::Shatter;
+            params.cells = 2 + static_cast<int>(rng.below(9));
+            params.sizeLaw.base = mesh.bounds().diagonal() * rng.uniform(0.15, 0.6);
+            params.sizeLaw.scale = 0;
+            const Impact impact{randomSurfacePoint(mesh, rng), {0, 1, 0}, 10};
+            const std::vector<ConvexPolytope> cells =
+                generateCells(mesh.bounds(), impact, params, rng.next());
+            ASSERT_GE(cells.size(), 2u);
+            ++runs;
+            auto r = detail::clipByConvexCells(mesh, cells);
+            if (!r) {
+                ++declined;
+                std::printf("declined: %s\n", r.error().message.c_str());
+                EXPECT_EQ(r.error().code, ErrorCode::GeometryFailure);
+                continue;
+            }
+            ASSERT_EQ(r->inside.size(), cells.size());
+            std::vector<const Mesh*> outputs{&r->outside};
+            double sum = r->outside.empty() ? 0.0 : signedVolume(r->outside);
+            EXPECT_TRUE(closedAndOriented(r->outside));
+            for (std::size_t k = 0; k < cells.size(); ++k) {
+                const Mesh& piece = r->inside[k];
+                outputs.push_back(&piece);
+                const double vk = piece.empty() ? 0.0 : signedVolume(piece);
+                sum += vk;
+                EXPECT_TRUE(closedAndOriented(piece)) << "cell " << k;
+                EXPECT_TRUE(piece.validate().isOk()) << "cell " << k;
+                EXPECT_LE(vk, cells[k].volume() * (1 + 1e-9)) << "cell " << k;
+                cellsCut += vk > 0;
+                auto alone = detail::clipByConvexCell(mesh, cells[k]);
+                if (alone) {
+                    EXPECT_NEAR(vk, alone->inside.empty() ? 0.0 : signedVolume(alone->inside), 1e-9 * v0)
+                        << "cell " << k;
+                }
+            }
+            EXPECT_NEAR(sum, v0, 1e-9 * v0);
+            EXPECT_TRUE(interiorFacesPairUp(outputs));
+            if (i % 5 == 0) {
+                auto again = detail::clipByConvexCells(mesh, cells);
+                ASSERT_TRUE(again.isOk());
+                EXPECT_EQ(again->outside.hash(), r->outside.hash());
+                for (std::size_t k = 0; k < cells.size(); ++k)
+                    EXPECT_EQ(again->inside[k].hash(), r->inside[k].hash());
+            }
+        }
+    }
+    std::printf("shatter clip: %d runs, %d declined, %d cell pieces\n", runs, declined, cellsCut);
+    EXPECT_GT(cellsCut, 2 * runs);
+    EXPECT_LE(declined, runs / 20);
+}
+
+// Two boxes sharing a face cut a sphere like the single box they make together; the shared face's caps are
+// twins.
+TEST(ConvexCellClipper, AdjacentBoxesMatchTheirUnion) {
+    const Mesh sphere = makeSphere({0.013, 0.021, -0.017}, 0.7, 32, 16);
+    const std::vector<ConvexPolytope> halves = {ConvexPolytope::fromAabb({{-0.5, -0.5, -0.5}, {0, 0.5, 0.5}}),
+                                                ConvexPolytope::fromAabb({{0, -0.5, -0.5}, {0.5, 0.5, 0.5}})};
+    auto both = detail::clipByConvexCells(sphere, halves);
+    auto whole =
+        detail::clipByConvexCell(sphere, ConvexPolytope::fromAabb({{-0.5, -0.5, -0.5}, {0.5, 0.5, 0.5}}));
+    ASSERT_TRUE(both.isOk()) << both.error().message;
+    ASSERT_TRUE(whole.isOk()) << whole.error().message;
+    const double v0 = signedVolume(sphere);
+    EXPECT_NEAR(signedVolume(both->outside), signedVolume(whole->outside), 1e-9 * v0);
+    EXPECT_NEAR(signedVolume(both->inside[0]) + signedVolume(both->inside[1]), signedVolume(whole->inside),
+                1e-9 * v0);
+    EXPECT_GT(signedVolume(both->inside[0]), 0.3 * signedVolume(whole->inside));
+    EXPECT_GT(signedVolume(both->inside[1]), 0.3 * signedVolume(whole->inside));
+    EXPECT_TRUE(closedAndOriented(both->outside));
+    EXPECT_TRUE(closedAndOriented(both->inside[0]));
+    EXPECT_TRUE(closedAndOriented(both->inside[1]));
+    EXPECT_TRUE(interiorFacesPairUp({&both->outside, &both->inside[0], &both->inside[1]}));
+}
+
+// Cells that overlap, or touch with faces that are not the same face, are not a complex: declined (the
+// fracture then uses an exact backend).
+TEST(ConvexCellClipper, CellsThatAreNotAComplexAreDeclined) {
+    const Mesh sphere = makeSphere({0.013, 0.021, -0.017}, 0.7, 32, 16);
+    const ConvexPolytope a = ConvexPolytope::fromAabb({{-0.5, -0.5, -0.5}, {0.1, 0.5, 0.5}});
+    const ConvexPolytope overlapping = ConvexPolytope::fromAabb({{0, -0.5, -0.5}, {0.5, 0.5, 0.5}});
+    const ConvexPolytope offset = ConvexPolytope::fromAabb({{0.1, -0.2, -0.5}, {0.5, 0.8, 0.5}});
+    for (const ConvexPolytope& b : {overlapping, offset}) {
+        auto r = detail::clipByConvexCells(sphere, {a, b});
+        ASSERT_FALSE(r.isOk());
+        EXPECT_EQ(r.error().code, ErrorCode::GeometryFailure);
+    }
+    EXPECT_FALSE(detail::clipByConvexCells(sphere, {}).isOk());
 }
