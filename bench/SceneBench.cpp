@@ -247,16 +247,7 @@ int runScene(const SceneArgs& a) {
     row("frame (ms)", frameMs);
     row("  physics step (ms)", physicsMs);
     row("  impacts + adoption (ms)", adoptMs);
-    auto stage = [](const char* name, const StageSummary& st) {
-        std::printf("%-28s %10.3f %10.3f %10.3f\n", name, st.p50, st.p99, st.max);
-    };
-    stage("impact -> adopted (ms)", ts.total);
-    stage("  queue wait (ms)", ts.queue);
-    stage("  cells (ms)", ts.cell);
-    stage("  booleans (ms)", ts.boolean);
-    stage("  islands + mass (ms)", ts.islands);
-    stage("  decomposition (ms)", ts.decomposition);
-    stage("  adoption (ms)", ts.adoption);
+    std::printf("impact -> adopted, per stage (total = latency): %s", formatTimingSummary(ts).c_str());
     std::printf("%-28s %10lld\n", "impacts", c.impacts);
     std::printf("%-28s %10lld\n", "fractures", c.fractures);
     std::printf("%-28s %10d\n", "stale results", ts.stale);
