@@ -567,7 +567,23 @@ void Clipper::cutTriangle(std::uint32_t t, const std::vector<std::uint32_t>& cel
 }
 
 bool Clipper::pointInsideMesh(const Vec3& p) const {
-    return insideByRayParity(mesh_, std::views::iota(std::size_t{0}, mesh_.triangles.size()), p);
+    // All triangle indices; not std::views::iota, which clang 14 cannot compile with libstdc++ 12 (the
+    // sanitizer and fuzzer builds use clang).
+    struct AllTriangles {
+        struct It {
+            std::size_t i;
+            std::size_t operator*() const { return i; }
+            It& operator++() {
+                ++i;
+                return *this;
+            }
+            bool operator!=(const It& o) const { return i != o.i; }
+        };
+        std::size_t n;
+        It begin() const { return {0}; }
+        It end() const { return {n}; }
+    };
+    return insideByRayParity(mesh_, AllTriangles{mesh_.triangles.size()}, p);
 }
 
 void Clipper::buildCaps() {
