@@ -75,6 +75,8 @@ struct FractureOutcome {
     std::vector<ObjectId> pieces;    ///< the new objects, already added to the world
     std::vector<Frame>
         pieceFrames; ///< piece local frame → parent local frame (centre of mass, principal axes)
+    std::vector<std::int32_t>
+        pieceCells;              ///< per piece: Piece::cell (−1: the remainder, i ≥ 0: debris of cell i)
     std::vector<Impact> impacts; ///< the impacts (parent local coordinates) that caused it
     double droppedVolume = 0;    ///< volume of slivers dropped (for volume bookkeeping)
 };

@@ -404,6 +404,7 @@ std::vector<FractureOutcome> DestructionWorld::collect() {
                 s.convexParts = std::move(job->localParts[i]);
                 o.pieces.push_back(s.id);
                 o.pieceFrames.push_back(job->frames[i]);
+                o.pieceCells.push_back(i < job->result.pieces.size() ? job->result.pieces[i].cell : -1);
                 im.objects.emplace(s.id, std::move(s));
             }
             // Impacts that arrived while this job ran go to the piece nearest to their point.
