@@ -8,7 +8,9 @@
 // the cells differ between runs and the fallback rate (how often Fast declines and Corefine redoes the split)
 // is counted over them. Reference: the thesis's program built on this machine needs 0.243 s (12 triangles)
 // .. 5.196 s (10,092) from impact to final collision shape (../shared/MEASUREMENTS.md). The thesis's single
-// cell is the default pattern; the largest cube is also run with a 6-cell shatter pattern.
+// cell is the default pattern; the largest cube is also run with a 6-cell shatter pattern. Chained rows
+// (`<case>_chain10`) measure the 10th successive impact on the largest remainder of the largest cube and of
+// two concave models, whose convex parts went through 9 incremental updates (parent_parts column).
 // Table on stdout, CSV in DIR/impact.csv, plot in DIR/impact.png (gnuplot).
 #include <algorithm>
 #include <chrono>
@@ -23,6 +25,7 @@
 #include "rubble/ConvexDecomposition.hpp"
 #include "rubble/Fracture.hpp"
 #include "rubble/MeshIO.hpp"
+#include "rubble/Random.hpp"
 
 namespace {
 
@@ -131,6 +134,57 @@ rubble::Vec3 surfacePointAtMaxX(const rubble::Mesh& m) {
     return (c[0] + c[1] + c[2]) * (1.0 / 3.0);
 }
 
+/// Impact on the surface point furthest along dir (the centroid of the triangle furthest along it).
+rubble::Impact impactAlong(const rubble::Mesh& m, const rubble::Vec3& dir) {
+    std::size_t best = 0;
+    double bestD = -1e300;
+    for (std::size_t t = 0; t < m.triangleCount(); ++t) {
+        const auto c = m.corners(t);
+        const double d = dot(c[0] + c[1] + c[2], dir);
+        if (d > bestD) {
+            bestD = d;
+            best = t;
+        }
+    }
+    const auto c = m.corners(best);
+    return {(c[0] + c[1] + c[2]) * (1.0 / 3.0), dir, 1};
+}
+
+/// Turns a fresh case into a chained one: chain − 1 impacts (Fast backend, seeded directions) each on the
+/// largest piece of the previous one, whose convex parts come from updateDecomposition as in the runtime
+/// (pieces of pieces). The measured impact is the chain-th, on that remainder with its updated parts.
+bool chainCase(Case& c, int chain) {
+    rubble::FractureParams params;
+    params.backend = rubble::BooleanKind::Fast;
+    params.sizeLaw.base = c.domain;
+    params.sizeLaw.scale = 0;
+    params.pattern = c.pattern;
+    params.cells = 6;
+    rubble::Rng rng(7);
+    for (int k = 1; k < chain; ++k) {
+        auto r = rubble::fracture(c.mesh, impactAlong(c.mesh, rng.unitVector()), params, 500 + k);
+        if (!r || r->pieces.empty()) {
+            std::cerr << "impact: " << c.name << ": chained impact " << k << " failed\n";
+            return false;
+        }
+        std::vector<rubble::Mesh> meshes;
+        std::vector<std::int32_t> pieceCells;
+        std::size_t largest = 0;
+        for (std::size_t i = 0; i < r->pieces.size(); ++i) {
+            meshes.push_back(r->pieces[i].mesh);
+            pieceCells.push_back(r->pieces[i].cell);
+            if (r->pieces[i].mass.volume > r->pieces[largest].mass.volume)
+                largest = i;
+        }
+        auto parts = rubble::updateDecomposition(c.parentParts, r->cells, meshes, pieceCells);
+        c.mesh = std::move(meshes[largest]);
+        c.parentParts = std::move(parts[largest]);
+    }
+    c.impact = impactAlong(c.mesh, rng.unitVector());
+    c.name += "_chain" + std::to_string(chain);
+    return true;
+}
+
 int runBench(const BenchArgs& args) {
     const int runs = args.quick ? 2 : std::max(1, args.runs);
     // The thesis's program measured here: impact → final collision shape (seconds, MEASUREMENTS.md).
@@ -178,11 +232,6 @@ int runBench(const BenchArgs& args) {
             cases.push_back(std::move(c));
         }
     }
-    if (!args.only.empty())
-        cases.erase(
-            std::remove_if(cases.begin(), cases.end(),
-                           [&](const Case& c) { return c.name.find(args.only) == std::string::npos; }),
-            cases.end());
     for (Case& c : cases) {
         const auto t0 = Clock::now();
         auto d = rubble::decompose(c.mesh);
@@ -190,6 +239,26 @@ int runBench(const BenchArgs& args) {
         if (d)
             c.parentParts = std::move(d->parts);
     }
+    // Chained impacts (pieces of pieces carry many convex parts): the 10th impact on the largest remainder
+    // of the largest cube and of two concave models.
+    if (!args.quick) {
+        const std::size_t fresh = cases.size();
+        for (std::size_t i = 0; i < fresh; ++i)
+            if (cases[i].pattern == rubble::CellPattern::SingleCell &&
+                (cases[i].name == "cube_10092" || cases[i].name == "building" ||
+                 cases[i].name == "fighter")) {
+                Case c = cases[i];
+                c.thesisS = -1;
+                if (chainCase(c, 10))
+                    cases.push_back(std::move(c));
+            }
+    }
+
+    if (!args.only.empty())
+        cases.erase(
+            std::remove_if(cases.begin(), cases.end(),
+                           [&](const Case& c) { return c.name.find(args.only) == std::string::npos; }),
+            cases.end());
 
     for (int run = 0; run < runs; ++run)
         for (Case& c : cases) {
@@ -211,6 +280,7 @@ int runBench(const BenchArgs& args) {
                     "failures",
                     "fallbacks",
                     "pieces",
+                    "parent_parts",
                     "convex_parts",
                     "pieces_median_ms",
                     "pieces_min_ms",
@@ -238,6 +308,7 @@ int runBench(const BenchArgs& args) {
                                   std::to_string(s.failures),
                                   std::to_string(s.fallbacks),
                                   std::to_string(s.pieceCount),
+                                  std::to_string(c.parentParts.size()),
                                   std::to_string(s.partCount),
                                   fixed(pieces.median),
                                   fixed(pieces.min),
