@@ -1093,6 +1093,25 @@ def scenes():
         obj_line("ship", "metal.png", -200, G, 200, 1.5, 500),
     ]
     out["performance_test.cfg"] = perf
+    # structural collapse: static (mass 0) columns, arches, walls and stacks on the ground; a cut through a
+    # column drops its top and whatever rests on it
+    collapse = [
+        SKY_LINE, GROUND_LINE, VEHICLE_LINE,
+        obj_line("column", "concrete.png", -24, G, -60, 1.5, 0),
+        obj_line("column", "concrete.png", -8, G, -60, 1.5, 0),
+        obj_line("column", "concrete.png", 8, G, -60, 1.5, 0),
+        obj_line("column", "concrete.png", 24, G, -60, 1.5, 0),
+        obj_line("column", "concrete.png", 0, G, -95, 1.5, 0),
+        obj_line("cube_108", "concrete.png", 0, G + 15.3 + 2.5, -95, 2.5, 0),
+        obj_line("cube_108", "concrete.png", -40, G + 3, -100, 3, 0),
+        obj_line("cube_108", "concrete.png", -40, G + 9, -100, 3, 0),
+        obj_line("cube_108", "concrete.png", -40, G + 15, -100, 3, 0),
+        obj_line("wall", "brick.png", 40, G, -100, 1.5, 0),
+        obj_line("arch", "brick.png", 0, G, -140, 2, 0),
+        obj_line("wall", "brick.png", -35, G, -150, 2, 0),
+        obj_line("column", "concrete.png", 35, G, -150, 2, 0),
+    ]
+    out["collapse_test.cfg"] = collapse
     return out
 
 

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <future>
+#include <map>
 #include <optional>
 
 #include "TestSupport.hpp"
@@ -44,11 +45,13 @@ struct Rig {
         destruction.reset();
         physics.reset();
     }
-    ObjectId addBox(const Vec3& half, const Frame& placement, double density, bool isStatic = false) {
+    ObjectId addBox(const Vec3& half, const Frame& placement, double density, bool isStatic = false,
+                    const FractureParams& fracture = {}) {
         ObjectDesc d;
         d.mesh = makeBox(-half, half);
         d.density = density;
         d.impulseThreshold = 1;
+        d.fracture = fracture;
         Result<ObjectId> id = bridge->addObject(std::move(d), placement, isStatic);
         EXPECT_TRUE(id) << (id ? "" : id.error().message);
         return id ? *id : 0;
@@ -329,6 +332,220 @@ TEST(DestructionBridge, ShutdownWithJobsInFlightNeitherHangsNorLeaks) {
     });
     ASSERT_EQ(done.wait_for(std::chrono::seconds(60)), std::future_status::ready) << "shutdown hung";
     EXPECT_EQ(done.get(), 6);
+}
+
+namespace {
+
+// One cell, a randomly rotated cube of the given edge centred at the impact (no other Voronoi sites): it
+// contains the ball of radius size/2 around the impact, so it cuts through anything narrower.
+FractureParams cubeCell(double size) {
+    FractureParams f;
+    f.seedPoints = 0;
+    f.sizeLaw.base = f.sizeLaw.minSize = f.sizeLaw.maxSize = size;
+    f.sizeLaw.scale = 0;
+    return f;
+}
+
+// The pieces of the first adopted outcome as the callback saw them: id, cell, static, centre height,
+// volume.
+struct PieceView {
+    ObjectId id = 0;
+    int cell = -1;
+    bool isStatic = false;
+    double y = 0;
+    double volume = 0;
+};
+
+struct CollapseRig : Rig {
+    explicit CollapseRig(bool collapse = true) : Rig(true, 1, true, config(collapse)) {}
+    static DestructionBridge::Config config(bool collapse) {
+        DestructionBridge::Config bc;
+        bc.collapseUnsupported = collapse;
+        bc.minPieceVolume = 0; // every piece keeps its body
+        return bc;
+    }
+    // impact on `id`, steps until adopted; returns the pieces of that fracture
+    std::vector<PieceView> breakAt(ObjectId id, const Impact& impact) {
+        std::vector<PieceView> out;
+        bridge->setOnAdopted([&](const FractureOutcome& o) {
+            if (!out.empty())
+                return;
+            EXPECT_EQ(o.pieceCells.size(), o.pieces.size());
+            for (std::size_t i = 0; i < o.pieces.size(); ++i) {
+                Body* b = bridge->bodyOf(o.pieces[i]);
+                EXPECT_NE(b, nullptr);
+                if (b)
+                    out.push_back({o.pieces[i], o.pieceCells[i], b->isStatic,
+                                   static_cast<double>(b->rigid->getCenterOfMassPosition().y()), b->volume});
+            }
+        });
+        EXPECT_TRUE(destruction->submitImpact(id, impact));
+        EXPECT_TRUE(runUntilFracture());
+        bridge->setOnAdopted({});
+        return out;
+    }
+    // the blast throws the debris out (the bridge gives it only the parent's velocity field, zero for a
+    // static parent): without this a cut-out chunk would stay wedged in its gap and hold up what is above
+    void ejectDebris(const std::vector<PieceView>& pieces, const Vec3& velocity) {
+        for (const PieceView& p : pieces)
+            if (Body* b = bridge->bodyOf(p.id); b && p.cell >= 0) {
+                b->rigid->setLinearVelocity(toBt(velocity));
+                b->rigid->activate(true);
+            }
+    }
+    double heightOf(ObjectId id) {
+        Body* b = bridge->bodyOf(id);
+        return b ? static_cast<double>(b->rigid->getCenterOfMassPosition().y()) : -1e9;
+    }
+    void step(int frames) {
+        for (int i = 0; i < frames; ++i)
+            bridge->stepFrame();
+    }
+};
+
+// A 1 × 8 × 1 column standing on the ground (y 0..8) is cut by cubeCell(2.4) at y = 2.5: the cell spans the
+// section there and reaches at most 2.08 m from the impact, so the remainder is one foot (y < 0.42 intact,
+// on the ground) and one top (y > 4.58), the top being the larger.
+const Impact kColumnCut{{0.5, -1.5, 0}, {1, 0, 0}, 100};
+constexpr double kCutY = 2.5;
+
+} // namespace
+
+TEST(DestructionBridgeCollapse, ColumnCutThroughItsMiddleDropsItsTopAndKeepsItsFoot) {
+    CollapseRig rig;
+    rig.bridge->addGround({0, -0.5, 0}, {50, 0.5, 50});
+    const ObjectId column =
+        rig.addBox({0.5, 4, 0.5}, Frame{Mat3::identity(), {0, 4, 0}}, 500, true, cubeCell(2.4));
+    rig.step(2);
+    const double before = rig.bridge->totalVolume();
+    const auto pieces = rig.breakAt(column, kColumnCut);
+    int upper = 0, lower = 0, debris = 0;
+    std::map<ObjectId, double> startY;
+    for (const PieceView& p : pieces) {
+        startY[p.id] = p.y;
+        if (p.cell >= 0) {
+            ++debris;
+            EXPECT_FALSE(p.isStatic) << "debris is always dynamic";
+        } else if (p.y > kCutY) {
+            ++upper;
+            EXPECT_FALSE(p.isStatic) << "the part above the cut has nothing under it";
+        } else {
+            ++lower;
+            EXPECT_TRUE(p.isStatic) << "the foot stands on the ground";
+        }
+    }
+    EXPECT_GE(debris, 1);
+    EXPECT_EQ(upper, 1);
+    EXPECT_EQ(lower, 1);
+    EXPECT_GE(rig.bridge->counters().piecesCollapsed, 1);
+    rig.ejectDebris(pieces, {-10, 0, 0});
+    rig.step(60);
+    for (const PieceView& p : pieces) {
+        if (p.cell < 0 && p.y > kCutY) { // the top fell
+            EXPECT_LT(rig.heightOf(p.id), p.y - 0.5);
+        }
+        if (p.cell < 0 && p.y < kCutY) { // the foot did not move
+            Body* b = rig.bridge->bodyOf(p.id);
+            ASSERT_NE(b, nullptr);
+            EXPECT_TRUE(b->isStatic);
+            EXPECT_EQ(rig.heightOf(p.id), p.y);
+        }
+    }
+    EXPECT_LT(std::abs(rig.bridge->totalVolume() - before) / before, 1e-9);
+}
+
+TEST(DestructionBridgeCollapse, WallHitAtItsTopCornerKeepsItsRemainderAndDropsTheDebris) {
+    CollapseRig rig;
+    rig.bridge->addGround({0, -0.5, 0}, {50, 0.5, 50});
+    const ObjectId wall =
+        rig.addBox({3, 2, 0.25}, Frame{Mat3::identity(), {0, 2, 0}}, 500, true, cubeCell(1.5));
+    rig.step(2);
+    const auto pieces = rig.breakAt(wall, Impact{{3, 2, 0}, {0.7071, 0.7071, 0}, 100});
+    double remainder = 0;
+    int debris = 0;
+    for (const PieceView& p : pieces) {
+        if (p.cell >= 0) {
+            ++debris;
+            EXPECT_FALSE(p.isStatic);
+        } else if (p.volume > remainder) {
+            remainder = p.volume;
+            EXPECT_TRUE(p.isStatic) << "the wall still stands on the ground";
+        }
+    }
+    EXPECT_GE(debris, 1);
+    EXPECT_GT(remainder, 0.8 * 6 * 4 * 0.5);
+    rig.ejectDebris(pieces, {5, 0, 0});
+    rig.step(60);
+    for (const PieceView& p : pieces)
+        if (p.cell >= 0) {
+            EXPECT_LT(rig.heightOf(p.id), p.y - 0.5) << "debris falls";
+        }
+}
+
+TEST(DestructionBridgeCollapse, FloatingPlatformKeepsItsLargestRemainderPieceStatic) {
+    CollapseRig rig;
+    rig.bridge->addGround({0, -0.5, 0}, {50, 0.5, 50});
+    // a 6 × 1 × 1 slab 10 m up, touching nothing, cut through off its middle
+    const ObjectId slab =
+        rig.addBox({3, 0.5, 0.5}, Frame{Mat3::identity(), {0, 10, 0}}, 500, true, cubeCell(2.4));
+    rig.step(2);
+    ASSERT_TRUE(rig.bridge->bodyOf(slab)->anchor) << "a static object touching nothing is an anchor";
+    const auto pieces = rig.breakAt(slab, Impact{{1, 0.5, 0}, {0, 1, 0}, 100});
+    double largest = 0;
+    for (const PieceView& p : pieces)
+        if (p.cell < 0)
+            largest = std::max(largest, p.volume);
+    int remainders = 0, statics = 0;
+    for (const PieceView& p : pieces) {
+        remainders += p.cell < 0 ? 1 : 0;
+        statics += p.isStatic ? 1 : 0;
+        EXPECT_EQ(p.isStatic, p.cell < 0 && p.volume == largest);
+        if (p.isStatic) {
+            EXPECT_TRUE(rig.bridge->bodyOf(p.id)->anchor) << "the kept piece is the new anchor";
+        }
+    }
+    EXPECT_GE(remainders, 2);
+    EXPECT_EQ(statics, 1);
+    EXPECT_EQ(rig.bridge->counters().piecesCollapsed, 0);
+}
+
+TEST(DestructionBridgeCollapse, CollapsePropagatesToWhatRestedOnTheBrokenPart) {
+    CollapseRig rig;
+    rig.bridge->addGround({0, -0.5, 0}, {50, 0.5, 50});
+    const ObjectId lower =
+        rig.addBox({0.5, 4, 0.5}, Frame{Mat3::identity(), {0, 4, 0}}, 500, true, cubeCell(2.4));
+    const ObjectId upper = rig.addBox({0.75, 0.5, 0.75}, Frame{Mat3::identity(), {0, 8.5, 0}}, 500, true);
+    rig.step(2);
+    EXPECT_FALSE(rig.bridge->bodyOf(upper)->anchor) << "it rests on a column that stands on the ground";
+    const double y0 = rig.heightOf(upper);
+    rig.ejectDebris(rig.breakAt(lower, kColumnCut), {-10, 0, 0});
+    Body* b = rig.bridge->bodyOf(upper);
+    ASSERT_NE(b, nullptr);
+    EXPECT_FALSE(b->isStatic) << "the block on top lost its support with the column's top";
+    rig.step(60);
+    EXPECT_LT(rig.heightOf(upper), y0 - 0.5);
+}
+
+TEST(DestructionBridgeCollapse, SwitchedOffTheLargestPieceStaysStaticAsBefore) {
+    CollapseRig rig(false);
+    rig.bridge->addGround({0, -0.5, 0}, {50, 0.5, 50});
+    const ObjectId column =
+        rig.addBox({0.5, 4, 0.5}, Frame{Mat3::identity(), {0, 4, 0}}, 500, true, cubeCell(2.4));
+    rig.step(2);
+    const auto pieces = rig.breakAt(column, kColumnCut);
+    double largest = 0;
+    for (const PieceView& p : pieces)
+        largest = std::max(largest, p.volume);
+    int statics = 0;
+    for (const PieceView& p : pieces) {
+        statics += p.isStatic ? 1 : 0;
+        EXPECT_EQ(p.isStatic, p.volume == largest);
+        if (p.isStatic) {
+            EXPECT_GT(p.y, kCutY) << "the old rule: the larger top floats";
+        }
+    }
+    EXPECT_EQ(statics, 1);
+    EXPECT_EQ(rig.bridge->counters().piecesCollapsed, 0);
 }
 
 #else

@@ -48,6 +48,49 @@ Frame principalFrame(const MassProperties& m) {
     return Frame{m.principalAxes, m.centerOfMass};
 }
 
+// Principal moments of a solid of the object's shape and density (floored so that slivers stay stable).
+btVector3 principalInertia(const ObjectState& st, double volume) {
+    const double floorMoment = 1e-9 * std::max(volume, 1e-12);
+    return toBt(Vec3{std::max(st.mass.principalMoments.x, floorMoment),
+                     std::max(st.mass.principalMoments.y, floorMoment),
+                     std::max(st.mass.principalMoments.z, floorMoment)} *
+                st.density);
+}
+
+// Static collision objects whose broadphase bounds overlap a box.
+struct StaticOverlaps : btBroadphaseAabbCallback {
+    const btCollisionObject* self = nullptr;
+    std::vector<btCollisionObject*> found;
+    bool process(const btBroadphaseProxy* proxy) override {
+        auto* o = static_cast<btCollisionObject*>(proxy->m_clientObject);
+        if (o != self && o->isStaticObject())
+            found.push_back(o);
+        return true;
+    }
+};
+
+// Whether a contact pair test found the two bodies within the callback's distance threshold.
+struct Touching : btCollisionWorld::ContactResultCallback {
+    bool touching = false;
+    btScalar addSingleResult(btManifoldPoint& cp, const btCollisionObjectWrapper*, int, int,
+                             const btCollisionObjectWrapper*, int, int) override {
+        if (cp.getDistance() <= m_closestDistanceThreshold)
+            touching = true;
+        return 0;
+    }
+};
+
+// Collapsible: a static destructible body that holds itself up only through what it touches.
+bool collapsible(const Body& b) {
+    return b.isStatic && !b.anchor && b.hasObject &&
+           (b.kind == BodyKind::Object || b.kind == BodyKind::Piece);
+}
+
+// A root of support: the ground, static scenery, an anchor.
+bool supportRoot(const Body& b) {
+    return b.isStatic && (b.kind == BodyKind::Ground || b.kind == BodyKind::Scenery || b.anchor);
+}
+
 } // namespace
 
 DestructionBridge::DestructionBridge(PhysicsWorld& physics, DestructionWorld& destruction, Config config)
@@ -152,21 +195,18 @@ Body* DestructionBridge::makeObjectBody(ObjectId id, const btTransform& bodyWorl
         b->shape = CollisionShape::box(box.empty() ? Vec3{0.1, 0.1, 0.1} : box.size() * 0.5);
     }
     b->mass = isStatic ? 0.0 : st->density * b->volume;
-    btVector3 inertia(0, 0, 0);
-    if (!isStatic) {
-        const double floorMoment = 1e-9 * std::max(b->volume, 1e-12);
-        inertia = toBt(Vec3{std::max(st->mass.principalMoments.x, floorMoment),
-                            std::max(st->mass.principalMoments.y, floorMoment),
-                            std::max(st->mass.principalMoments.z, floorMoment)} *
-                       st->density);
-    }
+    const btVector3 inertia = isStatic ? btVector3(0, 0, 0) : principalInertia(*st, b->volume);
     btRigidBody::btRigidBodyConstructionInfo info(static_cast<btScalar>(b->mass), nullptr, b->shape->shape(),
                                                   inertia);
     info.m_startWorldTransform = bodyWorld;
     info.m_friction = 0.7f;
     info.m_restitution = 0.1f;
     b->rigid = std::make_unique<btRigidBody>(info);
-    return &insert(std::move(b));
+    b->supportKnown = kind == BodyKind::Piece;
+    Body& ref = insert(std::move(b));
+    if (isStatic && kind == BodyKind::Object)
+        unclassified_.push_back(handleOf(ref));
+    return &ref;
 }
 
 Result<ObjectId> DestructionBridge::addObject(ObjectDesc desc, const Frame& placement, bool isStatic) {
@@ -231,6 +271,10 @@ Body& DestructionBridge::fireProjectile(const Vec3& from, const Vec3& velocity, 
 }
 
 void DestructionBridge::removeBody(Body& body) {
+    if (body.isStatic && config_.collapseUnsupported) {
+        FrameStats ignored;
+        queueNeighbours(body, ignored);
+    }
     destroy(handleOf(body), true);
 }
 
@@ -386,17 +430,29 @@ void DestructionBridge::adopt(const FractureOutcome& outcome, FrameStats& stats)
     const btVector3 w = parent.rigid->getAngularVelocity();
     const btVector3 c = parent.rigid->getCenterOfMassPosition();
     const bool parentStatic = parent.isStatic;
-    // the largest remainder piece keeps a static parent's static state
+    auto isRemainder = [&](std::size_t i) {
+        return i >= outcome.pieceCells.size() || outcome.pieceCells[i] < 0;
+    };
+    // Static parent, collapse on: remainder pieces start static and are checked for support after
+    // creation; a floating parent (an anchor) keeps its largest remainder piece as the new anchor.
+    // Collapse off: the largest piece stays static.
+    const bool collapse = parentStatic && config_.keepStaticRemainder && config_.collapseUnsupported;
+    const bool floating = collapse && parent.anchor;
     std::size_t keep = outcome.pieces.size();
-    if (parentStatic && config_.keepStaticRemainder) {
+    if (parentStatic && config_.keepStaticRemainder && (!collapse || floating)) {
         double best = -1;
         for (std::size_t i = 0; i < outcome.pieces.size(); ++i) {
             const ObjectState* st = destruction_.object(outcome.pieces[i]);
-            if (st && st->mass.volume > best) {
+            if (st && st->mass.volume > best && (!floating || isRemainder(i))) {
                 best = st->mass.volume;
                 keep = i;
             }
         }
+    }
+    if (collapse) {
+        const auto t0 = Clock::now();
+        queueNeighbours(parent, stats); // what rested on the parent is re-checked
+        stats.supportMs += msSince(t0);
     }
     destroy(parentHandle, false); // the DestructionWorld already removed the parent object
     ++stats.fractures;
@@ -409,7 +465,8 @@ void DestructionBridge::adopt(const FractureOutcome& outcome, FrameStats& stats)
         const Frame pieceFrame = i < outcome.pieceFrames.size() ? outcome.pieceFrames[i] : Frame{};
         const btTransform pieceObject = parentObject * toBt(pieceFrame);
         const btTransform bodyWorld = pieceObject * toBt(principalFrame(st->mass));
-        const bool isStatic = parentStatic && i == keep;
+        const bool checked = collapse && !floating && isRemainder(i); // static until its support check
+        const bool isStatic = (parentStatic && i == keep) || checked;
         const double volume = std::abs(st->mass.volume);
         const btVector3 pv = v + w.cross(bodyWorld.getOrigin() - c);
         if (!isStatic && volume < config_.minPieceVolume) {
@@ -430,11 +487,132 @@ void DestructionBridge::adopt(const FractureOutcome& outcome, FrameStats& stats)
             body->preLinearVelocity = pv;
             body->preAngularVelocity = w;
         }
+        body->anchor = floating && i == keep;
+        if (checked)
+            supportQueue_.push_front(byObject_.at(pid));
         ++stats.piecesCreated;
         ++counters_.piecesCreated;
     }
+    if (collapse) {
+        const auto t0 = Clock::now();
+        settleSupport(stats); // before the callback, so that it sees the pieces' final static state
+        stats.supportMs += msSince(t0);
+    }
     if (onAdopted_)
         onAdopted_(outcome);
+}
+
+std::vector<std::uint64_t> DestructionBridge::staticNeighbours(const Body& body, FrameStats& stats) {
+    const auto tol = static_cast<btScalar>(config_.supportTolerance);
+    btVector3 lo, hi;
+    body.rigid->getCollisionShape()->getAabb(body.rigid->getWorldTransform(), lo, hi);
+    StaticOverlaps overlaps;
+    overlaps.self = body.rigid.get();
+    physics_.world().getBroadphase()->aabbTest(lo - btVector3(tol, tol, tol), hi + btVector3(tol, tol, tol),
+                                               overlaps);
+    std::vector<std::uint64_t> out;
+    for (btCollisionObject* o : overlaps.found) {
+        auto* other = static_cast<Body*>(o->getUserPointer());
+        if (!other)
+            continue;
+        Touching touching;
+        touching.m_closestDistanceThreshold = tol;
+        physics_.world().contactPairTest(body.rigid.get(), o, touching);
+        ++stats.supportQueries;
+        ++counters_.supportQueries;
+        if (touching.touching)
+            out.push_back(static_cast<std::uint64_t>(o->getUserIndex())); // the body's handle (see insert)
+    }
+    std::sort(out.begin(), out.end()); // broadphase order is not part of the result
+    return out;
+}
+
+void DestructionBridge::queueNeighbours(const Body& body, FrameStats& stats) {
+    for (std::uint64_t h : staticNeighbours(body, stats))
+        if (collapsible(*bodies_.at(h)))
+            supportQueue_.push_back(h);
+}
+
+DestructionBridge::Support DestructionBridge::searchSupport(std::uint64_t start,
+                                                            std::vector<std::uint64_t>& component,
+                                                            FrameStats& stats) {
+    // breadth first over touching static bodies until a root turns up
+    component.assign(1, start);
+    for (std::size_t next = 0; next < component.size(); ++next) {
+        if (static_cast<int>(next) >= config_.maxSupportVisits)
+            return Support::Unknown;
+        for (std::uint64_t h : staticNeighbours(*bodies_.at(component[next]), stats)) {
+            const Body& b = *bodies_.at(h);
+            if (supportRoot(b))
+                return Support::Supported;
+            if (collapsible(b) && std::find(component.begin(), component.end(), h) == component.end())
+                component.push_back(h);
+        }
+    }
+    return Support::Unsupported;
+}
+
+void DestructionBridge::classifyStaticObjects(FrameStats& stats) {
+    // A static object whose static neighbourhood reaches no root was placed floating: it (and everything
+    // static in that neighbourhood) becomes an anchor.
+    std::vector<std::uint64_t> pending;
+    pending.swap(unclassified_);
+    std::vector<std::uint64_t> component;
+    for (std::uint64_t h : pending) {
+        auto it = bodies_.find(h);
+        if (it == bodies_.end() || it->second->supportKnown || !it->second->isStatic)
+            continue;
+        const Support s = searchSupport(h, component, stats);
+        for (std::uint64_t m : component) {
+            Body& b = *bodies_.at(m);
+            if (b.kind != BodyKind::Object || b.supportKnown)
+                continue;
+            b.supportKnown = true;
+            b.anchor = s == Support::Unsupported;
+        }
+        it->second->supportKnown = true;
+    }
+}
+
+void DestructionBridge::settleSupport(FrameStats& stats) {
+    std::vector<std::uint64_t> component;
+    while (!supportQueue_.empty() && supportSearchesLeft_ > 0) {
+        const std::uint64_t h = supportQueue_.front();
+        supportQueue_.pop_front();
+        auto it = bodies_.find(h);
+        if (it == bodies_.end() || !collapsible(*it->second))
+            continue;
+        --supportSearchesLeft_;
+        if (searchSupport(h, component, stats) != Support::Unsupported)
+            continue;
+        // nothing static below: the whole component falls
+        for (std::uint64_t m : component)
+            makeDynamic(m, stats);
+    }
+}
+
+void DestructionBridge::makeDynamic(std::uint64_t handle, FrameStats& stats) {
+    Body& b = *bodies_.at(handle);
+    const ObjectState* st = destruction_.object(b.object);
+    if (!b.isStatic || !st)
+        return;
+    btDiscreteDynamicsWorld& world = physics_.world();
+    world.removeRigidBody(b.rigid.get()); // re-added below so that it joins the dynamic broadphase set
+    b.isStatic = false;
+    b.anchor = false;
+    b.mass = st->density * b.volume;
+    b.rigid->setMassProps(static_cast<btScalar>(b.mass), principalInertia(*st, b.volume));
+    b.rigid->updateInertiaTensor();
+    b.rigid->setLinearVelocity(btVector3(0, 0, 0));
+    b.rigid->setAngularVelocity(btVector3(0, 0, 0));
+    b.preLinearVelocity = b.preAngularVelocity = btVector3(0, 0, 0);
+    b.rigid->forceActivationState(ACTIVE_TAG);
+    b.rigid->setDeactivationTime(0);
+    world.addRigidBody(b.rigid.get());
+    ++stats.piecesCollapsed;
+    ++counters_.piecesCollapsed;
+    if (b.kind == BodyKind::Piece && b.volume < config_.minPieceVolume)
+        retire(handle, stats);
 }
 
 void DestructionBridge::retire(std::uint64_t handle, FrameStats& stats) {
@@ -442,6 +620,8 @@ void DestructionBridge::retire(std::uint64_t handle, FrameStats& stats) {
     if (it == bodies_.end())
         return;
     Body& b = *it->second;
+    if (b.isStatic && config_.collapseUnsupported)
+        queueNeighbours(b, stats); // what this static piece held up is re-checked
     const btVector3 p = b.rigid->getCenterOfMassPosition();
     particles_.push_back({fromBt(p), fromBt(b.rigid->getLinearVelocity()), std::cbrt(b.volume), b.volume,
                           config_.debrisLifetime});
@@ -512,11 +692,22 @@ FrameStats DestructionBridge::stepFrame(double dt) {
     stats.physicsMs = msSince(t0);
     const auto t1 = Clock::now();
     ++counters_.frames;
+    supportSearchesLeft_ = config_.maxSupportSearches;
     submitImpacts(stats);
     destruction_.beginFrame();
+    const auto t2 = Clock::now();
+    if (config_.collapseUnsupported)
+        classifyStaticObjects(stats);
+    stats.supportMs += msSince(t2);
     for (const FractureOutcome& o : destruction_.collect())
         adopt(o, stats);
     retireExcess(stats);
+    const auto t3 = Clock::now();
+    if (config_.collapseUnsupported)
+        settleSupport(stats); // what retirement left unsupported, and what earlier frames left queued
+    else
+        supportQueue_.clear();
+    stats.supportMs += msSince(t3);
     advanceParticlesAndProjectiles(dt);
     stats.adoptMs = msSince(t1);
     return stats;

@@ -38,6 +38,9 @@ struct Body {
     double spentAge = 0;                   ///< projectile: seconds since its hit
     btVector3 preLinearVelocity{0, 0, 0};  ///< velocity before the current internal step
     btVector3 preAngularVelocity{0, 0, 0}; ///< angular velocity before the current internal step
+    bool anchor = false; ///< static object or piece that stays up by itself (a scene's floating platform, or
+                         ///< the kept piece of one): it supports what touches it, like the ground
+    bool supportKnown = false; ///< static object: whether it is an anchor has been decided
 
     /// World transform of the object's local frame (world ← object coordinates).
     btTransform objectTransform() const;

@@ -28,19 +28,24 @@ struct FrameStats {
     int fractures = 0;        ///< outcomes adopted
     int piecesCreated = 0;    ///< piece bodies created
     int piecesRetired = 0;    ///< pieces turned into debris particles (including ones never given a body)
+    int piecesCollapsed = 0;  ///< static objects or pieces that lost their support and became dynamic
+    int supportQueries = 0;   ///< contact pair tests run for support checks
+    double supportMs = 0;     ///< of adoptMs: support checks (neighbour queries, searches, collapses)
     double physicsMs = 0;     ///< physics step incl. contact gathering
     double adoptMs = 0;       ///< submit + collect + adoption + retiring
 };
 
 /// Totals since construction.
 struct BridgeCounters {
-    std::uint64_t frames = 0;     ///< frames stepped
-    long long impacts = 0;        ///< impacts accepted by the DestructionWorld
-    long long projectileHits = 0; ///< projectile hits on anything
-    long long fractures = 0;      ///< outcomes adopted
-    long long piecesCreated = 0;  ///< piece bodies created
-    long long piecesRetired = 0;  ///< pieces retired into particles
-    long long staleOutcomes = 0;  ///< outcomes whose parent had no body
+    std::uint64_t frames = 0;      ///< frames stepped
+    long long impacts = 0;         ///< impacts accepted by the DestructionWorld
+    long long projectileHits = 0;  ///< projectile hits on anything
+    long long fractures = 0;       ///< outcomes adopted
+    long long piecesCreated = 0;   ///< piece bodies created
+    long long piecesRetired = 0;   ///< pieces retired into particles
+    long long piecesCollapsed = 0; ///< static objects or pieces that lost their support and became dynamic
+    long long supportQueries = 0;  ///< contact pair tests run for support checks
+    long long staleOutcomes = 0;   ///< outcomes whose parent had no body
 };
 
 /// A recent impact, for debug drawing.
@@ -68,12 +73,22 @@ public:
         double debrisLifetime = 3.0;    ///< seconds a debris particle is drawn
         double singleHullVolume = 0.25; ///< pieces below this volume (m³) collide as one convex hull of their
                                         ///< parts (cheaper contacts for small debris)
-        double collisionMargin = 0.02;        ///< convex hull margin (hulls are eroded by it)
-        double linearSleep = 0.8;             ///< sleeping threshold (m/s)
-        double angularSleep = 1.0;            ///< sleeping threshold (rad/s)
-        double killBelowY = -500;             ///< pieces falling below this height retire
-        bool keepStaticRemainder = true;      ///< the largest remainder piece of a static object stays static
-        double projectileLifetime = 6;        ///< seconds before a projectile is removed
+        double collisionMargin = 0.02;   ///< convex hull margin (hulls are eroded by it)
+        double linearSleep = 0.8;        ///< sleeping threshold (m/s)
+        double angularSleep = 1.0;       ///< sleeping threshold (rad/s)
+        double killBelowY = -500;        ///< pieces falling below this height retire
+        bool keepStaticRemainder = true; ///< false: every piece of a static object becomes dynamic
+        bool collapseUnsupported = true; ///< a static object's remainder pieces stay static only while a
+                                         ///< chain of touching static bodies links them to the ground, static
+                                         ///< scenery or an anchor; others (and whatever they alone held up)
+                                         ///< fall. Off: the largest piece stays static, the rest falls.
+                                         ///< A static object that touched no supported static body (a
+                                         ///< floating platform) keeps its largest remainder piece static.
+        double supportTolerance = 0.02; ///< gap (m) between static bodies that still counts as touching
+        int maxSupportVisits = 64;      ///< static bodies one support search visits; a larger structure
+                                        ///< is assumed supported
+        int maxSupportSearches = 64;    ///< support searches per frame; the rest wait for the next frame
+        double projectileLifetime = 6;  ///< seconds before a projectile is removed
         double spentProjectileLifetime = 0.5; ///< seconds a projectile lives after its hit
         int maxImpactMarks = 64;              ///< recent impacts kept for debug drawing
     };
@@ -168,6 +183,13 @@ private:
     void adopt(const FractureOutcome& outcome, FrameStats& stats);
     void retire(std::uint64_t handle, FrameStats& stats);
     void retireExcess(FrameStats& stats);
+    std::vector<std::uint64_t> staticNeighbours(const Body& body, FrameStats& stats);
+    void queueNeighbours(const Body& body, FrameStats& stats);
+    enum class Support { Supported, Unsupported, Unknown };
+    Support searchSupport(std::uint64_t start, std::vector<std::uint64_t>& component, FrameStats& stats);
+    void classifyStaticObjects(FrameStats& stats);
+    void settleSupport(FrameStats& stats);
+    void makeDynamic(std::uint64_t handle, FrameStats& stats);
     void advanceParticlesAndProjectiles(double dt);
     std::uint64_t handleOf(const Body& body) const;
 
@@ -179,6 +201,9 @@ private:
     std::uint64_t nextHandle_ = 1;
     int livePieces_ = 0;
     std::vector<PendingImpact> projectileImpacts_;
+    std::vector<std::uint64_t> unclassified_; // static objects whose anchor flag is not decided yet
+    std::deque<std::uint64_t> supportQueue_;  // static bodies whose support must be re-checked
+    int supportSearchesLeft_ = 0;             // of config_.maxSupportSearches this frame
     std::map<ObjectId, PendingImpact> collisionImpacts_;
     std::vector<DebrisParticle> particles_;
     std::deque<ImpactMark> marks_;
