@@ -84,11 +84,11 @@ public:
                                          ///< fall. Off: the largest piece stays static, the rest falls.
                                          ///< A static object that touched no supported static body (a
                                          ///< floating platform) keeps its largest remainder piece static.
-        double supportTolerance = 0.02; ///< gap (m) between static bodies that still counts as touching
-        int maxSupportVisits = 64;      ///< static bodies one support search visits; a larger structure
-                                        ///< is assumed supported
-        int maxSupportSearches = 64;    ///< support searches per frame; the rest wait for the next frame
-        double projectileLifetime = 6;  ///< seconds before a projectile is removed
+        double supportTolerance = 0.02;  ///< gap (m) between static bodies that still counts as touching
+        int maxSupportVisits = 64;       ///< static bodies one support search visits; a larger structure
+                                         ///< is assumed supported
+        int maxSupportSearches = 64;     ///< support searches per frame; the rest wait for the next frame
+        double projectileLifetime = 6;   ///< seconds before a projectile is removed
         double spentProjectileLifetime = 0.5; ///< seconds a projectile lives after its hit
         int maxImpactMarks = 64;              ///< recent impacts kept for debug drawing
     };
