@@ -489,6 +489,7 @@ void Clipper::triangulateRegion(const std::vector<std::pair<std::uint32_t, std::
 void Clipper::cutTriangle(std::uint32_t t, const std::vector<std::uint32_t>& cells) {
     const Triangle& tri = mesh_.triangles[t];
     std::vector<std::pair<std::uint32_t, std::vector<Corner>>> polys;
+    std::uint32_t wholeIn = kNone;
     for (std::uint32_t c : cells) {
         std::vector<Corner> poly = clipTriangle(t, c);
         if (poly.empty())
@@ -499,13 +500,16 @@ void Clipper::cutTriangle(std::uint32_t t, const std::vector<std::uint32_t>& cel
             if (k.id >= nV_ && offEdge_[k.id - nV_])
                 throw Degenerate{"triangle through a cell vertex"};
         }
-        if (!created) { // wholly inside this cell (its distances said otherwise only within rounding)
-            if (!polys.empty() || cells.size() > 1)
-                throw Degenerate{"triangle inside a cell and cut by another"};
-            untouched_[c].push_back(t);
-            return;
-        }
-        polys.emplace_back(c, std::move(poly));
+        if (created)
+            polys.emplace_back(c, std::move(poly));
+        else // wholly inside this cell (its distances said otherwise only within rounding)
+            wholeIn = c;
+    }
+    if (wholeIn != kNone) {
+        if (!polys.empty())
+            throw Degenerate{"triangle inside a cell and cut by another"};
+        untouched_[wholeIn].push_back(t);
+        return;
     }
     if (polys.empty()) {
         untouched_[k_].push_back(t);
