@@ -46,7 +46,8 @@ enum class BooleanKind {
     Corefine, ///< CGAL Polygon_mesh_processing corefinement (exact; the fallback of Fast)
     Nef,      ///< CGAL Nef_polyhedron_3 (the thesis's method; reference and cross-check)
     Fast, ///< default: Rubble's convex-cell clipper, touching only triangles near the cells; implemented by
-          ///< detail::clipByConvexCell (src/fracture/ConvexCellClipper.hpp), applied cell by cell; when it
+          ///< detail::clipByConvexCells (src/fracture/ConvexCellClipper.hpp), all cells in one pass as a
+          ///< complex (adjacent shatter cells share their faces exactly); when it
           ///< declines a near-degenerate configuration, or its split fails verification, the whole split is
           ///< redone by Corefine (FractureResult::exactFallback). Same seed, same bytes, like the others.
 };
