@@ -148,7 +148,7 @@ int runScene(const SceneArgs& a) {
     Rng rng(mixSeed(a.seed, 0x5CE7E));
     const double dt = 1.0 / 60;
     const long frames = a.frames > 0 ? a.frames : std::max(1L, std::lround(a.seconds * 60));
-    std::vector<double> frameMs, physicsMs, adoptMs;
+    std::vector<double> frameMs, physicsMs, adoptMs, supportMs;
     frameMs.reserve(static_cast<std::size_t>(frames));
     std::ofstream framesOut;
     if (!a.framesCsv.empty()) {
@@ -177,6 +177,8 @@ int runScene(const SceneArgs& a) {
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         physicsMs.push_back(fs.physicsMs);
         adoptMs.push_back(fs.adoptMs);
+        if (fs.fractures > 0) // structural-collapse checks, per adopted outcome
+            supportMs.push_back(fs.supportMs / fs.fractures);
         frameMs.push_back(ms);
         maxPieces = std::max(maxPieces, bridge.livePieces());
         if (framesOut)
@@ -247,12 +249,15 @@ int runScene(const SceneArgs& a) {
     row("frame (ms)", frameMs);
     row("  physics step (ms)", physicsMs);
     row("  impacts + adoption (ms)", adoptMs);
+    row("  support / adoption (ms)", supportMs);
     std::printf("impact -> adopted, per stage (total = latency): %s", formatTimingSummary(ts).c_str());
     std::printf("%-28s %10lld\n", "impacts", c.impacts);
     std::printf("%-28s %10lld\n", "fractures", c.fractures);
     std::printf("%-28s %10d\n", "stale results", ts.stale);
     std::printf("%-28s %10d (max %d)\n", "pieces alive", bridge.livePieces(), maxPieces);
     std::printf("%-28s %10lld\n", "pieces retired", c.piecesRetired);
+    std::printf("%-28s %10lld (%lld contact tests)\n", "pieces collapsed", c.piecesCollapsed,
+                c.supportQueries);
     std::printf("%-28s %10.3g\n", "volume error", volumeError);
     std::printf("%-28s %10s\n", "state hash", hashText);
     std::printf("%-28s %10.1f\n", "peak RSS (MB)", rss);

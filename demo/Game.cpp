@@ -137,6 +137,7 @@ bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const Game
     bc.collisionImpulseThreshold = settings.collisionImpulse;
     bc.minPieceVolume = settings.minPieceVolume;
     bc.maxLivePieces = settings.maxPieces;
+    bc.collapseUnsupported = settings.collapseUnsupported;
     bc.projectileLifetime = 3;
     bc.spentProjectileLifetime = 0;
     bridge_ = std::make_unique<rubble::bullet::DestructionBridge>(*physics_, *destruction_, bc);
@@ -358,6 +359,7 @@ void Game::step(const ControlInput& input, float dt, Renderer& renderer) {
     bc.minPieceVolume = settings_.minPieceVolume;
     bc.maxLivePieces = settings_.maxPieces;
     bc.collisionImpulseThreshold = settings_.collisionImpulse;
+    bc.collapseUnsupported = settings_.collapseUnsupported;
 
     const long long impactsBefore = bridge_->counters().impacts;
     const long long retiredBefore = bridge_->counters().piecesRetired;

@@ -46,6 +46,7 @@ struct GameSettings {
     float fireInterval = 0.14f;      ///< s between shots while Space is held
     float minPieceVolume = 0.02f;    ///< m^3: smaller pieces become debris particles
     int maxPieces = 250;             ///< beyond this, the smallest old pieces retire to particles
+    bool collapseUnsupported = true; ///< static pieces with nothing static under them fall (live)
     bool debugShapes = false;        ///< draw collision shapes
     bool debugAabbs = false;         ///< draw AABBs
     bool debugImpacts = false;       ///< draw impact points
