@@ -58,6 +58,7 @@ const char* backendName(rubble::BooleanKind k) {
 /// Samples of one backend on one case.
 struct Samples {
     std::vector<double> pieces, withParts, cell, boolean, islands, mass, decomposition;
+    std::vector<double> excess; // (Σ part volume − Σ piece volume) / Σ piece volume
     int fallbacks = 0, failures = 0;
     std::size_t pieceCount = 0, partCount = 0; // of the last run
     std::string error;
@@ -114,8 +115,14 @@ void runOnce(Case& c, rubble::BooleanKind kind, std::uint64_t seed) {
     s.fallbacks += r->exactFallback ? 1 : 0;
     s.pieceCount = r->pieces.size();
     s.partCount = 0;
-    for (const auto& p : parts)
-        s.partCount += p.size();
+    double partVolume = 0, pieceVolume = 0;
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+        s.partCount += parts[i].size();
+        for (const rubble::ConvexPolytope& p : parts[i])
+            partVolume += p.volume();
+        pieceVolume += r->pieces[i].mass.volume;
+    }
+    s.excess.push_back(pieceVolume > 0 ? partVolume / pieceVolume - 1 : 0.0);
 }
 
 /// The centroid of the triangle furthest along +x: a point on the surface of any closed mesh.
@@ -293,6 +300,7 @@ int runBench(const BenchArgs& args) {
                     "islands_ms",
                     "mass_uv_ms",
                     "decomposition_ms",
+                    "parts_excess",
                     "initial_decomposition_ms",
                     "thesis_s",
                     "speedup_vs_thesis"};
@@ -321,6 +329,7 @@ int runBench(const BenchArgs& args) {
                                   fixed(stats(s.islands).median),
                                   fixed(stats(s.mass).median),
                                   fixed(stats(s.decomposition).median),
+                                  fixed(stats(s.excess).median, 4),
                                   fixed(c.decomposeMs),
                                   reference ? fixed(c.thesisS) : "",
                                   reference ? fixed(c.thesisS * 1000 / withParts.median, 0) : ""});

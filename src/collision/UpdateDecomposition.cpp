@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <unordered_map>
 
 #include "collision/MeshRegion.hpp"
 #include "rubble/ConvexDecomposition.hpp"
@@ -54,11 +55,19 @@ double distanceToBox(const Aabb& b, const Vec3& p) {
     return length(d);
 }
 
-/// Merges parts whose joint hull adds the least volume until at most maxParts remain. Only touching parts
-/// are candidates; pair costs are computed once and refreshed only for the part that changed. Siblings
-/// (fragments of the same parent part, origin[i] == origin[j]) are merged first: they tile their parent
-/// part minus the cells, and there are far fewer sibling pairs than pairs (each cost is a Qhull call). Only
-/// when that does not reach the budget are all touching pairs considered.
+double boxVolume(const Aabb& b) {
+    const Vec3 e = max(b.size(), Vec3{});
+    return e.x * e.y * e.z;
+}
+
+/// Merges touching parts until at most maxParts remain, preferring the pairs whose joint hull adds the least
+/// volume. Pairs are ranked by a cheap estimate, the volume their joint bounding box adds to the union of
+/// their two boxes (no hull per pair: the ranking was a Qhull call per touching pair, quadratic in the part
+/// count); the two best-ranked pairs are then compared by their true joint hull, and the winner's hull is the
+/// merged part. Hulls of the losers are kept for the next round (keyed by the pair's versions). Siblings
+/// (fragments of the same parent part, origin[i] == origin[j]) are merged first: they tile their parent part
+/// minus the cells, so their joint hull stays inside that convex part. Only when that does not reach the
+/// budget are all touching pairs considered.
 void mergeToBudget(std::vector<ConvexPolytope>& parts, const std::vector<std::uint32_t>& origin,
                    int maxParts) {
     const std::size_t budget = static_cast<std::size_t>(std::max(1, maxParts));
@@ -67,83 +76,116 @@ void mergeToBudget(std::vector<ConvexPolytope>& parts, const std::vector<std::ui
     struct Candidate {
         double cost;
         std::size_t i, j;
-        std::uint32_t vi, vj; // versions of i and j when computed
+        std::uint32_t vi, vj; // versions of i and j when ranked
         bool operator>(const Candidate& o) const { return cost > o.cost; }
     };
-    std::vector<std::uint32_t> version(parts.size(), 0);
-    std::vector<bool> alive(parts.size(), true);
-    std::vector<Aabb> bounds(parts.size());
-    std::vector<double> volumes(parts.size());
-    for (std::size_t i = 0; i < parts.size(); ++i) {
+    struct Hull {
+        std::uint32_t vi, vj;
+        double cost;
+        ConvexPolytope shape;
+    };
+    const std::size_t n = parts.size();
+    std::vector<std::uint32_t> version(n, 0);
+    std::vector<bool> alive(n, true);
+    std::vector<Aabb> bounds(n);
+    std::vector<double> volumes(n);
+    std::vector<std::vector<Vec3>> corners(n);
+    for (std::size_t i = 0; i < n; ++i) {
         bounds[i] = parts[i].bounds();
         volumes[i] = parts[i].volume();
+        corners[i] = parts[i].vertices();
     }
+    // Many fragments (a shatter pattern cuts each part into hundreds): the box ranking alone decides.
+    const std::size_t verified = n > 2 * budget ? 1 : 2;
     std::vector<Candidate> heap;
+    std::unordered_map<std::uint64_t, Hull> hulls; // true joint hulls computed so far, by pair
     bool siblingsOnly = true;
-    // Many fragments (a shatter pattern cuts each part into hundreds): rank pairs by the volume their joint
-    // bounding box adds instead of one Qhull call per pair; merges still build true hulls.
-    const bool boxCosts = parts.size() > 2 * budget;
     auto consider = [&](std::size_t i, std::size_t j) {
         if (siblingsOnly && origin[i] != origin[j])
             return;
         const double tol = 1e-9 * (bounds[i].diagonal() + bounds[j].diagonal());
         if (!bounds[i].overlaps(bounds[j], tol))
             return;
-        if (boxCosts) {
-            Aabb joint = bounds[i];
-            joint.extend(bounds[j]);
-            const Vec3 e = joint.size();
-            heap.push_back({e.x * e.y * e.z - volumes[i] - volumes[j], i, j, version[i], version[j]});
-            std::push_heap(heap.begin(), heap.end(), std::greater<>());
-            return;
-        }
-        std::vector<Vec3> pts = parts[i].vertices();
-        const std::vector<Vec3> pj = parts[j].vertices();
-        pts.insert(pts.end(), pj.begin(), pj.end());
-        auto h = convexHull(pts);
-        if (!h)
-            return;
-        heap.push_back({h->volume() - volumes[i] - volumes[j], i, j, version[i], version[j]});
+        Aabb joint = bounds[i], common;
+        joint.extend(bounds[j]);
+        common.lo = max(bounds[i].lo, bounds[j].lo);
+        common.hi = min(bounds[i].hi, bounds[j].hi);
+        const double added =
+            boxVolume(joint) - boxVolume(bounds[i]) - boxVolume(bounds[j]) + boxVolume(common);
+        heap.push_back({added, i, j, version[i], version[j]});
         std::push_heap(heap.begin(), heap.end(), std::greater<>());
     };
-    for (std::size_t i = 0; i < parts.size(); ++i)
-        for (std::size_t j = i + 1; j < parts.size(); ++j)
+    auto jointHull = [&](const Candidate& c) -> Hull* {
+        const std::uint64_t key = static_cast<std::uint64_t>(c.i) * n + c.j;
+        auto it = hulls.find(key);
+        if (it != hulls.end() && it->second.vi == c.vi && it->second.vj == c.vj)
+            return &it->second;
+        std::vector<Vec3> pts = corners[c.i];
+        pts.insert(pts.end(), corners[c.j].begin(), corners[c.j].end());
+        auto h = convexHull(pts);
+        if (!h)
+            return nullptr;
+        const double cost = h->volume() - volumes[c.i] - volumes[c.j];
+        Hull& slot = hulls[key];
+        slot = {c.vi, c.vj, cost, std::move(h.value())};
+        return &slot;
+    };
+    for (std::size_t i = 0; i < n; ++i)
+        for (std::size_t j = i + 1; j < n; ++j)
             consider(i, j);
-    std::size_t count = parts.size();
+    std::size_t count = n;
+    std::vector<Candidate> picked;
     while (count > budget) {
-        if (heap.empty()) {
+        picked.clear();
+        while (picked.size() < verified && !heap.empty()) {
+            std::pop_heap(heap.begin(), heap.end(), std::greater<>());
+            const Candidate c = heap.back();
+            heap.pop_back();
+            if (alive[c.i] && alive[c.j] && version[c.i] == c.vi && version[c.j] == c.vj)
+                picked.push_back(c);
+        }
+        if (picked.empty()) {
             if (!siblingsOnly)
                 break;
             siblingsOnly = false; // siblings were not enough: every touching pair
-            for (std::size_t i = 0; i < parts.size(); ++i)
-                for (std::size_t j = i + 1; j < parts.size(); ++j)
+            for (std::size_t i = 0; i < n; ++i)
+                for (std::size_t j = i + 1; j < n; ++j)
                     if (alive[i] && alive[j] && origin[i] != origin[j])
                         consider(i, j);
             continue;
         }
-        std::pop_heap(heap.begin(), heap.end(), std::greater<>());
-        const Candidate c = heap.back();
-        heap.pop_back();
-        if (!alive[c.i] || !alive[c.j] || version[c.i] != c.vi || version[c.j] != c.vj)
+        std::size_t best = picked.size();
+        Hull* bestHull = nullptr;
+        std::vector<bool> failed(picked.size(), false);
+        for (std::size_t k = 0; k < picked.size(); ++k) {
+            Hull* h = jointHull(picked[k]);
+            failed[k] = h == nullptr;
+            if (h && (!bestHull || h->cost < bestHull->cost)) {
+                best = k;
+                bestHull = h;
+            }
+        }
+        for (std::size_t k = 0; k < picked.size(); ++k)
+            if (k != best && !failed[k]) { // ranked again next round; a pair whose hull failed is dropped
+                heap.push_back(picked[k]);
+                std::push_heap(heap.begin(), heap.end(), std::greater<>());
+            }
+        if (!bestHull)
             continue;
-        std::vector<Vec3> pts = parts[c.i].vertices();
-        const std::vector<Vec3> pj = parts[c.j].vertices();
-        pts.insert(pts.end(), pj.begin(), pj.end());
-        auto h = convexHull(pts);
-        if (!h)
-            continue;
-        parts[c.i] = std::move(h.value());
+        const Candidate c = picked[best];
+        parts[c.i] = std::move(bestHull->shape);
         bounds[c.i] = parts[c.i].bounds();
         volumes[c.i] = parts[c.i].volume();
+        corners[c.i] = parts[c.i].vertices();
         ++version[c.i];
         alive[c.j] = false;
         --count;
-        for (std::size_t k = 0; k < parts.size(); ++k)
+        for (std::size_t k = 0; k < n; ++k)
             if (k != c.i && alive[k])
                 consider(std::min(k, c.i), std::max(k, c.i));
     }
     std::vector<ConvexPolytope> kept;
-    for (std::size_t i = 0; i < parts.size(); ++i)
+    for (std::size_t i = 0; i < n; ++i)
         if (alive[i])
             kept.push_back(std::move(parts[i]));
     // Parts that touch nothing are kept whole; if still over budget, the smallest go.

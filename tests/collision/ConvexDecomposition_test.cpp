@@ -349,6 +349,57 @@ TEST(UpdateDecomposition, ShatterPatternsKeepCoverageAndBudget) {
     }
 }
 
+TEST(UpdateDecomposition, ChainedMergesAreDeterministicAndKeepTheBudget) {
+    // Ten chained fractures of the biggest piece of a concave mesh: every update is computed twice and must
+    // give the same parts (the box-ranked merge has no hidden state), within the budget and covering.
+    Mesh mesh = makeLPrism(2);
+    auto d = decompose(mesh);
+    ASSERT_TRUE(d);
+    std::vector<ConvexPolytope> parts = d->parts;
+    DecompositionParams params;
+    params.maxParts = 5; // small budget: most updates merge
+    Rng rng(11);
+    int atBudget = 0;
+    for (int round = 0; round < 10; ++round) {
+        const Aabb b = mesh.bounds();
+        Impact impact;
+        impact.point = rng.inBox(b.lo, b.hi);
+        FractureParams fp;
+        fp.sizeLaw.base = 0.5 * b.size().x;
+        fp.sizeLaw.scale = 0;
+        auto fr = fracture(mesh, impact, fp, 200 + round);
+        if (!fr)
+            continue;
+        std::vector<Mesh> pieces;
+        std::vector<std::int32_t> pieceCells;
+        for (const Piece& p : fr->pieces) {
+            pieces.push_back(p.mesh);
+            pieceCells.push_back(p.cell);
+        }
+        const auto once = updateDecomposition(parts, fr->cells, pieces, pieceCells, params);
+        const auto twice = updateDecomposition(parts, fr->cells, pieces, pieceCells, params);
+        ASSERT_EQ(once.size(), pieces.size());
+        ASSERT_EQ(twice.size(), pieces.size());
+        std::size_t biggest = 0;
+        for (std::size_t i = 0; i < pieces.size(); ++i) {
+            SCOPED_TRACE("round " + std::to_string(round) + " piece " + std::to_string(i));
+            expectCovers(pieces[i], once[i], 1e-6 * diag(makeLPrism(2)));
+            EXPECT_LE(once[i].size(), 5u);
+            atBudget += once[i].size() == 5u ? 1 : 0;
+            ASSERT_EQ(once[i].size(), twice[i].size());
+            for (std::size_t k = 0; k < once[i].size(); ++k) {
+                EXPECT_EQ(once[i][k].volume(), twice[i][k].volume());
+                EXPECT_EQ(once[i][k].vertices(), twice[i][k].vertices());
+            }
+            if (fr->pieces[i].mass.volume > fr->pieces[biggest].mass.volume)
+                biggest = i;
+        }
+        mesh = pieces[biggest];
+        parts = once[biggest];
+    }
+    EXPECT_GT(atBudget, 0) << "no piece reached the budget: the merge was not exercised";
+}
+
 TEST(UpdateDecomposition, PieceWithoutFragmentsGetsAFreshDecomposition) {
     const Mesh l = makeLPrism();
     auto updated = updateDecomposition({}, {}, {l}, {-1});
