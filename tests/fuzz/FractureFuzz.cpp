@@ -169,9 +169,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 
     try {
         const auto r = fracture(mesh, impact, params, seed);
-        if (!acceptableInput(mesh)) {
+        if (!acceptableInput(mesh) || !isFinite(impact.point) || !std::isfinite(impact.impulse)) {
             if (r || r.error().code != ErrorCode::InvalidInput)
-                fail("a broken input was not rejected as InvalidInput");
+                fail("a broken input (mesh or impact) was not rejected as InvalidInput");
             return 0;
         }
         if (!r) {
