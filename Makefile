@@ -59,7 +59,7 @@ sanitize: deps-clang
 	@bash scripts/sanitize.sh all
 
 sanitize-ci: deps-clang
-	@bash scripts/sanitize.sh ci
+	@FUZZ_SECONDS=$(FUZZ_SECONDS) bash scripts/sanitize.sh ci
 
 fuzz-smoke: deps-clang
 	@bash scripts/fuzz.sh $(FUZZ_SECONDS)
