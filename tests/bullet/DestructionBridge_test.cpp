@@ -357,7 +357,16 @@ struct PieceView {
 };
 
 struct CollapseRig : Rig {
-    explicit CollapseRig(bool collapse = true) : Rig(true, 1, true, config(collapse)) {}
+    // with a ground whose top is y = 0
+    explicit CollapseRig(bool collapse = true) : Rig(true, 1, true, config(collapse)) {
+        bridge->addGround({0, -0.5, 0}, {50, 0.5, 50});
+    }
+    // a static box of density 500 centred at `centre`, let settle for two frames
+    ObjectId addStatic(const Vec3& half, const Vec3& centre, const FractureParams& fracture = {}) {
+        const ObjectId id = addBox(half, Frame{Mat3::identity(), centre}, 500, true, fracture);
+        step(2);
+        return id;
+    }
     static DestructionBridge::Config config(bool collapse) {
         DestructionBridge::Config bc;
         bc.collapseUnsupported = collapse;
@@ -413,10 +422,7 @@ constexpr double kCutY = 2.5;
 
 TEST(DestructionBridgeCollapse, ColumnCutThroughItsMiddleDropsItsTopAndKeepsItsFoot) {
     CollapseRig rig;
-    rig.bridge->addGround({0, -0.5, 0}, {50, 0.5, 50});
-    const ObjectId column =
-        rig.addBox({0.5, 4, 0.5}, Frame{Mat3::identity(), {0, 4, 0}}, 500, true, cubeCell(2.4));
-    rig.step(2);
+    const ObjectId column = rig.addStatic({0.5, 4, 0.5}, {0, 4, 0}, cubeCell(2.4));
     const double before = rig.bridge->totalVolume();
     const auto pieces = rig.breakAt(column, kColumnCut);
     int upper = 0, lower = 0, debris = 0;
@@ -456,10 +462,7 @@ TEST(DestructionBridgeCollapse, ColumnCutThroughItsMiddleDropsItsTopAndKeepsItsF
 
 TEST(DestructionBridgeCollapse, WallHitAtItsTopCornerKeepsItsRemainderAndDropsTheDebris) {
     CollapseRig rig;
-    rig.bridge->addGround({0, -0.5, 0}, {50, 0.5, 50});
-    const ObjectId wall =
-        rig.addBox({3, 2, 0.25}, Frame{Mat3::identity(), {0, 2, 0}}, 500, true, cubeCell(1.5));
-    rig.step(2);
+    const ObjectId wall = rig.addStatic({3, 2, 0.25}, {0, 2, 0}, cubeCell(1.5));
     const auto pieces = rig.breakAt(wall, Impact{{3, 2, 0}, {0.7071, 0.7071, 0}, 100});
     double remainder = 0;
     int debris = 0;
@@ -484,11 +487,8 @@ TEST(DestructionBridgeCollapse, WallHitAtItsTopCornerKeepsItsRemainderAndDropsTh
 
 TEST(DestructionBridgeCollapse, FloatingPlatformKeepsItsLargestRemainderPieceStatic) {
     CollapseRig rig;
-    rig.bridge->addGround({0, -0.5, 0}, {50, 0.5, 50});
     // a 6 × 1 × 1 slab 10 m up, touching nothing, cut through off its middle
-    const ObjectId slab =
-        rig.addBox({3, 0.5, 0.5}, Frame{Mat3::identity(), {0, 10, 0}}, 500, true, cubeCell(2.4));
-    rig.step(2);
+    const ObjectId slab = rig.addStatic({3, 0.5, 0.5}, {0, 10, 0}, cubeCell(2.4));
     ASSERT_TRUE(rig.bridge->bodyOf(slab)->anchor) << "a static object touching nothing is an anchor";
     const auto pieces = rig.breakAt(slab, Impact{{1, 0.5, 0}, {0, 1, 0}, 100});
     double largest = 0;
@@ -511,11 +511,8 @@ TEST(DestructionBridgeCollapse, FloatingPlatformKeepsItsLargestRemainderPieceSta
 
 TEST(DestructionBridgeCollapse, CollapsePropagatesToWhatRestedOnTheBrokenPart) {
     CollapseRig rig;
-    rig.bridge->addGround({0, -0.5, 0}, {50, 0.5, 50});
-    const ObjectId lower =
-        rig.addBox({0.5, 4, 0.5}, Frame{Mat3::identity(), {0, 4, 0}}, 500, true, cubeCell(2.4));
-    const ObjectId upper = rig.addBox({0.75, 0.5, 0.75}, Frame{Mat3::identity(), {0, 8.5, 0}}, 500, true);
-    rig.step(2);
+    const ObjectId lower = rig.addStatic({0.5, 4, 0.5}, {0, 4, 0}, cubeCell(2.4));
+    const ObjectId upper = rig.addStatic({0.75, 0.5, 0.75}, {0, 8.5, 0});
     EXPECT_FALSE(rig.bridge->bodyOf(upper)->anchor) << "it rests on a column that stands on the ground";
     const double y0 = rig.heightOf(upper);
     rig.ejectDebris(rig.breakAt(lower, kColumnCut), {-10, 0, 0});
@@ -528,10 +525,7 @@ TEST(DestructionBridgeCollapse, CollapsePropagatesToWhatRestedOnTheBrokenPart) {
 
 TEST(DestructionBridgeCollapse, SwitchedOffTheLargestPieceStaysStaticAsBefore) {
     CollapseRig rig(false);
-    rig.bridge->addGround({0, -0.5, 0}, {50, 0.5, 50});
-    const ObjectId column =
-        rig.addBox({0.5, 4, 0.5}, Frame{Mat3::identity(), {0, 4, 0}}, 500, true, cubeCell(2.4));
-    rig.step(2);
+    const ObjectId column = rig.addStatic({0.5, 4, 0.5}, {0, 4, 0}, cubeCell(2.4));
     const auto pieces = rig.breakAt(column, kColumnCut);
     double largest = 0;
     for (const PieceView& p : pieces)
