@@ -23,6 +23,18 @@ inline bool closedAndOriented(const Mesh& m) {
     return true;
 }
 
+/// Indices in range and attribute arrays of the right sizes. Unlike Mesh::validate(), non-finite coordinates
+/// are allowed: readers keep them so that `rubble check` can name the vertex.
+inline bool structurallyValid(const Mesh& m) {
+    for (const Triangle& t : m.triangles)
+        for (std::uint32_t v : t)
+            if (v >= m.positions.size())
+                return false;
+    const std::size_t n = m.triangles.size();
+    return (m.normals.empty() || m.normals.size() == 3 * n) && (m.uvs.empty() || m.uvs.size() == 3 * n) &&
+           (m.materials.empty() || m.materials.size() == n);
+}
+
 /// A concave L-shaped prism (volume 3): the outline (0,0) (2,0) (2,1) (1,1) (1,2) (0,2) extruded from z = 0
 /// to 1.
 inline Mesh makeLShape() {
