@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <list>
 #include <mutex>
 #include <unordered_map>
 #include <vector>
@@ -47,20 +48,39 @@ std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<C
                                                              const std::vector<std::int32_t>& pieceCells,
                                                              const DecompositionParams& params = {});
 
-/// Thread-safe cache of decompositions keyed by Mesh::hash(), optionally persisted in a directory.
+/// Thread-safe cache of decompositions keyed by Mesh::hash(), optionally persisted in a directory. The memory
+/// holds at most capacity() entries: on a miss beyond that, the least recently used entry is evicted (its
+/// file, if any, stays on disk), so a long run that adds many distinct meshes uses bounded memory.
 class DecompositionCache {
 public:
-    /// An in-memory cache; with a directory, entries are also read from and written to files there.
-    explicit DecompositionCache(std::filesystem::path directory = {});
+    /// Default in-memory capacity (entries).
+    static constexpr std::size_t kDefaultCapacity = 256;
+    /// An in-memory cache of at most capacity entries (0 is taken as 1); with a directory, entries are also
+    /// read from and written to files there.
+    explicit DecompositionCache(std::filesystem::path directory = {},
+                                std::size_t capacity = kDefaultCapacity);
     /// The cached decomposition of mesh, computing and storing it on a miss.
     Result<Decomposition> get(const Mesh& mesh, const DecompositionParams& params = {});
     /// Number of lookups answered from the cache (memory or disk).
     std::size_t hits() const;
+    /// Number of entries held in memory (never more than capacity()).
+    std::size_t size() const;
+    /// The most entries held in memory.
+    std::size_t capacity() const { return capacity_; }
 
 private:
+    struct Entry {
+        Decomposition decomposition;
+        std::list<std::uint64_t>::iterator recency; // position in recency_
+    };
+    // Stores (or refreshes) key under the lock, evicting the least recently used entries beyond capacity_.
+    void store(std::uint64_t key, const Decomposition& d);
+
     std::filesystem::path directory_;
+    std::size_t capacity_;
     mutable std::mutex mutex_;
-    std::unordered_map<std::uint64_t, Decomposition> memory_;
+    std::unordered_map<std::uint64_t, Entry> memory_;
+    std::list<std::uint64_t> recency_; // most recently used first
     std::size_t hits_ = 0;
 };
 

@@ -1,5 +1,6 @@
 // In-memory and on-disk cache of decompositions. Files are "<key>.rdc": a header, the parts and an FNV-1a
 // checksum; a file that is truncated, corrupt or from another version is ignored and rewritten.
+#include <algorithm>
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -119,11 +120,31 @@ bool deserialize(const std::string& s, std::uint64_t key, Decomposition& d) {
 
 } // namespace
 
-DecompositionCache::DecompositionCache(std::filesystem::path directory) : directory_(std::move(directory)) {}
+DecompositionCache::DecompositionCache(std::filesystem::path directory, std::size_t capacity)
+    : directory_(std::move(directory)), capacity_(std::max<std::size_t>(1, capacity)) {}
 
 std::size_t DecompositionCache::hits() const {
     std::lock_guard lock(mutex_);
     return hits_;
+}
+
+std::size_t DecompositionCache::size() const {
+    std::lock_guard lock(mutex_);
+    return memory_.size();
+}
+
+void DecompositionCache::store(std::uint64_t key, const Decomposition& d) {
+    if (auto it = memory_.find(key); it != memory_.end()) {
+        it->second.decomposition = d;
+        recency_.splice(recency_.begin(), recency_, it->second.recency);
+        return;
+    }
+    recency_.push_front(key);
+    memory_.emplace(key, Entry{d, recency_.begin()});
+    while (memory_.size() > capacity_) {
+        memory_.erase(recency_.back());
+        recency_.pop_back();
+    }
 }
 
 Result<Decomposition> DecompositionCache::get(const Mesh& mesh, const DecompositionParams& params) {
@@ -133,7 +154,8 @@ Result<Decomposition> DecompositionCache::get(const Mesh& mesh, const Decomposit
         auto it = memory_.find(key);
         if (it != memory_.end()) {
             ++hits_;
-            return it->second;
+            recency_.splice(recency_.begin(), recency_, it->second.recency);
+            return it->second.decomposition;
         }
     }
     char name[32];
@@ -148,7 +170,7 @@ Result<Decomposition> DecompositionCache::get(const Mesh& mesh, const Decomposit
             if (deserialize(ss.str(), key, d)) {
                 std::lock_guard lock(mutex_);
                 ++hits_;
-                memory_[key] = d;
+                store(key, d);
                 return d;
             }
         }
@@ -170,7 +192,7 @@ Result<Decomposition> DecompositionCache::get(const Mesh& mesh, const Decomposit
             std::filesystem::remove(tmp, ec);
     }
     std::lock_guard lock(mutex_);
-    memory_[key] = d.value();
+    store(key, d.value());
     return d;
 }
 

@@ -1,0 +1,66 @@
+// The in-memory DecompositionCache is bounded (issue #7, soak): DestructionWorld keeps one for the life of
+// the world and adds an entry for every object added without convex parts.
+#include <gtest/gtest.h>
+
+#include "TestSupport.hpp"
+#include "rubble/ConvexDecomposition.hpp"
+
+namespace rubble {
+namespace {
+
+Mesh boxOfWidth(int i) {
+    const double w = 1.0 + 0.25 * i;
+    return makeSubdividedBox({0, 0, 0}, {w, 1, 1}, 1);
+}
+
+TEST(DecompositionCacheBound, EntriesNeverExceedCapacityAfterManyDistinctMeshes) {
+    DecompositionCache cache({}, 4);
+    EXPECT_EQ(cache.capacity(), 4u);
+    for (int i = 0; i < 40; ++i) {
+        ASSERT_TRUE(cache.get(boxOfWidth(i)));
+        EXPECT_LE(cache.size(), 4u) << "after " << i + 1 << " distinct meshes";
+    }
+    EXPECT_EQ(cache.size(), 4u);
+    EXPECT_EQ(cache.hits(), 0u); // every mesh was distinct
+}
+
+TEST(DecompositionCacheBound, EvictsLeastRecentlyUsed) {
+    DecompositionCache cache({}, 3);
+    for (int i = 0; i < 3; ++i)
+        ASSERT_TRUE(cache.get(boxOfWidth(i)));
+    ASSERT_TRUE(cache.get(boxOfWidth(0))); // 0 is now the most recent; 1 the least
+    EXPECT_EQ(cache.hits(), 1u);
+    ASSERT_TRUE(cache.get(boxOfWidth(3))); // evicts 1
+    EXPECT_EQ(cache.size(), 3u);
+    for (int i : {0, 2, 3})
+        ASSERT_TRUE(cache.get(boxOfWidth(i)));
+    EXPECT_EQ(cache.hits(), 4u); // 0, 2 and 3 were still held
+    ASSERT_TRUE(cache.get(boxOfWidth(1)));
+    EXPECT_EQ(cache.hits(), 4u); // 1 was evicted: recomputed, not a hit
+    EXPECT_EQ(cache.size(), 3u);
+}
+
+TEST(DecompositionCacheBound, EvictedEntryIsRecomputedIdentically) {
+    DecompositionCache cache({}, 1);
+    auto first = cache.get(boxOfWidth(0));
+    ASSERT_TRUE(first);
+    ASSERT_TRUE(cache.get(boxOfWidth(1)));
+    auto again = cache.get(boxOfWidth(0));
+    ASSERT_TRUE(again);
+    EXPECT_EQ(cache.hits(), 0u);
+    ASSERT_EQ(first->parts.size(), again->parts.size());
+    EXPECT_DOUBLE_EQ(first->hullVolume, again->hullVolume);
+    EXPECT_DOUBLE_EQ(first->meshVolume, again->meshVolume);
+}
+
+TEST(DecompositionCacheBound, ZeroCapacityHoldsOne) {
+    DecompositionCache cache({}, 0);
+    EXPECT_EQ(cache.capacity(), 1u);
+    ASSERT_TRUE(cache.get(boxOfWidth(0)));
+    ASSERT_TRUE(cache.get(boxOfWidth(0)));
+    EXPECT_EQ(cache.hits(), 1u);
+    EXPECT_EQ(cache.size(), 1u);
+}
+
+} // namespace
+} // namespace rubble
