@@ -232,6 +232,23 @@ int runScene(const SceneArgs& a) {
         j["fractures"] = c.fractures;
         j["latency_ms"] = {{"p50", ts.total.p50}, {"p99", ts.total.p99}, {"max", ts.total.max}};
         j["pieces_alive"] = bridge.livePieces();
+        j["shots"] = shots;
+        j["pieces_retired"] = c.piecesRetired;
+        // what the long-lived containers hold at the end (a soak checks that they stay bounded)
+        j["bodies"] = bridge.bodyCount();
+        j["world_objects"] = destruction.objects().size();
+        j["timing_records"] = destruction.timings().size();
+        j["debris_particles"] = bridge.particles().size();
+        std::size_t triangles = 0, maxTriangles = 0, parts = 0;
+        for (ObjectId id : destruction.objects())
+            if (const ObjectState* st = destruction.object(id)) {
+                triangles += st->mesh.triangleCount();
+                maxTriangles = std::max(maxTriangles, st->mesh.triangleCount());
+                parts += st->convexParts.size();
+            }
+        j["world_triangles"] = triangles;
+        j["world_max_triangles"] = maxTriangles;
+        j["world_convex_parts"] = parts;
         j["volume_error"] = volumeError;
         j["state_hash"] = hashText;
         j["peak_rss_mb"] = rss;
