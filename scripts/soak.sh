@@ -4,7 +4,9 @@
 #        (extra arguments after SCENE go to rubble-bench scene, e.g. --shots-per-second 20 --workers 1)
 # Reports resident memory (VmRSS from /proc, sampled every second) at start (first sample after 2 s: the scene
 # is loaded and firing), at 10 %, 50 % and the end of the run, the peak (VmHWM), the growth over the second half, and the
-# bench's own volume error and counters. Exit 1 on a crash, a volume error above 1e-6, or a JSON it cannot read.
+# bench's own volume error and counters (with what the long-lived containers hold at the end: bodies, world
+# objects, timing records, debris particles, triangles of live objects). The JSON report is kept in a temp dir
+# (its path is printed). Exit 1 on a crash, a volume error above 1e-6, or a JSON it cannot read.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 dir=${1:-build-release}
@@ -45,12 +47,15 @@ at = lambda f: mb(rows[min(len(rows) - 1, int(f * (len(rows) - 1)))][1])
 # "start": the first sample after two seconds (the scene is loaded and firing has begun).
 start = mb(next((r for r in rows if r[0] >= 2), rows[0])[1])
 end, peak = mb(rows[-1][1]), max(mb(r[2]) for r in rows)
-print(f"soak: {report['frames']} frames in {sys.argv[3]} s, crash-free")
+print(f"soak: {report['frames']} frames in {sys.argv[3]} s, crash-free (report {sys.argv[1]})")
 print(f"  resident memory (MB): start {start:.1f}, 10% {at(0.1):.1f}, 50% {at(0.5):.1f}, end {end:.1f}, "
       f"peak {peak:.1f} (bench peak_rss_mb {report.get('peak_rss_mb', float('nan')):.1f}); "
       f"second-half growth {end - at(0.5):+.1f}")
 print(f"  shots {report.get('shots')}, impacts {report.get('impacts')}, fractures {report.get('fractures')}, "
       f"pieces alive {report.get('pieces_alive')}, retired {report.get('pieces_retired')}")
+print("  at the end: " + ", ".join(f"{k.replace('_', ' ')} {report[k]}" for k in
+      ("bodies", "world_objects", "timing_records", "debris_particles", "world_triangles", "world_max_triangles",
+       "world_convex_parts") if k in report))
 fm = report.get("frame_ms", {})
 print(f"  frame ms p50 {fm.get('p50', 0):.3f} p99 {fm.get('p99', 0):.3f} max {fm.get('max', 0):.3f}")
 err = report.get("volume_error")
