@@ -118,14 +118,16 @@ TEST(DestructionBridge, PieceBodiesHaveTrueMassAndCentreOfMass) {
 }
 
 TEST(DestructionBridge, PiecesFollowTheParentsVelocityFieldAndConserveMomentum) {
+    // declared before the rig: the bridge's destructor calls onRemoved for every body left (ASan found the
+    // callback reading a destroyed snap/id)
+    std::optional<ParentSnapshot> snap;
     Rig rig(false);
     const ObjectId id = rig.addBox({1, 1, 1}, Frame{Mat3::identity(), {0, 10, 0}}, 3.0);
     Body* parent = rig.bridge->bodyOf(id);
     ASSERT_NE(parent, nullptr);
     parent->rigid->setLinearVelocity({1, -2, 0.5f});
     parent->rigid->setAngularVelocity({0.3f, 1.2f, -0.7f});
-    std::optional<ParentSnapshot> snap;
-    rig.bridge->setOnRemoved([&](Body& b) {
+    rig.bridge->setOnRemoved([&snap, id](Body& b) {
         if (b.hasObject && b.object == id)
             snap =
                 ParentSnapshot{b.mass, fromBt(b.rigid->getCenterOfMassPosition()),
