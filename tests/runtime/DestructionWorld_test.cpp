@@ -340,5 +340,48 @@ TEST(DestructionWorld, EveryAcceptedImpactEndsInExactlyOneRecord) {
     EXPECT_EQ(recorded, accepted);
 }
 
+// Soak (issue #7): a long run must not leave state behind. Chained fractures where the caller keeps only the
+// largest piece (like the bridge's piece cap) leave exactly one live object and one timing record per job.
+TEST(DestructionWorld, RemovedPiecesLeaveNoStateBehindOverChainedFractures) {
+    HeldJobs jobs;
+    DestructionWorld w(heldConfig(jobs));
+    ObjectId live = w.addObject(boxDesc()).value();
+    const double v0 = w.object(live)->mass.volume;
+    double removed = 0, dropped = 0;
+    int fractures = 0;
+    const int rounds = 25;
+    for (int r = 0; r < rounds; ++r) {
+        const Aabb b = w.object(live)->mesh.bounds();
+        Impact i;
+        i.point = {0.5 * (b.lo.x + b.hi.x), 0.5 * (b.lo.y + b.hi.y), b.hi.z};
+        i.normal = {0, 0, 1};
+        i.impulse = 10;
+        ASSERT_TRUE(w.submitImpact(live, i)) << "round " << r;
+        jobs.runAll();
+        w.beginFrame();
+        auto out = w.collect();
+        ASSERT_LE(out.size(), 1u);
+        EXPECT_EQ(w.timings().size(), static_cast<std::size_t>(r + 1)) << "one record per job, no more";
+        if (out.empty())
+            continue; // a failed job leaves the object as it was
+        ++fractures;
+        dropped += out[0].droppedVolume;
+        ASSERT_FALSE(out[0].pieces.empty());
+        ObjectId largest = out[0].pieces.front();
+        for (ObjectId p : out[0].pieces)
+            if (w.object(p)->mass.volume > w.object(largest)->mass.volume)
+                largest = p;
+        for (ObjectId p : out[0].pieces)
+            if (p != largest) {
+                removed += w.object(p)->mass.volume;
+                w.removeObject(p);
+            }
+        live = largest;
+        EXPECT_EQ(w.objects().size(), 1u) << "round " << r;
+    }
+    EXPECT_GE(fractures, rounds / 2);
+    EXPECT_NEAR(w.object(live)->mass.volume + removed + dropped, v0, 1e-9 * v0);
+}
+
 } // namespace
 } // namespace rubble
