@@ -271,8 +271,10 @@ TEST(ObjReader, HugeFaceIsTriangulatedWithoutBlowingUp) {
         text += buf;
     }
     text += "f";
-    for (int i = 1; i <= n; ++i)
-        text += " " + std::to_string(i);
+    for (int i = 1; i <= n; ++i) { // two appends: gcc 12 -O3 warns falsely (-Wrestrict) on " " + to_string
+        text += ' ';
+        text += std::to_string(i);
+    }
     text += "\n";
     const int m = 1000;
     for (int i = 0; i < m; ++i) {
@@ -282,8 +284,10 @@ TEST(ObjReader, HugeFaceIsTriangulatedWithoutBlowingUp) {
         text += buf;
     }
     text += "f";
-    for (int i = 1; i <= m; ++i)
-        text += " " + std::to_string(n + i);
+    for (int i = 1; i <= m; ++i) {
+        text += ' ';
+        text += std::to_string(n + i);
+    }
     text += "\n";
     const auto r = parseObj(text, "big.obj");
     ASSERT_TRUE(r.isOk()) << r.error().message;
