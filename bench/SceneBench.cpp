@@ -13,7 +13,7 @@
 // bench/results/scene.csv.
 #include "Subcommand.hpp"
 
-#if defined(RUBBLE_HAVE_BULLET) && defined(RUBBLE_HAVE_RUNTIME)
+#if defined(RUBBLE_HAVE_BULLET)
 
 #include <algorithm>
 #include <chrono>

@@ -3,8 +3,6 @@
 // bookkeeping and the live-piece cap.
 #include <gtest/gtest.h>
 
-#if RUBBLE_HAVE_RUNTIME
-
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -543,9 +541,3 @@ TEST(DestructionBridgeCollapse, SwitchedOffTheLargestPieceStaysStaticAsBefore) {
     EXPECT_EQ(statics, 1);
     EXPECT_EQ(rig.bridge->counters().piecesCollapsed, 0);
 }
-
-#else
-TEST(DestructionBridge, NeedsTheRuntime) {
-    GTEST_SKIP() << "src/runtime has no implementation yet";
-}
-#endif

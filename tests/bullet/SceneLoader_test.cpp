@@ -1,8 +1,6 @@
 // Scene loading through the Bullet adapter: ground, objects, stand-ins for missing models, static objects.
 #include <gtest/gtest.h>
 
-#if RUBBLE_HAVE_RUNTIME
-
 #include <algorithm>
 
 #include "TestSupport.hpp"
@@ -138,9 +136,3 @@ TEST(SceneLoader, PrepareMeshHookSeesEveryObjectAndIndicesMapToTheScene) {
         EXPECT_EQ(st->mesh.uvs.front().x, 0.25);
     }
 }
-
-#else
-TEST(SceneLoader, NeedsTheRuntime) {
-    GTEST_SKIP() << "src/runtime has no implementation yet";
-}
-#endif
