@@ -118,4 +118,15 @@ void plotPng(const fs::path& dir, const std::string& stem, const std::string& da
     fs::remove(dat, ec);
 }
 
+std::vector<std::filesystem::path> repoModels() {
+    namespace fs = std::filesystem;
+    std::vector<fs::path> files;
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(fs::path(RUBBLE_SOURCE_DIR) / "assets" / "models", ec))
+        if (e.path().extension() == ".obj" && e.path().stem().string().rfind("cube_", 0) != 0)
+            files.push_back(e.path());
+    std::sort(files.begin(), files.end());
+    return files;
+}
+
 } // namespace rubble::bench

@@ -59,4 +59,7 @@ bool writeCsv(const std::filesystem::path& path, const Table& table);
 void plotPng(const std::filesystem::path& dir, const std::string& stem, const std::string& data,
              const std::string& plot);
 
+/// The repository's own models: assets/models/*.obj except the generated cubes (cube_*), sorted by path.
+std::vector<std::filesystem::path> repoModels();
+
 } // namespace rubble::bench

@@ -166,14 +166,7 @@ std::vector<Case> cases(bool quick) {
     }
     if (quick)
         return all;
-    const fs::path models = fs::path(RUBBLE_SOURCE_DIR) / "assets" / "models";
-    std::vector<fs::path> files;
-    std::error_code ec;
-    for (const auto& e : fs::directory_iterator(models, ec))
-        if (e.path().extension() == ".obj" && e.path().stem().string().rfind("cube_", 0) != 0)
-            files.push_back(e.path());
-    std::sort(files.begin(), files.end());
-    for (const fs::path& f : files) {
+    for (const fs::path& f : rubble::bench::repoModels()) {
         auto mesh = rubble::readMesh(f);
         if (!mesh) {
             std::cerr << "booleans: skipping " << f.string() << ": " << mesh.error().message << "\n";

@@ -219,12 +219,7 @@ int runBench(const BenchArgs& args) {
         cases.push_back(std::move(c));
     }
     if (!args.quick) {
-        std::vector<fs::path> models;
-        for (const auto& e : fs::directory_iterator(fs::path(RUBBLE_SOURCE_DIR) / "assets" / "models"))
-            if (e.path().extension() == ".obj" && e.path().stem().string().rfind("cube_", 0) != 0)
-                models.push_back(e.path());
-        std::sort(models.begin(), models.end());
-        for (const fs::path& p : models) {
+        for (const fs::path& p : rubble::bench::repoModels()) {
             auto m = rubble::readMesh(p);
             if (!m) {
                 std::cerr << "impact: skipping " << p.filename().string() << ": " << m.error().message
