@@ -62,6 +62,9 @@ struct FractureParams {
     double minPieceVolumeFraction = 1e-9;    ///< pieces below this fraction of the input volume are dropped
                                              ///< (their volume is reported in FractureResult::droppedVolume)
     double uvScale = 1.0;                    ///< texture repeats per unit length on cut faces
+    bool simplifyPieces = true;              ///< remove the vertices that carry no shape from every piece
+                                ///< (simplifyPlanarRegions, lossless): bounds the triangle count of
+                                ///< pieces that are hit again and again
 };
 
 /// One output piece: a closed, outward-oriented mesh in the input's coordinates.
@@ -73,11 +76,12 @@ struct Piece {
 
 /// Wall-clock durations of the stages of one fracture, in milliseconds.
 struct FractureTimings {
-    double cellMs = 0;    ///< building the cells
-    double booleanMs = 0; ///< difference and intersections
-    double islandsMs = 0; ///< splitting into islands and mass properties (includes massMs)
-    double massMs = 0;    ///< of islandsMs: mass properties of the pieces and interior UVs
-    double totalMs = 0;   ///< everything
+    double cellMs = 0;     ///< building the cells
+    double booleanMs = 0;  ///< difference and intersections
+    double islandsMs = 0;  ///< splitting into islands and mass properties (includes massMs)
+    double massMs = 0;     ///< of islandsMs: mass properties of the pieces and interior UVs
+    double simplifyMs = 0; ///< of islandsMs: simplifying the pieces' flat regions
+    double totalMs = 0;    ///< everything
 };
 
 /// Everything one fracture produced.

@@ -10,6 +10,7 @@
 #include "geometry/OrientedShells.hpp"
 #include "rubble/Fracture.hpp"
 #include "rubble/Islands.hpp"
+#include "rubble/MeshSimplify.hpp"
 
 namespace rubble {
 
@@ -57,8 +58,11 @@ void cutBasis(Vec3 n, Vec3& u, Vec3& v) {
     v = cross(n, u);
 }
 
-/// Cut faces: planar UVs (projection onto the cut plane, scaled by uvScale) and the plane's normal.
-void finishCutFaces(Mesh& m, const std::vector<ConvexPolytope>& cells, double uvScale) {
+/// Cut faces made by these cells: planar UVs (projection onto the cut plane, scaled by uvScale) and the
+/// plane's normal. Interior faces of earlier fractures (not on a face of these cells, or outside focus) keep
+/// theirs.
+void finishCutFaces(Mesh& m, const std::vector<ConvexPolytope>& cells, double uvScale, const Aabb& focus,
+                    double tolerance) {
     if (!m.hasMaterials())
         return;
     if (m.uvs.size() != 3 * m.triangles.size())
@@ -67,6 +71,8 @@ void finishCutFaces(Mesh& m, const std::vector<ConvexPolytope>& cells, double uv
         if (m.materials[t] != kInteriorMaterial)
             continue;
         const auto c = m.corners(t);
+        if (!focus.contains(c[0]) || !focus.contains(c[1]) || !focus.contains(c[2]))
+            continue;
         const Vec3 tn = cross(c[1] - c[0], c[2] - c[0]);
         // The cell face the triangle lies on: the plane nearest to its corners with a matching normal.
         const Plane* best = nullptr;
@@ -83,7 +89,9 @@ void finishCutFaces(Mesh& m, const std::vector<ConvexPolytope>& cells, double uv
                     best = &f.plane;
                 }
             }
-        Vec3 n = best ? best->normal : normalized(tn);
+        if (!best || bestErr > tolerance)
+            continue; // an earlier fracture's face
+        Vec3 n = best->normal;
         if (dot(n, tn) < 0)
             n = -n;
         Vec3 u, v;
@@ -97,11 +105,19 @@ void finishCutFaces(Mesh& m, const std::vector<ConvexPolytope>& cells, double uv
     }
 }
 
+/// The pieces of one split output. simplify: remove the vertices that carry no shape near the cells (focus).
 void addPieces(Mesh&& m, const detail::OutputShells& shells, std::int32_t cell, double minVolume,
-               FractureResult& out) {
+               bool simplify, const Aabb& focus, FractureResult& out) {
     if (m.empty())
         return;
     for (Mesh& island : splitIntoIslands(std::move(m), shells.triangleShell, shells.count)) {
+        if (simplify) {
+            const auto ts = Clock::now();
+            PlanarSimplifyParams sp;
+            sp.focus = focus;
+            island = simplifyPlanarRegions(island, sp);
+            out.timings.simplifyMs += msSince(ts);
+        }
         const auto tm = Clock::now();
         MassProperties mp = computeMassProperties(island);
         out.timings.massMs += msSince(tm);
@@ -203,14 +219,21 @@ Result<FractureResult> runPipeline(const Mesh& mesh, std::vector<ConvexPolytope>
     res.timings.booleanMs = msSince(t0);
 
     const auto t1 = Clock::now();
-    finishCutFaces(split->remainder, cells, params.uvScale);
+    Aabb focus; // where the cut made new faces and vertices (the cells, a little larger)
+    for (const ConvexPolytope& c : cells)
+        focus.extend(c.bounds());
+    const Vec3 grow = Vec3{1, 1, 1} * (1e-6 * (focus.diagonal() + meshBox.diagonal()));
+    focus = {focus.lo - grow, focus.hi + grow};
+    const double onPlane = 1e-7 * meshBox.diagonal();
+    finishCutFaces(split->remainder, cells, params.uvScale, focus, onPlane);
     for (Mesh& m : split->inside)
-        finishCutFaces(m, cells, params.uvScale);
+        finishCutFaces(m, cells, params.uvScale, focus, onPlane);
     res.timings.massMs = msSince(t1);
     const double minVolume = std::max(0.0, params.minPieceVolumeFraction) * inputVolume;
-    addPieces(std::move(split->remainder), shells[0], -1, minVolume, res);
+    addPieces(std::move(split->remainder), shells[0], -1, minVolume, params.simplifyPieces, focus, res);
     for (std::size_t i = 0; i < split->inside.size(); ++i)
-        addPieces(std::move(split->inside[i]), shells[i + 1], static_cast<std::int32_t>(i), minVolume, res);
+        addPieces(std::move(split->inside[i]), shells[i + 1], static_cast<std::int32_t>(i), minVolume,
+                  params.simplifyPieces, focus, res);
     res.timings.islandsMs = msSince(t1);
     res.cells = std::move(cells);
     res.timings.totalMs = msSince(t0);

@@ -1,0 +1,550 @@
+// Lossless simplification of flat regions (see MeshSimplify.hpp). Everything is local to the focus box: the
+// cost follows the part of the surface a fracture changed, not the size of the piece.
+//
+// 1. Local triangles: those with a corner in the focus; a directed-edge map over them finds twins.
+// 2. A vertex in the focus is removable when its triangles form one closed fan that is either one flat arc
+//    (compatible neighbours: same material, plane, normals and affine texture map; the arc checked against
+//    one plane and one least-squares texture map) or two flat arcs split by two collinear edges (a vertex in
+//    the middle of a straight crease; both sides lose it).
+// 3. The triangles around removed vertices form patches; each patch (split by incompatible edges) is
+//    triangulated anew from its boundary chains, from kept vertex to kept vertex (constrained Delaunay in its
+//    plane, inside = odd number of boundary crossings from outside). The new triangles must be
+//    counter-clockwise, cover the same area and close up exactly with the chains. A patch that fails keeps
+//    its vertices (and so do its neighbours: everything is redone until no patch fails).
+//    Each patch and its replacement must also enclose no volume together (they share their boundary).
+
+#include "rubble/MeshSimplify.hpp"
+
+#include <CGAL/Constrained_Delaunay_triangulation_2.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Triangulation_face_base_with_info_2.h>
+#include <CGAL/Triangulation_vertex_base_with_info_2.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <unordered_map>
+#include <unordered_set>
+#include <vector>
+
+namespace rubble {
+
+namespace {
+
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Vb = CGAL::Triangulation_vertex_base_with_info_2<std::uint32_t, K>;
+using Fbi = CGAL::Triangulation_face_base_with_info_2<int, K>;
+using Fb = CGAL::Constrained_triangulation_face_base_2<K, Fbi>;
+using Tds = CGAL::Triangulation_data_structure_2<Vb, Fb>;
+using CDT = CGAL::Constrained_Delaunay_triangulation_2<K, Tds, CGAL::Exact_predicates_tag>;
+using Tri = std::array<std::uint32_t, 3>;
+
+constexpr std::uint32_t kNone = 0xFFFFFFFFu;
+
+std::uint64_t directed(std::uint32_t a, std::uint32_t b) {
+    return (static_cast<std::uint64_t>(a) << 32) | b;
+}
+
+/// An orthonormal basis (u, v) of the plane with unit normal n such that u × v = n.
+void basisOf(const Vec3& n, Vec3& u, Vec3& v) {
+    u = normalized(std::abs(n.x) < 0.6 ? cross(Vec3{1, 0, 0}, n) : cross(Vec3{0, 1, 0}, n));
+    v = cross(n, u);
+}
+
+class Simplifier {
+public:
+    Simplifier(const Mesh& mesh, const PlanarSimplifyParams& params) : m_(mesh), params_(params) {}
+
+    /// The simplified mesh, or false when the input is to be returned as it is.
+    bool run(Mesh& out, PlanarSimplifyReport& report);
+
+private:
+    const Mesh& m_;
+    PlanarSimplifyParams params_;
+    double planeTol_ = 0, diag_ = 0;
+    std::unordered_map<std::uint64_t, std::uint32_t> edgeTri_;           // directed edge → local triangle
+    std::unordered_map<std::uint32_t, std::vector<std::uint32_t>> star_; // focus vertex → local triangles
+    std::unordered_set<std::uint32_t> removed_;
+
+    std::uint32_t twinTri(std::uint32_t t, int k) const { // triangle across edge k of t, or kNone
+        const Tri& tri = m_.triangles[t];
+        auto it = edgeTri_.find(
+            directed(tri[static_cast<std::size_t>((k + 1) % 3)], tri[static_cast<std::size_t>(k)]));
+        return it == edgeTri_.end() ? kNone : it->second;
+    }
+    bool compatible(std::uint32_t t, std::uint32_t s) const;
+    bool flat(const std::vector<std::uint32_t>& tris) const;
+    bool removable(std::uint32_t v) const;
+    bool retriangulate(const std::vector<std::uint32_t>& patch, std::vector<Tri>& out) const;
+};
+
+/// Can triangles t and s (sharing an edge) be one flat region? The plane is the larger triangle's.
+bool Simplifier::compatible(std::uint32_t t, std::uint32_t s) const {
+    const Vec3 nt = m_.triangleNormal(t), ns = m_.triangleNormal(s);
+    if (m_.material(t) != m_.material(s) || dot(nt, ns) <= 0)
+        return false;
+    const bool tBig = lengthSquared(nt) >= lengthSquared(ns);
+    const std::uint32_t r = tBig ? t : s, o = tBig ? s : t;
+    const Vec3 n = normalized(tBig ? nt : ns);
+    const auto rc = m_.corners(r), oc = m_.corners(o);
+    for (const Vec3& p : oc)
+        if (!(std::abs(dot(n, p - rc[0])) <= planeTol_))
+            return false;
+    if (m_.hasNormals())
+        for (std::size_t k = 0; k < 3; ++k)
+            for (std::uint32_t x : {t, s}) {
+                const Vec3 d = m_.normals[3 * x + k] - m_.normals[3 * t];
+                if (!(std::max({std::abs(d.x), std::abs(d.y), std::abs(d.z)}) <= 1e-6))
+                    return false;
+            }
+    if (m_.hasUvs()) {
+        // r's affine texture map at o's corners (barycentric coordinates in r's plane).
+        const Vec3 e1 = rc[1] - rc[0], e2 = rc[2] - rc[0];
+        const double a11 = dot(e1, e1), a12 = dot(e1, e2), a22 = dot(e2, e2), det = a11 * a22 - a12 * a12;
+        if (!(det > 0))
+            return false;
+        const Vec2* ru = &m_.uvs[3 * r];
+        for (std::size_t k = 0; k < 3; ++k) {
+            const Vec3 d = oc[k] - rc[0];
+            const double b1 = dot(d, e1), b2 = dot(d, e2);
+            const double l1 = (a22 * b1 - a12 * b2) / det, l2 = (a11 * b2 - a12 * b1) / det, l0 = 1 - l1 - l2;
+            const Vec2 want{l0 * ru[0].x + l1 * ru[1].x + l2 * ru[2].x,
+                            l0 * ru[0].y + l1 * ru[1].y + l2 * ru[2].y};
+            const Vec2& have = m_.uvs[3 * o + k];
+            const double tol = params_.uvTolerance * std::max({1.0, std::abs(have.x), std::abs(have.y)});
+            if (!(std::abs(want.x - have.x) <= tol) || !(std::abs(want.y - have.y) <= tol))
+                return false;
+        }
+    }
+    return true;
+}
+
+/// Every corner on the plane of the largest triangle and the texture coordinates one affine map (least
+/// squares), so tolerances cannot drift along a chain of compatible neighbours.
+bool Simplifier::flat(const std::vector<std::uint32_t>& tris) const {
+    std::uint32_t best = tris.front();
+    for (std::uint32_t t : tris)
+        if (lengthSquared(m_.triangleNormal(t)) > lengthSquared(m_.triangleNormal(best)))
+            best = t;
+    const Vec3 n = normalized(m_.triangleNormal(best)), o = m_.positions[m_.triangles[best][0]];
+    Vec3 u, v;
+    basisOf(n, u, v);
+    double s[3][3] = {}, su[3] = {}, sv[3] = {};
+    double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+    for (std::uint32_t t : tris)
+        for (std::size_t k = 0; k < 3; ++k) {
+            const Vec3 d = m_.positions[m_.triangles[t][k]] - o;
+            if (!(std::abs(dot(n, d)) <= planeTol_))
+                return false;
+            if (!m_.hasUvs())
+                continue;
+            const double q[3] = {dot(d, u), dot(d, v), 1};
+            const Vec2& uv = m_.uvs[3 * t + k];
+            for (int a = 0; a < 3; ++a) {
+                for (int b = 0; b < 3; ++b)
+                    s[a][b] += q[a] * q[b];
+                su[a] += q[a] * uv.x;
+                sv[a] += q[a] * uv.y;
+            }
+            lo[0] = std::min(lo[0], uv.x), hi[0] = std::max(hi[0], uv.x);
+            lo[1] = std::min(lo[1], uv.y), hi[1] = std::max(hi[1], uv.y);
+        }
+    if (!m_.hasUvs())
+        return true;
+    auto det3 = [](const double a[3][3]) {
+        return a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) -
+               a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
+               a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
+    };
+    const double d = det3(s);
+    if (!(std::abs(d) > 0))
+        return false;
+    auto solve = [&](const double rhs[3], double c[3]) { // Cramer's rule
+        for (int col = 0; col < 3; ++col) {
+            double a[3][3];
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j)
+                    a[i][j] = j == col ? rhs[i] : s[i][j];
+            c[col] = det3(a) / d;
+        }
+    };
+    double cu[3], cv[3];
+    solve(su, cu);
+    solve(sv, cv);
+    const double tol = params_.uvTolerance * std::max({1.0, hi[0] - lo[0], hi[1] - lo[1]});
+    for (std::uint32_t t : tris)
+        for (std::size_t k = 0; k < 3; ++k) {
+            const Vec3 dd = m_.positions[m_.triangles[t][k]] - o;
+            const double x = dot(dd, u), y = dot(dd, v);
+            const Vec2& uv = m_.uvs[3 * t + k];
+            if (!(std::abs(cu[0] * x + cu[1] * y + cu[2] - uv.x) <= tol) ||
+                !(std::abs(cv[0] * x + cv[1] * y + cv[2] - uv.y) <= tol))
+                return false;
+        }
+    return true;
+}
+
+bool Simplifier::removable(std::uint32_t v) const {
+    const auto it = star_.find(v);
+    if (it == star_.end())
+        return false;
+    const std::vector<std::uint32_t>& star = it->second;
+    // Walk the fan: from triangle t (corner k at v) to the triangle across its edge (previous corner → v).
+    std::vector<std::uint32_t> fan;
+    std::vector<bool> crease; // crease[i]: the edge between fan[i] and fan[i + 1] separates two regions
+    std::uint32_t t = star.front();
+    do {
+        const Tri& tri = m_.triangles[t];
+        const int k = tri[0] == v ? 0 : tri[1] == v ? 1 : 2;
+        const std::uint32_t next = twinTri(t, (k + 2) % 3);
+        if (next == kNone || fan.size() >= star.size())
+            return false;
+        fan.push_back(t);
+        crease.push_back(!compatible(t, next));
+        t = next;
+    } while (t != star.front());
+    if (fan.size() != star.size())
+        return false; // more than one fan: the surface touches itself here
+    const auto creases = std::count(crease.begin(), crease.end(), true);
+    if (creases == 0)
+        return flat(fan);
+    if (creases != 2)
+        return false;
+    // Two arcs; the vertex must lie between the far ends of the two crease edges.
+    std::vector<std::uint32_t> arcs[2], ends;
+    int arc = 0;
+    for (std::size_t i = 0; i < fan.size(); ++i) {
+        arcs[arc].push_back(fan[i]);
+        if (crease[i]) {
+            const Tri& tri = m_.triangles[fan[i]];
+            const int k = tri[0] == v ? 0 : tri[1] == v ? 1 : 2;
+            ends.push_back(tri[static_cast<std::size_t>((k + 2) % 3)]);
+            arc ^= 1;
+        }
+    }
+    const Vec3 &p = m_.positions[v], &a = m_.positions[ends[0]], &b = m_.positions[ends[1]];
+    const Vec3 d = b - a;
+    const double len2 = lengthSquared(d);
+    if (!(len2 > 0))
+        return false;
+    const double s = dot(p - a, d) / len2;
+    if (!(s > 0 && s < 1) || !(length(cross(p - a, d)) <= planeTol_ * std::sqrt(len2)))
+        return false;
+    // The first arc may continue at the end of the fan (it wrapped around).
+    return flat(arcs[0]) && flat(arcs[1]);
+}
+
+/// Triangulates a patch (compatible triangles around removed vertices) without those vertices.
+bool Simplifier::retriangulate(const std::vector<std::uint32_t>& patch, std::vector<Tri>& tris) const {
+    const std::unordered_set<std::uint32_t> in(patch.begin(), patch.end());
+    auto outside = [&](std::uint32_t t, int k) {
+        const std::uint32_t o = twinTri(t, k);
+        return o == kNone || !in.count(o);
+    };
+    // Boundary chains, from kept vertex to kept vertex.
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
+    std::unordered_set<std::uint64_t> constraint;
+    std::vector<std::uint32_t> ends;
+    for (std::uint32_t t : patch)
+        for (int k = 0; k < 3; ++k) {
+            const Tri& tri = m_.triangles[t];
+            const std::uint32_t a = tri[static_cast<std::size_t>(k)];
+            if (!outside(t, k) || removed_.count(a))
+                continue;
+            std::uint32_t x = tri[static_cast<std::size_t>((k + 1) % 3)];
+            std::size_t steps = 0;
+            while (removed_.count(x)) { // the one boundary edge of the patch leaving x
+                std::uint32_t next = kNone;
+                for (std::uint32_t s : star_.at(x)) {
+                    if (!in.count(s))
+                        continue;
+                    const Tri& st = m_.triangles[s];
+                    const int j = st[0] == x ? 0 : st[1] == x ? 1 : 2;
+                    if (outside(s, j)) {
+                        if (next != kNone)
+                            return false;
+                        next = st[static_cast<std::size_t>((j + 1) % 3)];
+                    }
+                }
+                if (next == kNone || ++steps > 3 * patch.size())
+                    return false;
+                x = next;
+            }
+            if (a == x || !constraint.insert(directed(a, x)).second || constraint.count(directed(x, a)))
+                return false;
+            edges.emplace_back(a, x);
+            ends.push_back(a);
+            ends.push_back(x);
+        }
+    if (edges.size() < 3)
+        return false;
+    std::sort(ends.begin(), ends.end());
+    ends.erase(std::unique(ends.begin(), ends.end()), ends.end());
+    for (std::uint32_t t : patch) // nothing kept inside
+        for (std::uint32_t v : m_.triangles[t])
+            if (!removed_.count(v) && !std::binary_search(ends.begin(), ends.end(), v))
+                return false;
+
+    std::uint32_t best = patch.front();
+    double before = 0;
+    for (std::uint32_t t : patch) {
+        before += length(m_.triangleNormal(t));
+        if (lengthSquared(m_.triangleNormal(t)) > lengthSquared(m_.triangleNormal(best)))
+            best = t;
+    }
+    Vec3 u, v;
+    basisOf(normalized(m_.triangleNormal(best)), u, v);
+    CDT cdt;
+    std::vector<CDT::Vertex_handle> handle(ends.size());
+    for (std::size_t i = 0; i < ends.size(); ++i) {
+        const Vec3& p = m_.positions[ends[i]];
+        const std::size_t count = cdt.number_of_vertices();
+        handle[i] = cdt.insert(K::Point_2(dot(p, u), dot(p, v)));
+        if (cdt.number_of_vertices() != count + 1)
+            return false; // two kept vertices project onto one point
+        handle[i]->info() = ends[i];
+    }
+    auto at = [&](std::uint32_t id) {
+        return handle[static_cast<std::size_t>(std::lower_bound(ends.begin(), ends.end(), id) -
+                                               ends.begin())];
+    };
+    for (const auto& [a, b] : edges)
+        cdt.insert_constraint(at(a), at(b));
+    if (cdt.number_of_vertices() != ends.size())
+        return false; // constraints cross
+
+    for (auto f = cdt.all_faces_begin(); f != cdt.all_faces_end(); ++f)
+        f->info() = -1;
+    std::vector<CDT::Face_handle> queue;
+    for (auto f = cdt.all_faces_begin(); f != cdt.all_faces_end(); ++f)
+        if (cdt.is_infinite(f)) {
+            f->info() = 0;
+            queue.push_back(f);
+        }
+    while (!queue.empty()) {
+        const CDT::Face_handle f = queue.back();
+        queue.pop_back();
+        for (int i = 0; i < 3; ++i) {
+            const CDT::Face_handle n = f->neighbor(i);
+            const CDT::Vertex_handle a = f->vertex(CDT::cw(i)), b = f->vertex(CDT::ccw(i));
+            const bool crosses = !cdt.is_infinite(a) && !cdt.is_infinite(b) &&
+                                 (constraint.count(directed(a->info(), b->info())) ||
+                                  constraint.count(directed(b->info(), a->info())));
+            const int state = f->info() ^ (crosses ? 1 : 0);
+            if (n->info() < 0) {
+                n->info() = state;
+                queue.push_back(n);
+            } else if (n->info() != state) {
+                return false;
+            }
+        }
+    }
+    // The new triangles: counter-clockwise, the same area, and every directed edge either inside (its reverse
+    // is there too) or one of the chains, each exactly once — so the patch closes up with its surroundings.
+    double area = 0;
+    std::unordered_map<std::uint64_t, int> used;
+    const std::size_t first = tris.size();
+    for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
+        if (f->info() != 1)
+            continue;
+        if (CGAL::orientation(f->vertex(0)->point(), f->vertex(1)->point(), f->vertex(2)->point()) !=
+            CGAL::LEFT_TURN)
+            return false;
+        const Tri t{f->vertex(0)->info(), f->vertex(1)->info(), f->vertex(2)->info()};
+        area +=
+            length(cross(m_.positions[t[1]] - m_.positions[t[0]], m_.positions[t[2]] - m_.positions[t[0]]));
+        for (std::size_t k = 0; k < 3; ++k)
+            ++used[directed(t[k], t[(k + 1) % 3])];
+        tris.push_back(t);
+    }
+    for (const auto& [e, n] : used) {
+        const bool chain = constraint.count(e) != 0;
+        const auto rev = used.find((e << 32) | (e >> 32));
+        if (n != 1 || chain == (rev != used.end()))
+            return false;
+    }
+    for (std::uint64_t e : constraint)
+        if (!used.count(e))
+            return false;
+    if (!(std::abs(area - before) <= 1e-7 * before) || tris.size() == first)
+        return false;
+    // The patch and its replacement share their boundary, so together they enclose a volume that must be nil.
+    const Vec3 o = m_.positions[ends.front()];
+    auto volume = [&](const Tri& t) {
+        return dot(m_.positions[t[0]] - o, cross(m_.positions[t[1]] - o, m_.positions[t[2]] - o));
+    };
+    double change = 0;
+    for (std::size_t i = first; i < tris.size(); ++i)
+        change += volume(tris[i]);
+    for (std::uint32_t t : patch)
+        change -= volume(m_.triangles[t]);
+    return std::abs(change) <= 1e-9 * before * diag_;
+}
+
+bool Simplifier::run(Mesh& result, PlanarSimplifyReport& report) {
+    const std::size_t nv = m_.positions.size(), nt = m_.triangles.size();
+    if (nt == 0 || (m_.hasUvs() && m_.uvs.size() != 3 * nt) ||
+        (m_.hasNormals() && m_.normals.size() != 3 * nt) || (m_.hasMaterials() && m_.materials.size() != nt))
+        return false;
+    for (const Tri& t : m_.triangles)
+        for (std::uint32_t v : t)
+            if (v >= nv)
+                return false;
+    diag_ = m_.bounds().diagonal();
+    planeTol_ = params_.planeTolerance * diag_;
+    const Aabb& focus = params_.focus;
+    const bool everywhere = focus.empty();
+
+    // Local triangles (a corner in the focus), their directed edges and the stars of focus vertices.
+    std::vector<std::uint32_t> local;
+    for (std::uint32_t t = 0; t < nt; ++t) {
+        const Tri& tri = m_.triangles[t];
+        bool any = everywhere;
+        for (std::size_t k = 0; k < 3 && !any; ++k)
+            any = focus.contains(m_.positions[tri[k]]);
+        if (!any)
+            continue;
+        local.push_back(t);
+        for (std::size_t k = 0; k < 3; ++k) {
+            if (tri[k] == tri[(k + 1) % 3] || !edgeTri_.emplace(directed(tri[k], tri[(k + 1) % 3]), t).second)
+                return false; // a repeated corner or directed edge: not a clean surface
+            if (everywhere || focus.contains(m_.positions[tri[k]]))
+                star_[tri[k]].push_back(t);
+        }
+    }
+
+    // Removable vertices, then patches; a patch that fails keeps its vertices and everything is redone.
+    std::vector<std::uint32_t> candidates;
+    for (const auto& [v, s] : star_)
+        candidates.push_back(v);
+    std::sort(candidates.begin(), candidates.end());
+    std::unordered_set<std::uint32_t> kept; // vertices a failed patch needs
+    std::vector<std::vector<std::uint32_t>> patches;
+    std::vector<std::vector<Tri>> fresh;
+    for (int round = 0;; ++round) {
+        removed_.clear();
+        for (std::uint32_t v : candidates)
+            if (!kept.count(v) && removable(v))
+                removed_.insert(v);
+        if (removed_.empty())
+            return false;
+        // Patches: the stars of removed vertices, split into edge-connected compatible groups.
+        std::vector<std::uint32_t> inPatch;
+        for (std::uint32_t v : removed_)
+            inPatch.insert(inPatch.end(), star_.at(v).begin(), star_.at(v).end());
+        std::sort(inPatch.begin(), inPatch.end());
+        inPatch.erase(std::unique(inPatch.begin(), inPatch.end()), inPatch.end());
+        std::unordered_map<std::uint32_t, std::uint32_t> group;
+        for (std::uint32_t t : inPatch)
+            group.emplace(t, kNone);
+        patches.clear();
+        for (std::uint32_t t : inPatch) {
+            if (group[t] != kNone)
+                continue;
+            const std::uint32_t id = static_cast<std::uint32_t>(patches.size());
+            patches.emplace_back(1, t);
+            group[t] = id;
+            for (std::size_t i = 0; i < patches[id].size(); ++i)
+                for (int k = 0; k < 3; ++k) {
+                    const std::uint32_t c = patches[id][i], o = twinTri(c, k);
+                    auto g = group.find(o);
+                    if (o != kNone && g != group.end() && g->second == kNone && compatible(c, o)) {
+                        g->second = id;
+                        patches[id].push_back(o);
+                    }
+                }
+            std::sort(patches[id].begin(), patches[id].end());
+        }
+        fresh.assign(patches.size(), {});
+        bool failed = false;
+        for (std::size_t p = 0; p < patches.size(); ++p)
+            if (!retriangulate(patches[p], fresh[p])) {
+                failed = true;
+                ++report.regionsKept;
+                for (std::uint32_t t : patches[p])
+                    for (std::uint32_t v : m_.triangles[t])
+                        kept.insert(v);
+            }
+        if (!failed)
+            break;
+        if (round == 8)
+            return false;
+    }
+
+    // Assemble: other triangles in input order; each patch's new triangles where its first triangle was.
+    std::vector<std::uint32_t> patchOf(nt, kNone);
+    for (std::size_t p = 0; p < patches.size(); ++p)
+        for (std::uint32_t t : patches[p])
+            patchOf[t] = static_cast<std::uint32_t>(p);
+    Mesh out;
+    out.materialNames = m_.materialNames;
+    out.triangles.reserve(nt);
+    out.materials.reserve(m_.materials.size());
+    out.uvs.reserve(m_.uvs.size());
+    out.normals.reserve(m_.normals.size());
+    std::vector<std::uint32_t> cornerOf(nv, kNone); // a corner of the patch at each vertex
+    auto emit = [&](const Tri& tri, std::uint32_t source, const std::uint32_t* corner) {
+        out.triangles.push_back(tri);
+        if (m_.hasMaterials())
+            out.materials.push_back(m_.materials[source]);
+        for (std::size_t k = 0; k < 3; ++k) {
+            const std::size_t c = corner ? corner[k] : 3 * source + k;
+            if (m_.hasUvs())
+                out.uvs.push_back(m_.uvs[c]);
+            if (m_.hasNormals())
+                out.normals.push_back(m_.normals[c]);
+        }
+    };
+    for (std::uint32_t t = 0; t < nt; ++t) {
+        const std::uint32_t p = patchOf[t];
+        if (p == kNone) {
+            emit(m_.triangles[t], t, nullptr);
+            continue;
+        }
+        if (patches[p].front() != t)
+            continue;
+        for (auto it = patches[p].rbegin(); it != patches[p].rend(); ++it) // the first corner wins
+            for (std::uint32_t k = 0; k < 3; ++k)
+                cornerOf[m_.triangles[*it][k]] = 3 * *it + k;
+        for (const Tri& tri : fresh[p]) {
+            const std::uint32_t corner[3] = {cornerOf[tri[0]], cornerOf[tri[1]], cornerOf[tri[2]]};
+            emit(tri, t, corner);
+        }
+        ++report.regionsRetriangulated;
+    }
+    // Drop the removed vertices (only those: the input's own unreferenced vertices stay).
+    std::vector<std::uint32_t> remap(nv, kNone);
+    out.positions.reserve(nv - removed_.size());
+    for (std::uint32_t v = 0; v < nv; ++v)
+        if (!removed_.count(v)) {
+            remap[v] = static_cast<std::uint32_t>(out.positions.size());
+            out.positions.push_back(m_.positions[v]);
+        }
+    for (Tri& tri : out.triangles)
+        for (std::uint32_t& v : tri)
+            v = remap[v];
+    report.verticesRemoved = removed_.size();
+    result = std::move(out);
+    return true;
+}
+
+} // namespace
+
+Mesh simplifyPlanarRegions(const Mesh& mesh, const PlanarSimplifyParams& params,
+                           PlanarSimplifyReport* report) {
+    PlanarSimplifyReport local;
+    PlanarSimplifyReport& rep = report ? *report : local;
+    rep = {};
+    rep.trianglesBefore = mesh.triangles.size();
+    Mesh out;
+    if (!Simplifier(mesh, params).run(out, rep)) {
+        rep = {};
+        rep.trianglesBefore = rep.trianglesAfter = mesh.triangles.size();
+        rep.unchanged = true;
+        return mesh;
+    }
+    rep.trianglesAfter = out.triangles.size();
+    return out;
+}
+
+} // namespace rubble
