@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <map>
 
 #include "rubble/Fracture.hpp"
 #include "rubble/MassProperties.hpp"
@@ -65,6 +66,41 @@ TEST(PieceSimplification, RepeatedHitsKeepTheRemainderSmall) {
             EXPECT_LT(peak, 2500u);
         }
     }
+}
+
+/// Texture coordinates of a crater's faces stay when the piece is hit elsewhere later (they used to be
+/// re-projected onto whichever plane of the new cells was nearest).
+TEST(PieceSimplification, AnEarlierCratersTextureStays) {
+    const Mesh box = makeBox({-2, -1, -1}, {2, 1, 1});
+    FractureParams p;
+    auto first = fracture(box, Impact{{-2, 0, 0}, {-1, 0, 0}, 20}, p, 3);
+    ASSERT_TRUE(first);
+    const Mesh& r1 = first->pieces[0].mesh;
+    auto second = fracture(r1, Impact{{2, 0, 0}, {1, 0, 0}, 20}, p, 4);
+    ASSERT_TRUE(second);
+    const Mesh& r2 = second->pieces[0].mesh;
+    std::map<std::array<double, 9>, std::array<double, 6>> before;
+    auto key = [](const Mesh& m, std::size_t t) {
+        const auto c = m.corners(t);
+        return std::array<double, 9>{c[0].x, c[0].y, c[0].z, c[1].x, c[1].y, c[1].z, c[2].x, c[2].y, c[2].z};
+    };
+    auto uv = [](const Mesh& m, std::size_t t) {
+        return std::array<double, 6>{m.uvs[3 * t].x,     m.uvs[3 * t].y,     m.uvs[3 * t + 1].x,
+                                     m.uvs[3 * t + 1].y, m.uvs[3 * t + 2].x, m.uvs[3 * t + 2].y};
+    };
+    for (std::size_t t = 0; t < r1.triangleCount(); ++t)
+        if (r1.material(t) == kInteriorMaterial)
+            before[key(r1, t)] = uv(r1, t);
+    ASSERT_FALSE(before.empty());
+    std::size_t same = 0;
+    for (std::size_t t = 0; t < r2.triangleCount(); ++t) {
+        const auto it = before.find(key(r2, t));
+        if (r2.material(t) != kInteriorMaterial || it == before.end())
+            continue;
+        ++same;
+        EXPECT_EQ(uv(r2, t), it->second) << "triangle " << t;
+    }
+    EXPECT_GT(same, 0u); // the first crater is still there
 }
 
 } // namespace
