@@ -64,8 +64,12 @@ struct TimingRecord {
     double totalMs = 0;         ///< submission → adopted
     int pieces = 0;             ///< pieces produced
     bool stale = false;         ///< discarded because the object changed meanwhile
-    bool failed = false;        ///< the fracture failed (e.g. its cells missed the mesh): the object stays
-                                ///< and impacts that waited on the job are retried
+    bool missed = false; ///< the impact's cells did not intersect the mesh (ErrorCode::NoIntersection, e.g.
+                         ///< an impact that waited on an in-flight job and was re-targeted to a piece while
+                         ///< its point lies in the removed crater): nothing to break, the object stays and
+                         ///< impacts that waited on the job are retried. Not a failure.
+    bool failed = false; ///< the fracture failed on the geometry (any other error): the object stays and
+                         ///< impacts that waited on the job are retried
 };
 
 /// A fracture ready to adopt: the parent object is replaced by the pieces.

@@ -55,6 +55,7 @@ struct Job {
     // outputs (written by the worker, read by the main thread after `finished` under Sync::mutex)
     bool finished = false;
     bool ok = false;
+    ErrorCode errorCode = ErrorCode::Ok;
     std::string error;
     FractureResult result;
     std::vector<Frame> frames;
@@ -83,7 +84,7 @@ ConvexPolytope toLocal(const ConvexPolytope& p, const Frame& f) {
 // Physics engines report contact points off the surface (a predictive CCD contact gives the projectile's
 // centre at the time of impact, a margin adds a few centimetres): the cells are centred on the nearest
 // surface point so that they always cut the mesh. A point farther away than the impact's cell domain is
-// left alone (such an impact is not a contact; its job fails with NoIntersection).
+// left alone (such an impact is not a contact; its job ends with NoIntersection and is recorded as a miss).
 Impact onSurface(const Mesh& mesh, Impact impact, const FractureParams& params) {
     double best = std::numeric_limits<double>::infinity();
     Vec3 closest = impact.point;
@@ -127,6 +128,7 @@ void runJob(Job& job) {
         r = fractureWithCells(job.mesh, cells, job.params);
     }
     if (!r) {
+        job.errorCode = r.error().code;
         job.error = r.error().message;
         return;
     }
@@ -441,11 +443,13 @@ std::vector<FractureOutcome> DestructionWorld::collect() {
             later.clear();
             rec.pieces = static_cast<int>(o.pieces.size());
             out.push_back(std::move(o));
+        } else if (job->errorCode == ErrorCode::NoIntersection) {
+            rec.missed = true; // nothing of the mesh inside the cells: a miss, not a failure
         } else {
             rec.failed = true;
         }
-        // A failed or stale job: impacts that waited on it run now on the (unchanged) object if it still
-        // exists.
+        // A missed, failed or stale job: impacts that waited on it run now on the (unchanged) object if it
+        // still exists.
         const bool relaunch = !later.empty() && im.objects.count(job->id) > 0;
         if (relaunch)
             im.launch(job->id, std::move(later));
@@ -478,12 +482,12 @@ Status DestructionWorld::writeTimingsCsv(const std::filesystem::path& path) cons
         return Error{ErrorCode::IoError, "cannot write " + path.string()};
     f << "object,frame,impacts_merged,queue_ms,cell_ms,boolean_ms,islands_ms,decomposition_ms,adoption_ms,"
          "total_ms,"
-         "pieces,stale,failed\n";
+         "pieces,stale,failed,missed\n";
     for (const auto& r : impl_->timings)
         f << r.object << ',' << r.frame << ',' << r.impactsMerged << ',' << r.queueMs << ',' << r.cellMs
           << ',' << r.booleanMs << ',' << r.islandsMs << ',' << r.decompositionMs << ',' << r.adoptionMs
           << ',' << r.totalMs << ',' << r.pieces << ',' << (r.stale ? 1 : 0) << ',' << (r.failed ? 1 : 0)
-          << '\n';
+          << ',' << (r.missed ? 1 : 0) << '\n';
     if (!f)
         return Error{ErrorCode::IoError, "write failed: " + path.string()};
     return Status::ok();

@@ -32,6 +32,10 @@ TimingSummary summarizeTimings(const std::vector<TimingRecord>& records) {
             ++out.stale;
             continue;
         }
+        if (r.missed) {
+            ++out.missed;
+            continue;
+        }
         if (r.failed) {
             ++out.failed;
             continue;
@@ -63,7 +67,8 @@ std::string formatTimingSummary(const TimingSummary& s) {
                       st.max);
         out += line;
     };
-    std::snprintf(line, sizeof line, "%d records, %d stale, %d failed\n", s.records, s.stale, s.failed);
+    std::snprintf(line, sizeof line, "%d records, %d stale, %d missed, %d failed\n", s.records, s.stale,
+                  s.missed, s.failed);
     out += line;
     add("queue", s.queue);
     add("cell", s.cell);

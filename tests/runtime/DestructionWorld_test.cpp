@@ -124,12 +124,12 @@ TEST(DestructionWorld, ImpactsDuringJobAreMergedNotLost) {
     EXPECT_EQ(handled, 3);
 }
 
-TEST(DestructionWorld, ImpactsWaitingOnAFailedJobAreMergedIntoOneJob) {
+TEST(DestructionWorld, ImpactsWaitingOnAMissedJobAreMergedIntoOneJob) {
     HeldJobs jobs;
     DestructionWorld w(heldConfig(jobs));
     auto id = w.addObject(boxDesc()).value();
     Impact miss = centreHit();
-    miss.point = {50, 50, 50}; // the cells miss the mesh: the job fails and the object stays
+    miss.point = {50, 50, 50}; // the cells miss the mesh: the job misses and the object stays
     ASSERT_TRUE(w.submitImpact(id, miss));
     Impact j = centreHit();
     j.point = {1, 0, 0};
@@ -150,7 +150,9 @@ TEST(DestructionWorld, ImpactsWaitingOnAFailedJobAreMergedIntoOneJob) {
     ASSERT_EQ(out.size(), 1u);
     EXPECT_EQ(out[0].impacts.size(), 2u);
     ASSERT_EQ(w.timings().size(), 2u);
-    EXPECT_TRUE(w.timings()[0].failed);
+    EXPECT_TRUE(w.timings()[0].missed);
+    EXPECT_FALSE(w.timings()[0].failed) << "a miss is not a geometry failure";
+    EXPECT_FALSE(w.timings()[1].missed);
     EXPECT_FALSE(w.timings()[1].failed);
     EXPECT_EQ(w.timings()[1].impactsMerged, 2);
     double v = out[0].droppedVolume;
@@ -381,6 +383,47 @@ TEST(DestructionWorld, RemovedPiecesLeaveNoStateBehindOverChainedFractures) {
     }
     EXPECT_GE(fractures, rounds / 2);
     EXPECT_NEAR(w.object(live)->mass.volume + removed + dropped, v0, 1e-9 * v0);
+}
+
+// An impact that waited on an in-flight job is re-targeted to the nearest piece; when its point lies deep in
+// the crater the first job cut, farther from the remaining surface than its own cell reaches, its cells miss
+// the mesh: a miss (the object stays), not a geometry failure.
+TEST(DestructionWorld, ReTargetedImpactInTheCraterIsAMissNotAFailure) {
+    HeldJobs jobs;
+    DestructionWorld w(heldConfig(jobs));
+    ObjectDesc d = boxDesc();  // [-1, 1]^3
+    d.fracture.seedPoints = 0; // the cell is the whole domain: a cube of edge sizeFor(impulse) at the point
+    d.fracture.sizeLaw.base = 0.05;
+    d.fracture.sizeLaw.scale = 0.05;
+    auto id = w.addObject(d).value();
+    Impact big = centreHit(); // (0, 0, 1)
+    big.impulse = 400;        // cube of edge 1.05: everything within 0.525 of the point is cut away
+    ASSERT_TRUE(w.submitImpact(id, big));
+    Impact small = centreHit();
+    small.point = {0, 0, 0.9};              // in the crater, ≥ 0.425 from what remains
+    small.impulse = 1;                      // cube of edge 0.1: reaches 0.1 at most
+    ASSERT_TRUE(w.submitImpact(id, small)); // waits for the first job
+    jobs.runAll();
+    w.beginFrame();
+    const auto out = w.collect();
+    ASSERT_EQ(out.size(), 1u);
+    ObjectId largest = 0;
+    for (ObjectId p : out[0].pieces)
+        if (!largest || w.object(p)->mass.volume > w.object(largest)->mass.volume)
+            largest = p;
+    ASSERT_EQ(w.jobsInFlight(), 1); // the waiting impact, re-targeted
+    jobs.runAll();
+    w.beginFrame();
+    EXPECT_TRUE(w.collect().empty());
+    ASSERT_EQ(w.timings().size(), 2u);
+    const TimingRecord& r = w.timings()[1];
+    EXPECT_EQ(r.object, largest) << "re-targeted to the remainder, whose bounds contain the point";
+    EXPECT_TRUE(r.missed);
+    EXPECT_FALSE(r.failed);
+    EXPECT_FALSE(r.stale);
+    EXPECT_EQ(r.pieces, 0);
+    EXPECT_NE(w.object(largest), nullptr) << "a miss leaves the object as it was";
+    EXPECT_FALSE(w.timings()[0].missed);
 }
 
 } // namespace
