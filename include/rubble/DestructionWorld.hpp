@@ -2,6 +2,7 @@
 /// \file DestructionWorld.hpp
 /// The engine-agnostic runtime: impacts in, fracture jobs on a JobSystem, versioned results out.
 
+#include <chrono>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
@@ -129,6 +130,11 @@ public:
     /// Results ready for adoption this frame (within the adoption budget). Pieces are added to the world and
     /// the parent removed before this returns; the caller replaces its bodies accordingly.
     std::vector<FractureOutcome> collect();
+    /// Blocks until a finished job waits for collect() or until deadline passes; true when one does. For
+    /// adopting results in the main thread's idle time between frames (collect() may be called again in
+    /// the same frame). Returns false at once when no job is in flight, and always in deterministic mode,
+    /// where adoption stays bound to frames so that replays are identical. A deadline in the past polls.
+    bool waitForResult(std::chrono::steady_clock::time_point deadline);
     /// Blocks until no job is in flight or queued (for tools, tests and shutdown).
     void waitIdle();
 

@@ -463,6 +463,18 @@ std::vector<FractureOutcome> DestructionWorld::collect() {
     return out;
 }
 
+bool DestructionWorld::waitForResult(Clock::time_point deadline) {
+    Impl& im = *impl_;
+    if (im.config.deterministic || im.inflight.empty())
+        return false;
+    // Only the main thread launches or removes jobs, so `inflight` is stable while this waits; `finished` is
+    // written by the workers under the mutex and read here under it.
+    std::unique_lock lock(im.sync->mutex);
+    return im.sync->done.wait_until(lock, deadline, [&] {
+        return std::any_of(im.inflight.begin(), im.inflight.end(), [](const auto& j) { return j->finished; });
+    });
+}
+
 void DestructionWorld::waitIdle() {
     std::unique_lock lock(impl_->sync->mutex);
     impl_->sync->done.wait(lock, [&] { return impl_->sync->outstanding == 0; });

@@ -9,6 +9,7 @@
 #include <future>
 #include <map>
 #include <optional>
+#include <thread>
 
 #include "TestSupport.hpp"
 
@@ -26,8 +27,9 @@ namespace {
 
 struct Rig {
     explicit Rig(bool gravity = true, int workers = 1, bool deterministic = true,
-                 DestructionBridge::Config bc = {}) {
+                 DestructionBridge::Config bc = {}, JobSystem* jobs = nullptr) {
         DestructionWorld::Config dc;
+        dc.jobs = jobs;
         dc.workers = workers;
         dc.deterministic = deterministic;
         dc.seed = 7;
@@ -73,6 +75,27 @@ Frame rotatedFrame(const Vec3& t) {
     Rng rng(3);
     return Frame{rng.rotation(), t};
 }
+
+// Runs each job on a thread of its own, but only once the test releases it (it decides when a result can be
+// ready). Declare it before the Rig: its destructor joins the threads.
+class GatedJobs final : public JobSystem {
+public:
+    ~GatedJobs() override {
+        for (auto& t : threads_)
+            t.join();
+    }
+    void submit(std::function<void()> job) override { held_.push_back(std::move(job)); }
+    int workerCount() const override { return 1; }
+    void release() {
+        for (auto& j : held_)
+            threads_.emplace_back(std::move(j));
+        held_.clear();
+    }
+
+private:
+    std::vector<std::function<void()>> held_; // only touched by the test's thread
+    std::vector<std::thread> threads_;
+};
 
 struct ParentSnapshot {
     double mass = 0;
@@ -207,11 +230,20 @@ TEST(DestructionBridge, DebugDrawHasShapesAabbsAndImpactCrosses) {
 
 namespace {
 
+// How runShootingScene adopts between frames.
+struct IdleAdoption {
+    bool deterministic = true; ///< the world's mode
+    bool call = false;         ///< after each frame: wait for the jobs, then waitForResult + adoptReady
+    long long waitedFor = 0;   ///< out: waitForResult returned true
+    long long adoptedIdle = 0; ///< out: fractures adoptReady adopted
+};
+
 // A small seeded shooting scene; returns the final state hash and volume error.
-std::pair<std::uint64_t, double> runShootingScene(int workers, int maxPieces = 400, int* maxSeen = nullptr) {
+std::pair<std::uint64_t, double> runShootingScene(int workers, int maxPieces = 400, int* maxSeen = nullptr,
+                                                  IdleAdoption* idle = nullptr) {
     DestructionBridge::Config bc;
     bc.maxLivePieces = maxPieces;
-    Rig rig(true, workers, true, bc);
+    Rig rig(true, workers, idle ? idle->deterministic : true, bc);
     rig.bridge->addGround({0, -0.5, 0}, {50, 0.5, 50});
     rig.addBox({1, 1, 1}, Frame{Mat3::identity(), {0, 1, 0}}, 500, true);
     rig.addBox({0.5, 1.5, 0.5}, Frame{Mat3::identity(), {4, 1.5, 0}}, 300);
@@ -225,6 +257,15 @@ std::pair<std::uint64_t, double> runShootingScene(int workers, int maxPieces = 4
             rig.bridge->fireProjectile(target + Vec3{0, 3, 15}, Vec3{0, -3, -15} * 8, 2, 0.15);
         }
         rig.bridge->stepFrame();
+        if (idle && idle->call) {
+            rig.destruction->waitIdle(); // every job done: whatever can be adopted now is ready
+            while (
+                rig.destruction->waitForResult(std::chrono::steady_clock::now() + std::chrono::seconds(5))) {
+                ++idle->waitedFor;
+                idle->adoptedIdle += rig.bridge->adoptReady().fractures;
+            }
+            idle->adoptedIdle += rig.bridge->adoptReady().fractures; // must be a no-op when nothing is ready
+        }
         seen = std::max(seen, rig.bridge->livePieces());
     }
     if (maxSeen)
@@ -239,6 +280,54 @@ TEST(DestructionBridge, DeterministicAcrossWorkerCounts) {
     const auto one = runShootingScene(1);
     const auto two = runShootingScene(2);
     EXPECT_EQ(one.first, two.first);
+}
+
+TEST(DestructionBridge, DeterministicModeIgnoresIdleAdoption) {
+    IdleAdoption idle;
+    idle.call = true;
+    const auto with = runShootingScene(2, 400, nullptr, &idle);
+    EXPECT_EQ(idle.waitedFor, 0);
+    EXPECT_EQ(idle.adoptedIdle, 0);
+    EXPECT_EQ(with.first, runShootingScene(2).first);
+}
+
+TEST(DestructionBridge, IdleAdoptionKeepsVolumeAndThePieceCap) {
+    // Non-deterministic mode with every result adopted between frames, as soon as it is ready.
+    IdleAdoption idle;
+    idle.deterministic = false;
+    idle.call = true;
+    int seen = 0;
+    const auto r = runShootingScene(2, 5, &seen, &idle);
+    EXPECT_GT(idle.adoptedIdle, 0);
+    EXPECT_LE(seen, 5);
+    EXPECT_LT(r.second, 1e-6);
+}
+
+// Issue #5: with idle adoption, a fracture whose job finishes after stepFrame's collect is adopted before the
+// next stepFrame (impact → adopted within the frame of the impact), not at the next one.
+TEST(DestructionBridge, IdleAdoptionAdoptsBeforeTheNextStepFrame) {
+    GatedJobs jobs;
+    Rig rig(false, 1, false, {}, &jobs);
+    const ObjectId id = rig.addBox({0.5, 0.5, 0.5}, Frame{Mat3::identity(), {0, 0, 0}}, 100);
+    rig.bridge->fireProjectile({-10, 0, 0.1}, {100, 0, 0}, 1, 0.1);
+    for (int i = 0; i < 60 && rig.bridge->counters().impacts == 0; ++i)
+        rig.bridge->stepFrame();
+    ASSERT_EQ(rig.bridge->counters().impacts, 1);
+    ASSERT_EQ(rig.bridge->counters().fractures, 0); // the job was held through stepFrame's collect
+    const std::uint64_t frame = rig.bridge->counters().frames;
+    EXPECT_EQ(rig.bridge->adoptReady().fractures, 0) << "nothing ready yet";
+    jobs.release(); // the job finishes in the idle time after the frame
+    ASSERT_TRUE(rig.destruction->waitForResult(std::chrono::steady_clock::now() + std::chrono::minutes(1)));
+    const FrameStats s = rig.bridge->adoptReady();
+    EXPECT_EQ(s.fractures, 1);
+    EXPECT_GE(s.piecesCreated + s.piecesRetired, 2);
+    EXPECT_EQ(rig.bridge->counters().fractures, 1);
+    EXPECT_EQ(rig.bridge->counters().frames, frame) << "no stepFrame in between";
+    EXPECT_EQ(rig.bridge->bodyOf(id), nullptr);
+    ASSERT_EQ(rig.destruction->timings().size(), 1u);
+    // stepFrame submits impacts just before DestructionWorld::beginFrame: the record carries the frame before
+    EXPECT_EQ(rig.destruction->timings()[0].frame + 1, rig.destruction->frame());
+    EXPECT_EQ(rig.bridge->adoptReady().fractures, 0) << "nothing left to adopt";
 }
 
 TEST(DestructionBridge, VolumeIsConservedThroughFracturesAndRetirement) {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include "TestSupport.hpp"
@@ -383,6 +384,54 @@ TEST(DestructionWorld, RemovedPiecesLeaveNoStateBehindOverChainedFractures) {
     }
     EXPECT_GE(fractures, rounds / 2);
     EXPECT_NEAR(w.object(live)->mass.volume + removed + dropped, v0, 1e-9 * v0);
+}
+
+// Idle adoption: a finished job is reported to the waiting main thread, which can adopt it in the same frame.
+TEST(DestructionWorld, WaitForResultReportsAFinishedJobForAdoptionInTheSameFrame) {
+    DestructionWorld::Config cfg;
+    cfg.workers = 1;
+    DestructionWorld w(cfg);
+    const auto soon = [] { return std::chrono::steady_clock::now() + std::chrono::minutes(1); };
+    EXPECT_FALSE(w.waitForResult(soon())) << "nothing in flight: returns at once";
+    auto id = w.addObject(boxDesc()).value();
+    w.beginFrame();
+    ASSERT_TRUE(w.submitImpact(id, centreHit()));
+    ASSERT_TRUE(w.waitForResult(soon()));
+    const auto out = w.collect(); // no beginFrame in between: the frame of the impact
+    ASSERT_EQ(out.size(), 1u);
+    EXPECT_EQ(out[0].parent, id);
+    ASSERT_EQ(w.timings().size(), 1u);
+    EXPECT_EQ(w.timings()[0].frame, w.frame());
+    EXPECT_FALSE(w.waitForResult(soon()));
+}
+
+TEST(DestructionWorld, WaitForResultTimesOutWhileTheJobHasNotRun) {
+    HeldJobs jobs;
+    DestructionWorld w(heldConfig(jobs));
+    auto id = w.addObject(boxDesc()).value();
+    ASSERT_TRUE(w.submitImpact(id, centreHit()));
+    EXPECT_FALSE(w.waitForResult(std::chrono::steady_clock::now() + std::chrono::milliseconds(20)));
+    EXPECT_FALSE(w.waitForResult(std::chrono::steady_clock::now() - std::chrono::seconds(1))); // a poll
+    jobs.runAll();
+    EXPECT_TRUE(w.waitForResult(std::chrono::steady_clock::now() - std::chrono::seconds(1)));
+    EXPECT_EQ(w.collect().size(), 1u);
+}
+
+TEST(DestructionWorld, WaitForResultIsAlwaysFalseInDeterministicMode) {
+    DestructionWorld::Config cfg;
+    cfg.workers = 1;
+    cfg.deterministic = true;
+    cfg.delayFrames = 2;
+    DestructionWorld w(cfg);
+    auto id = w.addObject(boxDesc()).value();
+    ASSERT_TRUE(w.submitImpact(id, centreHit()));
+    w.waitIdle(); // finished, but not due before frame 2
+    EXPECT_FALSE(w.waitForResult(std::chrono::steady_clock::now() + std::chrono::minutes(1)));
+    w.beginFrame();
+    EXPECT_TRUE(w.collect().empty());
+    EXPECT_TRUE(w.collect().empty()) << "collect() again in the same frame adopts nothing early";
+    w.beginFrame();
+    EXPECT_EQ(w.collect().size(), 1u);
 }
 
 // An impact that waited on an in-flight job is re-targeted to the nearest piece; when its point lies deep in

@@ -699,17 +699,31 @@ FrameStats DestructionBridge::stepFrame(double dt) {
     if (config_.collapseUnsupported)
         classifyStaticObjects(stats);
     stats.supportMs += msSince(t2);
+    adoptResults(stats);
+    advanceParticlesAndProjectiles(dt);
+    stats.adoptMs = msSince(t1);
+    return stats;
+}
+
+void DestructionBridge::adoptResults(FrameStats& stats) {
     for (const FractureOutcome& o : destruction_.collect())
         adopt(o, stats);
     retireExcess(stats);
-    const auto t3 = Clock::now();
+    const auto t0 = Clock::now();
     if (config_.collapseUnsupported)
         settleSupport(stats); // what retirement left unsupported, and what earlier frames left queued
     else
         supportQueue_.clear();
-    stats.supportMs += msSince(t3);
-    advanceParticlesAndProjectiles(dt);
-    stats.adoptMs = msSince(t1);
+    stats.supportMs += msSince(t0);
+}
+
+FrameStats DestructionBridge::adoptReady() {
+    FrameStats stats;
+    const auto t0 = Clock::now();
+    if (!destruction_.waitForResult(t0)) // nothing ready, or deterministic: adoption is frame-bound
+        return stats;
+    adoptResults(stats);
+    stats.adoptMs = msSince(t0);
     return stats;
 }
 

@@ -125,6 +125,12 @@ public:
     /// One frame: physics step of dt (fixed internal steps), impacts gathered and submitted,
     /// DestructionWorld::beginFrame() and collect(), outcomes adopted, pieces retired, particles advanced.
     FrameStats stepFrame(double dt = 1.0 / 60);
+    /// Adopts the results that are ready now, between frames (the adoption half of stepFrame: collect,
+    /// adopt, retire excess pieces, settle support within what is left of the frame's support budget), so
+    /// that pieces appear in the frame in which their job finished instead of at the next stepFrame. Does
+    /// nothing when no result is ready (DestructionWorld::waitForResult with a past deadline), hence nothing
+    /// in deterministic mode. Fills fractures, pieces*, support* and adoptMs of the returned stats.
+    FrameStats adoptReady();
 
     /// The body of an object, or null.
     Body* bodyOf(ObjectId id);
@@ -180,6 +186,7 @@ private:
     void preTick();
     void postTick();
     void submitImpacts(FrameStats& stats);
+    void adoptResults(FrameStats& stats);
     void adopt(const FractureOutcome& outcome, FrameStats& stats);
     void retire(std::uint64_t handle, FrameStats& stats);
     void retireExcess(FrameStats& stats);
