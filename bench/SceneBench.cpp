@@ -1,16 +1,32 @@
 // `rubble-bench scene FILE.cfg [--seconds T | --frames N] [--shots-per-second R] [--workers W] [--seed S]
-//  [--deterministic] [--unpaced] [--json] [--timings-csv FILE] [--frames-csv FILE] [--append-csv FILE]`
+//  [--deterministic] [--unpaced] [--no-idle-adoption] [--json] [--timings-csv FILE] [--frames-csv FILE]
+//  [--append-csv FILE]`
 //
 // Headless destruction run of a world.cfg scene through the Bullet adapter: seeded projectiles at the
 // destructible objects (target chosen with probability ∝ volume, aim point uniform in the central 80% of its
 // bounding box), fixed 1/60 s frames paced at 60 Hz wall clock like a game (--unpaced: back to back), no
 // rendering. Frame time = wall time of the main-thread frame (shooting + physics + impact gathering +
-// adoption). Reports frames, frame_ms, impacts, fractures, latency_ms (impact → adopted, wall clock, from
-// DestructionWorld timings), pieces_alive, volume_error (|live + retired + dropped − start| / start),
-// state_hash (of the final sorted piece set; reproducible in --deterministic mode) and peak_rss_mb. --json
-// prints exactly those keys; the table adds the physics and adoption shares of the frame and the fracture
-// stages. --append-csv adds one summary row to a CSV (header when the file is new), e.g.
-// bench/results/scene.csv.
+// adoption at the start of the frame).
+//
+// Idle adoption (paced, not --deterministic): after its frame the main thread does not sleep until the next
+// 1/60 s tick but waits for fracture results until the tick (DestructionWorld::waitForResult) and adopts each
+// as it arrives (DestructionBridge::adoptReady), like a game that adopts right before rendering; a result is
+// then adopted in the frame in which its job finished instead of at the start of the next one. That work is
+// not part of the frame time: it is reported separately as "idle adoption" (per frame: milliseconds spent
+// adopting in the idle time after it; the table's row, idle_adopt_ms in --frames-csv, idle_adoption_ms and
+// fractures_idle in --json). --no-idle-adoption sleeps until the tick instead (adoption only at the start of
+// a frame, the behaviour before idle adoption; for A/B runs). --unpaced and --deterministic adopt only in
+// stepFrame (deterministic adoption is frame-bound so that replays are identical).
+//
+// Reports frames, frame_ms, impacts, fractures, latency_ms (impact → adopted, wall clock, from
+// DestructionWorld timings: nearest-rank percentiles over the jobs whose pieces were adopted; stale, missed
+// and failed jobs are counted, not timed — see TimingSummary), pieces_alive, volume_error (|live + retired +
+// dropped − start| / start), state_hash (of the final sorted piece set; reproducible in --deterministic mode)
+// and peak_rss_mb. A miss is a job whose cells did not intersect the mesh (e.g. an impact re-targeted to a
+// piece while its point lies in the crater); a failure is a geometry failure. --json prints those keys and
+// the counts and idle-adoption figures; the table adds the physics and adoption shares of the frame and the
+// fracture stages. --append-csv adds one summary row to a CSV (header when the file is new), e.g.
+// bench/results/scene.csv (its columns are unchanged: no missed/failed or idle adoption columns).
 #include "Subcommand.hpp"
 
 #if defined(RUBBLE_HAVE_BULLET)
@@ -47,8 +63,9 @@ struct SceneArgs {
     int workers = -1;
     std::uint64_t seed = 1;
     bool deterministic = false;
-    long frames = 0;      // > 0: overrides seconds
-    bool unpaced = false; // run frames back to back instead of at 60 Hz wall clock
+    long frames = 0;             // > 0: overrides seconds
+    bool unpaced = false;        // run frames back to back instead of at 60 Hz wall clock
+    bool noIdleAdoption = false; // paced: sleep until the tick instead of adopting results as they arrive
     bool json = false;
     std::string timingsCsv;
     std::string framesCsv;
@@ -148,16 +165,20 @@ int runScene(const SceneArgs& a) {
     Rng rng(mixSeed(a.seed, 0x5CE7E));
     const double dt = 1.0 / 60;
     const long frames = a.frames > 0 ? a.frames : std::max(1L, std::lround(a.seconds * 60));
-    std::vector<double> frameMs, physicsMs, adoptMs, supportMs;
+    std::vector<double> frameMs, physicsMs, adoptMs, supportMs, idleAdoptMs;
     frameMs.reserve(static_cast<std::size_t>(frames));
+    idleAdoptMs.reserve(static_cast<std::size_t>(frames));
     std::ofstream framesOut;
     if (!a.framesCsv.empty()) {
         framesOut.open(a.framesCsv);
         if (!framesOut)
             std::cerr << "rubble-bench scene: cannot write " << a.framesCsv << "\n";
-        framesOut << "frame,frame_ms,physics_ms,adopt_ms,bodies,pieces_alive,jobs_in_flight,fractures\n";
+        framesOut << "frame,frame_ms,physics_ms,adopt_ms,idle_adopt_ms,bodies,pieces_alive,jobs_in_flight,"
+                     "fractures\n";
     }
+    const bool idleAdoption = !a.unpaced && !a.noIdleAdoption && !a.deterministic;
     long shots = 0;
+    long long idleFractures = 0;
     int maxPieces = 0;
     const auto runStart = std::chrono::steady_clock::now();
     const auto period =
@@ -180,13 +201,27 @@ int runScene(const SceneArgs& a) {
         if (fs.fractures > 0) // structural-collapse checks, per adopted outcome
             supportMs.push_back(fs.supportMs / fs.fractures);
         frameMs.push_back(ms);
+        // the idle rest of this frame: adopt results as they arrive until the next tick
+        double idleMs = 0;
+        if (idleAdoption) {
+            const auto next = runStart + period * (f + 1);
+            while (std::chrono::steady_clock::now() < next && destruction.waitForResult(next)) {
+                const FrameStats is = bridge.adoptReady();
+                idleMs += is.adoptMs;
+                idleFractures += is.fractures;
+                if (is.fractures > 0)
+                    supportMs.push_back(is.supportMs / is.fractures);
+            }
+        }
+        idleAdoptMs.push_back(idleMs);
         maxPieces = std::max(maxPieces, bridge.livePieces());
         if (framesOut)
-            framesOut << f << ',' << ms << ',' << fs.physicsMs << ',' << fs.adoptMs << ','
+            framesOut << f << ',' << ms << ',' << fs.physicsMs << ',' << fs.adoptMs << ',' << idleMs << ','
                       << bridge.bodyCount() << ',' << bridge.livePieces() << ',' << destruction.jobsInFlight()
                       << ',' << bridge.counters().fractures << '\n';
     }
-    // per-impact stages: the runtime's own summary (nearest-rank percentiles, stale records excluded)
+    // per-impact stages: the runtime's own summary (nearest-rank percentiles over adopted jobs; stale, missed
+    // and failed records are counted only)
     const TimingSummary ts = summarizeTimings(destruction.timings());
     const double volumeError =
         startVolume > 0 ? std::abs(bridge.totalVolume() - startVolume) / startVolume : 0;
@@ -231,6 +266,13 @@ int runScene(const SceneArgs& a) {
         j["impacts"] = c.impacts;
         j["fractures"] = c.fractures;
         j["latency_ms"] = {{"p50", ts.total.p50}, {"p99", ts.total.p99}, {"max", ts.total.max}};
+        j["stale"] = ts.stale;
+        j["missed"] = ts.missed;
+        j["failed"] = ts.failed;
+        j["fractures_idle"] = idleFractures;
+        j["idle_adoption_ms"] = {{"p50", percentile(idleAdoptMs, 0.5)},
+                                 {"p99", percentile(idleAdoptMs, 0.99)},
+                                 {"max", percentile(idleAdoptMs, 1.0)}};
         j["pieces_alive"] = bridge.livePieces();
         j["shots"] = shots;
         j["pieces_retired"] = c.piecesRetired;
@@ -255,9 +297,14 @@ int runScene(const SceneArgs& a) {
         std::cout << j.dump(2) << "\n";
         return 0;
     }
-    std::printf("scene %s: %ld frames (%.1f s at 1/60 s), %ld shots, %d workers%s, seed %llu, load %.1f ms\n",
-                a.file.c_str(), frames, static_cast<double>(frames) / 60.0, shots, workers,
-                a.deterministic ? " (deterministic)" : "", static_cast<unsigned long long>(a.seed), loadMs);
+    std::printf(
+        "scene %s: %ld frames (%.1f s at 1/60 s), %ld shots, %d workers%s%s, seed %llu, load %.1f ms\n",
+        a.file.c_str(), frames, static_cast<double>(frames) / 60.0, shots, workers,
+        a.deterministic ? " (deterministic)" : "",
+        a.unpaced      ? " (unpaced)"
+        : idleAdoption ? " (idle adoption)"
+                       : "",
+        static_cast<unsigned long long>(a.seed), loadMs);
     std::printf("%-28s %10s %10s %10s\n", "", "p50", "p99", "max");
     auto row = [](const char* name, const std::vector<double>& v) {
         std::printf("%-28s %10.3f %10.3f %10.3f\n", name, percentile(v, 0.5), percentile(v, 0.99),
@@ -267,10 +314,13 @@ int runScene(const SceneArgs& a) {
     row("  physics step (ms)", physicsMs);
     row("  impacts + adoption (ms)", adoptMs);
     row("  support / adoption (ms)", supportMs);
+    row("idle adoption / frame (ms)", idleAdoptMs); // after the frame, not in its time
     std::printf("impact -> adopted, per stage (total = latency): %s", formatTimingSummary(ts).c_str());
     std::printf("%-28s %10lld\n", "impacts", c.impacts);
-    std::printf("%-28s %10lld\n", "fractures", c.fractures);
+    std::printf("%-28s %10lld (%lld in idle time)\n", "fractures", c.fractures, idleFractures);
     std::printf("%-28s %10d\n", "stale results", ts.stale);
+    std::printf("%-28s %10d\n", "missed (cells off the mesh)", ts.missed);
+    std::printf("%-28s %10d\n", "failed (geometry)", ts.failed);
     std::printf("%-28s %10d (max %d)\n", "pieces alive", bridge.livePieces(), maxPieces);
     std::printf("%-28s %10lld\n", "pieces retired", c.piecesRetired);
     std::printf("%-28s %10lld (%lld contact tests)\n", "pieces collapsed", c.piecesCollapsed,
@@ -294,6 +344,9 @@ rubble::tools::Registrar registrar{
          app.add_flag("--json", args->json, "JSON on stdout");
          app.add_flag("--unpaced", args->unpaced,
                       "run frames back to back (default: paced at 60 Hz wall clock, like a game)");
+         app.add_flag(
+             "--no-idle-adoption", args->noIdleAdoption,
+             "paced: sleep until the next tick instead of adopting results as they arrive (A/B runs)");
          app.add_option("--frames", args->frames, "frames to run (overrides --seconds; for soak runs)");
          app.add_option("--timings-csv", args->timingsCsv, "write the per-impact timing records as CSV");
          app.add_option("--frames-csv", args->framesCsv, "write per-frame times and counts as CSV");
