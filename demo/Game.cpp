@@ -373,11 +373,27 @@ void Game::step(const ControlInput& input, float dt, Renderer& renderer) {
     for (auto& [body, v] : visuals_)
         v.heat = std::max(0.0f, v.heat - dt * 0.6f);
     particles_.step(dt, groundTop_);
+    updateCounters();
+}
 
+void Game::adoptReady() {
+    if (!bridge_)
+        return;
+    const long long impacts = bridge_->counters().impacts;
+    const long long retiredBefore = bridge_->counters().piecesRetired;
+    if (bridge_->adoptReady().piecesRetired > 0)
+        emitEffects(impacts, retiredBefore); // dust for pieces retired while adopting (no new impacts)
+    updateCounters();
+}
+
+void Game::updateCounters() {
+    // latencies of adopted jobs only (stale, missed and failed jobs are not impact → adopted times)
     const auto& timings = destruction_->timings();
-    for (; timingCursor_ < timings.size(); ++timingCursor_)
-        if (!timings[timingCursor_].stale)
-            latencies_.push_back(timings[timingCursor_].totalMs);
+    for (; timingCursor_ < timings.size(); ++timingCursor_) {
+        const rubble::TimingRecord& r = timings[timingCursor_];
+        if (!r.stale && !r.missed && !r.failed)
+            latencies_.push_back(r.totalMs);
+    }
     const auto& c = bridge_->counters();
     counters_.impacts = static_cast<int>(c.projectileHits);
     counters_.submitted = static_cast<int>(c.impacts);

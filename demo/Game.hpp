@@ -84,6 +84,9 @@ public:
 
     /// One fixed step of dt seconds (already scaled by slow motion).
     void step(const ControlInput& input, float dt, Renderer& renderer);
+    /// Adopts the fracture results that are ready now (call after the steps, right before drawing, so that
+    /// pieces appear in the frame in which their job finished); does nothing in deterministic mode.
+    void adoptReady();
     /// Queues the frame's draws (meshes, particles, debug lines) and updates the camera.
     void draw(Renderer& renderer, float dt);
 
@@ -128,6 +131,7 @@ private:
                    Renderer& renderer);
     void controlVehicle(const ControlInput& input, float dt);
     void emitEffects(long long impactsBefore, long long retiredBefore);
+    void updateCounters();
 
     GameSettings settings_;
     GameCounters counters_;

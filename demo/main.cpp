@@ -314,6 +314,11 @@ int main(int argc, char** argv) {
         } else {
             accumulator = 0;
         }
+        // Fracture results that finished during the steps are adopted now, before drawing, so that their
+        // pieces appear in this frame rather than after the next step (no-op in deterministic mode, which the
+        // autopilot uses; nothing changes while paused).
+        if (!app.paused || autopilot)
+            app.game.adoptReady();
         const double stepMs = std::chrono::duration<double, std::milli>(Clock::now() - stepStart).count();
 
         // Scene.
