@@ -7,24 +7,13 @@
 #include <unordered_map>
 #include <unordered_set>
 
-#include <CGAL/Constrained_Delaunay_triangulation_2.h>
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Triangulation_face_base_with_info_2.h>
-#include <CGAL/Triangulation_vertex_base_with_info_2.h>
-
+#include "geometry/PlanarTriangulation.hpp"
 #include "geometry/RayParity.hpp"
 #include "rubble/MassProperties.hpp"
 
 namespace rubble::detail {
 
 namespace {
-
-using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Vb = CGAL::Triangulation_vertex_base_with_info_2<std::uint32_t, K>;
-using Fbi = CGAL::Triangulation_face_base_with_info_2<int, K>;
-using Fb = CGAL::Constrained_triangulation_face_base_2<K, Fbi>;
-using Tds = CGAL::Triangulation_data_structure_2<Vb, Fb>;
-using CDT = CGAL::Constrained_Delaunay_triangulation_2<K, Tds, CGAL::Exact_predicates_tag>;
 
 /// Internal signal: this configuration is not handled robustly here; the caller uses an exact backend.
 struct Degenerate {
@@ -182,12 +171,6 @@ CellComplex buildComplex(const std::vector<ConvexPolytope>& polytopes, double ep
                 throw Degenerate{"cells overlap"};
         }
     return cx;
-}
-
-/// An orthonormal basis (u, v) of a plane with normal n such that u × v = n.
-void planeBasis(const Vec3& n, Vec3& u, Vec3& v) {
-    u = normalized(std::abs(n.x) < 0.6 ? cross(Vec3{1, 0, 0}, n) : cross(Vec3{0, 1, 0}, n));
-    v = cross(n, u);
 }
 
 /// Splits a mesh by a complex of convex cells in one pass: every point is computed once, from the input
@@ -417,73 +400,16 @@ void Clipper::emitConvex(const std::vector<std::uint32_t>& polyIn, const Vec3& n
 void Clipper::triangulateRegion(const std::vector<std::pair<std::uint32_t, std::uint32_t>>& edges,
                                 std::size_t boundaryEdges, const Vec3& normal, std::uint32_t source,
                                 std::uint32_t face, std::vector<OutTri>& out) {
-    Vec3 u, v;
-    planeBasis(normalized(normal), u, v);
-    auto to2 = [&](std::uint32_t id) {
-        const Vec3& p = pos(id);
-        return K::Point_2(dot(p, u), dot(p, v));
-    };
-    CDT cdt;
-    std::unordered_map<std::uint32_t, CDT::Vertex_handle> handle;
-    auto vertex = [&](std::uint32_t id) {
-        auto it = handle.find(id);
-        if (it != handle.end())
-            return it->second;
-        const std::size_t before = cdt.number_of_vertices();
-        CDT::Vertex_handle h = cdt.insert(to2(id));
-        if (cdt.number_of_vertices() != before + 1)
-            throw Degenerate{"coincident points in a cut face"};
-        h->info() = id;
-        handle.emplace(id, h);
-        return h;
-    };
-    std::unordered_map<std::uint64_t, int> flags;
-    for (std::size_t e = 0; e < edges.size(); ++e) {
-        const auto [a, b] = edges[e];
-        cdt.insert_constraint(vertex(a), vertex(b));
-        flags[pairKey(std::min(a, b), std::max(a, b))] ^= e < boundaryEdges ? 1 : 2;
-    }
-    if (cdt.number_of_vertices() != handle.size())
-        throw Degenerate{"cut face constraints intersect"};
-
-    for (auto f = cdt.all_faces_begin(); f != cdt.all_faces_end(); ++f)
-        f->info() = -1;
-    std::vector<CDT::Face_handle> queue;
-    for (auto f = cdt.all_faces_begin(); f != cdt.all_faces_end(); ++f)
-        if (cdt.is_infinite(f)) {
-            f->info() = 0;
-            queue.push_back(f);
-        }
-    while (!queue.empty()) {
-        const CDT::Face_handle f = queue.back();
-        queue.pop_back();
-        for (int i = 0; i < 3; ++i) {
-            const CDT::Face_handle n = f->neighbor(i);
-            const CDT::Vertex_handle a = f->vertex(CDT::cw(i)), b = f->vertex(CDT::ccw(i));
-            int toggle = 0;
-            if (!cdt.is_infinite(a) && !cdt.is_infinite(b)) {
-                auto it = flags.find(pairKey(std::min(a->info(), b->info()), std::max(a->info(), b->info())));
-                if (it != flags.end())
-                    toggle = it->second;
-            }
-            const int state = f->info() ^ toggle;
-            if (n->info() < 0) {
-                n->info() = state;
-                queue.push_back(n);
-            } else if (n->info() != state) {
-                throw Degenerate{"cut face boundary is not closed"};
-            }
-        }
-    }
-    for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
-        if (f->info() != 1)
-            continue;
-        if (CGAL::orientation(f->vertex(0)->point(), f->vertex(1)->point(), f->vertex(2)->point()) !=
-            CGAL::LEFT_TURN)
-            throw Degenerate{"flat triangle in a cut face"};
-        out.push_back(
-            {{f->vertex(0)->info(), f->vertex(1)->info(), f->vertex(2)->info()}, source, face, false});
-    }
+    std::vector<RegionEdge> region;
+    region.reserve(edges.size());
+    for (std::size_t e = 0; e < edges.size(); ++e)
+        region.push_back({edges[e].first, edges[e].second, e < boundaryEdges ? 1u : 2u});
+    std::vector<std::array<std::uint32_t, 3>> tris;
+    if (const char* why = triangulatePlanarRegion(
+            region, normal, [&](std::uint32_t id) { return pos(id); }, tris))
+        throw Degenerate{why};
+    for (const auto& t : tris)
+        out.push_back({{t[0], t[1], t[2]}, source, face, false});
 }
 
 void Clipper::cutTriangle(std::uint32_t t, const std::vector<std::uint32_t>& cells) {

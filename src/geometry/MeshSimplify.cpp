@@ -15,11 +15,6 @@
 
 #include "rubble/MeshSimplify.hpp"
 
-#include <CGAL/Constrained_Delaunay_triangulation_2.h>
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Triangulation_face_base_with_info_2.h>
-#include <CGAL/Triangulation_vertex_base_with_info_2.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -27,28 +22,18 @@
 #include <unordered_set>
 #include <vector>
 
+#include "geometry/PlanarTriangulation.hpp"
+
 namespace rubble {
 
 namespace {
 
-using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Vb = CGAL::Triangulation_vertex_base_with_info_2<std::uint32_t, K>;
-using Fbi = CGAL::Triangulation_face_base_with_info_2<int, K>;
-using Fb = CGAL::Constrained_triangulation_face_base_2<K, Fbi>;
-using Tds = CGAL::Triangulation_data_structure_2<Vb, Fb>;
-using CDT = CGAL::Constrained_Delaunay_triangulation_2<K, Tds, CGAL::Exact_predicates_tag>;
 using Tri = std::array<std::uint32_t, 3>;
 
 constexpr std::uint32_t kNone = 0xFFFFFFFFu;
 
 std::uint64_t directed(std::uint32_t a, std::uint32_t b) {
     return (static_cast<std::uint64_t>(a) << 32) | b;
-}
-
-/// An orthonormal basis (u, v) of the plane with unit normal n such that u × v = n.
-void basisOf(const Vec3& n, Vec3& u, Vec3& v) {
-    u = normalized(std::abs(n.x) < 0.6 ? cross(Vec3{1, 0, 0}, n) : cross(Vec3{0, 1, 0}, n));
-    v = cross(n, u);
 }
 
 class Simplifier {
@@ -128,7 +113,7 @@ bool Simplifier::flat(const std::vector<std::uint32_t>& tris) const {
             best = t;
     const Vec3 n = normalized(m_.triangleNormal(best)), o = m_.positions[m_.triangles[best][0]];
     Vec3 u, v;
-    basisOf(n, u, v);
+    detail::planeBasis(n, u, v);
     double s[3][3] = {}, su[3] = {}, sv[3] = {};
     double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
     for (std::uint32_t t : tris)
@@ -292,70 +277,24 @@ bool Simplifier::retriangulate(const std::vector<std::uint32_t>& patch, std::vec
         if (lengthSquared(m_.triangleNormal(t)) > lengthSquared(m_.triangleNormal(best)))
             best = t;
     }
-    Vec3 u, v;
-    basisOf(normalized(m_.triangleNormal(best)), u, v);
-    CDT cdt;
-    std::vector<CDT::Vertex_handle> handle(ends.size());
-    for (std::size_t i = 0; i < ends.size(); ++i) {
-        const Vec3& p = m_.positions[ends[i]];
-        const std::size_t count = cdt.number_of_vertices();
-        handle[i] = cdt.insert(K::Point_2(dot(p, u), dot(p, v)));
-        if (cdt.number_of_vertices() != count + 1)
-            return false; // two kept vertices project onto one point
-        handle[i]->info() = ends[i];
-    }
-    auto at = [&](std::uint32_t id) {
-        return handle[static_cast<std::size_t>(std::lower_bound(ends.begin(), ends.end(), id) -
-                                               ends.begin())];
-    };
+    std::vector<detail::RegionEdge> region;
+    region.reserve(edges.size());
     for (const auto& [a, b] : edges)
-        cdt.insert_constraint(at(a), at(b));
-    if (cdt.number_of_vertices() != ends.size())
-        return false; // constraints cross
-
-    for (auto f = cdt.all_faces_begin(); f != cdt.all_faces_end(); ++f)
-        f->info() = -1;
-    std::vector<CDT::Face_handle> queue;
-    for (auto f = cdt.all_faces_begin(); f != cdt.all_faces_end(); ++f)
-        if (cdt.is_infinite(f)) {
-            f->info() = 0;
-            queue.push_back(f);
-        }
-    while (!queue.empty()) {
-        const CDT::Face_handle f = queue.back();
-        queue.pop_back();
-        for (int i = 0; i < 3; ++i) {
-            const CDT::Face_handle n = f->neighbor(i);
-            const CDT::Vertex_handle a = f->vertex(CDT::cw(i)), b = f->vertex(CDT::ccw(i));
-            const bool crosses = !cdt.is_infinite(a) && !cdt.is_infinite(b) &&
-                                 (constraint.count(directed(a->info(), b->info())) ||
-                                  constraint.count(directed(b->info(), a->info())));
-            const int state = f->info() ^ (crosses ? 1 : 0);
-            if (n->info() < 0) {
-                n->info() = state;
-                queue.push_back(n);
-            } else if (n->info() != state) {
-                return false;
-            }
-        }
-    }
+        region.push_back({a, b, 1u});
+    const std::size_t first = tris.size();
+    if (detail::triangulatePlanarRegion(
+            region, m_.triangleNormal(best), [&](std::uint32_t id) { return m_.positions[id]; }, tris))
+        return false;
     // The new triangles: counter-clockwise, the same area, and every directed edge either inside (its reverse
     // is there too) or one of the chains, each exactly once — so the patch closes up with its surroundings.
     double area = 0;
     std::unordered_map<std::uint64_t, int> used;
-    const std::size_t first = tris.size();
-    for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
-        if (f->info() != 1)
-            continue;
-        if (CGAL::orientation(f->vertex(0)->point(), f->vertex(1)->point(), f->vertex(2)->point()) !=
-            CGAL::LEFT_TURN)
-            return false;
-        const Tri t{f->vertex(0)->info(), f->vertex(1)->info(), f->vertex(2)->info()};
+    for (std::size_t i = first; i < tris.size(); ++i) {
+        const Tri& t = tris[i];
         area +=
             length(cross(m_.positions[t[1]] - m_.positions[t[0]], m_.positions[t[2]] - m_.positions[t[0]]));
         for (std::size_t k = 0; k < 3; ++k)
             ++used[directed(t[k], t[(k + 1) % 3])];
-        tris.push_back(t);
     }
     for (const auto& [e, n] : used) {
         const bool chain = constraint.count(e) != 0;
