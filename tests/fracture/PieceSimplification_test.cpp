@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <map>
 
+#include "TestSupport.hpp"
 #include "rubble/Fracture.hpp"
 #include "rubble/MassProperties.hpp"
 #include "rubble/MeshCheck.hpp"
@@ -11,14 +12,6 @@
 
 namespace rubble {
 namespace {
-
-void expectClosedSameVolume(const Mesh& before, const Mesh& after) {
-    const MeshReport r = checkMesh(after);
-    EXPECT_TRUE(r.closed);
-    EXPECT_TRUE(r.oriented);
-    EXPECT_EQ(r.degenerateTriangles, 0u);
-    EXPECT_NEAR(signedVolume(after), signedVolume(before), 1e-9 * std::abs(signedVolume(before)));
-}
 
 TEST(PieceSimplification, IsIdempotentAndDeterministic) {
     const Mesh box = makeSubdividedBox({0, 0, 0}, {1, 1, 1}, 10);
@@ -28,7 +21,7 @@ TEST(PieceSimplification, IsIdempotentAndDeterministic) {
     ASSERT_TRUE(r);
     for (const Piece& piece : r->pieces) {
         const Mesh a = simplifyPlanarRegions(piece.mesh);
-        expectClosedSameVolume(piece.mesh, a);
+        test::expectSameSolid(piece.mesh, a);
         EXPECT_LE(a.triangleCount(), piece.mesh.triangleCount());
         EXPECT_EQ(simplifyPlanarRegions(piece.mesh).hash(), a.hash());
         EXPECT_EQ(simplifyPlanarRegions(a).triangleCount(), a.triangleCount());

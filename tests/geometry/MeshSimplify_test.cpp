@@ -5,19 +5,12 @@
 #include <cmath>
 #include <map>
 
+#include "TestSupport.hpp"
 #include "rubble/MassProperties.hpp"
 #include "rubble/MeshCheck.hpp"
 
 namespace rubble {
 namespace {
-
-void expectClosedSameVolume(const Mesh& before, const Mesh& after) {
-    const MeshReport r = checkMesh(after);
-    EXPECT_TRUE(r.closed);
-    EXPECT_TRUE(r.oriented);
-    EXPECT_EQ(r.degenerateTriangles, 0u);
-    EXPECT_NEAR(signedVolume(after), signedVolume(before), 1e-9 * std::abs(signedVolume(before)));
-}
 
 /// Area per material.
 std::map<std::uint32_t, double> areaByMaterial(const Mesh& m) {
@@ -37,7 +30,7 @@ TEST(MeshSimplify, SubdividedBoxBecomesTwelveTriangles) {
     EXPECT_FALSE(rep.unchanged);
     EXPECT_EQ(rep.regionsRetriangulated, 6u);
     EXPECT_EQ(rep.trianglesAfter, 12u);
-    expectClosedSameVolume(box, s);
+    test::expectSameSolid(box, s);
 }
 
 TEST(MeshSimplify, MaterialBoundariesAndTheirAreasStay) {
@@ -50,7 +43,7 @@ TEST(MeshSimplify, MaterialBoundariesAndTheirAreasStay) {
     }
     const Mesh s = simplifyPlanarRegions(box);
     EXPECT_LT(s.triangleCount(), box.triangleCount() / 10);
-    expectClosedSameVolume(box, s);
+    test::expectSameSolid(box, s);
     const auto a0 = areaByMaterial(box), a1 = areaByMaterial(s);
     ASSERT_EQ(a1.size(), 2u);
     for (const auto& [mat, area] : a0)
@@ -69,7 +62,7 @@ TEST(MeshSimplify, TextureCoordinatesStayOnTheAffineMap) {
         }
     const Mesh s = simplifyPlanarRegions(box);
     EXPECT_EQ(s.triangleCount(), 12u);
-    expectClosedSameVolume(box, s);
+    test::expectSameSolid(box, s);
     for (std::size_t t = 0; t < s.triangleCount(); ++t)
         for (std::size_t k = 0; k < 3; ++k) {
             const Vec3 p = s.positions[s.triangles[t][k]];
@@ -98,7 +91,7 @@ TEST(MeshSimplify, AVertexWhoseTextureBendsStays) {
             if (box.triangles[t][k] == centre)
                 box.uvs[3 * t + k].x += 0.25;
     const Mesh s = simplifyPlanarRegions(box);
-    expectClosedSameVolume(box, s);
+    test::expectSameSolid(box, s);
     EXPECT_LT(s.triangleCount(), box.triangleCount());
     bool kept = false;
     for (const Vec3& p : s.positions)
@@ -132,7 +125,7 @@ TEST(MeshSimplify, OnlyTheFocusChanges) {
     PlanarSimplifyParams p;
     p.focus = {{-1, -1, -1}, {1.2, 1.2, 1.2}}; // around the corner at the origin
     const Mesh s = simplifyPlanarRegions(box, p);
-    expectClosedSameVolume(box, s);
+    test::expectSameSolid(box, s);
     EXPECT_LT(s.triangleCount(), box.triangleCount());
     // Every vertex outside the focus is still there.
     std::size_t outside = 0, kept = 0;
@@ -153,7 +146,7 @@ TEST(MeshSimplify, BoxesTouchingAlongAnEdgeStayValid) {
     Mesh m = makeSubdividedBox({0, 0, 0}, {1, 1, 1}, 3);
     m.append(makeSubdividedBox({1, 1, 0}, {2, 2, 1}, 3)); // shares the edge x = y = 1 (not welded)
     const Mesh s = simplifyPlanarRegions(m);
-    expectClosedSameVolume(m, s);
+    test::expectSameSolid(m, s);
     EXPECT_EQ(s.triangleCount(), 24u);
 }
 

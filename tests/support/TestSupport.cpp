@@ -1,7 +1,13 @@
 #include "TestSupport.hpp"
 
+#include <gtest/gtest.h>
+
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
+
+#include "rubble/MassProperties.hpp"
+#include "rubble/MeshCheck.hpp"
 
 namespace rubble::test {
 
@@ -67,6 +73,14 @@ Mesh unwelded(const Mesh& m, bool withAttributes) {
     if (withAttributes)
         out.materialNames = {"a", "b", "c"};
     return out;
+}
+
+void expectSameSolid(const Mesh& before, const Mesh& after) {
+    const MeshReport r = checkMesh(after);
+    EXPECT_TRUE(r.closed);
+    EXPECT_TRUE(r.oriented);
+    EXPECT_EQ(r.degenerateTriangles, 0u);
+    EXPECT_NEAR(signedVolume(after), signedVolume(before), 1e-9 * std::abs(signedVolume(before)));
 }
 
 } // namespace rubble::test

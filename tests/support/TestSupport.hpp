@@ -25,6 +25,9 @@ bool mentions(const std::vector<std::string>& lines, const std::string& text);
 /// Every triangle gets its own three vertices (a "triangle soup", as some exporters write); with attributes,
 /// also per-corner normals (the face normal), UVs (x, y) and three materials "a", "b", "c" in turn.
 Mesh unwelded(const Mesh& m, bool withAttributes = false);
+/// EXPECTs that after is closed, consistently oriented, without degenerate triangles, and encloses before's
+/// volume (relative 1e-9): the contract of a lossless mesh operation.
+void expectSameSolid(const Mesh& before, const Mesh& after);
 
 } // namespace rubble::test
 
