@@ -19,33 +19,20 @@
 
 // GCC's -Wmaybe-uninitialized fires inside CGAL's templates instantiated here (false positives).
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#include <CGAL/Exact_predicates_exact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/corefinement.h>
-#include <CGAL/Surface_mesh.h>
 
 #include "BooleanBackends.hpp"
+#include "ExactMesh.hpp"
 
 namespace rubble::detail {
 
 namespace {
 
-using K = CGAL::Exact_predicates_exact_constructions_kernel;
-using SM = CGAL::Surface_mesh<K::Point_3>;
+using exact::Failure;
+using exact::K;
+using exact::SM;
+using exact::toDouble;
 namespace PMP = CGAL::Polygon_mesh_processing;
-
-/// A deterministic double for a lazy exact number: the approximation when it is a single double (e.g. an
-/// input coordinate), else the rounded exact value. CGAL::to_double of the interval is not deterministic:
-/// it depends on whether earlier predicates happened to refine the interval.
-double toDouble(const K::FT& x) {
-    const auto& a = x.approx();
-    if (a.inf() == a.sup())
-        return a.inf();
-    return CGAL::to_double(x.exact());
-}
-
-struct Failure {
-    std::string why;
-};
 
 /// Per-face source ids for every mesh the visitor sees (by address; meshes live in unique_ptrs).
 struct SourceTable {
@@ -77,91 +64,24 @@ struct SourceVisitor : PMP::Corefinement::Default_visitor<SM> {
 
 std::unique_ptr<SM> meshToSm(const Mesh& m, SourceTable& table) {
     auto sm = std::make_unique<SM>();
-    sm->reserve(static_cast<SM::size_type>(m.positions.size()),
-                static_cast<SM::size_type>(m.triangles.size() * 3 / 2),
-                static_cast<SM::size_type>(m.triangles.size()));
-    for (const Vec3& p : m.positions)
-        sm->add_vertex(K::Point_3(p.x, p.y, p.z));
-    auto& src = table.of[sm.get()];
-    src.resize(m.triangles.size(), kUnknownSource);
-    for (std::size_t t = 0; t < m.triangles.size(); ++t) {
-        const Triangle& tri = m.triangles[t];
-        const SM::Face_index f =
-            sm->add_face(SM::Vertex_index(tri[0]), SM::Vertex_index(tri[1]), SM::Vertex_index(tri[2]));
-        if (f == SM::null_face())
-            throw Failure{"the mesh is not a manifold surface (triangle " + std::to_string(t) + ")"};
-        table.set(*sm, f, static_cast<std::int64_t>(t));
-    }
+    table.of[sm.get()].resize(m.triangles.size(), kUnknownSource);
+    exact::addMesh(m, *sm,
+                   [&](std::size_t t, SM::Face_index f) { table.set(*sm, f, static_cast<std::int64_t>(t)); });
     return sm;
 }
 
-/// A convex cell as a closed triangle mesh: corners welded exactly, faces fanned from their
-/// lexicographically smallest corner (so a face shared by two cells is triangulated identically in both).
 std::unique_ptr<SM> cellToSm(const ConvexPolytope& cell, SourceTable& table) {
     auto sm = std::make_unique<SM>();
-    std::map<std::tuple<double, double, double>, SM::Vertex_index> index;
-    auto vertex = [&](const Vec3& p) {
-        auto [it, inserted] = index.emplace(std::make_tuple(p.x, p.y, p.z), SM::Vertex_index());
-        if (inserted)
-            it->second = sm->add_vertex(K::Point_3(p.x, p.y, p.z));
-        return it->second;
-    };
-    for (const PolytopeFace& face : cell.faces()) {
-        std::vector<SM::Vertex_index> loop;
-        for (const Vec3& c : face.corners) {
-            const SM::Vertex_index v = vertex(c);
-            if (loop.empty() || loop.back() != v)
-                loop.push_back(v);
-        }
-        while (loop.size() > 1 && loop.front() == loop.back())
-            loop.pop_back();
-        if (loop.size() < 3)
-            continue;
-        std::size_t apex = 0;
-        for (std::size_t i = 1; i < loop.size(); ++i)
-            if (face.corners.size() == loop.size() &&
-                std::make_tuple(face.corners[i].x, face.corners[i].y, face.corners[i].z) <
-                    std::make_tuple(face.corners[apex].x, face.corners[apex].y, face.corners[apex].z))
-                apex = i;
-        std::rotate(loop.begin(), loop.begin() + static_cast<std::ptrdiff_t>(apex), loop.end());
-        for (std::size_t i = 1; i + 1 < loop.size(); ++i) {
-            const SM::Face_index f = sm->add_face(loop[0], loop[i], loop[i + 1]);
-            if (f == SM::null_face())
-                throw Failure{"a cell is not a closed convex polytope"};
-            table.set(*sm, f, kCutFace);
-        }
-    }
-    if (sm->number_of_faces() < 4 || !CGAL::is_closed(*sm))
-        throw Failure{"a cell is not closed"};
+    exact::addCell(cell, *sm, [&](SM::Face_index f) { table.set(*sm, f, kCutFace); });
     return sm;
 }
 
 Mesh smToMesh(const SM& sm, SourceTable& table, const Mesh& input) {
     std::vector<Vec3> positions;
-    std::vector<std::uint32_t> local(sm.num_vertices(), 0xFFFFFFFFu);
     std::vector<Triangle> tris;
     std::vector<std::int64_t> sources;
-    tris.reserve(sm.number_of_faces());
     sources.reserve(sm.number_of_faces());
-    for (SM::Face_index f : sm.faces()) {
-        Triangle tri{};
-        int c = 0;
-        for (SM::Vertex_index v : CGAL::vertices_around_face(sm.halfedge(f), sm)) {
-            if (c == 3)
-                throw Failure{"a non-triangular face in the output"};
-            const auto i = static_cast<std::size_t>(v);
-            if (local[i] == 0xFFFFFFFFu) {
-                local[i] = static_cast<std::uint32_t>(positions.size());
-                const K::Point_3& p = sm.point(v);
-                positions.push_back({toDouble(p.x()), toDouble(p.y()), toDouble(p.z())});
-            }
-            tri[static_cast<std::size_t>(c++)] = local[i];
-        }
-        if (c != 3)
-            throw Failure{"a degenerate face in the output"};
-        tris.push_back(tri);
-        sources.push_back(table.get(sm, f));
-    }
+    exact::toTriangles(sm, positions, tris, [&](SM::Face_index f) { sources.push_back(table.get(sm, f)); });
     return assembleMesh(input, std::move(positions), tris, std::move(sources));
 }
 

@@ -9,70 +9,31 @@
 
 // GCC's -Wmaybe-uninitialized fires inside CGAL's templates instantiated here (false positives).
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#include <CGAL/Exact_predicates_exact_constructions_kernel.h>
 #include <CGAL/Nef_polyhedron_3.h>
 #include <CGAL/Polygon_mesh_processing/triangulate_faces.h>
-#include <CGAL/Surface_mesh.h>
 #include <CGAL/boost/graph/convert_nef_polyhedron_to_polygon_mesh.h>
 
 #include "BooleanBackends.hpp"
+#include "ExactMesh.hpp"
 
 namespace rubble::detail {
 
 namespace {
 
-using K = CGAL::Exact_predicates_exact_constructions_kernel;
-using SM = CGAL::Surface_mesh<K::Point_3>;
+using exact::Failure;
+using exact::K;
+using exact::SM;
 using Nef = CGAL::Nef_polyhedron_3<K>;
-
-/// A deterministic double for a lazy exact number: the approximation when it is a single double (e.g. an
-/// input coordinate), else the rounded exact value. CGAL::to_double of the interval is not deterministic:
-/// it depends on whether earlier predicates happened to refine the interval.
-double toDouble(const K::FT& x) {
-    const auto& a = x.approx();
-    if (a.inf() == a.sup())
-        return a.inf();
-    return CGAL::to_double(x.exact());
-}
-
-struct Failure {
-    std::string why;
-};
 
 SM meshToSm(const Mesh& m) {
     SM sm;
-    for (const Vec3& p : m.positions)
-        sm.add_vertex(K::Point_3(p.x, p.y, p.z));
-    for (const Triangle& t : m.triangles)
-        if (sm.add_face(SM::Vertex_index(t[0]), SM::Vertex_index(t[1]), SM::Vertex_index(t[2])) ==
-            SM::null_face())
-            throw Failure{"the mesh is not a manifold surface"};
+    exact::addMesh(m, sm);
     return sm;
 }
 
 SM cellToSm(const ConvexPolytope& cell) {
     SM sm;
-    std::map<std::tuple<double, double, double>, SM::Vertex_index> index;
-    for (const PolytopeFace& face : cell.faces()) {
-        std::vector<SM::Vertex_index> loop;
-        for (const Vec3& p : face.corners) {
-            auto [it, inserted] = index.emplace(std::make_tuple(p.x, p.y, p.z), SM::Vertex_index());
-            if (inserted)
-                it->second = sm.add_vertex(K::Point_3(p.x, p.y, p.z));
-            if (loop.empty() || loop.back() != it->second)
-                loop.push_back(it->second);
-        }
-        while (loop.size() > 1 && loop.front() == loop.back())
-            loop.pop_back();
-        if (loop.size() < 3)
-            continue;
-        // Triangles: the double corners of a face need not be exactly coplanar, and Nef needs planar faces.
-        for (std::size_t i = 1; i + 1 < loop.size(); ++i)
-            if (sm.add_face(loop[0], loop[i], loop[i + 1]) == SM::null_face())
-                throw Failure{"a cell is not a closed convex polytope"};
-    }
-    if (!CGAL::is_closed(sm))
-        throw Failure{"a cell is not closed"};
+    exact::addCell(cell, sm);
     return sm;
 }
 
@@ -82,26 +43,8 @@ Mesh nefToMesh(const Nef& nef, const Mesh& input) {
     SM sm;
     CGAL::convert_nef_polyhedron_to_polygon_mesh(nef, sm, true);
     std::vector<Vec3> positions;
-    std::vector<std::uint32_t> local(sm.num_vertices(), 0xFFFFFFFFu);
     std::vector<Triangle> tris;
-    for (SM::Face_index f : sm.faces()) {
-        Triangle tri{};
-        int c = 0;
-        for (SM::Vertex_index v : CGAL::vertices_around_face(sm.halfedge(f), sm)) {
-            if (c == 3)
-                throw Failure{"a non-triangular face in the output"};
-            const auto i = static_cast<std::size_t>(v);
-            if (local[i] == 0xFFFFFFFFu) {
-                local[i] = static_cast<std::uint32_t>(positions.size());
-                const K::Point_3& p = sm.point(v);
-                positions.push_back({toDouble(p.x()), toDouble(p.y()), toDouble(p.z())});
-            }
-            tri[static_cast<std::size_t>(c++)] = local[i];
-        }
-        if (c != 3)
-            throw Failure{"a degenerate face in the output"};
-        tris.push_back(tri);
-    }
+    exact::toTriangles(sm, positions, tris);
     // Nef's output order follows its internal (address-dependent) storage: number the vertices by their
     // coordinates and sort the triangles (each rotated to start at its smallest vertex, keeping its
     // orientation) so that the same input gives the same bytes on every run.
