@@ -4,24 +4,15 @@
 
 #include <map>
 
+#include "TestSupport.hpp"
 #include "rubble/Fracture.hpp"
 #include "rubble/MassProperties.hpp"
 #include "rubble/Random.hpp"
 
 using namespace rubble;
+using rubble::test::closedAndOriented;
 
 namespace {
-
-::testing::AssertionResult closedAndOriented(const Mesh& m) {
-    std::map<std::pair<std::uint32_t, std::uint32_t>, int> directed;
-    for (const Triangle& t : m.triangles)
-        for (int c = 0; c < 3; ++c)
-            ++directed[{t[c], t[(c + 1) % 3]}];
-    for (const auto& [e, count] : directed)
-        if (count != 1 || !directed.count({e.second, e.first}))
-            return ::testing::AssertionFailure() << "bad edge " << e.first << "-" << e.second;
-    return ::testing::AssertionSuccess();
-}
 
 // Every face is planar, counter-clockwise seen from outside, and every vertex is inside every plane.
 void checkConvexCell(const ConvexPolytope& cell, double size) {

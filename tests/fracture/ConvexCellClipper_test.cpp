@@ -2,30 +2,16 @@
 
 #include <map>
 
+#include "TestSupport.hpp"
 #include "fracture/ConvexCellClipper.hpp"
 #include "rubble/Fracture.hpp"
 #include "rubble/MassProperties.hpp"
 #include "rubble/Random.hpp"
 
 using namespace rubble;
+using rubble::test::closedAndOriented;
 
 namespace {
-
-// Closed and consistently oriented: every directed edge appears once and its reverse once.
-::testing::AssertionResult closedAndOriented(const Mesh& m) {
-    std::map<std::pair<std::uint32_t, std::uint32_t>, int> directed;
-    for (const Triangle& t : m.triangles)
-        for (int c = 0; c < 3; ++c)
-            ++directed[{t[c], t[(c + 1) % 3]}];
-    for (const auto& [e, count] : directed) {
-        if (count != 1)
-            return ::testing::AssertionFailure()
-                   << "edge " << e.first << "-" << e.second << " used " << count;
-        if (!directed.count({e.second, e.first}))
-            return ::testing::AssertionFailure() << "open edge " << e.first << "-" << e.second;
-    }
-    return ::testing::AssertionSuccess();
-}
 
 // A random convex cell around c: a large box clipped by random planes through points near c (the box's own,
 // axis-aligned faces are almost always cut away, so cells are in general position like Voronoi cells).

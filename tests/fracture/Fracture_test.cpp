@@ -14,24 +14,9 @@
 #include "rubble/Random.hpp"
 
 using namespace rubble;
+using rubble::test::closedAndOriented;
 
 namespace {
-
-// Closed, edge-manifold and consistently oriented: every directed edge once, and its reverse once.
-::testing::AssertionResult closedAndOriented(const Mesh& m) {
-    std::map<std::pair<std::uint32_t, std::uint32_t>, int> directed;
-    for (const Triangle& t : m.triangles)
-        for (int c = 0; c < 3; ++c)
-            ++directed[{t[c], t[(c + 1) % 3]}];
-    for (const auto& [e, count] : directed) {
-        if (count != 1)
-            return ::testing::AssertionFailure()
-                   << "edge " << e.first << "-" << e.second << " used " << count;
-        if (!directed.count({e.second, e.first}))
-            return ::testing::AssertionFailure() << "open edge " << e.first << "-" << e.second;
-    }
-    return ::testing::AssertionSuccess();
-}
 
 Mesh lPrism() {
     // An L-shaped (concave) prism: the L in the xy-plane, extruded along z.

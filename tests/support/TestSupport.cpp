@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <map>
 
 #include "rubble/MassProperties.hpp"
 #include "rubble/MeshCheck.hpp"
@@ -73,6 +74,21 @@ Mesh unwelded(const Mesh& m, bool withAttributes) {
     if (withAttributes)
         out.materialNames = {"a", "b", "c"};
     return out;
+}
+
+::testing::AssertionResult closedAndOriented(const Mesh& m) {
+    std::map<std::pair<std::uint32_t, std::uint32_t>, int> directed;
+    for (const Triangle& t : m.triangles)
+        for (std::size_t c = 0; c < 3; ++c)
+            ++directed[{t[c], t[(c + 1) % 3]}];
+    for (const auto& [e, count] : directed) {
+        if (count != 1)
+            return ::testing::AssertionFailure()
+                   << "edge " << e.first << "-" << e.second << " used " << count;
+        if (!directed.count({e.second, e.first}))
+            return ::testing::AssertionFailure() << "open edge " << e.first << "-" << e.second;
+    }
+    return ::testing::AssertionSuccess();
 }
 
 void expectSameSolid(const Mesh& before, const Mesh& after) {

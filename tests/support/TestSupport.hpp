@@ -1,6 +1,8 @@
 #pragma once
 // Helpers shared by Rubble's tests.
 
+#include <gtest/gtest.h>
+
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -28,6 +30,9 @@ Mesh unwelded(const Mesh& m, bool withAttributes = false);
 /// EXPECTs that after is closed, consistently oriented, without degenerate triangles, and encloses before's
 /// volume (relative 1e-9): the contract of a lossless mesh operation.
 void expectSameSolid(const Mesh& before, const Mesh& after);
+/// Closed, edge-manifold and consistently oriented: every directed edge once, and its reverse once (for
+/// EXPECT_TRUE; the failure names the first bad edge).
+::testing::AssertionResult closedAndOriented(const Mesh& m);
 
 } // namespace rubble::test
 
