@@ -49,6 +49,8 @@ struct ObjectState {
     FractureParams fracture;     ///< how it breaks
     std::vector<ConvexPolytope> convexParts; ///< collision parts in local coordinates
     std::string warning;                     ///< why it is indestructible, when it had to be made so
+    std::size_t crumbleAbove = 0; ///< a hit on it crumbles it once its mesh has more triangles than this
+                                  ///< (see Config::crumbleTriangles; pieces inherit their parent's)
 };
 
 /// Wall-clock timing of one impact from submission to adoption, in milliseconds.
@@ -71,6 +73,8 @@ struct TimingRecord {
                          ///< impacts that waited on the job are retried. Not a failure.
     bool failed = false; ///< the fracture failed on the geometry (any other error): the object stays and
                          ///< impacts that waited on the job are retried
+    bool crumbled =
+        false; ///< the object was over its triangle limit: the hit crumbled it (Config::crumbleTriangles)
 };
 
 /// A fracture ready to adopt: the parent object is replaced by the pieces.
@@ -99,6 +103,12 @@ public:
             1.0;                ///< main-thread time per frame for adoption (at least one result adopts)
         std::uint64_t seed = 1; ///< world seed; each job's seed derives from it, the object and version
         DecompositionParams decomposition; ///< convex parts of pieces
+        /// Every crater adds faces, so an object hit again and again would grow without bound. Once an
+        /// object's mesh has more triangles than max(crumbleTriangles, twice the triangles it was added
+        /// with), a hit crumbles it instead: crumbleCells shatter cells as large as the object break it into
+        /// a few big pieces (which the engine adapter can let fall and retire). 0 = never.
+        std::size_t crumbleTriangles = 16384;
+        int crumbleCells = 4; ///< cells of a crumbling hit
     };
 
     /// A world with the given configuration.

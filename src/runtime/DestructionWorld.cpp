@@ -47,6 +47,7 @@ struct Job {
     Mesh mesh;
     std::vector<ConvexPolytope> parts;
     FractureParams params;
+    bool crumble = false; // over its triangle limit: a shatter as large as the object
     DecompositionParams decomposition;
     std::uint64_t seed = 0;
     std::uint64_t frame = 0;      // frame of the first impact (timing records)
@@ -199,6 +200,14 @@ struct DestructionWorld::Impl {
         job->mesh = o.mesh;
         job->parts = o.convexParts;
         job->params = o.fracture;
+        if (o.mesh.triangleCount() > o.crumbleAbove) { // too much detail: break it up instead of a crater
+            job->crumble = true;
+            job->params.pattern = CellPattern::Shatter;
+            job->params.cells = std::max(2, config.crumbleCells);
+            // The shatter cuts the cells of the K sites nearest the impact among about 2K in a domain of this size
+            // (sites crowd the impact): four diagonals make those cells reach across the whole object.
+            job->params.sizeLaw.minSize = job->params.sizeLaw.maxSize = 4 * o.mesh.bounds().diagonal();
+        }
         job->decomposition = config.decomposition;
         job->seed = mixSeed(mixSeed(config.seed, id), o.version);
         job->frame = job->impacts.front().frame;
@@ -268,6 +277,9 @@ Result<ObjectId> DestructionWorld::addObject(ObjectDesc desc) {
     s.destructible = desc.destructible;
     s.impulseThreshold = desc.impulseThreshold;
     s.fracture = desc.fracture;
+    s.crumbleAbove = impl_->config.crumbleTriangles == 0
+                         ? std::numeric_limits<std::size_t>::max()
+                         : std::max(impl_->config.crumbleTriangles, 2 * desc.mesh.triangleCount());
     CheckOptions opts;
     MeshReport report = checkMesh(desc.mesh, opts);
     if (!report.valid()) {
@@ -376,6 +388,7 @@ std::vector<FractureOutcome> DestructionWorld::collect() {
         rec.booleanMs = job->result.timings.booleanMs;
         rec.islandsMs = job->result.timings.islandsMs;
         rec.decompositionMs = job->decompositionMs;
+        rec.crumbled = job->crumble;
         auto it = im.objects.find(job->id);
         std::vector<PendingImpact> later;
         if (auto w = im.waiting.find(job->id); w != im.waiting.end()) {
@@ -403,6 +416,7 @@ std::vector<FractureOutcome> DestructionWorld::collect() {
                 s.destructible = parent.destructible;
                 s.impulseThreshold = parent.impulseThreshold;
                 s.fracture = parent.fracture;
+                s.crumbleAbove = parent.crumbleAbove;
                 s.convexParts = std::move(job->localParts[i]);
                 o.pieces.push_back(s.id);
                 o.pieceFrames.push_back(job->frames[i]);

@@ -630,3 +630,30 @@ TEST(DestructionBridgeCollapse, SwitchedOffTheLargestPieceStaysStaticAsBefore) {
     EXPECT_EQ(statics, 1);
     EXPECT_EQ(rig.bridge->counters().piecesCollapsed, 0);
 }
+
+// Dynamic pieces keep their triangles under Config::maxLivePieceTriangles: the smallest retire to particles
+// (their volume counted as retired), so the meshes the bridge keeps alive stay bounded.
+TEST(DestructionBridge, DynamicPieceTrianglesStayWithinTheBudget) {
+    DestructionBridge::Config bc;
+    bc.maxLivePieceTriangles = 150;
+    Rig rig(true, 1, true, bc);
+    rig.bridge->addGround({0, -0.5, 0}, {50, 0.5, 50});
+    rig.addBox({0.5, 1.5, 0.5}, Frame{Mat3::identity(), {4, 1.5, 0}}, 300);
+    rig.addBox({1.5, 0.5, 0.5}, Frame{Mat3::identity(), {-4, 0.5, 1}}, 300);
+    const double start = rig.bridge->totalVolume();
+    Rng rng(5);
+    std::size_t most = 0;
+    for (int f = 0; f < 180; ++f) {
+        if (f % 6 == 0) {
+            const Vec3 target{rng.uniform(-4.5, 4.5), rng.uniform(0.2, 1.5), rng.uniform(-0.3, 0.5)};
+            rig.bridge->fireProjectile(target + Vec3{0, 3, 15}, Vec3{0, -3, -15} * 8, 2, 0.15);
+        }
+        rig.bridge->stepFrame();
+        ASSERT_LE(rig.bridge->livePieceTriangles(), bc.maxLivePieceTriangles) << "frame " << f;
+        most = std::max(most, rig.bridge->livePieceTriangles());
+    }
+    EXPECT_GT(rig.bridge->counters().fractures, 2);
+    EXPECT_GT(rig.bridge->counters().piecesRetired, 0);
+    EXPECT_GT(most, 0u);
+    EXPECT_NEAR(rig.bridge->totalVolume(), start, 1e-6 * start);
+}

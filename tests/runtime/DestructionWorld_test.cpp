@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include "TestSupport.hpp"
 #include "rubble/MassProperties.hpp"
@@ -473,6 +474,65 @@ TEST(DestructionWorld, ReTargetedImpactInTheCraterIsAMissNotAFailure) {
     EXPECT_EQ(r.pieces, 0);
     EXPECT_NE(w.object(largest), nullptr) << "a miss leaves the object as it was";
     EXPECT_FALSE(w.timings()[0].missed);
+}
+
+// A piece hit again and again cannot grow without bound: once its mesh has more triangles than
+// max(crumbleTriangles, twice the object's original count), a hit crumbles it into a few large pieces.
+TEST(DestructionWorld, AnObjectOverItsTriangleLimitCrumbles) {
+    HeldJobs jobs;
+    DestructionWorld::Config c = heldConfig(jobs);
+    c.crumbleTriangles = 1;
+    DestructionWorld w(c);
+    ObjectId live = w.addObject(boxDesc()).value();
+    const std::size_t limit = w.object(live)->crumbleAbove;
+    EXPECT_EQ(limit, 2 * w.object(live)->mesh.triangleCount());
+    const double v0 = w.object(live)->mass.volume;
+    double elsewhere = 0;
+    int crumbles = 0;
+    for (int r = 0; r < 60 && crumbles == 0; ++r) {
+        const ObjectState* o = w.object(live);
+        const bool over = o->mesh.triangleCount() > limit;
+        const double before = o->mass.volume;
+        const Aabb b = o->mesh.bounds();
+        Impact i;
+        i.point = {b.lo.x + (b.hi.x - b.lo.x) * (0.2 + 0.6 * ((r * 7) % 10) / 10.0),
+                   b.lo.y + (b.hi.y - b.lo.y) * (0.2 + 0.6 * ((r * 3) % 10) / 10.0), b.hi.z};
+        i.normal = {0, 0, 1};
+        i.impulse = 10;
+        ASSERT_TRUE(w.submitImpact(live, i));
+        jobs.runAll();
+        w.beginFrame();
+        auto out = w.collect();
+        if (out.empty())
+            continue;
+        EXPECT_EQ(w.timings().back().crumbled, over) << "round " << r;
+        ObjectId largest = out[0].pieces.front();
+        for (ObjectId p : out[0].pieces) {
+            EXPECT_EQ(w.object(p)->crumbleAbove, limit) << "pieces inherit the limit";
+            if (w.object(p)->mass.volume > w.object(largest)->mass.volume)
+                largest = p;
+        }
+        elsewhere += out[0].droppedVolume;
+        if (over) {
+            ++crumbles;
+            EXPECT_GE(out[0].pieces.size(), 2u);
+            EXPECT_LT(w.object(largest)->mass.volume, 0.9 * before) << "no piece keeps most of it";
+        }
+        for (ObjectId p : out[0].pieces)
+            if (p != largest) {
+                elsewhere += w.object(p)->mass.volume;
+                w.removeObject(p);
+            }
+        live = largest;
+    }
+    EXPECT_EQ(crumbles, 1);
+    EXPECT_NEAR(w.object(live)->mass.volume + elsewhere, v0, 1e-9 * v0);
+
+    DestructionWorld::Config never = heldConfig(jobs);
+    never.crumbleTriangles = 0;
+    DestructionWorld w2(never);
+    EXPECT_EQ(w2.object(w2.addObject(boxDesc()).value())->crumbleAbove,
+              std::numeric_limits<std::size_t>::max());
 }
 
 } // namespace

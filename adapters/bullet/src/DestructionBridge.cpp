@@ -644,12 +644,21 @@ void DestructionBridge::retireExcess(FrameStats& stats) {
     }
     for (std::uint64_t h : fallen)
         retire(h, stats);
+    std::sort(pieces.begin(), pieces.end());
+    // The triangle budget of dynamic pieces: the smallest go first.
+    std::size_t i = 0;
+    for (std::size_t triangles = livePieceTriangles();
+         triangles > config_.maxLivePieceTriangles && i < pieces.size(); ++i) {
+        const Body& b = *bodies_.at(pieces[i].second);
+        if (const ObjectState* st = destruction_.object(b.object))
+            triangles -= std::min(triangles, st->mesh.triangleCount());
+        retire(pieces[i].second, stats);
+    }
     const int excess = livePieces_ - config_.maxLivePieces;
     if (excess <= 0)
         return;
-    std::sort(pieces.begin(), pieces.end());
-    for (int i = 0; i < excess && i < static_cast<int>(pieces.size()); ++i)
-        retire(pieces[static_cast<std::size_t>(i)].second, stats);
+    for (int n = 0; n < excess && i < pieces.size(); ++n, ++i)
+        retire(pieces[i].second, stats);
     // static pieces count too; when they alone exceed the cap, retire the smallest of them
     if (livePieces_ > config_.maxLivePieces) {
         std::vector<std::pair<double, std::uint64_t>> rest;
@@ -657,8 +666,8 @@ void DestructionBridge::retireExcess(FrameStats& stats) {
             if (b->kind == BodyKind::Piece)
                 rest.push_back({b->volume, h});
         std::sort(rest.begin(), rest.end());
-        for (std::size_t i = 0; livePieces_ > config_.maxLivePieces && i < rest.size(); ++i)
-            retire(rest[i].second, stats);
+        for (std::size_t j = 0; livePieces_ > config_.maxLivePieces && j < rest.size(); ++j)
+            retire(rest[j].second, stats);
     }
 }
 
@@ -725,6 +734,15 @@ FrameStats DestructionBridge::adoptReady() {
     adoptResults(stats);
     stats.adoptMs = msSince(t0);
     return stats;
+}
+
+std::size_t DestructionBridge::livePieceTriangles() const {
+    std::size_t n = 0;
+    for (const auto& [h, b] : bodies_)
+        if (b->kind == BodyKind::Piece && !b->isStatic && b->hasObject)
+            if (const ObjectState* st = destruction_.object(b->object))
+                n += st->mesh.triangleCount();
+    return n;
 }
 
 double DestructionBridge::liveVolume() const {

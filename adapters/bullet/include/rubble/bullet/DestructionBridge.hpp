@@ -64,12 +64,15 @@ public:
         double collisionImpulseThreshold = 2500; ///< non-projectile contacts fracture only above this total
                                                  ///< impulse per contact pair and step (and the object's own
                                                  ///< threshold)
-        double minApproachSpeed = 2.0;  ///< non-projectile contacts also need this approach speed (m/s)
-        int graceFrames = 30;           ///< new pieces ignore non-projectile contacts for this many frames
-        double minPieceVolume = 1e-3;   ///< pieces below this volume (m³) become debris particles at once
-        double minFractureVolume = 0;   ///< impacts on objects below this volume are ignored
-        int maxLivePieces = 250;        ///< beyond this many piece bodies the smallest retire to particles
-                                        ///< (250 keeps the physics step p99 under 8 ms on the seed world)
+        double minApproachSpeed = 2.0; ///< non-projectile contacts also need this approach speed (m/s)
+        int graceFrames = 30;          ///< new pieces ignore non-projectile contacts for this many frames
+        double minPieceVolume = 1e-3;  ///< pieces below this volume (m³) become debris particles at once
+        double minFractureVolume = 0;  ///< impacts on objects below this volume are ignored
+        int maxLivePieces = 250;       ///< beyond this many piece bodies the smallest retire to particles
+                                       ///< (250 keeps the physics step p99 under 8 ms on the seed world)
+        std::size_t maxLivePieceTriangles =
+            200000;                     ///< beyond this many triangles in dynamic piece bodies the
+                                        ///< smallest retire to particles (bounds their memory)
         double debrisLifetime = 3.0;    ///< seconds a debris particle is drawn
         double singleHullVolume = 0.25; ///< pieces below this volume (m³) collide as one convex hull of their
                                         ///< parts (cheaper contacts for small debris)
@@ -140,6 +143,8 @@ public:
     std::size_t bodyCount() const { return bodies_.size(); }
     /// Live piece bodies.
     int livePieces() const { return livePieces_; }
+    /// Triangles of the meshes of the dynamic piece bodies (what Config::maxLivePieceTriangles bounds).
+    std::size_t livePieceTriangles() const;
     /// Debris particles still drawn.
     const std::vector<DebrisParticle>& particles() const { return particles_; }
     /// Recent impacts (oldest first).
