@@ -204,8 +204,8 @@ struct DestructionWorld::Impl {
             job->crumble = true;
             job->params.pattern = CellPattern::Shatter;
             job->params.cells = std::max(2, config.crumbleCells);
-            // The shatter cuts the cells of the K sites nearest the impact among about 2K in a domain of this size
-            // (sites crowd the impact): four diagonals make those cells reach across the whole object.
+            // The shatter cuts the cells of the K sites nearest the impact among about 2K in a domain of this
+            // size (sites crowd the impact): four diagonals make those cells reach across the whole object.
             job->params.sizeLaw.minSize = job->params.sizeLaw.maxSize = 4 * o.mesh.bounds().diagonal();
         }
         job->decomposition = config.decomposition;
