@@ -438,7 +438,7 @@ TEST(DestructionWorld, WaitForResultIsAlwaysFalseInDeterministicMode) {
 // An impact that waited on an in-flight job is re-targeted to the nearest piece; when its point lies deep in
 // the crater the first job cut, farther from the remaining surface than its own cell reaches, its cells miss
 // the mesh: a miss (the object stays), not a geometry failure.
-TEST(DestructionWorld, ReTargetedImpactInTheCraterIsAMissNotAFailure) {
+TEST(DestructionWorld, ReTargetedImpactInTheCraterBreaksTheCraterWall) {
     HeldJobs jobs;
     DestructionWorld w(heldConfig(jobs));
     ObjectDesc d = boxDesc();  // [-1, 1]^3
@@ -451,7 +451,7 @@ TEST(DestructionWorld, ReTargetedImpactInTheCraterIsAMissNotAFailure) {
     ASSERT_TRUE(w.submitImpact(id, big));
     Impact small = centreHit();
     small.point = {0, 0, 0.9};              // in the crater, ≥ 0.425 from what remains
-    small.impulse = 1;                      // cube of edge 0.1: reaches 0.1 at most
+    small.impulse = 1;                      // cube of edge 0.1: reaches 0.1 at most, from the crater's wall
     ASSERT_TRUE(w.submitImpact(id, small)); // waits for the first job
     jobs.runAll();
     w.beginFrame();
@@ -461,19 +461,43 @@ TEST(DestructionWorld, ReTargetedImpactInTheCraterIsAMissNotAFailure) {
     for (ObjectId p : out[0].pieces)
         if (!largest || w.object(p)->mass.volume > w.object(largest)->mass.volume)
             largest = p;
+    const double remainder = w.object(largest)->mass.volume;
     ASSERT_EQ(w.jobsInFlight(), 1); // the waiting impact, re-targeted
     jobs.runAll();
     w.beginFrame();
-    EXPECT_TRUE(w.collect().empty());
+    const auto again = w.collect();
+    ASSERT_EQ(again.size(), 1u) << "the impact moved onto the nearest surface: the crater's wall";
     ASSERT_EQ(w.timings().size(), 2u);
     const TimingRecord& r = w.timings()[1];
     EXPECT_EQ(r.object, largest) << "re-targeted to the remainder, whose bounds contain the point";
-    EXPECT_TRUE(r.missed);
+    EXPECT_FALSE(r.missed);
     EXPECT_FALSE(r.failed);
-    EXPECT_FALSE(r.stale);
-    EXPECT_EQ(r.pieces, 0);
-    EXPECT_NE(w.object(largest), nullptr) << "a miss leaves the object as it was";
-    EXPECT_FALSE(w.timings()[0].missed);
+    EXPECT_GE(r.pieces, 2);
+    double v = again[0].droppedVolume;
+    for (ObjectId p : again[0].pieces)
+        v += w.object(p)->mass.volume;
+    EXPECT_NEAR(v, remainder, 1e-9 * remainder);
+}
+
+// An impact farther from the mesh than the object's own size is no contact: its job is a miss (not a failure)
+// and the object stays as it was.
+TEST(DestructionWorld, AnImpactFarFromTheObjectIsAMissNotAFailure) {
+    HeldJobs jobs;
+    DestructionWorld w(heldConfig(jobs));
+    auto id = w.addObject(boxDesc()).value(); // [-1, 1]^3, diagonal 3.46
+    const std::uint64_t hash = w.object(id)->mesh.hash();
+    Impact far = centreHit();
+    far.point = {0, 0, 6}; // 5 from the top face
+    ASSERT_TRUE(w.submitImpact(id, far));
+    jobs.runAll();
+    w.beginFrame();
+    EXPECT_TRUE(w.collect().empty());
+    ASSERT_EQ(w.timings().size(), 1u);
+    EXPECT_TRUE(w.timings()[0].missed);
+    EXPECT_FALSE(w.timings()[0].failed);
+    EXPECT_EQ(w.timings()[0].pieces, 0);
+    ASSERT_NE(w.object(id), nullptr) << "a miss leaves the object as it was";
+    EXPECT_EQ(w.object(id)->mesh.hash(), hash);
 }
 
 // A piece hit again and again cannot grow without bound: once its mesh has more triangles than
