@@ -482,8 +482,8 @@ struct CollapseRig : Rig {
         bridge->setOnAdopted({});
         return out;
     }
-    // the blast throws the debris out (the bridge gives it only the parent's velocity field, zero for a
-    // static parent): without this a cut-out chunk would stay wedged in its gap and hold up what is above
+    // throws the debris out at a known velocity (the bridge's own kick, Config::debrisKick, depends on the
+    // hit's impulse and the debris mass): a cut-out chunk left in its gap would hold up what is above
     void ejectDebris(const std::vector<PieceView>& pieces, const Vec3& velocity) {
         for (const PieceView& p : pieces)
             if (Body* b = bridge->bodyOf(p.id); b && p.cell >= 0) {
@@ -656,4 +656,36 @@ TEST(DestructionBridge, DynamicPieceTrianglesStayWithinTheBudget) {
     EXPECT_GT(rig.bridge->counters().piecesRetired, 0);
     EXPECT_GT(most, 0u);
     EXPECT_NEAR(rig.bridge->totalVolume(), start, 1e-6 * start);
+}
+
+// The hit throws a static wall's debris outward (along the surface normal, away from the impact), at one
+// speed for all debris of the hit, bounded; with the kick off the debris starts at rest like the wall.
+TEST(DestructionBridgeCollapse, DebrisOfAStaticWallIsThrownOutward) {
+    for (const double share : {0.5, 0.0}) {
+        CollapseRig rig;
+        DestructionBridge::Config bc = CollapseRig::config(true);
+        bc.debrisKick = share;
+        rig.bridge = std::make_unique<DestructionBridge>(*rig.physics, *rig.destruction, bc);
+        rig.bridge->addGround({0, -0.5, 0}, {50, 0.5, 50});
+        const ObjectId wall = rig.addStatic({3, 2, 0.25}, {0, 2, 0}, cubeCell(1.0));
+        std::vector<btVector3> velocities;
+        rig.bridge->setOnAdopted([&](const FractureOutcome& o) {
+            for (std::size_t i = 0; i < o.pieces.size(); ++i)
+                if (o.pieceCells[i] >= 0)
+                    if (Body* b = rig.bridge->bodyOf(o.pieces[i]); b && !b->isStatic)
+                        velocities.push_back(b->rigid->getLinearVelocity());
+        });
+        ASSERT_TRUE(rig.destruction->submitImpact(wall, Impact{{0, 0, 0.25}, {0, 0, 1}, 200}));
+        ASSERT_TRUE(rig.runUntilFracture());
+        ASSERT_FALSE(velocities.empty());
+        for (const btVector3& v : velocities) {
+            if (share > 0) {
+                EXPECT_GT(v.z(), 0.1) << "outward, along the wall's normal";
+                EXPECT_LE(v.length(), bc.maxDebrisKickSpeed + 1e-9);
+                EXPECT_NEAR(v.length(), velocities.front().length(), 1e-6) << "one speed per hit";
+            } else {
+                EXPECT_LT(v.length(), 1e-9);
+            }
+        }
+    }
 }

@@ -457,6 +457,30 @@ void DestructionBridge::adopt(const FractureOutcome& outcome, FrameStats& stats)
     destroy(parentHandle, false); // the DestructionWorld already removed the parent object
     ++stats.fractures;
     ++counters_.fractures;
+    // Debris of a static object is thrown outward by the hit: a share of the impulse, split by mass (so all
+    // debris of one hit gets the same speed), along the surface normal and away from the impact point. A
+    // dynamic parent's pieces keep its velocity field only: the physics engine applied the impulse already.
+    double debrisMass = 0;
+    if (parentStatic && config_.debrisKick > 0 && !outcome.impacts.empty())
+        for (std::size_t i = 0; i < outcome.pieces.size(); ++i)
+            if (!isRemainder(i))
+                if (const ObjectState* st = destruction_.object(outcome.pieces[i]))
+                    debrisMass += st->density * std::abs(st->mass.volume);
+    auto kick = [&](std::size_t i) {
+        if (debrisMass <= 0 || isRemainder(i) || i >= outcome.pieceFrames.size())
+            return btVector3(0, 0, 0);
+        const Vec3 at = outcome.pieceFrames[i].translation; // the piece's centre, parent coordinates
+        const Impact* hit = &outcome.impacts.front();
+        for (const Impact& m : outcome.impacts)
+            if (lengthSquared(m.point - at) < lengthSquared(hit->point - at))
+                hit = &m;
+        Vec3 dir = normalized(hit->normal);
+        if (const Vec3 away = at - hit->point; lengthSquared(away) > 0)
+            dir = normalized(dir + 0.5 * normalized(away));
+        const double speed =
+            std::min(config_.debrisKick * hit->impulse / debrisMass, config_.maxDebrisKickSpeed);
+        return parentObject.getBasis() * toBt(dir * speed);
+    };
     for (std::size_t i = 0; i < outcome.pieces.size(); ++i) {
         const ObjectId pid = outcome.pieces[i];
         const ObjectState* st = destruction_.object(pid);
@@ -468,7 +492,8 @@ void DestructionBridge::adopt(const FractureOutcome& outcome, FrameStats& stats)
         const bool checked = collapse && !floating && isRemainder(i); // static until its support check
         const bool isStatic = (parentStatic && i == keep) || checked;
         const double volume = std::abs(st->mass.volume);
-        const btVector3 pv = v + w.cross(bodyWorld.getOrigin() - c);
+        const btVector3 pv =
+            v + w.cross(bodyWorld.getOrigin() - c) + (isStatic ? btVector3(0, 0, 0) : kick(i));
         if (!isStatic && volume < config_.minPieceVolume) {
             particles_.push_back({fromBt(bodyWorld.getOrigin()), fromBt(pv), std::cbrt(volume), volume,
                                   config_.debrisLifetime});

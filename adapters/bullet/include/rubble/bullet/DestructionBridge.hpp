@@ -71,9 +71,13 @@ public:
         int maxLivePieces = 250;       ///< beyond this many piece bodies the smallest retire to particles
                                        ///< (250 keeps the physics step p99 under 8 ms on the seed world)
         std::size_t maxLivePieceTriangles =
-            200000;                     ///< beyond this many triangles in dynamic piece bodies the
-                                        ///< smallest retire to particles (bounds their memory)
-        double debrisLifetime = 3.0;    ///< seconds a debris particle is drawn
+            200000;                  ///< beyond this many triangles in dynamic piece bodies the
+                                     ///< smallest retire to particles (bounds their memory)
+        double debrisLifetime = 3.0; ///< seconds a debris particle is drawn
+        double debrisKick = 0.5;     ///< share of a hit's impulse that throws the debris of a *static* object
+                                     ///< outward (along the surface normal, spread away from the impact);
+                                     ///< dynamic objects already took the impulse from the physics engine
+        double maxDebrisKickSpeed = 12; ///< upper bound of that outward speed (m/s)
         double singleHullVolume = 0.25; ///< pieces below this volume (m³) collide as one convex hull of their
                                         ///< parts (cheaper contacts for small debris)
         double collisionMargin = 0.02;   ///< convex hull margin (hulls are eroded by it)
