@@ -109,6 +109,9 @@ public:
         /// a few big pieces (which the engine adapter can let fall and retire). 0 = never.
         std::size_t crumbleTriangles = 16384;
         int crumbleCells = 4; ///< cells of a crumbling hit
+        /// timings() keeps at least this many of the latest records and at most twice as many, so a long game
+        /// does not accumulate them forever (0 = keep all).
+        std::size_t keepTimings = 16384;
     };
 
     /// A world with the given configuration.
@@ -150,7 +153,7 @@ public:
 
     /// Jobs running or waiting.
     int jobsInFlight() const;
-    /// Timing of every finished impact so far.
+    /// Timing of the finished impacts, oldest first (the latest Config::keepTimings to twice as many).
     const std::vector<TimingRecord>& timings() const;
     /// Writes timings() as CSV.
     Status writeTimingsCsv(const std::filesystem::path& path) const;

@@ -188,7 +188,14 @@ struct DestructionWorld::Impl {
         rec.impactsMerged = static_cast<int>(impacts.size());
         rec.stale = true;
         rec.totalMs = msBetween(impacts.front().time, Clock::now());
+        record(rec);
+    }
+
+    void record(const TimingRecord& rec) {
         timings.push_back(rec);
+        const std::size_t keep = config.keepTimings;
+        if (keep > 0 && timings.size() > 2 * keep) // amortised: drop the oldest half at once
+            timings.erase(timings.begin(), timings.end() - static_cast<std::ptrdiff_t>(keep));
     }
 
     bool busy(ObjectId id) const {
@@ -474,7 +481,7 @@ std::vector<FractureOutcome> DestructionWorld::collect() {
         const auto a1 = Clock::now();
         rec.adoptionMs = msBetween(a0, a1);
         rec.totalMs = msBetween(job->impacts.front().time, a1);
-        im.timings.push_back(rec);
+        im.record(rec);
         if (!relaunch)
             im.recordDropped(job->id, later);
     }

@@ -559,5 +559,25 @@ TEST(DestructionWorld, AnObjectOverItsTriangleLimitCrumbles) {
               std::numeric_limits<std::size_t>::max());
 }
 
+// A long game does not accumulate timing records forever: the latest keepTimings .. 2 × keepTimings stay.
+TEST(DestructionWorld, TimingRecordsKeepOnlyTheLatest) {
+    HeldJobs jobs;
+    DestructionWorld::Config c = heldConfig(jobs);
+    c.keepTimings = 3;
+    DestructionWorld w(c);
+    auto id = w.addObject(boxDesc()).value();
+    Impact far = centreHit();
+    far.point = {0, 0, 6}; // a miss: one record per job, the object stays
+    for (int i = 0; i < 20; ++i) {
+        ASSERT_TRUE(w.submitImpact(id, far));
+        jobs.runAll();
+        w.beginFrame();
+        w.collect();
+        ASSERT_GE(w.timings().size(), std::min<std::size_t>(3, static_cast<std::size_t>(i + 1)));
+        ASSERT_LE(w.timings().size(), 6u);
+        EXPECT_EQ(w.timings().back().frame + 1, w.frame()) << "the latest is kept (submitted last frame)";
+    }
+}
+
 } // namespace
 } // namespace rubble
