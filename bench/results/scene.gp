@@ -2,7 +2,7 @@ set terminal pngcairo size 1000,560
 # gnuplot bench/results/scene.gp (from the repository root) redraws scene.png from scene.csv
 set output 'bench/results/scene.png'
 set datafile separator ','
-set title "rubble-bench scene: 10 shots/s for 60 s, 1 worker, paced at 60 Hz with idle adoption (Release, 2-core VM, load 1.5-3 incl. the bench)"
+set title "rubble-bench scene: 10 shots/s, 60 s, 1 worker, 60 Hz, idle adoption (Release, 2-core VM, load 1.5-3)"
 set style data histograms
 set style histogram clustered gap 1
 set style fill solid 0.8 border -1
