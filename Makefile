@@ -4,9 +4,10 @@
 #   make bench   install, build Release, run the benchmarks (CSV + PNG in bench/results/)
 #   make build   install and build (RelWithDebInfo) into build/
 #   make sanitize    clang ASan+UBSan build of the whole test suite (build-asan/) and TSan build of the runtime
-#                    and threading tests (build-tsan/), both run by CTest (scripts/sanitize.sh)
-#   make sanitize-ci the part of both that CI runs after make test (geometry + io under ASan+UBSan, 3 fuzzers)
-#   make fuzz-smoke  every libFuzzer target for FUZZ_SECONDS (default 45) each, built into build-asan/
+#                    and Bullet tests (build-tsan/), both run by CTest (scripts/sanitize.sh)
+#   make sanitize-ci what CI runs after make test: make sanitize, then every libFuzzer target for a fixed seed and
+#                    input count (about a minute each; scripts/fuzz.sh ci), so CI findings reproduce
+#   make fuzz-smoke  every libFuzzer target for FUZZ_SECONDS (default 45) each with fresh seeds, in build-asan/
 #   make stress      the chained-fracture stress test with STRESS_IMPACTS (default 10000) impacts
 #   make soak        rubble-bench scene with continuous fire for SOAK_FRAMES (default 100000) frames
 
@@ -59,7 +60,7 @@ sanitize: deps-clang
 	@bash scripts/sanitize.sh all
 
 sanitize-ci: deps-clang
-	@FUZZ_SECONDS=$(FUZZ_SECONDS) bash scripts/sanitize.sh ci
+	@bash scripts/sanitize.sh ci
 
 fuzz-smoke: deps-clang
 	@bash scripts/fuzz.sh $(FUZZ_SECONDS)

@@ -1,49 +1,77 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets with clang (ASan + UBSan) and runs each for a bounded time.
-# Usage: scripts/fuzz.sh [SECONDS_PER_TARGET=60] [TARGET...]
+# Usage: scripts/fuzz.sh [SECONDS_PER_TARGET=60] [TARGET...]   exploration: random seeds, the corpus grows
+#        scripts/fuzz.sh ci [TARGET...]                          CI: a fixed seed and input count per target
 # The fuzzers live in the ASan tree of scripts/sanitize.sh (build-asan/, or $RUBBLE_FUZZ_DIR), so `make sanitize`
 # and `make fuzz-smoke` share one build. A crash leaves its input in <tree>/crashes/<target>/; minimise it
 # (fuzz_<target> -minimize_crash=1 -runs=10000 FILE) and add it to tests/corpus/<target>/ so that it stays a
-# regression test (fuzz_replay_<target> in CTest). Inputs that grew the coverage stay in <tree>/corpus/<target>/
-# for the next run; the repository's corpus is only read.
-# Environment: RUBBLE_FUZZ_SEED and RUBBLE_FUZZ_RUNS make a run reproducible (libFuzzer's -seed and -runs; the
-# time limit still caps it). CI sets both, so a finding there is found again locally by the same command.
+# regression test (fuzz_replay_<target> in CTest).
+# Exploration keeps the inputs that grew the coverage in <tree>/corpus/<target>/ for the next run (the repository's
+# corpus is only read). RUBBLE_FUZZ_SEED and RUBBLE_FUZZ_RUNS (libFuzzer's -seed and -runs; the time limit still
+# caps the run) make it reproducible.
+# CI mode runs each target from seed 1 for the input count in ci_runs below (sized to about a minute each on the
+# 2-core CI machine), starting from the repository's corpus and an empty work corpus (<tree>/corpus-ci/), with
+# ASLR off and libFuzzer's timed corpus reload off: with either on, two runs of the same seed diverge after a few
+# hundred inputs (the targets' coverage depends on addresses: pointer-keyed containers in CGAL and the repair
+# code). So a CI run is one fixed input sequence, and `scripts/fuzz.sh ci TARGET` repeats it with the same build.
+# ci_cap seconds bound each target on a loaded machine; a capped run is the same sequence cut short. A failing
+# input is also printed in base64, so it can be taken from the CI log.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-seconds=${1:-60}
+declare -A ci_runs=([obj]=500000 [scene]=400000 [mesh_repair]=70000 [convex_clip]=18000 [fracture]=1500)
+ci_cap=150
+ci=0
+if [ "${1:-}" = ci ]; then
+    ci=1
+    seconds=$ci_cap
+else
+    seconds=${1:-60}
+fi
 shift || true
 targets=("$@")
 [ ${#targets[@]} -gt 0 ] || targets=(obj scene mesh_repair convex_clip fracture)
 dir=${RUBBLE_FUZZ_DIR:-build-asan}
-if [ ! -f $dir/build.ninja ]; then
-    if [ "$dir" = build-asan ]; then bash scripts/sanitize.sh configure-asan; else
-        CC=clang CXX=clang++ cmake -S . -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRUBBLE_BUILD_DEMO=OFF \
-            -DRUBBLE_BUILD_BENCH=OFF -DRUBBLE_WERROR=OFF -DRUBBLE_SANITIZE=address,undefined -DRUBBLE_BUILD_FUZZERS=ON >/dev/null
-    fi
+if [ ! -f "$dir/build.ninja" ]; then
+    bash scripts/sanitize.sh configure-asan "$dir"
 else
-    cmake $dir >/dev/null # pick up new targets
+    cmake "$dir" >/dev/null # pick up new targets
 fi
 status=0
 for t in "${targets[@]}"; do
-    if ! grep -q "fuzz/fuzz_$t:" $dir/build.ninja; then
+    if ! grep -q "fuzz/fuzz_$t:" "$dir/build.ninja"; then
         echo "fuzz: no target fuzz_$t in $dir (configured without -DRUBBLE_BUILD_FUZZERS=ON?)"
         status=1
         continue
     fi
-    cmake --build $dir --target fuzz_$t -j "$(nproc)" >/dev/null
-    work=$dir/corpus/$t
-    mkdir -p $dir/crashes/$t "$work"
-    echo "fuzz: $t for ${seconds}s"
+    cmake --build "$dir" --target "fuzz_$t" -j "${JOBS:-$(nproc)}" >/dev/null
     repro=()
-    [ -z "${RUBBLE_FUZZ_SEED:-}" ] || repro+=(-seed="$RUBBLE_FUZZ_SEED")
-    [ -z "${RUBBLE_FUZZ_RUNS:-}" ] || repro+=(-runs="$RUBBLE_FUZZ_RUNS")
-    if ! $dir/fuzz/fuzz_$t "$work" tests/corpus/$t -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len=4096 \
-        "${repro[@]}" -artifact_prefix=$dir/crashes/$t/ -print_final_stats=1 2>$dir/fuzz_$t.log; then
+    norand=()
+    if [ $ci = 1 ]; then
+        work=$dir/corpus-ci/$t
+        rm -rf "$work"
+        repro=(-seed=1 -runs="${ci_runs[$t]}" -reload=0)
+        if setarch "$(uname -m)" -R true 2>/dev/null; then norand=(setarch "$(uname -m)" -R); fi
+        echo "fuzz: $t, seed 1, ${ci_runs[$t]} inputs (at most ${seconds}s)"
+    else
+        work=$dir/corpus/$t
+        [ -z "${RUBBLE_FUZZ_SEED:-}" ] || repro+=(-seed="$RUBBLE_FUZZ_SEED")
+        [ -z "${RUBBLE_FUZZ_RUNS:-}" ] || repro+=(-runs="$RUBBLE_FUZZ_RUNS")
+        echo "fuzz: $t for ${seconds}s"
+    fi
+    mkdir -p "$dir/crashes/$t" "$work"
+    t0=$(date +%s)
+    if ! "${norand[@]}" "$dir/fuzz/fuzz_$t" "$work" "tests/corpus/$t" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+        -max_len=4096 "${repro[@]}" -artifact_prefix="$dir/crashes/$t/" -print_final_stats=1 2>"$dir/fuzz_$t.log"; then
         echo "fuzz: $t FAILED; see $dir/fuzz_$t.log and $dir/crashes/$t/"
-        tail -40 $dir/fuzz_$t.log
+        tail -40 "$dir/fuzz_$t.log"
+        find "$dir/crashes/$t" -type f -newermt "@$t0" | while read -r f; do
+            echo "fuzz: $f (base64): $(base64 -w0 "$f")"
+        done
         status=1
     else
-        grep -E "stat::number_of_executed_units|cov:" $dir/fuzz_$t.log | tail -2
+        runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$dir/fuzz_$t.log")
+        cov=$(grep -o 'cov: [0-9]*' "$dir/fuzz_$t.log" | tail -1)
+        echo "fuzz: $t ok, $runs inputs in $(($(date +%s) - t0)) s, $cov"
     fi
 done
 exit $status

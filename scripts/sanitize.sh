@@ -1,20 +1,29 @@
 #!/usr/bin/env bash
-# Sanitizer runs (clang). Usage: scripts/sanitize.sh [all|asan|tsan|ci|configure-asan|configure-tsan]
-#   asan: the whole test suite (all labels but e2e) built with ASan + UBSan into build-asan/ and run by CTest;
-#         every finding is fatal (-fno-sanitize-recover=all, halt_on_error). The libFuzzer targets are built
-#         into the same tree (scripts/fuzz.sh uses it), so one tree serves both.
-#   tsan: only the runtime and threading tests (tests/runtime, tests/bullet) built with TSan into build-tsan/.
-#   ci:   the subset .ci/run can afford on a cold cache (see docs/robustness.md, section 7): the geometry and io
-#         modules and their tests under ASan + UBSan, then the obj, scene and mesh_repair fuzzers for
-#         FUZZ_SECONDS (default 30) each, in build-asan/. The CGAL-heavy fracture backends are left to
-#         `make sanitize` / `make fuzz-smoke`: compiling them under ASan alone takes longer than CI's budget.
+# Sanitizer runs (clang). Usage: scripts/sanitize.sh [all|asan|tsan|fuzz|ci|configure-asan [DIR]|configure-tsan]
+#   asan: the whole test suite built with ASan + UBSan into build-asan/ and run by CTest (every label but e2e: the
+#         e2e tests need rubble-demo and Xvfb, and sanitizer trees do not build the demo); every finding is fatal
+#         (-fno-sanitize-recover=all, halt_on_error). The libFuzzer targets are built into the same tree
+#         (scripts/fuzz.sh uses it), so one tree serves both.
+#   tsan: the threaded code, i.e. the runtime and Bullet-bridge tests (tests/runtime, tests/bullet), built with TSan
+#         into build-tsan/ and run by CTest.
+#   fuzz: every libFuzzer target for a fixed seed and input count (scripts/fuzz.sh ci).
+#   all:  asan, then tsan (`make sanitize`).  ci: asan, tsan, fuzz (`make sanitize-ci`, what .ci/run runs).
+# Both trees are RelWithDebInfo with -gline-tables-only instead of -g (half the object size, file:line stack traces
+# kept) and link with lld when it is installed (links 3x faster); -O1 compiled only 6 % faster but ran the tests
+# and fuzzers 25-60 % slower (docs/robustness.md, section 7). They share ccache with every other tree, so a warm
+# cache rebuilds only what changed.
 # Environment: JOBS (default nproc), RUBBLE_STRESS_IMPACTS (default 300 here: ASan is ~10x slower).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 what=${1:-all}
 jobs=${JOBS:-$(nproc)}
+flags="-O2 -gline-tables-only -DNDEBUG"
 common=(-G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRUBBLE_BUILD_DEMO=OFF -DRUBBLE_BUILD_BENCH=OFF
-    -DRUBBLE_WERROR=OFF) # warnings are enforced by the gcc build; clang only has to compile
+    -DRUBBLE_WERROR=OFF # warnings are enforced by the gcc build; clang only has to compile
+    "-DCMAKE_C_FLAGS_RELWITHDEBINFO=$flags" "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=$flags")
+if command -v ld.lld >/dev/null; then
+    common+=(-DCMAKE_EXE_LINKER_FLAGS=-fuse-ld=lld -DCMAKE_SHARED_LINKER_FLAGS=-fuse-ld=lld)
+fi
 
 configure() { # dir, sanitizers, extra cmake args...
     local dir=$1 san=$2
@@ -32,7 +41,7 @@ asan() {
     cmake --build build-asan -j "$jobs"
     echo "sanitize: ASan+UBSan build took $(elapsed "$t0")"
     t0=$(date +%s)
-    # Leak checking is on (ASan's default on Linux); the suppressions file names only third-party leaks.
+    # Leak checking is on (ASan's default on Linux).
     ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1 \
         UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
         RUBBLE_STRESS_IMPACTS=${RUBBLE_STRESS_IMPACTS:-300} \
@@ -59,23 +68,10 @@ tsan() {
     echo "sanitize: TSan tests took $(elapsed "$t0")"
 }
 
-ci() {
+fuzz() {
     local t0
     t0=$(date +%s)
-    configure build-asan address,undefined -DRUBBLE_BUILD_FUZZERS=ON
-    local targets
-    targets=$(ninja -C build-asan -t targets all | sed -n 's#^tests/\(\(geometry\|io\)_[A-Za-z]*_test\):.*#\1#p')
-    # shellcheck disable=SC2086
-    cmake --build build-asan -j "$jobs" --target $targets fuzz_replay_obj fuzz_replay_scene fuzz_replay_mesh_repair
-    echo "sanitize: ASan+UBSan build (geometry, io) took $(elapsed "$t0")"
-    t0=$(date +%s)
-    export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:strict_string_checks=1
-    export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
-    ctest --test-dir build-asan --output-on-failure -j "$jobs" --timeout 1200 -L 'geometry|io'
-    ctest --test-dir build-asan --output-on-failure -R '^fuzz_replay_(obj|scene|mesh_repair)$'
-    echo "sanitize: ASan+UBSan tests (geometry, io) took $(elapsed "$t0")"
-    t0=$(date +%s)
-    bash scripts/fuzz.sh "${FUZZ_SECONDS:-30}" obj scene mesh_repair
+    bash scripts/fuzz.sh ci
     echo "sanitize: fuzzing took $(elapsed "$t0")"
 }
 
@@ -83,8 +79,12 @@ case "$what" in
     all) asan && tsan ;;
     asan) asan ;;
     tsan) tsan ;;
-    ci) ci ;;
-    configure-asan) configure build-asan address,undefined -DRUBBLE_BUILD_FUZZERS=ON ;;
+    fuzz) fuzz ;;
+    ci) asan && tsan && fuzz ;;
+    configure-asan) configure "${2:-build-asan}" address,undefined -DRUBBLE_BUILD_FUZZERS=ON ;;
     configure-tsan) configure build-tsan thread ;;
-    *) echo "usage: scripts/sanitize.sh [all|asan|tsan|ci|configure-asan|configure-tsan]" >&2; exit 2 ;;
+    *)
+        echo "usage: scripts/sanitize.sh [all|asan|tsan|fuzz|ci|configure-asan [DIR]|configure-tsan]" >&2
+        exit 2
+        ;;
 esac
