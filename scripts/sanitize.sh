@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
 # Sanitizer runs (clang). Usage: scripts/sanitize.sh [all|asan|tsan|fuzz|ci|configure-asan [DIR]|configure-tsan]
-#   asan: the whole test suite built with ASan + UBSan into build-asan/ and run by CTest (every label but e2e: the
-#         e2e tests need rubble-demo and Xvfb, and sanitizer trees do not build the demo); every finding is fatal
+#   asan: the whole test suite built with ASan + UBSan into build-asan/ and run by CTest (every label, bench smoke
+#         runs included, but e2e: the e2e tests need rubble-demo and Xvfb, and sanitizer trees do not build the
+#         demo); every finding is fatal
 #         (-fno-sanitize-recover=all, halt_on_error). The libFuzzer targets are built into the same tree
 #         (scripts/fuzz.sh uses it), so one tree serves both.
-#   tsan: the threaded code, i.e. the runtime and Bullet-bridge tests (tests/runtime, tests/bullet), built with TSan
-#         into build-tsan/ and run by CTest.
+#   tsan: the threaded code, i.e. the runtime and Bullet-bridge tests (tests/runtime, tests/bullet) and the scene
+#         bench's smoke run (bench_scene_smoke), built with TSan into build-tsan/ and run by CTest.
 #   fuzz: every libFuzzer target for a fixed seed and input count (scripts/fuzz.sh ci).
 #   all:  asan, then tsan (`make sanitize`).  ci: asan, tsan, fuzz (`make sanitize-ci`, what .ci/run runs).
 # Both trees are RelWithDebInfo with -gline-tables-only instead of -g (half the object size, file:line stack traces
@@ -18,17 +19,16 @@ cd "$(dirname "$0")/.."
 what=${1:-all}
 jobs=${JOBS:-$(nproc)}
 flags="-O2 -gline-tables-only -DNDEBUG"
-common=(-G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRUBBLE_BUILD_DEMO=OFF -DRUBBLE_BUILD_BENCH=OFF
+common=(-G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRUBBLE_BUILD_DEMO=OFF -DRUBBLE_BUILD_BENCH=ON
     -DRUBBLE_WERROR=OFF # warnings are enforced by the gcc build; clang only has to compile
     "-DCMAKE_C_FLAGS_RELWITHDEBINFO=$flags" "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=$flags")
 if command -v ld.lld >/dev/null; then
     common+=(-DCMAKE_EXE_LINKER_FLAGS=-fuse-ld=lld -DCMAKE_SHARED_LINKER_FLAGS=-fuse-ld=lld)
 fi
 
-configure() { # dir, sanitizers, extra cmake args...
+configure() { # dir, sanitizers, extra cmake args... (re-applied to an existing tree, so option changes reach it)
     local dir=$1 san=$2
     shift 2
-    [ -f "$dir/build.ninja" ] && return 0
     CC=clang CXX=clang++ cmake -S . -B "$dir" "${common[@]}" -DRUBBLE_SANITIZE="$san" "$@" >/dev/null
 }
 
@@ -53,18 +53,20 @@ tsan() {
     local t0
     t0=$(date +%s)
     configure build-tsan thread
-    # Only the threaded code: the runtime's tests and the Bullet bridge (which drives DestructionWorld).
+    # Only the threaded code: the runtime's tests, the Bullet bridge (which drives DestructionWorld) and the
+    # scene bench's smoke run (the whole game loop with fracture workers).
     local targets
     targets=$(ninja -C build-tsan -t targets all | sed -n 's#^tests/\(\(runtime\|bullet\)_[A-Za-z]*_test\):.*#\1#p')
     # shellcheck disable=SC2086
-    cmake --build build-tsan -j "$jobs" --target $targets
+    cmake --build build-tsan -j "$jobs" --target $targets rubble-bench
     echo "sanitize: TSan build took $(elapsed "$t0")"
     t0=$(date +%s)
     # Clang 14's TSan cannot map its shadow with the larger ASLR entropy of recent kernels: run without ASLR.
     local norand=()
     if [ "$(cat /proc/sys/vm/mmap_rnd_bits 2>/dev/null || echo 28)" -gt 28 ]; then norand=(setarch "$(uname -m)" -R); fi
     TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1 \
-        "${norand[@]}" ctest --test-dir build-tsan --output-on-failure -j "$jobs" --timeout 1200 -L 'runtime|bullet'
+        "${norand[@]}" ctest --test-dir build-tsan --output-on-failure -j "$jobs" --timeout 1200 \
+        -L 'runtime|bullet|bench' -E '_quick$'
     echo "sanitize: TSan tests took $(elapsed "$t0")"
 }
 
