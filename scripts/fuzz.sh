@@ -11,9 +11,10 @@
 # caps the run) make it reproducible.
 # CI mode runs each target from seed 1 for the input count in ci_runs below (sized to about a minute each on the
 # 2-core CI machine), starting from the repository's corpus and an empty work corpus (<tree>/corpus-ci/), with
-# ASLR off and libFuzzer's timed corpus reload off: with either on, two runs of the same seed diverge after a few
-# hundred inputs (the targets' coverage depends on addresses: pointer-keyed containers in CGAL and the repair
-# code). So a CI run is one fixed input sequence, and `scripts/fuzz.sh ci TARGET` repeats it with the same build.
+# ASLR off, a fixed environment and libFuzzer's timed corpus reload off: otherwise two runs of the same seed
+# diverge after a few hundred inputs (the targets' coverage depends on addresses, heap and stack, and reloads
+# depend on time). So a CI run is one fixed input sequence, and `scripts/fuzz.sh ci TARGET` repeats it with the
+# same build in any clone.
 # ci_cap seconds bound each target on a loaded machine; a capped run is the same sequence cut short. A failing
 # input is also printed in base64, so it can be taken from the CI log.
 set -euo pipefail
@@ -50,7 +51,9 @@ for t in "${targets[@]}"; do
         work=$dir/corpus-ci/$t
         rm -rf "$work"
         repro=(-seed=1 -runs="${ci_runs[$t]}" -reload=0)
-        if setarch "$(uname -m)" -R true 2>/dev/null; then norand=(setarch "$(uname -m)" -R); fi
+        # A fixed, minimal environment too: with ASLR off, the stack's addresses still move with its size.
+        norand=(env -i PATH=/usr/bin:/bin)
+        if setarch "$(uname -m)" -R true 2>/dev/null; then norand+=(setarch "$(uname -m)" -R); fi
         echo "fuzz: $t, seed 1, ${ci_runs[$t]} inputs (at most ${seconds}s)"
     else
         work=$dir/corpus/$t
