@@ -60,7 +60,10 @@ struct Mesh {
     Status validate() const;
     /// Appends another mesh (its indices shifted), keeping attributes consistent.
     void append(const Mesh& other);
-    /// A copy with every position p mapped to rotation * (scale ⊙ p) + translation; normals follow.
+    /// Maps every position p to rotation * (scale ⊙ p) + translation in place; normals follow (and a
+    /// mirroring scale swaps two corners of every triangle so that it stays outward).
+    void transform(const Mat3& rotation, const Vec3& scale, const Vec3& translation);
+    /// A copy transformed as by transform().
     Mesh transformed(const Mat3& rotation, const Vec3& scale, const Vec3& translation) const;
     /// A copy translated by t.
     Mesh translated(const Vec3& t) const;

@@ -72,22 +72,26 @@ void Mesh::append(const Mesh& other) {
 
 Mesh Mesh::transformed(const Mat3& rotation, const Vec3& scale, const Vec3& translation) const {
     Mesh out = *this;
-    for (Vec3& p : out.positions)
+    out.transform(rotation, scale, translation);
+    return out;
+}
+
+void Mesh::transform(const Mat3& rotation, const Vec3& scale, const Vec3& translation) {
+    for (Vec3& p : positions)
         p = rotation * Vec3{p.x * scale.x, p.y * scale.y, p.z * scale.z} + translation;
     // Normals transform by the inverse transpose of rotation*scale = rotation * scale^-1.
-    for (Vec3& n : out.normals)
+    for (Vec3& n : normals)
         n = normalized(rotation * Vec3{n.x / scale.x, n.y / scale.y, n.z / scale.z});
     // A mirroring scale flips orientation: swap two corners to stay outward.
     if (scale.x * scale.y * scale.z < 0) {
-        for (std::size_t t = 0; t < out.triangles.size(); ++t) {
-            std::swap(out.triangles[t][1], out.triangles[t][2]);
-            if (!out.normals.empty())
-                std::swap(out.normals[3 * t + 1], out.normals[3 * t + 2]);
-            if (!out.uvs.empty())
-                std::swap(out.uvs[3 * t + 1], out.uvs[3 * t + 2]);
+        for (std::size_t t = 0; t < triangles.size(); ++t) {
+            std::swap(triangles[t][1], triangles[t][2]);
+            if (!normals.empty())
+                std::swap(normals[3 * t + 1], normals[3 * t + 2]);
+            if (!uvs.empty())
+                std::swap(uvs[3 * t + 1], uvs[3 * t + 2]);
         }
     }
-    return out;
 }
 
 Mesh Mesh::translated(const Vec3& t) const {
