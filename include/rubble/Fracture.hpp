@@ -76,6 +76,7 @@ struct Piece {
 
 /// Wall-clock durations of the stages of one fracture, in milliseconds.
 struct FractureTimings {
+    double validateMs = 0; ///< checking that the input mesh is a valid closed, oriented solid
     double cellMs = 0;     ///< building the cells
     double booleanMs = 0;  ///< difference and intersections
     double islandsMs = 0;  ///< splitting into islands and mass properties (includes massMs)

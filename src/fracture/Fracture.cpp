@@ -247,10 +247,17 @@ namespace detail {
 Result<FractureResult> fractureWithBackend(const Mesh& mesh, std::vector<ConvexPolytope> cells,
                                            const FractureParams& params, const BooleanBackend& backend,
                                            bool exactRedo) {
+    const auto t0 = Clock::now();
     double volume = 0;
     if (Status s = validateInput(mesh, volume); !s)
         return s.error();
-    return runPipeline(mesh, std::move(cells), params, backend, exactRedo, volume);
+    const double validateMs = msSince(t0);
+    auto r = runPipeline(mesh, std::move(cells), params, backend, exactRedo, volume);
+    if (r) {
+        r->timings.validateMs = validateMs;
+        r->timings.totalMs = msSince(t0);
+    }
+    return r;
 }
 
 } // namespace detail
@@ -269,6 +276,7 @@ Result<FractureResult> fracture(const Mesh& mesh, const Impact& impact, const Fr
         return s.error();
     if (!isFinite(impact.point) || !std::isfinite(impact.impulse))
         return makeError(ErrorCode::InvalidInput, "fracture: the impact point or impulse is not finite");
+    const double validateMs = msSince(t0);
     const auto tc = Clock::now();
     std::vector<ConvexPolytope> cells = generateCells(mesh.bounds(), impact, params, seed);
     const double cellMs = msSince(tc);
@@ -278,6 +286,7 @@ Result<FractureResult> fracture(const Mesh& mesh, const Impact& impact, const Fr
                          params.backend == BooleanKind::Fast, volume);
     if (!r)
         return r;
+    r->timings.validateMs = validateMs;
     r->timings.cellMs = cellMs;
     r->timings.totalMs = msSince(t0);
     return r;
