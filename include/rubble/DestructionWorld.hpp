@@ -53,17 +53,24 @@ struct ObjectState {
                                   ///< (see Config::crumbleTriangles; pieces inherit their parent's)
 };
 
-/// Wall-clock timing of one impact from submission to adoption, in milliseconds.
+/// Wall-clock timing of one impact from submission to adoption, in milliseconds. For an adopted job the
+/// stages follow one another without gaps: queue + prepare + cell + boolean + islands + decomposition +
+/// finish
+/// + handoff + adoption = total.
 struct TimingRecord {
     ObjectId object = 0;        ///< the object that was hit
     std::uint64_t frame = 0;    ///< frame of submission
     int impactsMerged = 1;      ///< impacts fractured in this job
     double queueMs = 0;         ///< waiting for a worker (and for an in-flight job on the same object)
+    double prepareMs = 0;       ///< moving the impacts onto the surface and checking the input mesh
     double cellMs = 0;          ///< building cells
-    double booleanMs = 0;       ///< booleans
-    double islandsMs = 0;       ///< islands and mass properties
+    double booleanMs = 0;       ///< booleans (with the check that the pieces close up)
+    double islandsMs = 0;       ///< islands, cut-face attributes, simplification, mass properties
     double decompositionMs = 0; ///< convex parts of the pieces
-    double adoptionMs = 0;      ///< main-thread adoption
+    double finishMs = 0;        ///< pieces moved into their principal frames, with their mass properties
+    double handoffMs = 0;       ///< the finished job waiting for the main thread to collect it
+    double adoptionMs = 0;      ///< main-thread adoption: the world's part in collect(), then the engine's
+                                ///< until finishAdoption() (its bodies and collision shapes)
     double totalMs = 0;         ///< submission → adopted
     int pieces = 0;             ///< pieces produced
     bool stale = false;         ///< discarded because the object changed meanwhile
@@ -88,6 +95,7 @@ struct FractureOutcome {
         pieceCells;              ///< per piece: Piece::cell (−1: the remainder, i ≥ 0: debris of cell i)
     std::vector<Impact> impacts; ///< the impacts (parent local coordinates) that caused it
     double droppedVolume = 0;    ///< volume of slivers dropped (for volume bookkeeping)
+    std::uint64_t record = 0;    ///< sequence number of its TimingRecord (for finishAdoption)
 };
 
 /// The runtime. All member functions are called from one (main) thread; work runs on the JobSystem.
@@ -148,6 +156,11 @@ public:
     /// the same frame). Returns false at once when no job is in flight, and always in deterministic mode,
     /// where adoption stays bound to frames so that replays are identical. A deadline in the past polls.
     bool waitForResult(std::chrono::steady_clock::time_point deadline);
+    /// Tells the world that the engine has adopted an outcome of the latest collect() (its bodies and
+    /// collision shapes exist): the outcome's TimingRecord then ends now, so that its adoptionMs and totalMs
+    /// include the engine's part. Without this call a record ends when collect() hands the outcome out. Has
+    /// no effect on outcomes of earlier collect() calls or when called twice.
+    void finishAdoption(const FractureOutcome& outcome);
     /// Blocks until no job is in flight or queued (for tools, tests and shutdown).
     void waitIdle();
 

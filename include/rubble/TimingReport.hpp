@@ -26,10 +26,13 @@ struct TimingSummary {
     int missed = 0;             ///< missed records (the cells did not intersect the mesh)
     int failed = 0;             ///< failed records (a geometry failure)
     StageSummary queue;         ///< TimingRecord::queueMs
+    StageSummary prepare;       ///< TimingRecord::prepareMs
     StageSummary cell;          ///< TimingRecord::cellMs
     StageSummary boolean;       ///< TimingRecord::booleanMs
     StageSummary islands;       ///< TimingRecord::islandsMs
     StageSummary decomposition; ///< TimingRecord::decompositionMs
+    StageSummary finish;        ///< TimingRecord::finishMs
+    StageSummary handoff;       ///< TimingRecord::handoffMs
     StageSummary adoption;      ///< TimingRecord::adoptionMs
     StageSummary total;         ///< TimingRecord::totalMs
 };

@@ -44,26 +44,32 @@ struct Job {
     ObjectId id = 0;
     std::uint32_t version = 0;
     std::vector<PendingImpact> impacts;
-    Mesh mesh;
-    std::vector<ConvexPolytope> parts;
+    std::shared_ptr<const ObjectState> object; // its mesh and convex parts (object states never change)
     FractureParams params;
     bool crumble = false; // over its triangle limit: a shatter as large as the object
     DecompositionParams decomposition;
     std::uint64_t seed = 0;
     std::uint64_t frame = 0;      // frame of the first impact (timing records)
     std::uint64_t readyFrame = 0; // deterministic mode: adopted at this frame
-    Clock::time_point submitted;
-    // outputs (written by the worker, read by the main thread after `finished` under Sync::mutex)
+    // outputs (written by the worker, read by the main thread after `finished` under Sync::mutex); the
+    // stages' boundaries are shared time points, so that the stages follow one another without gaps
     bool finished = false;
+    Clock::time_point started;     // a worker took it: queue → prepare
+    Clock::time_point finishStart; // decomposition → finish
+    Clock::time_point finishedAt;  // finish → handoff
     bool ok = false;
     ErrorCode errorCode = ErrorCode::Ok;
     std::string error;
-    FractureResult result;
+    FractureResult result; // its pieces' meshes are moved into localMeshes
     std::vector<Frame> frames;
     std::vector<Mesh> localMeshes;
+    std::vector<MassProperties> localMass;
     std::vector<std::vector<ConvexPolytope>> localParts;
     double queueMs = 0;
+    double prepareMs = 0;
+    double cellMs = 0;
     double decompositionMs = 0;
+    double finishMs = 0;
 };
 
 ConvexPolytope toLocal(const ConvexPolytope& p, const Frame& f) {
@@ -109,16 +115,19 @@ Impact onSurface(const Mesh& mesh, Impact impact, const FractureParams& params) 
 }
 
 void runJob(Job& job) {
+    const Mesh& mesh = job.object->mesh;
     for (PendingImpact& p : job.impacts)
-        p.impact = onSurface(job.mesh, p.impact, job.params);
-    std::vector<ConvexPolytope> cells;
+        p.impact = onSurface(mesh, p.impact, job.params);
+    job.prepareMs = msBetween(job.started, Clock::now());
     Result<FractureResult> r = Error{ErrorCode::NoIntersection, "no cells"};
     if (job.impacts.size() == 1) {
-        r = fracture(job.mesh, job.impacts.front().impact, job.params, mixSeed(job.seed, 0));
+        r = fracture(mesh, job.impacts.front().impact, job.params, mixSeed(job.seed, 0));
     } else {
         // Union of the cells of every merged impact; a cell overlapping an accepted one is skipped so that
         // the cells stay disjoint (the overlapping region is already cut by the earlier impact's cells).
-        const Aabb bounds = job.mesh.bounds();
+        const auto tc = Clock::now();
+        std::vector<ConvexPolytope> cells;
+        const Aabb bounds = mesh.bounds();
         for (std::size_t i = 0; i < job.impacts.size(); ++i) {
             const std::size_t earlier = cells.size(); // only cells of earlier impacts are compared
             for (auto& c : generateCells(bounds, job.impacts[i].impact, job.params, mixSeed(job.seed, i))) {
@@ -130,7 +139,8 @@ void runJob(Job& job) {
                     cells.push_back(std::move(c));
             }
         }
-        r = fractureWithCells(job.mesh, cells, job.params);
+        job.cellMs = msBetween(tc, Clock::now());
+        r = fractureWithCells(mesh, std::move(cells), job.params);
     }
     if (!r) {
         job.errorCode = r.error().code;
@@ -138,20 +148,28 @@ void runJob(Job& job) {
         return;
     }
     job.result = std::move(r).value();
-    const auto t0 = Clock::now();
+    job.prepareMs += job.result.timings.validateMs;
+    job.cellMs += job.result.timings.cellMs;
+    const auto t1 = Clock::now();
     std::vector<Mesh> meshes;
     std::vector<std::int32_t> pieceCells;
-    for (const auto& p : job.result.pieces) {
-        meshes.push_back(p.mesh);
+    for (auto& p : job.result.pieces) {
+        meshes.push_back(std::move(p.mesh));
         pieceCells.push_back(p.cell);
     }
-    auto parts = updateDecomposition(job.parts, job.result.cells, meshes, pieceCells, job.decomposition);
-    job.decompositionMs = msBetween(t0, Clock::now());
-    for (std::size_t i = 0; i < job.result.pieces.size(); ++i) {
+    auto parts =
+        updateDecomposition(job.object->convexParts, job.result.cells, meshes, pieceCells, job.decomposition);
+    job.finishStart = Clock::now();
+    job.decompositionMs = msBetween(t1, job.finishStart);
+    // Each piece in its principal frame, with the mass properties of that mesh (computed here, not by the
+    // main thread at adoption).
+    for (std::size_t i = 0; i < meshes.size(); ++i) {
         const auto& m = job.result.pieces[i].mass;
         Frame f{m.principalAxes, m.centerOfMass};
         const Mat3 rt = f.rotation.transposed();
-        job.localMeshes.push_back(meshes[i].transformed(rt, Vec3{1, 1, 1}, rt * (-1.0 * f.translation)));
+        meshes[i].transform(rt, Vec3{1, 1, 1}, rt * (-1.0 * f.translation));
+        job.localMass.push_back(computeMassProperties(meshes[i]));
+        job.localMeshes.push_back(std::move(meshes[i]));
         std::vector<ConvexPolytope> lp;
         if (i < parts.size())
             for (const auto& p : parts[i])
@@ -159,7 +177,7 @@ void runJob(Job& job) {
         job.localParts.push_back(std::move(lp));
         job.frames.push_back(f);
     }
-    job.ok = true;
+    job.ok = true; // finishMs ends when the worker marks the job finished
 }
 
 } // namespace
@@ -169,13 +187,21 @@ struct DestructionWorld::Impl {
     std::unique_ptr<ThreadPool> ownedPool;
     JobSystem* jobs = nullptr;
     std::shared_ptr<Sync> sync = std::make_shared<Sync>();
-    std::map<ObjectId, ObjectState> objects;
+    // Object states never change once made (a fracture replaces the object by new ones), so jobs share them.
+    std::map<ObjectId, std::shared_ptr<const ObjectState>> objects;
     ObjectId nextId = 1;
     std::uint64_t frame = 0;
     DecompositionCache cache;
     std::map<ObjectId, std::vector<PendingImpact>> waiting; // impacts waiting for an in-flight job
     std::vector<std::shared_ptr<Job>> inflight;             // in submission order
     std::vector<TimingRecord> timings;
+    std::uint64_t recordsErased = 0; // records dropped from the front of `timings` (sequence numbers stay)
+    struct HandedOut {
+        std::uint64_t record = 0;    // sequence number of its TimingRecord
+        Clock::time_point recordEnd; // where that record's adoption ended so far
+        bool finished = false;       // finishAdoption already extended it
+    };
+    std::vector<HandedOut> handedOut; // outcomes of the latest collect()
 
     // Impacts that can no longer run (their object is gone) still leave a stale timing record, so that every
     // accepted impact is accounted for in exactly one record.
@@ -191,11 +217,17 @@ struct DestructionWorld::Impl {
         record(rec);
     }
 
-    void record(const TimingRecord& rec) {
+    // Appends a record; returns its sequence number.
+    std::uint64_t record(const TimingRecord& rec) {
+        const std::uint64_t seq = recordsErased + timings.size();
         timings.push_back(rec);
         const std::size_t keep = config.keepTimings;
-        if (keep > 0 && timings.size() > 2 * keep) // amortised: drop the oldest half at once
-            timings.erase(timings.begin(), timings.end() - static_cast<std::ptrdiff_t>(keep));
+        if (keep > 0 && timings.size() > 2 * keep) { // amortised: drop the oldest half at once
+            const std::size_t drop = timings.size() - keep;
+            timings.erase(timings.begin(), timings.begin() + static_cast<std::ptrdiff_t>(drop));
+            recordsErased += drop;
+        }
+        return seq;
     }
 
     bool busy(ObjectId id) const {
@@ -203,13 +235,13 @@ struct DestructionWorld::Impl {
     }
 
     void launch(ObjectId id, std::vector<PendingImpact> impacts) {
-        const ObjectState& o = objects.at(id);
+        const std::shared_ptr<const ObjectState>& object = objects.at(id);
+        const ObjectState& o = *object;
         auto job = std::make_shared<Job>();
         job->id = id;
         job->version = o.version;
         job->impacts = std::move(impacts);
-        job->mesh = o.mesh;
-        job->parts = o.convexParts;
+        job->object = object;
         job->params = o.fracture;
         if (o.mesh.triangleCount() > o.crumbleAbove) { // too much detail: break it up instead of a crater
             job->crumble = true;
@@ -225,7 +257,6 @@ struct DestructionWorld::Impl {
         // Adopted delayFrames after the launch (not after the first impact: impacts forwarded to pieces or
         // re-run after a failed job would otherwise be due at once and block the main thread).
         job->readyFrame = frame + static_cast<std::uint64_t>(std::max(0, config.delayFrames));
-        job->submitted = Clock::now();
         inflight.push_back(job);
         {
             std::lock_guard lock(sync->mutex);
@@ -242,9 +273,13 @@ struct DestructionWorld::Impl {
                     return;
                 }
             }
-            job->queueMs = msBetween(job->impacts.front().time, Clock::now());
+            job->started = Clock::now();
+            job->queueMs = msBetween(job->impacts.front().time, job->started);
             runJob(*job);
             std::lock_guard lock(s->mutex);
+            job->finishedAt = Clock::now();
+            if (job->ok)
+                job->finishMs = msBetween(job->finishStart, job->finishedAt);
             job->finished = true;
             --s->outstanding;
             s->done.notify_all();
@@ -282,7 +317,8 @@ DestructionWorld::~DestructionWorld() {
 Result<ObjectId> DestructionWorld::addObject(ObjectDesc desc) {
     if (desc.mesh.triangles.empty() || desc.mesh.positions.empty())
         return Error{ErrorCode::InvalidInput, "addObject: empty mesh"};
-    ObjectState s;
+    auto state = std::make_shared<ObjectState>();
+    ObjectState& s = *state;
     s.id = impl_->nextId++;
     s.density = desc.density;
     s.destructible = desc.destructible;
@@ -321,7 +357,7 @@ Result<ObjectId> DestructionWorld::addObject(ObjectDesc desc) {
     }
     s.mesh = std::move(desc.mesh);
     const ObjectId id = s.id;
-    impl_->objects.emplace(id, std::move(s));
+    impl_->objects.emplace(id, std::move(state));
     return id;
 }
 
@@ -335,7 +371,7 @@ void DestructionWorld::removeObject(ObjectId id) {
 
 const ObjectState* DestructionWorld::object(ObjectId id) const {
     auto it = impl_->objects.find(id);
-    return it == impl_->objects.end() ? nullptr : &it->second;
+    return it == impl_->objects.end() ? nullptr : it->second.get();
 }
 
 std::vector<ObjectId> DestructionWorld::objects() const {
@@ -347,9 +383,9 @@ std::vector<ObjectId> DestructionWorld::objects() const {
 
 bool DestructionWorld::submitImpact(ObjectId id, const Impact& impact) {
     auto it = impl_->objects.find(id);
-    if (it == impl_->objects.end() || !it->second.destructible)
+    if (it == impl_->objects.end() || !it->second->destructible)
         return false;
-    if (impact.impulse < it->second.impulseThreshold)
+    if (impact.impulse < it->second->impulseThreshold)
         return false;
     PendingImpact p{impact, impl_->frame, Clock::now()};
     if (impl_->busy(id)) {
@@ -372,6 +408,7 @@ std::vector<FractureOutcome> DestructionWorld::collect() {
     std::vector<FractureOutcome> out;
     const auto start = Clock::now();
     Impl& im = *impl_;
+    im.handedOut.clear();
     for (std::size_t k = 0; k < im.inflight.size();) {
         auto job = im.inflight[k];
         if (im.config.deterministic) {
@@ -390,15 +427,19 @@ std::vector<FractureOutcome> DestructionWorld::collect() {
         }
         im.inflight.erase(im.inflight.begin() + static_cast<std::ptrdiff_t>(k));
         const auto a0 = Clock::now();
+        bool adopted = false;
         TimingRecord rec;
         rec.object = job->id;
         rec.frame = job->frame;
         rec.impactsMerged = static_cast<int>(job->impacts.size());
         rec.queueMs = job->queueMs;
-        rec.cellMs = job->result.timings.cellMs;
+        rec.prepareMs = job->prepareMs;
+        rec.cellMs = job->cellMs;
         rec.booleanMs = job->result.timings.booleanMs;
         rec.islandsMs = job->result.timings.islandsMs;
         rec.decompositionMs = job->decompositionMs;
+        rec.finishMs = job->finishMs;
+        rec.handoffMs = msBetween(job->finishedAt, a0);
         rec.crumbled = job->crumble;
         auto it = im.objects.find(job->id);
         std::vector<PendingImpact> later;
@@ -406,10 +447,10 @@ std::vector<FractureOutcome> DestructionWorld::collect() {
             later = std::move(w->second);
             im.waiting.erase(w);
         }
-        if (it == im.objects.end() || it->second.version != job->version) {
+        if (it == im.objects.end() || it->second->version != job->version) {
             rec.stale = true; // the object was removed or replaced meanwhile: the result is discarded
         } else if (job->ok) {
-            ObjectState parent = std::move(it->second);
+            const std::shared_ptr<const ObjectState> parent = std::move(it->second);
             im.objects.erase(it);
             FractureOutcome o;
             o.parent = job->id;
@@ -418,21 +459,21 @@ std::vector<FractureOutcome> DestructionWorld::collect() {
                 o.impacts.push_back(p.impact);
             o.droppedVolume = job->result.droppedVolume;
             for (std::size_t i = 0; i < job->localMeshes.size(); ++i) {
-                ObjectState s;
-                s.id = im.nextId++;
-                s.version = 0;
-                s.mesh = std::move(job->localMeshes[i]);
-                s.mass = computeMassProperties(s.mesh);
-                s.density = parent.density;
-                s.destructible = parent.destructible;
-                s.impulseThreshold = parent.impulseThreshold;
-                s.fracture = parent.fracture;
-                s.crumbleAbove = parent.crumbleAbove;
-                s.convexParts = std::move(job->localParts[i]);
-                o.pieces.push_back(s.id);
+                auto s = std::make_shared<ObjectState>();
+                s->id = im.nextId++;
+                s->version = 0;
+                s->mesh = std::move(job->localMeshes[i]);
+                s->mass = job->localMass[i];
+                s->density = parent->density;
+                s->destructible = parent->destructible;
+                s->impulseThreshold = parent->impulseThreshold;
+                s->fracture = parent->fracture;
+                s->crumbleAbove = parent->crumbleAbove;
+                s->convexParts = std::move(job->localParts[i]);
+                o.pieces.push_back(s->id);
                 o.pieceFrames.push_back(job->frames[i]);
-                o.pieceCells.push_back(i < job->result.pieces.size() ? job->result.pieces[i].cell : -1);
-                im.objects.emplace(s.id, std::move(s));
+                o.pieceCells.push_back(job->result.pieces[i].cell);
+                im.objects.emplace(s->id, std::move(s));
             }
             // Impacts that arrived while this job ran go to the piece nearest to their point.
             if (o.pieces.empty())
@@ -444,7 +485,7 @@ std::vector<FractureOutcome> DestructionWorld::collect() {
                 std::size_t bi = 0;
                 for (std::size_t i = 0; i < o.pieces.size(); ++i) {
                     const Frame& f = o.pieceFrames[i];
-                    const ObjectState& piece = im.objects.at(o.pieces[i]);
+                    const ObjectState& piece = *im.objects.at(o.pieces[i]);
                     const Aabb b = piece.mesh.bounds();
                     const Vec3 q = f.rotation.transposed() * (p.impact.point - f.translation);
                     const Vec3 outside = max(b.lo - q, max(q - b.hi, Vec3{}));
@@ -468,6 +509,7 @@ std::vector<FractureOutcome> DestructionWorld::collect() {
             later.clear();
             rec.pieces = static_cast<int>(o.pieces.size());
             out.push_back(std::move(o));
+            adopted = true;
         } else if (job->errorCode == ErrorCode::NoIntersection) {
             rec.missed = true; // nothing of the mesh inside the cells: a miss, not a failure
         } else {
@@ -481,11 +523,32 @@ std::vector<FractureOutcome> DestructionWorld::collect() {
         const auto a1 = Clock::now();
         rec.adoptionMs = msBetween(a0, a1);
         rec.totalMs = msBetween(job->impacts.front().time, a1);
-        im.record(rec);
+        const std::uint64_t seq = im.record(rec);
+        if (adopted) {
+            out.back().record = seq;
+            im.handedOut.push_back({seq, a1, false});
+        }
         if (!relaunch)
             im.recordDropped(job->id, later);
     }
     return out;
+}
+
+void DestructionWorld::finishAdoption(const FractureOutcome& outcome) {
+    Impl& im = *impl_;
+    const auto now = Clock::now();
+    for (Impl::HandedOut& h : im.handedOut) {
+        if (h.record != outcome.record || h.finished)
+            continue;
+        h.finished = true;
+        if (h.record < im.recordsErased)
+            return; // dropped from timings() already
+        TimingRecord& r = im.timings[static_cast<std::size_t>(h.record - im.recordsErased)];
+        const double engineMs = msBetween(h.recordEnd, now);
+        r.adoptionMs += engineMs;
+        r.totalMs += engineMs;
+        return;
+    }
 }
 
 bool DestructionWorld::waitForResult(Clock::time_point deadline) {
@@ -517,14 +580,14 @@ Status DestructionWorld::writeTimingsCsv(const std::filesystem::path& path) cons
     std::ofstream f(path);
     if (!f)
         return Error{ErrorCode::IoError, "cannot write " + path.string()};
-    f << "object,frame,impacts_merged,queue_ms,cell_ms,boolean_ms,islands_ms,decomposition_ms,adoption_ms,"
-         "total_ms,"
-         "pieces,stale,failed,missed\n";
+    f << "object,frame,impacts_merged,queue_ms,prepare_ms,cell_ms,boolean_ms,islands_ms,decomposition_ms,"
+         "finish_ms,handoff_ms,adoption_ms,total_ms,pieces,stale,failed,missed,crumbled\n";
     for (const auto& r : impl_->timings)
-        f << r.object << ',' << r.frame << ',' << r.impactsMerged << ',' << r.queueMs << ',' << r.cellMs
-          << ',' << r.booleanMs << ',' << r.islandsMs << ',' << r.decompositionMs << ',' << r.adoptionMs
-          << ',' << r.totalMs << ',' << r.pieces << ',' << (r.stale ? 1 : 0) << ',' << (r.failed ? 1 : 0)
-          << ',' << (r.missed ? 1 : 0) << '\n';
+        f << r.object << ',' << r.frame << ',' << r.impactsMerged << ',' << r.queueMs << ',' << r.prepareMs
+          << ',' << r.cellMs << ',' << r.booleanMs << ',' << r.islandsMs << ',' << r.decompositionMs << ','
+          << r.finishMs << ',' << r.handoffMs << ',' << r.adoptionMs << ',' << r.totalMs << ',' << r.pieces
+          << ',' << (r.stale ? 1 : 0) << ',' << (r.failed ? 1 : 0) << ',' << (r.missed ? 1 : 0) << ','
+          << (r.crumbled ? 1 : 0) << '\n';
     if (!f)
         return Error{ErrorCode::IoError, "write failed: " + path.string()};
     return Status::ok();

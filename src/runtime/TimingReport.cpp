@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <iterator>
+#include <utility>
 
 namespace rubble {
 namespace {
@@ -26,7 +28,14 @@ StageSummary summarize(std::vector<double> v) {
 
 TimingSummary summarizeTimings(const std::vector<TimingRecord>& records) {
     TimingSummary out;
-    std::vector<double> q, c, b, i, d, a, t;
+    // each stage of a record and where its summary goes
+    const std::pair<double TimingRecord::*, StageSummary*> stages[] = {
+        {&TimingRecord::queueMs, &out.queue},       {&TimingRecord::prepareMs, &out.prepare},
+        {&TimingRecord::cellMs, &out.cell},         {&TimingRecord::booleanMs, &out.boolean},
+        {&TimingRecord::islandsMs, &out.islands},   {&TimingRecord::decompositionMs, &out.decomposition},
+        {&TimingRecord::finishMs, &out.finish},     {&TimingRecord::handoffMs, &out.handoff},
+        {&TimingRecord::adoptionMs, &out.adoption}, {&TimingRecord::totalMs, &out.total}};
+    std::vector<std::vector<double>> samples(std::size(stages));
     for (const auto& r : records) {
         if (r.stale) {
             ++out.stale;
@@ -41,21 +50,11 @@ TimingSummary summarizeTimings(const std::vector<TimingRecord>& records) {
             continue;
         }
         ++out.records;
-        q.push_back(r.queueMs);
-        c.push_back(r.cellMs);
-        b.push_back(r.booleanMs);
-        i.push_back(r.islandsMs);
-        d.push_back(r.decompositionMs);
-        a.push_back(r.adoptionMs);
-        t.push_back(r.totalMs);
+        for (std::size_t k = 0; k < std::size(stages); ++k)
+            samples[k].push_back(r.*stages[k].first);
     }
-    out.queue = summarize(q);
-    out.cell = summarize(c);
-    out.boolean = summarize(b);
-    out.islands = summarize(i);
-    out.decomposition = summarize(d);
-    out.adoption = summarize(a);
-    out.total = summarize(t);
+    for (std::size_t k = 0; k < std::size(stages); ++k)
+        *stages[k].second = summarize(std::move(samples[k]));
     return out;
 }
 
@@ -71,10 +70,13 @@ std::string formatTimingSummary(const TimingSummary& s) {
                   s.missed, s.failed);
     out += line;
     add("queue", s.queue);
+    add("prepare", s.prepare);
     add("cell", s.cell);
     add("boolean", s.boolean);
     add("islands", s.islands);
     add("decomposition", s.decomposition);
+    add("finish", s.finish);
+    add("handoff", s.handoff);
     add("adoption", s.adoption);
     add("total", s.total);
     return out;

@@ -330,6 +330,27 @@ TEST(DestructionBridge, IdleAdoptionAdoptsBeforeTheNextStepFrame) {
     EXPECT_EQ(rig.bridge->adoptReady().fractures, 0) << "nothing left to adopt";
 }
 
+// Issue #5: "impact → adopted" ends when the pieces' bodies and collision shapes exist, so the engine's part
+// of the adoption is in the impact's timing record (the bridge calls DestructionWorld::finishAdoption). The
+// parent's removal callback runs inside the bridge's adoption; made slow, it must show in the record.
+TEST(DestructionBridge, TimingRecordIncludesTheEnginesAdoption) {
+    using namespace std::chrono_literals;
+    Rig rig(false, 1, true);
+    const ObjectId id = rig.addBox({0.5, 0.5, 0.5}, Frame{Mat3::identity(), {0, 0, 0}}, 100);
+    rig.bridge->setOnRemoved([&](Body& b) {
+        if (b.hasObject && b.object == id)
+            std::this_thread::sleep_for(20ms);
+    });
+    rig.bridge->fireProjectile({-10, 0, 0.1}, {100, 0, 0}, 1, 0.1);
+    ASSERT_TRUE(rig.runUntilFracture());
+    ASSERT_EQ(rig.destruction->timings().size(), 1u);
+    const TimingRecord& r = rig.destruction->timings()[0];
+    EXPECT_GE(r.adoptionMs, 20);
+    EXPECT_GE(r.totalMs, r.queueMs + r.prepareMs + r.cellMs + r.booleanMs + r.islandsMs + r.decompositionMs +
+                             r.finishMs + r.handoffMs + r.adoptionMs);
+    rig.bridge->setOnRemoved({});
+}
+
 TEST(DestructionBridge, VolumeIsConservedThroughFracturesAndRetirement) {
     const auto r = runShootingScene(1);
     EXPECT_LT(r.second, 1e-6);

@@ -35,5 +35,38 @@ TEST(TimingReport, PercentilesAndStale) {
     EXPECT_EQ(summarizeTimings({}).records, 0);
 }
 
+TEST(TimingReport, EachStageIsSummarisedFromItsOwnField) {
+    std::vector<TimingRecord> r(9);
+    for (std::size_t i = 0; i < r.size(); ++i) {
+        const double x = static_cast<double>(i + 1); // 1..9: the median is 5
+        r[i] = {.queueMs = x,
+                .prepareMs = 10 * x,
+                .cellMs = 100 * x,
+                .booleanMs = 1e3 * x,
+                .islandsMs = 1e4 * x,
+                .decompositionMs = 1e5 * x,
+                .finishMs = 1e6 * x,
+                .handoffMs = 1e7 * x,
+                .adoptionMs = 1e8 * x,
+                .totalMs = 1e9 * x};
+    }
+    const auto s = summarizeTimings(r);
+    EXPECT_DOUBLE_EQ(s.queue.p50, 5);
+    EXPECT_DOUBLE_EQ(s.prepare.p50, 50);
+    EXPECT_DOUBLE_EQ(s.cell.p50, 500);
+    EXPECT_DOUBLE_EQ(s.boolean.p50, 5e3);
+    EXPECT_DOUBLE_EQ(s.islands.p50, 5e4);
+    EXPECT_DOUBLE_EQ(s.decomposition.p50, 5e5);
+    EXPECT_DOUBLE_EQ(s.finish.p50, 5e6);
+    EXPECT_DOUBLE_EQ(s.handoff.p50, 5e7);
+    EXPECT_DOUBLE_EQ(s.adoption.p50, 5e8);
+    EXPECT_DOUBLE_EQ(s.total.p50, 5e9);
+    EXPECT_DOUBLE_EQ(s.handoff.max, 9e7);
+    const std::string text = formatTimingSummary(s);
+    for (const char* stage : {"queue", "prepare", "cell", "boolean", "islands", "decomposition", "finish",
+                              "handoff", "adoption", "total"})
+        EXPECT_NE(text.find(stage), std::string::npos) << stage;
+}
+
 } // namespace
 } // namespace rubble

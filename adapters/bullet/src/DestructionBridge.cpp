@@ -523,6 +523,8 @@ void DestructionBridge::adopt(const FractureOutcome& outcome, FrameStats& stats)
         settleSupport(stats); // before the callback, so that it sees the pieces' final static state
         stats.supportMs += msSince(t0);
     }
+    destruction_.finishAdoption(outcome); // the pieces' bodies and collision shapes exist: the impact's
+                                          // timing record ends here (not the renderer's upload below)
     if (onAdopted_)
         onAdopted_(outcome);
 }
