@@ -110,7 +110,8 @@ void Game::clear(Renderer& renderer) {
     particles_.clear();
     counters_ = {};
     latencies_.clear();
-    latencyCursor_ = timingCursor_ = 0;
+    latencyCursor_ = 0;
+    nextTiming_ = 0;
 }
 
 void Game::addVisual(const Body& body, const rubble::Mesh& mesh, const Look& look, float heat,
@@ -389,8 +390,10 @@ void Game::adoptReady() {
 void Game::updateCounters() {
     // latencies of adopted jobs only (stale, missed and failed jobs are not impact → adopted times)
     const auto& timings = destruction_->timings();
-    for (; timingCursor_ < timings.size(); ++timingCursor_) {
-        const rubble::TimingRecord& r = timings[timingCursor_];
+    // by sequence number: the world drops its oldest records in long games, which shifts the indices
+    const std::uint64_t first = destruction_->firstTimingRecord();
+    for (nextTiming_ = std::max(nextTiming_, first); nextTiming_ < first + timings.size(); ++nextTiming_) {
+        const rubble::TimingRecord& r = timings[static_cast<std::size_t>(nextTiming_ - first)];
         if (!r.stale && !r.missed && !r.failed)
             latencies_.push_back(r.totalMs);
     }

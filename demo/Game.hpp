@@ -150,7 +150,7 @@ private:
     float groundTop_ = -10;
     std::vector<double> latencies_;
     size_t latencyCursor_ = 0;
-    size_t timingCursor_ = 0;
+    std::uint64_t nextTiming_ = 0; // sequence number of the next timing record to read
     std::uint32_t burstSeed_ = 1;
     float noseOffset_ = 3;
 };

@@ -168,6 +168,10 @@ public:
     int jobsInFlight() const;
     /// Timing of the finished impacts, oldest first (the latest Config::keepTimings to twice as many).
     const std::vector<TimingRecord>& timings() const;
+    /// Sequence number of timings().front(): how many older records were dropped to keep timings() bounded.
+    /// Record k of the game (counting from 0) is timings()[k − firstTimingRecord()] while it is kept, so a
+    /// reader that resumes where it left off across frames keeps a sequence number, not an index.
+    std::uint64_t firstTimingRecord() const;
     /// Writes timings() as CSV.
     Status writeTimingsCsv(const std::filesystem::path& path) const;
 

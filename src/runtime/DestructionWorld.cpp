@@ -576,6 +576,10 @@ const std::vector<TimingRecord>& DestructionWorld::timings() const {
     return impl_->timings;
 }
 
+std::uint64_t DestructionWorld::firstTimingRecord() const {
+    return impl_->recordsErased;
+}
+
 Status DestructionWorld::writeTimingsCsv(const std::filesystem::path& path) const {
     std::ofstream f(path);
     if (!f)

@@ -577,6 +577,8 @@ TEST(DestructionWorld, TimingRecordsKeepOnlyTheLatest) {
         ASSERT_GE(w.timings().size(), std::min<std::size_t>(3, static_cast<std::size_t>(i + 1)));
         ASSERT_LE(w.timings().size(), 6u);
         EXPECT_EQ(w.timings().back().frame + 1, w.frame()) << "the latest is kept (submitted last frame)";
+        EXPECT_EQ(w.firstTimingRecord() + w.timings().size(), static_cast<std::uint64_t>(i + 1))
+            << "sequence numbers count every record of the game";
     }
 }
 
@@ -652,6 +654,8 @@ TEST(DestructionWorld, FinishAdoptionEndsTheRecordWhenTheEngineIsDone) {
     auto out = w.collect();
     ASSERT_EQ(out.size(), 1u);
     const TimingRecord before = w.timings().back();
+    EXPECT_EQ(out[0].record, w.firstTimingRecord() + w.timings().size() - 1)
+        << "the outcome names its record";
     std::this_thread::sleep_for(10ms); // the engine builds the pieces' bodies
     w.finishAdoption(out[0]);
     const TimingRecord after = w.timings().back();
