@@ -5,6 +5,8 @@
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
+#include <sstream>
+#include <thread>
 
 namespace rubble::bench {
 
@@ -15,6 +17,66 @@ Stats stats(std::vector<double> samples) {
         return {};
     std::sort(samples.begin(), samples.end());
     return {samples[samples.size() / 2], samples.front(), samples.back()};
+}
+
+namespace {
+
+// Busy and total ticks of all cores together ("cpu" line of /proc/stat) and this process's own ticks (utime +
+// stime of /proc/self/stat): the kernel charges each tick to the machine and to the task that ran in it, so
+// machine − own cancels exactly even over short intervals. False when unreadable.
+bool cpuTicks(long long& busy, long long& total, long long& own) {
+    std::ifstream in("/proc/stat");
+    std::string cpu;
+    long long v[8] = {};
+    if (!(in >> cpu) || cpu != "cpu")
+        return false;
+    for (long long& x : v)
+        if (!(in >> x))
+            return false;
+    total = 0;
+    for (long long x : v) // user nice system idle iowait irq softirq steal
+        total += x;
+    busy = total - v[3] - v[4];
+    std::ifstream self("/proc/self/stat");
+    std::string line;
+    std::getline(self, line);
+    const std::size_t close = line.rfind(')'); // the command name may hold spaces and parentheses
+    if (close == std::string::npos)
+        return false;
+    std::istringstream fields(line.substr(close + 1));
+    std::string field;
+    long long utime = 0, stime = 0;
+    for (int i = 3; i <= 15 && fields >> field; ++i) { // fields 14 and 15 of proc(5)
+        if (i == 14)
+            utime = std::stoll(field);
+        if (i == 15)
+            stime = std::stoll(field);
+    }
+    own = utime + stime;
+    return static_cast<bool>(fields);
+}
+
+} // namespace
+
+CpuMeter::CpuMeter() {
+    if (!cpuTicks(busyTicks_, totalTicks_, ownTicks_))
+        totalTicks_ = -1;
+}
+
+CpuMeter::Reading CpuMeter::read() const {
+    Reading r;
+    long long busy = 0, total = 0, own = 0;
+    // a reading over a few ticks says nothing (one tick of a kernel thread reads as a busy core)
+    constexpr long long kMinTicks = 100; // ~0.5 s on two cores at 100 ticks/s each
+    if (totalTicks_ < 0 || !cpuTicks(busy, total, own) || total - totalTicks_ < kMinTicks)
+        return r;
+    // /proc/stat's total counts every core's ticks: busy / total is the busy share of all cores
+    const double cores = static_cast<double>(std::max(1u, std::thread::hardware_concurrency()));
+    const double span = static_cast<double>(total - totalTicks_);
+    r.machine = cores * static_cast<double>(busy - busyTicks_) / span;
+    r.own = cores * static_cast<double>(own - ownTicks_) / span;
+    r.other = std::max(0.0, r.machine - r.own);
+    return r;
 }
 
 double msSince(std::chrono::steady_clock::time_point t0) {

@@ -37,6 +37,28 @@ Stats timeIt(int runs, F&& f) {
     return stats(ms);
 }
 
+/// CPU use while a benchmark runs, in average busy cores since construction: the whole machine's
+/// (/proc/stat), this process's own (/proc/self/stat) and the rest of the machine's (machine − own). `other`
+/// says whether a run was disturbed by other work; the load average does not (it read 0.8 here while a busy
+/// loop and a scene run kept both cores busy). Counted in 10 ms ticks per core: unknown (−1) over fewer than
+/// 100 ticks (about half a second on two cores), so a suite of short cases takes one reading for all of them.
+class CpuMeter {
+public:
+    /// Starts measuring.
+    CpuMeter();
+    /// Busy cores since construction; all −1 when unknown (/proc unreadable or too short a time).
+    struct Reading {
+        double machine = -1; ///< all processes
+        double own = -1;     ///< this process
+        double other = -1;   ///< everything else (machine − own, at least 0)
+    };
+    /// The reading from construction until now.
+    Reading read() const;
+
+private:
+    long long busyTicks_ = 0, totalTicks_ = -1, ownTicks_ = 0;
+};
+
 /// A number with `digits` digits after the point ("" for a negative value, meaning "no value").
 std::string fixed(double v, int digits = 3);
 

@@ -69,7 +69,6 @@ struct Row {
     std::size_t triangles = 0;
     std::size_t cellPlanes = 0;
     Stats ms[kBackends];
-    double loadAverage = -1;      // 1-minute load average when the case was measured (the machine is shared)
     std::string check[kBackends]; // "ok" or what is wrong
     Reference ref;
 };
@@ -154,7 +153,6 @@ Row measure(const Case& c, int runs, std::uint64_t seed) {
         }
     for (std::size_t b = 0; b < kBackends; ++b)
         row.ms[b] = rubble::bench::stats(samples[b]);
-    std::ifstream("/proc/loadavg") >> row.loadAverage;
     return row;
 }
 
@@ -181,8 +179,10 @@ int runBench(const BenchArgs& args) {
     const int runs = args.quick ? 1 : args.runs;
     std::vector<Row> rows;
     std::uint64_t seed = args.seed;
+    const rubble::bench::CpuMeter cpu; // most cases are short: one reading for all of them
     for (const Case& c : cases(args.quick))
         rows.push_back(measure(c, runs, seed++));
+    const double otherCpu = cpu.read().other; // cores other processes used meanwhile (the machine is shared)
 
     const char* names[kBackends] = {"nef", "corefine", "fast"};
     rubble::bench::Table table{{"case", "tris"}, {}};
@@ -201,7 +201,7 @@ int runBench(const BenchArgs& args) {
     for (const char* h : {"thesis T3.2", "nef proto", "seed prog", "checks"})
         table.header.push_back(h);
     for (const char* h : {"thesis_table_3_2_ms", "nef_prototype_here_ms", "seed_program_here_ms", "checks",
-                          "load_average_1m"})
+                          "other_cpu_cores"})
         csv.header.push_back(h);
 
     auto str = [](auto v) {
@@ -235,7 +235,7 @@ int runBench(const BenchArgs& args) {
         }
         t.push_back(checks);
         c.push_back(checks);
-        c.push_back(r.loadAverage >= 0 ? str(r.loadAverage) : "");
+        c.push_back(fixed(otherCpu, 2));
         table.rows.push_back(t);
         csv.rows.push_back(c);
         std::ostringstream& d = r.cube ? cubeData : modelData;
@@ -247,12 +247,9 @@ int runBench(const BenchArgs& args) {
         d << "\n";
     }
     rubble::bench::printTable(table);
-    double load = 0;
-    for (const Row& r : rows)
-        load = std::max(load, r.loadAverage);
-    std::cout << "load average (1 min) up to " << fixed(load, 2) << " on "
+    std::cout << "other processes used " << fixed(otherCpu, 2) << " of "
               << std::thread::hardware_concurrency()
-              << " hardware threads: absolute times grow with it, ratios between backends much less\n";
+              << " cores meanwhile: absolute times grow with it, ratios between backends much less\n";
     std::cout << "ms per split (difference + intersection with one seeded thesis cell), " << runs
               << (runs == 1 ? " run" : " runs")
               << " per backend, interleaved; reference columns in ms: thesis Table 3.2 (subtraction), "

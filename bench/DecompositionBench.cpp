@@ -105,6 +105,7 @@ int runBench(const BenchArgs& args) {
                                                                         {588, {0.261, 0.223}},
                                                                         {2700, {2.362, 1.120}},
                                                                         {10092, {12.007, 5.099}}};
+    const rubble::bench::CpuMeter cpu; // the cases are short: one reading for all of them
     std::vector<Row> rows;
     for (int n : grid) {
         const rubble::Mesh cube = rubble::makeSubdividedBox({-1, -1, -1}, {1, 1, 1}, n);
@@ -131,13 +132,14 @@ int runBench(const BenchArgs& args) {
         std::cout << "(seed media not found at " << media.string() << ": seed models skipped)\n";
     }
 
+    const double otherCpu = cpu.read().other;
     rubble::bench::Table table{{"model", "tris", "parts", "excess", "initial med ms", "min", "max",
                                 "update med ms", "min", "max", "thesis s", "seed s", "x thesis", "x seed"},
                                {}};
     rubble::bench::Table csv{{"model", "triangles", "parts", "excess", "runs", "initial_median_ms",
                               "initial_min_ms", "initial_max_ms", "update_median_ms", "update_min_ms",
                               "update_max_ms", "updated_parts", "pieces", "thesis_hacd_s", "seed_program_s",
-                              "speedup_vs_thesis", "speedup_vs_seed"},
+                              "speedup_vs_thesis", "speedup_vs_seed", "other_cpu_cores"},
                              {}};
     auto str = [](auto v) {
         std::ostringstream o;
@@ -158,7 +160,8 @@ int runBench(const BenchArgs& args) {
                             str(r.initial.median), str(r.initial.min), str(r.initial.max),
                             str(r.update.median), str(r.update.min), str(r.update.max), str(r.updatedParts),
                             r.pieces, ref ? str(r.thesisS) : "", ref ? str(r.seedS) : "",
-                            ref ? str(xThesis) : "", ref ? str(xSeed) : ""});
+                            ref ? str(xThesis) : "", ref ? str(xSeed) : "",
+                            rubble::bench::fixed(otherCpu, 2)});
         if (ref)
             data << r.triangles << " " << r.initial.median << " " << r.update.median << " "
                  << r.thesisS * 1000 << " " << r.seedS * 1000 << "\n";

@@ -263,6 +263,7 @@ int runBench(const BenchArgs& args) {
                            [&](const Case& c) { return c.name.find(args.only) == std::string::npos; }),
             cases.end());
 
+    const rubble::bench::CpuMeter cpu; // the cases are interleaved: one reading for all of them
     for (int run = 0; run < runs; ++run)
         for (Case& c : cases) {
             for (rubble::BooleanKind k :
@@ -275,6 +276,7 @@ int runBench(const BenchArgs& args) {
         }
 
     using rubble::bench::fixed;
+    const double otherCpu = cpu.read().other;
     rubble::bench::Table table;
     table.header = {"model",
                     "triangles",
@@ -299,7 +301,8 @@ int runBench(const BenchArgs& args) {
                     "parts_excess",
                     "initial_decomposition_ms",
                     "thesis_s",
-                    "speedup_vs_thesis"};
+                    "speedup_vs_thesis",
+                    "other_cpu_cores"};
     std::string failures;
     for (const Case& c : cases)
         for (const auto& [kind, s] : c.samples) {
@@ -328,7 +331,8 @@ int runBench(const BenchArgs& args) {
                                   fixed(stats(s.excess).median, 4),
                                   fixed(c.decomposeMs),
                                   reference ? fixed(c.thesisS) : "",
-                                  reference ? fixed(c.thesisS * 1000 / withParts.median, 0) : ""});
+                                  reference ? fixed(c.thesisS * 1000 / withParts.median, 0) : "",
+                                  fixed(otherCpu, 2)});
             if (s.failures > 0)
                 failures += c.name + " " + backendName(kind) + ": " + std::to_string(s.failures) + " of " +
                             std::to_string(runs) + " runs failed: " + s.error + "\n";
@@ -337,8 +341,9 @@ int runBench(const BenchArgs& args) {
     std::printf(
         "%sruns per case: %d, interleaved (run i uses seed 1000+i for every backend); stage columns are "
         "medians in ms; fallbacks = runs where Fast declined and Corefine made the split; the parent's "
-        "decomposition is cached before the impact (initial_decomposition_ms)\n",
-        failures.c_str(), runs);
+        "decomposition is cached before the impact (initial_decomposition_ms); other processes used %.2f "
+        "cores meanwhile\n",
+        failures.c_str(), runs, otherCpu);
     if (!rubble::bench::writeCsv(fs::path(args.out) / "impact.csv", table))
         return 1;
 

@@ -26,10 +26,14 @@
 // piece while its point lies in the crater); a failure is a geometry failure. --json prints those keys and
 // the counts and idle-adoption figures; the table adds the physics and adoption shares of the frame and the
 // fracture stages. --append-csv adds one summary row to a CSV (header when the file is new), e.g.
-// bench/results/scene.csv (its columns are unchanged: no missed/failed or idle adoption columns).
+// bench/results/scene.csv (scripts/scene-bench.sh writes it). Every report says how many cores the run used
+// and how many other processes took meanwhile (cpu_cores: own / other; see bench::CpuMeter): a run with other
+// work on the machine has inflated times.
 #include "Subcommand.hpp"
 
 #if defined(RUBBLE_HAVE_BULLET)
+
+#include "BenchUtil.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -180,6 +184,7 @@ int runScene(const SceneArgs& a) {
     long shots = 0;
     long long idleFractures = 0;
     int maxPieces = 0;
+    const rubble::bench::CpuMeter cpu; // whether something else ran meanwhile
     const auto runStart = std::chrono::steady_clock::now();
     const auto period =
         std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(dt));
@@ -230,6 +235,7 @@ int runScene(const SceneArgs& a) {
     std::snprintf(hashText, sizeof hashText, "%016llx", static_cast<unsigned long long>(hash));
     const BridgeCounters& c = bridge.counters();
     const double rss = peakRssMb();
+    const rubble::bench::CpuMeter::Reading cpuUse = cpu.read();
     const int workers = a.workers > 0 ? a.workers : rubble::ThreadPool::defaultWorkerCount();
 
     if (!a.timingsCsv.empty()) {
@@ -247,7 +253,8 @@ int runScene(const SceneArgs& a) {
                    "frame_max_ms,physics_p50_ms,physics_p99_ms,adopt_p99_ms,impacts,fractures,stale,"
                    "latency_p50_ms,latency_p99_ms,latency_max_ms,queue_p50_ms,boolean_p50_ms,"
                    "decomposition_p50_ms,pieces_alive,pieces_max,pieces_retired,volume_error,state_hash,"
-                   "peak_rss_mb\n";
+                   "peak_rss_mb,missed,failed,fractures_idle,handoff_p50_ms,adoption_p99_ms,own_cpu_cores,"
+                   "other_cpu_cores\n";
         out << a.file << ',' << workers << ',' << (a.deterministic ? 1 : 0) << ',' << a.seed << ','
             << a.shotsPerSecond << ',' << frames << ',' << shots << ',' << percentile(frameMs, 0.5) << ','
             << percentile(frameMs, 0.99) << ',' << percentile(frameMs, 1.0) << ','
@@ -255,7 +262,9 @@ int runScene(const SceneArgs& a) {
             << percentile(adoptMs, 0.99) << ',' << c.impacts << ',' << c.fractures << ',' << ts.stale << ','
             << ts.total.p50 << ',' << ts.total.p99 << ',' << ts.total.max << ',' << ts.queue.p50 << ','
             << ts.boolean.p50 << ',' << ts.decomposition.p50 << ',' << bridge.livePieces() << ',' << maxPieces
-            << ',' << c.piecesRetired << ',' << volumeError << ',' << hashText << ',' << rss << '\n';
+            << ',' << c.piecesRetired << ',' << volumeError << ',' << hashText << ',' << rss << ','
+            << ts.missed << ',' << ts.failed << ',' << idleFractures << ',' << ts.handoff.p50 << ','
+            << ts.adoption.p99 << ',' << cpuUse.own << ',' << cpuUse.other << '\n';
     }
     if (a.json) {
         nlohmann::json j;
@@ -294,6 +303,7 @@ int runScene(const SceneArgs& a) {
         j["volume_error"] = volumeError;
         j["state_hash"] = hashText;
         j["peak_rss_mb"] = rss;
+        j["cpu_cores"] = {{"own", cpuUse.own}, {"other", cpuUse.other}};
         std::cout << j.dump(2) << "\n";
         return 0;
     }
@@ -328,6 +338,8 @@ int runScene(const SceneArgs& a) {
     std::printf("%-28s %10.3g\n", "volume error", volumeError);
     std::printf("%-28s %10s\n", "state hash", hashText);
     std::printf("%-28s %10.1f\n", "peak RSS (MB)", rss);
+    std::printf("%-28s %10.2f (other processes: %.2f of %d)\n", "CPU cores used", cpuUse.own, cpuUse.other,
+                static_cast<int>(std::thread::hardware_concurrency()));
     return 0;
 }
 
