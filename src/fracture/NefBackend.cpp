@@ -15,6 +15,7 @@
 
 #include "BooleanBackends.hpp"
 #include "ExactMesh.hpp"
+#include "rubble/MeshCheck.hpp"
 
 namespace rubble::detail {
 
@@ -79,6 +80,13 @@ public:
 
     Result<SplitResult> split(const Mesh& mesh, const std::vector<ConvexPolytope>& cells) const override {
         try {
+            // Nef polyhedra need a simple solid. On a closed, oriented mesh that intersects itself,
+            // CGAL 5.5's binary operations can pair up an odd number of halfedges and write through a bogus
+            // handle (a segfault in SNC_external_structure::pair_up_halfedges, found by the fracture fuzzer;
+            // the check there is an assertion, off in release builds). Corefinement refuses such input
+            // (throw_on_self_intersection); so does this backend.
+            if (findSelfIntersections(mesh, 1).pairs > 0)
+                throw Failure{"the mesh intersects itself (Nef needs a simple solid)"};
             SM sm = meshToSm(mesh);
             Nef rem(sm);
             if (!rem.is_simple())

@@ -10,6 +10,7 @@
 #include "TestSupport.hpp"
 #include "rubble/Fracture.hpp"
 #include "rubble/MassProperties.hpp"
+#include "rubble/MeshCheck.hpp"
 #include "rubble/MeshIO.hpp"
 #include "rubble/Random.hpp"
 
@@ -367,6 +368,42 @@ TEST(Fracture, ImpactOutsideTheMeshIsNoIntersection) {
         auto l = fracture(lPrism(), {{1.7, 1.7, 0.5}, {1, 0, 0}, 1}, params, 2);
         ASSERT_FALSE(l.isOk());
         EXPECT_EQ(l.error().code, ErrorCode::NoIntersection) << l.error().message;
+    }
+}
+
+// A closed, consistently oriented mesh that intersects itself (two overlapping boxes) passes the input check
+// but is not a solid the exact backends can cut where it intersects itself. CGAL 5.5's Nef polyhedra could
+// write through a bogus handle on such input (the fracture fuzzer's
+// crash_nef_self_intersecting_sphere_shatter .bin): the Nef backend refuses any self-intersecting mesh as a
+// GeometryFailure. Corefinement (and Fast, through its exact fallback) check only the faces the cells cut: a
+// cut through the intersection is refused, one away from it may succeed and must then be sound. Nothing
+// crashes; a refused mesh stays whole.
+TEST(Fracture, SelfIntersectingMeshIsRefusedWhereItIsCut) {
+    Mesh overlapping = makeBox({-1, -1, -1}, {0.5, 1, 1});
+    overlapping.append(makeBox({-0.5, -0.8, -0.8}, {1, 0.8, 0.8}));
+    ASSERT_GT(findSelfIntersections(overlapping, 1).pairs, 0u);
+    FractureParams params;
+    params.pattern = CellPattern::Shatter;
+    params.cells = 4;
+    params.sizeLaw.base = 0.6;
+    params.sizeLaw.scale = 0;
+    const Impact throughIt{{0.5, 0, 0.8}, {0, 0, 1}, 1}; // on a line where the surfaces cross
+    const Impact awayFromIt{{1, 0.1, 0.2}, {1, 0, 0}, 1};
+    for (BooleanKind backend : {BooleanKind::Corefine, BooleanKind::Fast, BooleanKind::Nef}) {
+        params.backend = backend;
+        auto r = fracture(overlapping, throughIt, params, 5);
+        ASSERT_FALSE(r.isOk()) << static_cast<int>(backend);
+        EXPECT_EQ(r.error().code, ErrorCode::GeometryFailure) << r.error().message;
+        auto away = fracture(overlapping, awayFromIt, params, 5);
+        if (backend == BooleanKind::Nef) {
+            ASSERT_FALSE(away.isOk());
+            EXPECT_NE(away.error().message.find("intersects itself"), std::string::npos)
+                << away.error().message;
+        } else if (away.isOk()) {
+            checkResult(overlapping, *away, "a cut away from the self-intersection");
+        } else {
+            EXPECT_EQ(away.error().code, ErrorCode::GeometryFailure) << away.error().message;
+        }
     }
 }
 
