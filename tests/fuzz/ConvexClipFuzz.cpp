@@ -19,12 +19,18 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     case 1:
         mesh = makeSubdividedBox({-1, -1, -1}, {1, 1, 1}, 1 + in.byte() % 4);
         break;
-    case 2:
-        mesh = makeSphere({0, 0, 0}, 1.0, 6 + in.byte() % 10, 4 + in.byte() % 6);
+    case 2: { // (reads sequenced left to right: function arguments are not, and gcc and clang differ)
+        const int segments = 6 + in.byte() % 10;
+        const int rings = 4 + in.byte() % 6;
+        mesh = makeSphere({0, 0, 0}, 1.0, segments, rings);
         break;
-    case 3:
-        mesh = makeTorus({0, 0, 0}, 1.0, 0.4, 6 + in.byte() % 10, 4 + in.byte() % 6);
+    }
+    case 3: {
+        const int segments = 6 + in.byte() % 10;
+        const int rings = 4 + in.byte() % 6;
+        mesh = makeTorus({0, 0, 0}, 1.0, 0.4, segments, rings);
         break;
+    }
     default:
         mesh = makeBox({-2, -0.125, -1}, {2, 0.125, 1});
         break;

@@ -42,21 +42,31 @@ Mesh makeInput(fuzz::FuzzInput& in) {
     case 2:
         mesh = tetrahedron();
         break;
-    case 3:
-        mesh = makeSphere({0, 0, 0}, 1.0, 4 + in.byte() % 9, 3 + in.byte() % 6);
+    case 3: { // (reads sequenced left to right: function arguments are not, and gcc and clang differ)
+        const int segments = 4 + in.byte() % 9;
+        const int rings = 3 + in.byte() % 6;
+        mesh = makeSphere({0, 0, 0}, 1.0, segments, rings);
         break;
-    case 4:
-        mesh = makeTorus({0, 0, 0}, 1.0, 0.1 + (in.byte() % 8) / 10.0, 4 + in.byte() % 9, 3 + in.byte() % 6);
+    }
+    case 4: {
+        const double tube = 0.1 + (in.byte() % 8) / 10.0;
+        const int segments = 4 + in.byte() % 9;
+        const int rings = 3 + in.byte() % 6;
+        mesh = makeTorus({0, 0, 0}, 1.0, tube, segments, rings);
         break;
+    }
     case 5: { // two separate (or overlapping) parts
         mesh = makeBox({-1, -1, -1}, {0, 1, 1});
         const double dx = in.coordinate();
         mesh.append(makeBox({dx, -1, -1}, {dx + 1, 1, 1}));
         break;
     }
-    case 6: // thin plate
-        mesh = makeSubdividedBox({-2, -1.0 / (1 + in.byte()), -1}, {2, 1.0 / (1 + in.byte()), 1}, 1);
+    case 6: { // thin plate
+        const double below = 1.0 / (1 + in.byte());
+        const double above = 1.0 / (1 + in.byte());
+        mesh = makeSubdividedBox({-2, -below, -1}, {2, above, 1}, 1);
         break;
+    }
     case 7: { // a random soup: a few vertices, a few triangles (indices may be out of range)
         const int vertices = 3 + in.byte() % 10;
         for (int i = 0; i < vertices; ++i)
@@ -71,11 +81,12 @@ Mesh makeInput(fuzz::FuzzInput& in) {
     case 9:
         mesh = fuzz::makeLShape();
         break;
-    default: // scaled, far from the origin
-        mesh = makeBox({-1, -1, -1}, {1, 1, 1})
-                   .transformed(Mat3::identity(), {1.0 + in.byte() % 4, 1.0 / (1 + in.byte() % 8), 1.0},
-                                Vec3{1e5, -2e5, 3e5} * (in.byte() % 2));
+    default: { // scaled, far from the origin
+        const Vec3 scale{1.0 + in.byte() % 4, 1.0 / (1 + in.byte() % 8), 1.0};
+        const Vec3 offset = Vec3{1e5, -2e5, 3e5} * (in.byte() % 2);
+        mesh = makeBox({-1, -1, -1}, {1, 1, 1}).transformed(Mat3::identity(), scale, offset);
         break;
+    }
     }
     // Perturb some vertices (a perturbed box may become concave, flat or self-intersecting).
     const int moves = in.byte() % 4;
