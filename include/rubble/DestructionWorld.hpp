@@ -54,9 +54,8 @@ struct ObjectState {
 };
 
 /// Wall-clock timing of one impact from submission to adoption, in milliseconds. For an adopted job the
-/// stages follow one another without gaps: queue + prepare + cell + boolean + islands + decomposition +
-/// finish
-/// + handoff + adoption = total.
+/// stages follow one another without gaps:
+/// queue + prepare + cell + boolean + islands + decomposition + finish + handoff + adoption = total.
 struct TimingRecord {
     ObjectId object = 0;        ///< the object that was hit
     std::uint64_t frame = 0;    ///< frame of submission

@@ -169,7 +169,6 @@ void runJob(Job& job) {
         const Mat3 rt = f.rotation.transposed();
         meshes[i].transform(rt, Vec3{1, 1, 1}, rt * (-1.0 * f.translation));
         job.localMass.push_back(computeMassProperties(meshes[i]));
-        job.localMeshes.push_back(std::move(meshes[i]));
         std::vector<ConvexPolytope> lp;
         if (i < parts.size())
             for (const auto& p : parts[i])
@@ -177,6 +176,7 @@ void runJob(Job& job) {
         job.localParts.push_back(std::move(lp));
         job.frames.push_back(f);
     }
+    job.localMeshes = std::move(meshes);
     job.ok = true; // finishMs ends when the worker marks the job finished
 }
 
@@ -199,9 +199,8 @@ struct DestructionWorld::Impl {
     struct HandedOut {
         std::uint64_t record = 0;    // sequence number of its TimingRecord
         Clock::time_point recordEnd; // where that record's adoption ended so far
-        bool finished = false;       // finishAdoption already extended it
     };
-    std::vector<HandedOut> handedOut; // outcomes of the latest collect()
+    std::vector<HandedOut> handedOut; // outcomes of the latest collect() not yet finished by the engine
 
     // Impacts that can no longer run (their object is gone) still leave a stale timing record, so that every
     // accepted impact is accounted for in exactly one record.
@@ -526,7 +525,7 @@ std::vector<FractureOutcome> DestructionWorld::collect() {
         const std::uint64_t seq = im.record(rec);
         if (adopted) {
             out.back().record = seq;
-            im.handedOut.push_back({seq, a1, false});
+            im.handedOut.push_back({seq, a1});
         }
         if (!relaunch)
             im.recordDropped(job->id, later);
@@ -537,18 +536,18 @@ std::vector<FractureOutcome> DestructionWorld::collect() {
 void DestructionWorld::finishAdoption(const FractureOutcome& outcome) {
     Impl& im = *impl_;
     const auto now = Clock::now();
-    for (Impl::HandedOut& h : im.handedOut) {
-        if (h.record != outcome.record || h.finished)
-            continue;
-        h.finished = true;
-        if (h.record < im.recordsErased)
-            return; // dropped from timings() already
-        TimingRecord& r = im.timings[static_cast<std::size_t>(h.record - im.recordsErased)];
-        const double engineMs = msBetween(h.recordEnd, now);
-        r.adoptionMs += engineMs;
-        r.totalMs += engineMs;
+    auto h = std::find_if(im.handedOut.begin(), im.handedOut.end(),
+                          [&](const Impl::HandedOut& x) { return x.record == outcome.record; });
+    if (h == im.handedOut.end()) // an earlier collect()'s outcome, or finished already
         return;
-    }
+    const Impl::HandedOut handed = *h;
+    im.handedOut.erase(h);
+    if (handed.record < im.recordsErased)
+        return; // dropped from timings() already
+    TimingRecord& r = im.timings[static_cast<std::size_t>(handed.record - im.recordsErased)];
+    const double engineMs = msBetween(handed.recordEnd, now);
+    r.adoptionMs += engineMs;
+    r.totalMs += engineMs;
 }
 
 bool DestructionWorld::waitForResult(Clock::time_point deadline) {
