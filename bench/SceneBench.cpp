@@ -48,15 +48,14 @@
 
 #include <nlohmann/json.hpp>
 
-#include "rubble/DestructionWorld.hpp"
+#include "rubble/DestructionRuntime.hpp"
 #include "rubble/Random.hpp"
 #include "rubble/SceneConfig.hpp"
+#include "rubble/SceneLoader.hpp"
 #include "rubble/ThreadPool.hpp"
 #include "rubble/TimingReport.hpp"
-#include "rubble/bullet/Convert.hpp"
-#include "rubble/bullet/DestructionBridge.hpp"
+#include "rubble/bullet/BulletBinding.hpp"
 #include "rubble/bullet/PhysicsWorld.hpp"
-#include "rubble/bullet/SceneLoader.hpp"
 
 namespace {
 
@@ -74,7 +73,9 @@ struct SceneArgs {
     std::string timingsCsv;
     std::string framesCsv;
     std::string appendCsv;
-    int maxPieces = 250;
+    std::string pattern = "single";
+    int cells = 0;    // shatter cells (0: the library's default)
+    int maxAwake = 0; // awake debris budget (0: the runtime's default)
     double projectileSpeed = 120;
     double projectileMass = 2;
     double projectileRadius = 0.25;
@@ -100,14 +101,15 @@ double peakRssMb() {
 }
 
 // One projectile at a destructible body chosen with probability ∝ volume.
-void shoot(rubble::bullet::DestructionBridge& bridge, rubble::Rng& rng, const SceneArgs& a) {
-    using namespace rubble::bullet;
-    std::vector<Body*> targets;
+void shoot(rubble::DestructionRuntime& runtime, rubble::Rng& rng, const SceneArgs& a) {
+    using namespace rubble;
+    std::vector<const BodyRecord*> targets;
     double total = 0;
-    for (Body* b : bridge.bodies()) {
-        if (!b->hasObject || (b->kind != BodyKind::Object && b->kind != BodyKind::Piece))
+    for (BodyId id : runtime.bodies()) {
+        const BodyRecord* b = runtime.body(id);
+        if (!b->hasObject || (b->role != BodyRole::Object && b->role != BodyRole::Piece))
             continue;
-        const rubble::ObjectState* st = bridge.destruction().object(b->object);
+        const ObjectState* st = runtime.world().object(b->object);
         if (!st || !st->destructible)
             continue;
         targets.push_back(b);
@@ -116,27 +118,28 @@ void shoot(rubble::bullet::DestructionBridge& bridge, rubble::Rng& rng, const Sc
     if (targets.empty() || total <= 0)
         return;
     double pick = rng.uniform(0, total);
-    Body* target = targets.back();
-    for (Body* b : targets) {
+    const BodyRecord* target = targets.back();
+    for (const BodyRecord* b : targets) {
         if (pick < b->volume) {
             target = b;
             break;
         }
         pick -= b->volume;
     }
-    btVector3 lo, hi;
-    target->rigid->getAabb(lo, hi);
-    const rubble::Vec3 l = fromBt(lo), h = fromBt(hi), c = (l + h) * 0.5;
-    const rubble::Vec3 aim =
-        c + rubble::Vec3{rng.uniform(-0.4, 0.4) * (h.x - l.x), rng.uniform(-0.4, 0.4) * (h.y - l.y),
-                         rng.uniform(-0.4, 0.4) * (h.z - l.z)};
+    // aim uniformly in the central 80 % of its bounding box
+    const Frame f = runtime.motion(target->id).transform * target->objectToBody.inverse();
+    const Aabb box = runtime.world().object(target->object)->mesh.bounds();
+    const Vec3 local{box.lo.x + rng.uniform(0.1, 0.9) * (box.hi.x - box.lo.x),
+                     box.lo.y + rng.uniform(0.1, 0.9) * (box.hi.y - box.lo.y),
+                     box.lo.z + rng.uniform(0.1, 0.9) * (box.hi.z - box.lo.z)};
+    const Vec3 aim = f.apply(local);
     const double phi = rng.uniform(0, 2 * 3.14159265358979);
     const double y = rng.uniform(0.05, 0.6);
     const double r = std::sqrt(1 - y * y);
-    const rubble::Vec3 dir{r * std::cos(phi), y, r * std::sin(phi)};
-    const double distance = 30 + 0.5 * rubble::length(h - l);
-    bridge.fireProjectile(aim + dir * distance, dir * -a.projectileSpeed, a.projectileMass,
-                          a.projectileRadius);
+    const Vec3 dir{r * std::cos(phi), y, r * std::sin(phi)};
+    const double distance = 30 + box.diagonal();
+    runtime.fireProjectile(aim + dir * distance, dir * -a.projectileSpeed, a.projectileMass,
+                           a.projectileRadius);
 }
 
 int runScene(const SceneArgs& a) {
@@ -147,24 +150,36 @@ int runScene(const SceneArgs& a) {
         std::cerr << "rubble-bench scene: " << scene.error().message << "\n";
         return 2;
     }
-    DestructionWorld::Config dc;
-    dc.workers = a.workers;
-    dc.deterministic = a.deterministic;
-    dc.seed = a.seed;
-    DestructionWorld destruction(dc);
+    DestructionRuntime::Config rc;
+    rc.world.workers = a.workers;
+    rc.world.deterministic = a.deterministic;
+    rc.world.seed = a.seed;
+    if (a.maxAwake > 0)
+        rc.debris.maxAwakeBodies = a.maxAwake;
     PhysicsWorld physics;
-    DestructionBridge::Config bc;
-    bc.maxLivePieces = a.maxPieces;
-    DestructionBridge bridge(physics, destruction, bc);
+    BulletBinding binding(physics);
+    DestructionRuntime runtime(binding, rc);
+    DestructionWorld& destruction = runtime.world();
     SceneLoadOptions lo;
     lo.loadVehicle = false;
+    lo.fracture.pattern = a.pattern == "shatter" ? CellPattern::Shatter : CellPattern::SingleCell;
+    if (a.cells > 0)
+        lo.fracture.cells = a.cells;
     const auto tLoad = std::chrono::steady_clock::now();
-    const LoadedScene loaded = loadScene(*scene, bridge, lo);
+    const LoadedScene loaded = loadScene(*scene, runtime, lo);
     const double loadMs =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tLoad).count();
     for (const std::string& w : loaded.warnings)
         std::cerr << "warning: " << w << "\n";
-    const double startVolume = bridge.totalVolume();
+    const double startVolume = runtime.volumes().total();
+    { // distant tiny debris fades with distance from the middle of the scene
+        Vec3 centre;
+        for (ObjectId id : loaded.objects)
+            if (const BodyRecord* b = runtime.bodyOf(id))
+                centre += runtime.motion(b->id).transform.translation;
+        if (!loaded.objects.empty())
+            runtime.setFocus(centre / static_cast<double>(loaded.objects.size()));
+    }
 
     Rng rng(mixSeed(a.seed, 0x5CE7E));
     const double dt = 1.0 / 60;
@@ -177,8 +192,8 @@ int runScene(const SceneArgs& a) {
         framesOut.open(a.framesCsv);
         if (!framesOut)
             std::cerr << "rubble-bench scene: cannot write " << a.framesCsv << "\n";
-        framesOut << "frame,frame_ms,physics_ms,adopt_ms,idle_adopt_ms,bodies,pieces_alive,jobs_in_flight,"
-                     "fractures\n";
+        framesOut << "frame,frame_ms,physics_ms,adopt_ms,idle_adopt_ms,bodies,pieces_alive,awake_pieces,"
+                     "frozen_pieces,jobs_in_flight,fractures\n";
     }
     const bool idleAdoption = !a.unpaced && !a.noIdleAdoption && !a.deterministic;
     long shots = 0;
@@ -195,10 +210,10 @@ int runScene(const SceneArgs& a) {
         const auto t0 = std::chrono::steady_clock::now();
         const long due = static_cast<long>(std::floor(static_cast<double>(f) * a.shotsPerSecond / 60.0));
         while (shots < due) {
-            shoot(bridge, rng, a);
+            shoot(runtime, rng, a);
             ++shots;
         }
-        const FrameStats fs = bridge.stepFrame(dt);
+        const FrameStats fs = runtime.stepFrame(dt);
         const double ms =
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         physicsMs.push_back(fs.physicsMs);
@@ -211,7 +226,7 @@ int runScene(const SceneArgs& a) {
         if (idleAdoption) {
             const auto next = runStart + period * (f + 1);
             while (std::chrono::steady_clock::now() < next && destruction.waitForResult(next)) {
-                const FrameStats is = bridge.adoptReady();
+                const FrameStats is = runtime.adoptReady();
                 idleMs += is.adoptMs;
                 idleFractures += is.fractures;
                 if (is.fractures > 0)
@@ -219,21 +234,22 @@ int runScene(const SceneArgs& a) {
             }
         }
         idleAdoptMs.push_back(idleMs);
-        maxPieces = std::max(maxPieces, bridge.livePieces());
+        maxPieces = std::max(maxPieces, runtime.livePieces());
         if (framesOut)
             framesOut << f << ',' << ms << ',' << fs.physicsMs << ',' << fs.adoptMs << ',' << idleMs << ','
-                      << bridge.bodyCount() << ',' << bridge.livePieces() << ',' << destruction.jobsInFlight()
-                      << ',' << bridge.counters().fractures << '\n';
+                      << runtime.bodyCount() << ',' << runtime.livePieces() << ',' << runtime.awakeDebris()
+                      << ',' << runtime.frozenDebris() << ',' << destruction.jobsInFlight() << ','
+                      << runtime.counters().fractures << '\n';
     }
     // per-impact stages: the runtime's own summary (nearest-rank percentiles over adopted jobs; stale, missed
     // and failed records are counted only)
     const TimingSummary ts = summarizeTimings(destruction.timings());
     const double volumeError =
-        startVolume > 0 ? std::abs(bridge.totalVolume() - startVolume) / startVolume : 0;
-    const std::uint64_t hash = bridge.stateHash();
+        startVolume > 0 ? std::abs(runtime.volumes().total() - startVolume) / startVolume : 0;
+    const std::uint64_t hash = runtime.stateHash();
     char hashText[32];
     std::snprintf(hashText, sizeof hashText, "%016llx", static_cast<unsigned long long>(hash));
-    const BridgeCounters& c = bridge.counters();
+    const RuntimeCounters& c = runtime.counters();
     const double rss = peakRssMb();
     const rubble::bench::CpuMeter::Reading cpuUse = cpu.read();
     const int workers = a.workers > 0 ? a.workers : rubble::ThreadPool::defaultWorkerCount();
@@ -261,9 +277,9 @@ int runScene(const SceneArgs& a) {
             << percentile(physicsMs, 0.5) << ',' << percentile(physicsMs, 0.99) << ','
             << percentile(adoptMs, 0.99) << ',' << c.impacts << ',' << c.fractures << ',' << ts.stale << ','
             << ts.total.p50 << ',' << ts.total.p99 << ',' << ts.total.max << ',' << ts.queue.p50 << ','
-            << ts.boolean.p50 << ',' << ts.decomposition.p50 << ',' << bridge.livePieces() << ',' << maxPieces
-            << ',' << c.piecesRetired << ',' << volumeError << ',' << hashText << ',' << rss << ','
-            << ts.missed << ',' << ts.failed << ',' << idleFractures << ',' << ts.handoff.p50 << ','
+            << ts.boolean.p50 << ',' << ts.decomposition.p50 << ',' << runtime.livePieces() << ','
+            << maxPieces << ',' << c.piecesRetired << ',' << volumeError << ',' << hashText << ',' << rss
+            << ',' << ts.missed << ',' << ts.failed << ',' << idleFractures << ',' << ts.handoff.p50 << ','
             << ts.adoption.p99 << ',' << cpuUse.own << ',' << cpuUse.other << '\n';
     }
     if (a.json) {
@@ -282,14 +298,29 @@ int runScene(const SceneArgs& a) {
         j["idle_adoption_ms"] = {{"p50", percentile(idleAdoptMs, 0.5)},
                                  {"p99", percentile(idleAdoptMs, 0.99)},
                                  {"max", percentile(idleAdoptMs, 1.0)}};
-        j["pieces_alive"] = bridge.livePieces();
+        j["physics_ms"] = {{"p50", percentile(physicsMs, 0.5)},
+                           {"p99", percentile(physicsMs, 0.99)},
+                           {"max", percentile(physicsMs, 1.0)}};
+        j["pieces_alive"] = runtime.livePieces();
+        j["pieces_max"] = maxPieces;
+        j["awake_pieces"] = runtime.awakeDebris();
+        j["frozen_pieces"] = runtime.frozenDebris();
+        j["pieces_collapsed"] = c.piecesCollapsed;
+        j["pieces_frozen"] = c.piecesFrozen;
+        j["pieces_woken"] = c.piecesWoken;
+        const VolumeLedger v = runtime.volumes();
+        j["volume"] = {{"start", startVolume},
+                       {"live", v.live},
+                       {"retired", v.retired},
+                       {"dust", v.dust},
+                       {"dropped", v.dropped}};
         j["shots"] = shots;
         j["pieces_retired"] = c.piecesRetired;
         // what the long-lived containers hold at the end (a soak checks that they stay bounded)
-        j["bodies"] = bridge.bodyCount();
+        j["bodies"] = runtime.bodyCount();
         j["world_objects"] = destruction.objects().size();
         j["timing_records"] = destruction.timings().size();
-        j["debris_particles"] = bridge.particles().size();
+        j["debris_particles"] = runtime.particles().size();
         std::size_t triangles = 0, maxTriangles = 0, parts = 0;
         for (ObjectId id : destruction.objects())
             if (const ObjectState* st = destruction.object(id)) {
@@ -331,10 +362,11 @@ int runScene(const SceneArgs& a) {
     std::printf("%-28s %10d\n", "stale results", ts.stale);
     std::printf("%-28s %10d\n", "missed (cells off the mesh)", ts.missed);
     std::printf("%-28s %10d\n", "failed (geometry)", ts.failed);
-    std::printf("%-28s %10d (max %d)\n", "pieces alive", bridge.livePieces(), maxPieces);
+    std::printf("%-28s %10d (max %d; %d awake, %d frozen)\n", "pieces alive", runtime.livePieces(), maxPieces,
+                runtime.awakeDebris(), runtime.frozenDebris());
     std::printf("%-28s %10lld\n", "pieces retired", c.piecesRetired);
-    std::printf("%-28s %10lld (%lld contact tests)\n", "pieces collapsed", c.piecesCollapsed,
-                c.supportQueries);
+    std::printf("%-28s %10lld\n", "pieces collapsed", c.piecesCollapsed);
+    std::printf("%-28s %10lld (%lld woken)\n", "pieces frozen", c.piecesFrozen, c.piecesWoken);
     std::printf("%-28s %10.3g\n", "volume error", volumeError);
     std::printf("%-28s %10s\n", "state hash", hashText);
     std::printf("%-28s %10.1f\n", "peak RSS (MB)", rss);
@@ -364,7 +396,10 @@ rubble::tools::Registrar registrar{
          app.add_option("--frames-csv", args->framesCsv, "write per-frame times and counts as CSV");
          app.add_option("--append-csv", args->appendCsv,
                         "append a summary row to this CSV (e.g. bench/results/scene.csv)");
-         app.add_option("--max-pieces", args->maxPieces, "live piece body cap");
+         app.add_option("--pattern", args->pattern, "cell pattern of every object: single or shatter")
+             ->check(CLI::IsMember({"single", "shatter"}));
+         app.add_option("--cells", args->cells, "cells of a shatter pattern (default: the library's)");
+         app.add_option("--max-awake", args->maxAwake, "awake debris budget (default: the runtime's)");
          app.add_option("--projectile-speed", args->projectileSpeed, "m/s");
          app.add_option("--projectile-mass", args->projectileMass, "kg");
          return [args] { return runScene(*args); };

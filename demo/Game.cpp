@@ -7,15 +7,16 @@
 
 #include "rubble/MassProperties.hpp"
 #include "rubble/MeshIO.hpp"
+#include "rubble/SceneLoader.hpp"
 #include "rubble/bullet/Convert.hpp"
-#include "rubble/bullet/SceneLoader.hpp"
 
 namespace demo {
 
 namespace {
 
-using rubble::bullet::Body;
-using rubble::bullet::BodyKind;
+using rubble::BodyId;
+using rubble::BodyRecord;
+using rubble::BodyRole;
 
 V3 toV3(const btVector3& v) {
     return {v.x(), v.y(), v.z()};
@@ -84,29 +85,29 @@ rubble::Mesh standInJet() {
 Game::Game() = default;
 
 Game::~Game() {
-    if (bridge_) {
-        bridge_->setOnRemoved({});
-        bridge_->setOnAdopted({});
+    if (runtime_) {
+        runtime_->setOnRemoved({});
+        runtime_->setOnAdopted({});
     }
-    bridge_.reset();
+    runtime_.reset();
+    binding_.reset();
     physics_.reset();
-    destruction_.reset();
 }
 
 void Game::clear(Renderer& renderer) {
-    if (bridge_) {
-        bridge_->setOnAdopted({});
-        bridge_->setOnRemoved({});
+    if (runtime_) {
+        runtime_->setOnAdopted({});
+        runtime_->setOnRemoved({});
     }
     for (const auto& [body, v] : visuals_)
         if (v.mesh >= 0)
             renderer.removeMesh(v.mesh);
     visuals_.clear();
     looks_.clear();
-    vehicle_ = nullptr;
-    bridge_.reset();
+    vehicle_ = 0;
+    runtime_.reset();
+    binding_.reset();
     physics_.reset();
-    destruction_.reset();
     particles_.clear();
     counters_ = {};
     latencies_.clear();
@@ -114,13 +115,13 @@ void Game::clear(Renderer& renderer) {
     nextTiming_ = 0;
 }
 
-void Game::addVisual(const Body& body, const rubble::Mesh& mesh, const Look& look, float heat,
+void Game::addVisual(BodyId body, const rubble::Mesh& mesh, const Look& look, float heat,
                      Renderer& renderer) {
     Visual v;
     v.mesh = renderer.addMesh(mesh, look.texture, look.tint.x, look.tint.y, look.tint.z);
     v.heat = heat;
     v.tint = look.tint;
-    visuals_[&body] = v;
+    visuals_[body] = v;
 }
 
 bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const GameSettings& settings,
@@ -128,31 +129,30 @@ bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const Game
     clear(renderer);
     settings_ = settings;
     renderer.shadows = settings.shadows;
-    rubble::DestructionWorld::Config dc;
-    dc.workers = settings.workers;
-    dc.deterministic = settings.deterministic;
-    dc.seed = 20260522;
-    destruction_ = std::make_unique<rubble::DestructionWorld>(dc);
+    rubble::DestructionRuntime::Config rc;
+    rc.world.workers = settings.workers;
+    rc.world.deterministic = settings.deterministic;
+    rc.world.seed = 20260522;
+    rc.world.minPieceVolume = settings.minPieceVolume;
+    rc.impacts.collisionImpulseThreshold = settings.collisionImpulse;
+    rc.debris.maxAwakeBodies = settings.maxAwake;
+    rc.support.collapseUnsupported = settings.collapseUnsupported;
+    rc.projectileLifetime = 3;
+    rc.spentProjectileLifetime = 0;
     physics_ = std::make_unique<rubble::bullet::PhysicsWorld>();
-    rubble::bullet::DestructionBridge::Config bc;
-    bc.collisionImpulseThreshold = settings.collisionImpulse;
-    bc.minPieceVolume = settings.minPieceVolume;
-    bc.maxLivePieces = settings.maxPieces;
-    bc.collapseUnsupported = settings.collapseUnsupported;
-    bc.projectileLifetime = 3;
-    bc.spentProjectileLifetime = 0;
-    bridge_ = std::make_unique<rubble::bullet::DestructionBridge>(*physics_, *destruction_, bc);
-    bridge_->setOnRemoved([this, &renderer](Body& b) {
-        auto it = visuals_.find(&b);
+    binding_ = std::make_unique<rubble::bullet::BulletBinding>(*physics_);
+    runtime_ = std::make_unique<rubble::DestructionRuntime>(*binding_, rc);
+    runtime_->setOnRemoved([this, &renderer](const BodyRecord& b) {
+        auto it = visuals_.find(b.id);
         if (it == visuals_.end())
             return;
         if (it->second.mesh >= 0)
             renderer.removeMesh(it->second.mesh);
         visuals_.erase(it);
     });
-    bridge_->setOnAdopted([this, &renderer](const rubble::FractureOutcome& o) { onAdopted(o, renderer); });
+    runtime_->setOnAdopted([this, &renderer](const rubble::FractureOutcome& o) { onAdopted(o, renderer); });
 
-    rubble::bullet::SceneLoadOptions lo;
+    rubble::SceneLoadOptions lo;
     lo.loadVehicle = false; // the demo builds its own (stand-in jet, steering assist)
     lo.staticDensity = 400;
     lo.impulseThreshold = settings.impulseThreshold;
@@ -161,7 +161,7 @@ bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const Game
         m.normals.clear();
         ensureUvs(m, 4.0);
     };
-    const rubble::bullet::LoadedScene loaded = rubble::bullet::loadScene(scene, *bridge_, lo);
+    const rubble::LoadedScene loaded = rubble::loadScene(scene, *runtime_, lo);
     for (const auto& w : loaded.warnings)
         warnings.push_back(w);
 
@@ -178,15 +178,15 @@ bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const Game
                 box.uvs[3 * t + static_cast<size_t>(c)] = {(p.x + g.position.x) / 16.0,
                                                            (p.z + g.position.z) / 16.0};
             }
-        loaded.ground->rigid->setFriction(0.9f);
+        binding_->rigid(loaded.ground)->setFriction(0.9f);
         Look look;
         look.texture = g.textureFound ? renderer.loadTexture(g.texturePath, "grid", warnings)
                                       : renderer.proceduralTexture("grid");
         look.tint = {0.95f, 1.0f, 0.92f};
-        addVisual(*loaded.ground, box, look, 0, renderer);
+        addVisual(loaded.ground, box, look, 0, renderer);
         groundTop_ = static_cast<float>(loaded.groundTop);
     }
-    bridge_->config().killBelowY = groundTop_ - 60.0;
+    runtime_->config().debris.killBelowY = groundTop_ - 60.0;
 
     // Vehicle: the scene's model, or the built-in jet; an indestructible convex body steered by
     // controlVehicle.
@@ -212,11 +212,11 @@ bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const Game
         mesh = mesh.translated(rubble::Vec3{} - bb.center());
         const rubble::Vec3 he = bb.size() * 0.5;
         noseOffset_ = static_cast<float>(std::max(he.z, std::max(he.x, he.y))) + 2.0f;
-        auto body = bridge_->addConvexBody(
-            mesh.positions, rubble::Frame{rubble::Mat3::identity(), v.position}, std::max(v.mass, 1.0));
+        auto body = runtime_->addConvexBody(
+            mesh.positions, rubble::Frame{rubble::Mat3::identity(), v.position}, std::max(v.mass, 1.0), true);
         if (body) {
             vehicle_ = *body;
-            btRigidBody* rb = vehicle_->rigid.get();
+            btRigidBody* rb = binding_->rigid(vehicle_);
             rb->setFlags(rb->getFlags() | BT_DISABLE_WORLD_GRAVITY);
             rb->setGravity(btVector3(0, 0, 0));
             rb->setActivationState(DISABLE_DEACTIVATION);
@@ -225,7 +225,7 @@ bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const Game
             look.texture = v.textureFound ? renderer.loadTexture(v.texturePath, "metal", warnings)
                                           : renderer.proceduralTexture("metal");
             look.tint = {0.85f, 0.9f, 1.0f};
-            addVisual(*vehicle_, mesh, look, 0, renderer);
+            addVisual(vehicle_, mesh, look, 0, renderer);
             speed_ = v.mass > 0 ? 30.0f : 0.0f;
             rb->setLinearVelocity(btVector3(0, 0, -speed_));
         } else {
@@ -238,17 +238,18 @@ bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const Game
     for (size_t i = 0; i < loaded.objects.size(); ++i) {
         const rubble::ObjectId id = loaded.objects[i];
         const auto& o = scene.objects[loaded.sceneIndex[i]];
-        Body* body = bridge_->bodyOf(id);
-        const rubble::ObjectState* st = destruction_->object(id);
+        const BodyRecord* body = runtime_->bodyOf(id);
+        const rubble::ObjectState* st = runtime_->world().object(id);
         if (!body || !st)
             continue;
-        body->rigid->setFriction(0.8f);
-        body->rigid->setDamping(0.02f, 0.1f);
+        btRigidBody* rb = binding_->rigid(body->id);
+        rb->setFriction(0.8f);
+        rb->setDamping(0.02f, 0.1f);
         Look look;
         look.texture = o.textureFound ? renderer.loadTexture(o.texturePath, "concrete", warnings)
                                       : renderer.proceduralTexture("concrete");
         looks_[id] = look;
-        addVisual(*body, st->mesh, look, 0, renderer);
+        addVisual(body->id, st->mesh, look, 0, renderer);
     }
     counters_.warnings = static_cast<int>(warnings.size());
     V3 pos, fwd, up;
@@ -264,15 +265,15 @@ void Game::onAdopted(const rubble::FractureOutcome& o, Renderer& renderer) {
         look = it->second;
         looks_.erase(it);
     }
-    for (rubble::ObjectId pid : o.pieces) {
-        Body* b = bridge_->bodyOf(pid);
-        const rubble::ObjectState* st = destruction_->object(pid);
-        if (!b || !st)
-            continue; // retired at once into a debris particle
-        b->rigid->setFriction(0.8f);
-        b->rigid->setDamping(0.05f, 0.2f);
-        looks_[pid] = look;
-        addVisual(*b, st->mesh, look, 1.0f, renderer);
+    for (const rubble::AdoptedPiece& piece : o.pieces) {
+        const BodyRecord* b = runtime_->bodyOf(piece.id);
+        if (!b)
+            continue;
+        btRigidBody* rb = binding_->rigid(b->id);
+        rb->setFriction(0.8f);
+        rb->setDamping(0.05f, 0.2f);
+        looks_[piece.id] = look;
+        addVisual(b->id, piece.state->mesh, look, 1.0f, renderer);
     }
 }
 
@@ -283,7 +284,7 @@ void Game::vehicleFrame(V3& pos, V3& forward, V3& up) const {
         up = {0, 1, 0};
         return;
     }
-    const btTransform& t = vehicle_->rigid->getWorldTransform();
+    const btTransform& t = binding_->rigid(vehicle_)->getWorldTransform();
     pos = toV3(t.getOrigin());
     forward = toV3(t.getBasis() * btVector3(0, 0, -1));
     up = toV3(t.getBasis() * btVector3(0, 1, 0));
@@ -292,7 +293,7 @@ void Game::vehicleFrame(V3& pos, V3& forward, V3& up) const {
 void Game::controlVehicle(const ControlInput& in, float dt) {
     if (!vehicle_)
         return;
-    btRigidBody* rb = vehicle_->rigid.get();
+    btRigidBody* rb = binding_->rigid(vehicle_);
     const btMatrix3x3& R = rb->getWorldTransform().getBasis();
     speed_ = std::clamp(speed_ + in.throttle * 25.0f * dt, 0.0f, 90.0f);
     const btVector3 right = R * btVector3(1, 0, 0);
@@ -312,29 +313,31 @@ void Game::controlVehicle(const ControlInput& in, float dt) {
 }
 
 void Game::fire() {
-    const btTransform& vt = vehicle_->rigid->getWorldTransform();
+    const btRigidBody* vehicle = binding_->rigid(vehicle_);
+    const btTransform& vt = vehicle->getWorldTransform();
     const btVector3 fwd = vt.getBasis() * btVector3(0, 0, -1);
     const btVector3 from = vt.getOrigin() + fwd * noseOffset_;
-    const btVector3 vel = vehicle_->rigid->getLinearVelocity() + fwd * settings_.projectileSpeed;
-    Body& p = bridge_->fireProjectile(rubble::bullet::fromBt(from), rubble::bullet::fromBt(vel),
-                                      settings_.projectileMass, 0.35);
-    p.rigid->setFlags(p.rigid->getFlags() | BT_DISABLE_WORLD_GRAVITY);
-    p.rigid->setGravity(btVector3(0, -2.0f, 0));
+    const btVector3 vel = vehicle->getLinearVelocity() + fwd * settings_.projectileSpeed;
+    const BodyId p = runtime_->fireProjectile(rubble::bullet::fromBt(from), rubble::bullet::fromBt(vel),
+                                              settings_.projectileMass, 0.35);
+    btRigidBody* rb = binding_->rigid(p);
+    rb->setFlags(rb->getFlags() | BT_DISABLE_WORLD_GRAVITY);
+    rb->setGravity(btVector3(0, -2.0f, 0));
     ++counters_.shots;
 }
 
 void Game::emitEffects(long long impactsBefore, long long retiredBefore) {
     // sparks and dust at the impacts of this frame (the newest marks)
-    const auto& marks = bridge_->recentImpacts();
-    const long long fresh = std::min<long long>(bridge_->counters().impacts - impactsBefore,
+    const auto& marks = runtime_->recentImpacts();
+    const long long fresh = std::min<long long>(runtime_->counters().impacts - impactsBefore,
                                                 static_cast<long long>(marks.size()));
     for (long long k = 0; k < fresh; ++k) {
         const auto& m = marks[marks.size() - 1 - static_cast<size_t>(k)];
         particles_.impactBurst(toV3(m.point), toV3(m.normal), 1.0f, burstSeed_++);
     }
     // a puff of dust for every piece retired into a debris particle this frame (the newest particles)
-    const auto& debris = bridge_->particles();
-    const long long retired = std::min<long long>(bridge_->counters().piecesRetired - retiredBefore,
+    const auto& debris = runtime_->particles();
+    const long long retired = std::min<long long>(runtime_->counters().piecesRetired - retiredBefore,
                                                   static_cast<long long>(debris.size()));
     for (long long k = 0; k < retired; ++k) {
         const auto& d = debris[debris.size() - 1 - static_cast<size_t>(k)];
@@ -343,8 +346,8 @@ void Game::emitEffects(long long impactsBefore, long long retiredBefore) {
 }
 
 void Game::step(const ControlInput& input, float dt, Renderer& renderer) {
-    (void)renderer; // meshes follow the bridge's callbacks
-    if (!bridge_)
+    (void)renderer; // meshes follow the runtime's callbacks
+    if (!runtime_)
         return;
     ++counters_.frame;
     controlVehicle(input, dt);
@@ -355,22 +358,22 @@ void Game::step(const ControlInput& input, float dt, Renderer& renderer) {
     }
     fireWasDown_ = input.fire;
 
-    // live-tunable adapter settings
-    auto& bc = bridge_->config();
-    bc.minPieceVolume = settings_.minPieceVolume;
-    bc.maxLivePieces = settings_.maxPieces;
-    bc.collisionImpulseThreshold = settings_.collisionImpulse;
-    bc.collapseUnsupported = settings_.collapseUnsupported;
+    // live-tunable runtime settings
+    auto& rc = runtime_->config();
+    rc.debris.maxAwakeBodies = settings_.maxAwake;
+    rc.impacts.collisionImpulseThreshold = settings_.collisionImpulse;
+    rc.support.collapseUnsupported = settings_.collapseUnsupported;
 
-    const long long impactsBefore = bridge_->counters().impacts;
-    const long long retiredBefore = bridge_->counters().piecesRetired;
-    bridge_->stepFrame(dt);
+    const long long impactsBefore = runtime_->counters().impacts;
+    const long long retiredBefore = runtime_->counters().piecesRetired;
+    runtime_->setFocus({camera_.eye.x, camera_.eye.y, camera_.eye.z}); // distant tiny debris fades
+    runtime_->stepFrame(dt);
     emitEffects(impactsBefore, retiredBefore);
 
-    for (const Body* b : bridge_->bodies())
-        if (b->kind == BodyKind::Projectile)
-            particles_.emit(ParticleSystem::Kind::Trail, toV3(b->rigid->getCenterOfMassPosition()), V3{},
-                            0.18f, 0.5f, 1.0f, 0.7f, 0.3f);
+    for (BodyId id : runtime_->bodies())
+        if (runtime_->body(id)->role == BodyRole::Projectile)
+            particles_.emit(ParticleSystem::Kind::Trail, toV3(runtime_->motion(id).transform.translation),
+                            V3{}, 0.18f, 0.5f, 1.0f, 0.7f, 0.3f);
     for (auto& [body, v] : visuals_)
         v.heat = std::max(0.0f, v.heat - dt * 0.6f);
     particles_.step(dt, groundTop_);
@@ -378,44 +381,46 @@ void Game::step(const ControlInput& input, float dt, Renderer& renderer) {
 }
 
 void Game::adoptReady() {
-    if (!bridge_)
+    if (!runtime_)
         return;
-    const long long impacts = bridge_->counters().impacts;
-    const long long retiredBefore = bridge_->counters().piecesRetired;
-    if (bridge_->adoptReady().piecesRetired > 0)
+    const long long impacts = runtime_->counters().impacts;
+    const long long retiredBefore = runtime_->counters().piecesRetired;
+    if (runtime_->adoptReady().piecesRetired > 0)
         emitEffects(impacts, retiredBefore); // dust for pieces retired while adopting (no new impacts)
     updateCounters();
 }
 
 void Game::updateCounters() {
     // latencies of adopted jobs only (stale, missed and failed jobs are not impact → adopted times)
-    const auto& timings = destruction_->timings();
+    const auto& timings = runtime_->world().timings();
     // by sequence number: the world drops its oldest records in long games, which shifts the indices
-    const std::uint64_t first = destruction_->firstTimingRecord();
+    const std::uint64_t first = runtime_->world().firstTimingRecord();
     for (nextTiming_ = std::max(nextTiming_, first); nextTiming_ < first + timings.size(); ++nextTiming_) {
         const rubble::TimingRecord& r = timings[static_cast<std::size_t>(nextTiming_ - first)];
         if (!r.stale && !r.missed && !r.failed)
             latencies_.push_back(r.totalMs);
     }
-    const auto& c = bridge_->counters();
+    const auto& c = runtime_->counters();
     counters_.impacts = static_cast<int>(c.projectileHits);
     counters_.submitted = static_cast<int>(c.impacts);
     counters_.fractures = static_cast<int>(c.fractures);
     counters_.piecesCreated = static_cast<int>(c.piecesCreated);
     counters_.retired = static_cast<int>(c.piecesRetired);
-    counters_.bodies = static_cast<int>(bridge_->bodyCount());
-    counters_.pieces = bridge_->livePieces();
-    counters_.jobs = destruction_->jobsInFlight();
+    counters_.bodies = static_cast<int>(runtime_->bodyCount());
+    counters_.pieces = runtime_->livePieces();
+    counters_.jobs = runtime_->world().jobsInFlight();
 }
 
 void Game::draw(Renderer& renderer, float dt) {
-    if (!bridge_)
+    if (!runtime_)
         return;
     renderer.shadows = settings_.shadows;
-    for (const Body* b : bridge_->bodies()) {
-        if (b->kind == BodyKind::Projectile) {
+    for (BodyId id : runtime_->bodies()) {
+        const BodyRecord* b = runtime_->body(id);
+        const btRigidBody* rb = binding_->rigid(id);
+        if (b->role == BodyRole::Projectile) {
             Particle p;
-            p.pos = toV3(b->rigid->getCenterOfMassPosition());
+            p.pos = toV3(rb->getCenterOfMassPosition());
             p.size = 1.4f;
             p.r = 1.0f;
             p.g = 0.85f;
@@ -423,17 +428,17 @@ void Game::draw(Renderer& renderer, float dt) {
             renderer.addParticle(p, true);
             continue;
         }
-        auto it = visuals_.find(b);
+        auto it = visuals_.find(id);
         if (it == visuals_.end() || it->second.mesh < 0)
             continue;
         M4 m;
         // render meshes are in object coordinates; the body sits at the centre of mass
-        b->objectTransform().getOpenGLMatrix(m.m);
+        (rb->getWorldTransform() * rubble::bullet::toBt(b->objectToBody).inverse()).getOpenGLMatrix(m.m);
         renderer.drawMesh(it->second.mesh, m, it->second.heat);
     }
     if (vehicle_) {
         // Engine glow at the tail.
-        const btTransform& t = vehicle_->rigid->getWorldTransform();
+        const btTransform& t = binding_->rigid(vehicle_)->getWorldTransform();
         Particle p;
         p.pos = toV3(t * btVector3(0, 0, noseOffset_ - 2.2f));
         p.size = 1.1f + 0.02f * speed_;
@@ -444,7 +449,7 @@ void Game::draw(Renderer& renderer, float dt) {
         renderer.addParticle(p, true);
     }
     // retired pieces still flying: small dark chunks
-    for (const auto& d : bridge_->particles()) {
+    for (const auto& d : runtime_->particles()) {
         Particle p;
         p.pos = toV3(d.position);
         p.size = std::clamp(static_cast<float>(d.size), 0.05f, 1.5f);
@@ -460,7 +465,7 @@ void Game::draw(Renderer& renderer, float dt) {
         o.aabbs = settings_.debugAabbs;
         o.impacts = settings_.debugImpacts;
         o.impactCrossSize = 1.5;
-        for (const auto& l : bridge_->debugDraw(o).lines)
+        for (const auto& l : binding_->debugDraw(*runtime_, o).lines)
             renderer.addLine(toV3(l.from), toV3(l.to), static_cast<float>((l.rgba >> 24) & 0xFF) / 255.0f,
                              static_cast<float>((l.rgba >> 16) & 0xFF) / 255.0f,
                              static_cast<float>((l.rgba >> 8) & 0xFF) / 255.0f);
@@ -480,18 +485,21 @@ std::vector<double> Game::takeNewLatencies() {
 
 std::vector<V3> Game::targets() const {
     std::vector<V3> out;
-    if (!bridge_)
+    if (!runtime_)
         return out;
-    for (const Body* b : bridge_->bodies())
-        if (b->kind == BodyKind::Object || (b->kind == BodyKind::Piece && b->volume > 150 &&
-                                            b->rigid->getCenterOfMassPosition().y() > groundTop_ + 15))
-            out.push_back(toV3(b->rigid->getCenterOfMassPosition()));
+    for (BodyId id : runtime_->bodies()) {
+        const BodyRecord* b = runtime_->body(id);
+        const rubble::Vec3 c = runtime_->motion(id).transform.translation;
+        if (b->role == BodyRole::Object ||
+            (b->role == BodyRole::Piece && b->volume > 150 && c.y > groundTop_ + 15))
+            out.push_back(toV3(c));
+    }
     return out;
 }
 
 void Game::writeTimings(const std::string& path) const {
-    if (destruction_)
-        (void)destruction_->writeTimingsCsv(path);
+    if (runtime_)
+        (void)runtime_->world().writeTimingsCsv(path);
 }
 
 } // namespace demo

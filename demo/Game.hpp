@@ -1,8 +1,8 @@
 #pragma once
 /// \file Game.hpp
-/// The game: a world.cfg scene loaded through Rubble's Bullet adapter (PhysicsWorld, DestructionBridge,
-/// SceneLoader) on the DestructionWorld runtime, the flying vehicle with a stabilising assist, projectiles
-/// from its nose, and the renderer's meshes kept in step with the adapter's bodies.
+/// The game: a world.cfg scene loaded into Rubble's engine-neutral DestructionRuntime on the Bullet binding,
+/// the flying vehicle with a stabilising assist, projectiles from its nose, and the renderer's meshes kept in
+/// step with the runtime's bodies.
 
 #include <cstdint>
 #include <deque>
@@ -16,10 +16,10 @@
 #include "Math.hpp"
 #include "ParticleSystem.hpp"
 #include "Renderer.hpp"
-#include "rubble/DestructionWorld.hpp"
+#include "rubble/DestructionRuntime.hpp"
 #include "rubble/Fracture.hpp"
 #include "rubble/SceneConfig.hpp"
-#include "rubble/bullet/DestructionBridge.hpp"
+#include "rubble/bullet/BulletBinding.hpp"
 #include "rubble/bullet/PhysicsWorld.hpp"
 
 namespace demo {
@@ -44,8 +44,8 @@ struct GameSettings {
     float projectileSpeed = 170;     ///< m/s
     float projectileMass = 4;        ///< kg
     float fireInterval = 0.14f;      ///< s between shots while Space is held
-    float minPieceVolume = 0.02f;    ///< m^3: smaller pieces become debris particles
-    int maxPieces = 250;             ///< beyond this, the smallest old pieces retire to particles
+    float minPieceVolume = 0.02f;    ///< m^3: smaller pieces become debris particles (applied on restart)
+    int maxAwake = 400;              ///< awake debris budget: beyond it the smallest retire to particles
     bool collapseUnsupported = true; ///< static pieces with nothing static under them fall (live)
     bool debugShapes = false;        ///< draw collision shapes
     bool debugAabbs = false;         ///< draw AABBs
@@ -127,7 +127,7 @@ private:
     };
     void fire();
     void onAdopted(const rubble::FractureOutcome& outcome, Renderer& renderer);
-    void addVisual(const rubble::bullet::Body& body, const rubble::Mesh& mesh, const Look& look, float heat,
+    void addVisual(rubble::BodyId body, const rubble::Mesh& mesh, const Look& look, float heat,
                    Renderer& renderer);
     void controlVehicle(const ControlInput& input, float dt);
     void emitEffects(long long impactsBefore, long long retiredBefore);
@@ -137,13 +137,13 @@ private:
     GameCounters counters_;
     ChaseCamera camera_;
     ParticleSystem particles_;
-    // destroyed in reverse order: the bridge before the worlds it refers to
-    std::unique_ptr<rubble::DestructionWorld> destruction_;
+    // destroyed in reverse order: the runtime before the binding before the physics world
     std::unique_ptr<rubble::bullet::PhysicsWorld> physics_;
-    std::unique_ptr<rubble::bullet::DestructionBridge> bridge_;
-    std::unordered_map<const rubble::bullet::Body*, Visual> visuals_;
+    std::unique_ptr<rubble::bullet::BulletBinding> binding_;
+    std::unique_ptr<rubble::DestructionRuntime> runtime_;
+    std::unordered_map<rubble::BodyId, Visual> visuals_;
     std::map<rubble::ObjectId, Look> looks_;
-    rubble::bullet::Body* vehicle_ = nullptr;
+    rubble::BodyId vehicle_ = 0;
     float speed_ = 30;
     float fireCooldown_ = 0;
     bool fireWasDown_ = false;

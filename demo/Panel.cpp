@@ -108,7 +108,7 @@ bool Panel::draw(Game& game, GameSettings& pending, bool paused, const std::stri
         pending.collisionImpulse = coll;
         ImGui::SliderInt("workers (-1 auto)", &pending.workers, -1, 8);
         ImGui::SliderFloat("debris below", &pending.minPieceVolume, 0.0f, 1.0f, "%.3f m3");
-        ImGui::SliderInt("max pieces", &pending.maxPieces, 50, 2000);
+        ImGui::SliderInt("awake debris", &pending.maxAwake, 50, 2000);
         // live: takes effect at the next fracture, and is kept across restarts
         if (ImGui::Checkbox("collapse unsupported (live)", &live.collapseUnsupported))
             pending.collapseUnsupported = live.collapseUnsupported;

@@ -48,10 +48,9 @@ int main() {
     world.beginFrame();
     for (const rubble::FractureOutcome& outcome : world.collect()) {
         std::printf("object %u broke into %zu pieces:\n", outcome.parent, outcome.pieces.size());
-        for (std::size_t i = 0; i < outcome.pieces.size(); ++i) {
-            const rubble::ObjectState* piece = world.object(outcome.pieces[i]);
-            const rubble::Vec3 at =
-                outcome.pieceFrames[i].translation; // where its body goes (centre of mass)
+        for (const rubble::AdoptedPiece& adopted : outcome.pieces) {
+            const rubble::ObjectState* piece = adopted.state.get();
+            const rubble::Vec3 at = adopted.frame.translation; // where its body goes (centre of mass)
             std::printf("  id %u: volume %.4f, %zu convex parts, body at (%.3f, %.3f, %.3f)\n", piece->id,
                         piece->mass.volume, piece->convexParts.size(), at.x, at.y, at.z);
         }

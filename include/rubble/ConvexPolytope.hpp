@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "rubble/Aabb.hpp"
+#include "rubble/Frame.hpp"
 #include "rubble/Mesh.hpp"
 #include "rubble/Plane.hpp"
 
@@ -52,11 +53,18 @@ public:
         return clipped(plane.flipped(), tag, eps);
     }
 
+    /// The polytope moved rigidly by f (each point p becomes f.apply(p)).
+    ConvexPolytope transformed(const Frame& f) const;
+
     /// Closed triangle mesh of the boundary (faces fanned; material = face tag cast to unsigned when tagged).
     Mesh toMesh() const;
 
 private:
     std::vector<PolytopeFace> faces_;
 };
+
+/// True when the two polytopes overlap or are at most `gap` apart along every separating axis (face normals
+/// of both, and cross products of their edge directions): convex bodies that touch within a tolerance.
+bool withinGap(const ConvexPolytope& a, const ConvexPolytope& b, double gap);
 
 } // namespace rubble

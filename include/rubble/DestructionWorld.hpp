@@ -11,6 +11,7 @@
 
 #include "rubble/ConvexDecomposition.hpp"
 #include "rubble/Fracture.hpp"
+#include "rubble/Frame.hpp"
 #include "rubble/JobSystem.hpp"
 #include "rubble/Mesh.hpp"
 #include "rubble/Result.hpp"
@@ -19,12 +20,6 @@ namespace rubble {
 
 /// Identifies a destructible object in a DestructionWorld (never reused).
 using ObjectId = std::uint32_t;
-
-/// A rigid frame: p_parent = rotation · p_local + translation.
-struct Frame {
-    Mat3 rotation = Mat3::identity(); ///< orientation
-    Vec3 translation;                 ///< position
-};
 
 /// What an object is made of.
 struct ObjectDesc {
@@ -83,18 +78,34 @@ struct TimingRecord {
         false; ///< the object was over its triangle limit: the hit crumbled it (Config::crumbleTriangles)
 };
 
+/// A piece of a fracture, ready to adopt: a new object of the world.
+struct AdoptedPiece {
+    ObjectId id = 0;        ///< the new object, already added to the world
+    Frame frame;            ///< piece local frame → parent local frame (centre of mass, principal axes)
+    std::int32_t cell = -1; ///< Piece::cell: −1 part of the remainder, i ≥ 0 debris of cell i
+    std::shared_ptr<const ObjectState> state; ///< its mesh, mass properties and convex parts
+};
+
+/// A piece below the world's minimum volume (Config::minPieceVolume): never made an object, only reported,
+/// so that the engine can show it as a particle and keep its volume counted.
+struct DustPiece {
+    Vec3 center;            ///< its centre of mass (parent local coordinates)
+    double volume = 0;      ///< its volume
+    std::int32_t cell = -1; ///< Piece::cell
+};
+
 /// A fracture ready to adopt: the parent object is replaced by the pieces.
 struct FractureOutcome {
-    ObjectId parent = 0;             ///< the object that broke (removed from the world by adoption)
-    std::uint32_t parentVersion = 0; ///< its version when the job started
-    std::vector<ObjectId> pieces;    ///< the new objects, already added to the world
-    std::vector<Frame>
-        pieceFrames; ///< piece local frame → parent local frame (centre of mass, principal axes)
-    std::vector<std::int32_t>
-        pieceCells;              ///< per piece: Piece::cell (−1: the remainder, i ≥ 0: debris of cell i)
-    std::vector<Impact> impacts; ///< the impacts (parent local coordinates) that caused it
-    double droppedVolume = 0;    ///< volume of slivers dropped (for volume bookkeeping)
-    std::uint64_t record = 0;    ///< sequence number of its TimingRecord (for finishAdoption)
+    ObjectId parent = 0;              ///< the object that broke (removed from the world by collect())
+    std::uint32_t parentVersion = 0;  ///< its version when the job started
+    std::vector<AdoptedPiece> pieces; ///< the new objects
+    std::vector<DustPiece> dust;      ///< pieces too small to become objects
+    std::vector<Impact> impacts;      ///< the impacts (parent local coordinates) that caused it
+    double droppedVolume = 0;         ///< volume of slivers the kernel dropped (for volume bookkeeping)
+    std::uint64_t record = 0;         ///< sequence number of its TimingRecord (for finishAdoption)
+
+    /// Σ volume of dust.
+    double dustVolume() const;
 };
 
 /// The runtime. All member functions are called from one (main) thread; work runs on the JobSystem.
@@ -119,6 +130,8 @@ public:
         /// timings() keeps at least this many of the latest records and at most twice as many, so a long game
         /// does not accumulate them forever (0 = keep all).
         std::size_t keepTimings = 16384;
+        /// Pieces below this volume are not made objects; a FractureOutcome reports them as dust.
+        double minPieceVolume = 0;
     };
 
     /// A world with the given configuration.

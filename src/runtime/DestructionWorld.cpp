@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <cstdio>
 #include <fstream>
@@ -71,22 +72,6 @@ struct Job {
     double decompositionMs = 0;
     double finishMs = 0;
 };
-
-ConvexPolytope toLocal(const ConvexPolytope& p, const Frame& f) {
-    const Mat3 rt = f.rotation.transposed();
-    std::vector<PolytopeFace> faces;
-    faces.reserve(p.faces().size());
-    for (const auto& face : p.faces()) {
-        PolytopeFace out;
-        out.tag = face.tag;
-        for (const auto& c : face.corners)
-            out.corners.push_back(rt * (c - f.translation));
-        const Vec3 n = rt * face.plane.normal;
-        out.plane = out.corners.empty() ? Plane{n, 0} : Plane::fromPointNormal(out.corners.front(), n);
-        faces.push_back(std::move(out));
-    }
-    return ConvexPolytope::fromFaces(std::move(faces));
-}
 
 // Physics engines report contact points off the surface (a predictive CCD contact gives the projectile's
 // centre at the time of impact, a margin adds a few centimetres, and a convex part of a concave object covers
@@ -172,7 +157,7 @@ void runJob(Job& job) {
         std::vector<ConvexPolytope> lp;
         if (i < parts.size())
             for (const auto& p : parts[i])
-                lp.push_back(toLocal(p, f));
+                lp.push_back(p.transformed(f.inverse()));
         job.localParts.push_back(std::move(lp));
         job.frames.push_back(f);
     }
@@ -181,6 +166,13 @@ void runJob(Job& job) {
 }
 
 } // namespace
+
+double FractureOutcome::dustVolume() const {
+    double v = 0;
+    for (const DustPiece& d : dust)
+        v += d.volume;
+    return v;
+}
 
 struct DestructionWorld::Impl {
     Config config;
@@ -458,6 +450,11 @@ std::vector<FractureOutcome> DestructionWorld::collect() {
                 o.impacts.push_back(p.impact);
             o.droppedVolume = job->result.droppedVolume;
             for (std::size_t i = 0; i < job->localMeshes.size(); ++i) {
+                const std::int32_t cell = job->result.pieces[i].cell;
+                if (std::abs(job->localMass[i].volume) < im.config.minPieceVolume) {
+                    o.dust.push_back({job->frames[i].translation, std::abs(job->localMass[i].volume), cell});
+                    continue;
+                }
                 auto s = std::make_shared<ObjectState>();
                 s->id = im.nextId++;
                 s->version = 0;
@@ -469,9 +466,7 @@ std::vector<FractureOutcome> DestructionWorld::collect() {
                 s->fracture = parent->fracture;
                 s->crumbleAbove = parent->crumbleAbove;
                 s->convexParts = std::move(job->localParts[i]);
-                o.pieces.push_back(s->id);
-                o.pieceFrames.push_back(job->frames[i]);
-                o.pieceCells.push_back(job->result.pieces[i].cell);
+                o.pieces.push_back({s->id, job->frames[i], cell, s});
                 im.objects.emplace(s->id, std::move(s));
             }
             // Impacts that arrived while this job ran go to the piece nearest to their point.
@@ -481,29 +476,25 @@ std::vector<FractureOutcome> DestructionWorld::collect() {
                 // the piece whose bounds are nearest to the point (containing it: distance 0); among equally
                 // near pieces the largest, so that a waiting impact rarely lands on a sliver
                 double best = 1e300, bestVolume = 0;
-                std::size_t bi = 0;
-                for (std::size_t i = 0; i < o.pieces.size(); ++i) {
-                    const Frame& f = o.pieceFrames[i];
-                    const ObjectState& piece = *im.objects.at(o.pieces[i]);
-                    const Aabb b = piece.mesh.bounds();
-                    const Vec3 q = f.rotation.transposed() * (p.impact.point - f.translation);
+                const AdoptedPiece* target = &o.pieces.front();
+                for (const AdoptedPiece& piece : o.pieces) {
+                    const Aabb b = piece.state->mesh.bounds();
+                    const Vec3 q = piece.frame.applyInverse(p.impact.point);
                     const Vec3 outside = max(b.lo - q, max(q - b.hi, Vec3{}));
                     const double d = length(outside);
-                    if (d < best - 1e-9 || (d <= best + 1e-9 && piece.mass.volume > bestVolume)) {
+                    if (d < best - 1e-9 || (d <= best + 1e-9 && piece.state->mass.volume > bestVolume)) {
                         best = std::min(best, d);
-                        bestVolume = piece.mass.volume;
-                        bi = i;
+                        bestVolume = piece.state->mass.volume;
+                        target = &piece;
                     }
                 }
-                const Frame& f = o.pieceFrames[bi];
                 PendingImpact q = p;
-                q.impact.point = f.rotation.transposed() * (p.impact.point - f.translation);
-                q.impact.normal = f.rotation.transposed() * p.impact.normal;
-                const ObjectId pid = o.pieces[bi];
-                if (im.busy(pid))
-                    im.waiting[pid].push_back(q);
+                q.impact.point = target->frame.applyInverse(p.impact.point);
+                q.impact.normal = target->frame.rotation.transposed() * p.impact.normal;
+                if (im.busy(target->id))
+                    im.waiting[target->id].push_back(q);
                 else
-                    im.launch(pid, {q});
+                    im.launch(target->id, {q});
             }
             later.clear();
             rec.pieces = static_cast<int>(o.pieces.size());

@@ -1,12 +1,13 @@
-// Scene loading through the Bullet adapter: ground, objects, stand-ins for missing models, static objects.
+// Scene loading into the runtime on the Bullet binding: ground, objects, stand-ins for missing models, static
+// objects.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 
 #include "TestSupport.hpp"
 #include "rubble/SceneConfig.hpp"
-#include "rubble/bullet/Convert.hpp"
-#include "rubble/bullet/SceneLoader.hpp"
+#include "rubble/SceneLoader.hpp"
+#include "rubble/bullet/BulletBinding.hpp"
 
 using namespace rubble;
 using namespace rubble::bullet;
@@ -15,19 +16,19 @@ namespace {
 
 struct World {
     World() {
-        DestructionWorld::Config dc;
-        dc.workers = 1;
-        destruction = std::make_unique<DestructionWorld>(dc);
+        DestructionRuntime::Config rc;
+        rc.world.workers = 1;
         physics = std::make_unique<PhysicsWorld>();
-        bridge = std::make_unique<DestructionBridge>(*physics, *destruction, DestructionBridge::Config{});
+        binding = std::make_unique<BulletBinding>(*physics);
+        runtime = std::make_unique<DestructionRuntime>(*binding, rc);
     }
     ~World() {
-        bridge.reset();
-        destruction.reset();
+        runtime.reset();
+        binding.reset();
     }
-    std::unique_ptr<DestructionWorld> destruction;
     std::unique_ptr<PhysicsWorld> physics;
-    std::unique_ptr<DestructionBridge> bridge;
+    std::unique_ptr<BulletBinding> binding;
+    std::unique_ptr<DestructionRuntime> runtime;
 };
 
 bool anyContains(const std::vector<std::string>& v, const std::string& s) {
@@ -47,30 +48,30 @@ TEST(SceneLoader, MissingModelGivesAWarningAndAStandInBox) {
         parseSceneConfigText(text, "test.cfg", test::sourceDir() / "assets" / "models");
     ASSERT_TRUE(scene) << scene.error().message;
     World w;
-    const LoadedScene loaded = loadScene(*scene, *w.bridge);
+    const LoadedScene loaded = loadScene(*scene, *w.runtime);
     ASSERT_EQ(loaded.objects.size(), 2u);
     EXPECT_TRUE(anyContains(loaded.warnings, "no_such_model.obj"));
     EXPECT_TRUE(anyContains(loaded.warnings, "stand-in"));
-    ASSERT_NE(loaded.ground, nullptr);
+    ASSERT_NE(loaded.ground, 0u);
     EXPECT_NEAR(loaded.groundTop, -10, 1e-9);
-    ASSERT_NE(loaded.vehicle, nullptr); // a stand-in too
+    ASSERT_NE(loaded.vehicle, 0u); // a stand-in too
     // the stand-in is a 2 × 4 × 6 box at (3, -8, 1) with mass 50
-    Body* standIn = w.bridge->bodyOf(loaded.objects[0]);
+    const BodyRecord* standIn = w.runtime->bodyOf(loaded.objects[0]);
     ASSERT_NE(standIn, nullptr);
     EXPECT_NEAR(standIn->volume, 48, 1e-6);
     EXPECT_NEAR(standIn->mass, 50, 1e-6);
-    const Vec3 c = fromBt(standIn->rigid->getCenterOfMassPosition());
+    const Vec3 c = w.runtime->motion(standIn->id).transform.translation;
     EXPECT_NEAR(c.x, 3, 1e-5);
     EXPECT_NEAR(c.y, -8, 1e-5);
     EXPECT_NEAR(c.z, 1, 1e-5);
     // the model that exists: a static, destructible object
-    Body* cube = w.bridge->bodyOf(loaded.objects[1]);
+    const BodyRecord* cube = w.runtime->bodyOf(loaded.objects[1]);
     ASSERT_NE(cube, nullptr);
-    EXPECT_TRUE(cube->isStatic);
+    EXPECT_EQ(cube->motion, BodyMotionState::Static);
     EXPECT_NEAR(cube->volume, 8, 1e-6);
     EXPECT_NEAR(loaded.initialVolume, 56, 1e-6);
     for (int i = 0; i < 30; ++i)
-        w.bridge->stepFrame();
+        w.runtime->stepFrame();
 }
 
 TEST(SceneLoader, LoadsTheProjectsScenes) {
@@ -83,7 +84,7 @@ TEST(SceneLoader, LoadsTheProjectsScenes) {
         World w;
         SceneLoadOptions options;
         options.loadVehicle = false;
-        const LoadedScene loaded = loadScene(*scene, *w.bridge, options);
+        const LoadedScene loaded = loadScene(*scene, *w.runtime, options);
         EXPECT_EQ(loaded.objects.size(), scene->objects.size()) << name;
         EXPECT_GT(loaded.initialVolume, 0) << name;
     }
@@ -95,15 +96,15 @@ TEST(SceneLoader, SeedScenesLoadAsTheyAreWithWarningsForMissingFiles) {
         Result<SceneConfig> scene = parseSceneConfig(media / name);
         ASSERT_TRUE(scene) << name << ": " << scene.error().message;
         World w;
-        const LoadedScene loaded = loadScene(*scene, *w.bridge);
+        const LoadedScene loaded = loadScene(*scene, *w.runtime);
         EXPECT_EQ(loaded.objects.size(), scene->objects.size()) << name;
         // the missing vehicle model and ground texture are named with file and line
         EXPECT_TRUE(anyContains(loaded.warnings, std::string(name) + ":3")) << name;
         EXPECT_TRUE(anyContains(loaded.warnings, "fighter.3ds")) << name;
         EXPECT_TRUE(anyContains(loaded.warnings, "grid.jpg")) << name;
-        EXPECT_NE(loaded.vehicle, nullptr) << name; // a stand-in
+        EXPECT_NE(loaded.vehicle, 0u) << name; // a stand-in
         for (int i = 0; i < 10; ++i)
-            w.bridge->stepFrame();
+            w.runtime->stepFrame();
     }
 }
 
@@ -123,14 +124,14 @@ TEST(SceneLoader, PrepareMeshHookSeesEveryObjectAndIndicesMapToTheScene) {
         ++calls;
         m.uvs.assign(m.triangles.size() * 3, Vec2{0.25, 0.5});
     };
-    const LoadedScene loaded = loadScene(*scene, *w.bridge, options);
+    const LoadedScene loaded = loadScene(*scene, *w.runtime, options);
     EXPECT_EQ(calls, 2);
     ASSERT_EQ(loaded.sceneIndex.size(), loaded.objects.size());
     ASSERT_EQ(loaded.objects.size(), 2u);
     EXPECT_EQ(loaded.sceneIndex[0], 0u);
     EXPECT_EQ(loaded.sceneIndex[1], 1u);
     for (ObjectId id : loaded.objects) {
-        const ObjectState* st = w.destruction->object(id);
+        const ObjectState* st = w.runtime->world().object(id);
         ASSERT_NE(st, nullptr);
         ASSERT_FALSE(st->mesh.uvs.empty());
         EXPECT_EQ(st->mesh.uvs.front().x, 0.25);

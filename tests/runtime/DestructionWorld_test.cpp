@@ -30,6 +30,14 @@ public:
     std::vector<std::function<void()>> held;
 };
 
+// The ids of an outcome's pieces.
+std::vector<ObjectId> ids(const FractureOutcome& o) {
+    std::vector<ObjectId> out;
+    for (const AdoptedPiece& p : o.pieces)
+        out.push_back(p.id);
+    return out;
+}
+
 DestructionWorld::Config heldConfig(HeldJobs& jobs) {
     DestructionWorld::Config c;
     c.jobs = &jobs;
@@ -88,7 +96,7 @@ TEST(DestructionWorld, ImpactConservesVolumeAndMass) {
     ASSERT_EQ(out.size(), 1u);
     EXPECT_EQ(w.object(id), nullptr);
     double v = out[0].droppedVolume;
-    for (ObjectId p : out[0].pieces) {
+    for (const ObjectId p : ids(out[0])) {
         ASSERT_NE(w.object(p), nullptr);
         v += w.object(p)->mass.volume;
         EXPECT_NEAR(length(w.object(p)->mass.centerOfMass), 0, 1e-9);
@@ -159,7 +167,7 @@ TEST(DestructionWorld, ImpactsWaitingOnAMissedJobAreMergedIntoOneJob) {
     EXPECT_FALSE(w.timings()[1].failed);
     EXPECT_EQ(w.timings()[1].impactsMerged, 2);
     double v = out[0].droppedVolume;
-    for (ObjectId p : out[0].pieces)
+    for (const ObjectId p : ids(out[0]))
         v += w.object(p)->mass.volume;
     EXPECT_NEAR(v, 8.0, 8e-6);
 }
@@ -179,7 +187,7 @@ TEST(DestructionWorld, ImpactReportedOffTheSurfaceStillFractures) {
     ASSERT_EQ(out.size(), 1u);
     EXPECT_GE(out[0].pieces.size(), 2u);
     double v = out[0].droppedVolume;
-    for (ObjectId p : out[0].pieces)
+    for (const ObjectId p : ids(out[0]))
         v += w.object(p)->mass.volume;
     EXPECT_NEAR(v, 8.0, 8e-6);
 }
@@ -206,7 +214,7 @@ std::vector<std::uint64_t> pieceHashes(DestructionWorld::Config cfg) {
     for (int f = 0; f < 5; ++f) {
         w.beginFrame();
         for (const auto& o : w.collect())
-            for (ObjectId p : o.pieces)
+            for (const ObjectId p : ids(o))
                 h.push_back(w.object(p)->mesh.hash());
     }
     std::sort(h.begin(), h.end());
@@ -372,11 +380,11 @@ TEST(DestructionWorld, RemovedPiecesLeaveNoStateBehindOverChainedFractures) {
         ++fractures;
         dropped += out[0].droppedVolume;
         ASSERT_FALSE(out[0].pieces.empty());
-        ObjectId largest = out[0].pieces.front();
-        for (ObjectId p : out[0].pieces)
+        ObjectId largest = out[0].pieces.front().id;
+        for (const ObjectId p : ids(out[0]))
             if (w.object(p)->mass.volume > w.object(largest)->mass.volume)
                 largest = p;
-        for (ObjectId p : out[0].pieces)
+        for (const ObjectId p : ids(out[0]))
             if (p != largest) {
                 removed += w.object(p)->mass.volume;
                 w.removeObject(p);
@@ -459,7 +467,7 @@ TEST(DestructionWorld, ReTargetedImpactInTheCraterBreaksTheCraterWall) {
     const auto out = w.collect();
     ASSERT_EQ(out.size(), 1u);
     ObjectId largest = 0;
-    for (ObjectId p : out[0].pieces)
+    for (const ObjectId p : ids(out[0]))
         if (!largest || w.object(p)->mass.volume > w.object(largest)->mass.volume)
             largest = p;
     const double remainder = w.object(largest)->mass.volume;
@@ -475,7 +483,7 @@ TEST(DestructionWorld, ReTargetedImpactInTheCraterBreaksTheCraterWall) {
     EXPECT_FALSE(r.failed);
     EXPECT_GE(r.pieces, 2);
     double v = again[0].droppedVolume;
-    for (ObjectId p : again[0].pieces)
+    for (const ObjectId p : ids(again[0]))
         v += w.object(p)->mass.volume;
     EXPECT_NEAR(v, remainder, 1e-9 * remainder);
 }
@@ -531,8 +539,8 @@ TEST(DestructionWorld, AnObjectOverItsTriangleLimitCrumbles) {
         if (out.empty())
             continue;
         EXPECT_EQ(w.timings().back().crumbled, over) << "round " << r;
-        ObjectId largest = out[0].pieces.front();
-        for (ObjectId p : out[0].pieces) {
+        ObjectId largest = out[0].pieces.front().id;
+        for (const ObjectId p : ids(out[0])) {
             EXPECT_EQ(w.object(p)->crumbleAbove, limit) << "pieces inherit the limit";
             if (w.object(p)->mass.volume > w.object(largest)->mass.volume)
                 largest = p;
@@ -543,7 +551,7 @@ TEST(DestructionWorld, AnObjectOverItsTriangleLimitCrumbles) {
             EXPECT_GE(out[0].pieces.size(), 2u);
             EXPECT_LT(w.object(largest)->mass.volume, 0.9 * before) << "no piece keeps most of it";
         }
-        for (ObjectId p : out[0].pieces)
+        for (const ObjectId p : ids(out[0]))
             if (p != largest) {
                 elsewhere += w.object(p)->mass.volume;
                 w.removeObject(p);
@@ -625,7 +633,7 @@ TEST(DestructionWorld, TimingStagesAddUpToTheTotal) {
     expectStagesAddUp(r);
 
     // Merged impacts (cells of several impacts cut in one job): the cells are timed by the runtime.
-    const ObjectId piece = out[0].pieces.front();
+    const ObjectId piece = out[0].pieces.front().id;
     Impact a = centreHit(), b = centreHit();
     a.point = {0, 0, 0}; // snapped onto the piece's surface
     b.point = {0.5, 0.5, 0};
@@ -666,13 +674,13 @@ TEST(DestructionWorld, FinishAdoptionEndsTheRecordWhenTheEngineIsDone) {
     EXPECT_EQ(w.timings().back().totalMs, after.totalMs);
 
     // An outcome of an earlier collect() (never finished) is not extended any more.
-    ASSERT_TRUE(w.submitImpact(out[0].pieces.front(), centreHit()));
+    ASSERT_TRUE(w.submitImpact(out[0].pieces.front().id, centreHit()));
     jobs.runAll();
     w.beginFrame();
     const auto unfinished = w.collect();
     ASSERT_EQ(unfinished.size(), 1u);
     const double unfinishedTotal = w.timings().back().totalMs;
-    ASSERT_TRUE(w.submitImpact(unfinished[0].pieces.front(), centreHit()));
+    ASSERT_TRUE(w.submitImpact(unfinished[0].pieces.front().id, centreHit()));
     jobs.runAll();
     w.beginFrame();
     ASSERT_EQ(w.collect().size(), 1u);

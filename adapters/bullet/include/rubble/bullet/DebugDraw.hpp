@@ -16,7 +16,7 @@ struct DebugLine {
     std::uint32_t rgba = 0xFFFFFFFF; ///< colour
 };
 
-/// What to include in DestructionBridge::debugDraw().
+/// What to include in BulletBinding::debugDraw().
 struct DebugDrawOptions {
     bool shapes = true;           ///< wireframes of the collision shapes (convex parts)
     bool aabbs = false;           ///< axis-aligned bounding boxes

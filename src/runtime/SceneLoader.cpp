@@ -1,11 +1,11 @@
-#include "rubble/bullet/SceneLoader.hpp"
+#include "rubble/SceneLoader.hpp"
 
 #include <cmath>
 
 #include "rubble/MassProperties.hpp"
 #include "rubble/MeshIO.hpp"
 
-namespace rubble::bullet {
+namespace rubble {
 namespace {
 
 std::string where(const SceneConfig& scene, const SceneObject& o) {
@@ -31,7 +31,8 @@ Mesh modelOrStandIn(const SceneConfig& scene, const SceneObject& o, std::vector<
 
 } // namespace
 
-LoadedScene loadScene(const SceneConfig& scene, DestructionBridge& bridge, const SceneLoadOptions& options) {
+LoadedScene loadScene(const SceneConfig& scene, DestructionRuntime& runtime,
+                      const SceneLoadOptions& options) {
     LoadedScene out;
     for (const SceneWarning& w : scene.warnings)
         out.warnings.push_back(w.message);
@@ -39,7 +40,7 @@ LoadedScene loadScene(const SceneConfig& scene, DestructionBridge& bridge, const
     if (scene.ground.line != 0) {
         const Vec3 h{std::abs(scene.ground.scale.x) * 0.5, std::abs(scene.ground.scale.y) * 0.5,
                      std::abs(scene.ground.scale.z) * 0.5};
-        out.ground = &bridge.addGround(scene.ground.position, h);
+        out.ground = runtime.addGround(scene.ground.position, h);
         out.groundTop = scene.ground.position.y + h.y;
     }
     if (options.loadVehicle && scene.vehicle.line != 0) {
@@ -47,12 +48,11 @@ LoadedScene loadScene(const SceneConfig& scene, DestructionBridge& bridge, const
         const Mesh mesh = modelOrStandIn(scene, scene.vehicle, vehicleWarnings);
         for (std::string& w : vehicleWarnings)
             out.warnings.push_back(std::move(w));
-        Result<Body*> body = bridge.addConvexBody(
-            mesh.positions, Frame{Mat3::identity(), scene.vehicle.position}, scene.vehicle.mass);
-        if (body) {
+        Result<BodyId> body = runtime.addConvexBody(
+            mesh.positions, Frame{Mat3::identity(), scene.vehicle.position}, scene.vehicle.mass, true);
+        if (body)
             out.vehicle = *body;
-            out.vehicle->rigid->setActivationState(DISABLE_DEACTIVATION); // the player steers it
-        } else
+        else
             out.warnings.push_back(where(scene, scene.vehicle) + ": vehicle skipped (" +
                                    body.error().message + ")");
     }
@@ -68,7 +68,7 @@ LoadedScene loadScene(const SceneConfig& scene, DestructionBridge& bridge, const
         desc.fracture = options.fracture;
         desc.mesh = std::move(mesh);
         Result<ObjectId> id =
-            bridge.addObject(std::move(desc), Frame{Mat3::identity(), o.position}, o.isStatic());
+            runtime.addObject(std::move(desc), Frame{Mat3::identity(), o.position}, o.isStatic());
         if (!id) {
             out.warnings.push_back(where(scene, o) + ": '" + o.model + "' rejected (" + id.error().message +
                                    "); using an indestructible stand-in box");
@@ -79,13 +79,13 @@ LoadedScene loadScene(const SceneConfig& scene, DestructionBridge& bridge, const
                 options.prepareMesh(box.mesh);
             box.destructible = false;
             box.density = o.isStatic() ? options.staticDensity : o.mass / std::max(1e-9, 8 * h.x * h.y * h.z);
-            id = bridge.addObject(std::move(box), Frame{Mat3::identity(), o.position}, o.isStatic());
+            id = runtime.addObject(std::move(box), Frame{Mat3::identity(), o.position}, o.isStatic());
             if (!id)
                 continue;
         }
-        if (const ObjectState* st = bridge.destruction().object(*id); st && !st->warning.empty())
+        if (const ObjectState* st = runtime.world().object(*id); st && !st->warning.empty())
             out.warnings.push_back(where(scene, o) + ": '" + o.model + "': " + st->warning);
-        if (Body* b = bridge.bodyOf(*id))
+        if (const BodyRecord* b = runtime.bodyOf(*id))
             out.initialVolume += b->volume;
         out.objects.push_back(*id);
         out.sceneIndex.push_back(index);
@@ -93,4 +93,4 @@ LoadedScene loadScene(const SceneConfig& scene, DestructionBridge& bridge, const
     return out;
 }
 
-} // namespace rubble::bullet
+} // namespace rubble

@@ -1,17 +1,17 @@
 #pragma once
 /// \file SceneLoader.hpp
-/// Builds bodies from a parsed world.cfg scene (SceneConfig): ground box, vehicle, destructible objects.
+/// Builds the bodies of a parsed world.cfg scene (SceneConfig) in a DestructionRuntime: ground box, vehicle,
+/// destructible objects.
 
 #include <cstddef>
 #include <functional>
 #include <string>
 #include <vector>
 
-#include "rubble/DestructionWorld.hpp"
+#include "rubble/DestructionRuntime.hpp"
 #include "rubble/SceneConfig.hpp"
-#include "rubble/bullet/DestructionBridge.hpp"
 
-namespace rubble::bullet {
+namespace rubble {
 
 /// How scene objects are made.
 struct SceneLoadOptions {
@@ -26,8 +26,8 @@ struct SceneLoadOptions {
 
 /// What loading produced.
 struct LoadedScene {
-    Body* ground = nullptr;              ///< the ground box (null when the scene has none)
-    Body* vehicle = nullptr;             ///< the vehicle (null when not loaded)
+    BodyId ground = 0;                   ///< the ground box (0 when the scene has none)
+    BodyId vehicle = 0;                  ///< the vehicle (0 when not loaded; it never sleeps)
     double groundTop = 0;                ///< height of the ground's top face
     std::vector<ObjectId> objects;       ///< objects in file order (stand-ins included)
     std::vector<std::size_t> sceneIndex; ///< for each of objects: its index in SceneConfig::objects
@@ -40,7 +40,7 @@ struct LoadedScene {
 /// (x, y, z), mass 0 = static but destructible. A missing or unreadable model becomes a stand-in box (a cube
 /// of edge 1 scaled by (sx, sy, sz)) with a warning; a mesh that cannot be made valid stays intact and
 /// indestructible with one warning. Never fails on a parsed scene.
-LoadedScene loadScene(const SceneConfig& scene, DestructionBridge& bridge,
+LoadedScene loadScene(const SceneConfig& scene, DestructionRuntime& runtime,
                       const SceneLoadOptions& options = {});
 
-} // namespace rubble::bullet
+} // namespace rubble

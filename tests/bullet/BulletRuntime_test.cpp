@@ -1,6 +1,6 @@
-// The Bullet adapter with the real runtime: piece bodies at their true centre of mass with mass = density ·
-// volume, the parent's velocity field, conservation at adoption, impact filtering, determinism, volume
-// bookkeeping and the live-piece cap.
+// The engine-neutral runtime on the Bullet binding: piece bodies at their true centre of mass with mass =
+// density · volume, the parent's velocity field, conservation at adoption, impact filtering, determinism,
+// volume bookkeeping, structural collapse and the debris governor's budgets.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -13,12 +13,13 @@
 
 #include "TestSupport.hpp"
 
+#include "rubble/DestructionRuntime.hpp"
 #include "rubble/MassProperties.hpp"
 #include "rubble/Random.hpp"
 #include "rubble/SceneConfig.hpp"
+#include "rubble/SceneLoader.hpp"
+#include "rubble/bullet/BulletBinding.hpp"
 #include "rubble/bullet/Convert.hpp"
-#include "rubble/bullet/DestructionBridge.hpp"
-#include "rubble/bullet/SceneLoader.hpp"
 
 using namespace rubble;
 using namespace rubble::bullet;
@@ -27,24 +28,24 @@ namespace {
 
 struct Rig {
     explicit Rig(bool gravity = true, int workers = 1, bool deterministic = true,
-                 DestructionBridge::Config bc = {}, JobSystem* jobs = nullptr) {
-        DestructionWorld::Config dc;
-        dc.jobs = jobs;
-        dc.workers = workers;
-        dc.deterministic = deterministic;
-        dc.seed = 7;
-        destruction = std::make_unique<DestructionWorld>(dc);
+                 DestructionRuntime::Config rc = {}, JobSystem* jobs = nullptr) {
+        rc.world.jobs = jobs;
+        rc.world.workers = workers;
+        rc.world.deterministic = deterministic;
+        rc.world.seed = 7;
         PhysicsWorld::Config pc;
         if (!gravity)
             pc.gravity = {0, 0, 0};
         physics = std::make_unique<PhysicsWorld>(pc);
-        bridge = std::make_unique<DestructionBridge>(*physics, *destruction, bc);
+        binding = std::make_unique<BulletBinding>(*physics);
+        runtime = std::make_unique<DestructionRuntime>(*binding, rc);
     }
     ~Rig() {
-        bridge.reset();
-        destruction.reset();
+        runtime.reset();
+        binding.reset();
         physics.reset();
     }
+    DestructionWorld& world() { return runtime->world(); }
     ObjectId addBox(const Vec3& half, const Frame& placement, double density, bool isStatic = false,
                     const FractureParams& fracture = {}) {
         ObjectDesc d;
@@ -52,24 +53,33 @@ struct Rig {
         d.density = density;
         d.impulseThreshold = 1;
         d.fracture = fracture;
-        Result<ObjectId> id = bridge->addObject(std::move(d), placement, isStatic);
+        Result<ObjectId> id = runtime->addObject(std::move(d), placement, isStatic);
         EXPECT_TRUE(id) << (id ? "" : id.error().message);
         return id ? *id : 0;
     }
+    const BodyRecord* bodyOf(ObjectId id) const { return runtime->bodyOf(id); }
+    btRigidBody* rigidOf(ObjectId id) const {
+        const BodyRecord* b = runtime->bodyOf(id);
+        return b ? binding->rigid(b->id) : nullptr;
+    }
     // steps until at least one fracture was adopted (or the frame limit)
     bool runUntilFracture(int maxFrames = 240) {
-        const long long before = bridge->counters().fractures;
+        const long long before = runtime->counters().fractures;
         for (int i = 0; i < maxFrames; ++i) {
-            bridge->stepFrame();
-            if (bridge->counters().fractures > before)
+            runtime->stepFrame();
+            if (runtime->counters().fractures > before)
                 return true;
         }
         return false;
     }
-    std::unique_ptr<DestructionWorld> destruction;
     std::unique_ptr<PhysicsWorld> physics;
-    std::unique_ptr<DestructionBridge> bridge;
+    std::unique_ptr<BulletBinding> binding;
+    std::unique_ptr<DestructionRuntime> runtime;
 };
+
+bool isStatic(const BodyRecord& b) {
+    return b.motion == BodyMotionState::Static;
+}
 
 Frame rotatedFrame(const Vec3& t) {
     Rng rng(3);
@@ -104,79 +114,75 @@ struct ParentSnapshot {
 
 } // namespace
 
-TEST(DestructionBridge, PieceBodiesHaveTrueMassAndCentreOfMass) {
+TEST(BulletRuntime, PieceBodiesHaveTrueMassAndCentreOfMass) {
     Rig rig(false);
     const Frame placement = rotatedFrame({3, 4, -2});
     const double density = 2.5;
     const ObjectId id = rig.addBox({1, 0.5, 0.75}, placement, density);
     int checked = 0;
-    rig.bridge->setOnAdopted([&](const FractureOutcome& o) {
-        for (std::size_t i = 0; i < o.pieces.size(); ++i) {
-            Body* b = rig.bridge->bodyOf(o.pieces[i]);
-            if (!b)
-                continue; // retired into a particle
-            const ObjectState* st = rig.destruction->object(o.pieces[i]);
+    rig.runtime->setOnAdopted([&](const FractureOutcome& o) {
+        for (const AdoptedPiece& piece : o.pieces) {
+            const BodyRecord* b = rig.bodyOf(piece.id);
+            ASSERT_NE(b, nullptr);
+            const ObjectState* st = rig.world().object(piece.id);
             ASSERT_NE(st, nullptr);
+            EXPECT_EQ(st, piece.state.get()) << "the outcome hands the piece's state over";
             EXPECT_NEAR(b->mass, density * st->mass.volume, 1e-9 * b->mass);
-            EXPECT_NEAR(1.0 / b->rigid->getInvMass(), density * st->mass.volume, 1e-4 * b->mass);
+            EXPECT_NEAR(1.0 / rig.rigidOf(piece.id)->getInvMass(), density * st->mass.volume, 1e-4 * b->mass);
             // the piece mesh placed in the world through the parent's frame: its true centroid
             Mesh world = st->mesh;
-            for (Vec3& p : world.positions) {
-                const Vec3 inParent = o.pieceFrames[i].rotation * p + o.pieceFrames[i].translation;
-                p = placement.rotation * inParent + placement.translation;
-            }
+            for (Vec3& p : world.positions)
+                p = placement.apply(piece.frame.apply(p));
             const Vec3 truth = computeMassProperties(world).centerOfMass;
-            const Vec3 com = fromBt(b->rigid->getCenterOfMassPosition());
+            const Vec3 com = rig.runtime->motion(b->id).transform.translation;
             EXPECT_NEAR(com.x, truth.x, 1e-4);
             EXPECT_NEAR(com.y, truth.y, 1e-4);
             EXPECT_NEAR(com.z, truth.z, 1e-4);
             ++checked;
         }
     });
-    ASSERT_TRUE(rig.destruction->submitImpact(id, Impact{{1, 0.1, 0.2}, {1, 0, 0}, 100}));
+    ASSERT_TRUE(rig.world().submitImpact(id, Impact{{1, 0.1, 0.2}, {1, 0, 0}, 100}));
     ASSERT_TRUE(rig.runUntilFracture());
     EXPECT_GE(checked, 2);
 }
 
-TEST(DestructionBridge, PiecesFollowTheParentsVelocityFieldAndConserveMomentum) {
-    // declared before the rig: the bridge's destructor calls onRemoved for every body left (ASan found the
-    // callback reading a destroyed snap/id)
+TEST(BulletRuntime, PiecesFollowTheParentsVelocityFieldAndConserveMomentum) {
+    // declared before the rig: the runtime's destructor may still call back
     std::optional<ParentSnapshot> snap;
-    Rig rig(false);
+    DestructionRuntime::Config rc;
+    rc.world.minPieceVolume = 0; // keep every piece a body
+    Rig rig(false, 1, true, rc);
     const ObjectId id = rig.addBox({1, 1, 1}, Frame{Mat3::identity(), {0, 10, 0}}, 3.0);
-    Body* parent = rig.bridge->bodyOf(id);
+    btRigidBody* parent = rig.rigidOf(id);
     ASSERT_NE(parent, nullptr);
-    parent->rigid->setLinearVelocity({1, -2, 0.5f});
-    parent->rigid->setAngularVelocity({0.3f, 1.2f, -0.7f});
-    rig.bridge->setOnRemoved([&snap, id](Body& b) {
-        if (b.hasObject && b.object == id)
-            snap =
-                ParentSnapshot{b.mass, fromBt(b.rigid->getCenterOfMassPosition()),
-                               fromBt(b.rigid->getLinearVelocity()), fromBt(b.rigid->getAngularVelocity())};
+    parent->setLinearVelocity({1, -2, 0.5f});
+    parent->setAngularVelocity({0.3f, 1.2f, -0.7f});
+    rig.runtime->setOnRemoved([&snap, &rig, id](const BodyRecord& b) {
+        if (b.hasObject && b.object == id) {
+            const BodyMotion m = rig.runtime->motion(b.id);
+            snap = ParentSnapshot{b.mass, m.transform.translation, m.linearVelocity, m.angularVelocity};
+        }
     });
     bool checked = false;
-    rig.bridge->setOnAdopted([&](const FractureOutcome& o) {
+    rig.runtime->setOnAdopted([&](const FractureOutcome& o) {
         ASSERT_TRUE(snap);
         double mass = 0;
         Vec3 momentum;
-        for (ObjectId pid : o.pieces) {
-            Body* b = rig.bridge->bodyOf(pid);
-            if (!b)
-                continue;
-            const Vec3 p = fromBt(b->rigid->getCenterOfMassPosition());
-            const Vec3 expected = snap->v + cross(snap->w, p - snap->com);
-            const Vec3 got = fromBt(b->rigid->getLinearVelocity());
-            EXPECT_NEAR(got.x, expected.x, 1e-4);
-            EXPECT_NEAR(got.y, expected.y, 1e-4);
-            EXPECT_NEAR(got.z, expected.z, 1e-4);
-            const Vec3 w = fromBt(b->rigid->getAngularVelocity());
-            EXPECT_NEAR(w.x, snap->w.x, 1e-5);
-            EXPECT_NEAR(w.y, snap->w.y, 1e-5);
-            EXPECT_NEAR(w.z, snap->w.z, 1e-5);
+        for (const AdoptedPiece& piece : o.pieces) {
+            const BodyRecord* b = rig.bodyOf(piece.id);
+            ASSERT_NE(b, nullptr);
+            const BodyMotion m = rig.runtime->motion(b->id);
+            const Vec3 expected = snap->v + cross(snap->w, m.transform.translation - snap->com);
+            EXPECT_NEAR(m.linearVelocity.x, expected.x, 1e-4);
+            EXPECT_NEAR(m.linearVelocity.y, expected.y, 1e-4);
+            EXPECT_NEAR(m.linearVelocity.z, expected.z, 1e-4);
+            EXPECT_NEAR(m.angularVelocity.x, snap->w.x, 1e-5);
+            EXPECT_NEAR(m.angularVelocity.y, snap->w.y, 1e-5);
+            EXPECT_NEAR(m.angularVelocity.z, snap->w.z, 1e-5);
             mass += b->mass;
-            momentum += got * b->mass;
+            momentum += m.linearVelocity * b->mass;
         }
-        // conservation up to dropped slivers and retired debris (none for a clean box cut)
+        // conservation up to dropped slivers (none for a clean box cut)
         EXPECT_NEAR(mass, snap->mass, 1e-6 * snap->mass);
         const Vec3 p0 = snap->v * snap->mass;
         EXPECT_NEAR(momentum.x, p0.x, 1e-4 * snap->mass);
@@ -184,48 +190,48 @@ TEST(DestructionBridge, PiecesFollowTheParentsVelocityFieldAndConserveMomentum) 
         EXPECT_NEAR(momentum.z, p0.z, 1e-4 * snap->mass);
         checked = true;
     });
-    rig.bridge->config().minPieceVolume = 0; // keep every piece a body
-    ASSERT_TRUE(rig.destruction->submitImpact(id, Impact{{1, 0, 0}, {1, 0, 0}, 100}));
+    ASSERT_TRUE(rig.world().submitImpact(id, Impact{{1, 0, 0}, {1, 0, 0}, 100}));
     ASSERT_TRUE(rig.runUntilFracture());
     EXPECT_TRUE(checked);
+    rig.runtime->setOnRemoved({});
 }
 
-TEST(DestructionBridge, RestingBoxNeverFracturesButAProjectileHitDoes) {
-    DestructionBridge::Config bc;
-    bc.collisionImpulseThreshold = 1; // only the approach-speed filter protects resting contacts
-    Rig rig(true, 1, true, bc);
-    rig.bridge->addGround({0, -0.5, 0}, {50, 0.5, 50});
+TEST(BulletRuntime, RestingBoxNeverFracturesButAProjectileHitDoes) {
+    DestructionRuntime::Config rc;
+    rc.impacts.collisionImpulseThreshold = 1; // only the approach-speed filter protects resting contacts
+    Rig rig(true, 1, true, rc);
+    rig.runtime->addGround({0, -0.5, 0}, {50, 0.5, 50});
     const ObjectId id = rig.addBox({0.5, 0.5, 0.5}, Frame{Mat3::identity(), {0, 0.5, 0}}, 1000);
     for (int i = 0; i < 300; ++i)
-        rig.bridge->stepFrame();
-    EXPECT_EQ(rig.bridge->counters().impacts, 0);
-    EXPECT_EQ(rig.bridge->counters().fractures, 0);
-    ASSERT_NE(rig.bridge->bodyOf(id), nullptr);
-    rig.bridge->fireProjectile({-10, 0.5, 0.1}, {100, 0, 0}, 1, 0.1);
+        rig.runtime->stepFrame();
+    EXPECT_EQ(rig.runtime->counters().impacts, 0);
+    EXPECT_EQ(rig.runtime->counters().fractures, 0);
+    ASSERT_NE(rig.bodyOf(id), nullptr);
+    rig.runtime->fireProjectile({-10, 0.5, 0.1}, {100, 0, 0}, 1, 0.1);
     const bool fractured = rig.runUntilFracture(120);
-    EXPECT_EQ(rig.bridge->counters().projectileHits, 1);
-    EXPECT_EQ(rig.bridge->counters().impacts, 1);
+    EXPECT_EQ(rig.runtime->counters().projectileHits, 1);
+    EXPECT_EQ(rig.runtime->counters().impacts, 1);
     EXPECT_TRUE(fractured);
-    EXPECT_EQ(rig.bridge->bodyOf(id), nullptr);
+    EXPECT_EQ(rig.bodyOf(id), nullptr);
 }
 
-TEST(DestructionBridge, DebugDrawHasShapesAabbsAndImpactCrosses) {
+TEST(BulletRuntime, DebugDrawHasShapesAabbsAndImpactCrosses) {
     Rig rig(true);
-    rig.bridge->addGround({0, -0.5, 0}, {50, 0.5, 50});
+    rig.runtime->addGround({0, -0.5, 0}, {50, 0.5, 50});
     rig.addBox({0.5, 0.5, 0.5}, Frame{Mat3::identity(), {0, 0.5, 0}}, 100);
     DebugDrawOptions o;
     o.aabbs = false;
-    const std::size_t shapes = rig.bridge->debugDraw(o).lines.size();
+    const std::size_t shapes = rig.binding->debugDraw(*rig.runtime, o).lines.size();
     EXPECT_GE(shapes, 24u); // two boxes' edges
     o.aabbs = true;
-    EXPECT_EQ(rig.bridge->debugDraw(o).lines.size(), shapes + 24u);
-    rig.bridge->fireProjectile({-10, 0.5, 0}, {100, 0, 0}, 1, 0.1);
-    for (int i = 0; i < 30 && rig.bridge->recentImpacts().empty(); ++i)
-        rig.bridge->stepFrame();
-    ASSERT_EQ(rig.bridge->recentImpacts().size(), 1u);
-    EXPECT_NEAR(rig.bridge->recentImpacts().front().point.x, -0.5, 0.1);
+    EXPECT_EQ(rig.binding->debugDraw(*rig.runtime, o).lines.size(), shapes + 24u);
+    rig.runtime->fireProjectile({-10, 0.5, 0}, {100, 0, 0}, 1, 0.1);
+    for (int i = 0; i < 30 && rig.runtime->recentImpacts().empty(); ++i)
+        rig.runtime->stepFrame();
+    ASSERT_EQ(rig.runtime->recentImpacts().size(), 1u);
+    EXPECT_NEAR(rig.runtime->recentImpacts().front().point.x, -0.5, 0.1);
     o.shapes = o.aabbs = false;
-    EXPECT_EQ(rig.bridge->debugDraw(o).lines.size(), 4u); // a cross and its normal
+    EXPECT_EQ(rig.binding->debugDraw(*rig.runtime, o).lines.size(), 4u); // a cross and its normal
 }
 
 namespace {
@@ -239,50 +245,49 @@ struct IdleAdoption {
 };
 
 // A small seeded shooting scene; returns the final state hash and volume error.
-std::pair<std::uint64_t, double> runShootingScene(int workers, int maxPieces = 400, int* maxSeen = nullptr,
+std::pair<std::uint64_t, double> runShootingScene(int workers, int maxAwake = 400, int* maxSeen = nullptr,
                                                   IdleAdoption* idle = nullptr) {
-    DestructionBridge::Config bc;
-    bc.maxLivePieces = maxPieces;
-    Rig rig(true, workers, idle ? idle->deterministic : true, bc);
-    rig.bridge->addGround({0, -0.5, 0}, {50, 0.5, 50});
+    DestructionRuntime::Config rc;
+    rc.debris.maxAwakeBodies = maxAwake;
+    Rig rig(true, workers, idle ? idle->deterministic : true, rc);
+    rig.runtime->addGround({0, -0.5, 0}, {50, 0.5, 50});
     rig.addBox({1, 1, 1}, Frame{Mat3::identity(), {0, 1, 0}}, 500, true);
     rig.addBox({0.5, 1.5, 0.5}, Frame{Mat3::identity(), {4, 1.5, 0}}, 300);
     rig.addBox({1.5, 0.5, 0.5}, Frame{Mat3::identity(), {-4, 0.5, 1}}, 300);
-    const double start = rig.bridge->totalVolume();
+    const double start = rig.runtime->volumes().total();
     Rng rng(11);
     int seen = 0;
     for (int f = 0; f < 180; ++f) {
         if (f % 6 == 0) {
             const Vec3 target{rng.uniform(-4.5, 4.5), rng.uniform(0.2, 1.5), rng.uniform(-0.3, 0.5)};
-            rig.bridge->fireProjectile(target + Vec3{0, 3, 15}, Vec3{0, -3, -15} * 8, 2, 0.15);
+            rig.runtime->fireProjectile(target + Vec3{0, 3, 15}, Vec3{0, -3, -15} * 8, 2, 0.15);
         }
-        rig.bridge->stepFrame();
+        rig.runtime->stepFrame();
+        seen = std::max(seen, rig.runtime->awakeDebris());
         if (idle && idle->call) {
-            rig.destruction->waitIdle(); // every job done: whatever can be adopted now is ready
-            while (
-                rig.destruction->waitForResult(std::chrono::steady_clock::now() + std::chrono::seconds(5))) {
+            rig.world().waitIdle(); // every job done: whatever can be adopted now is ready
+            while (rig.world().waitForResult(std::chrono::steady_clock::now() + std::chrono::seconds(5))) {
                 ++idle->waitedFor;
-                idle->adoptedIdle += rig.bridge->adoptReady().fractures;
+                idle->adoptedIdle += rig.runtime->adoptReady().fractures;
             }
-            idle->adoptedIdle += rig.bridge->adoptReady().fractures; // must be a no-op when nothing is ready
+            idle->adoptedIdle += rig.runtime->adoptReady().fractures; // must be a no-op when nothing is ready
         }
-        seen = std::max(seen, rig.bridge->livePieces());
     }
     if (maxSeen)
         *maxSeen = seen;
-    EXPECT_GT(rig.bridge->counters().fractures, 0);
-    return {rig.bridge->stateHash(), std::abs(rig.bridge->totalVolume() - start) / start};
+    EXPECT_GT(rig.runtime->counters().fractures, 0);
+    return {rig.runtime->stateHash(), std::abs(rig.runtime->volumes().total() - start) / start};
 }
 
 } // namespace
 
-TEST(DestructionBridge, DeterministicAcrossWorkerCounts) {
+TEST(BulletRuntime, DeterministicAcrossWorkerCounts) {
     const auto one = runShootingScene(1);
     const auto two = runShootingScene(2);
     EXPECT_EQ(one.first, two.first);
 }
 
-TEST(DestructionBridge, DeterministicModeIgnoresIdleAdoption) {
+TEST(BulletRuntime, DeterministicModeIgnoresIdleAdoption) {
     IdleAdoption idle;
     idle.call = true;
     const auto with = runShootingScene(2, 400, nullptr, &idle);
@@ -291,7 +296,7 @@ TEST(DestructionBridge, DeterministicModeIgnoresIdleAdoption) {
     EXPECT_EQ(with.first, runShootingScene(2).first);
 }
 
-TEST(DestructionBridge, IdleAdoptionKeepsVolumeAndThePieceCap) {
+TEST(BulletRuntime, IdleAdoptionKeepsVolumeAndTheAwakeBudget) {
     // Non-deterministic mode with every result adopted between frames, as soon as it is ready.
     IdleAdoption idle;
     idle.deterministic = false;
@@ -305,58 +310,58 @@ TEST(DestructionBridge, IdleAdoptionKeepsVolumeAndThePieceCap) {
 
 // Issue #5: with idle adoption, a fracture whose job finishes after stepFrame's collect is adopted before the
 // next stepFrame (impact → adopted within the frame of the impact), not at the next one.
-TEST(DestructionBridge, IdleAdoptionAdoptsBeforeTheNextStepFrame) {
+TEST(BulletRuntime, IdleAdoptionAdoptsBeforeTheNextStepFrame) {
     GatedJobs jobs;
     Rig rig(false, 1, false, {}, &jobs);
     const ObjectId id = rig.addBox({0.5, 0.5, 0.5}, Frame{Mat3::identity(), {0, 0, 0}}, 100);
-    rig.bridge->fireProjectile({-10, 0, 0.1}, {100, 0, 0}, 1, 0.1);
-    for (int i = 0; i < 60 && rig.bridge->counters().impacts == 0; ++i)
-        rig.bridge->stepFrame();
-    ASSERT_EQ(rig.bridge->counters().impacts, 1);
-    ASSERT_EQ(rig.bridge->counters().fractures, 0); // the job was held through stepFrame's collect
-    const std::uint64_t frame = rig.bridge->counters().frames;
-    EXPECT_EQ(rig.bridge->adoptReady().fractures, 0) << "nothing ready yet";
+    rig.runtime->fireProjectile({-10, 0, 0.1}, {100, 0, 0}, 1, 0.1);
+    for (int i = 0; i < 60 && rig.runtime->counters().impacts == 0; ++i)
+        rig.runtime->stepFrame();
+    ASSERT_EQ(rig.runtime->counters().impacts, 1);
+    ASSERT_EQ(rig.runtime->counters().fractures, 0); // the job was held through stepFrame's collect
+    const std::uint64_t frame = rig.runtime->counters().frames;
+    EXPECT_EQ(rig.runtime->adoptReady().fractures, 0) << "nothing ready yet";
     jobs.release(); // the job finishes in the idle time after the frame
-    ASSERT_TRUE(rig.destruction->waitForResult(std::chrono::steady_clock::now() + std::chrono::minutes(1)));
-    const FrameStats s = rig.bridge->adoptReady();
+    ASSERT_TRUE(rig.world().waitForResult(std::chrono::steady_clock::now() + std::chrono::minutes(1)));
+    const FrameStats s = rig.runtime->adoptReady();
     EXPECT_EQ(s.fractures, 1);
     EXPECT_GE(s.piecesCreated + s.piecesRetired, 2);
-    EXPECT_EQ(rig.bridge->counters().fractures, 1);
-    EXPECT_EQ(rig.bridge->counters().frames, frame) << "no stepFrame in between";
-    EXPECT_EQ(rig.bridge->bodyOf(id), nullptr);
-    ASSERT_EQ(rig.destruction->timings().size(), 1u);
+    EXPECT_EQ(rig.runtime->counters().fractures, 1);
+    EXPECT_EQ(rig.runtime->counters().frames, frame) << "no stepFrame in between";
+    EXPECT_EQ(rig.bodyOf(id), nullptr);
+    ASSERT_EQ(rig.world().timings().size(), 1u);
     // stepFrame submits impacts just before DestructionWorld::beginFrame: the record carries the frame before
-    EXPECT_EQ(rig.destruction->timings()[0].frame + 1, rig.destruction->frame());
-    EXPECT_EQ(rig.bridge->adoptReady().fractures, 0) << "nothing left to adopt";
+    EXPECT_EQ(rig.world().timings()[0].frame + 1, rig.world().frame());
+    EXPECT_EQ(rig.runtime->adoptReady().fractures, 0) << "nothing left to adopt";
 }
 
 // Issue #5: "impact → adopted" ends when the pieces' bodies and collision shapes exist, so the engine's part
-// of the adoption is in the impact's timing record (the bridge calls DestructionWorld::finishAdoption). The
-// parent's removal callback runs inside the bridge's adoption; made slow, it must show in the record.
-TEST(DestructionBridge, TimingRecordIncludesTheEnginesAdoption) {
+// of the adoption is in the impact's timing record (the runtime calls DestructionWorld::finishAdoption). The
+// parent's removal callback runs inside the adoption; made slow, it must show in the record.
+TEST(BulletRuntime, TimingRecordIncludesTheEnginesAdoption) {
     using namespace std::chrono_literals;
     Rig rig(false, 1, true);
     const ObjectId id = rig.addBox({0.5, 0.5, 0.5}, Frame{Mat3::identity(), {0, 0, 0}}, 100);
-    rig.bridge->setOnRemoved([&](Body& b) {
+    rig.runtime->setOnRemoved([&](const BodyRecord& b) {
         if (b.hasObject && b.object == id)
             std::this_thread::sleep_for(20ms);
     });
-    rig.bridge->fireProjectile({-10, 0, 0.1}, {100, 0, 0}, 1, 0.1);
+    rig.runtime->fireProjectile({-10, 0, 0.1}, {100, 0, 0}, 1, 0.1);
     ASSERT_TRUE(rig.runUntilFracture());
-    ASSERT_EQ(rig.destruction->timings().size(), 1u);
-    const TimingRecord& r = rig.destruction->timings()[0];
+    ASSERT_EQ(rig.world().timings().size(), 1u);
+    const TimingRecord& r = rig.world().timings()[0];
     EXPECT_GE(r.adoptionMs, 20);
     EXPECT_GE(r.totalMs, r.queueMs + r.prepareMs + r.cellMs + r.booleanMs + r.islandsMs + r.decompositionMs +
                              r.finishMs + r.handoffMs + r.adoptionMs);
-    rig.bridge->setOnRemoved({});
+    rig.runtime->setOnRemoved({});
 }
 
-TEST(DestructionBridge, VolumeIsConservedThroughFracturesAndRetirement) {
+TEST(BulletRuntime, VolumeIsConservedThroughFracturesAndRetirement) {
     const auto r = runShootingScene(1);
     EXPECT_LT(r.second, 1e-6);
 }
 
-TEST(DestructionBridge, LivePieceCapIsRespected) {
+TEST(BulletRuntime, AwakeBudgetIsRespected) {
     int seen = 0;
     const auto r = runShootingScene(1, 3, &seen);
     EXPECT_LE(seen, 3);
@@ -382,35 +387,37 @@ SceneRun runSceneFile(const std::filesystem::path& file, int workers) {
     Rig rig(true, workers, true);
     SceneLoadOptions lo;
     lo.loadVehicle = false;
-    const LoadedScene loaded = loadScene(*scene, *rig.bridge, lo);
+    const LoadedScene loaded = loadScene(*scene, *rig.runtime, lo);
     EXPECT_FALSE(loaded.objects.empty());
-    const double start = rig.bridge->totalVolume();
+    const double start = rig.runtime->volumes().total();
     Rng rng(3);
     for (int f = 0; f < 150; ++f) {
         if (f % 10 == 0) {
             // at the largest destructible body, from above and in front
-            Body* target = nullptr;
-            for (Body* b : rig.bridge->bodies())
-                if ((b->kind == BodyKind::Object || b->kind == BodyKind::Piece) &&
+            const BodyRecord* target = nullptr;
+            for (BodyId id : rig.runtime->bodies()) {
+                const BodyRecord* b = rig.runtime->body(id);
+                if ((b->role == BodyRole::Object || b->role == BodyRole::Piece) &&
                     (!target || b->volume > target->volume))
                     target = b;
+            }
             if (target) {
-                const Vec3 c = fromBt(target->rigid->getCenterOfMassPosition());
+                const Vec3 c = rig.runtime->motion(target->id).transform.translation;
                 const Vec3 aim = c + Vec3{rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)};
-                rig.bridge->fireProjectile(aim + Vec3{0, 10, 30}, Vec3{0, -10, -30} * 4, 2, 0.25);
+                rig.runtime->fireProjectile(aim + Vec3{0, 10, 30}, Vec3{0, -10, -30} * 4, 2, 0.25);
             }
         }
-        rig.bridge->stepFrame();
+        rig.runtime->stepFrame();
     }
-    out.hash = rig.bridge->stateHash();
-    out.volumeError = std::abs(rig.bridge->totalVolume() - start) / start;
-    out.fractures = rig.bridge->counters().fractures;
+    out.hash = rig.runtime->stateHash();
+    out.volumeError = std::abs(rig.runtime->volumes().total() - start) / start;
+    out.fractures = rig.runtime->counters().fractures;
     return out;
 }
 
 } // namespace
 
-TEST(DestructionBridge, SceneFileIsDeterministicOnOneAndTwoWorkersAndConservesVolume) {
+TEST(BulletRuntime, SceneFileIsDeterministicOnOneAndTwoWorkersAndConservesVolume) {
     const auto file = test::sourceDir() / "assets" / "scenes" / "cube_test_108.cfg";
     ASSERT_TRUE(std::filesystem::exists(file));
     const SceneRun one = runSceneFile(file, 1);
@@ -424,7 +431,7 @@ TEST(DestructionBridge, SceneFileIsDeterministicOnOneAndTwoWorkersAndConservesVo
     EXPECT_LT(two.volumeError, 1e-6);
 }
 
-TEST(DestructionBridge, ShutdownWithJobsInFlightNeitherHangsNorLeaks) {
+TEST(BulletRuntime, ShutdownWithJobsInFlightNeitherHangsNorLeaks) {
     // Non-deterministic mode: impacts are submitted and the whole rig is torn down at once, with fracture
     // jobs running and queued (ASan/LSan builds check the leaks, the timeout the hang).
     auto done = std::async(std::launch::async, [] {
@@ -435,8 +442,8 @@ TEST(DestructionBridge, ShutdownWithJobsInFlightNeitherHangsNorLeaks) {
             for (int i = 0; i < 6; ++i)
                 ids.push_back(rig.addBox({1, 1, 1}, Frame{Mat3::identity(), {4.0 * i, 0, 0}}, 100));
             for (ObjectId id : ids)
-                submitted += rig.destruction->submitImpact(id, Impact{{1, 0.1, 0.2}, {1, 0, 0}, 100}) ? 1 : 0;
-            rig.bridge->stepFrame();
+                submitted += rig.world().submitImpact(id, Impact{{1, 0.1, 0.2}, {1, 0, 0}, 100}) ? 1 : 0;
+            rig.runtime->stepFrame();
         }
         return submitted;
     });
@@ -468,8 +475,9 @@ struct PieceView {
 
 struct CollapseRig : Rig {
     // with a ground whose top is y = 0
-    explicit CollapseRig(bool collapse = true) : Rig(true, 1, true, config(collapse)) {
-        bridge->addGround({0, -0.5, 0}, {50, 0.5, 50});
+    explicit CollapseRig(bool collapse = true, double debrisKick = 0.5)
+        : Rig(true, 1, true, config(collapse, debrisKick)) {
+        runtime->addGround({0, -0.5, 0}, {50, 0.5, 50});
     }
     // a static box of density 500 centred at `centre`, let settle for two frames
     ObjectId addStatic(const Vec3& half, const Vec3& centre, const FractureParams& fracture = {}) {
@@ -477,48 +485,48 @@ struct CollapseRig : Rig {
         step(2);
         return id;
     }
-    static DestructionBridge::Config config(bool collapse) {
-        DestructionBridge::Config bc;
-        bc.collapseUnsupported = collapse;
-        bc.minPieceVolume = 0; // every piece keeps its body
-        return bc;
+    static DestructionRuntime::Config config(bool collapse, double debrisKick) {
+        DestructionRuntime::Config rc;
+        rc.support.collapseUnsupported = collapse;
+        rc.adoption.debrisKick = debrisKick;
+        rc.world.minPieceVolume = 0;      // every piece keeps its body
+        rc.debris.freezeSleeping = false; // these tests watch pieces fall and lie; none should freeze early
+        rc.debris.freezeAfterFrames = 1000000;
+        return rc;
     }
     // impact on `id`, steps until adopted; returns the pieces of that fracture
     std::vector<PieceView> breakAt(ObjectId id, const Impact& impact) {
         std::vector<PieceView> out;
-        bridge->setOnAdopted([&](const FractureOutcome& o) {
+        runtime->setOnAdopted([&](const FractureOutcome& o) {
             if (!out.empty())
                 return;
-            EXPECT_EQ(o.pieceCells.size(), o.pieces.size());
-            for (std::size_t i = 0; i < o.pieces.size(); ++i) {
-                Body* b = bridge->bodyOf(o.pieces[i]);
+            for (const AdoptedPiece& p : o.pieces) {
+                const BodyRecord* b = bodyOf(p.id);
                 EXPECT_NE(b, nullptr);
                 if (b)
-                    out.push_back({o.pieces[i], o.pieceCells[i], b->isStatic,
-                                   static_cast<double>(b->rigid->getCenterOfMassPosition().y()), b->volume});
+                    out.push_back({p.id, p.cell, isStatic(*b), runtime->motion(b->id).transform.translation.y,
+                                   b->volume});
             }
         });
-        EXPECT_TRUE(destruction->submitImpact(id, impact));
+        EXPECT_TRUE(world().submitImpact(id, impact));
         EXPECT_TRUE(runUntilFracture());
-        bridge->setOnAdopted({});
+        runtime->setOnAdopted({});
         return out;
     }
-    // throws the debris out at a known velocity (the bridge's own kick, Config::debrisKick, depends on the
-    // hit's impulse and the debris mass): a cut-out chunk left in its gap would hold up what is above
+    // throws the debris out at a known velocity (the runtime's own kick, AdoptionPolicy::debrisKick, depends
+    // on the hit's impulse and the debris mass): a cut-out chunk left in its gap would hold up what is above
     void ejectDebris(const std::vector<PieceView>& pieces, const Vec3& velocity) {
         for (const PieceView& p : pieces)
-            if (Body* b = bridge->bodyOf(p.id); b && p.cell >= 0) {
-                b->rigid->setLinearVelocity(toBt(velocity));
-                b->rigid->activate(true);
-            }
+            if (const BodyRecord* b = bodyOf(p.id); b && p.cell >= 0)
+                binding->setVelocity(b->id, velocity, {});
     }
     double heightOf(ObjectId id) {
-        Body* b = bridge->bodyOf(id);
-        return b ? static_cast<double>(b->rigid->getCenterOfMassPosition().y()) : -1e9;
+        const BodyRecord* b = bodyOf(id);
+        return b ? runtime->motion(b->id).transform.translation.y : -1e9;
     }
     void step(int frames) {
         for (int i = 0; i < frames; ++i)
-            bridge->stepFrame();
+            runtime->stepFrame();
     }
 };
 
@@ -530,15 +538,13 @@ constexpr double kCutY = 2.5;
 
 } // namespace
 
-TEST(DestructionBridgeCollapse, ColumnCutThroughItsMiddleDropsItsTopAndKeepsItsFoot) {
+TEST(BulletRuntimeCollapse, ColumnCutThroughItsMiddleDropsItsTopAndKeepsItsFoot) {
     CollapseRig rig;
     const ObjectId column = rig.addStatic({0.5, 4, 0.5}, {0, 4, 0}, cubeCell(2.4));
-    const double before = rig.bridge->totalVolume();
+    const double before = rig.runtime->volumes().total();
     const auto pieces = rig.breakAt(column, kColumnCut);
     int upper = 0, lower = 0, debris = 0;
-    std::map<ObjectId, double> startY;
     for (const PieceView& p : pieces) {
-        startY[p.id] = p.y;
         if (p.cell >= 0) {
             ++debris;
             EXPECT_FALSE(p.isStatic) << "debris is always dynamic";
@@ -553,7 +559,7 @@ TEST(DestructionBridgeCollapse, ColumnCutThroughItsMiddleDropsItsTopAndKeepsItsF
     EXPECT_GE(debris, 1);
     EXPECT_EQ(upper, 1);
     EXPECT_EQ(lower, 1);
-    EXPECT_GE(rig.bridge->counters().piecesCollapsed, 1);
+    EXPECT_GE(rig.runtime->counters().piecesCollapsed, 1);
     rig.ejectDebris(pieces, {-10, 0, 0});
     rig.step(60);
     for (const PieceView& p : pieces) {
@@ -561,16 +567,16 @@ TEST(DestructionBridgeCollapse, ColumnCutThroughItsMiddleDropsItsTopAndKeepsItsF
             EXPECT_LT(rig.heightOf(p.id), p.y - 0.5);
         }
         if (p.cell < 0 && p.y < kCutY) { // the foot did not move
-            Body* b = rig.bridge->bodyOf(p.id);
+            const BodyRecord* b = rig.bodyOf(p.id);
             ASSERT_NE(b, nullptr);
-            EXPECT_TRUE(b->isStatic);
+            EXPECT_TRUE(isStatic(*b));
             EXPECT_EQ(rig.heightOf(p.id), p.y);
         }
     }
-    EXPECT_LT(std::abs(rig.bridge->totalVolume() - before) / before, 1e-9);
+    EXPECT_LT(std::abs(rig.runtime->volumes().total() - before) / before, 1e-9);
 }
 
-TEST(DestructionBridgeCollapse, WallHitAtItsTopCornerKeepsItsRemainderAndDropsTheDebris) {
+TEST(BulletRuntimeCollapse, WallHitAtItsTopCornerKeepsItsRemainderAndDropsTheDebris) {
     CollapseRig rig;
     const ObjectId wall = rig.addStatic({3, 2, 0.25}, {0, 2, 0}, cubeCell(1.5));
     const auto pieces = rig.breakAt(wall, Impact{{3, 2, 0}, {0.7071, 0.7071, 0}, 100});
@@ -595,11 +601,11 @@ TEST(DestructionBridgeCollapse, WallHitAtItsTopCornerKeepsItsRemainderAndDropsTh
         }
 }
 
-TEST(DestructionBridgeCollapse, FloatingPlatformKeepsItsLargestRemainderPieceStatic) {
+TEST(BulletRuntimeCollapse, FloatingPlatformKeepsItsLargestRemainderPieceStatic) {
     CollapseRig rig;
     // a 6 × 1 × 1 slab 10 m up, touching nothing, cut through off its middle
     const ObjectId slab = rig.addStatic({3, 0.5, 0.5}, {0, 10, 0}, cubeCell(2.4));
-    ASSERT_TRUE(rig.bridge->bodyOf(slab)->anchor) << "a static object touching nothing is an anchor";
+    ASSERT_TRUE(rig.bodyOf(slab)->anchor) << "a static object touching nothing is an anchor";
     const auto pieces = rig.breakAt(slab, Impact{{1, 0.5, 0}, {0, 1, 0}, 100});
     double largest = 0;
     for (const PieceView& p : pieces)
@@ -611,29 +617,29 @@ TEST(DestructionBridgeCollapse, FloatingPlatformKeepsItsLargestRemainderPieceSta
         statics += p.isStatic ? 1 : 0;
         EXPECT_EQ(p.isStatic, p.cell < 0 && p.volume == largest);
         if (p.isStatic) {
-            EXPECT_TRUE(rig.bridge->bodyOf(p.id)->anchor) << "the kept piece is the new anchor";
+            EXPECT_TRUE(rig.bodyOf(p.id)->anchor) << "the kept piece is the new anchor";
         }
     }
     EXPECT_GE(remainders, 2);
     EXPECT_EQ(statics, 1);
-    EXPECT_EQ(rig.bridge->counters().piecesCollapsed, 0);
+    EXPECT_EQ(rig.runtime->counters().piecesCollapsed, 0);
 }
 
-TEST(DestructionBridgeCollapse, CollapsePropagatesToWhatRestedOnTheBrokenPart) {
+TEST(BulletRuntimeCollapse, CollapsePropagatesToWhatRestedOnTheBrokenPart) {
     CollapseRig rig;
     const ObjectId lower = rig.addStatic({0.5, 4, 0.5}, {0, 4, 0}, cubeCell(2.4));
     const ObjectId upper = rig.addStatic({0.75, 0.5, 0.75}, {0, 8.5, 0});
-    EXPECT_FALSE(rig.bridge->bodyOf(upper)->anchor) << "it rests on a column that stands on the ground";
+    EXPECT_FALSE(rig.bodyOf(upper)->anchor) << "it rests on a column that stands on the ground";
     const double y0 = rig.heightOf(upper);
     rig.ejectDebris(rig.breakAt(lower, kColumnCut), {-10, 0, 0});
-    Body* b = rig.bridge->bodyOf(upper);
+    const BodyRecord* b = rig.bodyOf(upper);
     ASSERT_NE(b, nullptr);
-    EXPECT_FALSE(b->isStatic) << "the block on top lost its support with the column's top";
+    EXPECT_FALSE(isStatic(*b)) << "the block on top lost its support with the column's top";
     rig.step(60);
     EXPECT_LT(rig.heightOf(upper), y0 - 0.5);
 }
 
-TEST(DestructionBridgeCollapse, SwitchedOffTheLargestPieceStaysStaticAsBefore) {
+TEST(BulletRuntimeCollapse, SwitchedOffTheLargestPieceStaysStaticAsBefore) {
     CollapseRig rig(false);
     const ObjectId column = rig.addStatic({0.5, 4, 0.5}, {0, 4, 0}, cubeCell(2.4));
     const auto pieces = rig.breakAt(column, kColumnCut);
@@ -649,63 +655,59 @@ TEST(DestructionBridgeCollapse, SwitchedOffTheLargestPieceStaysStaticAsBefore) {
         }
     }
     EXPECT_EQ(statics, 1);
-    EXPECT_EQ(rig.bridge->counters().piecesCollapsed, 0);
+    EXPECT_EQ(rig.runtime->counters().piecesCollapsed, 0);
 }
 
-// Dynamic pieces keep their triangles under Config::maxLivePieceTriangles: the smallest retire to particles
-// (their volume counted as retired), so the meshes the bridge keeps alive stay bounded.
-TEST(DestructionBridge, DynamicPieceTrianglesStayWithinTheBudget) {
-    DestructionBridge::Config bc;
-    bc.maxLivePieceTriangles = 150;
-    Rig rig(true, 1, true, bc);
-    rig.bridge->addGround({0, -0.5, 0}, {50, 0.5, 50});
+// Debris keeps its triangles under DebrisBudget::maxTriangles: the smallest pieces become particles (their
+// volume counted as retired), so the meshes the runtime keeps alive stay bounded.
+TEST(BulletRuntime, DebrisTrianglesStayWithinTheBudget) {
+    DestructionRuntime::Config rc;
+    rc.debris.maxTriangles = 150;
+    Rig rig(true, 1, true, rc);
+    rig.runtime->addGround({0, -0.5, 0}, {50, 0.5, 50});
     rig.addBox({0.5, 1.5, 0.5}, Frame{Mat3::identity(), {4, 1.5, 0}}, 300);
     rig.addBox({1.5, 0.5, 0.5}, Frame{Mat3::identity(), {-4, 0.5, 1}}, 300);
-    const double start = rig.bridge->totalVolume();
+    const double start = rig.runtime->volumes().total();
     Rng rng(5);
     std::size_t most = 0;
     for (int f = 0; f < 180; ++f) {
         if (f % 6 == 0) {
             const Vec3 target{rng.uniform(-4.5, 4.5), rng.uniform(0.2, 1.5), rng.uniform(-0.3, 0.5)};
-            rig.bridge->fireProjectile(target + Vec3{0, 3, 15}, Vec3{0, -3, -15} * 8, 2, 0.15);
+            rig.runtime->fireProjectile(target + Vec3{0, 3, 15}, Vec3{0, -3, -15} * 8, 2, 0.15);
         }
-        rig.bridge->stepFrame();
-        ASSERT_LE(rig.bridge->livePieceTriangles(), bc.maxLivePieceTriangles) << "frame " << f;
-        most = std::max(most, rig.bridge->livePieceTriangles());
+        rig.runtime->stepFrame();
+        ASSERT_LE(rig.runtime->debrisTriangles(), rc.debris.maxTriangles) << "frame " << f;
+        most = std::max(most, rig.runtime->debrisTriangles());
     }
-    EXPECT_GT(rig.bridge->counters().fractures, 2);
-    EXPECT_GT(rig.bridge->counters().piecesRetired, 0);
+    EXPECT_GT(rig.runtime->counters().fractures, 2);
+    EXPECT_GT(rig.runtime->counters().piecesRetired, 0);
     EXPECT_GT(most, 0u);
-    EXPECT_NEAR(rig.bridge->totalVolume(), start, 1e-6 * start);
+    EXPECT_NEAR(rig.runtime->volumes().total(), start, 1e-6 * start);
 }
 
 // The hit throws a static wall's debris outward (along the surface normal, away from the impact), at one
 // speed for all debris of the hit, bounded; with the kick off the debris starts at rest like the wall.
-TEST(DestructionBridgeCollapse, DebrisOfAStaticWallIsThrownOutward) {
+TEST(BulletRuntimeCollapse, DebrisOfAStaticWallIsThrownOutward) {
     for (const double share : {0.5, 0.0}) {
-        CollapseRig rig;
-        DestructionBridge::Config bc = CollapseRig::config(true);
-        bc.debrisKick = share;
-        rig.bridge = std::make_unique<DestructionBridge>(*rig.physics, *rig.destruction, bc);
-        rig.bridge->addGround({0, -0.5, 0}, {50, 0.5, 50});
+        CollapseRig rig(true, share);
         const ObjectId wall = rig.addStatic({3, 2, 0.25}, {0, 2, 0}, cubeCell(1.0));
-        std::vector<btVector3> velocities;
-        rig.bridge->setOnAdopted([&](const FractureOutcome& o) {
-            for (std::size_t i = 0; i < o.pieces.size(); ++i)
-                if (o.pieceCells[i] >= 0)
-                    if (Body* b = rig.bridge->bodyOf(o.pieces[i]); b && !b->isStatic)
-                        velocities.push_back(b->rigid->getLinearVelocity());
+        std::vector<Vec3> velocities;
+        rig.runtime->setOnAdopted([&](const FractureOutcome& o) {
+            for (const AdoptedPiece& p : o.pieces)
+                if (p.cell >= 0)
+                    if (const BodyRecord* b = rig.bodyOf(p.id); b && !isStatic(*b))
+                        velocities.push_back(rig.runtime->motion(b->id).linearVelocity);
         });
-        ASSERT_TRUE(rig.destruction->submitImpact(wall, Impact{{0, 0, 0.25}, {0, 0, 1}, 200}));
+        ASSERT_TRUE(rig.world().submitImpact(wall, Impact{{0, 0, 0.25}, {0, 0, 1}, 200}));
         ASSERT_TRUE(rig.runUntilFracture());
         ASSERT_FALSE(velocities.empty());
-        for (const btVector3& v : velocities) {
+        for (const Vec3& v : velocities) {
             if (share > 0) {
-                EXPECT_GT(v.z(), 0.1) << "outward, along the wall's normal";
-                EXPECT_LE(v.length(), bc.maxDebrisKickSpeed + 1e-9);
-                EXPECT_NEAR(v.length(), velocities.front().length(), 1e-6) << "one speed per hit";
+                EXPECT_GT(v.z, 0.1) << "outward, along the wall's normal";
+                EXPECT_LE(length(v), rig.runtime->config().adoption.maxDebrisKickSpeed + 1e-5);
+                EXPECT_NEAR(length(v), length(velocities.front()), 1e-5) << "one speed per hit";
             } else {
-                EXPECT_LT(v.length(), 1e-9);
+                EXPECT_LT(length(v), 1e-9);
             }
         }
     }

@@ -1,0 +1,177 @@
+#include "runtime/DebrisGovernor.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+namespace rubble::detail {
+namespace {
+
+constexpr double kCellSize = 4.0; // m: frozen pieces are small, so a body's neighbourhood is a few cells
+
+std::int64_t cellCoord(double x) {
+    return static_cast<std::int64_t>(std::floor(x / kCellSize));
+}
+
+std::uint64_t packCell(std::int64_t x, std::int64_t y, std::int64_t z) {
+    auto b = [](std::int64_t v) { return static_cast<std::uint64_t>(v & 0x1FFFFF); };
+    return b(x) | (b(y) << 21) | (b(z) << 42);
+}
+
+} // namespace
+
+std::vector<DebrisGovernor::Cell> DebrisGovernor::cellsOf(const Vec3& lo, const Vec3& hi) const {
+    std::vector<Cell> out;
+    const std::int64_t x0 = cellCoord(lo.x), x1 = cellCoord(hi.x);
+    const std::int64_t y0 = cellCoord(lo.y), y1 = cellCoord(hi.y);
+    const std::int64_t z0 = cellCoord(lo.z), z1 = cellCoord(hi.z);
+    if ((x1 - x0 + 1) * (y1 - y0 + 1) * (z1 - z0 + 1) > 4096) // a huge box: every frozen body is near
+        return {};
+    for (std::int64_t x = x0; x <= x1; ++x)
+        for (std::int64_t y = y0; y <= y1; ++y)
+            for (std::int64_t z = z0; z <= z1; ++z)
+                out.push_back(packCell(x, y, z));
+    return out;
+}
+
+void DebrisGovernor::frozen(BodyId id, const Vec3& center, double radius) {
+    thawed(id);
+    frozen_[id] = {center, radius};
+    const Vec3 r{radius, radius, radius};
+    for (Cell c : cellsOf(center - r, center + r))
+        grid_[c].push_back(id);
+}
+
+void DebrisGovernor::thawed(BodyId id) {
+    restFrames_.erase(id);
+    auto it = frozen_.find(id);
+    if (it == frozen_.end())
+        return;
+    const Vec3 r{it->second.radius, it->second.radius, it->second.radius};
+    for (Cell c : cellsOf(it->second.center - r, it->second.center + r)) {
+        auto g = grid_.find(c);
+        if (g == grid_.end())
+            continue;
+        std::erase(g->second, id);
+        if (g->second.empty())
+            grid_.erase(g);
+    }
+    frozen_.erase(it);
+}
+
+void DebrisGovernor::wakeNear(const Aabb& box, double margin) {
+    if (box.empty() || frozen_.empty())
+        return;
+    const Vec3 m{margin, margin, margin};
+    const Vec3 lo = box.lo - m, hi = box.hi + m;
+    auto near = [&](BodyId id) {
+        const FrozenEntry& e = frozen_.at(id);
+        for (int k = 0; k < 3; ++k)
+            if (e.center[k] + e.radius < lo[k] || e.center[k] - e.radius > hi[k])
+                return false;
+        return true;
+    };
+    const std::vector<Cell> cells = cellsOf(lo, hi);
+    if (cells.empty() && !box.empty()) { // a huge box
+        for (const auto& [id, e] : frozen_)
+            if (near(id))
+                toWake_.push_back(id);
+        return;
+    }
+    for (Cell c : cells)
+        if (auto g = grid_.find(c); g != grid_.end())
+            for (BodyId id : g->second)
+                if (near(id))
+                    toWake_.push_back(id);
+}
+
+GovernorActions DebrisGovernor::update(const BodyTable& bodies, const PhysicsBinding& binding,
+                                       const std::map<BodyId, double>& frozenHits, double physicsMs,
+                                       bool deterministic, const Vec3& focus) {
+    GovernorActions out;
+    std::set<BodyId> woken;
+    for (const auto& [id, impulse] : frozenHits)
+        if (impulse >= budget_.wakeImpulse)
+            woken.insert(id);
+    woken.insert(toWake_.begin(), toWake_.end());
+    toWake_.clear();
+    for (BodyId id : woken)
+        if (const BodyRecord* r = bodies.find(id); r && r->motion == BodyMotionState::Frozen)
+            out.wake.push_back(id);
+
+    std::set<BodyId> leaving;
+    std::vector<std::pair<double, BodyId>> stillAwake;
+    for (BodyId id : bodies.awakeIds()) {
+        const BodyRecord& r = *bodies.find(id);
+        const BodyMotion m = binding.motion(id);
+        const Vec3 p = m.transform.translation;
+        if (p.y < budget_.killBelowY) {
+            out.retire.push_back({id, RetireReason::FellOut});
+            leaving.insert(id);
+            continue;
+        }
+        if (r.volume < budget_.fadeVolume && length(p - focus) > budget_.fadeDistance) {
+            out.retire.push_back({id, RetireReason::Fade});
+            leaving.insert(id);
+            continue;
+        }
+        const bool resting =
+            length(m.linearVelocity) < budget_.freezeSpeed && length(m.angularVelocity) < budget_.freezeSpeed;
+        int& rest = restFrames_[id];
+        rest = resting ? rest + 1 : 0;
+        if ((budget_.freezeSleeping && m.sleeping) || rest >= std::max(1, budget_.freezeAfterFrames)) {
+            out.freeze.push_back(id);
+            leaving.insert(id);
+            continue;
+        }
+        stillAwake.push_back({r.volume, id});
+    }
+
+    if (!deterministic && budget_.physicsBudgetMs > 0) { // shrink fast, grow back slowly
+        int b = awakeBudget();
+        if (physicsMs > budget_.physicsBudgetMs)
+            b = std::min(b, static_cast<int>(0.9 * static_cast<double>(bodies.awake())));
+        else if (physicsMs < 0.7 * budget_.physicsBudgetMs)
+            b += std::max(1, b / 50);
+        awakeBudget_ = std::clamp(b, std::min(32, budget_.maxAwakeBodies), budget_.maxAwakeBodies);
+    } else {
+        awakeBudget_ = -1;
+    }
+    const int excess = static_cast<int>(stillAwake.size() + out.wake.size()) - awakeBudget();
+    if (excess > 0) {
+        std::sort(stillAwake.begin(), stillAwake.end());
+        for (int i = 0; i < excess && i < static_cast<int>(stillAwake.size()); ++i) {
+            out.retire.push_back({stillAwake[i].second, RetireReason::Budget});
+            leaving.insert(stillAwake[i].second);
+        }
+    }
+
+    std::size_t triangles = bodies.debrisTriangles();
+    for (BodyId id : leaving)
+        if (std::any_of(out.retire.begin(), out.retire.end(), [&](const auto& r) { return r.first == id; }))
+            triangles -= std::min(triangles, bodies.find(id)->triangles);
+    if (triangles > budget_.maxTriangles) { // the smallest frozen pieces first, then the smallest awake
+        std::vector<std::pair<double, BodyId>> candidates;
+        for (BodyId id : bodies.frozenIds())
+            if (!woken.count(id))
+                candidates.push_back({bodies.find(id)->volume, id});
+        std::sort(candidates.begin(), candidates.end());
+        std::vector<std::pair<double, BodyId>> awake;
+        for (const auto& [v, id] : stillAwake)
+            if (!leaving.count(id))
+                awake.push_back({v, id});
+        std::sort(awake.begin(), awake.end());
+        candidates.insert(candidates.end(), awake.begin(), awake.end());
+        for (const auto& [v, id] : candidates) {
+            if (triangles <= budget_.maxTriangles)
+                break;
+            triangles -= std::min(triangles, bodies.find(id)->triangles);
+            out.retire.push_back({id, RetireReason::Budget});
+        }
+    }
+    for (BodyId id : leaving)
+        restFrames_.erase(id);
+    return out;
+}
+
+} // namespace rubble::detail

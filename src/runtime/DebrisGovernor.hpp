@@ -1,0 +1,63 @@
+#pragma once
+// Keeps debris affordable (DebrisBudget): freezes resting pieces, wakes them when hit or when what they rest
+// on goes, and turns the smallest into particles when a budget is exceeded.
+
+#include <cstdint>
+#include <map>
+#include <unordered_map>
+#include <vector>
+
+#include "rubble/DestructionRuntime.hpp"
+#include "runtime/BodyTable.hpp"
+
+namespace rubble::detail {
+
+/// Why a debris body leaves the simulation.
+enum class RetireReason { Budget, Fade, FellOut };
+
+/// What the governor decided for one frame, in a deterministic order.
+struct GovernorActions {
+    std::vector<BodyId> freeze;                          ///< make static
+    std::vector<BodyId> wake;                            ///< make dynamic again
+    std::vector<std::pair<BodyId, RetireReason>> retire; ///< turn into particles
+};
+
+/// The debris governor. Frozen bodies are kept in a grid so that the ones near a body that moves away or
+/// breaks can be woken.
+class DebrisGovernor {
+public:
+    /// Reads the budget at every call.
+    explicit DebrisGovernor(const DebrisBudget& budget) : budget_(budget) {}
+
+    /// The frame's decisions. frozenHits: strongest contact impulse on frozen bodies this frame; physicsMs:
+    /// this frame's physics step (ignored when deterministic).
+    GovernorActions update(const BodyTable& bodies, const PhysicsBinding& binding,
+                           const std::map<BodyId, double>& frozenHits, double physicsMs, bool deterministic,
+                           const Vec3& focus);
+    /// A body was frozen at center with the given bounding radius.
+    void frozen(BodyId id, const Vec3& center, double radius);
+    /// A body stopped being frozen (woken or removed).
+    void thawed(BodyId id);
+    /// Frozen bodies whose bounds come within `margin` of the box (they lose what they rest on when a body
+    /// there moves or breaks); they are woken at the next update.
+    void wakeNear(const Aabb& box, double margin);
+    /// The awake budget in force.
+    int awakeBudget() const { return awakeBudget_ < 0 ? budget_.maxAwakeBodies : awakeBudget_; }
+
+private:
+    using Cell = std::uint64_t;
+    struct FrozenEntry {
+        Vec3 center;
+        double radius = 0;
+    };
+    std::vector<Cell> cellsOf(const Vec3& lo, const Vec3& hi) const;
+
+    const DebrisBudget& budget_;
+    std::unordered_map<BodyId, int> restFrames_;
+    std::map<BodyId, FrozenEntry> frozen_;
+    std::unordered_map<Cell, std::vector<BodyId>> grid_;
+    std::vector<BodyId> toWake_;
+    int awakeBudget_ = -1; // < 0: the configured maximum
+};
+
+} // namespace rubble::detail

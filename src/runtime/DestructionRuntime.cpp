@@ -1,0 +1,570 @@
+#include "rubble/DestructionRuntime.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <chrono>
+#include <cmath>
+#include <set>
+
+#include "runtime/BodyTable.hpp"
+#include "runtime/DebrisGovernor.hpp"
+#include "runtime/ImpactCollector.hpp"
+#include "runtime/PieceAdopter.hpp"
+#include "runtime/SupportGraph.hpp"
+
+namespace rubble {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double msSince(Clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+std::uint64_t mix(std::uint64_t h, std::uint64_t v) {
+    h ^= v + 0x9E3779B97F4A7C15ull + (h << 6) + (h >> 2);
+    return h * 0x100000001B3ull;
+}
+
+// Distance of the farthest mesh vertex from the body origin.
+double boundingRadius(const Mesh& mesh, const Frame& objectToBody) {
+    double r2 = 0;
+    for (const Vec3& p : mesh.positions)
+        r2 = std::max(r2, lengthSquared(p - objectToBody.translation));
+    return std::sqrt(r2);
+}
+
+std::vector<ConvexPolytope> worldParts(const ObjectState& st, const Frame& objectToWorld) {
+    std::vector<ConvexPolytope> out;
+    for (const ConvexPolytope& p : st.convexParts)
+        out.push_back(p.transformed(objectToWorld));
+    if (out.empty())
+        out.push_back(ConvexPolytope::fromAabb(st.mesh.bounds()).transformed(objectToWorld));
+    return out;
+}
+
+} // namespace
+
+struct DestructionRuntime::Impl {
+    Impl(PhysicsBinding& b, const Config& c)
+        : binding(b), config(c), world(c.world), collector(config.impacts), support(config.support),
+          governor(config.debris) {}
+
+    PhysicsBinding& binding;
+    Config config;
+    DestructionWorld world;
+    detail::BodyTable bodies;
+    detail::ImpactCollector collector;
+    detail::SupportGraph support;
+    detail::DebrisGovernor governor;
+    std::set<BodyId> projectiles;
+    std::vector<DebrisParticle> particles;
+    std::deque<ImpactMark> marks;
+    RuntimeCounters counters;
+    VolumeLedger ledger; // live is computed on demand
+    BodyId nextId = 1;
+    Vec3 focus;
+    int searchesLeft = 0;
+    std::vector<ContactReport> contacts;
+    std::function<void(const FractureOutcome&)> onAdopted;
+    std::function<void(const BodyRecord&)> onRemoved;
+
+    bool deterministic() const { return config.world.deterministic; }
+
+    BodyRecord& insert(BodyRecord rec, const BodyDesc& desc) {
+        rec.id = nextId++;
+        rec.bornFrame = counters.frames;
+        binding.createBody(rec.id, desc);
+        if (rec.role == BodyRole::Projectile)
+            projectiles.insert(rec.id);
+        return bodies.insert(rec);
+    }
+
+    Aabb boundsOf(const BodyRecord& r) const {
+        const Vec3 c = binding.motion(r.id).transform.translation;
+        const Vec3 e{r.radius, r.radius, r.radius};
+        return Aabb{c - e, c + e};
+    }
+
+    // Removes a body; what rested on it is re-checked (support) or woken (frozen debris).
+    void destroy(BodyId id, bool removeObject) {
+        BodyRecord* r = bodies.find(id);
+        if (!r)
+            return;
+        if (onRemoved)
+            onRemoved(*r);
+        if (r->role != BodyRole::Projectile)
+            governor.wakeNear(boundsOf(*r), config.support.tolerance);
+        support.remove(id);
+        governor.thawed(id);
+        projectiles.erase(id);
+        binding.removeBody(id);
+        if (r->hasObject && removeObject)
+            world.removeObject(r->object);
+        bodies.erase(id);
+    }
+
+    void retire(BodyId id, FrameStats& stats) {
+        const BodyRecord* r = bodies.find(id);
+        if (!r)
+            return;
+        const BodyMotion m = binding.motion(id);
+        particles.push_back({m.transform.translation, m.linearVelocity, std::cbrt(r->volume), r->volume,
+                             config.debris.particleLifetime});
+        ledger.retired += r->volume;
+        ++stats.piecesRetired;
+        ++counters.piecesRetired;
+        destroy(id, true);
+    }
+
+    void makeDynamic(BodyId id) {
+        BodyRecord* r = bodies.find(id);
+        if (!r || r->motion == BodyMotionState::Dynamic)
+            return;
+        support.remove(id);
+        governor.thawed(id);
+        governor.wakeNear(boundsOf(*r), config.support.tolerance);
+        r->structural = false;
+        r->anchor = false;
+        binding.setMass(id, r->mass, r->inertia);
+        bodies.setMotion(*r, BodyMotionState::Dynamic);
+    }
+
+    void freeze(BodyId id) {
+        BodyRecord* r = bodies.find(id);
+        if (!r || r->motion != BodyMotionState::Dynamic)
+            return;
+        binding.setMass(id, 0, {});
+        bodies.setMotion(*r, BodyMotionState::Frozen);
+        governor.frozen(id, binding.motion(id).transform.translation, r->radius);
+    }
+
+    void submit(const detail::PendingImpact& p, FrameStats& stats) {
+        if (!world.submitImpact(p.object, p.impact))
+            return;
+        ++stats.impactsSubmitted;
+        ++counters.impacts;
+        marks.push_back({p.worldPoint, p.worldNormal, p.impact.impulse});
+        while (static_cast<int>(marks.size()) > config.impacts.maxImpactMarks)
+            marks.pop_front();
+    }
+
+    void adopt(const FractureOutcome& outcome, FrameStats& stats) {
+        ledger.dropped += outcome.droppedVolume;
+        ledger.dust += outcome.dustVolume();
+        const BodyRecord* parentPtr = bodies.findObject(outcome.parent);
+        if (!parentPtr) { // no body to replace: the pieces cannot be placed; their volume counts as retired
+            ++counters.staleOutcomes;
+            for (const AdoptedPiece& p : outcome.pieces) {
+                ledger.retired += std::abs(p.state->mass.volume);
+                world.removeObject(p.id);
+            }
+            return;
+        }
+        const BodyRecord parent = *parentPtr;
+        const BodyMotion parentMotion = binding.motion(parent.id);
+        const bool collapse = config.support.collapseUnsupported;
+        detail::AdoptionPlan plan = detail::planAdoption(outcome, parent, parentMotion, config.adoption,
+                                                         collapse, config.debris.particleLifetime);
+        destroy(parent.id, false); // the DestructionWorld removed the parent object already
+        ++stats.fractures;
+        ++counters.fractures;
+        for (std::size_t i = 0; i < plan.spawns.size(); ++i) {
+            const detail::PieceSpawn& s = plan.spawns[i];
+            const ObjectState& st = *outcome.pieces[i].state;
+            BodyRecord rec;
+            rec.role = BodyRole::Piece;
+            rec.motion = s.isStatic ? BodyMotionState::Static : BodyMotionState::Dynamic;
+            rec.hasObject = true;
+            rec.object = s.object;
+            rec.objectToBody = s.objectToBody;
+            rec.volume = s.volume;
+            rec.mass = s.mass;
+            rec.inertia = s.inertia;
+            rec.triangles = s.triangles;
+            rec.radius = boundingRadius(st.mesh, s.objectToBody);
+            rec.anchor = s.anchor;
+            rec.structural = s.structural;
+            const BodyRecord& made = insert(rec, s.desc);
+            if (s.structural) {
+                support.add(made.id, worldParts(st, s.desc.transform * s.objectToBody.inverse()), s.anchor);
+                support.queue(made.id);
+            }
+            ++stats.piecesCreated;
+            ++counters.piecesCreated;
+        }
+        stats.piecesRetired += static_cast<int>(plan.particles.size());
+        counters.piecesRetired += static_cast<long long>(plan.particles.size());
+        particles.insert(particles.end(), plan.particles.begin(), plan.particles.end());
+        settleSupport(stats);          // before the callback, so that it sees the pieces' final motion
+        world.finishAdoption(outcome); // the pieces' bodies exist: the impact's timing record ends here
+        if (onAdopted)
+            onAdopted(outcome);
+    }
+
+    void settleSupport(FrameStats& stats) {
+        if (!config.support.collapseUnsupported) {
+            int none = 0;
+            (void)support.settle(none);
+            return;
+        }
+        const auto t0 = Clock::now();
+        for (;;) {
+            const int before = searchesLeft;
+            const std::vector<BodyId> fallen = support.settle(searchesLeft);
+            stats.supportSearches += before - searchesLeft;
+            for (BodyId id : fallen) {
+                makeDynamic(id);
+                ++stats.piecesCollapsed;
+                ++counters.piecesCollapsed;
+            }
+            if (fallen.empty() || searchesLeft <= 0)
+                break;
+        }
+        stats.supportMs += msSince(t0);
+    }
+
+    void adoptResults(FrameStats& stats) {
+        for (const FractureOutcome& o : world.collect())
+            adopt(o, stats);
+        settleSupport(stats);
+    }
+
+    void govern(const std::map<BodyId, double>& frozenHits, FrameStats& stats) {
+        const detail::GovernorActions a =
+            governor.update(bodies, binding, frozenHits, stats.physicsMs, deterministic(), focus);
+        for (BodyId id : a.wake) {
+            makeDynamic(id);
+            ++stats.piecesWoken;
+            ++counters.piecesWoken;
+        }
+        for (BodyId id : a.freeze) {
+            freeze(id);
+            ++stats.piecesFrozen;
+            ++counters.piecesFrozen;
+        }
+        for (const auto& [id, reason] : a.retire)
+            retire(id, stats);
+    }
+
+    void advance(double dt) {
+        const Vec3 g = binding.gravity();
+        for (DebrisParticle& p : particles) {
+            p.velocity += g * dt;
+            p.position += p.velocity * dt;
+            p.lifetime -= dt;
+        }
+        std::erase_if(particles, [](const DebrisParticle& p) { return p.lifetime <= 0; });
+        std::vector<BodyId> expired;
+        for (BodyId id : projectiles) {
+            BodyRecord& b = *bodies.find(id);
+            b.age += dt;
+            if (b.spent)
+                b.spentAge += dt;
+            if (b.age > config.projectileLifetime || b.spentAge > config.spentProjectileLifetime ||
+                binding.motion(id).transform.translation.y < config.debris.killBelowY)
+                expired.push_back(id);
+        }
+        for (BodyId id : expired)
+            destroy(id, false);
+    }
+};
+
+DestructionRuntime::DestructionRuntime(PhysicsBinding& binding, Config config)
+    : impl_(std::make_unique<Impl>(binding, config)) {}
+
+DestructionRuntime::~DestructionRuntime() {
+    for (const auto& [id, r] : impl_->bodies.all())
+        impl_->binding.removeBody(id);
+}
+
+DestructionWorld& DestructionRuntime::world() {
+    return impl_->world;
+}
+
+const DestructionWorld& DestructionRuntime::world() const {
+    return impl_->world;
+}
+
+PhysicsBinding& DestructionRuntime::binding() {
+    return impl_->binding;
+}
+
+DestructionRuntime::Config& DestructionRuntime::config() {
+    return impl_->config;
+}
+
+BodyId DestructionRuntime::addGround(const Vec3& center, const Vec3& halfExtents) {
+    BodyDesc desc;
+    desc.shape.kind = BodyShape::Kind::Box;
+    desc.shape.halfExtents = halfExtents;
+    desc.transform.translation = center;
+    desc.friction = 0.8;
+    BodyRecord rec;
+    rec.role = BodyRole::Ground;
+    rec.motion = BodyMotionState::Static;
+    rec.structural = true;
+    rec.radius = length(halfExtents);
+    const BodyId id = impl_->insert(rec, desc).id;
+    impl_->support.add(id, {ConvexPolytope::fromAabb(Aabb{center - halfExtents, center + halfExtents})},
+                       true);
+    return id;
+}
+
+Result<ObjectId> DestructionRuntime::addObject(ObjectDesc desc, const Frame& placement, bool isStatic) {
+    Impl& im = *impl_;
+    Result<ObjectId> id = im.world.addObject(std::move(desc));
+    if (!id)
+        return id;
+    const ObjectState& st = *im.world.object(*id);
+    detail::PieceSpawn s = detail::describeObjectBody(st, isStatic, 0);
+    s.desc.transform = placement * s.objectToBody;
+    BodyRecord rec;
+    rec.role = BodyRole::Object;
+    rec.motion = isStatic ? BodyMotionState::Static : BodyMotionState::Dynamic;
+    rec.hasObject = true;
+    rec.object = *id;
+    rec.objectToBody = s.objectToBody;
+    rec.volume = s.volume;
+    rec.mass = s.mass;
+    rec.inertia = s.inertia;
+    rec.triangles = s.triangles;
+    rec.radius = boundingRadius(st.mesh, s.objectToBody);
+    rec.structural = isStatic;
+    const BodyId body = im.insert(rec, s.desc).id;
+    if (isStatic)
+        im.support.add(body, worldParts(st, placement), false, true);
+    return id;
+}
+
+Result<BodyId> DestructionRuntime::addConvexBody(const std::vector<Vec3>& points, const Frame& placement,
+                                                 double mass, bool neverSleeps) {
+    if (points.size() < 4)
+        return Error{ErrorCode::InvalidInput, "a convex body needs at least 4 points"};
+    Aabb box;
+    for (const Vec3& p : points)
+        box.extend(p);
+    const Vec3 s = box.size();
+    if (!(s.x > 0 && s.y > 0 && s.z > 0))
+        return Error{ErrorCode::InvalidInput, "points span no volume"};
+    const Vec3 centre = box.center();
+    BodyDesc desc;
+    double r2 = 0;
+    for (const Vec3& p : points) {
+        desc.shape.points.push_back(p - centre);
+        r2 = std::max(r2, lengthSquared(p - centre));
+    }
+    desc.transform = placement * Frame{Mat3::identity(), centre};
+    desc.mass = std::max(mass, 0.0);
+    desc.inertia =
+        Vec3{s.y * s.y + s.z * s.z, s.x * s.x + s.z * s.z, s.x * s.x + s.y * s.y} * (desc.mass / 12);
+    desc.neverSleeps = neverSleeps;
+    BodyRecord rec;
+    rec.role = BodyRole::Scenery;
+    rec.motion = mass > 0 ? BodyMotionState::Dynamic : BodyMotionState::Static;
+    rec.objectToBody = Frame{Mat3::identity(), centre};
+    rec.volume = s.x * s.y * s.z;
+    rec.mass = desc.mass;
+    rec.inertia = desc.inertia;
+    rec.radius = std::sqrt(r2);
+    rec.structural = mass <= 0;
+    const BodyId id = impl_->insert(rec, desc).id;
+    if (mass <= 0)
+        impl_->support.add(id, {ConvexPolytope::fromAabb(box).transformed(placement)}, true);
+    return id;
+}
+
+BodyId DestructionRuntime::fireProjectile(const Vec3& from, const Vec3& velocity, double mass,
+                                          double radius) {
+    BodyDesc desc;
+    desc.shape.kind = BodyShape::Kind::Sphere;
+    desc.shape.radius = radius;
+    desc.transform.translation = from;
+    desc.mass = mass;
+    const double moment = 0.4 * mass * radius * radius;
+    desc.inertia = Vec3{moment, moment, moment};
+    desc.linearVelocity = velocity;
+    desc.continuous = true;
+    desc.neverSleeps = true;
+    BodyRecord rec;
+    rec.role = BodyRole::Projectile;
+    rec.motion = BodyMotionState::Dynamic;
+    rec.mass = mass;
+    rec.inertia = desc.inertia;
+    rec.volume = 4.0 / 3.0 * 3.14159265358979 * radius * radius * radius;
+    rec.radius = radius;
+    return impl_->insert(rec, desc).id;
+}
+
+void DestructionRuntime::removeBody(BodyId id) {
+    impl_->destroy(id, true);
+}
+
+bool DestructionRuntime::submitImpact(BodyId id, const Vec3& worldPoint, const Vec3& worldNormal,
+                                      double impulse) {
+    Impl& im = *impl_;
+    const BodyRecord* r = im.bodies.find(id);
+    if (!r || !r->hasObject)
+        return false;
+    const Frame f = im.binding.motion(id).transform * r->objectToBody.inverse();
+    detail::PendingImpact p;
+    p.body = id;
+    p.object = r->object;
+    p.impact.point = f.applyInverse(worldPoint);
+    p.impact.normal = f.rotation.transposed() * worldNormal;
+    p.impact.impulse = impulse;
+    p.worldPoint = worldPoint;
+    p.worldNormal = worldNormal;
+    FrameStats ignored;
+    const long long before = im.counters.impacts;
+    im.submit(p, ignored);
+    return im.counters.impacts > before;
+}
+
+FrameStats DestructionRuntime::stepFrame(double dt) {
+    Impl& im = *impl_;
+    FrameStats stats;
+    const auto t0 = Clock::now();
+    im.contacts.clear();
+    stats.substeps = im.binding.step(dt, im.contacts);
+    stats.physicsMs = msSince(t0);
+    const auto t1 = Clock::now();
+    ++im.counters.frames;
+    im.searchesLeft = im.config.support.maxSearchesPerFrame;
+    im.collector.gather(im.contacts, im.bodies, im.world, im.binding, im.counters.frames);
+    const detail::ImpactBatch batch = im.collector.take();
+    stats.projectileHits = batch.projectileHits;
+    im.counters.projectileHits += batch.projectileHits;
+    for (const detail::PendingImpact& p : batch.impacts)
+        im.submit(p, stats);
+    im.world.beginFrame();
+    const auto t2 = Clock::now();
+    for (BodyId a : im.support.classify())
+        if (BodyRecord* r = im.bodies.find(a))
+            r->anchor = true;
+    stats.supportMs += msSince(t2);
+    im.adoptResults(stats);
+    im.govern(batch.frozenHits, stats);
+    im.settleSupport(stats);
+    im.advance(dt);
+    stats.adoptMs = msSince(t1);
+    return stats;
+}
+
+FrameStats DestructionRuntime::adoptReady() {
+    FrameStats stats;
+    const auto t0 = Clock::now();
+    if (!impl_->world.waitForResult(t0)) // nothing ready, or deterministic: adoption is frame-bound
+        return stats;
+    impl_->adoptResults(stats);
+    stats.adoptMs = msSince(t0);
+    return stats;
+}
+
+const BodyRecord* DestructionRuntime::body(BodyId id) const {
+    return impl_->bodies.find(id);
+}
+
+const BodyRecord* DestructionRuntime::bodyOf(ObjectId id) const {
+    return impl_->bodies.findObject(id);
+}
+
+std::vector<BodyId> DestructionRuntime::bodies() const {
+    std::vector<BodyId> out;
+    out.reserve(impl_->bodies.all().size());
+    for (const auto& [id, r] : impl_->bodies.all())
+        out.push_back(id);
+    return out;
+}
+
+BodyMotion DestructionRuntime::motion(BodyId id) const {
+    return impl_->binding.motion(id);
+}
+
+std::size_t DestructionRuntime::bodyCount() const {
+    return impl_->bodies.all().size();
+}
+
+int DestructionRuntime::livePieces() const {
+    return impl_->bodies.pieces();
+}
+
+int DestructionRuntime::awakeDebris() const {
+    return impl_->bodies.awake();
+}
+
+int DestructionRuntime::frozenDebris() const {
+    return impl_->bodies.frozen();
+}
+
+std::size_t DestructionRuntime::debrisTriangles() const {
+    return impl_->bodies.debrisTriangles();
+}
+
+int DestructionRuntime::awakeBudget() const {
+    return impl_->governor.awakeBudget();
+}
+
+const std::vector<DebrisParticle>& DestructionRuntime::particles() const {
+    return impl_->particles;
+}
+
+const std::deque<ImpactMark>& DestructionRuntime::recentImpacts() const {
+    return impl_->marks;
+}
+
+const RuntimeCounters& DestructionRuntime::counters() const {
+    return impl_->counters;
+}
+
+VolumeLedger DestructionRuntime::volumes() const {
+    VolumeLedger v = impl_->ledger;
+    v.live = 0;
+    for (const auto& [id, r] : impl_->bodies.all())
+        if (r.hasObject)
+            v.live += r.volume;
+    return v;
+}
+
+std::vector<BodyId> DestructionRuntime::supportNeighbours(BodyId id) const {
+    return impl_->support.neighbours(id);
+}
+
+void DestructionRuntime::setFocus(const Vec3& point) {
+    impl_->focus = point;
+}
+
+std::uint64_t DestructionRuntime::stateHash() const {
+    std::uint64_t h = 0xCBF29CE484222325ull;
+    for (const auto& [id, r] : impl_->bodies.all()) {
+        if (!r.hasObject)
+            continue;
+        h = mix(h, id);
+        h = mix(h, r.object);
+        h = mix(h, static_cast<std::uint64_t>(r.motion));
+        if (const ObjectState* st = impl_->world.object(r.object)) {
+            h = mix(h, st->version);
+            h = mix(h, st->mesh.hash());
+        }
+        const Frame t = impl_->binding.motion(id).transform;
+        for (int i = 0; i < 3; ++i) {
+            h = mix(h, std::bit_cast<std::uint64_t>(t.translation[i]));
+            for (int j = 0; j < 3; ++j)
+                h = mix(h, std::bit_cast<std::uint64_t>(t.rotation.m[i][j]));
+        }
+    }
+    const VolumeLedger& v = impl_->ledger;
+    for (double x : {v.retired, v.dust, v.dropped})
+        h = mix(h, std::bit_cast<std::uint64_t>(x));
+    return h;
+}
+
+void DestructionRuntime::setOnAdopted(std::function<void(const FractureOutcome&)> callback) {
+    impl_->onAdopted = std::move(callback);
+}
+
+void DestructionRuntime::setOnRemoved(std::function<void(const BodyRecord&)> callback) {
+    impl_->onRemoved = std::move(callback);
+}
+
+} // namespace rubble

@@ -1,0 +1,52 @@
+#pragma once
+// Turns the contacts of a physics step into impacts on objects (ImpactPolicy: thresholds and coalescing).
+
+#include <map>
+#include <vector>
+
+#include "rubble/DestructionRuntime.hpp"
+#include "runtime/BodyTable.hpp"
+
+namespace rubble::detail {
+
+/// An impact waiting to be submitted.
+struct PendingImpact {
+    BodyId body = 0;     ///< the body hit
+    ObjectId object = 0; ///< its object
+    Impact impact;       ///< in the object's coordinates
+    Vec3 worldPoint;     ///< where (world)
+    Vec3 worldNormal;    ///< out of the object (world)
+};
+
+/// What the contacts of one frame amount to.
+struct ImpactBatch {
+    std::vector<PendingImpact> impacts;  ///< projectile hits in contact order, then the strongest collision
+                                         ///< impact of each object, by object id
+    std::map<BodyId, double> frozenHits; ///< strongest contact impulse on each frozen body (projectile hits:
+                                         ///< infinite)
+    int projectileHits = 0;              ///< projectiles that hit anything
+};
+
+/// Applies the ImpactPolicy to contact reports: a projectile's first hit on a destructible object always
+/// counts (impulse ≥ the object's threshold), other contacts only above the policy's impulse and approach
+/// speed and outside a new piece's grace period; each object keeps its strongest collision impact per frame.
+class ImpactCollector {
+public:
+    /// Reads the policy at every call.
+    explicit ImpactCollector(const ImpactPolicy& policy) : policy_(policy) {}
+
+    /// Adds one step's contacts to the frame's batch (marks projectiles spent).
+    void gather(const std::vector<ContactReport>& contacts, BodyTable& bodies, const DestructionWorld& world,
+                const PhysicsBinding& binding, std::uint64_t frame);
+    /// The frame's batch; starts a new one.
+    ImpactBatch take();
+
+private:
+    const ImpactPolicy& policy_;
+    std::vector<PendingImpact> projectileImpacts_;
+    std::map<ObjectId, PendingImpact> collisionImpacts_;
+    std::map<BodyId, double> frozenHits_;
+    int projectileHits_ = 0;
+};
+
+} // namespace rubble::detail
