@@ -106,6 +106,36 @@ TEST(DestructionWorld, ImpactConservesVolumeAndMass) {
     ASSERT_EQ(w.timings().size(), 1u);
 }
 
+// Pieces below Config::minPieceVolume never become objects: the outcome reports them as dust, and pieces +
+// dust + dropped slivers still add up to the parent.
+TEST(DestructionWorld, PiecesBelowTheMinimumVolumeBecomeDust) {
+    HeldJobs jobs;
+    DestructionWorld::Config c = heldConfig(jobs);
+    c.minPieceVolume = 0.05;
+    DestructionWorld w(c);
+    ObjectDesc d = boxDesc();
+    d.fracture.pattern = CellPattern::Shatter;
+    d.fracture.cells = 16;
+    const ObjectId id = w.addObject(d).value();
+    const double v0 = w.object(id)->mass.volume;
+    ASSERT_TRUE(w.submitImpact(id, centreHit()));
+    jobs.runAll();
+    w.beginFrame();
+    auto out = w.collect();
+    ASSERT_EQ(out.size(), 1u);
+    ASSERT_FALSE(out[0].dust.empty()) << "a 16-cell shatter leaves small pieces";
+    double v = out[0].droppedVolume + out[0].dustVolume();
+    for (const DustPiece& dust : out[0].dust)
+        EXPECT_LT(dust.volume, c.minPieceVolume);
+    for (const AdoptedPiece& p : out[0].pieces) {
+        EXPECT_GE(p.state->mass.volume, c.minPieceVolume);
+        EXPECT_EQ(w.object(p.id), p.state.get());
+        v += p.state->mass.volume;
+    }
+    EXPECT_NEAR(v, v0, 1e-9 * v0);
+    EXPECT_EQ(w.timings().back().pieces, static_cast<int>(out[0].pieces.size()));
+}
+
 TEST(DestructionWorld, ImpactsDuringJobAreMergedNotLost) {
     HeldJobs jobs;
     DestructionWorld w(heldConfig(jobs));

@@ -1,0 +1,268 @@
+// The engine-neutral runtime on a second binding, the toy engine of tests/support (no Bullet): support and
+// collapse, freezing and waking, the debris governor's budgets and exact volume accounting with particles.
+#include "rubble/DestructionRuntime.hpp"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <thread>
+
+#include "TestSupport.hpp"
+#include "ToyPhysics.hpp"
+
+namespace rubble {
+namespace {
+
+// One cell, a randomly rotated cube of the given edge centred at the impact: it cuts through anything
+// narrower than size / 2 around the impact.
+FractureParams cubeCell(double size) {
+    FractureParams f;
+    f.seedPoints = 0;
+    f.sizeLaw.base = f.sizeLaw.minSize = f.sizeLaw.maxSize = size;
+    f.sizeLaw.scale = 0;
+    return f;
+}
+
+FractureParams shatter(int cells, double size) {
+    FractureParams f = cubeCell(size);
+    f.pattern = CellPattern::Shatter;
+    f.cells = cells;
+    return f;
+}
+
+struct ToyRig {
+    explicit ToyRig(DestructionRuntime::Config config = defaults(), test::ToyPhysics::Config physics = {})
+        : engine(physics), runtime(engine, config) {
+        runtime.addGround({0, -0.5, 0}, {50, 0.5, 50});
+    }
+    static DestructionRuntime::Config defaults() {
+        DestructionRuntime::Config c;
+        c.world.workers = 1;
+        c.world.deterministic = true;
+        c.world.seed = 5;
+        c.world.minPieceVolume = 0;
+        return c;
+    }
+    ObjectId addBox(const Vec3& half, const Vec3& centre, bool isStatic,
+                    const FractureParams& fracture = {}) {
+        ObjectDesc d;
+        d.mesh = makeBox(-1.0 * half, half);
+        d.density = 500;
+        d.impulseThreshold = 1;
+        d.fracture = fracture;
+        Result<ObjectId> id = runtime.addObject(std::move(d), Frame{Mat3::identity(), centre}, isStatic);
+        EXPECT_TRUE(id) << (id ? "" : id.error().message);
+        return id ? *id : 0;
+    }
+    double heightOf(ObjectId id) const {
+        const BodyRecord* b = runtime.bodyOf(id);
+        return b ? runtime.motion(b->id).transform.translation.y : -1e9;
+    }
+    BodyMotionState motionOf(ObjectId id) const { return runtime.bodyOf(id)->motion; }
+    void step(int frames) {
+        for (int i = 0; i < frames; ++i)
+            runtime.stepFrame();
+    }
+    // steps until a fracture of `object` was adopted; returns its outcome's pieces
+    std::vector<AdoptedPiece> breakAndWait(ObjectId object, int maxFrames = 60) {
+        std::vector<AdoptedPiece> out;
+        runtime.setOnAdopted([&](const FractureOutcome& o) {
+            if (o.parent == object)
+                out = o.pieces;
+        });
+        for (int i = 0; i < maxFrames && out.empty(); ++i)
+            runtime.stepFrame();
+        runtime.setOnAdopted({});
+        return out;
+    }
+    test::ToyPhysics engine;
+    DestructionRuntime runtime;
+};
+
+} // namespace
+
+TEST(DestructionRuntime, ColumnCutOnTheToyEngineKeepsItsFootAndDropsWhatItHeld) {
+    ToyRig rig;
+    const ObjectId column = rig.addBox({0.5, 4, 0.5}, {0, 4, 0}, true, cubeCell(2.4));
+    const ObjectId slab = rig.addBox({1.5, 0.25, 1.5}, {0, 8.25, 0}, true);
+    rig.step(1);
+    ASSERT_FALSE(rig.runtime.bodyOf(slab)->anchor) << "the slab rests on a column that stands on the ground";
+    const BodyId columnBody = rig.runtime.bodyOf(column)->id;
+    const BodyId slabBody = rig.runtime.bodyOf(slab)->id;
+    EXPECT_EQ(rig.runtime.supportNeighbours(slabBody), std::vector<BodyId>{columnBody});
+
+    ASSERT_TRUE(rig.runtime.world().submitImpact(column, Impact{{0.5, -1.5, 0}, {1, 0, 0}, 100}));
+    const std::vector<AdoptedPiece> pieces = rig.breakAndWait(column);
+    ASSERT_GE(pieces.size(), 3u);
+    EXPECT_EQ(rig.motionOf(slab), BodyMotionState::Dynamic) << "what the column held falls";
+    int feet = 0, tops = 0;
+    for (const AdoptedPiece& p : pieces) {
+        const BodyRecord* b = rig.runtime.bodyOf(p.id);
+        ASSERT_NE(b, nullptr);
+        const double y = rig.runtime.motion(b->id).transform.translation.y;
+        if (p.cell >= 0)
+            EXPECT_EQ(b->motion, BodyMotionState::Dynamic) << "debris flies";
+        else if (y < 2.5)
+            feet += b->motion == BodyMotionState::Static ? 1 : 0;
+        else
+            tops += b->motion == BodyMotionState::Dynamic ? 1 : 0;
+    }
+    EXPECT_EQ(feet, 1);
+    EXPECT_EQ(tops, 1);
+    const double slabBefore = rig.heightOf(slab);
+    rig.step(240);
+    EXPECT_LT(rig.heightOf(slab), slabBefore - 2) << "the slab fell";
+    EXPECT_GT(rig.runtime.counters().piecesCollapsed, 0);
+    EXPECT_GT(rig.runtime.counters().piecesFrozen, 0) << "fallen parts came to rest and were frozen";
+}
+
+TEST(DestructionRuntime, FrozenPiecesWakeAndBreakWhenHit) {
+    ToyRig rig;
+    const ObjectId box = rig.addBox({1, 1, 1}, {0, 1, 0}, false, shatter(6, 3));
+    ASSERT_TRUE(rig.runtime.world().submitImpact(box, Impact{{0, 1, 0}, {0, 1, 0}, 50}));
+    const std::vector<AdoptedPiece> pieces = rig.breakAndWait(box);
+    ASSERT_GE(pieces.size(), 2u);
+    rig.step(120);
+    // the largest piece has come to rest on the ground and was frozen
+    const AdoptedPiece* target = &pieces.front();
+    for (const AdoptedPiece& p : pieces)
+        if (p.state->mass.volume > target->state->mass.volume)
+            target = &p;
+    const BodyRecord* b = rig.runtime.bodyOf(target->id);
+    ASSERT_NE(b, nullptr);
+    ASSERT_EQ(b->motion, BodyMotionState::Frozen);
+    EXPECT_EQ(rig.runtime.frozenDebris(), static_cast<int>(rig.runtime.livePieces()));
+    const Vec3 at = rig.runtime.motion(b->id).transform.translation;
+    rig.runtime.fireProjectile(at + Vec3{-20, 0, 0}, {200, 0, 0}, 5, 0.1);
+    const std::vector<AdoptedPiece> again = rig.breakAndWait(target->id, 120);
+    EXPECT_GE(rig.runtime.counters().piecesWoken, 1);
+    EXPECT_FALSE(again.empty()) << "the frozen piece broke";
+    EXPECT_EQ(rig.runtime.bodyOf(target->id), nullptr);
+}
+
+TEST(DestructionRuntime, FrozenDebrisWakesWhenWhatItRestsOnFalls) {
+    ToyRig rig;
+    const ObjectId column = rig.addBox({0.5, 4, 0.5}, {0, 4, 0}, true, cubeCell(2.4));
+    const ObjectId slab = rig.addBox({1.5, 0.25, 1.5}, {0, 8.25, 0}, true);
+    const ObjectId brick = rig.addBox({0.2, 0.2, 0.2}, {1, 9.0, 1}, false); // dropped onto the slab
+    rig.step(90);
+    ASSERT_EQ(rig.motionOf(brick), BodyMotionState::Frozen) << "the brick came to rest on the slab";
+    ASSERT_NEAR(rig.heightOf(brick), 8.7, 1e-6);
+    ASSERT_TRUE(rig.runtime.world().submitImpact(column, Impact{{0.5, -1.5, 0}, {1, 0, 0}, 100}));
+    ASSERT_FALSE(rig.breakAndWait(column).empty());
+    ASSERT_NE(rig.motionOf(slab), BodyMotionState::Static);
+    rig.step(2);
+    EXPECT_GE(rig.runtime.counters().piecesWoken, 1);
+    rig.step(240);
+    EXPECT_LT(rig.heightOf(brick), 8) << "the brick fell with the slab instead of hanging in the air";
+}
+
+TEST(DestructionRuntime, AwakeBudgetRetiresTheSmallestAndKeepsTheVolume) {
+    DestructionRuntime::Config c = ToyRig::defaults();
+    c.debris.maxAwakeBodies = 5;
+    ToyRig rig(c);
+    for (int i = 0; i < 12; ++i) // twelve falling boxes of growing size
+        rig.addBox(Vec3{0.1, 0.1, 0.1} * (1 + i), {3.0 * i, 20, 0}, false);
+    const double start = rig.runtime.volumes().total();
+    rig.step(1);
+    EXPECT_EQ(rig.runtime.awakeDebris(), 5);
+    EXPECT_EQ(rig.runtime.counters().piecesRetired, 7);
+    EXPECT_EQ(rig.runtime.particles().size(), 7u);
+    for (BodyId id : rig.runtime.bodies()) { // the largest stayed
+        if (const BodyRecord* b = rig.runtime.body(id); b->isDebris()) {
+            EXPECT_GT(b->volume, std::pow(0.2 * 8, 3) * 0.999);
+        }
+    }
+    const VolumeLedger v = rig.runtime.volumes();
+    EXPECT_GT(v.retired, 0);
+    EXPECT_NEAR(v.total(), start, 1e-12 * start);
+}
+
+TEST(DestructionRuntime, TriangleBudgetAndFadingRetireDebris) {
+    DestructionRuntime::Config c = ToyRig::defaults();
+    c.debris.maxTriangles = 12 * 3; // three boxes
+    ToyRig rig(c);
+    for (int i = 0; i < 6; ++i)
+        rig.addBox(Vec3{0.3, 0.3, 0.3} * (1 + 0.1 * i), {3.0 * i, 0.3 * (1 + 0.1 * i), 0}, false);
+    rig.step(1);
+    EXPECT_LE(rig.runtime.debrisTriangles(), c.debris.maxTriangles);
+    EXPECT_EQ(rig.runtime.livePieces() + rig.runtime.awakeDebris() + rig.runtime.frozenDebris(), 3);
+
+    DestructionRuntime::Config f = ToyRig::defaults();
+    f.debris.fadeVolume = 0.1;
+    f.debris.fadeDistance = 10;
+    ToyRig far(f);
+    far.runtime.setFocus({0, 0, 0});
+    const ObjectId nearSmall = far.addBox({0.1, 0.1, 0.1}, {2, 0.1, 0}, false);
+    const ObjectId farSmall = far.addBox({0.1, 0.1, 0.1}, {30, 0.1, 0}, false);
+    const ObjectId farLarge = far.addBox({1, 1, 1}, {30, 1, 10}, false);
+    far.step(1);
+    EXPECT_NE(far.runtime.bodyOf(nearSmall), nullptr);
+    EXPECT_EQ(far.runtime.bodyOf(farSmall), nullptr) << "tiny and far: faded";
+    EXPECT_NE(far.runtime.bodyOf(farLarge), nullptr);
+}
+
+TEST(DestructionRuntime, VolumeAccountingIsExactWithDustParticlesAndRetirement) {
+    DestructionRuntime::Config c = ToyRig::defaults();
+    c.world.minPieceVolume = 0.05; // the smaller shatter pieces become dust
+    c.debris.maxAwakeBodies = 4;
+    ToyRig rig(c);
+    const ObjectId a = rig.addBox({1, 1, 1}, {0, 1, 0}, true, shatter(12, 1.5));
+    const ObjectId b = rig.addBox({0.5, 2, 0.5}, {5, 2, 0}, false, shatter(8, 1.2));
+    for (int i = 0; i < 4; ++i) // falling while the shatters land: more awake debris than the budget
+        rig.addBox({0.3, 0.3, 0.3}, {-5.0 - i, 30, 0}, false);
+    const double start = rig.runtime.volumes().total();
+    ASSERT_TRUE(rig.runtime.world().submitImpact(a, Impact{{1, 0.5, 0}, {1, 0, 0}, 80}));
+    ASSERT_TRUE(rig.runtime.world().submitImpact(b, Impact{{0.5, 1, 0}, {1, 0, 0}, 80}));
+    rig.step(200);
+    const VolumeLedger v = rig.runtime.volumes();
+    EXPECT_GT(rig.runtime.counters().fractures, 1);
+    EXPECT_GT(v.dust, 0) << "some pieces were below the minimum volume";
+    EXPECT_GT(v.retired, 0) << "the awake budget retired some pieces";
+    EXPECT_LT(std::abs(v.total() - start) / start, 1e-9);
+}
+
+TEST(DestructionRuntime, PhysicsTimeBudgetShrinksTheAwakeBudgetOutsideDeterministicMode) {
+    for (const bool deterministic : {false, true}) {
+        DestructionRuntime::Config c = ToyRig::defaults();
+        c.world.deterministic = deterministic;
+        c.debris.maxAwakeBodies = 50;
+        c.debris.physicsBudgetMs = 0.5;
+        test::ToyPhysics::Config slow;
+        slow.stepDelayMs = 2; // an engine that takes longer than the budget
+        ToyRig rig(c, slow);
+        for (int i = 0; i < 40; ++i)
+            rig.addBox({0.2, 0.2, 0.2}, {1.0 * i, 50, 0}, false);
+        rig.step(20);
+        if (deterministic) {
+            EXPECT_EQ(rig.runtime.awakeBudget(), 50) << "time must not change a deterministic run";
+            EXPECT_EQ(rig.runtime.awakeDebris(), 40);
+        } else {
+            EXPECT_LT(rig.runtime.awakeBudget(), 40);
+            EXPECT_LE(rig.runtime.awakeDebris(), rig.runtime.awakeBudget());
+        }
+    }
+}
+
+TEST(DestructionRuntime, SameStateOnOneAndTwoWorkers) {
+    auto run = [](int workers) {
+        DestructionRuntime::Config c = ToyRig::defaults();
+        c.world.workers = workers;
+        c.debris.maxAwakeBodies = 6;
+        ToyRig rig(c);
+        const ObjectId column = rig.addBox({0.5, 4, 0.5}, {0, 4, 0}, true, shatter(5, 2.4));
+        rig.addBox({1.5, 0.25, 1.5}, {0, 8.25, 0}, true, shatter(5, 1.5));
+        EXPECT_TRUE(rig.runtime.world().submitImpact(column, Impact{{0.5, -1.5, 0}, {1, 0, 0}, 100}));
+        for (int f = 0; f < 120; ++f) {
+            if (f % 20 == 10)
+                rig.runtime.fireProjectile({-15, 1.0 + 0.05 * f, 0.1}, {150, 0, 0}, 5, 0.1);
+            rig.runtime.stepFrame();
+        }
+        EXPECT_GT(rig.runtime.counters().fractures, 1);
+        return rig.runtime.stateHash();
+    };
+    EXPECT_EQ(run(1), run(2));
+}
+
+} // namespace rubble
