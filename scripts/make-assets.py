@@ -743,6 +743,108 @@ def make_cube(n):
     return finish(mb)
 
 
+def extrude_grid(name, occ, du, dv, w0, w1, layers, axes, centre_v=True):
+    """A solid made of grid cells: occ[i][j] marks the cells of a (u, v) grid of cell size du x dv that are
+    solid, extruded along w from w0 to w1 in `layers` layers. Every face is a grid quad, so the surface is
+    closed with no T-junction; holes in occ become openings. axes maps (u, v, w) to model axes; u (and v when
+    centre_v) is centred on 0, v otherwise starts at 0."""
+    mb = MeshBuilder(name)
+    nu, nv = len(occ), len(occ[0])
+
+    def solid(i, j):
+        return 0 <= i < nu and 0 <= j < nv and occ[i][j]
+
+    def pt(i, j, k):
+        v0 = -0.5 * nv * dv if centre_v else 0.0
+        uvw = (-0.5 * nu * du + i * du, v0 + j * dv, w0 + (w1 - w0) * k / layers)
+        p = [0.0, 0.0, 0.0]
+        for src, dst in enumerate(axes):
+            p[dst] = uvw[src]
+        return mb.v(p)
+
+    for i in range(nu):
+        for j in range(nv):
+            if not occ[i][j]:
+                continue
+            for k in (0, layers):  # caps
+                mb.quad(pt(i, j, k), pt(i + 1, j, k), pt(i + 1, j + 1, k), pt(i, j + 1, k))
+            for (di, dj, a, b) in ((-1, 0, (0, 0), (0, 1)), (1, 0, (1, 0), (1, 1)),
+                                   (0, -1, (0, 0), (1, 0)), (0, 1, (0, 1), (1, 1))):
+                if solid(i + di, j + dj):
+                    continue
+                for k in range(layers):  # side walls, one quad per layer
+                    mb.quad(pt(i + a[0], j + a[1], k), pt(i + b[0], j + b[1], k), pt(i + b[0], j + b[1], k + 1),
+                            pt(i + a[0], j + a[1], k + 1))
+    return finish(mb)
+
+
+# The demolition building: 12 x 12 m storeys of 3.5 m on a 6 m column grid. Columns stand on the slab below
+# (or the ground), slab panels rest on the columns, facade panels stand between the columns under the slab
+# above. Every element is its own static object (world.cfg mass 0), so the runtime's support graph finds
+# which rest on which.
+STOREY = 3.5
+SLAB_T = 0.3
+COLUMN_W = 0.6
+BAY = 6.0
+WALL_T = 0.25
+WALL_H = STOREY - SLAB_T
+WALL_L = BAY - COLUMN_W
+
+
+def make_slab():
+    """Floor slab panel 6 x 0.3 x 6 on a 0.3 m grid, base at y=0, centred in x and z."""
+    n = 20
+    return extrude_grid("slab", [[True] * n for _ in range(n)], BAY / n, BAY / n, 0.0, SLAB_T, 1, (0, 2, 1))
+
+
+def make_pillar():
+    """Square column 0.6 x 3.2 x 0.6, base at y=0, in 8 courses."""
+    return extrude_grid("pillar", [[True] * 2 for _ in range(2)], COLUMN_W / 2, COLUMN_W / 2, 0.0, WALL_H, 8,
+                        (0, 2, 1))
+
+
+def facade_cells(window):
+    nu, nv = 18, 11  # 0.3 m x 0.29 m cells over 5.4 x 3.2 m
+    occ = [[True] * nv for _ in range(nu)]
+    if window:
+        for i in range(6, 12):
+            for j in range(3, 9):
+                occ[i][j] = False
+    return occ, WALL_L / nu, WALL_H / nv
+
+
+def make_facade(axis, window):
+    """Facade panel 5.4 long, 3.2 high, 0.25 thick (optionally with a 1.8 x 1.75 window), base at y=0."""
+    occ, du, dv = facade_cells(window)
+    name = "facade_%s%s" % (axis, "_window" if window else "")
+    axes = (0, 1, 2) if axis == "x" else (2, 1, 0)
+    return extrude_grid(name, occ, du, dv, -0.5 * WALL_T, 0.5 * WALL_T, 1, axes, centre_v=False)
+
+
+def building_lines(x0, z0, storeys, ground):
+    """Object lines of one building: storeys x (9 columns, 8 facade panels, 4 slab panels), cornered at
+    (x0, z0) with its footprint in +x and +z, standing on y = ground."""
+    lines = []
+    for s in range(storeys):
+        y = ground + s * STOREY
+        for a in (0, 1, 2):
+            for b in (0, 1, 2):
+                lines.append(obj_line("pillar", "concrete.png", x0 + a * BAY, y, z0 + b * BAY, 1, 0))
+        for k in (0, 1):
+            mid = (k + 0.5) * BAY
+            window = (s + k) % 2 == 0
+            suffix = "_window" if window else ""
+            tex = "brick.png" if s == 0 else "facade.png"
+            for side in (0, 2):
+                lines.append(obj_line("facade_x" + suffix, tex, x0 + mid, y, z0 + side * BAY, 1, 0))
+                lines.append(obj_line("facade_z" + suffix, tex, x0 + side * BAY, y, z0 + mid, 1, 0))
+        for a in (0, 1):
+            for b in (0, 1):
+                lines.append(obj_line("slab", "concrete.png", x0 + (a + 0.5) * BAY, y + WALL_H,
+                                      z0 + (b + 0.5) * BAY, 1, 0))
+    return lines
+
+
 MODEL_SPECS = [
     # builder, texture, world units per texture repeat (model space), description
     (make_building, "facade.png", 4.0, "tower with five setbacks and a spire, 12.8 x 48 x 8.8, base at y=0"),
@@ -754,6 +856,12 @@ MODEL_SPECS = [
     (make_wall, "brick.png", 2.0, "crenellated wall slab, 16 x 6.2 x 1.6, base at y=0"),
     (make_column, "concrete.png", 2.0, "octagonal column with plinth and capital, 2.6 x 10.2 x 2.6, base at y=0"),
     (make_arch, "brick.png", 2.0, "gateway with a round-headed opening (genus 1), 12 x 9 x 3, base at y=0"),
+    (make_slab, "concrete.png", 2.0, "floor slab panel 6 x 0.3 x 6 (20 x 20 grid), base at y=0"),
+    (make_pillar, "concrete.png", 2.0, "square column 0.6 x 3.2 x 0.6 in 8 courses, base at y=0"),
+    (lambda: make_facade("x", False), "facade.png", 2.0, "facade panel 5.4 x 3.2 x 0.25 along x, base at y=0"),
+    (lambda: make_facade("x", True), "facade.png", 2.0, "facade panel along x with a window, base at y=0"),
+    (lambda: make_facade("z", False), "facade.png", 2.0, "facade panel 0.25 x 3.2 x 5.4 along z, base at y=0"),
+    (lambda: make_facade("z", True), "facade.png", 2.0, "facade panel along z with a window, base at y=0"),
 ] + [(lambda n=n: make_cube(n), "concrete.png", 2.0,
       "cube [-1,1]^3 centred at the origin, faces %dx%d grids" % (n, n)) for n in (1, 3, 7, 15, 29)]
 
@@ -1112,6 +1220,20 @@ def scenes():
         obj_line("column", "concrete.png", 35, G, -150, 2, 0),
     ]
     out["collapse_test.cfg"] = collapse
+    # demolition: one seven-storey building of 151 static elements (about 100k triangles) resting on each
+    # other, the vehicle in front of it
+    demo = [SKY_LINE, GROUND_LINE, "../models/fighter.obj;../textures/metal.png;0;20;90;1;1;1;100"]
+    demo += building_lines(-BAY, -BAY, 7, G)
+    demo += [obj_line("slab", "concrete.png", (a - 0.5) * BAY, G + 7 * STOREY, (b - 0.5) * BAY, 1, 0)
+             for a in (0, 1) for b in (0, 1)]  # the roof
+    out["demolition.cfg"] = demo
+    # demolition block: four buildings of 7 to 10 storeys around a square (about 500k triangles)
+    block = [SKY_LINE, GROUND_LINE, "../models/fighter.obj;../textures/metal.png;0;30;110;1;1;1;100"]
+    for (x0, z0, n) in ((-40, -40, 10), (16, -40, 8), (-40, 16, 7), (16, 16, 7)):
+        block += building_lines(x0, z0, n, G)
+        block += [obj_line("slab", "concrete.png", x0 + (a + 0.5) * BAY, G + n * STOREY, z0 + (b + 0.5) * BAY, 1, 0)
+                  for a in (0, 1) for b in (0, 1)]
+    out["demolition_block.cfg"] = block
     return out
 
 
