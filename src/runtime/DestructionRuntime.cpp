@@ -8,6 +8,7 @@
 
 #include "runtime/BodyTable.hpp"
 #include "runtime/DebrisGovernor.hpp"
+#include "runtime/DebrisPool.hpp"
 #include "runtime/ImpactCollector.hpp"
 #include "runtime/PieceAdopter.hpp"
 #include "runtime/SupportGraph.hpp"
@@ -58,7 +59,7 @@ struct DestructionRuntime::Impl {
     detail::SupportGraph support;
     detail::DebrisGovernor governor;
     std::set<BodyId> projectiles;
-    std::vector<DebrisParticle> particles;
+    detail::DebrisPool particles;
     std::deque<ImpactMark> marks;
     RuntimeCounters counters;
     VolumeLedger ledger; // live is computed on demand
@@ -109,8 +110,8 @@ struct DestructionRuntime::Impl {
         if (!r)
             return;
         const BodyMotion m = binding.motion(id);
-        particles.push_back({m.transform.translation, m.linearVelocity, std::cbrt(r->volume), r->volume,
-                             config.debris.particleLifetime});
+        particles.add({m.transform.translation, m.linearVelocity, std::cbrt(r->volume), r->volume,
+                       config.debris.particleLifetime});
         ledger.retired += r->volume;
         ++stats.piecesRetired;
         ++counters.piecesRetired;
@@ -195,7 +196,7 @@ struct DestructionRuntime::Impl {
         }
         stats.piecesRetired += static_cast<int>(plan.particles.size());
         counters.piecesRetired += static_cast<long long>(plan.particles.size());
-        particles.insert(particles.end(), plan.particles.begin(), plan.particles.end());
+        particles.add(plan.particles);
         settleSupport(stats);          // before the callback, so that it sees the pieces' final motion
         world.finishAdoption(outcome); // the pieces' bodies exist: the impact's timing record ends here
         if (onAdopted)
@@ -248,13 +249,7 @@ struct DestructionRuntime::Impl {
     }
 
     void advance(double dt) {
-        const Vec3 g = binding.gravity();
-        for (DebrisParticle& p : particles) {
-            p.velocity += g * dt;
-            p.position += p.velocity * dt;
-            p.lifetime -= dt;
-        }
-        std::erase_if(particles, [](const DebrisParticle& p) { return p.lifetime <= 0; });
+        particles.advance(dt, binding.gravity());
         std::vector<BodyId> expired;
         for (BodyId id : projectiles) {
             BodyRecord& b = *bodies.find(id);
@@ -506,7 +501,7 @@ int DestructionRuntime::awakeBudget() const {
 }
 
 const std::vector<DebrisParticle>& DestructionRuntime::particles() const {
-    return impl_->particles;
+    return impl_->particles.particles();
 }
 
 const std::deque<ImpactMark>& DestructionRuntime::recentImpacts() const {
