@@ -38,21 +38,22 @@ TEST(ConvexContact, BoxesTouchFaceToFaceAndSeparateBeyondTheGap) {
     EXPECT_FALSE(withinGap(a, ConvexPolytope{}, 1)) << "an empty polytope touches nothing";
 }
 
-// Two bars crossing like an X above each other, their edges skew: only an edge × edge axis separates them.
-// Face normals alone (and the bounding boxes) would call them touching.
+// Two cubes turned 45° about perpendicular axes, one above the other: the upper one's lowest edge crosses the
+// lower one's highest edge. Only an edge × edge axis separates them; every face normal still sees an overlap
+// (and so do the bounding boxes, once the pair is turned away from the coordinate axes).
 TEST(ConvexContact, SkewEdgesNeedTheEdgeCrossAxes) {
-    const ConvexPolytope bar = box({-2, -0.1, -0.1}, {2, 0.1, 0.1});
-    const Frame lower{rotation(normalized(Vec3{1, 1, 1}), 0.3), {0, 0, 0}};
-    const Frame upper{rotation(normalized(Vec3{1, -1, 0.5}), 1.1), {0, 0.45, 0}};
-    const ConvexPolytope a = bar.transformed(lower), b = bar.transformed(upper);
-    ASSERT_TRUE(a.bounds().overlaps(b.bounds()));
-    // distance along the common normal of the two bars' long edges
-    bool separated = false;
-    for (double lift = 0.45; lift > 0 && !separated; lift -= 0.01)
-        separated = !withinGap(a, bar.transformed(Frame{upper.rotation, {0, lift, 0}}), 0.001);
-    EXPECT_TRUE(separated);
-    EXPECT_TRUE(withinGap(a, bar.transformed(Frame{upper.rotation, {0, 0, 0}}), 0))
-        << "crossing at the origin";
+    const ConvexPolytope cube = box({-1, -1, -1}, {1, 1, 1});
+    const double pi = 3.14159265358979;
+    const Frame tilt{rotation(normalized(Vec3{1, 2, 3}), 0.7), {}};
+    const ConvexPolytope lower = cube.transformed(tilt * Frame{rotation({0, 0, 1}, pi / 4), {}});
+    auto upper = [&](double y) {
+        return cube.transformed(tilt * Frame{rotation({1, 0, 0}, pi / 4), {0, y, 0}});
+    };
+    ASSERT_TRUE(lower.bounds().overlaps(upper(2.9).bounds()));
+    // the edges are 2.9 − 2·√2 = 0.0716 apart
+    EXPECT_FALSE(withinGap(lower, upper(2.9), 0.05));
+    EXPECT_TRUE(withinGap(lower, upper(2.9), 0.08));
+    EXPECT_TRUE(withinGap(lower, upper(2.8), 0)) << "the edges cross";
 }
 
 TEST(ConvexContact, TransformedKeepsVolumeAndMovesTheCentroid) {
