@@ -349,6 +349,34 @@ TEST(UpdateDecomposition, ShatterPatternsKeepCoverageAndBudget) {
     }
 }
 
+TEST(UpdateDecomposition, OfAFractureResultGivesEachPieceItsParts) {
+    const Mesh start = makeLPrism(2);
+    auto d = decompose(start);
+    ASSERT_TRUE(d);
+    FractureParams fp;
+    fp.pattern = CellPattern::Shatter;
+    fp.cells = 4;
+    auto fr = fracture(start, {{1.5, 0.5, 2}, {0, 0, 1}, 30}, fp, 3);
+    ASSERT_TRUE(fr) << fr.error().message;
+    std::vector<Mesh> pieces;
+    std::vector<std::int32_t> pieceCells;
+    for (const Piece& p : fr->pieces) {
+        pieces.push_back(p.mesh);
+        pieceCells.push_back(p.cell);
+    }
+    DecompositionParams params;
+    params.maxParts = 6;
+    const auto expected = updateDecomposition(d->parts, fr->cells, pieces, pieceCells, params);
+    const auto parts = updateDecomposition(d->parts, *fr, params);
+    ASSERT_EQ(parts.size(), fr->pieces.size());
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+        ASSERT_EQ(parts[i].size(), expected[i].size());
+        for (std::size_t k = 0; k < parts[i].size(); ++k)
+            EXPECT_EQ(parts[i][k].vertices(), expected[i][k].vertices());
+        expectCovers(fr->pieces[i].mesh, parts[i], 1e-6 * diag(start));
+    }
+}
+
 TEST(UpdateDecomposition, ChainedMergesAreDeterministicAndKeepTheBudget) {
     // Ten chained fractures of the biggest piece of a concave mesh: every update is computed twice and must
     // give the same parts (the box-ranked merge has no hidden state), within the budget and covering.
