@@ -49,7 +49,7 @@ install: build
 
 release: deps
 	@[ -f $(RELEASE_DIR)/build.ninja ] || cmake -S . -B $(RELEASE_DIR) -G Ninja -DCMAKE_BUILD_TYPE=Release \
-	    -DRUBBLE_BUILD_TESTS=OFF $(CMAKE_ARGS)
+	    -DRUBBLE_BUILD_TESTS=OFF -DRUBBLE_BUILD_PYTHON=OFF $(CMAKE_ARGS)
 	cmake --build $(RELEASE_DIR) -j $(JOBS)
 
 lint: deps
