@@ -155,9 +155,8 @@ py::array_t<std::uint32_t> trianglesOf(const rubble::Mesh& mesh) {
     return out;
 }
 
-/// One piece of a fracture as Python sees it.
-struct PyPiece {
-    rubble::Mesh mesh;
+/// One piece of a fracture as Python sees it: a Mesh with its mass properties, cell and convex parts.
+struct PyPiece : rubble::Mesh {
     rubble::MassProperties mass;
     std::int32_t cell = -1;
     std::vector<std::vector<rubble::Vec3>> convexParts; // corner points per part
@@ -206,7 +205,7 @@ std::vector<PyPiece> fractureMesh(const rubble::Mesh& mesh, const py::object& po
     }
     for (std::size_t i = 0; i < result.pieces.size(); ++i) {
         PyPiece& p = pieces.emplace_back();
-        p.mesh = std::move(result.pieces[i].mesh);
+        static_cast<rubble::Mesh&>(p) = std::move(result.pieces[i].mesh);
         p.mass = result.pieces[i].mass;
         p.cell = result.pieces[i].cell;
         if (i < parts.size())
@@ -287,13 +286,7 @@ PYBIND11_MODULE(_rubble, m) {
                    std::to_string(r.problems.size()) + " problems>";
         });
 
-    py::class_<PyPiece>(m, "Piece")
-        .def_property_readonly("mesh", [](const PyPiece& p) { return p.mesh; })
-        .def_property_readonly("vertices", [](const PyPiece& p) { return rows(p.mesh.positions, 3); })
-        .def_property_readonly("triangles", [](const PyPiece& p) { return trianglesOf(p.mesh); })
-        .def_property_readonly("materials", [](const PyPiece& p) { return materialsOf(p.mesh); })
-        .def_property_readonly("uvs", [](const PyPiece& p) { return uvsOf(p.mesh); })
-        .def_property_readonly("normals", [](const PyPiece& p) { return normalsOf(p.mesh); })
+    py::class_<PyPiece, rubble::Mesh>(m, "Piece")
         .def_property_readonly("volume", [](const PyPiece& p) { return p.mass.volume; })
         .def_property_readonly("center_of_mass", [](const PyPiece& p) { return vec3(p.mass.centerOfMass); })
         .def_property_readonly("inertia", [](const PyPiece& p) { return mat3(p.mass.inertia); })
@@ -303,7 +296,7 @@ PYBIND11_MODULE(_rubble, m) {
         .def_readonly("cell", &PyPiece::cell)
         .def_property_readonly("convex_parts", [](const PyPiece& p) { return convexPartsOf(p.convexParts); })
         .def("__repr__", [](const PyPiece& p) {
-            return "<rubble.Piece " + std::to_string(p.mesh.triangleCount()) + " triangles, volume " +
+            return "<rubble.Piece " + std::to_string(p.triangleCount()) + " triangles, volume " +
                    std::to_string(p.mass.volume) + ", cell " + std::to_string(p.cell) + ">";
         });
 

@@ -4,32 +4,7 @@ Meshes are numpy arrays in and out; library errors raise rubble.Error (a Runtime
 and its error code (e.g. "invalid input"). Types: see __init__.pyi.
 """
 
-from ._rubble import (
-    INTERIOR_MATERIAL,
-    Error,
-    Mesh,
-    MeshReport,
-    Piece,
-    box,
-    check,
-    decompose,
-    fracture,
-    read_mesh,
-    repair,
-    write_obj,
-)
+from . import _rubble
+from ._rubble import *  # noqa: F403 (the names are listed in __init__.pyi)
 
-__all__ = [
-    "INTERIOR_MATERIAL",
-    "Error",
-    "Mesh",
-    "MeshReport",
-    "Piece",
-    "box",
-    "check",
-    "decompose",
-    "fracture",
-    "read_mesh",
-    "repair",
-    "write_obj",
-]
+__all__ = [name for name in dir(_rubble) if not name.startswith("_")]

@@ -122,27 +122,10 @@ class MeshReport:
     def problems(self) -> list[str]:
         """One sentence per problem, most important first; empty for a valid mesh."""
 
-class Piece:
-    """One piece of a fracture: a closed mesh in the input's coordinates with its mass properties."""
+class Piece(Mesh):
+    """One piece of a fracture: a closed Mesh in the input's coordinates (cut faces carry INTERIOR_MATERIAL and
+    planar uvs) with its mass properties, its cell and its convex collision parts."""
 
-    @property
-    def mesh(self) -> Mesh:
-        """The piece as a Mesh."""
-    @property
-    def vertices(self) -> Float64Array:
-        """(n, 3) float64 positions."""
-    @property
-    def triangles(self) -> UInt32Array:
-        """(m, 3) uint32 vertex indices."""
-    @property
-    def materials(self) -> UInt32Array | None:
-        """(m,) uint32 material ids (INTERIOR_MATERIAL on cut faces), or None."""
-    @property
-    def uvs(self) -> Float64Array | None:
-        """(3m, 2) float64 texture coordinates per triangle corner, or None."""
-    @property
-    def normals(self) -> Float64Array | None:
-        """(3m, 3) float64 normals per triangle corner, or None."""
     @property
     def volume(self) -> float:
         """Volume."""

@@ -101,6 +101,18 @@ bool valid(const rubble_world* w) {
     return w && w->tag == kWorldTag;
 }
 
+/// Deletes a handle of the right kind (null is fine), clearing its tag first.
+template <class Handle>
+rubble_status destroy(const char* function, Handle* handle, const char* what) {
+    if (!handle)
+        return ok();
+    if (!valid(handle))
+        return invalid(function, what);
+    handle->tag = 0;
+    delete handle;
+    return ok();
+}
+
 rubble::Vec3 vec(const double v[3]) {
     return {v[0], v[1], v[2]};
 }
@@ -289,15 +301,9 @@ rubble_status rubble_mesh_clone(const rubble_mesh* mesh, rubble_mesh** out) {
 
 rubble_status rubble_mesh_destroy(rubble_mesh* mesh) {
     return guarded(__func__, [&](const char* fn) {
-        if (!mesh)
-            return ok();
-        if (!valid(mesh))
-            return invalid(fn, "not a mesh handle");
-        if (mesh->ownedByFracture)
+        if (valid(mesh) && mesh->ownedByFracture)
             return invalid(fn, "the mesh belongs to a fracture; destroy the fracture instead");
-        mesh->tag = 0;
-        delete mesh;
-        return ok();
+        return destroy(fn, mesh, "not a mesh handle");
     });
 }
 
@@ -433,15 +439,7 @@ rubble_status rubble_fracture_mesh(const rubble_mesh* mesh, const rubble_impact*
 }
 
 rubble_status rubble_fracture_destroy(rubble_fracture* fracture) {
-    return guarded(__func__, [&](const char* fn) {
-        if (!fracture)
-            return ok();
-        if (!valid(fracture))
-            return invalid(fn, "not a fracture handle");
-        fracture->tag = 0;
-        delete fracture;
-        return ok();
-    });
+    return guarded(__func__, [&](const char* fn) { return destroy(fn, fracture, "not a fracture handle"); });
 }
 
 rubble_status rubble_fracture_get_info(const rubble_fracture* fracture, rubble_fracture_info* out) {
@@ -520,15 +518,7 @@ rubble_status rubble_world_create(const rubble_world_config* config, rubble_worl
 }
 
 rubble_status rubble_world_destroy(rubble_world* world) {
-    return guarded(__func__, [&](const char* fn) {
-        if (!world)
-            return ok();
-        if (!valid(world))
-            return invalid(fn, "not a world handle");
-        world->tag = 0;
-        delete world;
-        return ok();
-    });
+    return guarded(__func__, [&](const char* fn) { return destroy(fn, world, "not a world handle"); });
 }
 
 rubble_status rubble_object_desc_init(rubble_object_desc* desc) {

@@ -326,18 +326,12 @@ TEST(UpdateDecomposition, ShatterPatternsKeepCoverageAndBudget) {
             fp.sizeLaw.scale = 0;
             auto fr = fracture(start, {b.center() + Vec3{0.1, 0.05, 0.02}, {1, 0, 0}, 1}, fp, seed);
             ASSERT_TRUE(fr) << fr.error().message;
-            std::vector<Mesh> pieces;
-            std::vector<std::int32_t> pieceCells;
-            for (const Piece& p : fr->pieces) {
-                pieces.push_back(p.mesh);
-                pieceCells.push_back(p.cell);
-            }
             DecompositionParams params;
             params.maxParts = 8;
-            auto updated = updateDecomposition(d->parts, fr->cells, pieces, pieceCells, params);
-            ASSERT_EQ(updated.size(), pieces.size());
-            for (std::size_t i = 0; i < pieces.size(); ++i) {
-                expectCovers(pieces[i], updated[i], 1e-6 * diag(start));
+            auto updated = updateDecomposition(d->parts, *fr, params);
+            ASSERT_EQ(updated.size(), fr->pieces.size());
+            for (std::size_t i = 0; i < updated.size(); ++i) {
+                expectCovers(fr->pieces[i].mesh, updated[i], 1e-6 * diag(start));
                 EXPECT_LE(updated[i].size(), 8u);
                 for (const ConvexPolytope& part : updated[i]) {
                     const Aabb pb = part.bounds();

@@ -66,9 +66,9 @@ def test_obj_round_trip(tmp_path):
 def test_piece_round_trips_through_mesh_and_obj(tmp_path):
     piece = fracture_cube()[1]
     again = rubble.Mesh(piece.vertices, piece.triangles, materials=piece.materials, uvs=piece.uvs, normals=piece.normals)
-    assert again == piece.mesh
+    assert again == piece and again.hash() == piece.hash()
     path = tmp_path / "piece.obj"
-    rubble.write_obj(path, piece.mesh)
+    rubble.write_obj(path, piece)
     back = rubble.read_mesh(path)
     np.testing.assert_array_equal(back.vertices, piece.vertices)
     np.testing.assert_array_equal(back.triangles, piece.triangles)
@@ -107,8 +107,8 @@ def test_fracture_conserves_volume_and_gives_closed_pieces():
     assert {p.cell for p in pieces} >= {-1, 0}
     interior = 0
     for p in pieces:
-        assert rubble.check(p.mesh).valid
-        assert p.mesh.volume == pytest.approx(p.volume, rel=1e-9)
+        assert isinstance(p, rubble.Mesh) and rubble.check(p).valid
+        assert rubble.Mesh(p.vertices, p.triangles).volume == pytest.approx(p.volume, rel=1e-9)
         assert p.vertices.shape[1] == 3 and p.triangles.shape[1] == 3
         assert p.materials.shape == (p.triangles.shape[0],)
         assert p.uvs.shape == (3 * p.triangles.shape[0], 2)
@@ -167,11 +167,11 @@ def test_decompose():
 
 def test_same_seed_same_pieces_other_seed_other_pieces():
     a, b, c = fracture_cube(seed=11), fracture_cube(seed=11), fracture_cube(seed=12)
-    assert [p.mesh.hash() for p in a] == [p.mesh.hash() for p in b]
+    assert [p.hash() for p in a] == [p.hash() for p in b]
     for p, q in zip(a, b):
         np.testing.assert_array_equal(p.vertices, q.vertices)
         np.testing.assert_array_equal(p.triangles, q.triangles)
-    assert [p.mesh.hash() for p in a] != [p.mesh.hash() for p in c]
+    assert [p.hash() for p in a] != [p.hash() for p in c]
 
 
 # Errors
@@ -273,9 +273,11 @@ def test_stub_ships_and_matches_the_module():
             assert _stub_parameters(node) == _parameters(signature), (node.name, signature)
         if isinstance(node, ast.ClassDef) and node.name != "Error":
             cls = getattr(rubble, node.name)
+            assert [b.__name__ for b in cls.__bases__] == [b.id for b in node.bases] or not node.bases, node.name
             members = {m.name: m for m in node.body if isinstance(m, ast.FunctionDef)}
+            inherited = {m for b in cls.__bases__ for m in dir(b) if not m.startswith("_")}
             public_members = {m for m in dir(cls) if not m.startswith("_")}
-            assert public_members == set(members) - {"__init__", "__eq__"}, node.name
+            assert public_members == (set(members) | inherited) - {"__init__", "__eq__"}, node.name
             if "__init__" in members:
                 signature = cls.__init__.__doc__.splitlines()[0]
                 assert _stub_parameters(members["__init__"]) == _parameters(signature), (node.name, signature)
