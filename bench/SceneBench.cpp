@@ -1,12 +1,13 @@
 // `rubble-bench scene FILE.cfg [--seconds T | --frames N] [--shots-per-second R] [--workers W] [--seed S]
 //  [--deterministic] [--unpaced] [--no-idle-adoption] [--json] [--timings-csv FILE] [--frames-csv FILE]
-//  [--append-csv FILE]`
+//  [--append-csv FILE] [--pattern single|shatter] [--cells K] [--max-awake N]`
 //
-// Headless destruction run of a world.cfg scene through the Bullet adapter: seeded projectiles at the
-// destructible objects (target chosen with probability ∝ volume, aim point uniform in the central 80% of its
-// bounding box), fixed 1/60 s frames paced at 60 Hz wall clock like a game (--unpaced: back to back), no
-// rendering. Frame time = wall time of the main-thread frame (shooting + physics + impact gathering +
-// adoption at the start of the frame).
+// Headless destruction run of a world.cfg scene through the runtime on the Bullet binding: seeded projectiles
+// at the destructible objects (target chosen with probability ∝ volume, aim point uniform in the central 80%
+// of its bounding box), fixed 1/60 s frames paced at 60 Hz wall clock like a game (--unpaced: back to back),
+// no rendering. Frame time = wall time of the main-thread frame (firing + physics + impact gathering +
+// adoption + debris governor); choosing the targets scans every body, which a game would not do, and is not
+// timed.
 //
 // Idle adoption (paced, not --deterministic): after its frame the main thread does not sleep until the next
 // 1/60 s tick but waits for fracture results until the tick (DestructionWorld::waitForResult) and adopts each
@@ -42,6 +43,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -100,8 +102,15 @@ double peakRssMb() {
     return 0;
 }
 
-// One projectile at a destructible body chosen with probability ∝ volume.
-void shoot(rubble::DestructionRuntime& runtime, rubble::Rng& rng, const SceneArgs& a) {
+// A shot: from where, how fast.
+struct Shot {
+    rubble::Vec3 from;
+    rubble::Vec3 velocity;
+};
+
+// Aims one projectile at a destructible body chosen with probability ∝ volume (bench scaffolding: a scan of
+// every body, which a game would not do, so it runs outside the timed frame).
+std::optional<Shot> aim(const rubble::DestructionRuntime& runtime, rubble::Rng& rng, const SceneArgs& a) {
     using namespace rubble;
     std::vector<const BodyRecord*> targets;
     double total = 0;
@@ -116,7 +125,7 @@ void shoot(rubble::DestructionRuntime& runtime, rubble::Rng& rng, const SceneArg
         total += b->volume;
     }
     if (targets.empty() || total <= 0)
-        return;
+        return std::nullopt;
     double pick = rng.uniform(0, total);
     const BodyRecord* target = targets.back();
     for (const BodyRecord* b : targets) {
@@ -132,14 +141,13 @@ void shoot(rubble::DestructionRuntime& runtime, rubble::Rng& rng, const SceneArg
     const Vec3 local{box.lo.x + rng.uniform(0.1, 0.9) * (box.hi.x - box.lo.x),
                      box.lo.y + rng.uniform(0.1, 0.9) * (box.hi.y - box.lo.y),
                      box.lo.z + rng.uniform(0.1, 0.9) * (box.hi.z - box.lo.z)};
-    const Vec3 aim = f.apply(local);
+    const Vec3 at = f.apply(local);
     const double phi = rng.uniform(0, 2 * 3.14159265358979);
     const double y = rng.uniform(0.05, 0.6);
     const double r = std::sqrt(1 - y * y);
     const Vec3 dir{r * std::cos(phi), y, r * std::sin(phi)};
     const double distance = 30 + box.diagonal();
-    runtime.fireProjectile(aim + dir * distance, dir * -a.projectileSpeed, a.projectileMass,
-                           a.projectileRadius);
+    return Shot{at + dir * distance, dir * -a.projectileSpeed};
 }
 
 int runScene(const SceneArgs& a) {
@@ -172,6 +180,9 @@ int runScene(const SceneArgs& a) {
     for (const std::string& w : loaded.warnings)
         std::cerr << "warning: " << w << "\n";
     const double startVolume = runtime.volumes().total();
+    std::size_t startTriangles = 0;
+    for (ObjectId id : destruction.objects())
+        startTriangles += destruction.object(id)->mesh.triangleCount();
     { // distant tiny debris fades with distance from the middle of the scene
         Vec3 centre;
         for (ObjectId id : loaded.objects)
@@ -207,12 +218,14 @@ int runScene(const SceneArgs& a) {
         // like a game: one frame per 1/60 s of wall time (fracture jobs run in the idle part of the frame)
         if (!a.unpaced)
             std::this_thread::sleep_until(runStart + period * f);
-        const auto t0 = std::chrono::steady_clock::now();
         const long due = static_cast<long>(std::floor(static_cast<double>(f) * a.shotsPerSecond / 60.0));
-        while (shots < due) {
-            shoot(runtime, rng, a);
-            ++shots;
-        }
+        std::vector<Shot> volley;
+        for (; shots < due; ++shots)
+            if (std::optional<Shot> shot = aim(runtime, rng, a))
+                volley.push_back(*shot);
+        const auto t0 = std::chrono::steady_clock::now();
+        for (const Shot& shot : volley)
+            runtime.fireProjectile(shot.from, shot.velocity, a.projectileMass, a.projectileRadius);
         const FrameStats fs = runtime.stepFrame(dt);
         const double ms =
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -270,7 +283,7 @@ int runScene(const SceneArgs& a) {
                    "latency_p50_ms,latency_p99_ms,latency_max_ms,queue_p50_ms,boolean_p50_ms,"
                    "decomposition_p50_ms,pieces_alive,pieces_max,pieces_retired,volume_error,state_hash,"
                    "peak_rss_mb,missed,failed,fractures_idle,handoff_p50_ms,adoption_p99_ms,own_cpu_cores,"
-                   "other_cpu_cores\n";
+                   "other_cpu_cores,pattern,cells,triangles,awake_pieces,frozen_pieces,pieces_collapsed\n";
         out << a.file << ',' << workers << ',' << (a.deterministic ? 1 : 0) << ',' << a.seed << ','
             << a.shotsPerSecond << ',' << frames << ',' << shots << ',' << percentile(frameMs, 0.5) << ','
             << percentile(frameMs, 0.99) << ',' << percentile(frameMs, 1.0) << ','
@@ -280,7 +293,9 @@ int runScene(const SceneArgs& a) {
             << ts.boolean.p50 << ',' << ts.decomposition.p50 << ',' << runtime.livePieces() << ','
             << maxPieces << ',' << c.piecesRetired << ',' << volumeError << ',' << hashText << ',' << rss
             << ',' << ts.missed << ',' << ts.failed << ',' << idleFractures << ',' << ts.handoff.p50 << ','
-            << ts.adoption.p99 << ',' << cpuUse.own << ',' << cpuUse.other << '\n';
+            << ts.adoption.p99 << ',' << cpuUse.own << ',' << cpuUse.other << ',' << a.pattern << ','
+            << (a.cells > 0 ? a.cells : FractureParams{}.cells) << ',' << startTriangles << ','
+            << runtime.awakeDebris() << ',' << runtime.frozenDebris() << ',' << c.piecesCollapsed << '\n';
     }
     if (a.json) {
         nlohmann::json j;
@@ -301,6 +316,7 @@ int runScene(const SceneArgs& a) {
         j["physics_ms"] = {{"p50", percentile(physicsMs, 0.5)},
                            {"p99", percentile(physicsMs, 0.99)},
                            {"max", percentile(physicsMs, 1.0)}};
+        j["triangles_at_start"] = startTriangles;
         j["pieces_alive"] = runtime.livePieces();
         j["pieces_max"] = maxPieces;
         j["awake_pieces"] = runtime.awakeDebris();

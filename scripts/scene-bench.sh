@@ -2,6 +2,8 @@
 # The scene table of bench/results: every shipped scene (and the thesis's own scenes when ../shared/seed/media
 # is present) run by `rubble-bench scene` for SECONDS (default 60) at 10 shots/s with the default worker count,
 # paced at 60 Hz with idle adoption; one row each in a fresh scene.csv, then scene.png (bench/results/scene.gp).
+# The demolition scenes (assets/scenes/demolition*.cfg) run the same way with --pattern shatter; their frames
+# are summarised per half second in demolition_frames.csv and drawn over time in demolition.png.
 # Usage: scripts/scene-bench.sh BUILD_DIR [SECONDS]
 # RUBBLE_BENCH_RESULTS=DIR writes somewhere else than bench/results/; RUBBLE_SEED_MEDIA overrides the seed
 # media folder. Each row's other_cpu_cores says how much else ran meanwhile: re-run rows where it is not ~0.
@@ -26,23 +28,42 @@ for s in cube_test.cfg performance_test.cfg world.cfg; do
 done
 
 csv="$results/scene.csv"
-rm -f "$csv"
-for s in "${scenes[@]}"; do
-    echo "== $s ($seconds s)"
+frames="$results/demolition_frames.csv"
+rm -f "$csv" "$frames"
+run() { # scene, extra options...
+    local s=$1
+    shift
+    echo "== $s ($seconds s) $*"
     # the row names the scene relative to the repository (or seed: for the thesis's own)
     name="${s#"$root/"}"
     case "$s" in "$root"/*) ;; *) name="seed:$(basename "$s")" ;; esac
     tmp="$results/.scene-row.csv"
-    rm -f "$tmp"
-    "$bench" scene "$s" --seconds "$seconds" --shots-per-second 10 --append-csv "$tmp"
+    rm -f "$tmp" "$tmp.frames"
+    "$bench" scene "$s" --seconds "$seconds" --shots-per-second 10 --append-csv "$tmp" --frames-csv "$tmp.frames" "$@"
     [ -f "$csv" ] || head -n 1 "$tmp" >"$csv"
     tail -n +2 "$tmp" | sed "s#^[^,]*#$name#" >>"$csv"
-    rm -f "$tmp"
+    if [ "$*" != "" ]; then # per half second: worst and mean frame, worst physics step, pieces at its end
+        [ -f "$frames" ] || echo "scene,second,frame_max_ms,frame_mean_ms,physics_max_ms,pieces_alive,awake_pieces,frozen_pieces" >"$frames"
+        awk -F, -v name="$name" 'NR > 1 {
+            w = int($1 / 30); if (!(w in n)) order[++k] = w
+            n[w]++; sum[w] += $2; if ($2 > mx[w]) mx[w] = $2; if ($3 > ph[w]) ph[w] = $3
+            alive[w] = $7; awake[w] = $8; frozen[w] = $9 }
+            END { for (i = 1; i <= k; i++) { w = order[i]
+                printf "%s,%.1f,%.3f,%.3f,%.3f,%d,%d,%d\n", name, (w + 1) * 0.5, mx[w], sum[w] / n[w], ph[w], alive[w], awake[w], frozen[w] } }' \
+            "$tmp.frames" >>"$frames"
+    fi
+    rm -f "$tmp" "$tmp.frames"
+}
+for s in "${scenes[@]}"; do
+    run "$s"
 done
-echo "CSV: $csv"
+for s in demolition.cfg demolition_block.cfg; do
+    run "$root/assets/scenes/$s" --pattern shatter
+done
+echo "CSV: $csv, $frames"
 if command -v gnuplot >/dev/null 2>&1; then
-    (cd "$results" && gnuplot "$root/bench/results/scene.gp") &&
-        echo "plot: $results/scene.png"
+    (cd "$results" && gnuplot "$root/bench/results/scene.gp" && gnuplot "$root/bench/results/demolition.gp") &&
+        echo "plots: $results/scene.png, $results/demolition.png"
 else
     echo "scene-bench: no gnuplot: scene.png not redrawn"
 fi

@@ -91,7 +91,9 @@ struct SupportPolicy {
     int maxSearchesPerFrame = 64; ///< support searches per frame; the rest wait for the next frame
 };
 
-/// Budgets of the debris governor (DebrisGovernor): what keeps thousands of pieces affordable.
+/// Budgets of the debris governor (DebrisGovernor): what keeps thousands of pieces affordable. Every resting
+/// moving body that carries an object may be frozen, but only pieces are ever retired (the game's own objects
+/// leave only by falling out of the world).
 struct DebrisBudget {
     int maxAwakeBodies = 400;           ///< dynamic debris bodies; beyond it the slowest freeze, then the
                                         ///< smallest become particles

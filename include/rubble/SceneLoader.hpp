@@ -19,6 +19,8 @@ struct SceneLoadOptions {
     double staticDensity = 200;   ///< density (kg/m³) of static objects, used by their moving pieces
     double impulseThreshold = 50; ///< ObjectDesc::impulseThreshold of every object
     FractureParams fracture;      ///< ObjectDesc::fracture of every object
+    double maxOverlap = 0.5; ///< an object whose bounding box overlaps an earlier one's by more than this
+                             ///< share of the smaller box, one of them moving, is not loaded (with a warning)
     std::function<void(Mesh&)>
         prepareMesh; ///< called on every object mesh (scaled, object coordinates) before it is added, e.g.
                      ///< to generate texture coordinates; may be empty

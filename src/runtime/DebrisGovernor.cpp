@@ -100,7 +100,8 @@ GovernorActions DebrisGovernor::update(const BodyTable& bodies, const PhysicsBin
             out.wake.push_back(id);
 
     std::set<BodyId> leaving;
-    std::vector<std::pair<double, BodyId>> stillAwake;
+    std::vector<std::pair<double, BodyId>> stillAwake; // pieces: the game's own objects are never retired
+    int awakeObjects = 0;
     for (BodyId id : bodies.awakeIds()) {
         const BodyRecord& r = *bodies.find(id);
         const BodyMotion m = binding.motion(id);
@@ -110,7 +111,8 @@ GovernorActions DebrisGovernor::update(const BodyTable& bodies, const PhysicsBin
             leaving.insert(id);
             continue;
         }
-        if (r.volume < budget_.fadeVolume && length(p - focus) > budget_.fadeDistance) {
+        const bool piece = r.role == BodyRole::Piece;
+        if (piece && r.volume < budget_.fadeVolume && length(p - focus) > budget_.fadeDistance) {
             out.retire.push_back({id, RetireReason::Fade});
             leaving.insert(id);
             continue;
@@ -124,7 +126,10 @@ GovernorActions DebrisGovernor::update(const BodyTable& bodies, const PhysicsBin
             leaving.insert(id);
             continue;
         }
-        stillAwake.push_back({r.volume, id});
+        if (piece)
+            stillAwake.push_back({r.volume, id});
+        else
+            ++awakeObjects;
     }
 
     if (!deterministic && budget_.physicsBudgetMs > 0) { // shrink fast, grow back slowly
@@ -137,7 +142,7 @@ GovernorActions DebrisGovernor::update(const BodyTable& bodies, const PhysicsBin
     } else {
         awakeBudget_ = -1;
     }
-    const int excess = static_cast<int>(stillAwake.size() + out.wake.size()) - awakeBudget();
+    const int excess = static_cast<int>(stillAwake.size() + out.wake.size()) + awakeObjects - awakeBudget();
     if (excess > 0) {
         std::sort(stillAwake.begin(), stillAwake.end());
         for (int i = 0; i < excess && i < static_cast<int>(stillAwake.size()); ++i) {
@@ -153,8 +158,8 @@ GovernorActions DebrisGovernor::update(const BodyTable& bodies, const PhysicsBin
     if (triangles > budget_.maxTriangles) { // the smallest frozen pieces first, then the smallest awake
         std::vector<std::pair<double, BodyId>> candidates;
         for (BodyId id : bodies.frozenIds())
-            if (!woken.count(id))
-                candidates.push_back({bodies.find(id)->volume, id});
+            if (const BodyRecord* r = bodies.find(id); !woken.count(id) && r->role == BodyRole::Piece)
+                candidates.push_back({r->volume, id});
         std::sort(candidates.begin(), candidates.end());
         std::vector<std::pair<double, BodyId>> awake;
         for (const auto& [v, id] : stillAwake)

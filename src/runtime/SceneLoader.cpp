@@ -1,5 +1,6 @@
 #include "rubble/SceneLoader.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "rubble/MassProperties.hpp"
@@ -29,6 +30,19 @@ Mesh modelOrStandIn(const SceneConfig& scene, const SceneObject& o, std::vector<
     return makeBox(-h, h);
 }
 
+// Volume of the intersection of two boxes (0 when they do not overlap).
+double overlapVolume(const Aabb& a, const Aabb& b) {
+    double v = 1;
+    for (int k = 0; k < 3; ++k)
+        v *= std::max(0.0, std::min(a.hi[k], b.hi[k]) - std::max(a.lo[k], b.lo[k]));
+    return v;
+}
+
+double boxVolume(const Aabb& a) {
+    const Vec3 s = a.size();
+    return s.x * s.y * s.z;
+}
+
 } // namespace
 
 LoadedScene loadScene(const SceneConfig& scene, DestructionRuntime& runtime,
@@ -56,11 +70,33 @@ LoadedScene loadScene(const SceneConfig& scene, DestructionRuntime& runtime,
             out.warnings.push_back(where(scene, scene.vehicle) + ": vehicle skipped (" +
                                    body.error().message + ")");
     }
+    struct Placed {
+        Aabb bounds;
+        bool isStatic = true;
+        std::size_t line = 0;
+    };
+    std::vector<Placed> placed;
     for (std::size_t index = 0; index < scene.objects.size(); ++index) {
         const SceneObject& o = scene.objects[index];
         Mesh mesh = modelOrStandIn(scene, o, out.warnings);
         if (options.prepareMesh)
             options.prepareMesh(mesh);
+        // Bodies placed inside each other would push apart in one physics step of unbounded cost (600
+        // buildings on one spot: 6.6 s and 1.4 GB for the first step), so a moving object whose bounds lie
+        // mostly inside an earlier object's (or a static one inside a moving one's) is not loaded.
+        const Aabb bounds{mesh.bounds().lo + o.position, mesh.bounds().hi + o.position};
+        const auto clash = std::find_if(placed.begin(), placed.end(), [&](const Placed& p) {
+            return (!o.isStatic() || !p.isStatic) &&
+                   overlapVolume(bounds, p.bounds) >
+                       options.maxOverlap * std::min(boxVolume(bounds), boxVolume(p.bounds));
+        });
+        if (clash != placed.end()) {
+            out.warnings.push_back(where(scene, o) + ": '" + o.model + "' lies inside the object of line " +
+                                   std::to_string(clash->line) +
+                                   " (a moving body there would blow the pile apart); not loaded");
+            continue;
+        }
+        placed.push_back({bounds, o.isStatic(), o.line});
         const double volume = std::abs(signedVolume(mesh));
         ObjectDesc desc;
         desc.density = o.isStatic() || volume <= 0 ? options.staticDensity : o.mass / volume;

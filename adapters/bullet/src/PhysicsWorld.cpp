@@ -14,6 +14,7 @@ PhysicsWorld::PhysicsWorld(Config config) : config_(config) {
     world_ = std::make_unique<btDiscreteDynamicsWorld>(dispatcher_.get(), broadphase_.get(), solver_.get(),
                                                        collisionConfig_.get());
     world_->setGravity(toBt(config_.gravity));
+    world_->setForceUpdateAllAabbs(false); // static bodies (thousands of frozen pieces) keep their bounds
     world_->getSolverInfo().m_numIterations = config_.solverIterations;
     world_->setInternalTickCallback(&PhysicsWorld::preTickThunk, this, true);
     world_->setInternalTickCallback(&PhysicsWorld::postTickThunk, this, false);
