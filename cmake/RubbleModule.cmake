@@ -2,8 +2,8 @@
 # a static library built from every .cpp in the current folder. Each module is its own target so that it
 # can be built and tested alone; every module registers itself and its dependencies in the global properties
 # RUBBLE_CORE_MODULES and RUBBLE_CORE_LINK_DEPS, from which src/CMakeLists.txt makes the in-tree union
-# `rubble` and the installed shared library (Rubble::rubble). DEPS are what the module's public headers need, PRIVATE_DEPS what only its .cpp files
-# need. A module with no sources yet is an interface target.
+# `rubble` and the installed shared library (Rubble::rubble). DEPS are what the module's public headers need,
+# PRIVATE_DEPS what only its .cpp files need. A module with no sources yet is an interface target.
 function(rubble_module name)
     cmake_parse_arguments(ARG "" "" "DEPS;PRIVATE_DEPS;SYSTEM_INCLUDES" ${ARGN})
     file(GLOB sources CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*.cpp)
