@@ -11,6 +11,14 @@
 
 #define RUBBLE_C_API __attribute__((visibility("default")))
 
+/// Declares a C enum; in C++ its underlying type is int, so that any int a caller passes is a valid value
+/// (the library then refuses it as an invalid argument instead of reading an out-of-range enum).
+#ifdef __cplusplus
+#define RUBBLE_C_ENUM(name) enum name : int
+#else
+#define RUBBLE_C_ENUM(name) enum name
+#endif
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -19,7 +27,7 @@ extern "C" {
 #define RUBBLE_C_API_VERSION 1
 
 /// What a call returned: RUBBLE_OK or why it failed (1-7 are the library's rubble::ErrorCode values).
-typedef enum rubble_status {
+typedef RUBBLE_C_ENUM(rubble_status){
     RUBBLE_OK = 0,                      ///< success
     RUBBLE_ERROR_IO = 1,                ///< a file could not be opened, read or written
     RUBBLE_ERROR_PARSE = 2,             ///< a file was read but its content is malformed
@@ -121,13 +129,13 @@ RUBBLE_C_API rubble_status rubble_mesh_check(const rubble_mesh* mesh, rubble_mes
 RUBBLE_C_API rubble_status rubble_mesh_mass_properties(const rubble_mesh* mesh, rubble_mass_properties* out);
 
 /// Which cells an impact cuts.
-typedef enum rubble_pattern {
+typedef RUBBLE_C_ENUM(rubble_pattern){
     RUBBLE_PATTERN_SINGLE_CELL = 0, ///< one Voronoi cell at the impact (the thesis's method)
     RUBBLE_PATTERN_SHATTER = 1,     ///< `cells` Voronoi cells around the impact, denser near it
 } rubble_pattern;
 
 /// Which boolean implementation cuts.
-typedef enum rubble_backend {
+typedef RUBBLE_C_ENUM(rubble_backend){
     RUBBLE_BACKEND_FAST = 0,     ///< the convex-cell clipper with exact fallback (default)
     RUBBLE_BACKEND_COREFINE = 1, ///< CGAL corefinement (exact)
     RUBBLE_BACKEND_NEF = 2,      ///< CGAL Nef polyhedra (the thesis's method; slow)

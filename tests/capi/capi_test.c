@@ -290,6 +290,11 @@ static void test_fracture(void) {
     params.backend = (rubble_backend)9;
     CHECK(rubble_fracture_mesh(cube, &impact, &params, &missed) == RUBBLE_ERROR_INVALID_ARGUMENT);
     CHECK(contains(rubble_last_error(), "backend"));
+    params.backend = RUBBLE_BACKEND_FAST;
+    params.pattern = (rubble_pattern)-3;
+    CHECK(rubble_fracture_mesh(cube, &impact, &params, &missed) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(contains(rubble_last_error(), "pattern"));
+    params.pattern = RUBBLE_PATTERN_SHATTER;
     CHECK(rubble_fracture_mesh(cube, &far_away, NULL, &missed) == RUBBLE_ERROR_NO_INTERSECTION);
     CHECK(missed == NULL);
     {
