@@ -3,6 +3,8 @@
 #   make test    install, build, check formatting and layering, run all tests
 #   make bench   install, build Release, run the benchmarks (CSV + PNG in bench/results/)
 #   make build   install and build (RelWithDebInfo) into build/
+#   make install     build, then install headers, libraries, CMake package, pkg-config files, the CLI and the
+#                    Python module into PREFIX (default /usr/local): cmake --install build --prefix PREFIX
 #   make sanitize    clang ASan+UBSan build of the whole test suite (build-asan/) and TSan build of the runtime
 #                    and Bullet tests (build-tsan/), both run by CTest (scripts/sanitize.sh)
 #   make sanitize-ci what CI runs after make test: make sanitize, then every libFuzzer target for a fixed seed and
@@ -16,28 +18,38 @@ BUILD_TYPE ?= RelWithDebInfo
 RELEASE_DIR ?= build-release
 JOBS       ?= $(shell nproc)
 CMAKE_ARGS ?=
+PREFIX     ?= /usr/local
+# The dependency installer runs again only when scripts/install-deps.sh changed since it last succeeded.
+DEPS_STAMP  = .deps/core.stamp
+DEPS_ALL_STAMP = .deps/all.stamp
 
 FUZZ_SECONDS ?= 45
 STRESS_IMPACTS ?= 10000
 SOAK_FRAMES ?= 100000
 
-.PHONY: all deps build release test demo bench format format-check lint clean deps-clang sanitize sanitize-ci fuzz-smoke \
-	stress soak
+.PHONY: all deps build release install test demo bench format format-check lint clean deps-clang sanitize sanitize-ci \
+	fuzz-smoke stress soak
 
 all: build
 
-deps:
-	@bash scripts/install-deps.sh
+deps: $(DEPS_STAMP)
 
-$(BUILD_DIR)/build.ninja: | deps
+$(DEPS_STAMP): scripts/install-deps.sh
+	@bash scripts/install-deps.sh
+	@mkdir -p $(@D) && touch $@
+
+$(BUILD_DIR)/build.ninja: | $(DEPS_STAMP)
 	cmake -S . -B $(BUILD_DIR) -G Ninja -DCMAKE_BUILD_TYPE=$(BUILD_TYPE) $(CMAKE_ARGS)
 
 build: deps $(BUILD_DIR)/build.ninja
 	cmake --build $(BUILD_DIR) -j $(JOBS)
 
+install: build
+	cmake --install $(BUILD_DIR) --prefix $(PREFIX)
+
 release: deps
 	@[ -f $(RELEASE_DIR)/build.ninja ] || cmake -S . -B $(RELEASE_DIR) -G Ninja -DCMAKE_BUILD_TYPE=Release \
-	    -DRUBBLE_BUILD_TESTS=OFF $(CMAKE_ARGS)
+	    -DRUBBLE_BUILD_TESTS=OFF -DRUBBLE_BUILD_PYTHON=OFF $(CMAKE_ARGS)
 	cmake --build $(RELEASE_DIR) -j $(JOBS)
 
 lint: deps
@@ -53,8 +65,11 @@ demo: build
 bench: release
 	@bash scripts/run-bench.sh $(RELEASE_DIR)
 
-deps-clang:
+deps-clang: $(DEPS_ALL_STAMP)
+
+$(DEPS_ALL_STAMP): scripts/install-deps.sh
 	@bash scripts/install-deps.sh all
+	@mkdir -p $(@D) && touch $@
 
 sanitize: deps-clang
 	@bash scripts/sanitize.sh all

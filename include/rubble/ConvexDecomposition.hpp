@@ -15,6 +15,8 @@
 
 namespace rubble {
 
+struct FractureResult;
+
 /// Parameters of a decomposition.
 struct DecompositionParams {
     int maxParts = 24;       ///< at most this many convex parts
@@ -46,6 +48,10 @@ std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<C
                                                              const std::vector<ConvexPolytope>& cells,
                                                              const std::vector<Mesh>& pieces,
                                                              const std::vector<std::int32_t>& pieceCells,
+                                                             const DecompositionParams& params = {});
+/// updateDecomposition for the pieces of a fracture (rubble/Fracture.hpp): one part list per piece of result.
+std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<ConvexPolytope>& parentParts,
+                                                             const FractureResult& result,
                                                              const DecompositionParams& params = {});
 
 /// Thread-safe cache of decompositions keyed by Mesh::hash(), optionally persisted in a directory. The memory

@@ -1,6 +1,8 @@
 #pragma once
 /// \file Result.hpp
 /// Errors as data: no exception crosses Rubble's API. Functions that can fail return Result<T> or Status.
+/// Both are [[nodiscard]]: an ignored error is a compile warning. Reading the value of a failed Result is a
+/// programming error: it logs the error (see Log.hpp) and aborts.
 
 #include <cassert>
 #include <string>
@@ -31,7 +33,7 @@ struct Error {
 };
 
 /// Success or an Error, for functions without a value.
-class Status {
+class [[nodiscard]] Status {
 public:
     /// A successful status.
     Status() = default;
@@ -52,9 +54,16 @@ private:
     Error error_;
 };
 
+namespace detail {
+/// Logs "Result::value() called on a failed Result: <code>: <message>" as an error and aborts.
+[[noreturn]] void failedValueAccess(const Error& error);
+/// The Error of every successful Result (code Ok, no message).
+const Error& noError();
+} // namespace detail
+
 /// A value of type T or an Error.
 template <class T>
-class Result {
+class [[nodiscard]] Result {
 public:
     /// A successful result holding value.
     Result(T value) : v_(std::move(value)) {}
@@ -64,26 +73,42 @@ public:
     bool isOk() const { return std::holds_alternative<T>(v_); }
     /// True when a value is present.
     explicit operator bool() const { return isOk(); }
-    /// The value; only valid when isOk().
-    T& value() & { return std::get<T>(v_); }
-    /// The value; only valid when isOk().
-    const T& value() const& { return std::get<T>(v_); }
-    /// The value moved out; only valid when isOk().
-    T&& value() && { return std::get<T>(std::move(v_)); }
-    /// The value; only valid when isOk().
-    T& operator*() & { return std::get<T>(v_); }
-    /// The value; only valid when isOk().
-    const T& operator*() const& { return std::get<T>(v_); }
-    /// Pointer-like access to the value.
-    T* operator->() { return &std::get<T>(v_); }
-    /// Pointer-like access to the value.
-    const T* operator->() const { return &std::get<T>(v_); }
-    /// The error; only valid when !isOk().
-    const Error& error() const { return std::get<Error>(v_); }
+    /// The value; aborts with the error's message when !isOk().
+    T& value() & { return checked(); }
+    /// The value; aborts with the error's message when !isOk().
+    const T& value() const& { return checked(); }
+    /// The value moved out; aborts with the error's message when !isOk().
+    T&& value() && { return std::move(checked()); }
+    /// The value; aborts with the error's message when !isOk().
+    T& operator*() & { return checked(); }
+    /// The value; aborts with the error's message when !isOk().
+    const T& operator*() const& { return checked(); }
+    /// The value moved out; aborts with the error's message when !isOk().
+    T&& operator*() && { return std::move(checked()); }
+    /// Pointer-like access to the value; aborts with the error's message when !isOk().
+    T* operator->() { return &checked(); }
+    /// Pointer-like access to the value; aborts with the error's message when !isOk().
+    const T* operator->() const { return &checked(); }
+    /// The error (code Ok when successful, like Status::error()).
+    const Error& error() const {
+        const Error* e = std::get_if<Error>(&v_);
+        return e ? *e : detail::noError();
+    }
     /// The status of this result.
     Status status() const { return isOk() ? Status() : Status(error()); }
 
 private:
+    T& checked() {
+        if (T* v = std::get_if<T>(&v_))
+            return *v;
+        detail::failedValueAccess(std::get<Error>(v_));
+    }
+    const T& checked() const {
+        if (const T* v = std::get_if<T>(&v_))
+            return *v;
+        detail::failedValueAccess(std::get<Error>(v_));
+    }
+
     std::variant<T, Error> v_;
 };
 

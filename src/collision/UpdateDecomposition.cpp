@@ -7,6 +7,7 @@
 
 #include "collision/MeshRegion.hpp"
 #include "rubble/ConvexDecomposition.hpp"
+#include "rubble/Fracture.hpp"
 #include "rubble/MassProperties.hpp"
 
 namespace rubble {
@@ -331,6 +332,19 @@ std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<C
         mergeToBudget(parts, origins[i], params.maxParts);
     }
     return result;
+}
+
+std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<ConvexPolytope>& parentParts,
+                                                             const FractureResult& result,
+                                                             const DecompositionParams& params) {
+    std::vector<Mesh> meshes;
+    std::vector<std::int32_t> pieceCells;
+    meshes.reserve(result.pieces.size());
+    for (const Piece& piece : result.pieces) {
+        meshes.push_back(piece.mesh);
+        pieceCells.push_back(piece.cell);
+    }
+    return updateDecomposition(parentParts, result.cells, meshes, pieceCells, params);
 }
 
 } // namespace rubble

@@ -1,5 +1,10 @@
 #include "rubble/Result.hpp"
 
+#include <cstdlib>
+#include <string>
+
+#include "rubble/Log.hpp"
+
 namespace rubble {
 
 const char* toString(ErrorCode code) {
@@ -25,3 +30,18 @@ const char* toString(ErrorCode code) {
 }
 
 } // namespace rubble
+
+namespace rubble::detail {
+
+void failedValueAccess(const Error& error) {
+    logMessage(LogLevel::Error, std::string("Result::value() called on a failed Result: ") +
+                                    toString(error.code) + ": " + error.message);
+    std::abort();
+}
+
+const Error& noError() {
+    static const Error none;
+    return none;
+}
+
+} // namespace rubble::detail

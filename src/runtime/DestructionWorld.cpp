@@ -4,13 +4,14 @@
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
-#include <cstdio>
 #include <fstream>
 #include <limits>
 #include <map>
 #include <mutex>
+#include <string>
 
 #include "geometry/ClosestPoint.hpp"
+#include "rubble/Log.hpp"
 #include "rubble/MassProperties.hpp"
 #include "rubble/MeshCheck.hpp"
 #include "rubble/MeshRepair.hpp"
@@ -327,7 +328,7 @@ Result<ObjectId> DestructionWorld::addObject(ObjectDesc desc) {
         if (again.valid()) {
             s.warning = "mesh was repaired: " +
                         (report.problems.empty() ? std::string("invalid") : report.problems.front());
-            std::fprintf(stderr, "rubble: warning: object %u: %s\n", s.id, s.warning.c_str());
+            logMessage(LogLevel::Warning, "object " + std::to_string(s.id) + ": " + s.warning);
             desc.mesh = std::move(repaired);
             report = std::move(again);
         }
@@ -337,7 +338,7 @@ Result<ObjectId> DestructionWorld::addObject(ObjectDesc desc) {
         s.warning = "mesh is not a valid closed solid";
         if (!report.problems.empty())
             s.warning += ": " + report.problems.front();
-        std::fprintf(stderr, "rubble: warning: object %u is indestructible: %s\n", s.id, s.warning.c_str());
+        logMessage(LogLevel::Warning, "object " + std::to_string(s.id) + " is indestructible: " + s.warning);
     }
     s.mass = computeMassProperties(desc.mesh);
     s.convexParts = std::move(desc.convexParts);

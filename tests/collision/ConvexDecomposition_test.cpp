@@ -326,18 +326,12 @@ TEST(UpdateDecomposition, ShatterPatternsKeepCoverageAndBudget) {
             fp.sizeLaw.scale = 0;
             auto fr = fracture(start, {b.center() + Vec3{0.1, 0.05, 0.02}, {1, 0, 0}, 1}, fp, seed);
             ASSERT_TRUE(fr) << fr.error().message;
-            std::vector<Mesh> pieces;
-            std::vector<std::int32_t> pieceCells;
-            for (const Piece& p : fr->pieces) {
-                pieces.push_back(p.mesh);
-                pieceCells.push_back(p.cell);
-            }
             DecompositionParams params;
             params.maxParts = 8;
-            auto updated = updateDecomposition(d->parts, fr->cells, pieces, pieceCells, params);
-            ASSERT_EQ(updated.size(), pieces.size());
-            for (std::size_t i = 0; i < pieces.size(); ++i) {
-                expectCovers(pieces[i], updated[i], 1e-6 * diag(start));
+            auto updated = updateDecomposition(d->parts, *fr, params);
+            ASSERT_EQ(updated.size(), fr->pieces.size());
+            for (std::size_t i = 0; i < updated.size(); ++i) {
+                expectCovers(fr->pieces[i].mesh, updated[i], 1e-6 * diag(start));
                 EXPECT_LE(updated[i].size(), 8u);
                 for (const ConvexPolytope& part : updated[i]) {
                     const Aabb pb = part.bounds();
@@ -346,6 +340,34 @@ TEST(UpdateDecomposition, ShatterPatternsKeepCoverageAndBudget) {
                 }
             }
         }
+    }
+}
+
+TEST(UpdateDecomposition, OfAFractureResultGivesEachPieceItsParts) {
+    const Mesh start = makeLPrism(2);
+    auto d = decompose(start);
+    ASSERT_TRUE(d);
+    FractureParams fp;
+    fp.pattern = CellPattern::Shatter;
+    fp.cells = 4;
+    auto fr = fracture(start, {{1.5, 0.5, 2}, {0, 0, 1}, 30}, fp, 3);
+    ASSERT_TRUE(fr) << fr.error().message;
+    std::vector<Mesh> pieces;
+    std::vector<std::int32_t> pieceCells;
+    for (const Piece& p : fr->pieces) {
+        pieces.push_back(p.mesh);
+        pieceCells.push_back(p.cell);
+    }
+    DecompositionParams params;
+    params.maxParts = 6;
+    const auto expected = updateDecomposition(d->parts, fr->cells, pieces, pieceCells, params);
+    const auto parts = updateDecomposition(d->parts, *fr, params);
+    ASSERT_EQ(parts.size(), fr->pieces.size());
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+        ASSERT_EQ(parts[i].size(), expected[i].size());
+        for (std::size_t k = 0; k < parts[i].size(); ++k)
+            EXPECT_EQ(parts[i][k].vertices(), expected[i][k].vertices());
+        expectCovers(fr->pieces[i].mesh, parts[i], 1e-6 * diag(start));
     }
 }
 

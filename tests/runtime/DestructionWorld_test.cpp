@@ -6,9 +6,12 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include "TestSupport.hpp"
+#include "rubble/Log.hpp"
 #include "rubble/MassProperties.hpp"
 #include "rubble/Random.hpp"
 #include "rubble/ThreadPool.hpp"
@@ -76,12 +79,24 @@ TEST(DestructionWorld, OpenMeshIsIndestructible) {
     DestructionWorld w(heldConfig(jobs));
     ObjectDesc d = boxDesc();
     d.mesh.triangles.pop_back();
+    std::vector<std::string> logged;
+    setLogFunction([&](LogLevel level, std::string_view message) {
+        logged.push_back(std::string(toString(level)) + ": " + std::string(message));
+    });
+    testing::internal::CaptureStderr();
     auto id = w.addObject(d);
+    const std::string printed = testing::internal::GetCapturedStderr();
+    setLogFunction({});
     ASSERT_TRUE(id);
     ASSERT_NE(w.object(id.value()), nullptr);
     EXPECT_FALSE(w.object(id.value())->destructible);
     EXPECT_FALSE(w.object(id.value())->warning.empty());
     EXPECT_FALSE(w.submitImpact(id.value(), centreHit()));
+    // The warning goes to the log function, not to stderr.
+    ASSERT_EQ(logged.size(), 1u);
+    EXPECT_EQ(logged[0], "warning: object " + std::to_string(*id) +
+                             " is indestructible: " + w.object(id.value())->warning);
+    EXPECT_EQ(printed, "");
 }
 
 TEST(DestructionWorld, ImpactConservesVolumeAndMass) {

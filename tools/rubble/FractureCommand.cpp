@@ -143,16 +143,9 @@ void runJob(MeshJob& job, const rubble::Impact& impact, const rubble::FracturePa
         return;
     }
     job.timings = fr->timings;
-    std::vector<rubble::Mesh> meshes;
-    std::vector<std::int32_t> pieceCells;
-    for (const rubble::Piece& p : fr->pieces) {
-        meshes.push_back(p.mesh);
-        pieceCells.push_back(p.cell);
-    }
     const auto td = Clock::now();
     const std::vector<rubble::ConvexPolytope> none;
-    const auto parts =
-        rubble::updateDecomposition(parent ? parent->parts : none, fr->cells, meshes, pieceCells);
+    const auto parts = rubble::updateDecomposition(parent ? parent->parts : none, *fr);
     job.decompositionMs = msSince(td);
     rubble::CheckOptions noSelfIntersections;
     noSelfIntersections.selfIntersections = false;

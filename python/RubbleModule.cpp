@@ -1,0 +1,348 @@
+// The Python module rubble._rubble (re-exported by rubble/__init__.py; typed in rubble/__init__.pyi): meshes
+// as numpy arrays, checks, fracture with mass properties and convex parts, decomposition. Library errors
+// become rubble.Error with the library's message; the GIL is released while the library works.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "rubble/ConvexDecomposition.hpp"
+#include "rubble/Fracture.hpp"
+#include "rubble/MassProperties.hpp"
+#include "rubble/Mesh.hpp"
+#include "rubble/MeshCheck.hpp"
+#include "rubble/MeshIO.hpp"
+#include "rubble/MeshRepair.hpp"
+
+namespace py = pybind11;
+
+namespace {
+
+using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
+using IndexArray = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>;
+
+/// A library error on its way to Python (becomes rubble.Error).
+struct LibraryError {
+    rubble::Error error;
+};
+
+template <class T>
+T unwrap(rubble::Result<T> result) {
+    if (!result)
+        throw LibraryError{result.error()};
+    return std::move(result).value();
+}
+
+void unwrap(const rubble::Status& status) {
+    if (!status)
+        throw LibraryError{status.error()};
+}
+
+/// An (n, columns) float64 array copied from n records of `columns` doubles each.
+template <class T>
+DoubleArray rows(const std::vector<T>& values, py::ssize_t columns) {
+    static_assert(sizeof(T) % sizeof(double) == 0);
+    DoubleArray out({static_cast<py::ssize_t>(values.size()), columns});
+    if (!values.empty())
+        std::memcpy(out.mutable_data(), values.data(), values.size() * sizeof(T));
+    return out;
+}
+
+DoubleArray vec3(const rubble::Vec3& v) {
+    DoubleArray out(3);
+    auto d = out.mutable_unchecked<1>();
+    d(0) = v.x;
+    d(1) = v.y;
+    d(2) = v.z;
+    return out;
+}
+
+DoubleArray mat3(const rubble::Mat3& m) {
+    DoubleArray out({3, 3});
+    auto d = out.mutable_unchecked<2>();
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c)
+            d(r, c) = m.m[r][c];
+    return out;
+}
+
+/// An array of exactly `columns` columns (any number of rows), or ValueError naming `what`.
+DoubleArray doubleRows(const py::object& input, py::ssize_t columns, const char* what) {
+    DoubleArray a = DoubleArray::ensure(input);
+    if (!a)
+        throw py::value_error(std::string(what) + ": expected an array of numbers");
+    if (a.ndim() != 2 || a.shape(1) != columns)
+        throw py::value_error(std::string(what) + ": expected shape (n, " + std::to_string(columns) + ")");
+    return a;
+}
+
+/// A length-3 vector, or ValueError naming `what`.
+rubble::Vec3 toVec3(const py::object& input, const char* what) {
+    DoubleArray a = DoubleArray::ensure(input);
+    if (!a || a.ndim() != 1 || a.shape(0) != 3)
+        throw py::value_error(std::string(what) + ": expected 3 numbers");
+    return {a.at(0), a.at(1), a.at(2)};
+}
+
+template <class T>
+std::vector<T> fromRows(const DoubleArray& a) {
+    std::vector<T> out(static_cast<std::size_t>(a.shape(0)));
+    if (!out.empty())
+        std::memcpy(static_cast<void*>(out.data()), a.data(), out.size() * sizeof(T));
+    return out;
+}
+
+/// A Mesh from numpy arrays; triangles must be integers in range.
+rubble::Mesh makeMesh(const py::object& vertices, const py::object& triangles, const py::object& materials,
+                      const py::object& uvs, const py::object& normals) {
+    rubble::Mesh mesh;
+    mesh.positions = fromRows<rubble::Vec3>(doubleRows(vertices, 3, "vertices"));
+    py::array raw = py::array::ensure(triangles);
+    if (!raw || (raw.size() > 0 && raw.dtype().kind() != 'i' && raw.dtype().kind() != 'u'))
+        throw py::value_error("triangles: expected an array of integers");
+    IndexArray tri = IndexArray::ensure(raw);
+    if (tri.ndim() != 2 || tri.shape(1) != 3) {
+        if (!(tri.ndim() == 1 && tri.shape(0) == 0))
+            throw py::value_error("triangles: expected shape (m, 3)");
+    }
+    const std::size_t m = tri.ndim() == 2 ? static_cast<std::size_t>(tri.shape(0)) : 0;
+    mesh.triangles.resize(m);
+    const std::int64_t* t = tri.data();
+    for (std::size_t i = 0; i < 3 * m; ++i) {
+        if (t[i] < 0 || t[i] >= static_cast<std::int64_t>(mesh.positions.size()))
+            throw py::value_error("triangles: index " + std::to_string(t[i]) + " of triangle " +
+                                  std::to_string(i / 3) + " is out of range (" +
+                                  std::to_string(mesh.positions.size()) + " vertices)");
+        mesh.triangles[i / 3][i % 3] = static_cast<std::uint32_t>(t[i]);
+    }
+    if (!materials.is_none())
+        mesh.materials = materials.cast<std::vector<std::uint32_t>>();
+    if (!uvs.is_none())
+        mesh.uvs = fromRows<rubble::Vec2>(doubleRows(uvs, 2, "uvs"));
+    if (!normals.is_none())
+        mesh.normals = fromRows<rubble::Vec3>(doubleRows(normals, 3, "normals"));
+    unwrap(mesh.validate());
+    return mesh;
+}
+
+py::object materialsOf(const rubble::Mesh& mesh) {
+    if (mesh.materials.empty())
+        return py::none();
+    return py::array_t<std::uint32_t>(static_cast<py::ssize_t>(mesh.materials.size()), mesh.materials.data());
+}
+
+py::object uvsOf(const rubble::Mesh& mesh) {
+    return mesh.uvs.empty() ? py::object(py::none()) : rows(mesh.uvs, 2);
+}
+
+py::object normalsOf(const rubble::Mesh& mesh) {
+    return mesh.normals.empty() ? py::object(py::none()) : rows(mesh.normals, 3);
+}
+
+py::array_t<std::uint32_t> trianglesOf(const rubble::Mesh& mesh) {
+    py::array_t<std::uint32_t> out({static_cast<py::ssize_t>(mesh.triangles.size()), py::ssize_t{3}});
+    if (!mesh.triangles.empty())
+        std::memcpy(out.mutable_data(), mesh.triangles.data(),
+                    mesh.triangles.size() * sizeof(rubble::Triangle));
+    return out;
+}
+
+/// One piece of a fracture as Python sees it: a Mesh with its mass properties, cell and convex parts.
+struct PyPiece : rubble::Mesh {
+    rubble::MassProperties mass;
+    std::int32_t cell = -1;
+    std::vector<std::vector<rubble::Vec3>> convexParts; // corner points per part
+};
+
+py::list convexPartsOf(const std::vector<std::vector<rubble::Vec3>>& parts) {
+    py::list out;
+    for (const auto& points : parts)
+        out.append(rows(points, 3));
+    return out;
+}
+
+rubble::BooleanKind backendOf(const std::string& name) {
+    if (name == "fast")
+        return rubble::BooleanKind::Fast;
+    if (name == "corefine")
+        return rubble::BooleanKind::Corefine;
+    if (name == "nef")
+        return rubble::BooleanKind::Nef;
+    throw py::value_error("backend: expected 'fast', 'corefine' or 'nef', got '" + name + "'");
+}
+
+std::vector<PyPiece> fractureMesh(const rubble::Mesh& mesh, const py::object& point, const py::object& normal,
+                                  double impulse, int cells, std::uint64_t seed, const std::string& backend,
+                                  bool convexParts, int maxParts) {
+    rubble::Impact impact;
+    impact.point = toVec3(point, "point");
+    impact.normal = toVec3(normal, "normal");
+    impact.impulse = impulse;
+    if (cells < 1)
+        throw py::value_error("cells: expected at least 1");
+    if (maxParts < 1)
+        throw py::value_error("max_parts: expected at least 1");
+    rubble::FractureParams params;
+    params.backend = backendOf(backend);
+    params.pattern = cells > 1 ? rubble::CellPattern::Shatter : rubble::CellPattern::SingleCell;
+    params.cells = cells;
+    std::vector<PyPiece> pieces;
+    py::gil_scoped_release unlocked;
+    rubble::FractureResult result = unwrap(rubble::fracture(mesh, impact, params, seed));
+    std::vector<std::vector<rubble::ConvexPolytope>> parts;
+    if (convexParts) {
+        rubble::DecompositionParams dp;
+        dp.maxParts = maxParts;
+        parts = rubble::updateDecomposition(unwrap(rubble::decompose(mesh, dp)).parts, result, dp);
+    }
+    for (std::size_t i = 0; i < result.pieces.size(); ++i) {
+        PyPiece& p = pieces.emplace_back();
+        static_cast<rubble::Mesh&>(p) = std::move(result.pieces[i].mesh);
+        p.mass = result.pieces[i].mass;
+        p.cell = result.pieces[i].cell;
+        if (i < parts.size())
+            for (const rubble::ConvexPolytope& part : parts[i])
+                p.convexParts.push_back(part.vertices());
+    }
+    return pieces;
+}
+
+py::list decomposeMesh(const rubble::Mesh& mesh, int maxParts, double concavity) {
+    if (maxParts < 1)
+        throw py::value_error("max_parts: expected at least 1");
+    rubble::DecompositionParams params;
+    params.maxParts = maxParts;
+    params.concavity = concavity;
+    std::vector<std::vector<rubble::Vec3>> parts;
+    {
+        py::gil_scoped_release unlocked;
+        for (const rubble::ConvexPolytope& part : unwrap(rubble::decompose(mesh, params)).parts)
+            parts.push_back(part.vertices());
+    }
+    return convexPartsOf(parts);
+}
+
+} // namespace
+
+PYBIND11_MODULE(_rubble, m) {
+    m.doc() =
+        "Rubble: fracture closed meshes at an impact into pieces with mass properties and convex parts.";
+    static py::exception<LibraryError> error(m, "Error", PyExc_RuntimeError);
+    py::register_exception_translator([](std::exception_ptr p) {
+        try {
+            if (p)
+                std::rethrow_exception(p);
+        } catch (const LibraryError& e) {
+            py::object instance = py::reinterpret_borrow<py::object>(error.ptr())(e.error.message);
+            instance.attr("code") = rubble::toString(e.error.code);
+            PyErr_SetObject(error.ptr(), instance.ptr());
+        }
+    });
+    m.attr("INTERIOR_MATERIAL") = rubble::kInteriorMaterial;
+
+    py::class_<rubble::Mesh>(m, "Mesh")
+        .def(py::init(&makeMesh), py::arg("vertices"), py::arg("triangles"), py::kw_only(),
+             py::arg("materials") = py::none(), py::arg("uvs") = py::none(), py::arg("normals") = py::none())
+        .def_property_readonly("vertices", [](const rubble::Mesh& mesh) { return rows(mesh.positions, 3); })
+        .def_property_readonly("triangles", &trianglesOf)
+        .def_property_readonly("materials", &materialsOf)
+        .def_property_readonly("uvs", &uvsOf)
+        .def_property_readonly("normals", &normalsOf)
+        .def_property_readonly("vertex_count", &rubble::Mesh::vertexCount)
+        .def_property_readonly("triangle_count", &rubble::Mesh::triangleCount)
+        .def_property_readonly("volume", [](const rubble::Mesh& mesh) { return rubble::signedVolume(mesh); })
+        .def("hash", &rubble::Mesh::hash)
+        .def("__eq__", [](const rubble::Mesh& a, const rubble::Mesh& b) { return a == b; })
+        .def("__repr__", [](const rubble::Mesh& mesh) {
+            return "<rubble.Mesh " + std::to_string(mesh.vertexCount()) + " vertices, " +
+                   std::to_string(mesh.triangleCount()) + " triangles>";
+        });
+
+    py::class_<rubble::MeshReport>(m, "MeshReport")
+        .def_property_readonly("valid", &rubble::MeshReport::valid)
+        .def_readonly("closed", &rubble::MeshReport::closed)
+        .def_property_readonly("manifold", &rubble::MeshReport::manifold)
+        .def_readonly("oriented", &rubble::MeshReport::oriented)
+        .def_readonly("outward", &rubble::MeshReport::outward)
+        .def_readonly("boundary_edges", &rubble::MeshReport::boundaryEdges)
+        .def_readonly("non_manifold_edges", &rubble::MeshReport::nonManifoldEdges)
+        .def_readonly("degenerate_triangles", &rubble::MeshReport::degenerateTriangles)
+        .def_readonly("self_intersections", &rubble::MeshReport::selfIntersections)
+        .def_readonly("shells", &rubble::MeshReport::shells)
+        .def_readonly("volume", &rubble::MeshReport::volume)
+        .def_property_readonly("center_of_mass",
+                               [](const rubble::MeshReport& r) { return vec3(r.centerOfMass); })
+        .def_readonly("problems", &rubble::MeshReport::problems)
+        .def("__repr__", [](const rubble::MeshReport& r) {
+            return std::string("<rubble.MeshReport ") + (r.valid() ? "valid" : "invalid") + ", " +
+                   std::to_string(r.problems.size()) + " problems>";
+        });
+
+    py::class_<PyPiece, rubble::Mesh>(m, "Piece")
+        .def_property_readonly("volume", [](const PyPiece& p) { return p.mass.volume; })
+        .def_property_readonly("center_of_mass", [](const PyPiece& p) { return vec3(p.mass.centerOfMass); })
+        .def_property_readonly("inertia", [](const PyPiece& p) { return mat3(p.mass.inertia); })
+        .def_property_readonly("principal_moments",
+                               [](const PyPiece& p) { return vec3(p.mass.principalMoments); })
+        .def_property_readonly("principal_axes", [](const PyPiece& p) { return mat3(p.mass.principalAxes); })
+        .def_readonly("cell", &PyPiece::cell)
+        .def_property_readonly("convex_parts", [](const PyPiece& p) { return convexPartsOf(p.convexParts); })
+        .def("__repr__", [](const PyPiece& p) {
+            return "<rubble.Piece " + std::to_string(p.triangleCount()) + " triangles, volume " +
+                   std::to_string(p.mass.volume) + ", cell " + std::to_string(p.cell) + ">";
+        });
+
+    m.def(
+        "read_mesh",
+        [](const std::filesystem::path& path) {
+            py::gil_scoped_release unlocked;
+            return unwrap(rubble::readMesh(path));
+        },
+        py::arg("path"), "Reads a mesh file (.obj, .off, .stl, .ply, .3ds, .gltf, .glb).");
+    m.def(
+        "write_obj",
+        [](const std::filesystem::path& path, const rubble::Mesh& mesh) {
+            py::gil_scoped_release unlocked;
+            unwrap(rubble::writeObj(path, mesh));
+        },
+        py::arg("path"), py::arg("mesh"), "Writes a mesh as OBJ (and an MTL file when it has materials).");
+    m.def(
+        "box",
+        [](const py::object& lo, const py::object& hi, int subdivisions) {
+            if (subdivisions < 1 || subdivisions > 1000)
+                throw py::value_error("subdivisions: expected 1..1000");
+            return rubble::makeSubdividedBox(toVec3(lo, "lo"), toVec3(hi, "hi"), subdivisions);
+        },
+        py::arg("lo"), py::arg("hi"), py::arg("subdivisions") = 1,
+        "A closed box from lo to hi, each face split into subdivisions x subdivisions squares.");
+    m.def(
+        "check",
+        [](const rubble::Mesh& mesh) {
+            py::gil_scoped_release unlocked;
+            return rubble::checkMesh(mesh);
+        },
+        py::arg("mesh"), "Checks whether a mesh is a valid closed solid.");
+    m.def(
+        "repair",
+        [](rubble::Mesh mesh) {
+            py::gil_scoped_release unlocked;
+            rubble::repairMesh(mesh);
+            return mesh;
+        },
+        py::arg("mesh"), "A repaired copy (duplicate vertices, degenerate triangles, orientation).");
+    m.def("fracture", &fractureMesh, py::arg("mesh"), py::kw_only(), py::arg("point"),
+          py::arg("normal") = py::make_tuple(0.0, 1.0, 0.0), py::arg("impulse") = 1.0, py::arg("cells") = 1,
+          py::arg("seed") = 1, py::arg("backend") = "fast", py::arg("convex_parts") = true,
+          py::arg("max_parts") = 24,
+          "Breaks a closed mesh at an impact into pieces (cells > 1: a shatter pattern of that many cells).");
+    m.def("decompose", &decomposeMesh, py::arg("mesh"), py::kw_only(), py::arg("max_parts") = 24,
+          py::arg("concavity") = 0.02, "Convex parts of a closed mesh, each as its corner points.");
+}

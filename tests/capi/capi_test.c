@@ -1,0 +1,458 @@
+/* The C API (rubble/rubble.h) from C11: every function, its results and its error paths. Exits non-zero
+ * naming every failed check. Built as C and linked against librubble.so; CI runs it under ASan+UBSan too.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "rubble/rubble.h"
+
+static int failures = 0;
+
+#define CHECK(cond)                                                                                          \
+    do {                                                                                                     \
+        if (!(cond)) {                                                                                       \
+            fprintf(stderr, "%s:%d: check failed: %s (last error: %s)\n", __FILE__, __LINE__, #cond,         \
+                    rubble_last_error());                                                                    \
+            ++failures;                                                                                      \
+        }                                                                                                    \
+    } while (0)
+
+#define CHECK_OK(call) CHECK((call) == RUBBLE_OK)
+
+static int contains(const char* text, const char* part) {
+    return strstr(text, part) != NULL;
+}
+
+static int log_calls = 0;
+static void count_log(int level, const char* message, void* user) {
+    (void)message;
+    if (level == 1 && user == &log_calls)
+        ++log_calls;
+}
+
+static void test_status_and_version(void) {
+    CHECK(rubble_api_version() == RUBBLE_C_API_VERSION);
+    CHECK(strcmp(rubble_status_name(RUBBLE_OK), "ok") == 0);
+    CHECK(strcmp(rubble_status_name(RUBBLE_ERROR_INVALID_INPUT), "invalid input") == 0);
+    CHECK(strcmp(rubble_status_name(RUBBLE_ERROR_INVALID_ARGUMENT), "invalid argument") == 0);
+    CHECK(strcmp(rubble_status_name((rubble_status)12345), "unknown status") == 0);
+}
+
+/* Null arguments give RUBBLE_ERROR_INVALID_ARGUMENT with a message naming the function, never a crash. */
+static void test_null_arguments(void) {
+    rubble_mesh* mesh = NULL;
+    rubble_mesh_data data;
+    rubble_mesh_report report;
+    rubble_fracture_info info;
+    rubble_piece piece;
+    rubble_impact impact = {{0, 1, 0}, {0, 1, 0}, 10};
+    size_t count = 0;
+    uint32_t id = 0;
+    CHECK(rubble_mesh_create(NULL, 3, NULL, 1, &mesh) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(mesh == NULL);
+    CHECK(contains(rubble_last_error(), "rubble_mesh_create"));
+    CHECK(rubble_mesh_create(NULL, 0, NULL, 0, NULL) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(rubble_mesh_create_box(NULL, NULL, 1, &mesh) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(rubble_mesh_read(NULL, &mesh) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(rubble_mesh_write_obj(NULL, "x.obj") == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(rubble_mesh_clone(NULL, &mesh) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(rubble_mesh_get_data(NULL, &data) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(rubble_mesh_check(NULL, &report) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(rubble_mesh_repair(NULL) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(rubble_mesh_mass_properties(NULL, NULL) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(rubble_fracture_params_init(NULL) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(rubble_fracture_mesh(NULL, &impact, NULL, NULL) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(rubble_fracture_get_info(NULL, &info) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(rubble_fracture_get_piece(NULL, 0, &piece) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(rubble_fracture_get_convex_part(NULL, 0, 0, NULL, 0, &count) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(rubble_world_config_init(NULL) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(rubble_world_create(NULL, NULL) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(rubble_object_desc_init(NULL) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(rubble_world_add_object(NULL, NULL, &id) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(rubble_world_remove_object(NULL, 1) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(rubble_world_submit_impact(NULL, 1, &impact, NULL) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(rubble_world_begin_frame(NULL) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(rubble_world_wait_idle(NULL) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(rubble_world_collect(NULL, &count) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(rubble_world_get_outcome(NULL, 0, NULL) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(rubble_world_get_outcome_piece(NULL, 0, 0, NULL) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(rubble_world_object_count(NULL, &count) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(rubble_world_get_object(NULL, 1, NULL) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(rubble_world_copy_object_mesh(NULL, 1, &mesh) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(rubble_world_get_convex_part(NULL, 1, 0, NULL, 0, &count) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    /* Destroying nothing is fine. */
+    CHECK_OK(rubble_mesh_destroy(NULL));
+    CHECK_OK(rubble_fracture_destroy(NULL));
+    CHECK_OK(rubble_world_destroy(NULL));
+    CHECK(strcmp(rubble_last_error(), "") == 0);
+}
+
+/* A handle of one kind passed where another is expected is refused by its tag. */
+static void test_wrong_handles(void) {
+    rubble_world* world = NULL;
+    rubble_mesh_data data;
+    CHECK_OK(rubble_world_create(NULL, &world));
+    CHECK(rubble_mesh_get_data((const rubble_mesh*)(const void*)world, &data) ==
+          RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(rubble_mesh_destroy((rubble_mesh*)(void*)world) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(rubble_fracture_destroy((rubble_fracture*)(void*)world) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK_OK(rubble_world_destroy(world));
+}
+
+/* Meshes: build from arrays, read back, check, repair, mass properties, write and read an OBJ. */
+static void test_meshes(const char* dir) {
+    /* A tetrahedron, outward. */
+    const double positions[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    const uint32_t indices[] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
+    const uint32_t bad_indices[] = {0, 2, 1, 0, 1, 9};
+    const double nan_positions[] = {0, 0, 0, 1, 0, 0, 0, NAN, 0};
+    const uint32_t open_indices[] = {0, 2, 1, 0, 1, 3, 0, 3, 2}; /* one face missing */
+    rubble_mesh* tet = NULL;
+    rubble_mesh* open = NULL;
+    rubble_mesh* flipped = NULL;
+    rubble_mesh* bad = NULL;
+    rubble_mesh* read_back = NULL;
+    rubble_mesh_data data;
+    rubble_mesh_report report;
+    rubble_mass_properties mass;
+    char path[1024];
+    const uint32_t flipped_indices[] = {0, 1, 2, 0, 3, 1, 0, 2, 3, 1, 3, 2};
+
+    CHECK_OK(rubble_mesh_create(positions, 4, indices, 4, &tet));
+    CHECK_OK(rubble_mesh_get_data(tet, &data));
+    CHECK(data.vertex_count == 4 && data.triangle_count == 4);
+    CHECK(memcmp(data.positions, positions, sizeof positions) == 0);
+    CHECK(memcmp(data.indices, indices, sizeof indices) == 0);
+    CHECK(data.materials == NULL && data.uvs == NULL && data.normals == NULL);
+
+    CHECK_OK(rubble_mesh_check(tet, &report));
+    CHECK(report.valid && report.closed && report.manifold && report.oriented && report.outward);
+    CHECK(report.problem_count == 0 && fabs(report.volume - 1.0 / 6) < 1e-12);
+    CHECK_OK(rubble_mesh_mass_properties(tet, &mass));
+    CHECK(fabs(mass.volume - 1.0 / 6) < 1e-12);
+    CHECK(fabs(mass.center_of_mass[0] - 0.25) < 1e-12 && fabs(mass.center_of_mass[2] - 0.25) < 1e-12);
+    CHECK(mass.principal_moments[0] > 0 && mass.principal_moments[0] <= mass.principal_moments[2]);
+    CHECK(fabs(mass.inertia[1] - mass.inertia[3]) < 1e-15); /* symmetric */
+
+    /* Bad input: an index out of range and a NaN coordinate are invalid input, with a message. */
+    CHECK(rubble_mesh_create(positions, 4, bad_indices, 2, &bad) == RUBBLE_ERROR_INVALID_INPUT);
+    CHECK(bad == NULL && strlen(rubble_last_error()) > 0);
+    CHECK(rubble_mesh_create(nan_positions, 3, indices, 1, &bad) == RUBBLE_ERROR_INVALID_INPUT);
+    CHECK(bad == NULL);
+
+    /* An open mesh fails the check, which lists why, and the report is filled. */
+    CHECK_OK(rubble_mesh_create(positions, 4, open_indices, 3, &open));
+    CHECK(rubble_mesh_check(open, &report) == RUBBLE_ERROR_INVALID_INPUT);
+    CHECK(!report.valid && !report.closed && report.boundary_edges == 3 && report.problem_count > 0);
+    CHECK(contains(rubble_last_error(), "not a valid solid"));
+
+    /* An inward mesh is repaired into an outward one. */
+    CHECK_OK(rubble_mesh_create(positions, 4, flipped_indices, 4, &flipped));
+    CHECK(rubble_mesh_check(flipped, &report) == RUBBLE_ERROR_INVALID_INPUT && !report.outward);
+    CHECK_OK(rubble_mesh_repair(flipped));
+    CHECK_OK(rubble_mesh_check(flipped, &report));
+    CHECK(report.outward && fabs(report.volume - 1.0 / 6) < 1e-12);
+
+    /* OBJ round trip keeps positions and triangles. */
+    snprintf(path, sizeof path, "%s/capi_tet.obj", dir);
+    CHECK_OK(rubble_mesh_write_obj(tet, path));
+    CHECK_OK(rubble_mesh_read(path, &read_back));
+    CHECK_OK(rubble_mesh_get_data(read_back, &data));
+    CHECK(data.vertex_count == 4 && data.triangle_count == 4);
+    if (data.vertex_count == 4)
+        CHECK(memcmp(data.positions, positions, sizeof positions) == 0);
+
+    /* Files: a missing file is an IO error naming it; an unknown extension is unsupported. */
+    snprintf(path, sizeof path, "%s/does_not_exist.obj", dir);
+    CHECK(rubble_mesh_read(path, &bad) == RUBBLE_ERROR_IO);
+    CHECK(contains(rubble_last_error(), "does_not_exist.obj"));
+    snprintf(path, sizeof path, "%s/mesh.xyz", dir);
+    CHECK(rubble_mesh_read(path, &bad) == RUBBLE_ERROR_UNSUPPORTED);
+
+    CHECK_OK(rubble_mesh_destroy(tet));
+    CHECK_OK(rubble_mesh_destroy(open));
+    CHECK_OK(rubble_mesh_destroy(flipped));
+    CHECK_OK(rubble_mesh_destroy(read_back));
+}
+
+static double sum_piece_volumes(const rubble_fracture* fracture) {
+    rubble_fracture_info info;
+    rubble_piece piece;
+    double total = 0;
+    size_t i;
+    if (rubble_fracture_get_info(fracture, &info) != RUBBLE_OK)
+        return -1;
+    for (i = 0; i < info.piece_count; ++i) {
+        if (rubble_fracture_get_piece(fracture, i, &piece) != RUBBLE_OK)
+            return -1;
+        total += piece.mass.volume;
+    }
+    return total + info.dropped_volume;
+}
+
+/* Fracture: pieces that conserve volume, are closed, carry cut materials and convex parts; determinism. */
+static void test_fracture(void) {
+    const double lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1};
+    rubble_mesh* cube = NULL;
+    rubble_mesh* copy = NULL;
+    rubble_fracture* broken = NULL;
+    rubble_fracture* again = NULL;
+    rubble_fracture* shattered = NULL;
+    rubble_fracture* missed = NULL;
+    rubble_fracture_params params;
+    rubble_fracture_info info;
+    rubble_piece piece, piece_again;
+    rubble_mesh_data data, data_again;
+    rubble_mesh_report report;
+    rubble_impact impact = {{0.3, 1.0, 0.2}, {0, 1, 0}, 40};
+    rubble_impact far_away = {{50, 50, 50}, {0, 1, 0}, 1};
+    double points[3 * 64];
+    size_t count = 0, i, p, interior = 0, remainder = 0, debris = 0;
+
+    CHECK(rubble_mesh_create_box(lo, hi, 0, &cube) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(rubble_mesh_create_box(hi, lo, 2, &cube) == RUBBLE_ERROR_INVALID_INPUT);
+    CHECK_OK(rubble_mesh_create_box(lo, hi, 7, &cube));
+    CHECK_OK(rubble_mesh_get_data(cube, &data));
+    CHECK(data.triangle_count == 12 * 49);
+
+    CHECK_OK(rubble_fracture_params_init(&params));
+    CHECK(params.pattern == RUBBLE_PATTERN_SINGLE_CELL && params.backend == RUBBLE_BACKEND_FAST);
+    CHECK(params.convex_parts == 1 && params.max_convex_parts >= 1 && params.cells >= 1);
+    params.seed = 7;
+    CHECK_OK(rubble_fracture_mesh(cube, &impact, &params, &broken));
+    CHECK_OK(rubble_fracture_get_info(broken, &info));
+    CHECK(info.piece_count >= 2 && fabs(info.input_volume - 8) < 1e-9 && info.total_ms >= 0);
+    CHECK(fabs(sum_piece_volumes(broken) - info.input_volume) < 1e-9 * info.input_volume);
+    for (i = 0; i < info.piece_count; ++i) {
+        CHECK_OK(rubble_fracture_get_piece(broken, i, &piece));
+        CHECK(piece.mass.volume > 0 && piece.convex_part_count >= 1);
+        if (piece.cell < 0)
+            ++remainder;
+        else
+            ++debris;
+        CHECK_OK(rubble_mesh_check(piece.mesh, &report));
+        CHECK(report.valid && fabs(report.volume - piece.mass.volume) < 1e-9);
+        CHECK_OK(rubble_mesh_get_data(piece.mesh, &data));
+        CHECK(data.materials != NULL && data.uvs != NULL);
+        for (p = 0; data.materials && p < data.triangle_count; ++p)
+            interior += data.materials[p] == RUBBLE_INTERIOR_MATERIAL;
+        /* Convex parts: ask for the count, then read them; every point lies within the cube. */
+        for (p = 0; p < piece.convex_part_count; ++p) {
+            size_t k;
+            CHECK_OK(rubble_fracture_get_convex_part(broken, i, p, NULL, 0, &count));
+            CHECK(count >= 4 && count <= 64);
+            CHECK_OK(rubble_fracture_get_convex_part(broken, i, p, points, 64, &count));
+            for (k = 0; k < count && k < 64; ++k)
+                CHECK(fabs(points[3 * k]) <= 1 + 1e-9 && fabs(points[3 * k + 1]) <= 1 + 1e-9 &&
+                      fabs(points[3 * k + 2]) <= 1 + 1e-9);
+        }
+        CHECK(rubble_fracture_get_convex_part(broken, i, piece.convex_part_count, points, 64, &count) ==
+              RUBBLE_ERROR_INVALID_ARGUMENT);
+        CHECK(rubble_fracture_get_convex_part(broken, i, 0, NULL, 5, &count) ==
+              RUBBLE_ERROR_INVALID_ARGUMENT);
+    }
+    CHECK(remainder >= 1 && debris >= 1 && interior > 0);
+    CHECK(rubble_fracture_get_piece(broken, info.piece_count, &piece) == RUBBLE_ERROR_INVALID_ARGUMENT);
+
+    /* A piece mesh belongs to its fracture: it cannot be destroyed or repaired, but cloned. */
+    CHECK_OK(rubble_fracture_get_piece(broken, 0, &piece));
+    CHECK(rubble_mesh_destroy((rubble_mesh*)piece.mesh) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(rubble_mesh_repair((rubble_mesh*)piece.mesh) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK_OK(rubble_mesh_clone(piece.mesh, &copy));
+
+    /* Same seed, same pieces (byte for byte). */
+    CHECK_OK(rubble_fracture_mesh(cube, &impact, &params, &again));
+    CHECK_OK(rubble_fracture_get_piece(again, 0, &piece_again));
+    CHECK_OK(rubble_mesh_get_data(piece.mesh, &data));
+    CHECK_OK(rubble_mesh_get_data(piece_again.mesh, &data_again));
+    CHECK(data.vertex_count == data_again.vertex_count && data.triangle_count == data_again.triangle_count);
+    if (data.vertex_count == data_again.vertex_count)
+        CHECK(memcmp(data.positions, data_again.positions, 3 * sizeof(double) * data.vertex_count) == 0);
+
+    /* A shatter pattern with the exact backend, without convex parts. */
+    params.pattern = RUBBLE_PATTERN_SHATTER;
+    params.cells = 4;
+    params.backend = RUBBLE_BACKEND_COREFINE;
+    params.convex_parts = 0;
+    CHECK_OK(rubble_fracture_mesh(cube, &impact, &params, &shattered));
+    CHECK_OK(rubble_fracture_get_info(shattered, &info));
+    CHECK(info.piece_count >= 3);
+    CHECK(fabs(sum_piece_volumes(shattered) - 8) < 1e-9 * 8);
+    CHECK_OK(rubble_fracture_get_piece(shattered, 0, &piece));
+    CHECK(piece.convex_part_count == 0);
+
+    /* Errors: bad parameters, an impact whose cells miss the mesh, an open mesh. */
+    params.cells = 0;
+    CHECK(rubble_fracture_mesh(cube, &impact, &params, &missed) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    params.cells = 4;
+    params.backend = (rubble_backend)9;
+    CHECK(rubble_fracture_mesh(cube, &impact, &params, &missed) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(contains(rubble_last_error(), "backend"));
+    params.backend = RUBBLE_BACKEND_FAST;
+    params.pattern = (rubble_pattern)-3;
+    CHECK(rubble_fracture_mesh(cube, &impact, &params, &missed) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(contains(rubble_last_error(), "pattern"));
+    params.pattern = RUBBLE_PATTERN_SHATTER;
+    CHECK(rubble_fracture_mesh(cube, &far_away, NULL, &missed) == RUBBLE_ERROR_NO_INTERSECTION);
+    CHECK(missed == NULL);
+    {
+        const double positions[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+        const uint32_t open_indices[] = {0, 2, 1, 0, 1, 3, 0, 3, 2};
+        rubble_mesh* open = NULL;
+        rubble_impact hit = {{0.1, 0.1, 0.1}, {0, 0, -1}, 10};
+        CHECK_OK(rubble_mesh_create(positions, 4, open_indices, 3, &open));
+        CHECK(rubble_fracture_mesh(open, &hit, NULL, &missed) == RUBBLE_ERROR_INVALID_INPUT);
+        CHECK(missed == NULL && strlen(rubble_last_error()) > 0);
+        CHECK_OK(rubble_mesh_destroy(open));
+    }
+
+    CHECK_OK(rubble_fracture_destroy(broken));
+    CHECK_OK(rubble_fracture_destroy(again));
+    CHECK_OK(rubble_fracture_destroy(shattered));
+    /* The clone outlives its fracture. */
+    CHECK_OK(rubble_mesh_check(copy, &report));
+    CHECK(report.valid);
+    CHECK_OK(rubble_mesh_destroy(copy));
+    CHECK_OK(rubble_mesh_destroy(cube));
+}
+
+/* The world: add, impact, collect; the parent is replaced by pieces whose volumes add up. */
+static void test_world(void) {
+    const double lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1};
+    rubble_world_config config;
+    rubble_world* world = NULL;
+    rubble_mesh* cube = NULL;
+    rubble_mesh* piece_mesh = NULL;
+    rubble_object_desc desc;
+    rubble_object_info object;
+    rubble_outcome outcome;
+    rubble_outcome_piece piece;
+    rubble_mesh_report report;
+    rubble_impact impact = {{0.3, 1.0, 0.2}, {0, 1, 0}, 40};
+    rubble_impact weak = {{0.3, 1.0, 0.2}, {0, 1, 0}, 5};
+    uint32_t id = 0, other = 0;
+    size_t outcomes = 0, count = 0, i;
+    int accepted = -1;
+    double volume = 0, points[3 * 256];
+
+    CHECK_OK(rubble_world_config_init(&config));
+    CHECK(config.workers == -1 && config.deterministic == 0);
+    config.workers = 0;
+    CHECK(rubble_world_create(&config, &world) == RUBBLE_ERROR_INVALID_ARGUMENT && world == NULL);
+    config.workers = 2;
+    config.seed = 5;
+    CHECK_OK(rubble_world_create(&config, &world));
+
+    CHECK_OK(rubble_object_desc_init(&desc));
+    CHECK(desc.mesh == NULL && desc.density == 1 && desc.destructible == 1);
+    CHECK(rubble_world_add_object(world, &desc, &id) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK_OK(rubble_mesh_create_box(lo, hi, 7, &cube));
+    desc.mesh = cube;
+    desc.density = 0;
+    CHECK(rubble_world_add_object(world, &desc, &id) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    desc.density = 2;
+    desc.impulse_threshold = 10;
+    CHECK_OK(rubble_world_add_object(world, &desc, &id));
+    CHECK_OK(rubble_world_add_object(world, &desc, &other));
+    CHECK(id != other);
+    CHECK_OK(rubble_world_object_count(world, &count));
+    CHECK(count == 2);
+    CHECK_OK(rubble_world_get_object(world, id, &object));
+    CHECK(object.id == id && object.destructible && object.density == 2 && object.convex_part_count >= 1);
+    CHECK(fabs(object.mass.volume - 8) < 1e-9 && object.triangle_count == 12 * 49);
+    CHECK_OK(rubble_world_get_convex_part(world, id, 0, points, 256, &count));
+    CHECK(count >= 4);
+    CHECK(rubble_world_get_convex_part(world, id, object.convex_part_count, points, 256, &count) ==
+          RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(rubble_world_get_object(world, 999, &object) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(rubble_world_remove_object(world, 999) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK_OK(rubble_world_remove_object(world, other));
+    CHECK(rubble_world_get_object(world, other, &object) == RUBBLE_ERROR_INVALID_ARGUMENT);
+
+    /* Below the threshold or on an unknown object: ignored, not an error. */
+    CHECK_OK(rubble_world_submit_impact(world, id, &weak, &accepted));
+    CHECK(accepted == 0);
+    CHECK_OK(rubble_world_submit_impact(world, 999, &impact, &accepted));
+    CHECK(accepted == 0);
+    CHECK_OK(rubble_world_submit_impact(world, id, &impact, &accepted));
+    CHECK(accepted == 1);
+    CHECK_OK(rubble_world_wait_idle(world));
+    CHECK_OK(rubble_world_begin_frame(world));
+    CHECK_OK(rubble_world_collect(world, &outcomes));
+    CHECK(outcomes == 1);
+    CHECK_OK(rubble_world_get_outcome(world, 0, &outcome));
+    CHECK(outcome.parent == id && outcome.piece_count >= 2);
+    CHECK(rubble_world_get_outcome(world, 1, &outcome) == RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(rubble_world_get_object(world, id, &object) == RUBBLE_ERROR_INVALID_ARGUMENT); /* replaced */
+    volume = outcome.dropped_volume;
+    for (i = 0; i < outcome.piece_count; ++i) {
+        CHECK_OK(rubble_world_get_outcome_piece(world, 0, i, &piece));
+        CHECK_OK(rubble_world_get_object(world, piece.id, &object));
+        CHECK(object.mass.volume > 0 && object.convex_part_count >= 1 && object.density == 2);
+        /* A piece's mesh is centred at its centre of mass; its frame puts it back into the parent. */
+        CHECK(fabs(object.mass.center_of_mass[0]) < 1e-9 && fabs(object.mass.center_of_mass[1]) < 1e-9);
+        CHECK(fabs(piece.translation[0]) <= 1 && fabs(piece.translation[1]) <= 1);
+        CHECK(fabs(piece.rotation[0] * piece.rotation[0] + piece.rotation[3] * piece.rotation[3] +
+                   piece.rotation[6] * piece.rotation[6] - 1) < 1e-9);
+        volume += object.mass.volume;
+        CHECK_OK(rubble_world_copy_object_mesh(world, piece.id, &piece_mesh));
+        CHECK_OK(rubble_mesh_check(piece_mesh, &report));
+        CHECK(report.valid);
+        CHECK_OK(rubble_mesh_destroy(piece_mesh));
+        piece_mesh = NULL;
+    }
+    CHECK(rubble_world_get_outcome_piece(world, 0, outcome.piece_count, &piece) ==
+          RUBBLE_ERROR_INVALID_ARGUMENT);
+    CHECK(fabs(volume - 8) < 1e-6);
+    /* The next collect has nothing new and forgets the old outcomes. */
+    CHECK_OK(rubble_world_begin_frame(world));
+    CHECK_OK(rubble_world_collect(world, &outcomes));
+    CHECK(outcomes == 0);
+    CHECK(rubble_world_get_outcome(world, 0, &outcome) == RUBBLE_ERROR_INVALID_ARGUMENT);
+
+    CHECK_OK(rubble_world_destroy(world));
+    CHECK_OK(rubble_mesh_destroy(cube));
+}
+
+/* Log messages reach the callback (an open mesh added to a world is repaired or made indestructible, with a
+ * warning), and NULL restores the default. */
+static void test_log_callback(void) {
+    const double positions[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    const uint32_t open_indices[] = {0, 2, 1, 0, 1, 3, 0, 3, 2};
+    rubble_world* world = NULL;
+    rubble_mesh* open = NULL;
+    rubble_object_desc desc;
+    rubble_object_info info;
+    uint32_t id = 0;
+    CHECK_OK(rubble_set_log_callback(count_log, &log_calls));
+    CHECK_OK(rubble_world_create(NULL, &world));
+    CHECK_OK(rubble_mesh_create(positions, 4, open_indices, 3, &open));
+    CHECK_OK(rubble_object_desc_init(&desc));
+    desc.mesh = open;
+    CHECK_OK(rubble_world_add_object(world, &desc, &id));
+    CHECK_OK(rubble_world_get_object(world, id, &info));
+    CHECK(info.destructible == 0);
+    CHECK(log_calls == 1);
+    CHECK_OK(rubble_set_log_callback(NULL, NULL));
+    CHECK_OK(rubble_world_destroy(world));
+    CHECK_OK(rubble_mesh_destroy(open));
+}
+
+int main(int argc, char** argv) {
+    const char* dir = argc > 1 ? argv[1] : ".";
+    test_status_and_version();
+    test_null_arguments();
+    test_wrong_handles();
+    test_meshes(dir);
+    test_fracture();
+    test_world();
+    test_log_callback();
+    if (failures) {
+        fprintf(stderr, "%d checks failed\n", failures);
+        return 1;
+    }
+    printf("C API: all checks passed\n");
+    return 0;
+}
