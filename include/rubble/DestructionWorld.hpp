@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -13,6 +14,7 @@
 #include "rubble/Fracture.hpp"
 #include "rubble/Frame.hpp"
 #include "rubble/JobSystem.hpp"
+#include "rubble/Journal.hpp"
 #include "rubble/Mesh.hpp"
 #include "rubble/Result.hpp"
 
@@ -46,6 +48,7 @@ struct ObjectState {
     std::string warning;                     ///< why it is indestructible, when it had to be made so
     std::size_t crumbleAbove = 0; ///< a hit on it crumbles it once its mesh has more triangles than this
                                   ///< (see Config::crumbleTriangles; pieces inherit their parent's)
+    std::uint64_t meshHash = 0;   ///< mesh.hash(), computed once when the object is made
 };
 
 /// Wall-clock timing of one impact from submission to adoption, in milliseconds. For an adopted job the
@@ -153,8 +156,21 @@ public:
 
     /// Submits an impact in the object's local coordinates. Returns false when it is ignored (unknown or
     /// indestructible object, impulse below threshold). An impact on an object with a job in flight is merged
-    /// into the next job for that object.
+    /// into the next job for that object. An accepted impact is rounded to single precision
+    /// (journalPrecision) and journaled.
     bool submitImpact(ObjectId id, const Impact& impact);
+
+    /// Called with every journal event as it happens: each accepted impact and each removal of a live object.
+    void setJournalSink(std::function<void(const JournalEvent&)> sink);
+    /// Journal events so far (the position a snapshot records).
+    std::uint64_t journalPosition() const;
+    /// Applies one journal event now (as submitImpact or removeObject would). Fails, changing nothing, when
+    /// the object does not exist, refuses the impact, or its fracture pattern or next job seed differ from
+    /// the event's (a journal of another scene or world seed).
+    Status applyJournalEvent(const JournalEvent& event);
+    /// Order-independent hash of the geometry: every live object's id, version and mesh hash. Equal worlds
+    /// give equal hashes on any worker count and compiler (docs/journal.md). O(1): kept up to date.
+    std::uint64_t geometryHash() const;
 
     /// Advances the frame counter; call once per frame before collect().
     void beginFrame();

@@ -67,6 +67,7 @@ struct Job {
     std::vector<Mesh> localMeshes;
     std::vector<MassProperties> localMass;
     std::vector<std::vector<ConvexPolytope>> localParts;
+    std::vector<std::uint64_t> meshHashes; // localMeshes[i].hash(), computed by the worker
     double queueMs = 0;
     double prepareMs = 0;
     double cellMs = 0;
@@ -155,6 +156,7 @@ void runJob(Job& job) {
         const Mat3 rt = f.rotation.transposed();
         meshes[i].transform(rt, Vec3{1, 1, 1}, rt * (-1.0 * f.translation));
         job.localMass.push_back(computeMassProperties(meshes[i]));
+        job.meshHashes.push_back(meshes[i].hash());
         std::vector<ConvexPolytope> lp;
         if (i < parts.size())
             for (const auto& p : parts[i])
@@ -194,6 +196,30 @@ struct DestructionWorld::Impl {
         Clock::time_point recordEnd; // where that record's adoption ended so far
     };
     std::vector<HandedOut> handedOut; // outcomes of the latest collect() not yet finished by the engine
+    std::function<void(const JournalEvent&)> journalSink;
+    std::uint64_t journalLength = 0;
+    std::uint64_t geometrySum = 0; // Σ geometryTerm over live objects (wrapping)
+
+    static std::uint64_t geometryTerm(const ObjectState& o) {
+        return mixSeed(mixSeed(o.id, o.version), o.meshHash);
+    }
+    void insertObject(std::shared_ptr<const ObjectState> s) {
+        geometrySum += geometryTerm(*s);
+        const ObjectId id = s->id;
+        objects.emplace(id, std::move(s));
+    }
+    void eraseObject(std::map<ObjectId, std::shared_ptr<const ObjectState>>::iterator it) {
+        geometrySum -= geometryTerm(*it->second);
+        objects.erase(it);
+    }
+    std::uint64_t jobSeed(const ObjectState& o) const {
+        return mixSeed(mixSeed(config.seed, o.id), o.version);
+    }
+    void journal(const JournalEvent& e) {
+        ++journalLength;
+        if (journalSink)
+            journalSink(e);
+    }
 
     // Impacts that can no longer run (their object is gone) still leave a stale timing record, so that every
     // accepted impact is accounted for in exactly one record.
@@ -244,7 +270,7 @@ struct DestructionWorld::Impl {
             job->params.sizeLaw.minSize = job->params.sizeLaw.maxSize = 4 * o.mesh.bounds().diagonal();
         }
         job->decomposition = config.decomposition;
-        job->seed = mixSeed(mixSeed(config.seed, id), o.version);
+        job->seed = jobSeed(o);
         job->frame = job->impacts.front().frame;
         // Adopted delayFrames after the launch (not after the first impact: impacts forwarded to pieces or
         // re-run after a failed job would otherwise be due at once and block the main thread).
@@ -348,13 +374,21 @@ Result<ObjectId> DestructionWorld::addObject(ObjectDesc desc) {
             s.convexParts = d.value().parts;
     }
     s.mesh = std::move(desc.mesh);
+    s.meshHash = s.mesh.hash();
     const ObjectId id = s.id;
-    impl_->objects.emplace(id, std::move(state));
+    impl_->insertObject(std::move(state));
     return id;
 }
 
 void DestructionWorld::removeObject(ObjectId id) {
-    impl_->objects.erase(id);
+    if (auto it = impl_->objects.find(id); it != impl_->objects.end()) {
+        JournalEvent e;
+        e.kind = JournalEventKind::Remove;
+        e.object = id;
+        e.tick = static_cast<std::uint32_t>(impl_->frame);
+        impl_->eraseObject(it);
+        impl_->journal(e);
+    }
     if (auto w = impl_->waiting.find(id); w != impl_->waiting.end()) {
         impl_->recordDropped(id, w->second);
         impl_->waiting.erase(w);
@@ -377,15 +411,66 @@ bool DestructionWorld::submitImpact(ObjectId id, const Impact& impact) {
     auto it = impl_->objects.find(id);
     if (it == impl_->objects.end() || !it->second->destructible)
         return false;
-    if (impact.impulse < it->second->impulseThreshold)
+    const Impact rounded = journalPrecision(impact);
+    if (!(rounded.impulse >= it->second->impulseThreshold)) // also refuses NaN
         return false;
-    PendingImpact p{impact, impl_->frame, Clock::now()};
+    const ObjectState& o = *it->second;
+    JournalEvent e;
+    e.kind = JournalEventKind::Impact;
+    e.object = id;
+    e.tick = static_cast<std::uint32_t>(impl_->frame);
+    e.point = {static_cast<float>(rounded.point.x), static_cast<float>(rounded.point.y),
+               static_cast<float>(rounded.point.z)};
+    e.normal = {static_cast<float>(rounded.normal.x), static_cast<float>(rounded.normal.y),
+                static_cast<float>(rounded.normal.z)};
+    e.impulse = static_cast<float>(rounded.impulse);
+    e.pattern = static_cast<std::uint8_t>(o.fracture.pattern);
+    e.cells = static_cast<std::uint16_t>(std::clamp(o.fracture.cells, 0, 65535));
+    e.seed = impl_->jobSeed(o);
+    impl_->journal(e);
+    PendingImpact p{rounded, impl_->frame, Clock::now()};
     if (impl_->busy(id)) {
         impl_->waiting[id].push_back(p);
     } else {
         impl_->launch(id, {p});
     }
     return true;
+}
+
+void DestructionWorld::setJournalSink(std::function<void(const JournalEvent&)> sink) {
+    impl_->journalSink = std::move(sink);
+}
+
+std::uint64_t DestructionWorld::journalPosition() const {
+    return impl_->journalLength;
+}
+
+Status DestructionWorld::applyJournalEvent(const JournalEvent& e) {
+    const std::string where =
+        "journal event at tick " + std::to_string(e.tick) + ", object " + std::to_string(e.object) + ": ";
+    auto it = impl_->objects.find(e.object);
+    if (it == impl_->objects.end())
+        return Error{ErrorCode::InvalidInput, where + "no such object"};
+    if (e.kind == JournalEventKind::Remove) {
+        removeObject(e.object);
+        return Status::ok();
+    }
+    if (e.kind != JournalEventKind::Impact)
+        return Error{ErrorCode::InvalidInput, where + "unknown kind " + std::to_string(int(e.kind))};
+    const ObjectState& o = *it->second;
+    if (e.pattern != static_cast<std::uint8_t>(o.fracture.pattern) ||
+        e.cells != static_cast<std::uint16_t>(std::clamp(o.fracture.cells, 0, 65535)))
+        return Error{ErrorCode::InvalidInput,
+                     where + "pattern differs from the object's fracture parameters"};
+    if (e.seed != impl_->jobSeed(o))
+        return Error{ErrorCode::InvalidInput, where + "seed differs (another scene or world seed)"};
+    if (!submitImpact(e.object, e.impact()))
+        return Error{ErrorCode::InvalidInput, where + "the object refuses the impact"};
+    return Status::ok();
+}
+
+std::uint64_t DestructionWorld::geometryHash() const {
+    return mixSeed(impl_->geometrySum, impl_->objects.size());
 }
 
 void DestructionWorld::beginFrame() {
@@ -442,8 +527,8 @@ std::vector<FractureOutcome> DestructionWorld::collect() {
         if (it == im.objects.end() || it->second->version != job->version) {
             rec.stale = true; // the object was removed or replaced meanwhile: the result is discarded
         } else if (job->ok) {
-            const std::shared_ptr<const ObjectState> parent = std::move(it->second);
-            im.objects.erase(it);
+            const std::shared_ptr<const ObjectState> parent = it->second;
+            im.eraseObject(it);
             FractureOutcome o;
             o.parent = job->id;
             o.parentVersion = job->version;
@@ -467,8 +552,9 @@ std::vector<FractureOutcome> DestructionWorld::collect() {
                 s->fracture = parent->fracture;
                 s->crumbleAbove = parent->crumbleAbove;
                 s->convexParts = std::move(job->localParts[i]);
+                s->meshHash = job->meshHashes[i];
                 o.pieces.push_back({s->id, job->frames[i], cell, s});
-                im.objects.emplace(s->id, std::move(s));
+                im.insertObject(std::move(s));
             }
             // Impacts that arrived while this job ran go to the piece nearest to their point.
             if (o.pieces.empty())

@@ -1,0 +1,187 @@
+// The destruction journal: 48-byte events, recorded for every accepted impact and removal, replayed on a
+// fresh world from the same scene to the same geometry on 1 or 2 workers; the journal file and its errors.
+#include "rubble/JournalFile.hpp"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "JournalScene.hpp"
+#include "TestSupport.hpp"
+#include "rubble/JournalPlayer.hpp"
+
+namespace rubble {
+namespace {
+
+struct Recording {
+    std::vector<JournalEvent> events;
+    std::uint64_t frame = 0;
+    std::uint64_t geometry = 0;
+    std::uint64_t journalPosition = 0;
+    long long fractures = 0;
+};
+
+Recording record(int workers, int frames) {
+    test::JournalRig rig(workers);
+    Recording r;
+    rig.runtime.world().setJournalSink([&](const JournalEvent& e) { r.events.push_back(e); });
+    rig.play(frames);
+    rig.settle();
+    r.frame = rig.runtime.world().frame();
+    r.geometry = rig.runtime.world().geometryHash();
+    r.journalPosition = rig.runtime.world().journalPosition();
+    r.fractures = rig.runtime.counters().fractures;
+    return r;
+}
+
+std::uint64_t replay(const std::vector<JournalEvent>& events, std::uint64_t frame, int workers) {
+    auto world = test::journalWorld(workers);
+    JournalPlayer player(*world);
+    for (const JournalEvent& e : events)
+        EXPECT_TRUE(player.receive(e));
+    EXPECT_TRUE(player.advanceTo(frame));
+    EXPECT_EQ(player.pending(), 0u);
+    EXPECT_EQ(world->jobsInFlight(), 0);
+    EXPECT_EQ(world->journalPosition(), events.size()) << "the replaying world journals the same events";
+    return world->geometryHash();
+}
+
+TEST(Journal, EventIs48BytesAndRoundTrips) {
+    JournalEvent e;
+    e.kind = JournalEventKind::Impact;
+    e.object = 0xDEADBEEF;
+    e.tick = 123456;
+    e.point = {1.5f, -2.25f, 1e-7f};
+    e.normal = {0.f, 1.f, 0.f};
+    e.impulse = 2500.f;
+    e.pattern = 1;
+    e.cells = 300;
+    e.seed = 0x0123456789ABCDEFull;
+    const auto bytes = encodeJournalEvent(e);
+    static_assert(std::tuple_size_v<decltype(bytes)> == 48);
+    EXPECT_EQ(bytes[0], 1);
+    EXPECT_EQ(bytes[4], 0xEF) << "little-endian object id at offset 4";
+    EXPECT_EQ(bytes[40], 0xEF) << "seed at offset 40";
+    Result<JournalEvent> back = decodeJournalEvent(bytes.data());
+    ASSERT_TRUE(back) << back.error().message;
+    EXPECT_EQ(*back, e);
+}
+
+TEST(Journal, DecodingRefusesUnknownKindsAndNonFiniteNumbers) {
+    JournalEvent e;
+    auto bytes = encodeJournalEvent(e);
+    bytes[0] = 7;
+    Result<JournalEvent> bad = decodeJournalEvent(bytes.data(), 96);
+    ASSERT_FALSE(bad);
+    EXPECT_NE(bad.error().message.find("offset 96, field kind"), std::string::npos) << bad.error().message;
+    e.impulse = std::numeric_limits<float>::quiet_NaN();
+    bytes = encodeJournalEvent(e);
+    bad = decodeJournalEvent(bytes.data());
+    ASSERT_FALSE(bad);
+    EXPECT_NE(bad.error().message.find("offset 36, field impulse"), std::string::npos) << bad.error().message;
+}
+
+TEST(Journal, AcceptedImpactsAreRoundedToTheJournalPrecision) {
+    auto world = test::journalWorld(1);
+    std::vector<JournalEvent> events;
+    world->setJournalSink([&](const JournalEvent& e) { events.push_back(e); });
+    const Impact exact{{0.1, 0.2 + 1e-12, 0.3}, {1, 0, 0}, 1000.0 / 3};
+    ASSERT_TRUE(world->submitImpact(1, exact));
+    EXPECT_FALSE(world->submitImpact(1, Impact{{0, 0, 0}, {1, 0, 0}, 0.5})) << "below the threshold";
+    ASSERT_EQ(events.size(), 1u);
+    EXPECT_EQ(events[0].impact().point.y, static_cast<double>(0.2f));
+    EXPECT_EQ(events[0].impact().impulse, static_cast<double>(1000.0f / 3));
+    EXPECT_EQ(events[0].tick, 0u);
+    world->removeObject(2);
+    world->removeObject(2); // already gone: not journaled twice
+    ASSERT_EQ(events.size(), 2u);
+    EXPECT_EQ(events[1].kind, JournalEventKind::Remove);
+    EXPECT_EQ(world->journalPosition(), 2u);
+}
+
+TEST(Journal, ReplayRebuildsTheSameGeometryOnOneAndTwoWorkers) {
+    const Recording rec = record(1, 240);
+    ASSERT_GT(rec.fractures, 5);
+    const auto removals = std::count_if(rec.events.begin(), rec.events.end(), [](const JournalEvent& e) {
+        return e.kind == JournalEventKind::Remove;
+    });
+    EXPECT_GT(removals, 0) << "the awake budget retired debris: removals are journaled too";
+    EXPECT_EQ(rec.journalPosition, rec.events.size());
+    EXPECT_EQ(record(2, 240).geometry, rec.geometry) << "recording is deterministic";
+    EXPECT_EQ(replay(rec.events, rec.frame, 1), rec.geometry);
+    EXPECT_EQ(replay(rec.events, rec.frame, 2), rec.geometry);
+    // Every event counts: without the last impact the geometry differs.
+    std::vector<JournalEvent> fewer = rec.events;
+    const auto lastImpact = std::find_if(fewer.rbegin(), fewer.rend(), [](const JournalEvent& e) {
+        return e.kind == JournalEventKind::Impact;
+    });
+    ASSERT_NE(lastImpact, fewer.rend());
+    fewer.erase(std::next(lastImpact).base());
+    auto world = test::journalWorld(1);
+    JournalPlayer player(*world);
+    for (const JournalEvent& e : fewer)
+        if (!player.receive(e))
+            break;
+    (void)player.advanceTo(rec.frame);
+    (void)player.drain();
+    EXPECT_NE(world->geometryHash(), rec.geometry);
+}
+
+TEST(Journal, ReplayRefusesEventsOfAnotherWorldOrOutOfOrder) {
+    const Recording rec = record(1, 60);
+    ASSERT_FALSE(rec.events.empty());
+    DestructionRuntime::Config other = test::journalConfig(1);
+    other.world.seed = 12;
+    DestructionWorld world(other.world);
+    for (test::SceneObject& o : test::journalScene())
+        ASSERT_TRUE(world.addObject(std::move(o.desc)));
+    const JournalEvent first = rec.events.front();
+    ASSERT_EQ(first.kind, JournalEventKind::Impact);
+    Status s = world.applyJournalEvent(first);
+    ASSERT_FALSE(s);
+    EXPECT_NE(s.message().find("seed"), std::string::npos) << s.message();
+    EXPECT_EQ(world.journalPosition(), 0u) << "nothing applied";
+    JournalEvent missing = first;
+    missing.object = 999;
+    EXPECT_FALSE(world.applyJournalEvent(missing));
+
+    auto fresh = test::journalWorld(1);
+    JournalPlayer player(*fresh);
+    ASSERT_TRUE(player.advanceTo(first.tick + 1));
+    Status late = player.receive(first);
+    ASSERT_FALSE(late);
+    EXPECT_NE(late.message().find("journal order"), std::string::npos) << late.message();
+    EXPECT_FALSE(checkJournalHeader(journalHeaderOf(test::journalConfig(1).world), other.world));
+}
+
+TEST(Journal, FileRoundTripsAndNamesTheOffsetOfDamage) {
+    const Recording rec = record(1, 60);
+    JournalFile j{journalHeaderOf(test::journalConfig(1).world, "tests/journal-scene"), rec.events};
+    const std::filesystem::path path = test::tempDir("journal") / "run.rjournal";
+    ASSERT_TRUE(writeJournal(path, j));
+    EXPECT_EQ(std::filesystem::file_size(path),
+              4 + 2 + 2 + 8 + 4 + 8 + 4 + 8 + 4 + j.header.scene.size() + 4 + 48 * j.events.size() + 4);
+    Result<JournalFile> back = readJournal(path);
+    ASSERT_TRUE(back) << back.error().message;
+    EXPECT_EQ(back->header, j.header);
+    EXPECT_EQ(back->events, j.events);
+    EXPECT_TRUE(checkJournalHeader(back->header, test::journalConfig(2).world)) << "workers do not matter";
+
+    std::vector<std::uint8_t> bytes = encodeJournal(j);
+    std::vector<std::uint8_t> flipped = bytes;
+    flipped[60] ^= 0x10;
+    Result<JournalFile> bad = decodeJournal(flipped.data(), flipped.size(), "x.rjournal");
+    ASSERT_FALSE(bad);
+    EXPECT_NE(bad.error().message.find("field crc32"), std::string::npos) << bad.error().message;
+    bad = decodeJournal(bytes.data(), bytes.size() - 30, "x.rjournal");
+    ASSERT_FALSE(bad);
+    EXPECT_NE(bad.error().message.find("x.rjournal: offset"), std::string::npos) << bad.error().message;
+    std::vector<std::uint8_t> future = bytes;
+    future[4] = 9;
+    bad = decodeJournal(future.data(), future.size(), "x.rjournal");
+    ASSERT_FALSE(bad);
+    EXPECT_NE(bad.error().message.find("offset 4, field version"), std::string::npos) << bad.error().message;
+}
+
+} // namespace
+} // namespace rubble
