@@ -1,0 +1,103 @@
+// Determinism across builds, pinned (as Box2D pins EXPECTED_HASH): a fixed journal replayed on a fixed scene
+// must give this geometry hash in the gcc build and in the clang sanitizer build alike. A change of this
+// value is a change of every saved journal's meaning: update it only on purpose (docs/journal.md).
+#include <gtest/gtest.h>
+
+#include "persist/Bytes.hpp"
+#include "rubble/JournalFile.hpp"
+#include "rubble/JournalPlayer.hpp"
+
+namespace rubble {
+namespace {
+
+constexpr std::uint64_t kExpectedGeometryHash = 0xF93BA5490D2E0ABBull;
+constexpr std::uint32_t kExpectedJournalCrc = 0x2144DF1Cu;
+
+DestructionWorld::Config goldenConfig(int workers) {
+    DestructionWorld::Config c;
+    c.workers = workers;
+    c.deterministic = true;
+    c.seed = 20261125;
+    c.minPieceVolume = 1e-4;
+    return c;
+}
+
+// A subdivided wall (shatter), a sphere (single cell) and a torus (shatter, crumbles once detailed enough).
+void addScene(DestructionWorld& world) {
+    ObjectDesc wall;
+    wall.mesh = makeSubdividedBox({-2, 0, -0.2}, {2, 3, 0.2}, 6);
+    wall.fracture.pattern = CellPattern::Shatter;
+    wall.fracture.cells = 6;
+    ObjectDesc ball;
+    ball.mesh = makeSphere({0, 0, 0}, 1.0, 24, 16);
+    ObjectDesc ring;
+    ring.mesh = makeTorus({0, 0, 0}, 1.5, 0.4, 32, 12);
+    ring.fracture.pattern = CellPattern::Shatter;
+    ring.fracture.cells = 4;
+    for (ObjectDesc* d : {&wall, &ball, &ring})
+        ASSERT_TRUE(world.addObject(std::move(*d)));
+}
+
+// The journal: impacts on the three objects, some in the same frame (merged into one job), and hits on the
+// pieces of earlier fractures (ids 4 and up), derived from the world as it plays so that the test also
+// records them; the recorded journal is then replayed on a fresh world.
+std::vector<JournalEvent> recordGoldenJournal() {
+    DestructionWorld world(goldenConfig(1));
+    addScene(world);
+    std::vector<JournalEvent> events;
+    world.setJournalSink([&](const JournalEvent& e) { events.push_back(e); });
+    for (int frame = 0; frame < 40; ++frame) {
+        if (frame == 0) {
+            EXPECT_TRUE(world.submitImpact(1, Impact{{0.3, 1.4, 0.2}, {0, 0, 1}, 400}));
+            EXPECT_TRUE(world.submitImpact(1, Impact{{-1.2, 2.1, 0.2}, {0, 0, 1}, 900}));
+            EXPECT_TRUE(world.submitImpact(2, Impact{{0.6, 0.8, 0.0}, {0.6, 0.8, 0}, 300}));
+            EXPECT_TRUE(world.submitImpact(3, Impact{{1.9, 0.0, 0.0}, {1, 0, 0}, 700}));
+        }
+        if (frame == 10 || frame == 20) { // the largest live object is hit near its centre, then removed
+            ObjectId largest = 0;
+            double volume = 0;
+            for (ObjectId id : world.objects())
+                if (world.object(id)->mass.volume > volume) {
+                    volume = world.object(id)->mass.volume;
+                    largest = id;
+                }
+            const Aabb b = world.object(largest)->mesh.bounds();
+            EXPECT_TRUE(world.submitImpact(largest, Impact{b.hi, {0.577, 0.577, 0.577}, 1500}));
+            if (frame == 20)
+                world.removeObject(world.objects().front());
+        }
+        world.beginFrame();
+        (void)world.collect();
+    }
+    return events;
+}
+
+std::uint64_t replay(const JournalFile& journal, int workers) {
+    DestructionWorld world(goldenConfig(workers));
+    EXPECT_TRUE(checkJournalHeader(journal.header, goldenConfig(workers)));
+    addScene(world);
+    JournalPlayer player(world);
+    for (const JournalEvent& e : journal.events)
+        EXPECT_TRUE(player.receive(e));
+    EXPECT_TRUE(player.drain());
+    return world.geometryHash();
+}
+
+TEST(GoldenHash, FixedJournalOnFixedSceneGivesThePinnedGeometry) {
+    JournalFile journal{journalHeaderOf(goldenConfig(1), "golden"), recordGoldenJournal()};
+    ASSERT_EQ(journal.events.size(), 7u);
+    const std::vector<std::uint8_t> bytes = encodeJournal(journal);
+    const std::uint32_t crc = persist::crc32(bytes.data(), bytes.size());
+    Result<JournalFile> decoded = decodeJournal(bytes.data(), bytes.size(), "golden");
+    ASSERT_TRUE(decoded) << decoded.error().message;
+    const std::uint64_t one = replay(*decoded, 1);
+    const std::uint64_t two = replay(*decoded, 2);
+    EXPECT_EQ(one, two);
+    std::printf("golden: journal crc 0x%08X, geometry hash 0x%016llX\n", crc,
+                static_cast<unsigned long long>(one));
+    EXPECT_EQ(crc, kExpectedJournalCrc) << "the journal's encoding or its recorded values changed";
+    EXPECT_EQ(one, kExpectedGeometryHash) << "the geometry differs from the pinned one";
+}
+
+} // namespace
+} // namespace rubble
