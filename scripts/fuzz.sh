@@ -30,7 +30,7 @@ else
 fi
 shift || true
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(obj scene mesh_repair convex_clip fracture)
+[ ${#targets[@]} -gt 0 ] || targets=(obj scene mesh_repair convex_clip fracture snapshot)
 dir=${RUBBLE_FUZZ_DIR:-build-asan}
 if [ ! -f "$dir/build.ninja" ]; then
     bash scripts/sanitize.sh configure-asan "$dir"

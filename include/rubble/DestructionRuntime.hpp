@@ -168,6 +168,15 @@ struct VolumeLedger {
     double total() const { return live + retired + dust + dropped; }
 };
 
+/// Where an object's body is and how it moves (what a snapshot or a network host sends).
+struct ObjectPlacement {
+    ObjectId object = 0;                              ///< the object
+    BodyMotionState motion = BodyMotionState::Static; ///< static, dynamic or frozen
+    Frame objectToWorld;                              ///< world ← object coordinates
+    Vec3 linearVelocity;                              ///< m/s (world)
+    Vec3 angularVelocity;                             ///< rad/s (world)
+};
+
 /// The runtime. Call everything from one (main) thread; fracture jobs run on the DestructionWorld's workers.
 class DestructionRuntime {
 public:
@@ -254,6 +263,9 @@ public:
     std::vector<BodyId> supportNeighbours(BodyId id) const;
     /// The point distant debris fades from (e.g. the camera).
     void setFocus(const Vec3& point);
+
+    /// The placement of every body that carries an object, ascending body id.
+    std::vector<ObjectPlacement> placements() const;
 
     /// Hash of the live body set (id, role, motion, object version and mesh hash, transform bits) and of the
     /// volume ledger: equal runs give equal hashes.

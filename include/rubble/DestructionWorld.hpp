@@ -111,6 +111,25 @@ struct FractureOutcome {
     double dustVolume() const;
 };
 
+/// Fracture work not yet adopted: a job in flight (to be relaunched on load) or impacts waiting for one.
+struct PendingWork {
+    ObjectId object = 0;              ///< the object hit
+    std::uint32_t version = 0;        ///< its version when the job started
+    bool inFlight = false;            ///< a launched job (true) or impacts waiting for the object's job
+    std::uint64_t readyFrame = 0;     ///< in flight: the frame it is adopted in (deterministic mode)
+    std::vector<Impact> impacts;      ///< as submitted (journal precision), in order
+    std::vector<std::uint64_t> ticks; ///< frame of each impact's submission
+};
+
+/// Everything a DestructionWorld holds besides its settings and timings: what a snapshot saves.
+struct WorldState {
+    std::uint64_t frame = 0;           ///< DestructionWorld::frame()
+    ObjectId nextId = 1;               ///< the id the next new object gets
+    std::uint64_t journalPosition = 0; ///< journal events so far
+    std::vector<ObjectState> objects;  ///< live objects, ascending id
+    std::vector<PendingWork> work;     ///< jobs in flight (launch order), then waiting impacts (by object)
+};
+
 /// The runtime. All member functions are called from one (main) thread; work runs on the JobSystem.
 class DestructionWorld {
 public:
@@ -168,6 +187,13 @@ public:
     /// the object does not exist, refuses the impact, or its fracture pattern or next job seed differ from
     /// the event's (a journal of another scene or world seed).
     Status applyJournalEvent(const JournalEvent& event);
+    /// The world's state (objects, frame, id counter, journal position, unadopted work).
+    WorldState saveState() const;
+    /// Replaces the world's state by state (pending results of the current state are discarded; work in the
+    /// state is relaunched as it was). Fails, changing nothing, when the state is inconsistent (ids not
+    /// ascending or not below nextId, work on a missing object or version, an empty mesh).
+    Status loadState(WorldState state);
+
     /// Order-independent hash of the geometry: every live object's id, version and mesh hash. Equal worlds
     /// give equal hashes on any worker count and compiler (docs/journal.md). O(1): kept up to date.
     std::uint64_t geometryHash() const;

@@ -529,6 +529,18 @@ void DestructionRuntime::setFocus(const Vec3& point) {
     impl_->focus = point;
 }
 
+std::vector<ObjectPlacement> DestructionRuntime::placements() const {
+    std::vector<ObjectPlacement> out;
+    for (const auto& [id, r] : impl_->bodies.all()) {
+        if (!r.hasObject)
+            continue;
+        const BodyMotion m = impl_->binding.motion(id);
+        out.push_back({r.object, r.motion, m.transform * r.objectToBody.inverse(), m.linearVelocity,
+                       m.angularVelocity});
+    }
+    return out;
+}
+
 std::uint64_t DestructionRuntime::stateHash() const {
     std::uint64_t h = 0xCBF29CE484222325ull;
     for (const auto& [id, r] : impl_->bodies.all()) {

@@ -8,6 +8,7 @@
 #include <limits>
 #include <map>
 #include <mutex>
+#include <set>
 #include <string>
 
 #include "geometry/ClosestPoint.hpp"
@@ -46,6 +47,7 @@ struct Job {
     ObjectId id = 0;
     std::uint32_t version = 0;
     std::vector<PendingImpact> impacts;
+    std::vector<Impact> submitted;             // the impacts as submitted (runJob moves `impacts`)
     std::shared_ptr<const ObjectState> object; // its mesh and convex parts (object states never change)
     FractureParams params;
     bool crumble = false; // over its triangle limit: a shatter as large as the object
@@ -252,13 +254,15 @@ struct DestructionWorld::Impl {
         return std::any_of(inflight.begin(), inflight.end(), [&](const auto& j) { return j->id == id; });
     }
 
-    void launch(ObjectId id, std::vector<PendingImpact> impacts) {
+    std::shared_ptr<Job> launch(ObjectId id, std::vector<PendingImpact> impacts) {
         const std::shared_ptr<const ObjectState>& object = objects.at(id);
         const ObjectState& o = *object;
         auto job = std::make_shared<Job>();
         job->id = id;
         job->version = o.version;
         job->impacts = std::move(impacts);
+        for (const PendingImpact& p : job->impacts)
+            job->submitted.push_back(p.impact);
         job->object = object;
         job->params = o.fracture;
         if (o.mesh.triangleCount() > o.crumbleAbove) { // too much detail: break it up instead of a crater
@@ -302,6 +306,7 @@ struct DestructionWorld::Impl {
             --s->outstanding;
             s->done.notify_all();
         });
+        return job;
     }
 
     bool isFinished(const Job& j) {
@@ -466,6 +471,85 @@ Status DestructionWorld::applyJournalEvent(const JournalEvent& e) {
         return Error{ErrorCode::InvalidInput, where + "seed differs (another scene or world seed)"};
     if (!submitImpact(e.object, e.impact()))
         return Error{ErrorCode::InvalidInput, where + "the object refuses the impact"};
+    return Status::ok();
+}
+
+WorldState DestructionWorld::saveState() const {
+    const Impl& im = *impl_;
+    WorldState w;
+    w.frame = im.frame;
+    w.nextId = im.nextId;
+    w.journalPosition = im.journalLength;
+    for (const auto& [id, o] : im.objects)
+        w.objects.push_back(*o);
+    for (const auto& job : im.inflight) {
+        PendingWork p{job->id, job->version, true, job->readyFrame, job->submitted, {}};
+        for (const PendingImpact& q : job->impacts)
+            p.ticks.push_back(q.frame);
+        w.work.push_back(std::move(p));
+    }
+    for (const auto& [id, impacts] : im.waiting) {
+        auto o = im.objects.find(id);
+        PendingWork p{id, o == im.objects.end() ? 0u : o->second->version, false, 0, {}, {}};
+        for (const PendingImpact& q : impacts) {
+            p.impacts.push_back(q.impact);
+            p.ticks.push_back(q.frame);
+        }
+        w.work.push_back(std::move(p));
+    }
+    return w;
+}
+
+Status DestructionWorld::loadState(WorldState w) {
+    Impl& im = *impl_;
+    auto bad = [](const std::string& what) { return Error{ErrorCode::InvalidInput, "world state: " + what}; };
+    ObjectId last = 0;
+    std::map<ObjectId, std::uint32_t> versions;
+    for (const ObjectState& o : w.objects) {
+        if (o.id <= last || o.id >= w.nextId)
+            return bad("object id " + std::to_string(o.id) + " is not ascending or not below nextId " +
+                       std::to_string(w.nextId));
+        if (o.mesh.triangles.empty() || o.mesh.positions.empty())
+            return bad("object " + std::to_string(o.id) + " has an empty mesh");
+        last = o.id;
+        versions[o.id] = o.version;
+    }
+    std::set<ObjectId> busy, waiting;
+    for (const PendingWork& p : w.work) {
+        auto v = versions.find(p.object);
+        const std::string which = "work on object " + std::to_string(p.object);
+        if (v == versions.end() || v->second != p.version)
+            return bad(which + ": no such object or version");
+        if (p.impacts.empty() || p.ticks.size() != p.impacts.size())
+            return bad(which + ": no impacts, or not one tick per impact");
+        if (!(p.inFlight ? busy : waiting).insert(p.object).second)
+            return bad(which + ": listed twice");
+        if (!p.inFlight && !busy.count(p.object))
+            return bad(which + ": impacts wait for a job that is not in flight");
+    }
+    // Consistent: replace everything. Jobs of the old state finish on their own; their results are dropped.
+    im.inflight.clear();
+    im.waiting.clear();
+    im.handedOut.clear();
+    im.objects.clear();
+    im.geometrySum = 0;
+    for (ObjectState& o : w.objects) {
+        o.meshHash = o.mesh.hash();
+        im.insertObject(std::make_shared<const ObjectState>(std::move(o)));
+    }
+    im.frame = w.frame;
+    im.nextId = w.nextId;
+    im.journalLength = w.journalPosition;
+    const auto now = Clock::now();
+    for (const PendingWork& p : w.work) {
+        std::vector<PendingImpact> impacts;
+        for (std::size_t i = 0; i < p.impacts.size(); ++i)
+            impacts.push_back({p.impacts[i], p.ticks[i], now});
+        if (p.inFlight)
+            im.launch(p.object, std::move(impacts))->readyFrame = p.readyFrame;
+        else
+            im.waiting[p.object] = std::move(impacts);
+    }
     return Status::ok();
 }
 

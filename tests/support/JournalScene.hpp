@@ -59,9 +59,11 @@ struct JournalRig {
         for (SceneObject& o : journalScene())
             EXPECT_TRUE(runtime.addObject(std::move(o.desc), o.placement, o.isStatic));
     }
-    /// Steps `frames` frames firing a projectile every `every` frames at the wall and the column.
+    /// Steps `frames` frames firing a projectile every `every` frames (counted across calls) at the wall and
+    /// the column.
     void play(int frames, int every = 7) {
-        for (int f = 0; f < frames; ++f) {
+        for (int i = 0; i < frames; ++i) {
+            const int f = played++;
             if (f % every == 0) {
                 const double y = 0.4 + 0.37 * (f % 11);
                 const double z = (f / every) % 2 == 0 ? -1.5 + 0.29 * (f % 13) : 4.0;
@@ -77,6 +79,7 @@ struct JournalRig {
     }
     ToyPhysics engine;
     DestructionRuntime runtime;
+    int played = 0; ///< frames played
 };
 
 /// A bare world (no engine) with the scene's objects: what a replay or a client starts from.

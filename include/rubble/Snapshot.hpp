@@ -1,0 +1,43 @@
+#pragma once
+/// \file Snapshot.hpp
+/// Snapshots of a destroyed world: a versioned, checksummed binary format holding every object's mesh,
+/// convex parts, mass properties, material and fracture settings, the bodies' placements and velocities, the
+/// unadopted work and the journal position (layout in docs/journal.md).
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "rubble/DestructionRuntime.hpp"
+#include "rubble/DestructionWorld.hpp"
+#include "rubble/Result.hpp"
+
+namespace rubble {
+
+/// A saved world.
+struct Snapshot {
+    std::uint64_t seed = 1;                  ///< DestructionWorld::Config::seed it needs
+    std::int32_t delayFrames = 2;            ///< DestructionWorld::Config::delayFrames it needs
+    WorldState world;                        ///< objects, frame, ids, journal position, work
+    std::vector<ObjectPlacement> placements; ///< bodies (empty for a world without an engine)
+};
+
+/// The snapshot of a world (and of its bodies, when placements are given).
+Snapshot takeSnapshot(const DestructionWorld& world, const DestructionWorld::Config& config,
+                      std::vector<ObjectPlacement> placements = {});
+/// Loads a snapshot into a world built with matching settings; fails (naming the field), changing nothing,
+/// when seed or delay differ or the state is inconsistent.
+Status restoreSnapshot(DestructionWorld& world, const DestructionWorld::Config& config, Snapshot snapshot);
+
+/// The snapshot's bytes.
+std::vector<std::uint8_t> encodeSnapshot(const Snapshot& snapshot);
+/// Parses a snapshot; a truncated, corrupted, wrong-version or hostile input gives an error naming source,
+/// offset and field (checksum first, then every count against the bytes left, every index and number).
+Result<Snapshot> decodeSnapshot(const std::uint8_t* data, std::size_t size, const std::string& source);
+/// Writes a snapshot atomically (temporary file, fsync, rename).
+Status saveSnapshot(const std::filesystem::path& path, const Snapshot& snapshot);
+/// Reads a snapshot file.
+Result<Snapshot> loadSnapshot(const std::filesystem::path& path);
+
+} // namespace rubble

@@ -1,0 +1,191 @@
+// Snapshots: load then save gives the same bytes and geometry, a late joiner converges with snapshot +
+// journal tail, damaged or hostile files are refused naming offset and field with the world untouched, and a
+// process killed mid-save leaves the previous snapshot intact.
+#include "rubble/Snapshot.hpp"
+
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <random>
+
+#include "JournalScene.hpp"
+#include "TestSupport.hpp"
+#include "persist/Bytes.hpp"
+#include "rubble/JournalFile.hpp"
+#include "rubble/JournalPlayer.hpp"
+
+namespace rubble {
+namespace {
+
+const DestructionWorld::Config kConfig = test::journalConfig(1).world;
+
+// A world in mid-fire (jobs in flight) and its snapshot with the bodies' placements.
+struct MidFire {
+    test::JournalRig rig{1};
+    Snapshot snapshot;
+    MidFire() {
+        rig.play(100);
+        for (int i = 0; i < 30 && rig.runtime.world().jobsInFlight() == 0; ++i)
+            rig.play(1, 1);
+        snapshot = takeSnapshot(rig.runtime.world(), kConfig, rig.runtime.placements());
+    }
+};
+
+void refix(std::vector<std::uint8_t>& bytes) { // a valid checksum over tampered bytes
+    const std::uint32_t crc = persist::crc32(bytes.data(), bytes.size() - 4);
+    for (int i = 0; i < 4; ++i)
+        bytes[bytes.size() - 4 + i] = static_cast<std::uint8_t>(crc >> (8 * i));
+}
+
+TEST(Snapshot, LoadThenSaveGivesIdenticalBytesAndGeometry) {
+    MidFire m;
+    ASSERT_GT(m.snapshot.world.work.size(), 0u) << "saved with jobs in flight";
+    ASSERT_GT(m.snapshot.world.objects.size(), 5u);
+    ASSERT_EQ(m.snapshot.placements.size(), m.snapshot.world.objects.size());
+    const std::vector<std::uint8_t> bytes = encodeSnapshot(m.snapshot);
+    Result<Snapshot> decoded = decodeSnapshot(bytes.data(), bytes.size(), "mid.rsnap");
+    ASSERT_TRUE(decoded) << decoded.error().message;
+    DestructionWorld world(kConfig);
+    const std::vector<ObjectPlacement> placements = decoded->placements;
+    ASSERT_TRUE(restoreSnapshot(world, kConfig, std::move(*decoded)));
+    EXPECT_EQ(world.geometryHash(), m.rig.runtime.world().geometryHash());
+    EXPECT_EQ(world.journalPosition(), m.rig.runtime.world().journalPosition());
+    EXPECT_EQ(encodeSnapshot(takeSnapshot(world, kConfig, placements)), bytes);
+}
+
+TEST(Snapshot, SnapshotPlusJournalTailConvergesWithTheHost) {
+    MidFire m;
+    std::vector<JournalEvent> tail;
+    m.rig.runtime.world().setJournalSink([&](const JournalEvent& e) { tail.push_back(e); });
+    m.rig.play(120);
+    m.rig.settle();
+    ASSERT_GT(tail.size(), 3u);
+    for (int workers : {1, 2}) {
+        DestructionWorld::Config c = kConfig;
+        c.workers = workers;
+        DestructionWorld late(c);
+        ASSERT_TRUE(restoreSnapshot(late, c, m.snapshot));
+        JournalPlayer player(late);
+        for (const JournalEvent& e : tail)
+            ASSERT_TRUE(player.receive(e));
+        ASSERT_TRUE(player.advanceTo(m.rig.runtime.world().frame()));
+        EXPECT_EQ(late.geometryHash(), m.rig.runtime.world().geometryHash()) << workers << " workers";
+        EXPECT_EQ(late.journalPosition(), m.rig.runtime.world().journalPosition());
+    }
+}
+
+TEST(Snapshot, DamagedFilesAreRefusedNamingOffsetAndFieldAndTheWorldStaysAsItWas) {
+    MidFire m;
+    const std::vector<std::uint8_t> bytes = encodeSnapshot(m.snapshot);
+    DestructionWorld world(kConfig);
+    ASSERT_TRUE(restoreSnapshot(world, kConfig, m.snapshot));
+    const std::uint64_t before = world.geometryHash();
+    auto refused = [&](const std::vector<std::uint8_t>& b, const std::string& expect) {
+        Result<Snapshot> r = decodeSnapshot(b.data(), b.size(), "bad.rsnap");
+        EXPECT_FALSE(r) << expect;
+        if (r)
+            return;
+        EXPECT_NE(r.error().message.find("bad.rsnap: offset "), std::string::npos) << r.error().message;
+        EXPECT_NE(r.error().message.find(expect), std::string::npos) << r.error().message;
+    };
+    // Truncated anywhere.
+    std::mt19937 rng(7);
+    for (int i = 0; i < 40; ++i) {
+        const std::size_t n = std::uniform_int_distribution<std::size_t>(0, bytes.size() - 1)(rng);
+        refused(std::vector<std::uint8_t>(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(n)),
+                "field ");
+    }
+    // A flipped bit: the checksum.
+    std::vector<std::uint8_t> b = bytes;
+    b[bytes.size() / 2] ^= 4;
+    refused(b, "field crc32: checksum mismatch");
+    // Another version, another format.
+    b = bytes;
+    b[4] = 2;
+    refused(b, "offset 4, field version");
+    b = bytes;
+    b[0] = 'X';
+    refused(b, "offset 0, field magic");
+    // Hostile but checksummed: a huge count, an out-of-range vertex index, a NaN.
+    b = bytes;
+    const std::size_t objectsCount = 4 + 2 + 2 + 8 + 4 + 8 + 4 + 8;
+    b[objectsCount + 3] = 0x7F;
+    refix(b);
+    refused(b, "offset " + std::to_string(objectsCount) + ", field objects.count: count");
+    const std::size_t firstObject = objectsCount + 4;
+    const std::size_t meshAt = firstObject + 4 + 4 + 1 + 8 + 8 + 8 + 1 + 4 + 4 + 40 + 1 + 8 + 8 + 1 + 8 + 24 +
+                               72 + 24 + 72; // positions.count
+    const std::uint32_t nPos = m.snapshot.world.objects[0].mesh.positions.size();
+    const std::size_t firstIndex = meshAt + 4 + 24 * nPos + 4;
+    b = bytes;
+    b[firstIndex + 2] = 0x10;
+    refix(b);
+    refused(b, "offset " + std::to_string(firstIndex) + ", field objects[0].mesh.triangles: vertex index");
+    b = bytes;
+    for (int k = 0; k < 8; ++k)
+        b[meshAt + 4 + k] = 0xFF; // positions[0].x = NaN
+    refix(b);
+    refused(b, "offset " + std::to_string(meshAt + 4) + ", field objects[0].mesh.positions.x: is not finite");
+    // A consistent file of another world, and an inconsistent state: refused, the world untouched.
+    DestructionWorld::Config other = kConfig;
+    other.seed = 99;
+    Status s = restoreSnapshot(world, other, m.snapshot);
+    EXPECT_FALSE(s);
+    EXPECT_NE(s.message().find("field seed"), std::string::npos) << s.message();
+    Snapshot broken = m.snapshot;
+    broken.world.work.push_back({12345, 0, true, 0, {Impact{}}, {0}});
+    s = restoreSnapshot(world, kConfig, broken);
+    EXPECT_FALSE(s);
+    EXPECT_NE(s.message().find("work on object 12345"), std::string::npos) << s.message();
+    EXPECT_EQ(world.geometryHash(), before);
+    EXPECT_EQ(encodeSnapshot(takeSnapshot(world, kConfig, m.snapshot.placements)), bytes);
+}
+
+TEST(Snapshot, AProcessKilledMidSaveLeavesThePreviousSnapshot) {
+    std::vector<std::uint8_t> a, b;
+    {
+        MidFire m;
+        a = encodeSnapshot(m.snapshot);
+        m.rig.play(60);
+        b = encodeSnapshot(takeSnapshot(m.rig.runtime.world(), kConfig, m.rig.runtime.placements()));
+    } // the worlds' threads are gone before fork()
+    ASSERT_NE(a, b);
+    ASSERT_GT(a.size(), 100000u) << "large enough that a kill lands inside a write";
+    const std::filesystem::path dir = test::tempDir("snapshot-kill");
+    const std::filesystem::path path = dir / "world.rsnap";
+    ASSERT_TRUE(writeFileAtomic(path, a));
+    std::mt19937 rng(20261125);
+    int sawA = 0, sawB = 0;
+    for (int round = 0; round < 25; ++round) {
+        const pid_t child = fork();
+        ASSERT_GE(child, 0);
+        if (child == 0) { // saves B and A in turn until killed
+            for (int i = 0;; ++i)
+                if (!writeFileAtomic(path, i % 2 ? a : b))
+                    _exit(3);
+        }
+        usleep(std::uniform_int_distribution<unsigned>(200, 20000)(rng));
+        kill(child, SIGKILL);
+        int status = 0;
+        ASSERT_EQ(waitpid(child, &status, 0), child);
+        ASSERT_TRUE(WIFSIGNALED(status)) << "the child was killed, not finished (" << status << ")";
+        Result<std::vector<std::uint8_t>> now = readFileBinary(path);
+        ASSERT_TRUE(now);
+        ASSERT_TRUE(*now == a || *now == b)
+            << "round " << round << ": " << now->size() << " bytes, neither snapshot";
+        (*now == a ? sawA : sawB)++;
+        Result<Snapshot> loaded = loadSnapshot(path);
+        EXPECT_TRUE(loaded) << loaded.error().message;
+    }
+    EXPECT_GT(sawA + sawB, 0);
+    std::size_t leftovers = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(dir))
+        leftovers += entry.path().filename().string().find(".tmp.") != std::string::npos;
+    std::printf("kill test: %d times the first, %d times the second snapshot, %zu temporary files left\n",
+                sawA, sawB, leftovers);
+}
+
+} // namespace
+} // namespace rubble
