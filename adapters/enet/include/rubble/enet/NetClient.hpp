@@ -1,0 +1,54 @@
+#pragma once
+/// \file NetClient.hpp
+/// The following side of loopback multiplayer: loads the host's snapshot, then replays its journal events
+/// and checks its geometry hash against the host's at every frame sync (docs/netplay.md).
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "rubble/DestructionWorld.hpp"
+#include "rubble/Result.hpp"
+
+namespace rubble::net {
+
+/// Totals of a client.
+struct ClientStats {
+    bool connected = false;         ///< the host accepted the connection
+    bool joined = false;            ///< the snapshot arrived and was loaded
+    double joinMs = 0;              ///< connect → snapshot loaded (ms)
+    long long events = 0;           ///< journal events applied
+    long long syncs = 0;            ///< frame syncs checked
+    long long mismatchedHashes = 0; ///< syncs whose geometry hash differed from the host's
+    std::uint64_t frame = 0;        ///< the world's frame after the last sync
+};
+
+/// A client of a NetHost on a loopback address. Its world must be built with the host's settings (any
+/// worker count); the snapshot replaces its content.
+class NetClient {
+public:
+    /// Starts connecting to address:port (a loopback address); service() completes it (ENet gives up after
+    /// about 5 s without an answer, and service() then fails).
+    static Result<std::unique_ptr<NetClient>> connect(DestructionWorld& world,
+                                                      const DestructionWorld::Config& config,
+                                                      const std::string& address, std::uint16_t port);
+    ~NetClient();
+    NetClient(const NetClient&) = delete;
+    NetClient& operator=(const NetClient&) = delete;
+
+    /// Receives and applies what arrived within timeoutMs. Fails when the host sent something the world
+    /// refuses (a corrupted snapshot or an event out of order) or the connection was lost.
+    Status service(int timeoutMs = 0);
+    /// Called for every outcome the world adopts (its pieces are in the world already).
+    void setOnOutcome(std::function<void(const FractureOutcome&)> callback);
+    /// Totals.
+    const ClientStats& stats() const;
+
+private:
+    struct Impl;
+    explicit NetClient(std::unique_ptr<Impl> impl);
+    std::unique_ptr<Impl> impl_;
+};
+
+} // namespace rubble::net

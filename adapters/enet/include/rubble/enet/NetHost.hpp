@@ -1,0 +1,57 @@
+#pragma once
+/// \file NetHost.hpp
+/// The authoritative side of loopback multiplayer: sends a joining client a snapshot, then every journal
+/// event and, once per frame, the frame number with the geometry hash it must match (docs/netplay.md).
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "rubble/DestructionWorld.hpp"
+#include "rubble/Result.hpp"
+
+namespace rubble::net {
+
+/// Totals of a host.
+struct HostStats {
+    int clients = 0;                ///< clients connected now
+    long long joins = 0;            ///< clients that joined (each got a snapshot)
+    long long eventsSent = 0;       ///< journal events sent (per client)
+    long long eventBytes = 0;       ///< bytes of journal event messages sent (per client, payload)
+    long long snapshotBytes = 0;    ///< bytes of snapshots sent
+    long long syncs = 0;            ///< frame syncs sent (per client)
+    long long acks = 0;             ///< clients' hash reports received
+    long long mismatchedHashes = 0; ///< reports whose geometry hash differed from the host's at that frame
+};
+
+/// A host on 127.0.0.1 (only loopback addresses are accepted). Replicates the world it is given; the world
+/// must be deterministic (Config::deterministic), since clients replay its journal.
+class NetHost {
+public:
+    /// Listens on address:port (port 0 = any free port) for at most maxClients. Fails for a non-loopback
+    /// address, a world that is not deterministic, or when ENet cannot bind.
+    static Result<std::unique_ptr<NetHost>> listen(DestructionWorld& world,
+                                                   const DestructionWorld::Config& config,
+                                                   const std::string& address, std::uint16_t port,
+                                                   int maxClients = 8);
+    ~NetHost();
+    NetHost(const NetHost&) = delete;
+    NetHost& operator=(const NetHost&) = delete;
+
+    /// The port it listens on.
+    std::uint16_t port() const;
+    /// Sends every client the journal events since its last publish and a sync for the world's current
+    /// frame; call once per frame after the world (or runtime) stepped.
+    void publish();
+    /// Handles the network (joins, leaves, clients' hash reports) for up to timeoutMs.
+    void service(int timeoutMs = 0);
+    /// Totals.
+    const HostStats& stats() const;
+
+private:
+    struct Impl;
+    explicit NetHost(std::unique_ptr<Impl> impl);
+    std::unique_ptr<Impl> impl_;
+};
+
+} // namespace rubble::net

@@ -1,0 +1,151 @@
+#include "rubble/enet/NetClient.hpp"
+
+#include <chrono>
+
+#include "Protocol.hpp"
+#include "rubble/JournalFile.hpp"
+#include "rubble/JournalPlayer.hpp"
+#include "rubble/Snapshot.hpp"
+
+namespace rubble::net {
+
+using detail::Message;
+using Clock = std::chrono::steady_clock;
+
+struct NetClient::Impl {
+    Impl(DestructionWorld& w, const DestructionWorld::Config& c) : world(w), config(c), player(w) {}
+    DestructionWorld& world;
+    DestructionWorld::Config config;
+    JournalPlayer player;
+    ENetHost* host = nullptr;
+    ENetPeer* server = nullptr;
+    Clock::time_point connected;
+    ClientStats stats;
+
+    Status receive(const ENetPacket* packet) {
+        const std::uint8_t* d = packet->data;
+        const std::size_t n = packet->dataLength;
+        if (n == 0)
+            return Error{ErrorCode::ParseError, "netplay: empty message"};
+        switch (static_cast<Message>(d[0])) {
+        case Message::Snapshot: {
+            Result<Snapshot> s = decodeSnapshot(d + 1, n - 1, "host snapshot");
+            if (!s)
+                return s.error();
+            if (Status st = restoreSnapshot(world, config, std::move(*s)); !st)
+                return st;
+            stats.joined = true;
+            stats.joinMs = std::chrono::duration<double, std::milli>(Clock::now() - connected).count();
+            return Status::ok();
+        }
+        case Message::Events: {
+            if (!stats.joined)
+                return Error{ErrorCode::InvalidInput, "netplay: events before the snapshot"};
+            std::uint32_t count = 0;
+            for (int i = 0; i < 4 && n >= 5; ++i)
+                count |= static_cast<std::uint32_t>(d[1 + i]) << (8 * i);
+            if (n < 5 || n != 5 + static_cast<std::size_t>(count) * kJournalEventBytes)
+                return Error{ErrorCode::ParseError,
+                             "netplay: events message of " + std::to_string(n) + " bytes"};
+            for (std::uint32_t i = 0; i < count; ++i) {
+                Result<JournalEvent> e =
+                    decodeJournalEvent(d + 5 + i * kJournalEventBytes, 5 + i * kJournalEventBytes);
+                if (!e)
+                    return e.error();
+                if (Status st = player.receive(*e); !st)
+                    return st;
+                ++stats.events;
+            }
+            return Status::ok();
+        }
+        case Message::Sync: {
+            if (n != 25)
+                return Error{ErrorCode::ParseError,
+                             "netplay: sync message of " + std::to_string(n) + " bytes"};
+            if (!stats.joined)
+                return Status::ok();
+            const std::uint64_t frame = detail::readU64(d + 1), position = detail::readU64(d + 9),
+                                hash = detail::readU64(d + 17);
+            if (Status st = player.advanceTo(frame); !st)
+                return st;
+            const std::uint64_t mine = world.geometryHash();
+            ++stats.syncs;
+            stats.frame = world.frame();
+            if (mine != hash || world.journalPosition() != position)
+                ++stats.mismatchedHashes;
+            std::vector<std::uint8_t> ack{static_cast<std::uint8_t>(Message::Ack)};
+            detail::appendU64(ack, frame);
+            detail::appendU64(ack, mine);
+            detail::sendReliable(server, ack);
+            return Status::ok();
+        }
+        default:
+            return Error{ErrorCode::ParseError, "netplay: unknown message type " + std::to_string(d[0])};
+        }
+    }
+};
+
+NetClient::NetClient(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+
+NetClient::~NetClient() {
+    if (impl_->host) {
+        if (impl_->server)
+            enet_peer_disconnect_now(impl_->server, 0);
+        enet_host_destroy(impl_->host);
+    }
+}
+
+Result<std::unique_ptr<NetClient>> NetClient::connect(DestructionWorld& world,
+                                                      const DestructionWorld::Config& config,
+                                                      const std::string& address, std::uint16_t port) {
+    if (!config.deterministic)
+        return Error{ErrorCode::InvalidInput, "netplay needs a deterministic world"};
+    detail::initialiseEnet();
+    Result<ENetAddress> a = detail::loopbackAddress(address, port);
+    if (!a)
+        return a.error();
+    auto impl = std::make_unique<Impl>(world, config);
+    impl->host = enet_host_create(nullptr, 1, 1, 0, 0);
+    if (!impl->host)
+        return Error{ErrorCode::IoError, "cannot create an ENet client"};
+    auto client = std::unique_ptr<NetClient>(new NetClient(std::move(impl)));
+    Impl& im = *client->impl_;
+    im.connected = Clock::now();
+    im.server = enet_host_connect(im.host, &*a, 1, 0);
+    if (!im.server)
+        return Error{ErrorCode::IoError, "cannot connect to " + address + ":" + std::to_string(port)};
+    return client;
+}
+
+Status NetClient::service(int timeoutMs) {
+    Impl& im = *impl_;
+    ENetEvent e;
+    int r = enet_host_service(im.host, &e, static_cast<enet_uint32>(std::max(0, timeoutMs)));
+    for (; r > 0; r = enet_host_service(im.host, &e, 0)) {
+        if (e.type == ENET_EVENT_TYPE_CONNECT) {
+            im.stats.connected = true;
+        } else if (e.type == ENET_EVENT_TYPE_RECEIVE) {
+            Status s = im.receive(e.packet);
+            enet_packet_destroy(e.packet);
+            if (!s)
+                return s;
+        } else if (e.type == ENET_EVENT_TYPE_DISCONNECT) {
+            im.server = nullptr;
+            return Error{ErrorCode::IoError, im.stats.connected ? "netplay: the host closed the connection"
+                                                                : "netplay: no host answered"};
+        }
+    }
+    if (r < 0)
+        return Error{ErrorCode::IoError, "netplay: ENet service failed"};
+    return Status::ok();
+}
+
+void NetClient::setOnOutcome(std::function<void(const FractureOutcome&)> callback) {
+    impl_->player.setOnOutcome(std::move(callback));
+}
+
+const ClientStats& NetClient::stats() const {
+    return impl_->stats;
+}
+
+} // namespace rubble::net

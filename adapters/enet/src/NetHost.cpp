@@ -1,0 +1,145 @@
+#include "rubble/enet/NetHost.hpp"
+
+#include <map>
+#include <vector>
+
+#include "Protocol.hpp"
+#include "rubble/JournalFile.hpp"
+#include "rubble/Snapshot.hpp"
+
+namespace rubble::net {
+
+using detail::Message;
+
+struct NetHost::Impl {
+    Impl(DestructionWorld& w, const DestructionWorld::Config& c) : world(w), config(c) {}
+    DestructionWorld& world;
+    DestructionWorld::Config config;
+    ENetHost* host = nullptr;
+    std::vector<JournalEvent> journal;             // events since base
+    std::uint64_t base = 0;                        // journal position of journal.front()
+    std::map<ENetPeer*, std::uint64_t> peers;      // journal position each client has been sent up to
+    std::map<std::uint64_t, std::uint64_t> hashes; // frame → geometry hash sent in its sync (recent ones)
+    HostStats stats;
+
+    void join(ENetPeer* peer) {
+        std::vector<std::uint8_t> msg{static_cast<std::uint8_t>(Message::Snapshot)};
+        const std::vector<std::uint8_t> bytes = encodeSnapshot(takeSnapshot(world, config));
+        msg.insert(msg.end(), bytes.begin(), bytes.end());
+        if (!detail::sendReliable(peer, msg)) {
+            enet_peer_disconnect(peer, 0);
+            return;
+        }
+        peers[peer] = world.journalPosition();
+        ++stats.joins;
+        stats.snapshotBytes += static_cast<long long>(bytes.size());
+        enet_host_flush(host);
+    }
+
+    void receive(ENetPeer* peer, const ENetPacket* packet) {
+        const std::uint8_t* d = packet->data;
+        if (packet->dataLength != 17 || d[0] != static_cast<std::uint8_t>(Message::Ack) || !peers.count(peer))
+            return; // clients send nothing else
+        ++stats.acks;
+        const std::uint64_t frame = detail::readU64(d + 1), hash = detail::readU64(d + 9);
+        if (auto it = hashes.find(frame); it != hashes.end() && it->second != hash)
+            ++stats.mismatchedHashes;
+    }
+};
+
+NetHost::NetHost(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+
+NetHost::~NetHost() {
+    impl_->world.setJournalSink({});
+    if (impl_->host) {
+        for (auto& [peer, position] : impl_->peers)
+            enet_peer_disconnect_now(peer, 0);
+        enet_host_destroy(impl_->host);
+    }
+}
+
+Result<std::unique_ptr<NetHost>> NetHost::listen(DestructionWorld& world,
+                                                 const DestructionWorld::Config& config,
+                                                 const std::string& address, std::uint16_t port,
+                                                 int maxClients) {
+    if (!config.deterministic)
+        return Error{ErrorCode::InvalidInput,
+                     "netplay needs a deterministic world (clients replay its journal)"};
+    detail::initialiseEnet();
+    Result<ENetAddress> a = detail::loopbackAddress(address, port);
+    if (!a)
+        return a.error();
+    auto impl = std::make_unique<Impl>(world, config);
+    impl->host = enet_host_create(&*a, static_cast<std::size_t>(maxClients), 1, 0, 0);
+    if (!impl->host)
+        return Error{ErrorCode::IoError, "cannot listen on " + address + ":" + std::to_string(port)};
+    impl->base = world.journalPosition();
+    Impl* raw = impl.get();
+    world.setJournalSink([raw](const JournalEvent& e) { raw->journal.push_back(e); });
+    return std::unique_ptr<NetHost>(new NetHost(std::move(impl)));
+}
+
+std::uint16_t NetHost::port() const {
+    return impl_->host->address.port;
+}
+
+void NetHost::publish() {
+    Impl& im = *impl_;
+    const std::uint64_t end = im.world.journalPosition();
+    const std::uint64_t frame = im.world.frame(), hash = im.world.geometryHash();
+    im.hashes[frame] = hash;
+    while (im.hashes.size() > 4096)
+        im.hashes.erase(im.hashes.begin());
+    for (auto& [peer, position] : im.peers) {
+        if (position < end) {
+            std::vector<std::uint8_t> msg{static_cast<std::uint8_t>(Message::Events)};
+            const auto n = static_cast<std::uint32_t>(end - position);
+            for (int i = 0; i < 4; ++i)
+                msg.push_back(static_cast<std::uint8_t>(n >> (8 * i)));
+            for (std::uint64_t k = position; k < end; ++k) {
+                const auto bytes = encodeJournalEvent(im.journal[static_cast<std::size_t>(k - im.base)]);
+                msg.insert(msg.end(), bytes.begin(), bytes.end());
+            }
+            detail::sendReliable(peer, msg);
+            im.stats.eventsSent += n;
+            im.stats.eventBytes += static_cast<long long>(msg.size());
+            position = end;
+        }
+        std::vector<std::uint8_t> sync{static_cast<std::uint8_t>(Message::Sync)};
+        detail::appendU64(sync, frame);
+        detail::appendU64(sync, end);
+        detail::appendU64(sync, hash);
+        detail::sendReliable(peer, sync);
+        ++im.stats.syncs;
+    }
+    enet_host_flush(im.host);
+}
+
+void NetHost::service(int timeoutMs) {
+    Impl& im = *impl_;
+    ENetEvent e;
+    for (int r = enet_host_service(im.host, &e, static_cast<enet_uint32>(std::max(0, timeoutMs))); r > 0;
+         r = enet_host_service(im.host, &e, 0)) {
+        switch (e.type) {
+        case ENET_EVENT_TYPE_CONNECT:
+            im.join(e.peer);
+            break;
+        case ENET_EVENT_TYPE_RECEIVE:
+            im.receive(e.peer, e.packet);
+            enet_packet_destroy(e.packet);
+            break;
+        case ENET_EVENT_TYPE_DISCONNECT:
+            im.peers.erase(e.peer);
+            break;
+        default:
+            break;
+        }
+    }
+    im.stats.clients = static_cast<int>(im.peers.size());
+}
+
+const HostStats& NetHost::stats() const {
+    return impl_->stats;
+}
+
+} // namespace rubble::net
