@@ -18,6 +18,7 @@ TEST(NetLoopback, ClientsConvergeToTheHostsGeometryHash) {
     ASSERT_TRUE(server) << server.error().message;
     net::NetHost& h = **server;
     ASSERT_NE(h.port(), 0);
+    h.setPlacementSource([&] { return host.runtime.placements(); });
 
     DestructionWorld::Config c2 = config;
     c2.workers = 2;
@@ -40,6 +41,8 @@ TEST(NetLoopback, ClientsConvergeToTheHostsGeometryHash) {
     for (int frame = 0; frame < 240; ++frame) {
         host.play(1);
         h.publish();
+        if (frame % 6 == 0) // 10 Hz
+            h.publishPlacements(host.runtime.placements());
         pump();
         if (frame == 120) { // joins mid-fire, with jobs in flight
             auto c = net::NetClient::connect(late, c2, "127.0.0.1", h.port());
@@ -57,6 +60,31 @@ TEST(NetLoopback, ClientsConvergeToTheHostsGeometryHash) {
         h.service(2);
     }
     ASSERT_TRUE(second && second->stats().joined);
+    // Motion: the host's last placements arrive, and a late joiner knows the static objects from its
+    // snapshot.
+    const std::vector<ObjectPlacement> last = host.runtime.placements();
+    h.publishPlacements(last);
+    for (int i = 0; i < 20; ++i) {
+        pump();
+        h.service(1);
+    }
+    const double now = static_cast<double>(host.runtime.world().frame());
+    int moving = 0, still = 0;
+    for (const ObjectPlacement& p : last) {
+        for (net::NetClient* c : {first->get(), second.get()}) {
+            const std::optional<Frame> f = c->placement(p.object, now);
+            if (p.motion != BodyMotionState::Dynamic) {
+                still += f.has_value();
+                continue;
+            }
+            ASSERT_TRUE(f) << "object " << p.object;
+            ++moving;
+            EXPECT_LT(length(f->translation - p.objectToWorld.translation), 1e-4);
+            EXPECT_LT(length(f->rotation * Vec3{1, 0, 0} - p.objectToWorld.rotation * Vec3{1, 0, 0}), 1e-5);
+        }
+    }
+    EXPECT_GT(moving, 0);
+    EXPECT_GT(still, 0);
     EXPECT_GT(host.runtime.counters().fractures, 5);
     EXPECT_EQ(early.geometryHash(), host.runtime.world().geometryHash());
     EXPECT_EQ(late.geometryHash(), host.runtime.world().geometryHash());
@@ -67,8 +95,11 @@ TEST(NetLoopback, ClientsConvergeToTheHostsGeometryHash) {
     EXPECT_EQ(h.stats().joins, 2);
     const double bytesPerEvent = double(h.stats().eventBytes) / double(h.stats().eventsSent);
     EXPECT_LT(bytesPerEvent, 60) << "48 bytes per event plus a 5-byte header per batch";
-    std::printf("netplay: %lld events, %.1f bytes/event, snapshot %lld bytes, late join %.1f ms\n",
-                h.stats().eventsSent, bytesPerEvent, h.stats().snapshotBytes, second->stats().joinMs);
+    std::printf(
+        "netplay: %lld events, %.1f bytes/event, snapshot %lld bytes, late join %.1f ms, %lld placement "
+        "bytes\n",
+        h.stats().eventsSent, bytesPerEvent, h.stats().snapshotBytes, second->stats().joinMs,
+        h.stats().placementBytes);
 }
 
 TEST(NetLoopback, OnlyLoopbackAddressesAndDeterministicWorlds) {

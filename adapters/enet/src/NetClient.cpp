@@ -1,6 +1,9 @@
 #include "rubble/enet/NetClient.hpp"
 
 #include <chrono>
+#include <map>
+
+#include <algorithm>
 
 #include "Protocol.hpp"
 #include "rubble/JournalFile.hpp"
@@ -13,7 +16,9 @@ using detail::Message;
 using Clock = std::chrono::steady_clock;
 
 struct NetClient::Impl {
-    Impl(DestructionWorld& w, const DestructionWorld::Config& c) : world(w), config(c), player(w) {}
+    Impl(DestructionWorld& w, const DestructionWorld::Config& c) : world(w), config(c), player(w) {
+        player.setOnOutcome([this](const FractureOutcome& o) { adopted(o); });
+    }
     DestructionWorld& world;
     DestructionWorld::Config config;
     JournalPlayer player;
@@ -21,6 +26,51 @@ struct NetClient::Impl {
     ENetPeer* server = nullptr;
     Clock::time_point connected;
     ClientStats stats;
+    struct Track {
+        double f0 = 0, f1 = 0;
+        Frame a, b;
+    };
+    std::map<ObjectId, Track> tracks;
+    std::function<void(const FractureOutcome&)> onOutcome;
+
+    void adopted(const FractureOutcome& o) {
+        if (auto t = tracks.find(o.parent); t != tracks.end()) {
+            const Track parent = t->second;
+            tracks.erase(t);
+            for (const AdoptedPiece& p : o.pieces) // piece → parent local → world
+                tracks[p.id] = {parent.f1, parent.f1, parent.b * p.frame, parent.b * p.frame};
+        }
+        if (onOutcome)
+            onOutcome(o);
+    }
+
+    void placements(const std::uint8_t* d, std::size_t n) {
+        if (n < 13)
+            return;
+        const double frame = static_cast<double>(detail::readU64(d + 1));
+        const std::uint32_t count = detail::readU32(d + 9);
+        if (n != 13 + static_cast<std::size_t>(count) * detail::kPlacementBytes)
+            return; // unreliable channel: a malformed packet is dropped
+        stats.placementBytes += static_cast<long long>(n);
+        for (std::uint32_t i = 0; i < count; ++i) {
+            const std::uint8_t* r = d + 13 + i * detail::kPlacementBytes;
+            const ObjectId id = detail::readU32(r);
+            if (!world.object(id))
+                continue;
+            Frame f;
+            f.translation = {detail::readF32(r + 4), detail::readF32(r + 8), detail::readF32(r + 12)};
+            f.rotation = detail::fromQuaternion({detail::readF32(r + 16), detail::readF32(r + 20),
+                                                 detail::readF32(r + 24), detail::readF32(r + 28)});
+            Track& t = tracks[id];
+            if (frame <= t.f1 && t.f1 > 0)
+                continue; // older than what we have (unsequenced)
+            t.f0 = t.f1 > 0 ? t.f1 : frame;
+            t.a = t.f1 > 0 ? t.b : f;
+            t.f1 = frame;
+            t.b = f;
+            ++stats.placements;
+        }
+    }
 
     Status receive(const ENetPacket* packet) {
         const std::uint8_t* d = packet->data;
@@ -32,8 +82,13 @@ struct NetClient::Impl {
             Result<Snapshot> s = decodeSnapshot(d + 1, n - 1, "host snapshot");
             if (!s)
                 return s.error();
+            const double frame = static_cast<double>(s->world.frame);
+            std::map<ObjectId, Track> fresh;
+            for (const ObjectPlacement& p : s->placements)
+                fresh[p.object] = {frame, frame, p.objectToWorld, p.objectToWorld};
             if (Status st = restoreSnapshot(world, config, std::move(*s)); !st)
                 return st;
+            tracks = std::move(fresh);
             stats.joined = true;
             stats.joinMs = std::chrono::duration<double, std::milli>(Clock::now() - connected).count();
             return Status::ok();
@@ -79,6 +134,9 @@ struct NetClient::Impl {
             detail::sendReliable(server, ack);
             return Status::ok();
         }
+        case Message::Placements:
+            placements(d, n);
+            return Status::ok();
         default:
             return Error{ErrorCode::ParseError, "netplay: unknown message type " + std::to_string(d[0])};
         }
@@ -105,13 +163,13 @@ Result<std::unique_ptr<NetClient>> NetClient::connect(DestructionWorld& world,
     if (!a)
         return a.error();
     auto impl = std::make_unique<Impl>(world, config);
-    impl->host = enet_host_create(nullptr, 1, 1, 0, 0);
+    impl->host = enet_host_create(nullptr, 1, 2, 0, 0);
     if (!impl->host)
         return Error{ErrorCode::IoError, "cannot create an ENet client"};
     auto client = std::unique_ptr<NetClient>(new NetClient(std::move(impl)));
     Impl& im = *client->impl_;
     im.connected = Clock::now();
-    im.server = enet_host_connect(im.host, &*a, 1, 0);
+    im.server = enet_host_connect(im.host, &*a, 2, 0);
     if (!im.server)
         return Error{ErrorCode::IoError, "cannot connect to " + address + ":" + std::to_string(port)};
     return client;
@@ -141,7 +199,26 @@ Status NetClient::service(int timeoutMs) {
 }
 
 void NetClient::setOnOutcome(std::function<void(const FractureOutcome&)> callback) {
-    impl_->player.setOnOutcome(std::move(callback));
+    impl_->onOutcome = std::move(callback);
+}
+
+std::optional<Frame> NetClient::placement(ObjectId object, double frame) const {
+    auto it = impl_->tracks.find(object);
+    if (it == impl_->tracks.end())
+        return std::nullopt;
+    const Impl::Track& t = it->second;
+    const double span = t.f1 - t.f0;
+    const double s = span > 0 ? std::clamp((frame - t.f0) / span, 0.0, 1.0) : 1.0;
+    Frame f;
+    f.translation = t.a.translation * (1 - s) + t.b.translation * s;
+    auto qa = detail::toQuaternion(t.a.rotation), qb = detail::toQuaternion(t.b.rotation);
+    const double dot = qa[0] * qb[0] + qa[1] * qb[1] + qa[2] * qb[2] + qa[3] * qb[3];
+    const double sign = dot < 0 ? -1 : 1; // the shorter way round
+    std::array<double, 4> q{};
+    for (int i = 0; i < 4; ++i)
+        q[i] = qa[i] * (1 - s) + sign * qb[i] * s;
+    f.rotation = detail::fromQuaternion(q);
+    return f;
 }
 
 const ClientStats& NetClient::stats() const {

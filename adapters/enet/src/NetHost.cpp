@@ -21,10 +21,12 @@ struct NetHost::Impl {
     std::map<ENetPeer*, std::uint64_t> peers;      // journal position each client has been sent up to
     std::map<std::uint64_t, std::uint64_t> hashes; // frame → geometry hash sent in its sync (recent ones)
     HostStats stats;
+    std::function<std::vector<ObjectPlacement>()> placementSource;
 
     void join(ENetPeer* peer) {
         std::vector<std::uint8_t> msg{static_cast<std::uint8_t>(Message::Snapshot)};
-        const std::vector<std::uint8_t> bytes = encodeSnapshot(takeSnapshot(world, config));
+        const std::vector<std::uint8_t> bytes = encodeSnapshot(takeSnapshot(
+            world, config, placementSource ? placementSource() : std::vector<ObjectPlacement>{}));
         msg.insert(msg.end(), bytes.begin(), bytes.end());
         if (!detail::sendReliable(peer, msg)) {
             enet_peer_disconnect(peer, 0);
@@ -70,7 +72,7 @@ Result<std::unique_ptr<NetHost>> NetHost::listen(DestructionWorld& world,
     if (!a)
         return a.error();
     auto impl = std::make_unique<Impl>(world, config);
-    impl->host = enet_host_create(&*a, static_cast<std::size_t>(maxClients), 1, 0, 0);
+    impl->host = enet_host_create(&*a, static_cast<std::size_t>(maxClients), 2, 0, 0);
     if (!impl->host)
         return Error{ErrorCode::IoError, "cannot listen on " + address + ":" + std::to_string(port)};
     impl->base = world.journalPosition();
@@ -97,7 +99,9 @@ void NetHost::publish() {
             for (int i = 0; i < 4; ++i)
                 msg.push_back(static_cast<std::uint8_t>(n >> (8 * i)));
             for (std::uint64_t k = position; k < end; ++k) {
-                const auto bytes = encodeJournalEvent(im.journal[static_cast<std::size_t>(k - im.base)]);
+                const JournalEvent& e = im.journal[static_cast<std::size_t>(k - im.base)];
+                im.stats.impactEvents += e.kind == JournalEventKind::Impact;
+                const auto bytes = encodeJournalEvent(e);
                 msg.insert(msg.end(), bytes.begin(), bytes.end());
             }
             detail::sendReliable(peer, msg);
@@ -113,6 +117,40 @@ void NetHost::publish() {
         ++im.stats.syncs;
     }
     enet_host_flush(im.host);
+}
+
+void NetHost::publishPlacements(const std::vector<ObjectPlacement>& placements) {
+    Impl& im = *impl_;
+    constexpr std::size_t kPerPacket = 37; // 13 + 37 · 32 = 1197 bytes: one UDP datagram
+    std::vector<const ObjectPlacement*> moving;
+    for (const ObjectPlacement& p : placements)
+        if (p.motion == BodyMotionState::Dynamic)
+            moving.push_back(&p);
+    for (std::size_t start = 0; start < moving.size(); start += kPerPacket) {
+        const std::size_t n = std::min(kPerPacket, moving.size() - start);
+        std::vector<std::uint8_t> msg{static_cast<std::uint8_t>(Message::Placements)};
+        detail::appendU64(msg, im.world.frame());
+        for (int i = 0; i < 4; ++i)
+            msg.push_back(static_cast<std::uint8_t>(n >> (8 * i)));
+        for (std::size_t k = start; k < start + n; ++k) {
+            const ObjectPlacement& p = *moving[k];
+            for (int i = 0; i < 4; ++i)
+                msg.push_back(static_cast<std::uint8_t>(p.object >> (8 * i)));
+            for (int i = 0; i < 3; ++i)
+                detail::appendF32(msg, static_cast<float>(p.objectToWorld.translation[i]));
+            for (double c : detail::toQuaternion(p.objectToWorld.rotation))
+                detail::appendF32(msg, static_cast<float>(c));
+        }
+        for (auto& [peer, position] : im.peers) {
+            detail::sendUnreliable(peer, msg);
+            im.stats.placementBytes += static_cast<long long>(msg.size());
+        }
+    }
+    enet_host_flush(im.host);
+}
+
+void NetHost::setPlacementSource(std::function<std::vector<ObjectPlacement>()> source) {
+    impl_->placementSource = std::move(source);
 }
 
 void NetHost::service(int timeoutMs) {

@@ -3,21 +3,92 @@
 
 #include <enet/enet.h>
 
+#include <array>
+#include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <string>
 #include <vector>
 
+#include "rubble/Frame.hpp"
 #include "rubble/Result.hpp"
 
 namespace rubble::net::detail {
 
 /// Message types (first byte of every packet; all on channel 0, reliable and ordered).
 enum class Message : std::uint8_t {
-    Snapshot = 1, ///< the snapshot bytes (rubble/Snapshot.hpp)
-    Events = 2,   ///< u32 count, then count × 48-byte journal events
-    Sync = 3,     ///< u64 frame, u64 journal position, u64 geometry hash
-    Ack = 4,      ///< client → host: u64 frame, u64 its geometry hash after that sync
+    Snapshot = 1,   ///< the snapshot bytes (rubble/Snapshot.hpp)
+    Events = 2,     ///< u32 count, then count × 48-byte journal events
+    Sync = 3,       ///< u64 frame, u64 journal position, u64 geometry hash
+    Ack = 4,        ///< client → host: u64 frame, u64 its geometry hash after that sync
+    Placements = 5, ///< channel 1, unreliable: u64 frame, u32 count, count × (u32 object, 3 f32 position,
+                    ///< 4 f32 rotation quaternion x y z w)
 };
+
+/// Bytes of one placement record.
+inline constexpr std::size_t kPlacementBytes = 32;
+
+/// Appends a little-endian float.
+inline void appendF32(std::vector<std::uint8_t>& out, float f) {
+    std::uint32_t v;
+    std::memcpy(&v, &f, 4);
+    for (int i = 0; i < 4; ++i)
+        out.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
+}
+/// Little-endian u32 at p.
+inline std::uint32_t readU32(const std::uint8_t* p) {
+    return static_cast<std::uint32_t>(p[0]) | static_cast<std::uint32_t>(p[1]) << 8 |
+           static_cast<std::uint32_t>(p[2]) << 16 | static_cast<std::uint32_t>(p[3]) << 24;
+}
+/// Little-endian float at p.
+inline float readF32(const std::uint8_t* p) {
+    const std::uint32_t v = readU32(p);
+    float f;
+    std::memcpy(&f, &v, 4);
+    return f;
+}
+
+/// Unit quaternion (x, y, z, w) of a rotation matrix.
+inline std::array<double, 4> toQuaternion(const Mat3& r) {
+    const auto& m = r.m;
+    const double t = m[0][0] + m[1][1] + m[2][2];
+    std::array<double, 4> q{};
+    if (t > 0) {
+        const double s = 0.5 / std::sqrt(t + 1);
+        q = {(m[2][1] - m[1][2]) * s, (m[0][2] - m[2][0]) * s, (m[1][0] - m[0][1]) * s, 0.25 / s};
+    } else if (m[0][0] > m[1][1] && m[0][0] > m[2][2]) {
+        const double s = 2 * std::sqrt(1 + m[0][0] - m[1][1] - m[2][2]);
+        q = {0.25 * s, (m[0][1] + m[1][0]) / s, (m[0][2] + m[2][0]) / s, (m[2][1] - m[1][2]) / s};
+    } else if (m[1][1] > m[2][2]) {
+        const double s = 2 * std::sqrt(1 + m[1][1] - m[0][0] - m[2][2]);
+        q = {(m[0][1] + m[1][0]) / s, 0.25 * s, (m[1][2] + m[2][1]) / s, (m[0][2] - m[2][0]) / s};
+    } else {
+        const double s = 2 * std::sqrt(1 + m[2][2] - m[0][0] - m[1][1]);
+        q = {(m[0][2] + m[2][0]) / s, (m[1][2] + m[2][1]) / s, 0.25 * s, (m[1][0] - m[0][1]) / s};
+    }
+    return q;
+}
+
+/// Rotation matrix of a quaternion (normalised first).
+inline Mat3 fromQuaternion(std::array<double, 4> q) {
+    const double n = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    for (double& c : q)
+        c = n > 0 ? c / n : 0;
+    if (n == 0)
+        q[3] = 1;
+    const double x = q[0], y = q[1], z = q[2], w = q[3];
+    Mat3 r;
+    r.m[0][0] = 1 - 2 * (y * y + z * z);
+    r.m[0][1] = 2 * (x * y - z * w);
+    r.m[0][2] = 2 * (x * z + y * w);
+    r.m[1][0] = 2 * (x * y + z * w);
+    r.m[1][1] = 1 - 2 * (x * x + z * z);
+    r.m[1][2] = 2 * (y * z - x * w);
+    r.m[2][0] = 2 * (x * z - y * w);
+    r.m[2][1] = 2 * (y * z + x * w);
+    r.m[2][2] = 1 - 2 * (x * x + y * y);
+    return r;
+}
 
 /// Little-endian u64 at p.
 inline std::uint64_t readU64(const std::uint8_t* p) {
@@ -30,6 +101,18 @@ inline std::uint64_t readU64(const std::uint8_t* p) {
 inline void appendU64(std::vector<std::uint8_t>& out, std::uint64_t v) {
     for (int i = 0; i < 8; ++i)
         out.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
+}
+
+/// Sends bytes unreliably (and unsequenced) on channel 1.
+inline bool sendUnreliable(ENetPeer* peer, const std::vector<std::uint8_t>& bytes) {
+    ENetPacket* p = enet_packet_create(bytes.data(), bytes.size(), ENET_PACKET_FLAG_UNSEQUENCED);
+    if (!p)
+        return false;
+    if (enet_peer_send(peer, 1, p) != 0) {
+        enet_packet_destroy(p);
+        return false;
+    }
+    return true;
 }
 
 /// Sends bytes reliably on channel 0.

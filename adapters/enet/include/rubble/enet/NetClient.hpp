@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "rubble/DestructionWorld.hpp"
@@ -22,6 +23,8 @@ struct ClientStats {
     long long syncs = 0;            ///< frame syncs checked
     long long mismatchedHashes = 0; ///< syncs whose geometry hash differed from the host's
     std::uint64_t frame = 0;        ///< the world's frame after the last sync
+    long long placements = 0;       ///< placement records received
+    long long placementBytes = 0;   ///< bytes of placement messages received
 };
 
 /// A client of a NetHost on a loopback address. Its world must be built with the host's settings (any
@@ -40,6 +43,10 @@ public:
     /// Receives and applies what arrived within timeoutMs. Fails when the host sent something the world
     /// refuses (a corrupted snapshot or an event out of order) or the connection was lost.
     Status service(int timeoutMs = 0);
+    /// Where an object is at (fractional) host frame `frame`: interpolated between the two latest placements
+    /// the host sent for it (position linearly, rotation by normalised quaternion blend), held at the ends.
+    /// A new piece starts where its parent was. Empty for an object the client has no placement of.
+    std::optional<Frame> placement(ObjectId object, double frame) const;
     /// Called for every outcome the world adopts (its pieces are in the world already).
     void setOnOutcome(std::function<void(const FractureOutcome&)> callback);
     /// Totals.

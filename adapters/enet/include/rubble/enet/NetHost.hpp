@@ -4,9 +4,12 @@
 /// event and, once per frame, the frame number with the geometry hash it must match (docs/netplay.md).
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
+#include "rubble/DestructionRuntime.hpp"
 #include "rubble/DestructionWorld.hpp"
 #include "rubble/Result.hpp"
 
@@ -20,6 +23,8 @@ struct HostStats {
     long long eventBytes = 0;       ///< bytes of journal event messages sent (per client, payload)
     long long snapshotBytes = 0;    ///< bytes of snapshots sent
     long long syncs = 0;            ///< frame syncs sent (per client)
+    long long impactEvents = 0;     ///< of eventsSent: impacts (the rest are removals)
+    long long placementBytes = 0;   ///< bytes of placement messages sent (per client, payload)
     long long acks = 0;             ///< clients' hash reports received
     long long mismatchedHashes = 0; ///< reports whose geometry hash differed from the host's at that frame
 };
@@ -43,6 +48,11 @@ public:
     /// Sends every client the journal events since its last publish and a sync for the world's current
     /// frame; call once per frame after the world (or runtime) stepped.
     void publish();
+    /// Sends every client the placements of the dynamic bodies among placements (unreliable, unsequenced,
+    /// on channel 1, at most 37 per packet): the host is authoritative for motion. Call at a modest rate.
+    void publishPlacements(const std::vector<ObjectPlacement>& placements);
+    /// Where joining clients' snapshots get the bodies' placements from (e.g. the runtime's placements()).
+    void setPlacementSource(std::function<std::vector<ObjectPlacement>()> source);
     /// Handles the network (joins, leaves, clients' hash reports) for up to timeoutMs.
     void service(int timeoutMs = 0);
     /// Totals.
