@@ -3,8 +3,6 @@
 
 #include <cerrno>
 #include <cstring>
-#include <fstream>
-#include <iterator>
 
 #include "rubble/JournalFile.hpp"
 
@@ -58,12 +56,25 @@ Status writeFileAtomic(const std::filesystem::path& path, const std::vector<std:
 }
 
 Result<std::vector<std::uint8_t>> readFileBinary(const std::filesystem::path& path) {
-    std::ifstream f(path, std::ios::binary);
-    if (!f)
-        return Error{ErrorCode::IoError, path.string() + ": cannot open: " + std::strerror(errno)};
-    std::vector<std::uint8_t> out((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-    if (f.bad())
-        return Error{ErrorCode::IoError, path.string() + ": read failed"};
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0)
+        return ioError(path, "cannot open");
+    std::vector<std::uint8_t> out;
+    std::uint8_t buf[1 << 16];
+    for (;;) {
+        const ssize_t n = ::read(fd, buf, sizeof buf);
+        if (n < 0 && errno == EINTR)
+            continue;
+        if (n < 0) {
+            Error e = ioError(path, "read failed");
+            ::close(fd);
+            return e;
+        }
+        if (n == 0)
+            break;
+        out.insert(out.end(), buf, buf + n);
+    }
+    ::close(fd);
     return out;
 }
 

@@ -38,8 +38,10 @@ public:
 
 private:
     void le(std::uint64_t v, int n) {
+        std::uint8_t b[8];
         for (int i = 0; i < n; ++i)
-            out_.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
+            b[i] = static_cast<std::uint8_t>(v >> (8 * i));
+        out_.insert(out_.end(), b, b + n);
     }
     std::vector<std::uint8_t> out_;
 };
@@ -59,6 +61,18 @@ public:
     std::int32_t i32(std::string_view field) { return static_cast<std::int32_t>(u32(field)); }
     float f32(std::string_view field) { return std::bit_cast<float>(u32(field)); }
     double f64(std::string_view field) { return std::bit_cast<double>(u64(field)); }
+    /// Copies n raw bytes to dst (fails naming the field when fewer are left).
+    void raw(void* dst, std::size_t n, std::string_view field) {
+        if (!ok())
+            return;
+        if (size_ - pos_ < n) {
+            fail(pos_, field, "file ends before its " + std::to_string(n) + " bytes");
+            return;
+        }
+        if (n > 0)
+            std::memcpy(dst, data_ + pos_, n);
+        pos_ += n;
+    }
     /// A finite double (fails naming the field otherwise).
     double finite(std::string_view field) {
         const std::size_t at = pos_;
@@ -78,13 +92,15 @@ public:
                      " bytes");
         return ok() ? n : 0;
     }
-    /// Records an error at offset naming the field.
+    /// Records an error at offset naming the field (after the context, e.g. "objects[3].").
     void fail(std::size_t offset, std::string_view field, const std::string& what) {
         if (!error_.empty())
             return;
-        error_ = source_ + ": offset " + std::to_string(base_ + offset) + ", field " + std::string(field) +
-                 ": " + what;
+        error_ = source_ + ": offset " + std::to_string(base_ + offset) + ", field " + context_ +
+                 std::string(field) + ": " + what;
     }
+    /// What field names are prefixed with in errors from now on.
+    void setContext(std::string context) { context_ = std::move(context); }
     bool ok() const { return error_.empty(); }
     const std::string& error() const { return error_; }
     std::size_t offset() const { return pos_; }
@@ -111,6 +127,7 @@ private:
     std::size_t base_;
     std::size_t pos_ = 0;
     std::string source_;
+    std::string context_;
     std::string error_;
 };
 

@@ -1,5 +1,7 @@
 #include "rubble/Snapshot.hpp"
 
+#include <bit>
+
 #include "persist/Bytes.hpp"
 #include "rubble/JournalFile.hpp"
 
@@ -10,6 +12,43 @@ using persist::ByteReader;
 using persist::ByteWriter;
 
 constexpr std::uint8_t kMagic[4] = {'R', 'B', 'S', 'N'};
+// Mesh arrays are copied in bulk on little-endian machines (the file's byte order); elsewhere value by value.
+constexpr bool kBulk = std::endian::native == std::endian::little && sizeof(Vec3) == 24 &&
+                       sizeof(Vec2) == 16 && sizeof(Triangle) == 12;
+
+template <class T>
+void writeArray(ByteWriter& w, const std::vector<T>& v, auto&& each) {
+    w.u32(static_cast<std::uint32_t>(v.size()));
+    if constexpr (kBulk)
+        w.bytes(v.data(), v.size() * sizeof(T));
+    else
+        for (const T& x : v)
+            each(x);
+}
+
+// Reads n records of T (bytes each) in bulk when possible, else with `each`; then `check` every record
+// (index, byte offset of the record) for values that are not allowed.
+template <class T>
+void readArray(ByteReader& r, std::vector<T>& v, std::uint32_t n, const char* field, auto&& each) {
+    if constexpr (kBulk) {
+        v.resize(n);
+        r.raw(v.data(), n * sizeof(T), field);
+    } else {
+        v.reserve(n);
+        for (std::uint32_t i = 0; i < n && r.ok(); ++i)
+            v.push_back(each());
+    }
+}
+
+// Fails at the first non-finite coordinate of doubles stored from offset `start`.
+void checkFinite(ByteReader& r, const double* values, std::size_t count, std::size_t start, const char* field,
+                 int perRecord, const char* const* parts) {
+    for (std::size_t i = 0; i < count && r.ok(); ++i)
+        if (!(values[i] - values[i] == 0))
+            r.fail(start + 8 * i, std::string(field) + parts[i % static_cast<std::size_t>(perRecord)],
+                   "is not finite");
+}
+constexpr const char* kXyz[3] = {".x", ".y", ".z"};
 constexpr std::uint16_t kVersion = 1;
 
 void vec(ByteWriter& w, const Vec3& v) {
@@ -31,28 +70,38 @@ void text(ByteWriter& w, const std::string& s) {
     w.bytes(s.data(), s.size());
 }
 
-Vec3 vec(ByteReader& r, const std::string& field) {
+// Readers with literal field names: a name with its index or axis is only built when something fails.
+double real(ByteReader& r, const char* field, const char* part = "") {
+    const std::size_t at = r.offset();
+    const double v = r.f64(field);
+    if (r.ok() && !(v - v == 0))
+        r.fail(at, std::string(field) + part, "is not finite");
+    return r.ok() ? v : 0;
+}
+Vec3 vec(ByteReader& r, const char* field) {
     Vec3 v;
-    v.x = r.finite(field + ".x");
-    v.y = r.finite(field + ".y");
-    v.z = r.finite(field + ".z");
+    v.x = real(r, field, ".x");
+    v.y = real(r, field, ".y");
+    v.z = real(r, field, ".z");
     return v;
 }
-Mat3 mat(ByteReader& r, const std::string& field) {
+Mat3 mat(ByteReader& r, const char* field) {
+    static const char* cells[3][3] = {
+        {"[0][0]", "[0][1]", "[0][2]"}, {"[1][0]", "[1][1]", "[1][2]"}, {"[2][0]", "[2][1]", "[2][2]"}};
     Mat3 m;
     for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j)
-            m.m[i][j] = r.finite(field + "[" + std::to_string(i) + "][" + std::to_string(j) + "]");
+            m.m[i][j] = real(r, field, cells[i][j]);
     return m;
 }
-Frame frame(ByteReader& r, const std::string& field) {
+Frame frame(ByteReader& r, const char* rotation, const char* translation) {
     Frame f;
-    f.rotation = mat(r, field + ".rotation");
-    f.translation = vec(r, field + ".translation");
+    f.rotation = mat(r, rotation);
+    f.translation = vec(r, translation);
     return f;
 }
-std::string text(ByteReader& r, const std::uint8_t* data, const std::string& field) {
-    const std::uint32_t n = r.count(field + ".length", 1);
+std::string text(ByteReader& r, const std::uint8_t* data, const char* lengthField, const char* field) {
+    const std::uint32_t n = r.count(lengthField, 1);
     std::string s;
     if (r.ok())
         s.assign(reinterpret_cast<const char*>(data + r.offset()), n);
@@ -85,24 +134,17 @@ void writeObject(ByteWriter& w, const ObjectState& o) {
     vec(w, o.mass.principalMoments);
     mat(w, o.mass.principalAxes);
     const Mesh& m = o.mesh;
-    w.u32(static_cast<std::uint32_t>(m.positions.size()));
-    for (const Vec3& p : m.positions)
-        vec(w, p);
-    w.u32(static_cast<std::uint32_t>(m.triangles.size()));
-    for (const Triangle& t : m.triangles)
+    writeArray(w, m.positions, [&](const Vec3& p) { vec(w, p); });
+    writeArray(w, m.triangles, [&](const Triangle& t) {
         for (auto i : t)
             w.u32(i);
-    w.u32(static_cast<std::uint32_t>(m.normals.size()));
-    for (const Vec3& n : m.normals)
-        vec(w, n);
-    w.u32(static_cast<std::uint32_t>(m.uvs.size()));
-    for (const Vec2& u : m.uvs) {
+    });
+    writeArray(w, m.normals, [&](const Vec3& n) { vec(w, n); });
+    writeArray(w, m.uvs, [&](const Vec2& u) {
         w.f64(u.x);
         w.f64(u.y);
-    }
-    w.u32(static_cast<std::uint32_t>(m.materials.size()));
-    for (std::uint32_t id : m.materials)
-        w.u32(id);
+    });
+    writeArray(w, m.materials, [&](std::uint32_t id) { w.u32(id); });
     w.u32(static_cast<std::uint32_t>(m.materialNames.size()));
     for (const std::string& s : m.materialNames)
         text(w, s);
@@ -121,104 +163,116 @@ void writeObject(ByteWriter& w, const ObjectState& o) {
     text(w, o.warning);
 }
 
-ObjectState readObject(ByteReader& r, const std::uint8_t* data, const std::string& at) {
+ObjectState readObject(ByteReader& r, const std::uint8_t* data) {
     ObjectState o;
-    o.id = r.u32(at + ".id");
-    o.version = r.u32(at + ".version");
-    o.destructible = r.u8(at + ".destructible") != 0;
-    o.density = r.finite(at + ".density");
-    o.impulseThreshold = r.finite(at + ".impulseThreshold");
-    o.crumbleAbove = r.u64(at + ".crumbleAbove");
+    o.id = r.u32("id");
+    o.version = r.u32("version");
+    o.destructible = r.u8("destructible") != 0;
+    o.density = real(r, "density");
+    o.impulseThreshold = real(r, "impulseThreshold");
+    o.crumbleAbove = r.u64("crumbleAbove");
     FractureParams& f = o.fracture;
     std::size_t pos = r.offset();
-    const std::uint8_t pattern = r.u8(at + ".fracture.pattern");
+    const std::uint8_t pattern = r.u8("fracture.pattern");
     if (r.ok() && pattern > static_cast<std::uint8_t>(CellPattern::Shatter))
-        r.fail(pos, at + ".fracture.pattern", "unknown pattern " + std::to_string(pattern));
+        r.fail(pos, "fracture.pattern", "unknown pattern " + std::to_string(pattern));
     f.pattern = static_cast<CellPattern>(pattern);
-    f.seedPoints = r.i32(at + ".fracture.seedPoints");
-    f.cells = r.i32(at + ".fracture.cells");
-    f.sizeLaw.base = r.finite(at + ".fracture.sizeLaw.base");
-    f.sizeLaw.scale = r.finite(at + ".fracture.sizeLaw.scale");
-    f.sizeLaw.exponent = r.finite(at + ".fracture.sizeLaw.exponent");
-    f.sizeLaw.minSize = r.finite(at + ".fracture.sizeLaw.minSize");
-    f.sizeLaw.maxSize = r.finite(at + ".fracture.sizeLaw.maxSize");
+    f.seedPoints = r.i32("fracture.seedPoints");
+    f.cells = r.i32("fracture.cells");
+    f.sizeLaw.base = real(r, "fracture.sizeLaw.base");
+    f.sizeLaw.scale = real(r, "fracture.sizeLaw.scale");
+    f.sizeLaw.exponent = real(r, "fracture.sizeLaw.exponent");
+    f.sizeLaw.minSize = real(r, "fracture.sizeLaw.minSize");
+    f.sizeLaw.maxSize = real(r, "fracture.sizeLaw.maxSize");
     pos = r.offset();
-    const std::uint8_t backend = r.u8(at + ".fracture.backend");
+    const std::uint8_t backend = r.u8("fracture.backend");
     if (r.ok() && backend > static_cast<std::uint8_t>(BooleanKind::Fast))
-        r.fail(pos, at + ".fracture.backend", "unknown backend " + std::to_string(backend));
+        r.fail(pos, "fracture.backend", "unknown backend " + std::to_string(backend));
     f.backend = static_cast<BooleanKind>(backend);
-    f.minPieceVolumeFraction = r.finite(at + ".fracture.minPieceVolumeFraction");
-    f.uvScale = r.finite(at + ".fracture.uvScale");
-    f.simplifyPieces = r.u8(at + ".fracture.simplifyPieces") != 0;
-    o.mass.volume = r.finite(at + ".mass.volume");
-    o.mass.centerOfMass = vec(r, at + ".mass.centerOfMass");
-    o.mass.inertia = mat(r, at + ".mass.inertia");
-    o.mass.principalMoments = vec(r, at + ".mass.principalMoments");
-    o.mass.principalAxes = mat(r, at + ".mass.principalAxes");
+    f.minPieceVolumeFraction = real(r, "fracture.minPieceVolumeFraction");
+    f.uvScale = real(r, "fracture.uvScale");
+    f.simplifyPieces = r.u8("fracture.simplifyPieces") != 0;
+    o.mass.volume = real(r, "mass.volume");
+    o.mass.centerOfMass = vec(r, "mass.centerOfMass");
+    o.mass.inertia = mat(r, "mass.inertia");
+    o.mass.principalMoments = vec(r, "mass.principalMoments");
+    o.mass.principalAxes = mat(r, "mass.principalAxes");
     Mesh& m = o.mesh;
-    const std::uint32_t nPos = r.count(at + ".mesh.positions.count", 24);
-    m.positions.reserve(nPos);
-    for (std::uint32_t i = 0; i < nPos && r.ok(); ++i)
-        m.positions.push_back(vec(r, at + ".mesh.positions"));
-    const std::uint32_t nTri = r.count(at + ".mesh.triangles.count", 12);
-    m.triangles.reserve(nTri);
-    for (std::uint32_t i = 0; i < nTri && r.ok(); ++i) {
+    const std::uint32_t nPos = r.count("mesh.positions.count", 24);
+    std::size_t start = r.offset();
+    readArray(r, m.positions, nPos, "mesh.positions", [&] { return vec(r, "mesh.positions"); });
+    if (kBulk)
+        checkFinite(r, &m.positions.data()->x, 3ull * nPos, start, "mesh.positions", 3, kXyz);
+    const std::uint32_t nTri = r.count("mesh.triangles.count", 12);
+    start = r.offset();
+    readArray(r, m.triangles, nTri, "mesh.triangles", [&] {
         Triangle t{};
-        for (auto& v : t) {
-            pos = r.offset();
-            v = r.u32(at + ".mesh.triangles");
-            if (r.ok() && v >= nPos)
-                r.fail(pos, at + ".mesh.triangles",
-                       "vertex index " + std::to_string(v) + " out of range (" + std::to_string(nPos) + ")");
-        }
-        m.triangles.push_back(t);
-    }
-    auto perCorner = [&](std::uint32_t n, const std::string& field, std::size_t where) {
+        for (auto& v : t)
+            v = r.u32("mesh.triangles");
+        return t;
+    });
+    for (std::size_t i = 0; i < m.triangles.size() && r.ok(); ++i)
+        for (int k = 0; k < 3; ++k)
+            if (m.triangles[i][k] >= nPos) {
+                r.fail(start + 12 * i + 4 * k, "mesh.triangles",
+                       "vertex index " + std::to_string(m.triangles[i][k]) + " out of range (" +
+                           std::to_string(nPos) + ")");
+                break;
+            }
+    auto perCorner = [&](std::uint32_t n, const char* field, std::size_t where) {
         if (r.ok() && n != 0 && n != 3ull * nTri)
             r.fail(where, field, std::to_string(n) + " entries for " + std::to_string(nTri) + " triangles");
     };
     pos = r.offset();
-    const std::uint32_t nNormals = r.count(at + ".mesh.normals.count", 24);
-    perCorner(nNormals, at + ".mesh.normals.count", pos);
-    for (std::uint32_t i = 0; i < nNormals && r.ok(); ++i)
-        m.normals.push_back(vec(r, at + ".mesh.normals"));
+    const std::uint32_t nNormals = r.count("mesh.normals.count", 24);
+    perCorner(nNormals, "mesh.normals.count", pos);
+    start = r.offset();
+    readArray(r, m.normals, r.ok() ? nNormals : 0, "mesh.normals", [&] { return vec(r, "mesh.normals"); });
+    if (kBulk)
+        checkFinite(r, m.normals.empty() ? nullptr : &m.normals.data()->x, 3ull * m.normals.size(), start,
+                    "mesh.normals", 3, kXyz);
     pos = r.offset();
-    const std::uint32_t nUvs = r.count(at + ".mesh.uvs.count", 16);
-    perCorner(nUvs, at + ".mesh.uvs.count", pos);
-    for (std::uint32_t i = 0; i < nUvs && r.ok(); ++i) {
+    const std::uint32_t nUvs = r.count("mesh.uvs.count", 16);
+    perCorner(nUvs, "mesh.uvs.count", pos);
+    start = r.offset();
+    readArray(r, m.uvs, r.ok() ? nUvs : 0, "mesh.uvs", [&] {
         Vec2 u;
-        u.x = r.finite(at + ".mesh.uvs");
-        u.y = r.finite(at + ".mesh.uvs");
-        m.uvs.push_back(u);
-    }
+        u.x = real(r, "mesh.uvs", ".x");
+        u.y = real(r, "mesh.uvs", ".y");
+        return u;
+    });
+    if (kBulk)
+        checkFinite(r, m.uvs.empty() ? nullptr : &m.uvs.data()->x, 2ull * m.uvs.size(), start, "mesh.uvs", 2,
+                    kXyz);
     pos = r.offset();
-    const std::uint32_t nMat = r.count(at + ".mesh.materials.count", 4);
+    const std::uint32_t nMat = r.count("mesh.materials.count", 4);
     if (r.ok() && nMat != 0 && nMat != nTri)
-        r.fail(pos, at + ".mesh.materials.count",
+        r.fail(pos, "mesh.materials.count",
                std::to_string(nMat) + " entries for " + std::to_string(nTri) + " triangles");
-    for (std::uint32_t i = 0; i < nMat && r.ok(); ++i)
-        m.materials.push_back(r.u32(at + ".mesh.materials"));
-    const std::uint32_t nNames = r.count(at + ".mesh.materialNames.count", 4);
+    readArray(r, m.materials, r.ok() ? nMat : 0, "mesh.materials", [&] { return r.u32("mesh.materials"); });
+    const std::uint32_t nNames = r.count("mesh.materialNames.count", 4);
     for (std::uint32_t i = 0; i < nNames && r.ok(); ++i)
-        m.materialNames.push_back(text(r, data, at + ".mesh.materialNames"));
-    const std::uint32_t nParts = r.count(at + ".convexParts.count", 4);
+        m.materialNames.push_back(text(r, data, "mesh.materialNames.length", "mesh.materialNames"));
+    const std::uint32_t nParts = r.count("convexParts.count", 4);
+    o.convexParts.reserve(nParts);
     for (std::uint32_t i = 0; i < nParts && r.ok(); ++i) {
-        const std::string part = at + ".convexParts[" + std::to_string(i) + "]";
-        const std::uint32_t nFaces = r.count(part + ".faces.count", 40);
+        const std::uint32_t nFaces = r.count("convexParts.faces.count", 40);
         std::vector<PolytopeFace> faces;
+        faces.reserve(nFaces);
         for (std::uint32_t k = 0; k < nFaces && r.ok(); ++k) {
             PolytopeFace face;
-            face.plane.normal = vec(r, part + ".plane.normal");
-            face.plane.offset = r.finite(part + ".plane.offset");
-            face.tag = r.i32(part + ".tag");
-            const std::uint32_t nCorners = r.count(part + ".corners.count", 24);
+            face.plane.normal = vec(r, "convexParts.plane.normal");
+            face.plane.offset = real(r, "convexParts.plane.offset");
+            face.tag = r.i32("convexParts.tag");
+            const std::uint32_t nCorners = r.count("convexParts.corners.count", 24);
+            face.corners.reserve(nCorners);
             for (std::uint32_t c = 0; c < nCorners && r.ok(); ++c)
-                face.corners.push_back(vec(r, part + ".corners"));
+                face.corners.push_back(vec(r, "convexParts.corners"));
             faces.push_back(std::move(face));
         }
         o.convexParts.push_back(ConvexPolytope::fromFaces(std::move(faces)));
     }
-    o.warning = text(r, data, at + ".warning");
+    o.warning = text(r, data, "warning.length", "warning");
     return o;
 }
 
@@ -247,6 +301,12 @@ Status restoreSnapshot(DestructionWorld& world, const DestructionWorld::Config& 
 
 std::vector<std::uint8_t> encodeSnapshot(const Snapshot& s) {
     ByteWriter w;
+    std::size_t estimate = 64;
+    for (const ObjectState& o : s.world.objects)
+        estimate += 512 + 24 * o.mesh.positions.size() + 12 * o.mesh.triangles.size() +
+                    24 * o.mesh.normals.size() + 16 * o.mesh.uvs.size() + 4 * o.mesh.materials.size() +
+                    256 * o.convexParts.size();
+    w.data().reserve(estimate);
     w.bytes(kMagic, 4);
     w.u16(kVersion);
     w.u16(0); // reserved
@@ -321,42 +381,49 @@ Result<Snapshot> decodeSnapshot(const std::uint8_t* data, std::size_t size, cons
     s.world.nextId = body.u32("nextId");
     s.world.journalPosition = body.u64("journalPosition");
     const std::uint32_t nObjects = body.count("objects.count", 64);
-    for (std::uint32_t i = 0; i < nObjects && body.ok(); ++i)
-        s.world.objects.push_back(readObject(body, data, "objects[" + std::to_string(i) + "]"));
+    s.world.objects.reserve(nObjects);
+    for (std::uint32_t i = 0; i < nObjects && body.ok(); ++i) {
+        body.setContext("objects[" + std::to_string(i) + "].");
+        s.world.objects.push_back(readObject(body, data));
+    }
+    body.setContext("");
     const std::uint32_t nPlacements = body.count("placements.count", 149);
+    s.placements.reserve(nPlacements);
     for (std::uint32_t i = 0; i < nPlacements && body.ok(); ++i) {
-        const std::string at = "placements[" + std::to_string(i) + "]";
+        body.setContext("placements[" + std::to_string(i) + "].");
         ObjectPlacement p;
-        p.object = body.u32(at + ".object");
+        p.object = body.u32("object");
         const std::size_t pos = body.offset();
-        const std::uint8_t motion = body.u8(at + ".motion");
+        const std::uint8_t motion = body.u8("motion");
         if (body.ok() && motion > static_cast<std::uint8_t>(BodyMotionState::Frozen))
-            body.fail(pos, at + ".motion", "unknown motion state " + std::to_string(motion));
+            body.fail(pos, "motion", "unknown motion state " + std::to_string(motion));
         p.motion = static_cast<BodyMotionState>(motion);
-        p.objectToWorld = frame(body, at + ".objectToWorld");
-        p.linearVelocity = vec(body, at + ".linearVelocity");
-        p.angularVelocity = vec(body, at + ".angularVelocity");
+        p.objectToWorld = frame(body, "objectToWorld.rotation", "objectToWorld.translation");
+        p.linearVelocity = vec(body, "linearVelocity");
+        p.angularVelocity = vec(body, "angularVelocity");
         s.placements.push_back(p);
     }
+    body.setContext("");
     const std::uint32_t nWork = body.count("work.count", 21);
     for (std::uint32_t i = 0; i < nWork && body.ok(); ++i) {
-        const std::string at = "work[" + std::to_string(i) + "]";
+        body.setContext("work[" + std::to_string(i) + "].");
         PendingWork p;
-        p.object = body.u32(at + ".object");
-        p.version = body.u32(at + ".version");
-        p.inFlight = body.u8(at + ".inFlight") != 0;
-        p.readyFrame = body.u64(at + ".readyFrame");
-        const std::uint32_t nImpacts = body.count(at + ".impacts.count", 64);
+        p.object = body.u32("object");
+        p.version = body.u32("version");
+        p.inFlight = body.u8("inFlight") != 0;
+        p.readyFrame = body.u64("readyFrame");
+        const std::uint32_t nImpacts = body.count("impacts.count", 64);
         for (std::uint32_t k = 0; k < nImpacts && body.ok(); ++k) {
             Impact im;
-            im.point = vec(body, at + ".impacts.point");
-            im.normal = vec(body, at + ".impacts.normal");
-            im.impulse = body.finite(at + ".impacts.impulse");
+            im.point = vec(body, "impacts.point");
+            im.normal = vec(body, "impacts.normal");
+            im.impulse = real(body, "impacts.impulse");
             p.impacts.push_back(im);
-            p.ticks.push_back(body.u64(at + ".impacts.tick"));
+            p.ticks.push_back(body.u64("impacts.tick"));
         }
         s.world.work.push_back(std::move(p));
     }
+    body.setContext("");
     if (body.ok() && body.remaining() != 0)
         body.fail(body.offset(), "crc32", std::to_string(body.remaining()) + " unexpected bytes before it");
     if (!body.ok())

@@ -8,6 +8,7 @@
 
 #include "JournalScene.hpp"
 #include "TestSupport.hpp"
+#include "persist/Bytes.hpp"
 #include "rubble/JournalPlayer.hpp"
 
 namespace rubble {
@@ -65,6 +66,25 @@ TEST(Journal, EventIs48BytesAndRoundTrips) {
     Result<JournalEvent> back = decodeJournalEvent(bytes.data());
     ASSERT_TRUE(back) << back.error().message;
     EXPECT_EQ(*back, e);
+}
+
+TEST(Journal, Crc32IsTheStandardOne) {
+    const std::string check = "123456789"; // the CRC-32 (IEEE) check value, as zlib computes it
+    EXPECT_EQ(persist::crc32(reinterpret_cast<const std::uint8_t*>(check.data()), check.size()), 0xCBF43926u);
+    std::vector<std::uint8_t> bytes(1000);
+    for (std::size_t i = 0; i < bytes.size(); ++i)
+        bytes[i] = static_cast<std::uint8_t>(i * 7 + 3);
+    auto oneByteAtATime = [&](std::size_t n) { // the reference for the eight-at-a-time version
+        std::uint32_t c = 0xFFFFFFFFu;
+        for (std::size_t i = 0; i < n; ++i) {
+            c ^= bytes[i];
+            for (int k = 0; k < 8; ++k)
+                c = (c & 1) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
+        }
+        return c ^ 0xFFFFFFFFu;
+    };
+    for (std::size_t n : {0, 1, 7, 8, 13, 1000})
+        EXPECT_EQ(persist::crc32(bytes.data(), n), oneByteAtATime(n)) << n << " bytes";
 }
 
 TEST(Journal, DecodingRefusesUnknownKindsAndNonFiniteNumbers) {
