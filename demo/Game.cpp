@@ -1,5 +1,8 @@
 #include "Game.hpp"
 
+#include "rubble/JournalFile.hpp"
+#include "rubble/Snapshot.hpp"
+
 #include <btBulletDynamicsCommon.h>
 
 #include <algorithm>
@@ -142,6 +145,9 @@ bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const Game
     physics_ = std::make_unique<rubble::bullet::PhysicsWorld>();
     binding_ = std::make_unique<rubble::bullet::BulletBinding>(*physics_);
     runtime_ = std::make_unique<rubble::DestructionRuntime>(*binding_, rc);
+    worldConfig_ = rc.world;
+    journal_.clear();
+    runtime_->world().setJournalSink([this](const rubble::JournalEvent& e) { journal_.push_back(e); });
     runtime_->setOnRemoved([this, &renderer](const BodyRecord& b) {
         auto it = visuals_.find(b.id);
         if (it == visuals_.end())
@@ -500,6 +506,36 @@ std::vector<V3> Game::targets() const {
 void Game::writeTimings(const std::string& path) const {
     if (runtime_)
         (void)runtime_->world().writeTimingsCsv(path);
+}
+
+bool Game::writeJournal(const std::string& path, const std::string& scene, std::string& message) const {
+    if (!runtime_) {
+        message = "no scene loaded";
+        return false;
+    }
+    const rubble::JournalFile journal{rubble::journalHeaderOf(worldConfig_, scene), journal_};
+    if (rubble::Status s = rubble::writeJournal(path, journal); !s) {
+        message = s.message();
+        return false;
+    }
+    message = std::to_string(journal_.size()) + " events, " +
+              std::to_string(rubble::encodeJournal(journal).size()) + " bytes";
+    return true;
+}
+
+bool Game::saveSnapshot(const std::string& path, std::string& message) const {
+    if (!runtime_) {
+        message = "no scene loaded";
+        return false;
+    }
+    const rubble::Snapshot snapshot =
+        rubble::takeSnapshot(runtime_->world(), worldConfig_, runtime_->placements());
+    if (rubble::Status s = rubble::saveSnapshot(path, snapshot); !s) {
+        message = s.message();
+        return false;
+    }
+    message = std::to_string(snapshot.world.objects.size()) + " objects";
+    return true;
 }
 
 } // namespace demo

@@ -112,6 +112,11 @@ public:
     static bool fractureAvailable() { return true; }
     /// Writes the runtime's timing records as CSV.
     void writeTimings(const std::string& path) const;
+    /// Writes the journal of everything destroyed since load() (a bug report: replays to the same geometry on
+    /// a world built from the same scene, docs/journal.md); false with a message when it cannot.
+    bool writeJournal(const std::string& path, const std::string& scene, std::string& message) const;
+    /// Saves a snapshot of the destroyed world and its bodies (F5); false with a message when it cannot.
+    bool saveSnapshot(const std::string& path, std::string& message) const;
 
 private:
     /// How a body with a render mesh looks.
@@ -141,6 +146,8 @@ private:
     std::unique_ptr<rubble::bullet::PhysicsWorld> physics_;
     std::unique_ptr<rubble::bullet::BulletBinding> binding_;
     std::unique_ptr<rubble::DestructionRuntime> runtime_;
+    rubble::DestructionWorld::Config worldConfig_;
+    std::vector<rubble::JournalEvent> journal_; // every accepted impact and removal since load()
     std::unordered_map<rubble::BodyId, Visual> visuals_;
     std::map<rubble::ObjectId, Look> looks_;
     rubble::BodyId vehicle_ = 0;

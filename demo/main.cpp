@@ -57,6 +57,7 @@ struct Options {
     bool noPanel = false;
     bool deterministic = false;
     bool noShadows = false;
+    std::string record; // journal file written at exit
 };
 
 struct App {
@@ -101,6 +102,13 @@ void keyCallback(GLFWwindow* w, int key, int, int action, int) {
     case GLFW_KEY_F2:
         a.screenshotRequested = true;
         break;
+    case GLFW_KEY_F5: { // quick save: a snapshot of the destroyed world (loading it back is not done yet)
+        const std::string path = (a.opt.out.empty() ? std::string(".") : a.opt.out) + "/quicksave.rsnap";
+        std::string message;
+        const bool ok = a.game.saveSnapshot(path, message);
+        std::printf("F5: %s %s (%s)\n", ok ? "saved" : "cannot save", path.c_str(), message.c_str());
+        break;
+    }
     case GLFW_KEY_F3: {
         auto& s = a.game.settings();
         const bool on = !(s.debugShapes || s.debugAabbs || s.debugImpacts);
@@ -181,6 +189,8 @@ int main(int argc, char** argv) {
     cli.add_flag("--no-panel", o.noPanel, "hide the ImGui panel (F1 toggles it)");
     cli.add_flag("--deterministic", o.deterministic, "adopt fractures a fixed number of frames after impact");
     cli.add_flag("--no-shadows", o.noShadows, "disable shadow mapping");
+    cli.add_option("--record", o.record,
+                   "write the destruction journal (every impact and removal, 48 bytes each) to FILE at exit");
     CLI11_PARSE(cli, argc, argv);
 
     const bool haveDisplay = std::getenv("DISPLAY") && *std::getenv("DISPLAY");
@@ -423,6 +433,17 @@ int main(int argc, char** argv) {
             std::fprintf(stderr, "error: cannot write the report into %s\n", o.out.c_str());
         }
     }
+    int status = 0;
+    if (!o.record.empty()) {
+        std::string message;
+        if (app.game.writeJournal(o.record, app.scene.baseDir.string() + "/" + app.sceneName, message)) {
+            std::printf("journal: %s (%s)\n", o.record.c_str(), message.c_str());
+        } else {
+            std::fprintf(stderr, "error: cannot write the journal %s: %s\n", o.record.c_str(),
+                         message.c_str());
+            status = 1;
+        }
+    }
     std::fflush(stdout);
 
     ImGui_ImplOpenGL3_Shutdown();
@@ -432,5 +453,5 @@ int main(int argc, char** argv) {
     app.game.clear(app.renderer);
     app.renderer.shutdown();
     app.gl.reset();
-    return 0;
+    return status;
 }

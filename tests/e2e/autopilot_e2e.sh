@@ -21,7 +21,7 @@ run() { # run NAME ARGS...
         fail "$name: rubble-demo exited with $?"
 }
 
-run a --scene "$here/e2e.cfg" --autopilot 2 --screenshot-every 1
+run a --scene "$here/e2e.cfg" --autopilot 2 --screenshot-every 1 --record "$work/a.rjournal"
 run b --scene "$here/e2e.cfg" --autopilot 2 --screenshot-every 1
 for f in report.json frames.csv shot_0001.png shot_0002.png; do
     [ -s "$work/a/$f" ] || fail "missing $f"
@@ -30,6 +30,9 @@ grep -q '"fps"' "$work/a/report.json" || fail "report.json has no fps"
 grep -q '"latency_ms"' "$work/a/report.json" || fail "report.json has no latency"
 [ "$(wc -l <"$work/a/frames.csv")" -eq 121 ] || fail "frames.csv should have 120 frames"
 cmp -s "$work/a/shot_0002.png" "$work/b/shot_0002.png" || fail "fixed-step runs are not pixel-identical"
+[ "$(head -c 4 "$work/a.rjournal")" = RBJL ] || fail "--record wrote no journal"
+events=$(sed -n 's/^journal: .* (\([0-9]*\) events, \([0-9]*\) bytes)$/\1/p' "$work/a.log")
+[ -n "$events" ] && [ "$events" -gt 0 ] || fail "the journal has no events: $(grep journal "$work/a.log")"
 echo "ok: headless autopilot, report and deterministic screenshots"
 
 media=${RUBBLE_SEED_MEDIA:-$here/../../../shared/seed/media}
