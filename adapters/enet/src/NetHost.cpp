@@ -116,6 +116,9 @@ void NetHost::publish() {
         detail::sendReliable(peer, sync);
         ++im.stats.syncs;
     }
+    // Every client has been sent everything, and a client that joins later gets a snapshot: nothing to keep.
+    im.journal.clear();
+    im.base = end;
     enet_host_flush(im.host);
 }
 
