@@ -1,6 +1,7 @@
 #include "Game.hpp"
 
 #include "rubble/JournalFile.hpp"
+#include "rubble/JournalPlayer.hpp"
 #include "rubble/Snapshot.hpp"
 
 #include <btBulletDynamicsCommon.h>
@@ -520,6 +521,43 @@ bool Game::writeJournal(const std::string& path, const std::string& scene, std::
     }
     message = std::to_string(journal_.size()) + " events, " +
               std::to_string(rubble::encodeJournal(journal).size()) + " bytes";
+    return true;
+}
+
+std::uint64_t Game::finishRecording() {
+    if (!runtime_)
+        return 0;
+    for (int i = 0; i < 600 && runtime_->world().jobsInFlight() > 0; ++i)
+        runtime_->stepFrame();
+    return runtime_->world().geometryHash();
+}
+
+bool Game::replayJournal(const std::string& path, std::uint64_t& hash, std::string& message) {
+    if (!runtime_) {
+        message = "no scene loaded";
+        return false;
+    }
+    rubble::Result<rubble::JournalFile> journal = rubble::readJournal(path);
+    if (!journal) {
+        message = journal.error().message;
+        return false;
+    }
+    if (rubble::Status s = rubble::checkJournalHeader(journal->header, worldConfig_); !s) {
+        message = s.message() + " (replay with the recording's options, e.g. --deterministic)";
+        return false;
+    }
+    rubble::JournalPlayer player(runtime_->world());
+    for (const rubble::JournalEvent& e : journal->events)
+        if (rubble::Status s = player.receive(e); !s) {
+            message = s.message();
+            return false;
+        }
+    if (rubble::Status s = player.drain(); !s) {
+        message = s.message();
+        return false;
+    }
+    hash = runtime_->world().geometryHash();
+    message = std::to_string(journal->events.size()) + " events";
     return true;
 }
 

@@ -115,6 +115,13 @@ public:
     /// Writes the journal of everything destroyed since load() (a bug report: replays to the same geometry on
     /// a world built from the same scene, docs/journal.md); false with a message when it cannot.
     bool writeJournal(const std::string& path, const std::string& scene, std::string& message) const;
+    /// Steps until no fracture job is in flight (so that a replay of the journal ends in the same state) and
+    /// returns the world's geometry hash.
+    std::uint64_t finishRecording();
+    /// Replays a journal file on the freshly loaded scene (the world steps alone, no bodies are made) until
+    /// no job is in flight; the geometry hash then equals the recording's finishRecording(). False with a
+    /// message when the file cannot be read or does not belong to this scene and these settings.
+    bool replayJournal(const std::string& path, std::uint64_t& hash, std::string& message);
     /// Saves a snapshot of the destroyed world and its bodies (F5); false with a message when it cannot.
     bool saveSnapshot(const std::string& path, std::string& message) const;
 

@@ -58,6 +58,7 @@ struct Options {
     bool deterministic = false;
     bool noShadows = false;
     std::string record; // journal file written at exit
+    std::string replay; // journal file replayed on the loaded scene instead of playing
 };
 
 struct App {
@@ -191,6 +192,10 @@ int main(int argc, char** argv) {
     cli.add_flag("--no-shadows", o.noShadows, "disable shadow mapping");
     cli.add_option("--record", o.record,
                    "write the destruction journal (every impact and removal, 48 bytes each) to FILE at exit");
+    cli.add_option(
+        "--replay", o.replay,
+        "replay the journal FILE on the loaded scene, print its geometry hash and exit (a bug report's "
+        "fractures, reproduced; run with the recording's options)");
     CLI11_PARSE(cli, argc, argv);
 
     const bool haveDisplay = std::getenv("DISPLAY") && *std::getenv("DISPLAY");
@@ -254,6 +259,21 @@ int main(int argc, char** argv) {
     if (!loadScene(app, error)) {
         std::fprintf(stderr, "error: %s\n", error.c_str());
         return 1;
+    }
+
+    if (!o.replay.empty()) {
+        std::uint64_t hash = 0;
+        std::string message;
+        const bool ok = app.game.replayJournal(o.replay, hash, message);
+        if (ok)
+            std::printf("replay: %s (%s), geometry hash %016llx\n", o.replay.c_str(), message.c_str(),
+                        static_cast<unsigned long long>(hash));
+        else
+            std::fprintf(stderr, "error: cannot replay %s: %s\n", o.replay.c_str(), message.c_str());
+        app.game.clear(app.renderer);
+        app.renderer.shutdown();
+        app.gl.reset();
+        return ok ? 0 : 1;
     }
 
     IMGUI_CHECKVERSION();
@@ -436,8 +456,10 @@ int main(int argc, char** argv) {
     int status = 0;
     if (!o.record.empty()) {
         std::string message;
+        const std::uint64_t hash = app.game.finishRecording();
         if (app.game.writeJournal(o.record, app.scene.baseDir.string() + "/" + app.sceneName, message)) {
-            std::printf("journal: %s (%s)\n", o.record.c_str(), message.c_str());
+            std::printf("journal: %s (%s), geometry hash %016llx\n", o.record.c_str(), message.c_str(),
+                        static_cast<unsigned long long>(hash));
         } else {
             std::fprintf(stderr, "error: cannot write the journal %s: %s\n", o.record.c_str(),
                          message.c_str());

@@ -1,7 +1,8 @@
 #pragma once
 /// \file rubble.hpp
 /// The game-facing API in one include: meshes and their files, checks and repair, the fracture kernel, convex
-/// decomposition, and the engine-neutral runtime (DestructionWorld, DestructionRuntime, PhysicsBinding).
+/// decomposition, the engine-neutral runtime (DestructionWorld, DestructionRuntime, PhysicsBinding), and the
+/// destruction journal and snapshots (JournalPlayer, JournalFile, Snapshot).
 /// Tools-only headers (TimingReport.hpp, SceneConfig.hpp, SceneLoader.hpp, MeshSimplify.hpp, Islands.hpp,
 /// ThreadPool.hpp) are included on their own. The C API is rubble/rubble.h.
 
@@ -10,6 +11,9 @@
 #include "rubble/DestructionWorld.hpp"
 #include "rubble/Fracture.hpp"
 #include "rubble/Frame.hpp"
+#include "rubble/Journal.hpp"
+#include "rubble/JournalFile.hpp"
+#include "rubble/JournalPlayer.hpp"
 #include "rubble/Log.hpp"
 #include "rubble/MassProperties.hpp"
 #include "rubble/Mesh.hpp"
@@ -19,4 +23,5 @@
 #include "rubble/PhysicsBinding.hpp"
 #include "rubble/Random.hpp"
 #include "rubble/Result.hpp"
+#include "rubble/Snapshot.hpp"
 #include "rubble/Vec3.hpp"
