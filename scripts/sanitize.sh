@@ -5,7 +5,8 @@
 #         demo); every finding is fatal
 #         (-fno-sanitize-recover=all, halt_on_error). The libFuzzer targets are built into the same tree
 #         (scripts/fuzz.sh uses it), so one tree serves both.
-#   tsan: the threaded code, i.e. the runtime and Bullet-bridge tests (tests/runtime, tests/bullet) and the scene
+#   tsan: the threaded code, i.e. the runtime, Bullet-bridge, journal/snapshot and netplay tests (tests/runtime,
+#         tests/bullet, tests/persist, tests/net) and the scene
 #         bench's smoke run (bench_scene_smoke), built with TSan into build-tsan/ and run by CTest.
 #   fuzz: every libFuzzer target for a fixed seed and input count (scripts/fuzz.sh ci).
 #   all:  asan, then tsan (`make sanitize`).  ci: asan, tsan, fuzz (`make sanitize-ci`, what .ci/run runs).
@@ -58,7 +59,7 @@ tsan() {
     # Only the threaded code: the runtime's tests, the Bullet bridge (which drives DestructionWorld) and the
     # scene bench's smoke run (the whole game loop with fracture workers).
     local targets
-    targets=$(ninja -C build-tsan -t targets all | sed -n 's#^tests/\(\(runtime\|bullet\)_[A-Za-z]*_test\):.*#\1#p')
+    targets=$(ninja -C build-tsan -t targets all | sed -n 's#^tests/\(\(runtime\|bullet\|persist\|net\)_[A-Za-z]*_test\):.*#\1#p')
     # shellcheck disable=SC2086
     cmake --build build-tsan -j "$jobs" --target $targets rubble-bench
     echo "sanitize: TSan build took $(elapsed "$t0")"
@@ -68,7 +69,7 @@ tsan() {
     if [ "$(cat /proc/sys/vm/mmap_rnd_bits 2>/dev/null || echo 28)" -gt 28 ]; then norand=(setarch "$(uname -m)" -R); fi
     TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1 \
         "${norand[@]}" ctest --test-dir build-tsan --output-on-failure -j "$jobs" --timeout 1200 \
-        -L 'runtime|bullet|bench' -E '_quick$'
+        -L 'runtime|bullet|bench|persist|net' -E '_quick$'
     echo "sanitize: TSan tests took $(elapsed "$t0")"
 }
 
