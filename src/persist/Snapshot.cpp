@@ -40,15 +40,26 @@ void readArray(ByteReader& r, std::vector<T>& v, std::uint32_t n, const char* fi
     }
 }
 
-// Fails at the first non-finite coordinate of doubles stored from offset `start`.
-void checkFinite(ByteReader& r, const double* values, std::size_t count, std::size_t start, const char* field,
-                 int perRecord, const char* const* parts) {
-    for (std::size_t i = 0; i < count && r.ok(); ++i)
-        if (!(values[i] - values[i] == 0))
-            r.fail(start + 8 * i, std::string(field) + parts[i % static_cast<std::size_t>(perRecord)],
-                   "is not finite");
+// Fails at the first non-finite coordinate of records stored from offset `start` (8 bytes per coordinate).
+void checkFinite(ByteReader& r, const std::vector<Vec3>& v, std::size_t start, const char* field) {
+    static const char* axis[3] = {".x", ".y", ".z"};
+    for (std::size_t i = 0; i < v.size() && r.ok(); ++i)
+        for (int k = 0; k < 3; ++k)
+            if (!(v[i][k] - v[i][k] == 0)) {
+                r.fail(start + 24 * i + 8 * static_cast<std::size_t>(k), std::string(field) + axis[k],
+                       "is not finite");
+                break;
+            }
 }
-constexpr const char* kXyz[3] = {".x", ".y", ".z"};
+void checkFinite(ByteReader& r, const std::vector<Vec2>& v, std::size_t start, const char* field) {
+    for (std::size_t i = 0; i < v.size() && r.ok(); ++i) {
+        if (!(v[i].x - v[i].x == 0))
+            r.fail(start + 16 * i, std::string(field) + ".x", "is not finite");
+        else if (!(v[i].y - v[i].y == 0))
+            r.fail(start + 16 * i + 8, std::string(field) + ".y", "is not finite");
+    }
+}
+
 constexpr std::uint16_t kVersion = 1;
 
 void vec(ByteWriter& w, const Vec3& v) {
@@ -68,6 +79,15 @@ void frame(ByteWriter& w, const Frame& f) {
 void text(ByteWriter& w, const std::string& s) {
     w.u32(static_cast<std::uint32_t>(s.size()));
     w.bytes(s.data(), s.size());
+}
+
+// A boolean stored as 0 or 1 (anything else is refused, so that an accepted file encodes to its own bytes).
+bool flag(ByteReader& r, const char* field) {
+    const std::size_t at = r.offset();
+    const std::uint8_t v = r.u8(field);
+    if (r.ok() && v > 1)
+        r.fail(at, field, "is " + std::to_string(v) + ", expected 0 or 1");
+    return v == 1;
 }
 
 // Readers with literal field names: a name with its index or axis is only built when something fails.
@@ -167,7 +187,7 @@ ObjectState readObject(ByteReader& r, const std::uint8_t* data) {
     ObjectState o;
     o.id = r.u32("id");
     o.version = r.u32("version");
-    o.destructible = r.u8("destructible") != 0;
+    o.destructible = flag(r, "destructible");
     o.density = real(r, "density");
     o.impulseThreshold = real(r, "impulseThreshold");
     o.crumbleAbove = r.u64("crumbleAbove");
@@ -191,7 +211,7 @@ ObjectState readObject(ByteReader& r, const std::uint8_t* data) {
     f.backend = static_cast<BooleanKind>(backend);
     f.minPieceVolumeFraction = real(r, "fracture.minPieceVolumeFraction");
     f.uvScale = real(r, "fracture.uvScale");
-    f.simplifyPieces = r.u8("fracture.simplifyPieces") != 0;
+    f.simplifyPieces = flag(r, "fracture.simplifyPieces");
     o.mass.volume = real(r, "mass.volume");
     o.mass.centerOfMass = vec(r, "mass.centerOfMass");
     o.mass.inertia = mat(r, "mass.inertia");
@@ -202,7 +222,7 @@ ObjectState readObject(ByteReader& r, const std::uint8_t* data) {
     std::size_t start = r.offset();
     readArray(r, m.positions, nPos, "mesh.positions", [&] { return vec(r, "mesh.positions"); });
     if (kBulk)
-        checkFinite(r, &m.positions.data()->x, 3ull * nPos, start, "mesh.positions", 3, kXyz);
+        checkFinite(r, m.positions, start, "mesh.positions");
     const std::uint32_t nTri = r.count("mesh.triangles.count", 12);
     start = r.offset();
     readArray(r, m.triangles, nTri, "mesh.triangles", [&] {
@@ -229,8 +249,7 @@ ObjectState readObject(ByteReader& r, const std::uint8_t* data) {
     start = r.offset();
     readArray(r, m.normals, r.ok() ? nNormals : 0, "mesh.normals", [&] { return vec(r, "mesh.normals"); });
     if (kBulk)
-        checkFinite(r, m.normals.empty() ? nullptr : &m.normals.data()->x, 3ull * m.normals.size(), start,
-                    "mesh.normals", 3, kXyz);
+        checkFinite(r, m.normals, start, "mesh.normals");
     pos = r.offset();
     const std::uint32_t nUvs = r.count("mesh.uvs.count", 16);
     perCorner(nUvs, "mesh.uvs.count", pos);
@@ -242,8 +261,7 @@ ObjectState readObject(ByteReader& r, const std::uint8_t* data) {
         return u;
     });
     if (kBulk)
-        checkFinite(r, m.uvs.empty() ? nullptr : &m.uvs.data()->x, 2ull * m.uvs.size(), start, "mesh.uvs", 2,
-                    kXyz);
+        checkFinite(r, m.uvs, start, "mesh.uvs");
     pos = r.offset();
     const std::uint32_t nMat = r.count("mesh.materials.count", 4);
     if (r.ok() && nMat != 0 && nMat != nTri)
@@ -357,7 +375,8 @@ Result<Snapshot> decodeSnapshot(const std::uint8_t* data, std::size_t size, cons
         r.fail(4, "version",
                "version " + std::to_string(version) + " is not supported (this build reads " +
                    std::to_string(kVersion) + ")");
-    (void)r.u16("reserved");
+    if (const std::uint16_t reserved = r.u16("reserved"); r.ok() && reserved != 0)
+        r.fail(6, "reserved", "is " + std::to_string(reserved) + ", expected 0");
     if (!r.ok())
         return bad();
     if (size < 12) {
@@ -410,7 +429,7 @@ Result<Snapshot> decodeSnapshot(const std::uint8_t* data, std::size_t size, cons
         PendingWork p;
         p.object = body.u32("object");
         p.version = body.u32("version");
-        p.inFlight = body.u8("inFlight") != 0;
+        p.inFlight = flag(body, "inFlight");
         p.readyFrame = body.u64("readyFrame");
         const std::uint32_t nImpacts = body.count("impacts.count", 64);
         for (std::uint32_t k = 0; k < nImpacts && body.ok(); ++k) {
