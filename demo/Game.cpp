@@ -561,6 +561,34 @@ bool Game::replayJournal(const std::string& path, std::uint64_t& hash, std::stri
     return true;
 }
 
+bool Game::loadSnapshot(const std::string& path, Renderer& renderer, std::string& message) {
+    if (!runtime_) {
+        message = "no scene loaded";
+        return false;
+    }
+    rubble::Result<rubble::Snapshot> snapshot = rubble::loadSnapshot(path);
+    if (!snapshot) {
+        message = snapshot.error().message;
+        return false;
+    }
+    const std::size_t objects = snapshot->world.objects.size();
+    if (rubble::Status s = rubble::restoreSnapshot(*runtime_, std::move(*snapshot)); !s) {
+        message = s.message();
+        return false;
+    }
+    // The old bodies' visuals went with them (onRemoved); the new ones keep the looks of their objects.
+    for (BodyId id : runtime_->bodies()) {
+        const rubble::BodyRecord* b = runtime_->body(id);
+        if (!b->hasObject || visuals_.count(id))
+            continue;
+        const auto look = looks_.find(b->object);
+        addVisual(id, runtime_->world().object(b->object)->mesh, look == looks_.end() ? Look{} : look->second,
+                  0.0f, renderer);
+    }
+    message = std::to_string(objects) + " objects";
+    return true;
+}
+
 bool Game::saveSnapshot(const std::string& path, std::string& message) const {
     if (!runtime_) {
         message = "no scene loaded";

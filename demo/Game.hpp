@@ -122,6 +122,9 @@ public:
     /// no job is in flight; the geometry hash then equals the recording's finishRecording(). False with a
     /// message when the file cannot be read or does not belong to this scene and these settings.
     bool replayJournal(const std::string& path, std::uint64_t& hash, std::string& message);
+    /// Loads a snapshot saved by saveSnapshot (F9): the world and its objects' bodies are replaced; false
+    /// with a message (the game unchanged) when the file is damaged or belongs to other settings.
+    bool loadSnapshot(const std::string& path, Renderer& renderer, std::string& message);
     /// Saves a snapshot of the destroyed world and its bodies (F5); false with a message when it cannot.
     bool saveSnapshot(const std::string& path, std::string& message) const;
 

@@ -103,11 +103,17 @@ void keyCallback(GLFWwindow* w, int key, int, int action, int) {
     case GLFW_KEY_F2:
         a.screenshotRequested = true;
         break;
-    case GLFW_KEY_F5: { // quick save: a snapshot of the destroyed world (loading it back is not done yet)
+    case GLFW_KEY_F5: // quick save / quick load: a snapshot of the destroyed world and its bodies
+    case GLFW_KEY_F9: {
         const std::string path = (a.opt.out.empty() ? std::string(".") : a.opt.out) + "/quicksave.rsnap";
         std::string message;
-        const bool ok = a.game.saveSnapshot(path, message);
-        std::printf("F5: %s %s (%s)\n", ok ? "saved" : "cannot save", path.c_str(), message.c_str());
+        const bool save = key == GLFW_KEY_F5;
+        const bool ok =
+            save ? a.game.saveSnapshot(path, message) : a.game.loadSnapshot(path, a.renderer, message);
+        std::printf("%s: %s %s (%s)\n", save ? "F5" : "F9",
+                    ok ? (save ? "saved" : "loaded") : (save ? "cannot save" : "cannot load"), path.c_str(),
+                    message.c_str());
+        std::fflush(stdout);
         break;
     }
     case GLFW_KEY_F3: {

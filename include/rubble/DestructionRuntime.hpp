@@ -171,6 +171,7 @@ struct VolumeLedger {
 /// Where an object's body is and how it moves (what a snapshot or a network host sends).
 struct ObjectPlacement {
     ObjectId object = 0;                              ///< the object
+    BodyRole role = BodyRole::Object;                 ///< an object of the scene or a piece of a fracture
     BodyMotionState motion = BodyMotionState::Static; ///< static, dynamic or frozen
     Frame objectToWorld;                              ///< world ← object coordinates
     Vec3 linearVelocity;                              ///< m/s (world)
@@ -266,6 +267,13 @@ public:
 
     /// The placement of every body that carries an object, ascending body id.
     std::vector<ObjectPlacement> placements() const;
+    /// Replaces the world's state and every body that carries an object by a saved world (a snapshot): each
+    /// object gets a body at its placement with its velocities and motion state (static ones join the support
+    /// graph, frozen ones the governor's grid). Bodies without objects (ground, scenery, projectiles) stay.
+    /// The volume ledger restarts (retired, dust and dropped are not saved). Fails, changing nothing, when
+    /// the state is inconsistent (DestructionWorld::loadState) or an object has no placement or a placement
+    /// no object, or a placement's role is neither Object nor Piece.
+    Status restore(WorldState state, const std::vector<ObjectPlacement>& placements);
 
     /// Hash of the live body set (id, role, motion, object version and mesh hash, transform bits) and of the
     /// volume ledger: equal runs give equal hashes.

@@ -30,6 +30,10 @@ Snapshot takeSnapshot(const DestructionWorld& world, const DestructionWorld::Con
 /// when seed or delay differ or the state is inconsistent.
 Status restoreSnapshot(DestructionWorld& world, const DestructionWorld::Config& config, Snapshot snapshot);
 
+/// Loads a snapshot into a runtime (DestructionRuntime::restore): its world and the bodies of its objects;
+/// fails, changing nothing, like restoreSnapshot(world, ...) or when the placements do not match the objects.
+Status restoreSnapshot(DestructionRuntime& runtime, Snapshot snapshot);
+
 /// The snapshot's bytes.
 std::vector<std::uint8_t> encodeSnapshot(const Snapshot& snapshot);
 /// Parses a snapshot; a truncated, corrupted, wrong-version or hostile input gives an error naming source,

@@ -317,6 +317,16 @@ Status restoreSnapshot(DestructionWorld& world, const DestructionWorld::Config& 
     return world.loadState(std::move(snapshot.world));
 }
 
+Status restoreSnapshot(DestructionRuntime& runtime, Snapshot snapshot) {
+    const DestructionWorld::Config& config = runtime.config().world;
+    if (snapshot.seed != config.seed || snapshot.delayFrames != config.delayFrames)
+        return Error{ErrorCode::InvalidInput,
+                     "snapshot fields seed / delayFrames are " + std::to_string(snapshot.seed) + " / " +
+                         std::to_string(snapshot.delayFrames) + ", the world's " +
+                         std::to_string(config.seed) + " / " + std::to_string(config.delayFrames)};
+    return runtime.restore(std::move(snapshot.world), snapshot.placements);
+}
+
 std::vector<std::uint8_t> encodeSnapshot(const Snapshot& s) {
     ByteWriter w;
     std::size_t estimate = 64;
@@ -339,6 +349,7 @@ std::vector<std::uint8_t> encodeSnapshot(const Snapshot& s) {
     w.u32(static_cast<std::uint32_t>(s.placements.size()));
     for (const ObjectPlacement& p : s.placements) {
         w.u32(p.object);
+        w.u8(static_cast<std::uint8_t>(p.role));
         w.u8(static_cast<std::uint8_t>(p.motion));
         frame(w, p.objectToWorld);
         vec(w, p.linearVelocity);
@@ -406,12 +417,19 @@ Result<Snapshot> decodeSnapshot(const std::uint8_t* data, std::size_t size, cons
         s.world.objects.push_back(readObject(body, data));
     }
     body.setContext("");
-    const std::uint32_t nPlacements = body.count("placements.count", 149);
+    const std::uint32_t nPlacements = body.count("placements.count", 150);
     s.placements.reserve(nPlacements);
     for (std::uint32_t i = 0; i < nPlacements && body.ok(); ++i) {
         body.setContext("placements[" + std::to_string(i) + "].");
         ObjectPlacement p;
         p.object = body.u32("object");
+        const std::size_t rolePos = body.offset();
+        const std::uint8_t role = body.u8("role");
+        if (body.ok() && role != static_cast<std::uint8_t>(BodyRole::Object) &&
+            role != static_cast<std::uint8_t>(BodyRole::Piece))
+            body.fail(rolePos, "role",
+                      "is " + std::to_string(role) + ", expected an object (2) or a piece (3)");
+        p.role = static_cast<BodyRole>(role);
         const std::size_t pos = body.offset();
         const std::uint8_t motion = body.u8("motion");
         if (body.ok() && motion > static_cast<std::uint8_t>(BodyMotionState::Frozen))

@@ -4,7 +4,9 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <set>
+#include <string>
 
 #include "runtime/BodyTable.hpp"
 #include "runtime/DebrisGovernor.hpp"
@@ -535,10 +537,70 @@ std::vector<ObjectPlacement> DestructionRuntime::placements() const {
         if (!r.hasObject)
             continue;
         const BodyMotion m = impl_->binding.motion(id);
-        out.push_back({r.object, r.motion, m.transform * r.objectToBody.inverse(), m.linearVelocity,
+        out.push_back({r.object, r.role, r.motion, m.transform * r.objectToBody.inverse(), m.linearVelocity,
                        m.angularVelocity});
     }
     return out;
+}
+
+Status DestructionRuntime::restore(WorldState state, const std::vector<ObjectPlacement>& placements) {
+    Impl& im = *impl_;
+    std::map<ObjectId, const ObjectPlacement*> where;
+    for (const ObjectPlacement& p : placements) {
+        const std::string which = "placement of object " + std::to_string(p.object);
+        if (p.role != BodyRole::Object && p.role != BodyRole::Piece)
+            return Error{ErrorCode::InvalidInput, which + ": role is neither object nor piece"};
+        if (!where.emplace(p.object, &p).second)
+            return Error{ErrorCode::InvalidInput, which + ": listed twice"};
+    }
+    if (where.size() != state.objects.size())
+        return Error{ErrorCode::InvalidInput, std::to_string(state.objects.size()) + " objects but " +
+                                                  std::to_string(where.size()) + " placements"};
+    for (const ObjectState& o : state.objects)
+        if (!where.count(o.id))
+            return Error{ErrorCode::InvalidInput, "object " + std::to_string(o.id) + " has no placement"};
+    // The old objects' bodies go (the world's objects are replaced below); nothing is journaled.
+    std::vector<BodyId> old;
+    for (const auto& [id, r] : im.bodies.all())
+        if (r.hasObject)
+            old.push_back(id);
+    if (Status s = im.world.loadState(std::move(state)); !s)
+        return s;
+    for (BodyId id : old)
+        im.destroy(id, false);
+    im.ledger = VolumeLedger{};
+    for (ObjectId id : im.world.objects()) {
+        const ObjectState& st = *im.world.object(id);
+        const ObjectPlacement& p = *where.at(id);
+        const bool isStatic = p.motion != BodyMotionState::Dynamic;
+        detail::PieceSpawn s = detail::describeObjectBody(
+            st, isStatic, p.role == BodyRole::Piece ? im.config.adoption.singleHullVolume : 0);
+        s.desc.transform = p.objectToWorld * s.objectToBody;
+        s.desc.linearVelocity = p.linearVelocity;
+        s.desc.angularVelocity = p.angularVelocity;
+        if (p.role == BodyRole::Piece) {
+            s.desc.friction = im.config.adoption.friction;
+            s.desc.restitution = im.config.adoption.restitution;
+        }
+        BodyRecord rec;
+        rec.role = p.role;
+        rec.motion = p.motion;
+        rec.hasObject = true;
+        rec.object = id;
+        rec.objectToBody = s.objectToBody;
+        rec.volume = s.volume;
+        rec.mass = s.mass;
+        rec.inertia = s.inertia;
+        rec.triangles = s.triangles;
+        rec.radius = boundingRadius(st.mesh, s.objectToBody);
+        rec.structural = p.motion == BodyMotionState::Static;
+        const BodyId body = im.insert(rec, s.desc).id;
+        if (p.motion == BodyMotionState::Static)
+            im.support.add(body, worldParts(st, p.objectToWorld), false, true);
+        else if (p.motion == BodyMotionState::Frozen)
+            im.governor.frozen(body, s.desc.transform.translation, rec.radius);
+    }
+    return Status::ok();
 }
 
 std::uint64_t DestructionRuntime::stateHash() const {

@@ -115,6 +115,19 @@ diff=$(echo "$stats" | sed -n 's/.*diff=\([0-9.]*\).*/\1/p')
 python3 -c "import sys; sys.exit(0 if float('$var') > 50 else 1)" || fail "screenshot looks blank (variance $var)"
 python3 -c "import sys; sys.exit(0 if float('$diff') > 0.05 else 1)" || fail "screenshots before/after the hit are the same (diff $diff)"
 
+# F5 saves a snapshot of the destroyed world, F9 loads it back, and the game plays on.
+key F5
+saved() { grep -q '^F5: saved ' "$work/log"; }
+wait_for 20 saved || fail "F5 did not save: $(grep '^F5' "$work/log")"
+[ -s "$work/out/quicksave.rsnap" ] || fail "F5 wrote no quicksave.rsnap"
+key F9
+loaded() { grep -q '^F9: loaded ' "$work/log"; }
+wait_for 20 loaded || fail "F9 did not load: $(grep '^F9' "$work/log")"
+f3=$(field frame)
+moving() { [ "$(field frame)" -gt "$f3" ]; }
+wait_for 20 moving || fail "the game stopped after F9"
+echo "ok: $(grep '^F9' "$work/log" | tail -n 1)"
+
 # Esc quits with status 0.
 key Escape
 for _ in $(seq 1 200); do
