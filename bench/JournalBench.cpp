@@ -66,7 +66,7 @@ SnapshotTiming timeSnapshot(const rubble::DestructionWorld& world,
                             const rubble::DestructionWorld::Config& config, const std::string& dir) {
     SnapshotTiming t;
     const auto s0 = Clock::now();
-    const std::vector<std::uint8_t> bytes = rubble::encodeSnapshot(rubble::takeSnapshot(world, config));
+    const std::vector<std::uint8_t> bytes = rubble::encodeSnapshot(rubble::takeSnapshot(world));
     t.encodeMs = msSince(s0);
     t.bytes = bytes.size();
     fs::create_directories(dir);
@@ -79,7 +79,7 @@ SnapshotTiming timeSnapshot(const rubble::DestructionWorld& world,
     const auto l0 = Clock::now();
     auto snap = rubble::loadSnapshot(file); // read + decode
     t.decodeMs = msSince(l0);
-    const bool ok = snap && rubble::restoreSnapshot(loaded, config, std::move(*snap));
+    const bool ok = snap && rubble::restoreSnapshot(loaded, std::move(*snap));
     t.loadMs = msSince(l0);
     fs::remove(file);
     t.same = ok && loaded.geometryHash() == world.geometryHash();

@@ -109,6 +109,7 @@ void Game::clear(Renderer& renderer) {
     visuals_.clear();
     looks_.clear();
     vehicle_ = 0;
+    net_.reset();
     runtime_.reset();
     binding_.reset();
     physics_.reset();
@@ -376,6 +377,12 @@ void Game::step(const ControlInput& input, float dt, Renderer& renderer) {
     runtime_->setFocus({camera_.eye.x, camera_.eye.y, camera_.eye.z}); // distant tiny debris fades
     runtime_->stepFrame(dt);
     emitEffects(impactsBefore, retiredBefore);
+    if (net_) { // clients follow by journal events and placements (10 Hz)
+        net_->publish();
+        if (counters_.frame % 6 == 0)
+            net_->publishPlacements(runtime_->placements());
+        net_->service(0);
+    }
 
     for (BodyId id : runtime_->bodies())
         if (runtime_->body(id)->role == BodyRole::Projectile)
@@ -561,6 +568,27 @@ bool Game::replayJournal(const std::string& path, std::uint64_t& hash, std::stri
     return true;
 }
 
+bool Game::host(std::uint16_t port, std::string& message) {
+    if (!runtime_) {
+        message = "no scene loaded";
+        return false;
+    }
+    auto server = rubble::net::NetHost::listen(runtime_->world(), worldConfig_, "127.0.0.1", port);
+    if (!server) {
+        message = server.error().message;
+        return false;
+    }
+    net_ = std::move(*server);
+    net_->setPlacementSource([this] { return runtime_->placements(); });
+    // One journal sink: the recording and the clients both get every event.
+    runtime_->world().setJournalSink([this](const rubble::JournalEvent& e) {
+        journal_.push_back(e);
+        net_->journaled(e);
+    });
+    message = "127.0.0.1:" + std::to_string(net_->port());
+    return true;
+}
+
 bool Game::loadSnapshot(const std::string& path, Renderer& renderer, std::string& message) {
     if (!runtime_) {
         message = "no scene loaded";
@@ -594,8 +622,7 @@ bool Game::saveSnapshot(const std::string& path, std::string& message) const {
         message = "no scene loaded";
         return false;
     }
-    const rubble::Snapshot snapshot =
-        rubble::takeSnapshot(runtime_->world(), worldConfig_, runtime_->placements());
+    const rubble::Snapshot snapshot = rubble::takeSnapshot(runtime_->world(), runtime_->placements());
     if (rubble::Status s = rubble::saveSnapshot(path, snapshot); !s) {
         message = s.message();
         return false;

@@ -21,6 +21,7 @@
 #include "rubble/SceneConfig.hpp"
 #include "rubble/bullet/BulletBinding.hpp"
 #include "rubble/bullet/PhysicsWorld.hpp"
+#include "rubble/enet/NetHost.hpp"
 
 namespace demo {
 
@@ -122,6 +123,13 @@ public:
     /// no job is in flight; the geometry hash then equals the recording's finishRecording(). False with a
     /// message when the file cannot be read or does not belong to this scene and these settings.
     bool replayJournal(const std::string& path, std::uint64_t& hash, std::string& message);
+    /// Hosts loopback multiplayer on 127.0.0.1:port (docs/netplay.md): clients get a snapshot, then the
+    /// journal and the bodies' placements every step. Needs deterministic settings; false with a message.
+    bool host(std::uint16_t port, std::string& message);
+    /// The host's totals, or null when not hosting.
+    const rubble::net::HostStats* hostStats() const { return net_ ? &net_->stats() : nullptr; }
+    /// The world's geometry hash.
+    std::uint64_t geometryHash() const { return runtime_ ? runtime_->world().geometryHash() : 0; }
     /// Loads a snapshot saved by saveSnapshot (F9): the world and its objects' bodies are replaced; false
     /// with a message (the game unchanged) when the file is damaged or belongs to other settings.
     bool loadSnapshot(const std::string& path, Renderer& renderer, std::string& message);
@@ -157,6 +165,7 @@ private:
     std::unique_ptr<rubble::bullet::BulletBinding> binding_;
     std::unique_ptr<rubble::DestructionRuntime> runtime_;
     rubble::DestructionWorld::Config worldConfig_;
+    std::unique_ptr<rubble::net::NetHost> net_; // hosting loopback multiplayer (before the runtime goes)
     std::vector<rubble::JournalEvent> journal_; // every accepted impact and removal since load()
     std::unordered_map<rubble::BodyId, Visual> visuals_;
     std::map<rubble::ObjectId, Look> looks_;

@@ -59,6 +59,7 @@ struct Options {
     bool noShadows = false;
     std::string record; // journal file written at exit
     std::string replay; // journal file replayed on the loaded scene instead of playing
+    int host = 0;       // port to host loopback multiplayer on
 };
 
 struct App {
@@ -202,6 +203,11 @@ int main(int argc, char** argv) {
         "--replay", o.replay,
         "replay the journal FILE on the loaded scene, print its geometry hash and exit (a bug report's "
         "fractures, reproduced; run with the recording's options)");
+    cli.add_option(
+           "--host", o.host,
+           "host loopback multiplayer on 127.0.0.1:PORT (needs --deterministic); clients: rubble-bench "
+           "netplay-client --port PORT")
+        ->check(CLI::Range(1, 65535));
     CLI11_PARSE(cli, argc, argv);
 
     const bool haveDisplay = std::getenv("DISPLAY") && *std::getenv("DISPLAY");
@@ -267,6 +273,15 @@ int main(int argc, char** argv) {
         return 1;
     }
 
+    if (o.host > 0) {
+        std::string message;
+        if (!app.game.host(static_cast<std::uint16_t>(o.host), message)) {
+            std::fprintf(stderr, "error: cannot host on port %d: %s\n", o.host, message.c_str());
+            return 1;
+        }
+        std::printf("host: listening on %s\n", message.c_str());
+        std::fflush(stdout);
+    }
     if (!o.replay.empty()) {
         std::uint64_t hash = 0;
         std::string message;
@@ -460,6 +475,11 @@ int main(int argc, char** argv) {
         }
     }
     int status = 0;
+    if (const rubble::net::HostStats* h = app.game.hostStats())
+        std::printf("host: %lld clients joined, %lld syncs sent, %lld acknowledged, %lld mismatched hashes, "
+                    "geometry hash %016llx\n",
+                    h->joins, h->syncs, h->acks, h->mismatchedHashes,
+                    static_cast<unsigned long long>(app.game.geometryHash()));
     if (!o.record.empty()) {
         std::string message;
         const std::uint64_t hash = app.game.finishRecording();

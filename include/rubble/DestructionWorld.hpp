@@ -121,13 +121,19 @@ struct PendingWork {
     std::vector<std::uint64_t> ticks; ///< frame of each impact's submission
 };
 
-/// Everything a DestructionWorld holds besides its settings and timings: what a snapshot saves.
+/// Everything a DestructionWorld holds besides its threads and timings: what a snapshot saves. The settings
+/// that decide the geometry travel with it, so that a world loading it cuts the same pieces.
 struct WorldState {
-    std::uint64_t frame = 0;           ///< DestructionWorld::frame()
-    ObjectId nextId = 1;               ///< the id the next new object gets
-    std::uint64_t journalPosition = 0; ///< journal events so far
-    std::vector<ObjectState> objects;  ///< live objects, ascending id
-    std::vector<PendingWork> work;     ///< jobs in flight (launch order), then waiting impacts (by object)
+    std::uint64_t seed = 1;             ///< Config::seed
+    std::int32_t delayFrames = 2;       ///< Config::delayFrames
+    std::uint64_t crumbleTriangles = 0; ///< Config::crumbleTriangles
+    std::int32_t crumbleCells = 0;      ///< Config::crumbleCells
+    double minPieceVolume = 0;          ///< Config::minPieceVolume
+    std::uint64_t frame = 0;            ///< DestructionWorld::frame()
+    ObjectId nextId = 1;                ///< the id the next new object gets
+    std::uint64_t journalPosition = 0;  ///< journal events so far
+    std::vector<ObjectState> objects;   ///< live objects, ascending id
+    std::vector<PendingWork> work;      ///< jobs in flight (launch order), then waiting impacts (by object)
 };
 
 /// The runtime. All member functions are called from one (main) thread; work runs on the JobSystem.
@@ -189,9 +195,10 @@ public:
     Status applyJournalEvent(const JournalEvent& event);
     /// The world's state (objects, frame, id counter, journal position, unadopted work).
     WorldState saveState() const;
-    /// Replaces the world's state by state (pending results of the current state are discarded; work in the
-    /// state is relaunched as it was). Fails, changing nothing, when the state is inconsistent (ids not
-    /// ascending or not below nextId, work on a missing object or version, an empty mesh).
+    /// Replaces the world's state by state, its settings included (pending results of the current state are
+    /// discarded; work in the state is relaunched as it was). Fails, changing nothing, when the state is
+    /// inconsistent (ids not ascending or not below nextId, work on a missing object or version, an empty
+    /// mesh, a negative delay or cell count, a minimum piece volume that is negative or not finite).
     Status loadState(WorldState state);
 
     /// Order-independent hash of the geometry: every live object's id, version and mesh hash. Equal worlds

@@ -17,19 +17,15 @@ namespace rubble {
 
 /// A saved world.
 struct Snapshot {
-    std::uint64_t seed = 1;                  ///< DestructionWorld::Config::seed it needs
-    std::int32_t delayFrames = 2;            ///< DestructionWorld::Config::delayFrames it needs
-    WorldState world;                        ///< objects, frame, ids, journal position, work
+    WorldState world;                        ///< settings, objects, frame, ids, journal position, work
     std::vector<ObjectPlacement> placements; ///< bodies (empty for a world without an engine)
 };
 
 /// The snapshot of a world (and of its bodies, when placements are given).
-Snapshot takeSnapshot(const DestructionWorld& world, const DestructionWorld::Config& config,
-                      std::vector<ObjectPlacement> placements = {});
-/// Loads a snapshot into a world built with matching settings; fails (naming the field), changing nothing,
-/// when seed or delay differ or the state is inconsistent.
-Status restoreSnapshot(DestructionWorld& world, const DestructionWorld::Config& config, Snapshot snapshot);
-
+Snapshot takeSnapshot(const DestructionWorld& world, std::vector<ObjectPlacement> placements = {});
+/// Loads a snapshot into a world (any worker count; the world adopts the snapshot's settings); fails,
+/// changing nothing, when the state is inconsistent (DestructionWorld::loadState).
+Status restoreSnapshot(DestructionWorld& world, Snapshot snapshot);
 /// Loads a snapshot into a runtime (DestructionRuntime::restore): its world and the bodies of its objects;
 /// fails, changing nothing, like restoreSnapshot(world, ...) or when the placements do not match the objects.
 Status restoreSnapshot(DestructionRuntime& runtime, Snapshot snapshot);

@@ -296,34 +296,18 @@ ObjectState readObject(ByteReader& r, const std::uint8_t* data) {
 
 } // namespace
 
-Snapshot takeSnapshot(const DestructionWorld& world, const DestructionWorld::Config& config,
-                      std::vector<ObjectPlacement> placements) {
+Snapshot takeSnapshot(const DestructionWorld& world, std::vector<ObjectPlacement> placements) {
     Snapshot s;
-    s.seed = config.seed;
-    s.delayFrames = config.delayFrames;
     s.world = world.saveState();
     s.placements = std::move(placements);
     return s;
 }
 
-Status restoreSnapshot(DestructionWorld& world, const DestructionWorld::Config& config, Snapshot snapshot) {
-    if (snapshot.seed != config.seed)
-        return Error{ErrorCode::InvalidInput, "snapshot field seed is " + std::to_string(snapshot.seed) +
-                                                  ", the world's is " + std::to_string(config.seed)};
-    if (snapshot.delayFrames != config.delayFrames)
-        return Error{ErrorCode::InvalidInput, "snapshot field delayFrames is " +
-                                                  std::to_string(snapshot.delayFrames) + ", the world's is " +
-                                                  std::to_string(config.delayFrames)};
+Status restoreSnapshot(DestructionWorld& world, Snapshot snapshot) {
     return world.loadState(std::move(snapshot.world));
 }
 
 Status restoreSnapshot(DestructionRuntime& runtime, Snapshot snapshot) {
-    const DestructionWorld::Config& config = runtime.config().world;
-    if (snapshot.seed != config.seed || snapshot.delayFrames != config.delayFrames)
-        return Error{ErrorCode::InvalidInput,
-                     "snapshot fields seed / delayFrames are " + std::to_string(snapshot.seed) + " / " +
-                         std::to_string(snapshot.delayFrames) + ", the world's " +
-                         std::to_string(config.seed) + " / " + std::to_string(config.delayFrames)};
     return runtime.restore(std::move(snapshot.world), snapshot.placements);
 }
 
@@ -338,8 +322,11 @@ std::vector<std::uint8_t> encodeSnapshot(const Snapshot& s) {
     w.bytes(kMagic, 4);
     w.u16(kVersion);
     w.u16(0); // reserved
-    w.u64(s.seed);
-    w.i32(s.delayFrames);
+    w.u64(s.world.seed);
+    w.i32(s.world.delayFrames);
+    w.u64(s.world.crumbleTriangles);
+    w.i32(s.world.crumbleCells);
+    w.f64(s.world.minPieceVolume);
     w.u64(s.world.frame);
     w.u32(s.world.nextId);
     w.u64(s.world.journalPosition);
@@ -405,8 +392,11 @@ Result<Snapshot> decodeSnapshot(const std::uint8_t* data, std::size_t size, cons
     for (int i = 0; i < 8; ++i)
         (void)body.u8("header");
     Snapshot s;
-    s.seed = body.u64("seed");
-    s.delayFrames = body.i32("delayFrames");
+    s.world.seed = body.u64("seed");
+    s.world.delayFrames = body.i32("delayFrames");
+    s.world.crumbleTriangles = body.u64("crumbleTriangles");
+    s.world.crumbleCells = body.i32("crumbleCells");
+    s.world.minPieceVolume = real(body, "minPieceVolume");
     s.world.frame = body.u64("frame");
     s.world.nextId = body.u32("nextId");
     s.world.journalPosition = body.u64("journalPosition");

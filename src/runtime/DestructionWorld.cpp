@@ -477,6 +477,11 @@ Status DestructionWorld::applyJournalEvent(const JournalEvent& e) {
 WorldState DestructionWorld::saveState() const {
     const Impl& im = *impl_;
     WorldState w;
+    w.seed = im.config.seed;
+    w.delayFrames = im.config.delayFrames;
+    w.crumbleTriangles = im.config.crumbleTriangles;
+    w.crumbleCells = im.config.crumbleCells;
+    w.minPieceVolume = im.config.minPieceVolume;
     w.frame = im.frame;
     w.nextId = im.nextId;
     w.journalPosition = im.journalLength;
@@ -503,6 +508,10 @@ WorldState DestructionWorld::saveState() const {
 Status DestructionWorld::loadState(WorldState w) {
     Impl& im = *impl_;
     auto bad = [](const std::string& what) { return Error{ErrorCode::InvalidInput, "world state: " + what}; };
+    if (w.delayFrames < 0 || w.crumbleCells < 0 || !(w.minPieceVolume >= 0 && w.minPieceVolume < 1e300))
+        return bad("settings out of range (delayFrames " + std::to_string(w.delayFrames) + ", crumbleCells " +
+                   std::to_string(w.crumbleCells) + ", minPieceVolume " + std::to_string(w.minPieceVolume) +
+                   ")");
     ObjectId last = 0;
     std::map<ObjectId, std::uint32_t> versions;
     for (const ObjectState& o : w.objects) {
@@ -537,6 +546,11 @@ Status DestructionWorld::loadState(WorldState w) {
         o.meshHash = o.mesh.hash();
         im.insertObject(std::make_shared<const ObjectState>(std::move(o)));
     }
+    im.config.seed = w.seed;
+    im.config.delayFrames = w.delayFrames;
+    im.config.crumbleTriangles = static_cast<std::size_t>(w.crumbleTriangles);
+    im.config.crumbleCells = w.crumbleCells;
+    im.config.minPieceVolume = w.minPieceVolume;
     im.frame = w.frame;
     im.nextId = w.nextId;
     im.journalLength = w.journalPosition;

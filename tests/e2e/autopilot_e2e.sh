@@ -3,9 +3,11 @@
 # with fixed 1/60 s steps, writes PNGs and the JSON/CSV report. Two runs give pixel-identical screenshots.
 # When the thesis's media folder is present, its world.cfg, performance_test.cfg and cube_test.cfg must load
 # as they are (missing fighter.3ds and grid.jpg become warnings with stand-ins).
-# Usage: autopilot_e2e.sh PATH/TO/rubble-demo
+# With rubble-bench, the demo also hosts loopback multiplayer for a client process that must follow it.
+# Usage: autopilot_e2e.sh PATH/TO/rubble-demo [PATH/TO/rubble-bench]
 set -uo pipefail
-demo=${1:?usage: autopilot_e2e.sh PATH/TO/rubble-demo}
+demo=${1:?usage: autopilot_e2e.sh PATH/TO/rubble-demo [PATH/TO/rubble-bench]}
+bench=${2:-}
 here=$(cd "$(dirname "$0")" && pwd)
 work=$(mktemp -d /tmp/rubble-autopilot.XXXXXX)
 trap 'rm -rf "$work"' EXIT
@@ -42,6 +44,25 @@ replayed=$(sed -n 's/^replay: .*geometry hash \([0-9a-f]*\)$/\1/p' "$work/replay
 events=$(sed -n 's/^journal: .* (\([0-9]*\) events, [0-9]* bytes).*$/\1/p' "$work/c.log")
 [ -n "$events" ] && [ "$events" -gt 0 ] || fail "the deterministic session journaled nothing"
 echo "ok: --record and --replay ($events events, geometry hash $recorded)"
+
+# --host: a client process (rubble-bench netplay-client) follows the demo over ENet on 127.0.0.1.
+if [ -n "$bench" ]; then
+    port=$(python3 -c "import socket; s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM); s.bind(('127.0.0.1', 0)); print(s.getsockname()[1])")
+    "$bench" netplay-client --port "$port" --seconds 120 >"$work/client.json" 2>"$work/client.err" &
+    client=$!
+    run host --scene "$here/e2e.cfg" --autopilot 4 --deterministic --host "$port"
+    wait "$client" || fail "the client failed: $(cat "$work/client.json" "$work/client.err")"
+    python3 - "$work/client.json" "$work/host.log" <<'PY' || fail "the client did not follow the host: $(cat "$work/client.json")"
+import json, re, sys
+c = json.load(open(sys.argv[1]))
+log = open(sys.argv[2]).read()
+h = re.search(r"host: (\d+) clients joined, (\d+) syncs sent, (\d+) acknowledged, (\d+) mismatched", log)
+assert c["joined"] and c["syncs"] > 100 and c["events"] > 0, c
+assert c["mismatched_hashes"] == 0, c
+assert h and int(h.group(1)) == 1 and int(h.group(4)) == 0, log[-400:]
+print("ok: --host: the client checked %d syncs and %d events, 0 mismatched hashes" % (c["syncs"], c["events"]))
+PY
+fi
 echo "ok: headless autopilot, report and deterministic screenshots"
 
 media=${RUBBLE_SEED_MEDIA:-$here/../../../shared/seed/media}

@@ -41,7 +41,7 @@ const std::vector<std::uint8_t>& validSnapshot() {
             (void)world.collect();
         }
         (void)world.submitImpact(world.objects().back(), Impact{{0, 1, 0}, {0, 1, 0}, 100});
-        return encodeSnapshot(takeSnapshot(world, config()));
+        return encodeSnapshot(takeSnapshot(world));
     }();
     return bytes;
 }
@@ -76,7 +76,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         fail("an accepted snapshot does not encode to its own bytes");
     DestructionWorld world(config());
     const std::uint64_t before = world.geometryHash();
-    if (!restoreSnapshot(world, config(), std::move(*s)) && world.geometryHash() != before)
+    if (!restoreSnapshot(world, std::move(*s)) && world.geometryHash() != before)
         fail("a refused snapshot changed the world");
     world.waitIdle();
     return 0;

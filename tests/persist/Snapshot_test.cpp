@@ -31,7 +31,7 @@ struct MidFire {
         rig.play(100);
         for (int i = 0; i < 30 && rig.runtime.world().jobsInFlight() == 0; ++i)
             rig.play(1, 1);
-        snapshot = takeSnapshot(rig.runtime.world(), kConfig, rig.runtime.placements());
+        snapshot = takeSnapshot(rig.runtime.world(), rig.runtime.placements());
     }
 };
 
@@ -51,10 +51,10 @@ TEST(Snapshot, LoadThenSaveGivesIdenticalBytesAndGeometry) {
     ASSERT_TRUE(decoded) << decoded.error().message;
     DestructionWorld world(kConfig);
     const std::vector<ObjectPlacement> placements = decoded->placements;
-    ASSERT_TRUE(restoreSnapshot(world, kConfig, std::move(*decoded)));
+    ASSERT_TRUE(restoreSnapshot(world, std::move(*decoded)));
     EXPECT_EQ(world.geometryHash(), m.rig.runtime.world().geometryHash());
     EXPECT_EQ(world.journalPosition(), m.rig.runtime.world().journalPosition());
-    EXPECT_EQ(encodeSnapshot(takeSnapshot(world, kConfig, placements)), bytes);
+    EXPECT_EQ(encodeSnapshot(takeSnapshot(world, placements)), bytes);
 }
 
 TEST(Snapshot, RestoresARuntimeWithTheBodiesOfItsObjects) {
@@ -112,10 +112,12 @@ TEST(Snapshot, SnapshotPlusJournalTailConvergesWithTheHost) {
     m.rig.settle();
     ASSERT_GT(tail.size(), 3u);
     for (int workers : {1, 2}) {
-        DestructionWorld::Config c = kConfig;
+        DestructionWorld::Config
+            c; // another seed and minimum piece volume: the snapshot's settings are adopted
         c.workers = workers;
+        c.deterministic = true;
         DestructionWorld late(c);
-        ASSERT_TRUE(restoreSnapshot(late, c, m.snapshot));
+        ASSERT_TRUE(restoreSnapshot(late, m.snapshot));
         JournalPlayer player(late);
         for (const JournalEvent& e : tail)
             ASSERT_TRUE(player.receive(e));
@@ -129,7 +131,7 @@ TEST(Snapshot, DamagedFilesAreRefusedNamingOffsetAndFieldAndTheWorldStaysAsItWas
     MidFire m;
     const std::vector<std::uint8_t> bytes = encodeSnapshot(m.snapshot);
     DestructionWorld world(kConfig);
-    ASSERT_TRUE(restoreSnapshot(world, kConfig, m.snapshot));
+    ASSERT_TRUE(restoreSnapshot(world, m.snapshot));
     const std::uint64_t before = world.geometryHash();
     auto refused = [&](const std::vector<std::uint8_t>& b, const std::string& expect) {
         Result<Snapshot> r = decodeSnapshot(b.data(), b.size(), "bad.rsnap");
@@ -159,7 +161,8 @@ TEST(Snapshot, DamagedFilesAreRefusedNamingOffsetAndFieldAndTheWorldStaysAsItWas
     refused(b, "offset 0, field magic");
     // Hostile but checksummed: a huge count, an out-of-range vertex index, a NaN.
     b = bytes;
-    const std::size_t objectsCount = 4 + 2 + 2 + 8 + 4 + 8 + 4 + 8;
+    const std::size_t objectsCount =
+        4 + 2 + 2 + 8 + 4 + 8 + 4 + 8 + 8 + 4 + 8; // header, settings, frame, ids
     b[objectsCount + 3] = 0x7F;
     refix(b);
     refused(b, "offset " + std::to_string(objectsCount) + ", field objects.count: count");
@@ -177,19 +180,19 @@ TEST(Snapshot, DamagedFilesAreRefusedNamingOffsetAndFieldAndTheWorldStaysAsItWas
         b[meshAt + 4 + k] = 0xFF; // positions[0].x = NaN
     refix(b);
     refused(b, "offset " + std::to_string(meshAt + 4) + ", field objects[0].mesh.positions.x: is not finite");
-    // A consistent file of another world, and an inconsistent state: refused, the world untouched.
-    DestructionWorld::Config other = kConfig;
-    other.seed = 99;
-    Status s = restoreSnapshot(world, other, m.snapshot);
-    EXPECT_FALSE(s);
-    EXPECT_NE(s.message().find("field seed"), std::string::npos) << s.message();
+    // Inconsistent states: refused, the world untouched.
     Snapshot broken = m.snapshot;
+    broken.world.delayFrames = -1;
+    Status s = restoreSnapshot(world, broken);
+    EXPECT_FALSE(s);
+    EXPECT_NE(s.message().find("settings out of range"), std::string::npos) << s.message();
+    broken = m.snapshot;
     broken.world.work.push_back({12345, 0, true, 0, {Impact{}}, {0}});
-    s = restoreSnapshot(world, kConfig, broken);
+    s = restoreSnapshot(world, broken);
     EXPECT_FALSE(s);
     EXPECT_NE(s.message().find("work on object 12345"), std::string::npos) << s.message();
     EXPECT_EQ(world.geometryHash(), before);
-    EXPECT_EQ(encodeSnapshot(takeSnapshot(world, kConfig, m.snapshot.placements)), bytes);
+    EXPECT_EQ(encodeSnapshot(takeSnapshot(world, m.snapshot.placements)), bytes);
 }
 
 TEST(Snapshot, AProcessKilledMidSaveLeavesThePreviousSnapshot) {
@@ -198,7 +201,7 @@ TEST(Snapshot, AProcessKilledMidSaveLeavesThePreviousSnapshot) {
         MidFire m;
         a = encodeSnapshot(m.snapshot);
         m.rig.play(60);
-        b = encodeSnapshot(takeSnapshot(m.rig.runtime.world(), kConfig, m.rig.runtime.placements()));
+        b = encodeSnapshot(takeSnapshot(m.rig.runtime.world(), m.rig.runtime.placements()));
     } // the worlds' threads are gone before fork()
     ASSERT_NE(a, b);
     ASSERT_GT(a.size(), 100000u) << "large enough that a kill lands inside a write";

@@ -86,7 +86,7 @@ struct NetClient::Impl {
             std::map<ObjectId, Track> fresh;
             for (const ObjectPlacement& p : s->placements)
                 fresh[p.object] = {frame, frame, p.objectToWorld, p.objectToWorld};
-            if (Status st = restoreSnapshot(world, config, std::move(*s)); !st)
+            if (Status st = restoreSnapshot(world, std::move(*s)); !st)
                 return st;
             tracks = std::move(fresh);
             stats.joined = true;

@@ -25,8 +25,8 @@ struct NetHost::Impl {
 
     void join(ENetPeer* peer) {
         std::vector<std::uint8_t> msg{static_cast<std::uint8_t>(Message::Snapshot)};
-        const std::vector<std::uint8_t> bytes = encodeSnapshot(takeSnapshot(
-            world, config, placementSource ? placementSource() : std::vector<ObjectPlacement>{}));
+        const std::vector<std::uint8_t> bytes = encodeSnapshot(
+            takeSnapshot(world, placementSource ? placementSource() : std::vector<ObjectPlacement>{}));
         msg.insert(msg.end(), bytes.begin(), bytes.end());
         if (!detail::sendReliable(peer, msg)) {
             enet_peer_disconnect(peer, 0);
@@ -79,6 +79,10 @@ Result<std::unique_ptr<NetHost>> NetHost::listen(DestructionWorld& world,
     Impl* raw = impl.get();
     world.setJournalSink([raw](const JournalEvent& e) { raw->journal.push_back(e); });
     return std::unique_ptr<NetHost>(new NetHost(std::move(impl)));
+}
+
+void NetHost::journaled(const JournalEvent& event) {
+    impl_->journal.push_back(event);
 }
 
 std::uint16_t NetHost::port() const {

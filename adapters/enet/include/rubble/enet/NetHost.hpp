@@ -43,6 +43,9 @@ public:
     NetHost(const NetHost&) = delete;
     NetHost& operator=(const NetHost&) = delete;
 
+    /// Takes a journal event. listen() makes this the world's journal sink; a game that has its own sink
+    /// forwards the events here instead.
+    void journaled(const JournalEvent& event);
     /// The port it listens on.
     std::uint16_t port() const;
     /// Sends every client the journal events since its last publish and a sync for the world's current
