@@ -52,12 +52,15 @@ enum class BooleanKind {
           ///< redone by Corefine (FractureResult::exactFallback). Same seed, same bytes, like the others.
 };
 
+/// The most cells a Shatter pattern has (FractureParams::cells is clamped to it).
+inline constexpr int kMaxShatterCells = 1000;
+
 /// Parameters of one fracture.
 struct FractureParams {
     CellPattern pattern = CellPattern::SingleCell; ///< single cell (thesis) or shatter pattern
-    int seedPoints = 15;                     ///< random Voronoi sites in the domain besides the impact point
-    int cells = 6;                           ///< K, the number of cells of a Shatter pattern
-    CellSizeLaw sizeLaw;                     ///< domain size from impulse
+    int seedPoints = 15; ///< random Voronoi sites in the domain besides the impact point
+    int cells = 6;       ///< K, the number of cells of a Shatter pattern (1..kMaxShatterCells)
+    CellSizeLaw sizeLaw; ///< domain size from impulse
     BooleanKind backend = BooleanKind::Fast; ///< boolean implementation
     double minPieceVolumeFraction = 1e-9;    ///< pieces below this fraction of the input volume are dropped
                                              ///< (their volume is reported in FractureResult::droppedVolume)
