@@ -32,8 +32,10 @@ public:
             auto r = clipByConvexCells(mesh, used);
             if (!r) {
                 auto exact = makeCorefineBackend()->split(mesh, cells);
-                if (exact)
-                    exact->exactFallback = true;
+                if (!exact)
+                    return makeError(exact.error().code,
+                                     r.error().message + "; the exact redo failed: " + exact.error().message);
+                exact->exactFallback = true;
                 return exact;
             }
             for (std::size_t k = 0; k < index.size(); ++k)

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <span>
 
 #include "BooleanBackends.hpp"
 #include "FracturePipeline.hpp"
@@ -60,8 +61,8 @@ void cutBasis(Vec3 n, Vec3& u, Vec3& v) {
 
 /// Cut faces made by these cells: planar UVs (projection onto the cut plane, scaled by uvScale) and the
 /// plane's normal. Interior faces of earlier fractures (not on a face of these cells, or outside focus) keep
-/// theirs.
-void finishCutFaces(Mesh& m, const std::vector<ConvexPolytope>& cells, double uvScale, const Aabb& focus,
+/// theirs. Only cells whose bounds hold a triangle are searched for its plane.
+void finishCutFaces(Mesh& m, std::span<const ConvexPolytope> cells, double uvScale, const Aabb& focus,
                     double tolerance) {
     if (!m.hasMaterials())
         return;
@@ -77,7 +78,12 @@ void finishCutFaces(Mesh& m, const std::vector<ConvexPolytope>& cells, double uv
         // The cell face the triangle lies on: the plane nearest to its corners with a matching normal.
         const Plane* best = nullptr;
         double bestErr = std::numeric_limits<double>::infinity();
-        for (const ConvexPolytope& cell : cells)
+        Aabb box;
+        for (const Vec3& p : c)
+            box.extend(p);
+        for (const ConvexPolytope& cell : cells) {
+            if (!cell.bounds().overlaps(box, tolerance))
+                continue;
             for (const PolytopeFace& f : cell.faces()) {
                 if (std::abs(dot(f.plane.normal, tn)) < 0.5 * length(tn))
                     continue;
@@ -89,6 +95,7 @@ void finishCutFaces(Mesh& m, const std::vector<ConvexPolytope>& cells, double uv
                     best = &f.plane;
                 }
             }
+        }
         if (!best || bestErr > tolerance)
             continue; // an earlier fracture's face
         Vec3 n = best->normal;
@@ -207,7 +214,8 @@ Result<FractureResult> runPipeline(const Mesh& mesh, std::vector<ConvexPolytope>
     if (!sound)
         return makeError(ErrorCode::GeometryFailure,
                          "fracture: the " + backend.name() +
-                             " backend produced pieces that are not closed or do not conserve volume");
+                             " backend produced pieces that are not closed or do not conserve volume" +
+                             (exactRedo ? ", and so did its exact redo (corefine)" : ""));
     bool hit = false;
     for (const Mesh& m : split->inside)
         hit |= !m.empty();
@@ -226,8 +234,8 @@ Result<FractureResult> runPipeline(const Mesh& mesh, std::vector<ConvexPolytope>
     focus = {focus.lo - grow, focus.hi + grow};
     const double onPlane = 1e-7 * meshBox.diagonal();
     finishCutFaces(split->remainder, cells, params.uvScale, focus, onPlane);
-    for (Mesh& m : split->inside)
-        finishCutFaces(m, cells, params.uvScale, focus, onPlane);
+    for (std::size_t i = 0; i < split->inside.size(); ++i) // a cell's piece is cut by that cell only
+        finishCutFaces(split->inside[i], std::span(cells).subspan(i, 1), params.uvScale, focus, onPlane);
     res.timings.massMs = msSince(t1);
     const double minVolume = std::max(0.0, params.minPieceVolumeFraction) * inputVolume;
     addPieces(std::move(split->remainder), shells[0], -1, minVolume, params.simplifyPieces, focus, res);
