@@ -25,6 +25,7 @@
 #include "rubble/Random.hpp"
 
 using namespace rubble;
+using rubble::test::surfacePoint;
 
 namespace {
 
@@ -50,13 +51,6 @@ std::vector<Shape> stressShapes() {
             shapes.push_back({name, *m});
     }
     return shapes;
-}
-
-// A uniformly distributed point of a random triangle (square-root barycentric sampling).
-Vec3 surfacePoint(const Mesh& m, Rng& rng) {
-    const auto corners = m.corners(static_cast<std::size_t>(rng.below(m.triangleCount())));
-    const double r = std::sqrt(rng.uniform()), s = rng.uniform();
-    return corners[0] * (1 - r) + corners[1] * (r * (1 - s)) + corners[2] * (r * s);
 }
 
 std::uint64_t hashPieces(const FractureResult& r) {
