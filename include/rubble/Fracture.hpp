@@ -49,7 +49,8 @@ enum class BooleanKind {
           ///< detail::clipByConvexCells (src/fracture/ConvexCellClipper.hpp), all cells in one pass as a
           ///< complex (adjacent shatter cells share their faces exactly); when it
           ///< declines a near-degenerate configuration, or its split fails verification, the whole split is
-          ///< redone by Corefine (FractureResult::exactFallback). Same seed, same bytes, like the others.
+          ///< redone by Corefine (FractureResult::exactFallback). fracture() first redraws a declined
+          ///< pattern up to twice (FractureResult::redraws). Same seed, same bytes, like the others.
 };
 
 /// The most cells a Shatter pattern has (FractureParams::cells is clamped to it).
@@ -95,7 +96,9 @@ struct FractureResult {
     double inputVolume = 0;            ///< volume of the input mesh
     double droppedVolume = 0;          ///< volume of pieces dropped as too small
     bool exactFallback = false;        ///< Fast declined or failed verification; Corefine made the split
-    FractureTimings timings;           ///< stage durations
+    int redraws = 0; ///< fracture() with Fast: cell patterns redrawn (from derived seeds) because the clipper
+                     ///< declined a near-degenerate one; 0 = the seed's own pattern
+    FractureTimings timings; ///< stage durations
 };
 
 /// Builds the cutting cells for an impact on a mesh with the given bounds. Deterministic in seed.

@@ -4,12 +4,15 @@
 // randomly about it. Everything is a pure function of the inputs and the seed.
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <numbers>
 
 #include <CGAL/Delaunay_triangulation_3.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Exact_rational.h>
+#include <CGAL/Simple_cartesian.h>
 #include <CGAL/Triangulation_vertex_base_with_info_3.h>
 #include <voro++/voro++.hh>
 
@@ -129,15 +132,27 @@ using Delaunay = CGAL::Delaunay_triangulation_3<
     Kernel,
     CGAL::Triangulation_data_structure_3<VertexBase, CGAL::Delaunay_triangulation_cell_base_3<Kernel>>>;
 
+/// A tetrahedron's circumcentre, computed exactly and rounded: a flat tetrahedron (nearly cospherical sites)
+/// makes the floating-point formula lose up to half its digits, and the Voronoi faces around it would bend.
+Vec3 circumcentre(const Delaunay::Cell& tet) {
+    using Exact = CGAL::Simple_cartesian<CGAL::Exact_rational>;
+    std::array<Exact::Point_3, 4> p;
+    for (int i = 0; i < 4; ++i) {
+        const Kernel::Point_3& q = tet.vertex(i)->point();
+        p[static_cast<std::size_t>(i)] = Exact::Point_3(q.x(), q.y(), q.z());
+    }
+    const Exact::Point_3 c = CGAL::circumcenter(p[0], p[1], p[2], p[3]);
+    return {CGAL::to_double(c.x()), CGAL::to_double(c.y()), CGAL::to_double(c.z())};
+}
+
 /// The Voronoi cells of sites[wanted[i]] (local coordinates) as one complex: the dual of the Delaunay
 /// triangulation of the sites and 26 ghost sites (ids -1 .. -26) at 2h{-1,0,1}^3 that bound every cell (the
 /// cell of the origin among the ghosts alone is the cube [-h, h]^3). Every Voronoi vertex is the circumcentre
-/// of one tetrahedron, computed once and shared by all cells around it; Voronoi edges shorter than `collapse`
-/// are contracted in every cell alike. Vertices are mapped to world coordinates by p -> impact + rotation *
-/// (scale * p). A duplicated site gets an empty cell.
+/// of one tetrahedron, computed once (exactly, then rounded) and shared by all cells around it; edges whose
+/// ends round to the same point are contracted in every cell alike. Vertices are mapped to world coordinates
+/// by p -> impact + rotation * (scale * p). A duplicated site gets an empty cell.
 std::vector<RawCell> voronoiComplex(const std::vector<Vec3>& sites, const std::vector<std::size_t>& wanted,
-                                    double h, const Mat3& rotation, double scale, const Vec3& impact,
-                                    double collapse) {
+                                    double h, const Mat3& rotation, double scale, const Vec3& impact) {
     std::vector<std::pair<Kernel::Point_3, int>> points;
     for (std::size_t i = 0; i < sites.size(); ++i)
         points.emplace_back(Kernel::Point_3(sites[i].x, sites[i].y, sites[i].z), static_cast<int>(i));
@@ -171,10 +186,8 @@ std::vector<RawCell> voronoiComplex(const std::vector<Vec3>& sites, const std::v
             auto around = dt.incident_cells(e), start = around;
             do {
                 auto [it, inserted] = vertexOf.emplace(around, positions.size());
-                if (inserted) {
-                    const Kernel::Point_3 c = dt.dual(around);
-                    positions.push_back(impact + rotation * (Vec3{c.x(), c.y(), c.z()} * scale));
-                }
+                if (inserted)
+                    positions.push_back(impact + rotation * (circumcentre(*around) * scale));
                 loop.push_back(it->second);
             } while (++around != start);
             byNeighbour.emplace_back(other->info(), std::move(loop));
@@ -186,7 +199,7 @@ std::vector<RawCell> voronoiComplex(const std::vector<Vec3>& sites, const std::v
             faces[w].push_back(std::move(loop));
     }
 
-    // Contract short Voronoi edges, the same way in every cell.
+    // Contract the Voronoi edges of zero length (cospherical sites), the same way in every cell.
     std::vector<std::size_t> parent(positions.size());
     for (std::size_t i = 0; i < parent.size(); ++i)
         parent[i] = i;
@@ -199,7 +212,7 @@ std::vector<RawCell> voronoiComplex(const std::vector<Vec3>& sites, const std::v
         for (const auto& loop : cell)
             for (std::size_t i = 0; i < loop.size(); ++i) {
                 const std::size_t a = loop[i], b = loop[(i + 1) % loop.size()];
-                if (length(positions[a] - positions[b]) < collapse) {
+                if (positions[a] == positions[b]) {
                     const std::size_t ra = find(a), rb = find(b);
                     parent[std::max(ra, rb)] = std::min(ra, rb);
                 }
@@ -268,8 +281,7 @@ std::vector<ConvexPolytope> generateCells(const Aabb& meshBounds, const Impact& 
     });
     std::vector<std::size_t> wanted(order.begin(),
                                     order.begin() + std::min<std::ptrdiff_t>(k, std::ssize(order)));
-    std::vector<RawCell> raws =
-        voronoiComplex(sites, wanted, h, rotation, scale, impact.point, 1e-8 * h * scale);
+    std::vector<RawCell> raws = voronoiComplex(sites, wanted, h, rotation, scale, impact.point);
     for (const RawCell& r : raws) {
         ConvexPolytope p = toPolytope(r);
         if (!p.empty())

@@ -12,6 +12,7 @@
 #include "rubble/Fracture.hpp"
 #include "rubble/Islands.hpp"
 #include "rubble/MeshSimplify.hpp"
+#include "rubble/Random.hpp"
 
 namespace rubble {
 
@@ -285,19 +286,41 @@ Result<FractureResult> fracture(const Mesh& mesh, const Impact& impact, const Fr
     if (!isFinite(impact.point) || !std::isfinite(impact.impulse))
         return makeError(ErrorCode::InvalidInput, "fracture: the impact point or impulse is not finite");
     const double validateMs = msSince(t0);
-    const auto tc = Clock::now();
-    std::vector<ConvexPolytope> cells = generateCells(mesh.bounds(), impact, params, seed);
-    const double cellMs = msSince(tc);
+    double cellMs = 0;
+    auto cellsFor = [&](std::uint64_t s) {
+        const auto tc = Clock::now();
+        std::vector<ConvexPolytope> cells = generateCells(mesh.bounds(), impact, params, s);
+        cellMs += msSince(tc);
+        return cells;
+    };
+    auto finish = [&](Result<FractureResult> r, int redraws) {
+        if (r) {
+            r->redraws = redraws;
+            r->timings.validateMs = validateMs;
+            r->timings.cellMs = cellMs;
+            r->timings.totalMs = msSince(t0);
+        }
+        return r;
+    };
+    // The pattern is random: one the clipper declines as near-degenerate is redrawn (from derived seeds)
+    // before the exact fallback cuts the seed's own pattern.
+    constexpr int kRedraws = 2;
+    if (params.backend == BooleanKind::Fast)
+        for (int redraw = 0; redraw <= kRedraws; ++redraw) {
+            std::vector<ConvexPolytope> cells = cellsFor(redraw == 0 ? seed : mixSeed(seed, 0xDA7A + redraw));
+            if (cells.empty())
+                break;
+            auto r =
+                runPipeline(mesh, std::move(cells), params, *detail::makeFastBackend(false), false, volume);
+            if (r || r.error().code != ErrorCode::GeometryFailure)
+                return finish(std::move(r), redraw);
+        }
+    std::vector<ConvexPolytope> cells = cellsFor(seed);
     if (cells.empty())
         return makeError(ErrorCode::NoIntersection, "fracture: no cell could be built around the impact");
-    auto r = runPipeline(mesh, std::move(cells), params, *makeBooleanBackend(params.backend),
-                         params.backend == BooleanKind::Fast, volume);
-    if (!r)
-        return r;
-    r->timings.validateMs = validateMs;
-    r->timings.cellMs = cellMs;
-    r->timings.totalMs = msSince(t0);
-    return r;
+    return finish(runPipeline(mesh, std::move(cells), params, *makeBooleanBackend(params.backend),
+                              params.backend == BooleanKind::Fast, volume),
+                  0);
 }
 
 } // namespace rubble

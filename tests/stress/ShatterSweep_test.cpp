@@ -49,7 +49,7 @@ int sweepCount(int ciDefault) {
 }
 
 struct Sweep {
-    int shatters = 0, failures = 0, fallbacks = 0, pieces = 0;
+    int shatters = 0, failures = 0, redraws = 0, fallbacks = 0, pieces = 0;
     double worstVolumeError = 0;
 };
 
@@ -80,6 +80,7 @@ Sweep runSweep(BooleanKind backend, int count, std::uint64_t seed) {
             continue;
         }
         s.fallbacks += r->exactFallback;
+        s.redraws += r->redraws;
         const double v0 = signedVolume(shape.mesh);
         double sum = r->droppedVolume;
         for (const Piece& p : r->pieces) {
@@ -92,8 +93,9 @@ Sweep runSweep(BooleanKind backend, int count, std::uint64_t seed) {
         s.worstVolumeError = std::max(s.worstVolumeError, err);
         EXPECT_LT(err, 1e-7) << what;
     }
-    std::printf("%d shatters, %d failed, %d exact fallbacks, %d pieces, worst relative volume error %.3g\n",
-                s.shatters, s.failures, s.fallbacks, s.pieces, s.worstVolumeError);
+    std::printf("%d shatters, %d failed, %d patterns redrawn, %d exact fallbacks, %d pieces, worst relative "
+                "volume error %.3g\n",
+                s.shatters, s.failures, s.redraws, s.fallbacks, s.pieces, s.worstVolumeError);
     return s;
 }
 

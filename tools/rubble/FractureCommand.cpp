@@ -431,7 +431,7 @@ const rubble::tools::Registrar registrar{
              ->capture_default_str();
          app.add_option("--cells", args->cells,
                         "1: the thesis's single Voronoi cell; K > 1: shatter into K cells")
-             ->check(CLI::Range(1, 1000))
+             ->check(CLI::Range(1, rubble::kMaxShatterCells))
              ->capture_default_str();
          app.add_option("--seed", args->seed, "random seed (same seed, same pieces, byte for byte)")
              ->capture_default_str();
