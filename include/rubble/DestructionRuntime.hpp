@@ -95,10 +95,14 @@ struct SupportPolicy {
 /// moving body that carries an object may be frozen, but only pieces are ever retired (the game's own objects
 /// leave only by falling out of the world).
 struct DebrisBudget {
-    int maxAwakeBodies = 400;           ///< dynamic debris bodies; beyond it the slowest freeze, then the
-                                        ///< smallest become particles
-    double physicsBudgetMs = 8;         ///< physics step time to hold; above it the awake budget shrinks
-                                        ///< (ignored in deterministic mode, where time must not matter)
+    int maxAwakeBodies = 400;   ///< dynamic debris bodies; beyond it the slowest settling pieces
+                                ///< (below settlingSpeed) freeze, then the smallest become particles
+    double settlingSpeed = 1.0; ///< m/s (and rad/s): a piece this slow for 10 frames in a row may be frozen
+                                ///< to hold the awake budget
+    int awakeOvershoot = 16;    ///< pieces beyond maxAwakeBodies that may stay awake while they settle (new
+                                ///< pieces get 10 frames, slow ones until they freeze); beyond it, hard
+    double physicsBudgetMs = 8; ///< physics step time to hold; above it the awake budget shrinks
+                                ///< (ignored in deterministic mode, where time must not matter)
     std::size_t maxTriangles = 4000000; ///< triangles of all debris bodies (dynamic and frozen); beyond it
                                         ///< the smallest frozen pieces become particles
     bool freezeSleeping = true;         ///< a debris body the engine put to sleep is frozen (made static)

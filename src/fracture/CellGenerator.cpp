@@ -263,7 +263,8 @@ std::vector<ConvexPolytope> generateCells(const Aabb& meshBounds, const Impact& 
         return out;
     }
 
-    // Shatter: sites concentrated at the impact (radius ~ u^2), the K sites nearest the impact cut.
+    // Shatter: sites denser near the impact (radius ~ sqrt(u): density ~ 1/r), the K sites nearest the impact
+    // cut.
     const double scale = rng.uniform(0.8, 1.25);
     const double h = size / 2;
     const int k = std::clamp(params.cells, 1, kMaxShatterCells);
@@ -271,7 +272,7 @@ std::vector<ConvexPolytope> generateCells(const Aabb& meshBounds, const Impact& 
     std::vector<Vec3> sites{{0, 0, 0}};
     for (int i = 0; i < n; ++i) {
         const double u = rng.uniform();
-        sites.push_back(rng.unitVector() * (h * 0.98 * u * u));
+        sites.push_back(rng.unitVector() * (h * 0.98 * std::sqrt(u)));
     }
     std::vector<std::size_t> order(sites.size());
     for (std::size_t i = 0; i < order.size(); ++i)
