@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "../fuzz/FuzzChecks.hpp"
+#include "RepositoryModels.hpp"
 #include "TestSupport.hpp"
 #include "rubble/Fracture.hpp"
 #include "rubble/MassProperties.hpp"
@@ -29,10 +30,7 @@ using rubble::test::surfacePoint;
 
 namespace {
 
-struct Shape {
-    std::string name;
-    Mesh mesh;
-};
+using Shape = test::NamedMesh;
 
 std::vector<Shape> stressShapes() {
     Mesh twoParts = makeSubdividedBox({-1, -1, -1}, {0, 1, 1}, 2);
@@ -43,13 +41,8 @@ std::vector<Shape> stressShapes() {
                               {"plate", makeSubdividedBox({-1, -0.02, -1}, {1, 0.02, 1}, 2)},
                               {"sphere", makeSphere({0, 0, 0}, 1, 16, 8)},
                               {"twoparts", twoParts}};
-    for (const char* name : {"arch", "building", "column", "cube_588", "fighter", "missile", "projectile",
-                             "pyramid", "ship", "wall"}) {
-        auto m = readObj(test::sourceDir() / "assets" / "models" / (std::string(name) + ".obj"));
-        EXPECT_TRUE(m.isOk()) << name << ": " << (m ? "" : m.error().message);
-        if (m)
-            shapes.push_back({name, *m});
-    }
+    test::appendRepositoryModels(shapes, {"arch", "building", "column", "cube_588", "fighter", "missile",
+                                          "projectile", "pyramid", "ship", "wall"});
     return shapes;
 }
 

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "RepositoryModels.hpp"
 #include "TestSupport.hpp"
 #include "rubble/Fracture.hpp"
 #include "rubble/MassProperties.hpp"
@@ -23,22 +24,15 @@ using rubble::test::surfacePoint;
 
 namespace {
 
-struct Shape {
-    std::string name;
-    Mesh mesh;
-};
+using Shape = test::NamedMesh;
 
 std::vector<Shape> sweepShapes() {
     std::vector<Shape> shapes{{"box1", makeSubdividedBox({0, 0, 0}, {1, 1, 1}, 1)},
                               {"box4", makeSubdividedBox({0, 0, 0}, {1, 1, 1}, 4)},
                               {"box16", makeSubdividedBox({-1, -1, -1}, {1, 1, 1}, 16)}};
-    for (const char* name : {"arch", "building", "column", "cube_588", "facade_x_window", "fighter",
-                             "missile", "pillar", "projectile", "pyramid", "ship", "slab", "wall"}) {
-        auto m = readObj(test::sourceDir() / "assets" / "models" / (std::string(name) + ".obj"));
-        EXPECT_TRUE(m.isOk()) << name;
-        if (m)
-            shapes.push_back({name, std::move(*m)});
-    }
+    test::appendRepositoryModels(shapes,
+                                 {"arch", "building", "column", "cube_588", "facade_x_window", "fighter",
+                                  "missile", "pillar", "projectile", "pyramid", "ship", "slab", "wall"});
     return shapes;
 }
 
