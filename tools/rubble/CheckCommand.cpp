@@ -16,6 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "JsonText.hpp"
 #include "Subcommand.hpp"
 #include "rubble/MeshCheck.hpp"
 #include "rubble/MeshIO.hpp"
@@ -86,7 +87,7 @@ void printProblems(std::ostream& out, const std::vector<std::string>& problems, 
 
 nlohmann::json jsonOf(const std::string& file, const rubble::MeshReport& r) {
     nlohmann::json j;
-    j["file"] = file;
+    j["file"] = rubble::tools::utf8Escaped(file);
     j["vertices"] = r.vertices;
     j["triangles"] = r.triangles;
     j["closed"] = r.closed;
@@ -149,7 +150,8 @@ int runCheck(const CheckArgs& args) {
         if (!mesh) {
             std::cerr << "rubble check: " << mesh.error().message << "\n";
             if (args.json)
-                doc["meshes"].push_back({{"file", file}, {"error", mesh.error().message}});
+                doc["meshes"].push_back({{"file", rubble::tools::utf8Escaped(file)},
+                                         {"error", rubble::tools::utf8Escaped(mesh.error().message)}});
             exitCode = 2;
             continue;
         }
@@ -200,7 +202,7 @@ int runCheck(const CheckArgs& args) {
             exitCode = std::max(exitCode, 1);
     }
     if (args.json)
-        std::cout << doc.dump() << "\n";
+        std::cout << rubble::tools::dumpJson(doc) << "\n";
     return exitCode;
 }
 

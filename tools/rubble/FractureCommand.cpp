@@ -34,6 +34,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "JsonText.hpp"
 #include "Subcommand.hpp"
 #include "rubble/ConvexDecomposition.hpp"
 #include "rubble/Fracture.hpp"
@@ -164,7 +165,7 @@ void runJob(MeshJob& job, const rubble::Impact& impact, const rubble::FracturePa
 nlohmann::json jsonOf(const MeshJob& job, bool withFile) {
     nlohmann::json j;
     if (withFile)
-        j["file"] = job.file;
+        j["file"] = rubble::tools::utf8Escaped(job.file);
     j["input"] = {
         {"volume", job.inputVolume}, {"triangles", job.input.triangleCount()}, {"closed", job.inputClosed}};
     j["pieces"] = nlohmann::json::array();
@@ -183,7 +184,7 @@ nlohmann::json jsonOf(const MeshJob& job, bool withFile) {
                        {"decomposition", job.decompositionMs},
                        {"total", job.timings.totalMs + job.decompositionMs}};
     if (job.outcome == Outcome::Failed)
-        j["error"] = job.message;
+        j["error"] = rubble::tools::utf8Escaped(job.message);
     return j;
 }
 
@@ -394,7 +395,7 @@ int runFracture(const FractureArgs& args) {
         } else {
             doc = jsonOf(jobs[0], false);
         }
-        std::cout << doc.dump() << "\n";
+        std::cout << rubble::tools::dumpJson(doc) << "\n";
     }
     return code;
 }

