@@ -75,7 +75,8 @@ Status writeGltf(const std::filesystem::path& path, const std::vector<GltfNode>&
 /// Reads a mesh by extension: .obj with readObj; .off, .stl, .ply, .3ds, .gltf and .glb through Assimp
 /// (triangulated, positions welded exactly, node transforms applied). Size claims in headers (binary STL
 /// triangle count, PLY element counts, OFF counts, 3DS chunk lengths, glTF buffer/accessor lengths) are
-/// checked against the file before Assimp sees it. Errors: Unsupported for other extensions, IoError,
+/// checked against the file before Assimp sees it, and so are glTF's JSON depth and node hierarchy (at most
+/// 256 and 1024 levels; nodes must form trees). Errors: Unsupported for other extensions, IoError,
 /// ParseError; every message names the file.
 Result<Mesh> readMesh(const std::filesystem::path& path);
 

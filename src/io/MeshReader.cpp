@@ -306,9 +306,93 @@ long double base64Bytes(const std::string& uri) {
     return static_cast<long double>(n / 4 * 3) - static_cast<long double>(pad);
 }
 
+// Assimp's glTF parser and importer recurse once per JSON level and once per node level: deep files crash
+// them.
+constexpr std::size_t kMaxGltfJsonDepth = 256;
+constexpr std::size_t kMaxGltfNodeDepth = 1024;
+
+// The JSON's nesting depth stays within kMaxGltfJsonDepth (scanned before any parser sees the text).
+Status guardJsonDepth(std::string_view text, const std::string& name) {
+    std::size_t depth = 0;
+    bool inString = false;
+    for (std::size_t i = 0; i < text.size(); ++i) {
+        const char c = text[i];
+        if (inString) {
+            if (c == '\\')
+                ++i;
+            else if (c == '"')
+                inString = false;
+        } else if (c == '"') {
+            inString = true;
+        } else if (c == '[' || c == '{') {
+            if (++depth > kMaxGltfJsonDepth)
+                return parseError(name, "its JSON is nested more than " + std::to_string(kMaxGltfJsonDepth) +
+                                            " levels deep (at byte " + std::to_string(i) + ")");
+        } else if ((c == ']' || c == '}') && depth > 0) {
+            --depth;
+        }
+    }
+    return {};
+}
+
+// Node children are valid indices, every node has at most one parent, there is no cycle, and the hierarchy
+// is at most kMaxGltfNodeDepth deep (glTF's nodes form disjoint strict trees).
+Status guardGltfNodes(const nlohmann::json& j, const std::string& name) {
+    if (!j.contains("nodes") || !j["nodes"].is_array())
+        return {};
+    const nlohmann::json& nodes = j["nodes"];
+    const std::size_t n = nodes.size();
+    std::vector<std::size_t> parent(n, SIZE_MAX);
+    for (std::size_t i = 0; i < n; ++i) {
+        if (!nodes[i].is_object() || !nodes[i].contains("children"))
+            continue;
+        const nlohmann::json& children = nodes[i]["children"];
+        if (!children.is_array())
+            return parseError(name, "node " + std::to_string(i) + ": 'children' is not an array");
+        for (const nlohmann::json& c : children) {
+            if (!c.is_number_unsigned())
+                return parseError(name,
+                                  "node " + std::to_string(i) + " has a child that is not a node index");
+            if (c.get<std::uint64_t>() >= n)
+                return parseError(name, "node " + std::to_string(i) + " has child " +
+                                            std::to_string(c.get<std::uint64_t>()) + " but there are only " +
+                                            std::to_string(n) + " nodes");
+            const auto k = c.get<std::size_t>();
+            if (parent[k] != SIZE_MAX || k == i)
+                return parseError(name, "node " + std::to_string(k) +
+                                            " has more than one parent (glTF nodes form trees)");
+            parent[k] = i;
+        }
+    }
+    // Depth of every node by walking up to its root (memoised); a walk longer than n is a cycle.
+    std::vector<std::size_t> depth(n, 0);
+    std::vector<std::size_t> path;
+    for (std::size_t i = 0; i < n; ++i) {
+        path.clear();
+        std::size_t k = i;
+        while (k != SIZE_MAX && depth[k] == 0) {
+            path.push_back(k);
+            if (path.size() > n)
+                return parseError(name, "node " + std::to_string(i) + " is its own ancestor (a cycle)");
+            k = parent[k];
+        }
+        std::size_t d = k == SIZE_MAX ? 0 : depth[k];
+        for (auto it = path.rbegin(); it != path.rend(); ++it) {
+            depth[*it] = ++d;
+            if (d > kMaxGltfNodeDepth)
+                return parseError(name, "the node hierarchy is more than " +
+                                            std::to_string(kMaxGltfNodeDepth) + " levels deep (node " +
+                                            std::to_string(*it) + ")");
+        }
+    }
+    return {};
+}
+
 Status guardGltfJson(const nlohmann::json& j, const std::filesystem::path& path, const std::string& name,
                      long double glbBinBytes) {
     using nlohmann::json;
+    if (Status s = guardGltfNodes(j, name); !s)
+        return s;
     auto count = [](const json& v, const char* key) -> long double {
         const auto it = v.find(key);
         if (it == v.end() || !it->is_number())
@@ -418,6 +502,8 @@ Status guardGltf(const std::string& b, const std::filesystem::path& path, const 
     } else {
         jsonText = b;
     }
+    if (Status s = guardJsonDepth(jsonText, name); !s)
+        return s;
     const nlohmann::json j = nlohmann::json::parse(jsonText, nullptr, false);
     if (j.is_discarded() || !j.is_object())
         return parseError(name, "not a glTF file (its JSON is malformed)");

@@ -283,3 +283,61 @@ TEST(MeshReader, BinaryStlWithTrailingBytesAndAsciiStl) {
     test::writeFile(dir / "ascii.stl", ascii);
     expectValidTetra(readMesh(dir / "ascii.stl"));
 }
+
+namespace {
+// The tetra glTF with its single node replaced by `nodes` and `extras` added to the top level.
+std::string gltfWithNodes(const std::string& nodes, const std::string& extras = "0") {
+    const std::string entry =
+        R"({"byteLength":72,"uri":"data:application/octet-stream;base64,)" + base64(tetraBuffer()) + R"("})";
+    std::string json = gltfJson(entry);
+    const std::string single = R"("nodes":[{"mesh":0}])";
+    json.replace(json.find(single), single.size(), R"("nodes":)" + nodes);
+    return R"({"extras":)" + extras + "," + json.substr(1);
+}
+
+// A chain of `depth` nodes, each the only child of the one before; the last holds the mesh.
+std::string nodeChain(std::size_t depth) {
+    std::string nodes = "[";
+    for (std::size_t i = 0; i + 1 < depth; ++i)
+        nodes += R"({"children":[)" + std::to_string(i + 1) + "]},";
+    return nodes + R"({"mesh":0}])";
+}
+} // namespace
+
+TEST(MeshReader, DeepGltfNestingIsRefusedBeforeAssimp) {
+    // Assimp recursed once per level and crashed (SIGSEGV) on both of these.
+    const auto dir = test::tempDir("MeshReader_deep_gltf");
+    test::writeFile(dir / "chain.gltf", gltfWithNodes(nodeChain(20000)));
+    Error e = errorOf(dir / "chain.gltf");
+    EXPECT_EQ(e.code, ErrorCode::ParseError);
+    EXPECT_EQ(e.message, (dir / "chain.gltf").string() +
+                             ": the node hierarchy is more than 1024 levels deep (node 1024)");
+    const std::size_t deep = 1000000;
+    test::writeFile(dir / "extras.gltf",
+                    gltfWithNodes(nodeChain(1), std::string(deep, '[') + std::string(deep, ']')));
+    e = errorOf(dir / "extras.gltf");
+    EXPECT_NE(e.message.find("extras.gltf: its JSON is nested more than 256 levels deep (at byte 265)"),
+              std::string::npos)
+        << e.message;
+    // Brackets inside strings do not count.
+    test::writeFile(dir / "strings.gltf",
+                    gltfWithNodes(nodeChain(1), "\"" + std::string(1000, '[') + "\\\"\""));
+    expectValidTetra(readMesh(dir / "strings.gltf"));
+    // Up to the limits the files are read (the node transforms are identities).
+    test::writeFile(dir / "chain1024.gltf", gltfWithNodes(nodeChain(1024)));
+    expectValidTetra(readMesh(dir / "chain1024.gltf"));
+    test::writeFile(dir / "extras250.gltf",
+                    gltfWithNodes(nodeChain(1), std::string(250, '[') + std::string(250, ']')));
+    expectValidTetra(readMesh(dir / "extras250.gltf"));
+    // Cycles, shared children and children out of range (glTF nodes form disjoint trees).
+    test::writeFile(dir / "cycle.gltf", gltfWithNodes(R"([{"mesh":0,"children":[1]},{"children":[0]}])"));
+    EXPECT_NE(errorOf(dir / "cycle.gltf").message.find("is its own ancestor (a cycle)"), std::string::npos);
+    test::writeFile(dir / "self.gltf", gltfWithNodes(R"([{"mesh":0,"children":[0]}])"));
+    EXPECT_NE(errorOf(dir / "self.gltf").message.find("node 0 has more than one parent"), std::string::npos);
+    test::writeFile(dir / "shared.gltf", gltfWithNodes(R"([{"children":[2]},{"children":[2]},{"mesh":0}])"));
+    EXPECT_NE(errorOf(dir / "shared.gltf").message.find("node 2 has more than one parent"),
+              std::string::npos);
+    test::writeFile(dir / "range.gltf", gltfWithNodes(R"([{"mesh":0,"children":[7]}])"));
+    EXPECT_NE(errorOf(dir / "range.gltf").message.find("node 0 has child 7 but there are only 1 nodes"),
+              std::string::npos);
+}
