@@ -1,6 +1,7 @@
 #pragma once
 // Private helpers of the io module: reading a whole file with a clear error.
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
 
@@ -8,8 +9,14 @@
 
 namespace rubble::io {
 
-/// The whole content of a file, or an IoError naming it ("<file>: cannot open: <reason>").
-Result<std::string> readFileBytes(const std::filesystem::path& path);
+/// Largest file the readers accept (2 GiB): far above any mesh Rubble fractures, and a clear error instead of
+/// running out of memory.
+inline constexpr std::uint64_t kMaxFileBytes = std::uint64_t{1} << 31;
+
+/// The whole content of a regular file of at most maxBytes, or an IoError naming it ("<file>: cannot open:
+/// <reason>", "<file>: cannot read: it is a FIFO, not a regular file", "<file>: the file has N bytes, more
+/// than the limit of M bytes"). Devices, FIFOs and sockets are refused without being opened.
+Result<std::string> readFileBytes(const std::filesystem::path& path, std::uint64_t maxBytes = kMaxFileBytes);
 
 /// The name used for a path in messages (the path as given).
 std::string displayName(const std::filesystem::path& path);

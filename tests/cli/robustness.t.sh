@@ -34,4 +34,12 @@ json_ok "$tmp/f1.json" "len(d['pieces']) >= 2" || fail "fracture JSON: $(cat "$t
 json_ok "$tmp/f2.json" "d['results'][0]['file'].endswith('cube_\\\\xE9.obj') and len(d['results']) == 2" \
     || fail "batch JSON: $(cat "$tmp/f2.json")"
 
+# --- Regular files only -----------------------------------------------------------------------------------------
+ln -s /dev/zero "$tmp/zero.obj"
+mkfifo "$tmp/pipe.obj"
+run "$tmp/z.json" timeout 20 "$RUBBLE" check --json "$tmp/zero.obj" "$tmp/pipe.obj"
+[ "$c" -eq 2 ] || fail "/dev/zero and a FIFO: exit $c, expected 2: $(cat "$tmp/z.json.err")"
+json_ok "$tmp/z.json" "'character device, not a regular file' in d['meshes'][0]['error'] and \
+    'a FIFO, not a regular file' in d['meshes'][1]['error']" || fail "special files: $(cat "$tmp/z.json")"
+
 exit 0

@@ -4,6 +4,8 @@
 #include <fstream>
 #include <iterator>
 
+#include <sys/stat.h>
+
 #include "TestSupport.hpp"
 #include "rubble/MeshCheck.hpp"
 #include "rubble/MeshIO.hpp"
@@ -340,4 +342,26 @@ TEST(MeshReader, DeepGltfNestingIsRefusedBeforeAssimp) {
     test::writeFile(dir / "range.gltf", gltfWithNodes(R"([{"mesh":0,"children":[7]}])"));
     EXPECT_NE(errorOf(dir / "range.gltf").message.find("node 0 has child 7 but there are only 1 nodes"),
               std::string::npos);
+}
+
+TEST(MeshReader, OnlyRegularFilesOfBoundedSizeAreRead) {
+    // /dev/zero behind a mesh name was read until memory ran out, and a FIFO blocked forever.
+    const auto dir = test::tempDir("MeshReader_special");
+    std::filesystem::create_symlink("/dev/zero", dir / "zero.obj");
+    Error e = errorOf(dir / "zero.obj");
+    EXPECT_EQ(e.code, ErrorCode::IoError);
+    EXPECT_EQ(e.message,
+              (dir / "zero.obj").string() + ": cannot read: it is a character device, not a regular file");
+    ASSERT_EQ(::mkfifo((dir / "pipe.stl").c_str(), 0600), 0);
+    e = errorOf(dir / "pipe.stl"); // returns at once: the FIFO is never opened
+    EXPECT_EQ(e.message, (dir / "pipe.stl").string() + ": cannot read: it is a FIFO, not a regular file");
+    // A (sparse) file one byte over the 2 GiB limit.
+    { std::ofstream big(dir / "big.off"); }
+    std::filesystem::resize_file(dir / "big.off", (std::uint64_t{1} << 31) + 1);
+    e = errorOf(dir / "big.off");
+    EXPECT_EQ(e.message, (dir / "big.off").string() +
+                             ": the file has 2147483649 bytes, more than the limit of 2147483648 bytes");
+    // Symbolic links to regular files are fine.
+    std::filesystem::create_symlink(kData / "tetra.stl", dir / "link.stl");
+    expectValidTetra(readMesh(dir / "link.stl"));
 }
