@@ -44,6 +44,14 @@ Result<Mesh> parseObj(std::string_view text, const std::string& displayName);
 /// Parses OBJ text keeping objects apart (see NamedMesh); objects without faces are dropped.
 Result<std::vector<NamedMesh>> parseObjObjects(std::string_view text, const std::string& displayName);
 
+/// Parses OFF text (Rubble's own reader: numbers exact to the double, polygons of any size triangulated as in
+/// parseObj, `#` comments anywhere). The header [ST][C][N][4][n]OFF is followed by the vertex, face and
+/// (ignored) edge counts; each vertex is one line `x y z` (`x y z w` for 4OFF, divided by w), each face one
+/// line `n i1 ... in` with 0-based indices; anything after the numbers a line needs (normals, colours) is
+/// ignored. The declared counts must match the file. Unreferenced vertices are dropped. Errors (ParseError,
+/// Unsupported for binary OFF and dimensions other than 3) name displayName and the line.
+Result<Mesh> parseOff(std::string_view text, const std::string& displayName);
+
 /// Reads an OBJ file into one mesh (see parseObj). Errors: IoError when the file cannot be read, ParseError
 /// naming file and line when it is malformed or has no triangles.
 Result<Mesh> readObj(const std::filesystem::path& path);
@@ -72,12 +80,12 @@ struct GltfNode {
 /// InvalidInput for an empty or invalid mesh, IoError naming the file.
 Status writeGltf(const std::filesystem::path& path, const std::vector<GltfNode>& nodes);
 
-/// Reads a mesh by extension: .obj with readObj; .off, .stl, .ply, .3ds, .gltf and .glb through Assimp
-/// (triangulated, positions welded exactly, node transforms applied). Size claims in headers (binary STL
-/// triangle count, PLY element counts, OFF counts, 3DS chunk lengths, glTF buffer/accessor lengths) are
-/// checked against the file before Assimp sees it, and so are glTF's JSON depth and node hierarchy (at most
-/// 256 and 1024 levels; nodes must form trees). Errors: Unsupported for other extensions, IoError,
-/// ParseError; every message names the file.
+/// Reads a mesh by extension: .obj with readObj and .off with parseOff (exact doubles); .stl, .ply, .3ds,
+/// .gltf and .glb through Assimp (single precision; triangulated, positions welded exactly, node transforms
+/// applied). Size claims in headers (binary STL triangle count, PLY element counts, OFF counts, 3DS chunk
+/// lengths, glTF buffer/accessor lengths) are checked against the file before Assimp sees it, and so are
+/// glTF's JSON depth and node hierarchy (at most 256 and 1024 levels; nodes must form trees). Errors:
+/// Unsupported for other extensions, IoError, ParseError; every message names the file.
 Result<Mesh> readMesh(const std::filesystem::path& path);
 
 /// The extensions readMesh accepts, lower case with the dot (".obj", ".stl", ...).

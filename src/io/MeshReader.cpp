@@ -1,5 +1,5 @@
-// readMesh: OBJ through Rubble's reader, other formats through Assimp after checking size claims in their
-// headers (Assimp trusts them and may try to allocate what a broken or hostile file claims).
+// readMesh: OBJ and OFF through Rubble's readers, other formats through Assimp after checking size claims in
+// their headers (Assimp trusts them and may try to allocate what a broken or hostile file claims).
 #include <algorithm>
 #include <array>
 #include <cctype>
@@ -48,11 +48,19 @@ Error parseError(const std::string& name, const std::string& message) {
     return makeError(ErrorCode::ParseError, name + ": " + message);
 }
 
+// The face count a header declares, compared with what Assimp read (where: "file:line" or "file").
+struct DeclaredFaces {
+    std::uint64_t count = 0;
+    std::string where;
+    bool known = false;
+};
+
 // --- STL --------------------------------------------------------------------------------------------------
 
 // Binary STL files with bytes after the last facet (padding some exporters add) are cut to their real size,
 // because Assimp only recognises a binary STL whose size matches its triangle count exactly.
-Status guardStl(const std::string& b, const std::string& name, std::size_t& truncateTo) {
+Status guardStl(const std::string& b, const std::string& name, std::size_t& truncateTo,
+                DeclaredFaces& faces) {
     const bool solid = b.size() >= 5 && lower(b.substr(0, 5)) == "solid";
     if (b.size() < 84) {
         if (solid)
@@ -62,10 +70,17 @@ Status guardStl(const std::string& b, const std::string& name, std::size_t& trun
     }
     const std::uint32_t count = readU32(b, 80);
     const long double needed = 84.0L + 50.0L * count;
-    if (needed == static_cast<long double>(b.size()))
+    if (needed == static_cast<long double>(b.size())) {
+        faces = {count, name, true};
         return {};
+    }
     if (solid) // ASCII STL ("solid ..."), read as text
         return {};
+    if (count == 0 && (b.size() - 84) % 50 == 0)
+        return parseError(name, "binary STL header claims 0 triangles but " + std::to_string(b.size() - 84) +
+                                    " bytes of facets (" + std::to_string((b.size() - 84) / 50) +
+                                    " triangles) follow it");
+    faces = {count, name, true};
     if (needed > static_cast<long double>(b.size()))
         return parseError(name, "binary STL header claims " + std::to_string(count) + " triangles (" +
                                     bytesText(needed) + " bytes) but the file has " +
@@ -105,7 +120,7 @@ bool parseCount(const std::string& s, std::uint64_t& out) {
     return ec == std::errc() && ptr == s.data() + s.size();
 }
 
-Status guardPly(const std::string& b, const std::string& name) {
+Status guardPly(const std::string& b, const std::string& name, DeclaredFaces& faces) {
     constexpr std::size_t kMaxHeader = 1 << 20;
     struct Element {
         std::string name;
@@ -176,6 +191,9 @@ Status guardPly(const std::string& b, const std::string& name) {
         return parseError(name, "PLY header has no 'format' line");
     const long double body = pos >= b.size() ? 0.0L : static_cast<long double>(b.size() - pos);
     long double total = 0;
+    for (const Element& e : elements)
+        if (e.name == "face")
+            faces = {e.count, name + ":" + std::to_string(e.line), true};
     for (const Element& e : elements) {
         const long double per = format == "ascii" ? std::max<long double>(1, 2.0L * e.properties)
                                                   : std::max<long double>(1, e.minBinary);
@@ -537,7 +555,8 @@ PosKey keyOf(const Vec3& p) {
 }
 
 Result<Mesh> readWithAssimp(const std::filesystem::path& path, const std::string& name,
-                            const std::string* memory = nullptr, const char* hint = "") {
+                            const DeclaredFaces& declared, const std::string* memory = nullptr,
+                            const char* hint = "") {
     Assimp::Importer importer;
     importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
     const aiScene* scene = nullptr;
@@ -558,6 +577,15 @@ Result<Mesh> readWithAssimp(const std::filesystem::path& path, const std::string
     }
     if (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE || !scene->mRootNode)
         return parseError(name, "the file describes an incomplete scene (no mesh data)");
+    if (declared.known) {
+        std::uint64_t read = 0;
+        for (unsigned i = 0; i < scene->mNumMeshes; ++i)
+            read += scene->mMeshes[i]->mNumFaces;
+        if (read != declared.count)
+            return makeError(ErrorCode::ParseError, declared.where + ": the header declares " +
+                                                        std::to_string(declared.count) + " faces but " +
+                                                        std::to_string(read) + " were read");
+    }
 
     bool anyNormals = false, anyUvs = false;
     for (unsigned i = 0; i < scene->mNumMeshes; ++i) {
@@ -685,6 +713,7 @@ Result<Mesh> readMesh(const std::filesystem::path& path) {
                          name + ": unsupported mesh format '" + ext + "' (supported: " + list + ")");
     }
     Status guard;
+    DeclaredFaces declared;
     std::string truncated; // a binary STL cut to its real size, read from memory
     {
         auto bytes = io::readFileBytes(path);
@@ -693,15 +722,18 @@ Result<Mesh> readMesh(const std::filesystem::path& path) {
         const std::string& b = bytes.value();
         if (b.empty())
             return parseError(name, "no triangles (the file is empty)");
+        if (ext == ".off") {
+            if (Status s = guardOff(b, name); !s)
+                return s.error();
+            return parseOff(b, name);
+        }
         std::size_t truncateTo = 0;
         if (ext == ".stl") {
-            guard = guardStl(b, name, truncateTo);
+            guard = guardStl(b, name, truncateTo, declared);
             if (guard && truncateTo > 0 && truncateTo < b.size())
                 truncated = b.substr(0, truncateTo);
         } else if (ext == ".ply")
-            guard = guardPly(b, name);
-        else if (ext == ".off")
-            guard = guardOff(b, name);
+            guard = guardPly(b, name, declared);
         else if (ext == ".3ds")
             guard = guard3ds(b, name);
         else
@@ -710,8 +742,8 @@ Result<Mesh> readMesh(const std::filesystem::path& path) {
     if (!guard)
         return guard.error();
     if (!truncated.empty())
-        return readWithAssimp(path, name, &truncated, "stl");
-    return readWithAssimp(path, name);
+        return readWithAssimp(path, name, declared, &truncated, "stl");
+    return readWithAssimp(path, name, declared);
 }
 
 } // namespace rubble

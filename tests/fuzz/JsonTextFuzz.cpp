@@ -1,5 +1,6 @@
 // Fuzz target: the CLI's JSON output of arbitrary paths and reader messages (non-UTF-8 bytes included).
-// Input: one byte n, then n % 64 bytes of file name, then the file's text (read as OBJ).
+// Input: one byte n, then n % 64 bytes of file name, then the file's text (read as OFF when n >= 128, else
+// OBJ).
 #include <cstdint>
 #include <string>
 #include <string_view>
@@ -14,7 +15,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const std::string path(reinterpret_cast<const char*>(data + 1), n);
     const std::string_view text(reinterpret_cast<const char*>(data + 1 + n), size - 1 - n);
     nlohmann::json entry = {{"file", rubble::tools::utf8Escaped(path)}};
-    auto mesh = rubble::parseObj(text, path);
+    auto mesh = data[0] >= 128 ? rubble::parseOff(text, path) : rubble::parseObj(text, path);
     if (mesh)
         entry["triangles"] = mesh->triangleCount();
     else

@@ -365,3 +365,19 @@ TEST(MeshReader, OnlyRegularFilesOfBoundedSizeAreRead) {
     std::filesystem::create_symlink(kData / "tetra.stl", dir / "link.stl");
     expectValidTetra(readMesh(dir / "link.stl"));
 }
+
+TEST(MeshReader, DeclaredFaceCountsAreComparedWithWhatAssimpRead) {
+    const auto dir = test::tempDir("MeshReader_counts");
+    std::string bin;
+    {
+        std::ifstream in(kData / "tetra.stl", std::ios::binary);
+        bin.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    }
+    // A binary STL whose header says 0 triangles but holds 4 was called "empty".
+    std::string zero = bin;
+    zero.replace(80, 4, std::string(4, '\0'));
+    test::writeFile(dir / "zero.stl", zero);
+    EXPECT_EQ(errorOf(dir / "zero.stl").message,
+              (dir / "zero.stl").string() +
+                  ": binary STL header claims 0 triangles but 200 bytes of facets (4 triangles) follow it");
+}
