@@ -60,7 +60,8 @@ Result<std::vector<NamedMesh>> readObjObjects(const std::filesystem::path& path)
 
 /// Writes mesh as OBJ (exact shortest round-trip numbers), with normals and texture coordinates when present,
 /// and, when the mesh has materials, `usemtl` statements and an MTL file (same stem, .mtl) in which
-/// kInteriorMaterial is "interior" with its own colour. Triangles keep their order.
+/// kInteriorMaterial is "interior" with its own colour. Triangles keep their order. Each file is written to a
+/// staging file next to it and renamed, so a failed write (IoError) leaves the previous file as it was.
 Status writeObj(const std::filesystem::path& path, const Mesh& mesh, const ObjWriteOptions& options = {});
 
 /// One node of a glTF scene written by writeGltf.
@@ -77,7 +78,8 @@ struct GltfNode {
 /// (float, relative to the origin), NORMAL (unit; flat face normals when the mesh has none), TEXCOORD_0
 /// (V flipped to glTF's top-left origin; (0, 0) when the mesh has none) and uint32 indices; corners with
 /// equal position, normal and UV share a vertex. Output is byte-identical for identical input. Errors:
-/// InvalidInput for an empty or invalid mesh, IoError naming the file.
+/// InvalidInput for an empty or invalid mesh, IoError naming the file (written through a staging file and a
+/// rename, as writeObj).
 Status writeGltf(const std::filesystem::path& path, const std::vector<GltfNode>& nodes);
 
 /// Reads a mesh by extension: .obj with readObj and .off with parseOff (exact doubles); .stl, .ply, .3ds,

@@ -4,7 +4,9 @@
 #include <cstring>
 #include <fstream>
 
+#include <fcntl.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 namespace rubble::io {
 
@@ -55,6 +57,38 @@ Result<std::string> readFileBytes(const std::filesystem::path& path, std::uint64
     if (in.gcount() != static_cast<std::streamsize>(bytes.size()))
         return makeError(ErrorCode::IoError, displayName(path) + ": cannot read the whole file");
     return bytes;
+}
+
+std::filesystem::path stagingPath(const std::filesystem::path& target) {
+    const std::filesystem::path name = target.filename();
+    return target.parent_path() / ("." + name.string() + ".rubble-tmp-" + std::to_string(::getpid()));
+}
+
+Status writeFileAtomically(const std::filesystem::path& path, std::string_view bytes) {
+    const std::filesystem::path tmp = stagingPath(path);
+    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+    if (fd < 0) {
+        const int err = errno;
+        return makeError(ErrorCode::IoError,
+                         displayName(path) + ": cannot open for writing: " + std::strerror(err));
+    }
+    int err = 0;
+    for (std::size_t done = 0; done < bytes.size() && err == 0;) {
+        const ::ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+        if (n < 0 && errno != EINTR)
+            err = errno;
+        else if (n > 0)
+            done += static_cast<std::size_t>(n);
+    }
+    if (::close(fd) != 0 && err == 0)
+        err = errno;
+    if (err == 0 && ::rename(tmp.c_str(), path.c_str()) != 0)
+        err = errno;
+    if (err != 0) {
+        ::unlink(tmp.c_str());
+        return makeError(ErrorCode::IoError, displayName(path) + ": write failed: " + std::strerror(err));
+    }
+    return {};
 }
 
 } // namespace rubble::io

@@ -42,4 +42,37 @@ run "$tmp/z.json" timeout 20 "$RUBBLE" check --json "$tmp/zero.obj" "$tmp/pipe.o
 json_ok "$tmp/z.json" "'character device, not a regular file' in d['meshes'][0]['error'] and \
     'a FIFO, not a regular file' in d['meshes'][1]['error']" || fail "special files: $(cat "$tmp/z.json")"
 
+# --- check --repair -o: colliding stems refused, failed writes leave no partial file and still print JSON ---------
+mkdir -p "$tmp/a" "$tmp/b"
+cp "$data/cube.obj" "$tmp/a/m.obj"
+cp "$data/cube.off" "$tmp/b/m.off"
+run "$tmp/col.txt" "$RUBBLE" check --repair -o "$tmp/rep" "$tmp/a/m.obj" "$tmp/b/m.off"
+[ "$c" -eq 2 ] || fail "colliding stems: exit $c, expected 2"
+grep -q "two inputs would be repaired into the same file" "$tmp/col.txt.err" || fail "stems: $(cat "$tmp/col.txt.err")"
+[ ! -e "$tmp/rep/m.obj" ] || fail "colliding stems: something was written"
+# A 4 KiB file size limit (SIGXFSZ ignored): the 10,092-triangle cube cannot be written, the tetrahedron can.
+mkdir -p "$tmp/rep"
+echo "old" >"$tmp/rep/cube_10092.obj"
+set +e
+(trap '' XFSZ; ulimit -f 4; exec "$RUBBLE" check --json --repair -o "$tmp/rep" "$root/assets/models/cube_10092.obj" \
+    "$data/tetra.obj" >"$tmp/full.json" 2>"$tmp/full.err")
+c=$?
+set -e
+[ "$c" -eq 2 ] || fail "failed write: exit $c, expected 2: $(cat "$tmp/full.err")"
+json_ok "$tmp/full.json" "'write failed: File too large' in d['meshes'][0]['error'] and d['meshes'][1]['valid']" \
+    || fail "failed write JSON: $(cat "$tmp/full.json")"
+[ "$(cat "$tmp/rep/cube_10092.obj")" = old ] || fail "failed write replaced the previous file"
+[ -z "$(ls -A "$tmp/rep" | grep rubble-tmp || true)" ] || fail "failed write left $(ls -A "$tmp/rep")"
+"$RUBBLE" check "$tmp/rep/tetra.obj" >/dev/null || fail "the tetrahedron was not written"
+
+# --- Staging folders of killed runs are removed; those of live processes are kept ------------------------------
+sleep 0 & dead=$!
+wait $dead
+mkdir -p "$tmp/stale/.out.rubble-tmp-$dead/sub" "$tmp/stale/.out.rubble-tmp-$$"
+"$RUBBLE" fracture "$data/cube.obj" --impact 0.5,0.5,1 --impulse 200 -o "$tmp/stale/out" >/dev/null \
+    || fail "fracture next to stale staging folders failed"
+[ ! -e "$tmp/stale/.out.rubble-tmp-$dead" ] || fail "the stale staging folder of PID $dead was not removed"
+[ -d "$tmp/stale/.out.rubble-tmp-$$" ] || fail "the staging folder of a live process was removed"
+[ -n "$(ls "$tmp/stale/out")" ] || fail "no pieces written"
+
 exit 0

@@ -2,21 +2,25 @@
 //
 // Exit codes: 0 all meshes valid (after repair, with --repair); 1 some mesh readable but invalid;
 // 2 some mesh unreadable, or a usage error. In --json mode stdout holds only the JSON document
-// {"meshes":[{"file","vertices","triangles","closed","manifold","oriented","self_intersections","volume",
-// "center_of_mass":[x,y,z],"bbox":[[lo],[hi]]}]}, where self_intersections is the number of intersecting
-// triangle pairs or null when the test did not run; an unreadable file appears as {"file","error"}.
-// With --repair the entries describe the repaired meshes, "file" being the path written.
+// {"meshes":[{"file","valid","problems":[...],"vertices","triangles","closed","manifold","oriented",
+// "self_intersections","volume","center_of_mass":[x,y,z],"bbox":[[lo],[hi]]}]}, where self_intersections is
+// the number of intersecting triangle pairs or null when the test did not run; an unreadable file appears as
+// {"file","error"}. With --repair the entries describe the repaired meshes, "file" being the path written (or
+// {"file","error"} when it could not be written; exit 2). Two inputs with the same stem are refused with
+// --repair into a folder. Outputs are written through a staging file and renamed.
 // Problems and repair notes go to stderr in --json mode.
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <set>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
 
 #include "JsonText.hpp"
+#include "Staging.hpp"
 #include "Subcommand.hpp"
 #include "rubble/MeshCheck.hpp"
 #include "rubble/MeshIO.hpp"
@@ -88,6 +92,10 @@ void printProblems(std::ostream& out, const std::vector<std::string>& problems, 
 nlohmann::json jsonOf(const std::string& file, const rubble::MeshReport& r) {
     nlohmann::json j;
     j["file"] = rubble::tools::utf8Escaped(file);
+    j["valid"] = r.valid();
+    j["problems"] = nlohmann::json::array();
+    for (const std::string& p : r.problems)
+        j["problems"].push_back(rubble::tools::utf8Escaped(p));
     j["vertices"] = r.vertices;
     j["triangles"] = r.triangles;
     j["closed"] = r.closed;
@@ -133,8 +141,24 @@ int runCheck(const CheckArgs& args) {
         std::cerr << "rubble check: cannot write '" << args.output << "': only .obj output is supported\n";
         return 2;
     }
-    if (args.repair && outIsDir)
-        fs::create_directories(args.output, ec);
+    // Every input's output path, known before anything is read: two inputs must not share one.
+    std::vector<fs::path> outputs;
+    if (args.repair) {
+        std::set<fs::path> seen;
+        for (const std::string& file : args.files) {
+            outputs.push_back(outIsDir ? fs::path(args.output) / (fs::path(file).stem().string() + ".obj")
+                                       : fs::path(args.output));
+            if (!seen.insert(outputs.back()).second) {
+                std::cerr << "rubble check: two inputs would be repaired into the same file '"
+                          << outputs.back().string() << "' (" << file << "); repair them one at a time\n";
+                return 2;
+            }
+        }
+        if (outIsDir)
+            fs::create_directories(args.output, ec);
+        // Staging files of earlier runs that were killed.
+        rubble::tools::removeStaleStaging(outputs.front().parent_path());
+    }
 
     rubble::CheckOptions checkOptions;
     checkOptions.selfIntersections = !args.noSelfIntersections;
@@ -178,8 +202,7 @@ int runCheck(const CheckArgs& args) {
         rubble::RepairOptions repairOptions;
         repairOptions.checkSelfIntersections = !args.noSelfIntersections;
         const rubble::RepairReport rep = rubble::repairMesh(repaired, repairOptions);
-        const fs::path out = outIsDir ? fs::path(args.output) / (fs::path(file).stem().string() + ".obj")
-                                      : fs::path(args.output);
+        const fs::path& out = outputs[i];
         text << file << ": " << (before.valid() ? "valid" : "INVALID") << " before repair\n";
         printProblems(text, before.problems, "problems");
         if (rep.fixed.empty()) {
@@ -189,9 +212,18 @@ int runCheck(const CheckArgs& args) {
             for (const std::string& f : rep.fixed)
                 text << "    - " << f << "\n";
         }
-        if (const rubble::Status s = rubble::writeObj(out, repaired); !s) {
-            std::cerr << "rubble check: " << s.message() << "\n";
-            return 2;
+        rubble::Status written;
+        {
+            const rubble::tools::DeferSignals
+                deferred; // a kill waits until the staging file is renamed or gone
+            written = rubble::writeObj(out, repaired);
+        }
+        if (!written) {
+            std::cerr << "rubble check: " << written.message() << "\n";
+            doc["meshes"].push_back({{"file", rubble::tools::utf8Escaped(out.string())},
+                                     {"error", rubble::tools::utf8Escaped(written.message())}});
+            exitCode = 2;
+            continue;
         }
         text << "  written to " << out.string() << ": " << (rep.valid() ? "valid" : "still INVALID") << "\n";
         if (!args.json)

@@ -8,9 +8,11 @@
 // fractured in parallel (batch pre-fracture), each into DIR/<mesh stem>/.
 //
 // Everything is computed before anything is written, and the output is staged in a sibling folder renamed to
-// DIR at the end, so that an error leaves no partial output. Exit codes: 0 every mesh fractured and written;
-// 1 a fracture or a write failed (the other meshes are written); 2 unreadable or invalid mesh, or a usage
-// error (nothing written); 3 the impact misses a mesh (no pieces for it; the other meshes are written).
+// DIR at the end, so that an error leaves no partial output. SIGINT and SIGTERM are held back while the
+// staging folder exists; staging folders of killed runs (".DIR.rubble-tmp-PID" of a dead PID) are removed.
+// Exit codes: 0 every mesh fractured and written; 1 a fracture or a write failed (the other meshes are
+// written); 2 unreadable or invalid mesh, or a usage error (nothing written); 3 the impact misses a mesh (no
+// pieces for it; the other meshes are written).
 // --json prints {"input":{"volume","triangles","closed"},"pieces":[{"volume","triangles","closed","oriented",
 // "center_of_mass":[x,y,z],"convex_parts"}],"timings_ms":{"cell","boolean","islands","decomposition","total"}}
 // (with "error" added when the fracture failed); with several meshes {"results":[...]} with one such object
@@ -35,6 +37,7 @@
 #include <nlohmann/json.hpp>
 
 #include "JsonText.hpp"
+#include "Staging.hpp"
 #include "Subcommand.hpp"
 #include "rubble/ConvexDecomposition.hpp"
 #include "rubble/Fracture.hpp"
@@ -258,8 +261,10 @@ int commitOutput(const std::vector<MeshJob>& jobs, const fs::path& dir, const st
     std::error_code ec;
     const fs::path parent = dir.has_parent_path() ? dir.parent_path() : fs::path(".");
     fs::create_directories(parent, ec);
-    const fs::path stage =
-        parent / ("." + dir.filename().string() + ".rubble-tmp-" + std::to_string(::getpid()));
+    rubble::tools::removeStaleStaging(parent); // left by earlier runs that were killed
+    // SIGINT / SIGTERM wait until the staging folder is renamed or removed.
+    const rubble::tools::DeferSignals deferred;
+    const fs::path stage = rubble::tools::stagingPath(dir);
     fs::remove_all(stage, ec);
     auto fail = [&](const std::string& message) {
         std::cerr << "rubble fracture: " << message << "\n";
