@@ -4,7 +4,9 @@
 #include <array>
 #include <cctype>
 #include <charconv>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <unordered_map>
 
@@ -89,6 +91,26 @@ Status guardStl(const std::string& b, const std::string& name, std::size_t& trun
     return {};
 }
 
+struct PosKey {
+    std::array<std::uint64_t, 3> bits;
+    bool operator==(const PosKey&) const = default;
+};
+struct PosKeyHash {
+    std::size_t operator()(const PosKey& k) const {
+        return static_cast<std::size_t>(k.bits[0] * 0x9E3779B97F4A7C15ull ^
+                                        k.bits[1] * 0xC2B2AE3D27D4EB4Full ^
+                                        k.bits[2] * 0x165667B19E3779F9ull);
+    }
+};
+
+PosKey keyOf(const Vec3& p) {
+    PosKey k;
+    const double c[3] = {p.x + 0.0, p.y + 0.0, p.z + 0.0};
+    for (int i = 0; i < 3; ++i)
+        std::memcpy(&k.bits[i], &c[i], sizeof(double));
+    return k;
+}
+
 // --- PLY --------------------------------------------------------------------------------------------------
 
 int plyTypeSize(const std::string& t) {
@@ -120,15 +142,30 @@ bool parseCount(const std::string& s, std::uint64_t& out) {
     return ec == std::errc() && ptr == s.data() + s.size();
 }
 
-Status guardPly(const std::string& b, const std::string& name, DeclaredFaces& faces) {
+struct PlyProperty {
+    std::string name;
+    bool list = false;
+};
+
+struct PlyElement {
+    std::string name;
+    std::uint64_t count = 0;
+    std::size_t line = 0;
+    long double minBinary = 0; // bytes per element, at least
+    std::size_t properties = 0;
+    std::vector<PlyProperty> props;
+};
+
+// A parsed PLY header: the format, the elements and where the body starts.
+struct PlyHeader {
+    std::string format;
+    std::vector<PlyElement> elements;
+    std::size_t bodyPos = 0, bodyLine = 0;
+};
+
+Status guardPly(const std::string& b, const std::string& name, DeclaredFaces& faces, PlyHeader& header) {
     constexpr std::size_t kMaxHeader = 1 << 20;
-    struct Element {
-        std::string name;
-        std::uint64_t count = 0;
-        std::size_t line = 0;
-        long double minBinary = 0; // bytes per element, at least
-        std::size_t properties = 0;
-    };
+    using Element = PlyElement;
     std::vector<Element> elements;
     std::string format;
     std::size_t pos = 0, line = 0;
@@ -175,10 +212,12 @@ Status guardPly(const std::string& b, const std::string& name, DeclaredFaces& fa
                     return makeError(ErrorCode::ParseError,
                                      where + "expected 'property list <count type> <item type> <name>'");
                 e.minBinary += plyTypeSize(w[2]);
+                e.props.push_back({w[4], true});
             } else {
                 if (w.size() != 3 || plyTypeSize(w[1]) == 0)
                     return makeError(ErrorCode::ParseError, where + "expected 'property <type> <name>'");
                 e.minBinary += plyTypeSize(w[1]);
+                e.props.push_back({w[2], false});
             }
             ++e.properties;
         } else {
@@ -205,7 +244,147 @@ Status guardPly(const std::string& b, const std::string& name, DeclaredFaces& fa
                                                         " bytes of data) but only " + bytesText(body) +
                                                         " bytes follow the header");
     }
+    header = {format, std::move(elements), pos, line};
     return {};
+}
+
+// ASCII PLY, read by Rubble (exact doubles, file:line errors): one element per line; vertex x, y, z and the
+// face list vertex_indices (or vertex_index) are used, every other property is checked to be a number and
+// ignored. Exactly equal positions are welded (exporters split vertices per face for normals and colours).
+Result<Mesh> readAsciiPly(const std::string& b, const std::string& name, const PlyHeader& h) {
+    std::size_t pos = h.bodyPos, line = h.bodyLine;
+    auto fail = [&](const std::string& message) {
+        return makeError(ErrorCode::ParseError, name + ":" + std::to_string(line) + ": " + message);
+    };
+    std::vector<std::string> tok;
+    auto nextLine = [&]() {
+        tok.clear();
+        while (tok.empty() && pos < b.size()) {
+            ++line;
+            std::size_t end = b.find('\n', pos);
+            if (end == std::string::npos)
+                end = b.size();
+            tok = words(std::string_view(b.data() + pos, end - pos));
+            pos = end + 1;
+        }
+    };
+    // 0: a number; 1: not a number; 2: beyond the double range (underflow gives 0 or a subnormal).
+    auto number = [](const std::string& t, double& v) {
+        const char* first = t.data() + (!t.empty() && t[0] == '+' ? 1 : 0);
+        const auto [ptr, ec] = std::from_chars(first, t.data() + t.size(), v);
+        if (ptr != t.data() + t.size() || first == t.data() + t.size())
+            return 1;
+        if (ec == std::errc::result_out_of_range) {
+            v = std::strtod(first, nullptr);
+            return std::isinf(v) ? 2 : 0;
+        }
+        return ec == std::errc() ? 0 : 1;
+    };
+    std::vector<Vec3> positions;
+    std::vector<Triangle> triangles;
+    std::size_t vertexCount = 0;
+    for (const PlyElement& e : h.elements) {
+        const bool isVertex = e.name == "vertex", isFace = e.name == "face";
+        int xyz[3] = {-1, -1, -1};
+        if (isVertex) {
+            for (std::size_t k = 0; k < e.props.size(); ++k)
+                for (int c = 0; c < 3; ++c)
+                    if (!e.props[k].list && e.props[k].name == std::string(1, static_cast<char>('x' + c)))
+                        xyz[c] = static_cast<int>(k);
+            if (xyz[0] < 0 || xyz[1] < 0 || xyz[2] < 0) {
+                line = e.line;
+                return fail("the vertex element has no x, y and z properties");
+            }
+            vertexCount = static_cast<std::size_t>(e.count);
+        }
+        for (std::uint64_t i = 0; i < e.count; ++i) {
+            nextLine();
+            if (tok.empty())
+                return fail("the file ends after " + std::to_string(i) + " of the " +
+                            std::to_string(e.count) + " declared '" + e.name + "' elements");
+            const std::string what = "'" + e.name + "' " + std::to_string(i);
+            std::size_t t = 0;
+            double c[3] = {0, 0, 0};
+            std::vector<std::uint32_t> corners;
+            for (std::size_t k = 0; k < e.props.size(); ++k) {
+                const PlyProperty& p = e.props[k];
+                std::uint64_t n = 1;
+                if (p.list) {
+                    if (t >= tok.size() || !parseCount(tok[t], n))
+                        return fail(
+                            what + ": expected the length of the list '" + p.name + "', got " +
+                            (t < tok.size() ? "'" + tok[t].substr(0, 40) + "'" : "the end of the line"));
+                    ++t;
+                }
+                if (n > tok.size() - t)
+                    return fail(what + ": the line ends before its properties do (" +
+                                std::to_string(tok.size()) + " numbers; truncated?)");
+                const bool indices =
+                    isFace && p.list && (p.name == "vertex_indices" || p.name == "vertex_index");
+                for (std::uint64_t m = 0; m < n; ++m, ++t) {
+                    double v = 0;
+                    const int kind = number(tok[t], v);
+                    if (kind == 1)
+                        return fail(what + ": expected a number for '" + p.name + "', got '" +
+                                    tok[t].substr(0, 40) + "'");
+                    if (kind == 2)
+                        return fail(what + ": value '" + tok[t].substr(0, 40) + "' for '" + p.name +
+                                    "' is out of range");
+                    for (int a = 0; a < 3; ++a)
+                        if (isVertex && static_cast<int>(k) == xyz[a])
+                            c[a] = v;
+                    if (indices) {
+                        if (!(v >= 0 && v < static_cast<double>(vertexCount)) || v != std::floor(v))
+                            return fail(what + " refers to vertex " + tok[t].substr(0, 40) +
+                                        " but there are " + std::to_string(vertexCount) +
+                                        " (PLY indices start at 0)");
+                        corners.push_back(static_cast<std::uint32_t>(v));
+                    }
+                }
+                if (indices && corners.size() < 3)
+                    return fail(what + " has " + std::to_string(corners.size()) +
+                                (corners.size() == 1 ? " corner" : " corners") + "; at least 3 are needed");
+            }
+            if (t != tok.size())
+                return fail(what + ": " + std::to_string(tok.size() - t) +
+                            " more numbers than its properties need");
+            if (isVertex)
+                positions.push_back({c[0], c[1], c[2]});
+            if (corners.size() == 3) {
+                triangles.push_back({corners[0], corners[1], corners[2]});
+            } else if (!corners.empty()) {
+                std::vector<Vec3> pts;
+                for (std::uint32_t v : corners)
+                    pts.push_back(positions[v]);
+                for (const auto& tri : io::triangulatePolygon(pts))
+                    triangles.push_back({corners[tri[0]], corners[tri[1]], corners[tri[2]]});
+            }
+        }
+    }
+    nextLine();
+    if (!tok.empty())
+        return fail("unexpected '" + tok[0].substr(0, 40) +
+                    "' after the declared elements (the header's counts do not match the file)");
+    if (triangles.empty())
+        return parseError(name, "no triangles");
+    // Weld exactly equal positions (first occurrence wins); unreferenced vertices are dropped.
+    Mesh m;
+    std::unordered_map<PosKey, std::uint32_t, PosKeyHash> index;
+    std::vector<std::uint32_t> remap(positions.size(), UINT32_MAX);
+    for (Triangle& tri : triangles) {
+        for (std::uint32_t& v : tri) {
+            if (remap[v] == UINT32_MAX) {
+                auto [it, inserted] =
+                    index.emplace(keyOf(positions[v]), static_cast<std::uint32_t>(m.positions.size()));
+                if (inserted)
+                    m.positions.push_back(positions[v]);
+                remap[v] = it->second;
+            }
+            v = remap[v];
+        }
+        m.triangles.push_back(tri);
+    }
+    return m;
 }
 
 // --- OFF --------------------------------------------------------------------------------------------------
@@ -534,26 +713,6 @@ Status guardGltf(const std::string& b, const std::filesystem::path& path, const 
 
 // --- Assimp -----------------------------------------------------------------------------------------------
 
-struct PosKey {
-    std::array<std::uint64_t, 3> bits;
-    bool operator==(const PosKey&) const = default;
-};
-struct PosKeyHash {
-    std::size_t operator()(const PosKey& k) const {
-        return static_cast<std::size_t>(k.bits[0] * 0x9E3779B97F4A7C15ull ^
-                                        k.bits[1] * 0xC2B2AE3D27D4EB4Full ^
-                                        k.bits[2] * 0x165667B19E3779F9ull);
-    }
-};
-
-PosKey keyOf(const Vec3& p) {
-    PosKey k;
-    const double c[3] = {p.x + 0.0, p.y + 0.0, p.z + 0.0};
-    for (int i = 0; i < 3; ++i)
-        std::memcpy(&k.bits[i], &c[i], sizeof(double));
-    return k;
-}
-
 Result<Mesh> readWithAssimp(const std::filesystem::path& path, const std::string& name,
                             const DeclaredFaces& declared, const std::string* memory = nullptr,
                             const char* hint = "") {
@@ -732,9 +891,12 @@ Result<Mesh> readMesh(const std::filesystem::path& path) {
             guard = guardStl(b, name, truncateTo, declared);
             if (guard && truncateTo > 0 && truncateTo < b.size())
                 truncated = b.substr(0, truncateTo);
-        } else if (ext == ".ply")
-            guard = guardPly(b, name, declared);
-        else if (ext == ".3ds")
+        } else if (ext == ".ply") {
+            PlyHeader header;
+            guard = guardPly(b, name, declared, header);
+            if (guard && header.format == "ascii")
+                return readAsciiPly(b, name, header);
+        } else if (ext == ".3ds")
             guard = guard3ds(b, name);
         else
             guard = guardGltf(b, path, name, ext == ".glb");

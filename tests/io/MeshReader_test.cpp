@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <iterator>
@@ -380,4 +381,99 @@ TEST(MeshReader, DeclaredFaceCountsAreComparedWithWhatAssimpRead) {
     EXPECT_EQ(errorOf(dir / "zero.stl").message,
               (dir / "zero.stl").string() +
                   ": binary STL header claims 0 triangles but 200 bytes of facets (4 triangles) follow it");
+}
+
+namespace {
+// The unit cube as ASCII PLY: vertices with a colour, quads; `faces` replaces the face block when given.
+std::string asciiPlyCube(const std::string& faces = "", int declaredFaces = 6) {
+    std::string ply =
+        "ply\nformat ascii 1.0\ncomment cube\nelement vertex 8\nproperty double x\nproperty double y\n"
+        "property double z\nproperty uchar red\nelement face " +
+        std::to_string(declaredFaces) + "\nproperty list uchar int vertex_indices\nend_header\n";
+    for (const char* v : {"0 0 0", "1 0 0", "1 1 0", "0 1 0", "0 0 1", "1 0 1", "1 1 1", "0 1 1"})
+        ply += std::string(v) + " 255\n";
+    return ply +
+           (faces.empty() ? "4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n4 3 7 6 2\n4 0 4 7 3\n4 1 2 6 5\n" : faces);
+}
+} // namespace
+
+TEST(MeshReader, AsciiPlyIsReadExactlyWithLineNumbers) {
+    const auto dir = test::tempDir("MeshReader_ascii_ply");
+    auto read = [&](const std::string& file, const std::string& text) {
+        test::writeFile(dir / file, text);
+        return readMesh(dir / file);
+    };
+    const auto cube = read("cube.ply", asciiPlyCube());
+    ASSERT_TRUE(cube.isOk()) << cube.error().message;
+    EXPECT_EQ(cube->vertexCount(), 8u);
+    EXPECT_TRUE(checkMesh(cube.value()).valid());
+    // Doubles exactly as written (Assimp rounded them to float).
+    std::string exact = asciiPlyCube();
+    exact.replace(exact.find("1 1 1 255"), 9, "10.2041 1 1 255");
+    const auto e = read("exact.ply", exact);
+    ASSERT_TRUE(e.isOk()) << e.error().message;
+    bool found = false;
+    for (const Vec3& p : e->positions)
+        found = found || p.x == 10.2041;
+    EXPECT_TRUE(found);
+    // Vertices split per face (as exporters write them for normals or colours) are welded exactly.
+    std::string split =
+        "ply\nformat ascii 1.0\nelement vertex 12\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 4\nproperty list uchar uint vertex_index\nend_header\n";
+    for (const char* v : {"0 0 0", "0 1 0", "1 0 0", "0 0 0", "1 0 0", "0 0 1", "1 0 0", "0 1 0", "0 0 1",
+                          "0 1 0", "0 0 0", "0 0 1"})
+        split += std::string(v) + "\n";
+    split += "3 0 1 2\n3 3 4 5\n3 6 7 8\n3 9 10 11\n";
+    expectValidTetra(read("split.ply", split));
+    // Truncated lines, a file that ends early, counts that do not match: file:line messages (Assimp's text
+    // had no line, or Assimp silently filled in a face).
+    const std::string faces5 = "4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n4 3 7 6 2\n4 0 4 7 3\n";
+    const std::string p = dir.string() + "/";
+    EXPECT_EQ(read("short.ply", asciiPlyCube(faces5)).error().message,
+              p + "short.ply:24: the file ends after 5 of the 6 declared 'face' elements");
+    EXPECT_EQ(read("trunc.ply", asciiPlyCube(faces5 + "4 1 2 6\n")).error().message,
+              p + "trunc.ply:25: 'face' 5: the line ends before its properties do (4 numbers; truncated?)");
+    EXPECT_EQ(
+        read("long.ply", asciiPlyCube(faces5 + "4 1 2 6 5\n4 1 2 6 5\n")).error().message,
+        p + "long.ply:26: unexpected '4' after the declared elements (the header's counts do not match the "
+            "file)");
+    std::string truncVertex = asciiPlyCube();
+    truncVertex.replace(truncVertex.find("1 1 0 255"), 9, "1 1");
+    EXPECT_EQ(read("tv.ply", truncVertex).error().message,
+              p + "tv.ply:14: 'vertex' 2: the line ends before its properties do (2 numbers; truncated?)");
+    EXPECT_EQ(read("idx.ply", asciiPlyCube(faces5 + "4 1 2 6 8\n")).error().message,
+              p + "idx.ply:25: 'face' 5 refers to vertex 8 but there are 8 (PLY indices start at 0)");
+    EXPECT_EQ(read("two.ply", asciiPlyCube(faces5 + "2 1 2\n")).error().message,
+              p + "two.ply:25: 'face' 5 has 2 corners; at least 3 are needed");
+    std::string bad = asciiPlyCube();
+    bad.replace(bad.find("0 1 1 255"), 9, "0 1 abc 255");
+    EXPECT_EQ(read("bad.ply", bad).error().message,
+              p + "bad.ply:19: 'vertex' 7: expected a number for 'z', got 'abc'");
+    bad.replace(bad.find("abc"), 3, "1e999");
+    EXPECT_EQ(read("big.ply", bad).error().message,
+              p + "big.ply:19: 'vertex' 7: value '1e999' for 'z' is out of range");
+    EXPECT_EQ(read("extra.ply", asciiPlyCube(faces5 + "4 1 2 6 5 7\n")).error().message,
+              p + "extra.ply:25: 'face' 5: 1 more numbers than its properties need");
+    // A 12-gon face (Assimp's OFF importer dropped polygons over 9 corners; PLY polygons are kept whole
+    // here).
+    std::string prism =
+        "ply\nformat ascii 1.0\nelement vertex 24\nproperty double x\nproperty double y\n"
+        "property double z\nelement face 14\nproperty list uchar int vertex_indices\nend_header\n";
+    for (int z = 0; z < 2; ++z)
+        for (int i = 0; i < 12; ++i)
+            prism += std::to_string(std::cos(i * 3.141592653589793 / 6)) + " " +
+                     std::to_string(std::sin(i * 3.141592653589793 / 6)) + " " + std::to_string(z) + "\n";
+    std::string bottom = "12", top = "12";
+    for (int i = 0; i < 12; ++i) {
+        bottom += " " + std::to_string(11 - i);
+        top += " " + std::to_string(12 + i);
+    }
+    prism += bottom + "\n" + top + "\n";
+    for (int i = 0; i < 12; ++i)
+        prism += "4 " + std::to_string(i) + " " + std::to_string((i + 1) % 12) + " " +
+                 std::to_string(12 + (i + 1) % 12) + " " + std::to_string(12 + i) + "\n";
+    const auto pr = read("prism.ply", prism);
+    ASSERT_TRUE(pr.isOk()) << pr.error().message;
+    EXPECT_EQ(pr->triangleCount(), 2u * 10 + 24);
+    EXPECT_TRUE(checkMesh(pr.value()).valid());
 }
