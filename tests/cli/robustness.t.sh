@@ -75,4 +75,34 @@ mkdir -p "$tmp/stale/.out.rubble-tmp-$dead/sub" "$tmp/stale/.out.rubble-tmp-$$"
 [ -d "$tmp/stale/.out.rubble-tmp-$$" ] || fail "the staging folder of a live process was removed"
 [ -n "$(ls "$tmp/stale/out")" ] || fail "no pieces written"
 
+# --- Messages and validation -------------------------------------------------------------------------------------
+for seed in -1 18446744073709551616 1e3; do
+    run "$tmp/seed.txt" "$RUBBLE" fracture "$data/cube.obj" --impact 0.5,0.5,1 --seed "$seed" -o "$tmp/seed"
+    [ "$c" -eq 2 ] || fail "--seed $seed: exit $c, expected 2"
+    grep -q "is not a whole number from 0 to 18446744073709551615" "$tmp/seed.txt.err" || fail "--seed $seed message"
+done
+"$RUBBLE" fracture "$data/cube.obj" --impact 0.5,0.5,1 --seed 18446744073709551615 -o "$tmp/seedmax" >/dev/null \
+    || fail "--seed 2^64-1 should be accepted"
+run "$tmp/nan.txt" "$RUBBLE" fracture "$data/cube.obj" --impact 0.5,0.5,1 --impulse nan -o "$tmp/nan"
+[ "$c" -eq 2 ] && grep -q "'nan' is not a finite number" "$tmp/nan.txt.err" || fail "--impulse nan: exit $c"
+run "$tmp/cnan.txt" "$RUBBLE" decompose "$data/cube.obj" --concavity nan
+[ "$c" -eq 2 ] && grep -q "'nan' is not a finite number" "$tmp/cnan.txt.err" || fail "--concavity nan: exit $c"
+# A mesh smaller than the smallest cell: one piece, the input itself, and the output says so.
+awk '/^v /{printf "v %.17g %.17g %.17g\n", $2*0.001, $3*0.001, $4*0.001; next} {print}' "$data/cube.obj" >"$tmp/tiny.obj"
+run "$tmp/tiny.json" "$RUBBLE" fracture "$tmp/tiny.obj" --impact 0.0005,0.0005,0.001 -o "$tmp/tiny" --json
+[ "$c" -eq 0 ] || fail "tiny cube: exit $c"
+json_ok "$tmp/tiny.json" "d['cut'] is False and d['dropped_volume'] == 0 and len(d['pieces']) == 1" \
+    || fail "tiny cube JSON: $(cat "$tmp/tiny.json")"
+grep -q "nothing was cut" "$tmp/tiny.json.err" || fail "tiny cube: no 'nothing was cut' on stderr"
+# A cube scaled by 1e300 overflows; check --json says valid false and lists the problem.
+awk '/^v /{printf "v %s %s %s\n", $2*1e300, $3*1e300, $4*1e300; next} {print}' "$data/cube.obj" >"$tmp/huge.obj"
+run "$tmp/huge.json" "$RUBBLE" check --json "$tmp/huge.obj"
+[ "$c" -eq 1 ] || fail "1e300 cube: exit $c"
+json_ok "$tmp/huge.json" "d['meshes'][0]['valid'] is False and d['meshes'][0]['problems'] == \
+    [\"the mesh's volume overflows the range of doubles (coordinates up to 1e+300); scale the mesh down\"]" \
+    || fail "1e300 cube JSON: $(cat "$tmp/huge.json")"
+"$RUBBLE" check --json "$data/cube.obj" >"$tmp/valid.json"
+json_ok "$tmp/valid.json" "d['meshes'][0]['valid'] is True and d['meshes'][0]['problems'] == []" \
+    || fail "valid cube JSON: $(cat "$tmp/valid.json")"
+
 exit 0

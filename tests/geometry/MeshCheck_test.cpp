@@ -292,3 +292,22 @@ TEST(MeshCheck, SelfIntersectionTestIsSkippedAroundVeryHighValenceVertices) {
     EXPECT_TRUE(small.selfIntersectionsChecked);
     EXPECT_EQ(small.selfIntersections, 0u);
 }
+
+TEST(MeshCheck, HugeAndTinyMeshesAreJudgedWithoutOverflow) {
+    // A cube scaled by 1e300 was reported "encloses no volume" (and its triangles degenerate): it overflowed.
+    const MeshReport huge = checkMesh(makeBox({0, 0, 0}, {1e300, 1e300, 1e300}));
+    EXPECT_FALSE(huge.valid());
+    EXPECT_EQ(huge.degenerateTriangles, 0u);
+    ASSERT_EQ(huge.problems.size(), 1u) << test::joinLines(huge.problems);
+    EXPECT_EQ(
+        huge.problems[0],
+        "the mesh's volume overflows the range of doubles (coordinates up to 1e+300); scale the mesh down");
+    // 1e-100: the squared areas (1e-400) underflowed and every triangle was called degenerate.
+    const MeshReport tiny = checkMesh(makeBox({0, 0, 0}, {1e-100, 1e-100, 1e-100}));
+    EXPECT_TRUE(tiny.valid()) << test::joinLines(tiny.problems);
+    EXPECT_EQ(tiny.degenerateTriangles, 0u);
+    // Scaling by powers of two changes nothing for ordinary triangles.
+    EXPECT_TRUE(isDegenerateTriangle({0, 0, 0}, {1, 0, 0}, {2, 1e-13, 0}));
+    EXPECT_FALSE(isDegenerateTriangle({0, 0, 0}, {1, 0, 0}, {2, 1e-11, 0}));
+    EXPECT_TRUE(isDegenerateTriangle({5, 5, 5}, {5, 5, 5}, {1, 2, 3}));
+}

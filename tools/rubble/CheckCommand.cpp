@@ -10,6 +10,7 @@
 // --repair into a folder. Outputs are written through a staging file and renamed.
 // Problems and repair notes go to stderr in --json mode.
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -70,7 +71,7 @@ void printStats(std::ostream& out, const rubble::MeshReport& r) {
         out << " (" << r.nonManifoldVertices << " non-manifold "
             << (r.nonManifoldVertices == 1 ? "vertex" : "vertices") << ")";
     out << "\n  oriented            " << yesNo(r.oriented);
-    if (r.oriented && r.closed && r.volume != 0)
+    if (r.oriented && r.closed && r.volume != 0 && std::isfinite(r.volume))
         out << (r.volume > 0 ? " (outward)" : " (inside out)");
     out << "\n  self-intersections  " << selfIntersectionText(r) << "\n";
     out << "  volume              " << num(r.volume) << "\n";

@@ -70,6 +70,7 @@ const rubble::tools::Registrar registrar{
              ->check(CLI::Range(1, 100000));
          app.add_option("--concavity", args->concavity,
                         "stop splitting below this depth, as a fraction of the bounding-box diagonal")
+             ->check(rubble::tools::finiteNumber())
              ->check(CLI::Range(0.0, 1.0));
          app.add_flag("--json", args->json,
                       "print {\"parts\",\"mesh_volume\",\"hull_volume\",\"excess\",\"ms\"} as JSON");
