@@ -82,10 +82,10 @@ struct GltfNode {
 /// rename, as writeObj).
 Status writeGltf(const std::filesystem::path& path, const std::vector<GltfNode>& nodes);
 
-/// Reads a mesh by extension: .obj with readObj, .off with parseOff and ASCII .ply with Rubble's own reader
-/// (exact doubles, file:line errors, equal positions welded); .stl, binary .ply, .3ds, .gltf and .glb through
-/// Assimp (single precision; triangulated, positions welded exactly, node transforms applied). Size claims in
-/// headers (binary STL triangle count, PLY element counts, OFF counts, 3DS chunk lengths, glTF
+/// Reads a mesh by extension: .obj with readObj, .off with parseOff, ASCII .ply and .stl with Rubble's own
+/// readers (exact doubles, file:line errors, equal positions welded); binary .stl and .ply, .3ds, .gltf and
+/// .glb through Assimp (single precision; triangulated, positions welded exactly, node transforms applied).
+/// Size claims in headers (binary STL triangle count, PLY element counts, OFF counts, 3DS chunk lengths, glTF
 /// buffer/accessor lengths) are checked against the file before Assimp sees it, and so are glTF's JSON depth
 /// and node hierarchy (at most 256 and 1024 levels; nodes must form trees). Errors: Unsupported for other
 /// extensions, IoError, ParseError; every message names the file.

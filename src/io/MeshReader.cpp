@@ -61,6 +61,19 @@ struct DeclaredFaces {
 
 // Binary STL files with bytes after the last facet (padding some exporters add) are cut to their real size,
 // because Assimp only recognises a binary STL whose size matches its triangle count exactly.
+// Starts with "solid" and holds no control bytes but whitespace: ASCII (a binary header may start with
+// "solid" too, but its numbers hold zero bytes).
+bool isAsciiStl(const std::string& b) {
+    if (b.size() < 5 || lower(b.substr(0, 5)) != "solid")
+        return false;
+    for (const char c : b) {
+        const auto u = static_cast<unsigned char>(c);
+        if (u < 0x20 && c != '\t' && c != '\n' && c != '\r' && c != '\v' && c != '\f')
+            return false;
+    }
+    return true;
+}
+
 Status guardStl(const std::string& b, const std::string& name, std::size_t& truncateTo,
                 DeclaredFaces& faces) {
     const bool solid = b.size() >= 5 && lower(b.substr(0, 5)) == "solid";
@@ -111,17 +124,6 @@ PosKey keyOf(const Vec3& p) {
     return k;
 }
 
-// --- PLY --------------------------------------------------------------------------------------------------
-
-int plyTypeSize(const std::string& t) {
-    static const std::unordered_map<std::string, int> sizes = {
-        {"char", 1},   {"int8", 1},    {"uchar", 1},  {"uint8", 1},  {"short", 2}, {"int16", 2},
-        {"ushort", 2}, {"uint16", 2},  {"int", 4},    {"int32", 4},  {"uint", 4},  {"uint32", 4},
-        {"float", 4},  {"float32", 4}, {"double", 8}, {"float64", 8}};
-    const auto it = sizes.find(t);
-    return it == sizes.end() ? 0 : it->second;
-}
-
 std::vector<std::string> words(std::string_view s) {
     std::vector<std::string> out;
     std::size_t i = 0;
@@ -135,6 +137,110 @@ std::vector<std::string> words(std::string_view s) {
             out.emplace_back(s.substr(st, i - st));
     }
     return out;
+}
+
+// ASCII STL, read by Rubble (exact doubles, file:line errors): solid / facet normal / outer loop / vertex x y
+// z (three or more) / endloop / endfacet / endsolid, several solids allowed; keywords in any case. Normals
+// are not kept; exactly equal positions are welded (STL repeats every corner).
+Result<Mesh> readAsciiStl(const std::string& b, const std::string& name) {
+    std::size_t pos = 0, line = 0;
+    std::vector<std::string> tok;
+    auto fail = [&](const std::string& message) {
+        return makeError(ErrorCode::ParseError, name + ":" + std::to_string(line) + ": " + message);
+    };
+    auto nextLine = [&]() {
+        tok.clear();
+        while (tok.empty() && pos < b.size()) {
+            ++line;
+            std::size_t end = b.find('\n', pos);
+            if (end == std::string::npos)
+                end = b.size();
+            tok = words(std::string_view(b.data() + pos, end - pos));
+            pos = end + 1;
+        }
+        if (!tok.empty())
+            tok[0] = lower(tok[0]);
+        return !tok.empty();
+    };
+    auto shown = [](const std::string& t) { return "'" + t.substr(0, 40) + "'"; };
+    Mesh m;
+    std::unordered_map<PosKey, std::uint32_t, PosKeyHash> index;
+    bool inSolid = false;
+    while (nextLine()) {
+        if (!inSolid) {
+            if (tok[0] != "solid")
+                return fail("expected 'solid', got " + shown(tok[0]));
+            inSolid = true;
+            continue;
+        }
+        if (tok[0] == "endsolid") {
+            inSolid = false;
+            continue;
+        }
+        if (tok[0] != "facet")
+            return fail("expected 'facet' or 'endsolid', got " + shown(tok[0]));
+        if (!nextLine() || tok[0] != "outer" || tok.size() != 2 || lower(tok[1]) != "loop")
+            return fail(tok.empty() ? std::string("the file ends inside a facet")
+                                    : "expected 'outer loop', got " + shown(tok[0]));
+        std::vector<Vec3> corners;
+        while (nextLine() && tok[0] == "vertex") {
+            if (tok.size() != 4)
+                return fail("vertex needs 3 numbers, got " + std::to_string(tok.size() - 1));
+            double c[3];
+            for (int k = 0; k < 3; ++k) {
+                const std::string& t = tok[static_cast<std::size_t>(k) + 1];
+                const char* first = t.data() + (t[0] == '+' ? 1 : 0);
+                const auto [ptr, ec] = std::from_chars(first, t.data() + t.size(), c[k]);
+                if (ptr != t.data() + t.size() || first == ptr)
+                    return fail("vertex: expected a number for " +
+                                std::string(1, static_cast<char>('x' + k)) + ", got " + shown(t));
+                if (ec == std::errc::result_out_of_range) {
+                    c[k] = std::strtod(first, nullptr);
+                    if (std::isinf(c[k]))
+                        return fail("vertex: value " + shown(t) + " for " +
+                                    std::string(1, static_cast<char>('x' + k)) + " is out of range");
+                }
+            }
+            corners.push_back({c[0], c[1], c[2]});
+        }
+        if (tok.empty())
+            return fail("the file ends inside a facet");
+        if (tok[0] != "endloop")
+            return fail("expected 'vertex' or 'endloop', got " + shown(tok[0]));
+        if (corners.size() < 3)
+            return fail("facet has " + std::to_string(corners.size()) +
+                        (corners.size() == 1 ? " vertex" : " vertices") + "; at least 3 are needed");
+        if (!nextLine() || tok[0] != "endfacet")
+            return fail(tok.empty() ? std::string("the file ends inside a facet")
+                                    : "expected 'endfacet', got " + shown(tok[0]));
+        std::vector<std::uint32_t> ids;
+        for (const Vec3& p : corners) {
+            auto [it, inserted] = index.emplace(keyOf(p), static_cast<std::uint32_t>(m.positions.size()));
+            if (inserted)
+                m.positions.push_back(p);
+            ids.push_back(it->second);
+        }
+        for (const auto& t : io::triangulatePolygon(corners))
+            m.triangles.push_back({ids[t[0]], ids[t[1]], ids[t[2]]});
+        if (m.positions.size() >= 0xFFFF'FFF0u)
+            return fail("too many vertices");
+    }
+    if (inSolid)
+        return fail("the file ends without 'endsolid' (truncated?)");
+    if (m.triangles.empty())
+        return parseError(name, "no triangles");
+    return m;
+}
+
+// --- PLY --------------------------------------------------------------------------------------------------
+
+int plyTypeSize(const std::string& t) {
+    static const std::unordered_map<std::string, int> sizes = {
+        {"char", 1},   {"int8", 1},    {"uchar", 1},  {"uint8", 1},  {"short", 2}, {"int16", 2},
+        {"ushort", 2}, {"uint16", 2},  {"int", 4},    {"int32", 4},  {"uint", 4},  {"uint32", 4},
+        {"float", 4},  {"float32", 4}, {"double", 8}, {"float64", 8}};
+    const auto it = sizes.find(t);
+    return it == sizes.end() ? 0 : it->second;
 }
 
 bool parseCount(const std::string& s, std::uint64_t& out) {
@@ -888,6 +994,8 @@ Result<Mesh> readMesh(const std::filesystem::path& path) {
         }
         std::size_t truncateTo = 0;
         if (ext == ".stl") {
+            if (isAsciiStl(b))
+                return readAsciiStl(b, name);
             guard = guardStl(b, name, truncateTo, declared);
             if (guard && truncateTo > 0 && truncateTo < b.size())
                 truncated = b.substr(0, truncateTo);

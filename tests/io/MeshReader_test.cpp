@@ -477,3 +477,58 @@ TEST(MeshReader, AsciiPlyIsReadExactlyWithLineNumbers) {
     EXPECT_EQ(pr->triangleCount(), 2u * 10 + 24);
     EXPECT_TRUE(checkMesh(pr.value()).valid());
 }
+
+TEST(MeshReader, AsciiStlIsReadExactlyWithLineNumbers) {
+    const auto dir = test::tempDir("MeshReader_ascii_stl");
+    auto read = [&](const std::string& file, const std::string& text) {
+        test::writeFile(dir / file, text);
+        return readMesh(dir / file);
+    };
+    const char* p[4] = {"0 0 0", "10.2041 0 0", "0 1 0", "0 0 1"};
+    const int f[4][3] = {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {2, 0, 3}};
+    std::string stl = "solid tetra\n";
+    for (const auto& tri : f) {
+        stl += "  facet normal 0 0 0\n    outer loop\n";
+        for (int k : tri)
+            stl += "      vertex " + std::string(p[k]) + "\n";
+        stl += "    endloop\n  endfacet\n";
+    }
+    const std::string whole = stl + "endsolid tetra\n";
+    const auto r = read("tetra.stl", whole);
+    ASSERT_TRUE(r.isOk()) << r.error().message;
+    EXPECT_EQ(r->vertexCount(), 4u);       // every corner repeated per facet, welded exactly
+    EXPECT_EQ(r->positions[2].x, 10.2041); // Assimp rounded to float: 10.204099655...
+    EXPECT_TRUE(checkMesh(r.value()).valid());
+    // Upper-case keywords, two solids in one file.
+    const auto two =
+        read("two.stl", whole + "SOLID b\nFACET NORMAL 0 0 1\nOUTER LOOP\nVERTEX 5 5 5\nVERTEX 6 5 5\n"
+                                "VERTEX 5 6 5\nENDLOOP\nENDFACET\nENDSOLID b\n");
+    ASSERT_TRUE(two.isOk()) << two.error().message;
+    EXPECT_EQ(two->triangleCount(), 5u);
+    const std::string d = dir.string() + "/";
+    EXPECT_EQ(read("trunc.stl", stl).error().message,
+              d + "trunc.stl:29: the file ends without 'endsolid' (truncated?)");
+    EXPECT_EQ(read("mid.stl", stl.substr(0, stl.rfind("      vertex"))).error().message,
+              d + "mid.stl:26: the file ends inside a facet");
+    std::string bad = whole;
+    bad.replace(bad.find("vertex 0 1 0"), 12, "vertex 0 x 0");
+    EXPECT_EQ(read("bad.stl", bad).error().message,
+              d + "bad.stl:5: vertex: expected a number for y, got 'x'");
+    bad = whole;
+    bad.replace(bad.find("vertex 0 1 0"), 12, "vertex 0 1");
+    EXPECT_EQ(read("short.stl", bad).error().message, d + "short.stl:5: vertex needs 3 numbers, got 2");
+    bad = whole;
+    bad.replace(bad.find("vertex 0 1 0"), 12, "vertex 0 1e999 0");
+    EXPECT_EQ(read("huge.stl", bad).error().message,
+              d + "huge.stl:5: vertex: value '1e999' for y is out of range");
+    EXPECT_EQ(read("two_corners.stl",
+                   "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nendloop\n"
+                   "endfacet\nendsolid\n")
+                  .error()
+                  .message,
+              d + "two_corners.stl:6: facet has 2 vertices; at least 3 are needed");
+    EXPECT_EQ(read("junk.stl", "solid x\nhello\n").error().message,
+              d + "junk.stl:2: expected 'facet' or 'endsolid', got 'hello'");
+    EXPECT_EQ(read("empty_solid.stl", "solid x\nendsolid x\n").error().message,
+              d + "empty_solid.stl: no triangles");
+}
