@@ -18,6 +18,7 @@
 
 #include "io/FileBytes.hpp"
 #include "io/PolygonTriangulation.hpp"
+#include "io/TextMeshReaders.hpp"
 #include "rubble/MeshIO.hpp"
 
 namespace rubble {
@@ -958,6 +959,22 @@ Result<Mesh> readWithAssimp(const std::filesystem::path& path, const std::string
     return m;
 }
 } // namespace
+
+namespace io {
+Result<Mesh> parseAsciiPly(const std::string& bytes, const std::string& displayName) {
+    DeclaredFaces declared;
+    PlyHeader header;
+    if (Status s = guardPly(bytes, displayName, declared, header); !s)
+        return s.error();
+    if (header.format != "ascii")
+        return makeError(ErrorCode::Unsupported, displayName + ": not an ASCII PLY file");
+    return readAsciiPly(bytes, displayName, header);
+}
+
+Result<Mesh> parseAsciiStl(const std::string& bytes, const std::string& displayName) {
+    return readAsciiStl(bytes, displayName);
+}
+} // namespace io
 
 const std::vector<std::string>& supportedMeshExtensions() {
     static const std::vector<std::string> ext = {".obj", ".off", ".stl", ".ply", ".3ds", ".gltf", ".glb"};
