@@ -13,13 +13,15 @@ namespace rubble {
 
 /// The contact patch two solids share, as a plane section.
 struct BondInterface {
-    double area = 0;           ///< m^2
-    Vec3 centroid;             ///< area centroid
-    Vec3 normal;               ///< unit, pointing from the first solid to the second
-    Vec3 u, v;                 ///< in-plane unit axes, u x v = normal
-    double iuu = 0;            ///< integral of t^2 dA about the centroid (t along v): bending about u
-    double ivv = 0;            ///< integral of s^2 dA about the centroid (s along u): bending about v
-    double iuv = 0;            ///< integral of s*t dA about the centroid
+    double area = 0;        ///< m^2, the sum of the contact patches' areas
+    double sectionArea = 0; ///< m^2, the patches projected on the plane normal to `normal` (the section that
+                            ///< carries load; equal to area for a planar interface)
+    Vec3 centroid;          ///< area centroid
+    Vec3 normal;            ///< unit, from the first solid to the second: the patches' mean (area-weighted)
+    Vec3 u, v;              ///< in-plane unit axes, u x v = normal
+    double iuu = 0;         ///< integral of t^2 dA about the centroid (t along v): bending about u
+    double ivv = 0;         ///< integral of s^2 dA about the centroid (s along u): bending about v
+    double iuv = 0;         ///< integral of s*t dA about the centroid
     std::vector<Vec2> corners; ///< patch corners in (s, t) about the centroid (for the extreme fibres)
 };
 

@@ -25,7 +25,7 @@ struct StructureNode {
 /// The node of a solid of convex parts with the given density (kg/m^3).
 StructureNode structureNode(const std::vector<ConvexPolytope>& parts, double density, bool root);
 
-/// What a bond withstands, in Pa.
+/// What a bond withstands, in Pa (0: unlimited).
 struct StrengthLimits {
     double compressive = 0; ///< Pa
     double tensile = 0;     ///< Pa
@@ -76,6 +76,8 @@ public:
     Vec3 bondMoment(std::size_t i) const { return bonds_[i].moment; }
     /// The stresses over the bond's section at its current health.
     BondStress stress(std::size_t i) const;
+    /// The largest ratio of a stress to its limit (1 = breaking; 0 for a broken bond).
+    double utilisation(std::size_t i) const;
     /// The bond's remaining fraction of section, 1 when whole.
     double health(std::size_t i) const { return bonds_[i].health; }
     /// True when the bond has broken.
@@ -86,6 +88,8 @@ public:
     void damage(const Vec3& point, double radius, double amount);
     /// Breaks every bond whose stress exceeds its limits; returns them, ascending.
     std::vector<std::size_t> breakOverstressed();
+    /// Sets a bond's health (e.g. carried over from an earlier graph); 0 breaks it.
+    void setHealth(std::size_t i, double health);
     /// Breaks one bond.
     void breakBond(std::size_t i);
     /// Takes a node out of the structure (it fell or was removed); its bonds break.

@@ -114,16 +114,23 @@ BondInterface bondInterface(const std::vector<ConvexPolytope>& a, const std::vec
         }
     BondInterface out;
     // Area-weighted normal and a common basis; then every patch's moments about the common centroid.
-    Vec3 n;
+    Vec3 n, largest;
+    double area = 0, largestArea = 0;
     for (const Patch& p : patches) {
         Vec3 twice;
         for (std::size_t i = 1; i + 1 < p.corners.size(); ++i)
             twice += cross(p.corners[i] - p.corners[0], p.corners[i + 1] - p.corners[0]);
         n += twice;
+        area += length(twice) / 2;
+        if (length(twice) / 2 > largestArea) {
+            largestArea = length(twice) / 2;
+            largest = p.normal;
+        }
     }
-    if (length(n) / 2 < settings.minArea)
+    if (area < settings.minArea)
         return out;
-    out.normal = normalized(n);
+    // Patches around a corner may nearly cancel: then the largest patch's normal.
+    out.normal = length(n) / 2 > 0.1 * area ? normalized(n) : largest;
     basisOf(out.normal, out.u, out.v);
     Moments total;
     std::vector<std::vector<Vec2>> flat;
@@ -131,9 +138,11 @@ BondInterface bondInterface(const std::vector<ConvexPolytope>& a, const std::vec
         std::vector<Vec2> q;
         for (const Vec3& c : p.corners)
             q.push_back({dot(c, out.u), dot(c, out.v)});
-        const Moments m = polygonMoments(q);
-        if (m.area <= 0)
-            continue;
+        Moments m = polygonMoments(q);
+        if (m.area < 0) { // a patch facing away from the mean normal
+            std::reverse(q.begin(), q.end());
+            m = polygonMoments(q);
+        }
         total.area += m.area;
         total.s += m.s;
         total.t += m.t;
@@ -142,7 +151,7 @@ BondInterface bondInterface(const std::vector<ConvexPolytope>& a, const std::vec
         total.st += m.st;
         flat.push_back(std::move(q));
     }
-    if (total.area < settings.minArea)
+    if (total.area <= 0)
         return out;
     const double cs = total.s / total.area, ct = total.t / total.area;
     double depth = 0, weight = 0;
@@ -151,7 +160,8 @@ BondInterface bondInterface(const std::vector<ConvexPolytope>& a, const std::vec
             depth += dot(c, out.normal);
             weight += 1;
         }
-    out.area = total.area;
+    out.area = area;
+    out.sectionArea = total.area;
     out.centroid = out.u * cs + out.v * ct + out.normal * (depth / weight);
     out.ivv = total.ss - total.area * cs * cs;
     out.iuu = total.tt - total.area * ct * ct;

@@ -173,9 +173,9 @@ BondStress StressSolver::stress(std::size_t i) const {
     const BondState& b = bonds_[i];
     const BondInterface& s = b.bond.section;
     BondStress out;
-    if (b.broken || s.area <= 0)
+    if (b.broken || s.sectionArea <= 0)
         return out;
-    const double axial = dot(b.force, s.normal) / s.area; // > 0: b pulls a (tension)
+    const double axial = dot(b.force, s.normal) / s.sectionArea; // > 0: b pulls a (tension)
     // Linear fibre stress sigma = alpha s + beta t whose moment about the centroid is the bond's couple.
     const double lu = dot(b.moment, s.u), lv = dot(b.moment, s.v);
     const double iss = s.ivv, itt = s.iuu, ist = s.iuv;
@@ -197,8 +197,17 @@ BondStress StressSolver::stress(std::size_t i) const {
     const double polar = iss + itt;
     out.tension = std::max(0.0, hi) / b.health;
     out.compression = std::max(0.0, -lo) / b.health;
-    out.shear = (length(transverse) / s.area + (polar > 0 ? std::abs(torsion) * rmax / polar : 0)) / b.health;
+    out.shear =
+        (length(transverse) / s.sectionArea + (polar > 0 ? std::abs(torsion) * rmax / polar : 0)) / b.health;
     return out;
+}
+
+double StressSolver::utilisation(std::size_t i) const {
+    const BondStress s = stress(i);
+    const StrengthLimits& l = bonds_[i].limits;
+    auto ratio = [](double stress, double limit) { return limit > 0 ? stress / limit : 0.0; };
+    return std::max(
+        {ratio(s.compression, l.compressive), ratio(s.tension, l.tensile), ratio(s.shear, l.shear)});
 }
 
 void StressSolver::damage(const Vec3& point, double radius, double amount) {
@@ -220,14 +229,18 @@ std::vector<std::size_t> StressSolver::breakOverstressed() {
     for (std::size_t i = 0; i < bonds_.size(); ++i) {
         if (bonds_[i].broken)
             continue;
-        const BondStress s = stress(i);
-        const StrengthLimits& l = bonds_[i].limits;
-        if (s.compression > l.compressive || s.tension > l.tensile || s.shear > l.shear)
+        if (utilisation(i) > 1)
             out.push_back(i);
     }
     for (std::size_t i : out)
         breakBond(i);
     return out;
+}
+
+void StressSolver::setHealth(std::size_t i, double health) {
+    bonds_[i].health = std::clamp(health, 0.0, 1.0);
+    if (bonds_[i].health <= 0)
+        breakBond(i);
 }
 
 void StressSolver::breakBond(std::size_t i) {

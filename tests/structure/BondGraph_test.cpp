@@ -21,6 +21,7 @@ TEST(BondGraph, BoxOnBoxSharesTheOverlapRectangle) {
     const auto upper = box({0.5, 1, -1}, {2.5, 2, 2});
     const BondInterface s = bondInterface(lower, upper, {});
     EXPECT_NEAR(s.area, 0.5 * 2, 1e-12);
+    EXPECT_NEAR(s.sectionArea, s.area, 1e-12);
     EXPECT_NEAR(s.centroid.x, 0.75, 1e-12);
     EXPECT_NEAR(s.centroid.y, 1, 1e-12);
     EXPECT_NEAR(s.centroid.z, 1, 1e-12);
@@ -88,4 +89,18 @@ TEST(BondGraph, MultiPartSolidsSumTheirPatches) {
     EXPECT_NEAR(s.centroid.x, 1.5, 1e-12);
     EXPECT_NEAR(s.centroid.z, 0.5, 1e-12);
     EXPECT_EQ(s.corners.size(), 8u);
+}
+
+TEST(BondGraph, AnInterfaceAroundACornerCountsEveryPatch) {
+    // A unit cube nested in the corner of an L of three boxes: three faces touch, the section is their
+    // projection on the mean normal (1, 1, 1) / sqrt 3.
+    const auto cube = box({0, 0, 0}, {1, 1, 1});
+    auto corner = box({-1, -1, -1}, {0, 1, 1});
+    corner.push_back(box({0, -1, -1}, {1, 0, 1})[0]);
+    corner.push_back(box({0, 0, -1}, {1, 1, 0})[0]);
+    const BondInterface s = bondInterface(corner, cube, {});
+    EXPECT_NEAR(s.area, 3, 1e-12);
+    EXPECT_NEAR(s.normal.x, 1 / std::sqrt(3.0), 1e-12);
+    EXPECT_NEAR(s.normal.y, 1 / std::sqrt(3.0), 1e-12);
+    EXPECT_NEAR(s.sectionArea, 3 / std::sqrt(3.0), 1e-12);
 }
