@@ -94,8 +94,8 @@ struct SupportPolicy {
 };
 
 /// Structural stress (StructureMonitor, docs/structure.md): bonds between touching static bodies carry their
-/// weight; a bond over its material's limit breaks and what no chain of bonds holds up falls. Set at
-/// construction.
+/// weight and the contact forces of moving bodies on them; a bond over its material's limit breaks and what
+/// no chain of bonds holds up falls. Set at construction.
 struct StructurePolicy {
     bool enabled = false;              ///< off: support is connectivity only (SupportPolicy)
     BondSettings bonds{0.02, 1, 1e-4}; ///< what counts as a bond (gap as SupportPolicy::tolerance)

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <map>
 #include <set>
+#include <tuple>
 
 #include "runtime/BodyTable.hpp"
 #include "runtime/DebrisGovernor.hpp"
@@ -251,6 +252,21 @@ struct DestructionRuntime::Impl {
                 break;
         }
         stats.supportMs += msSince(t0);
+    }
+
+    // Contact forces of moving bodies on structure nodes (impulse over the frame).
+    void feedContactLoads(double dt) {
+        if (!config.structure.enabled || dt <= 0)
+            return;
+        for (const ContactReport& c : contacts) {
+            const Vec3 onA = c.normalOnB * (c.impulse / dt); // b pushes a away from b
+            for (const auto& [self, other, force, point] :
+                 {std::tuple{c.a, c.b, onA, c.pointOnA}, std::tuple{c.b, c.a, -onA, c.pointOnB}}) {
+                const BodyRecord* o = bodies.find(other);
+                if (o && o->motion == BodyMotionState::Dynamic && structure.contains(self))
+                    structure.addLoad(self, force, point);
+            }
+        }
     }
 
     // Solves the structure; what lost its bonded support falls, and what rested on that is re-checked.
@@ -502,6 +518,7 @@ FrameStats DestructionRuntime::stepFrame(double dt) {
     im.adoptResults(stats);
     im.govern(batch.frozenHits, stats);
     im.settleSupport(stats);
+    im.feedContactLoads(dt);
     im.settleStructure(stats);
     im.advance(dt);
     stats.adoptMs = msSince(t1);

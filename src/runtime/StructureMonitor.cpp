@@ -20,6 +20,10 @@ void StructureMonitor::remove(BodyId id) {
         dirty_ = true;
 }
 
+void StructureMonitor::addLoad(BodyId id, const Vec3& force, const Vec3& point) {
+    pendingLoads_.push_back({id, force, point});
+}
+
 void StructureMonitor::damage(const Vec3& point, double impulse) {
     pendingDamage_.push_back({point, impulse});
 }
@@ -98,6 +102,11 @@ std::vector<BodyId> StructureMonitor::step(const Vec3& gravity, int& broken) {
     for (const auto& [point, impulse] : pendingDamage_)
         solver_.damage(point, policy_.damageRadius, impulse * policy_.damagePerImpulse);
     pendingDamage_.clear();
+    for (const Load& l : pendingLoads_) // order_ is ascending
+        if (const auto it = std::lower_bound(order_.begin(), order_.end(), l.id);
+            it != order_.end() && *it == l.id)
+            solver_.addLoad(static_cast<std::uint32_t>(it - order_.begin()), l.force, l.point);
+    pendingLoads_.clear();
     solver_.settings() = policy_.stress;
     solver_.settings().gravity = gravity;
     solver_.solve();

@@ -23,6 +23,10 @@ public:
     void add(BodyId id, const std::vector<ConvexPolytope>& worldParts, const Material& material, bool root);
     /// Removes a node; its bonds go with it.
     void remove(BodyId id);
+    /// True when id is a node.
+    bool contains(BodyId id) const { return nodes_.count(id) > 0; }
+    /// A load on a node for the next step (a contact force, N, at a world point).
+    void addLoad(BodyId id, const Vec3& force, const Vec3& point);
     /// Weakens the bonds near a hit.
     void damage(const Vec3& point, double impulse);
     /// Solves under gravity, breaks overstressed bonds (counted in `broken`); returns the bodies that lost
@@ -49,6 +53,11 @@ private:
     std::map<Pair, double> health_;
     std::set<Pair> broken_;
     std::vector<std::pair<Vec3, double>> pendingDamage_;
+    struct Load {
+        BodyId id;
+        Vec3 force, point;
+    };
+    std::vector<Load> pendingLoads_;
     StressSolver solver_;
     bool dirty_ = false;
 };
