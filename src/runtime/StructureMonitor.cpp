@@ -40,6 +40,10 @@ void StructureMonitor::rebuild() {
         else if (solver_.health(i) < 1)
             health_[pairOf(i)] = solver_.health(i);
     }
+    // Forget pairs whose bodies are gone (ids are never reused).
+    auto gone = [&](const Pair& p) { return !nodes_.count(p.first) || !nodes_.count(p.second); };
+    std::erase_if(health_, [&](const auto& e) { return gone(e.first); });
+    std::erase_if(broken_, gone);
     order_.clear();
     std::vector<std::vector<ConvexPolytope>> solids;
     std::vector<StructureNode> nodes;
