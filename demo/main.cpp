@@ -57,6 +57,7 @@ struct Options {
     bool noPanel = false;
     bool deterministic = false;
     bool noShadows = false;
+    bool structure = false;
 };
 
 struct App {
@@ -181,6 +182,8 @@ int main(int argc, char** argv) {
     cli.add_flag("--no-panel", o.noPanel, "hide the ImGui panel (F1 toggles it)");
     cli.add_flag("--deterministic", o.deterministic, "adopt fractures a fixed number of frames after impact");
     cli.add_flag("--no-shadows", o.noShadows, "disable shadow mapping");
+    cli.add_flag("--structure", o.structure,
+                 "stress solver: bonds between static parts break under load; draws them by stress");
     CLI11_PARSE(cli, argc, argv);
 
     const bool haveDisplay = std::getenv("DISPLAY") && *std::getenv("DISPLAY");
@@ -234,6 +237,7 @@ int main(int argc, char** argv) {
     app.pending.fracture.uvScale = 0.25;
     app.pending.shadows = !o.noShadows;
     app.pending.debugShapes = app.pending.debugAabbs = app.pending.debugImpacts = o.debug;
+    app.pending.structure = app.pending.debugBonds = o.structure;
 
     std::string error;
     app.gl = demo::GlContext::create(o.width, o.height, headless, error);
