@@ -287,6 +287,7 @@ const rubble::tools::Registrar registrar{
              ->check(CLI::Range(1, 10000))
              ->capture_default_str();
          app.add_option("--seed", args->seed, "seed of the first case's impact and cell (then +1 per case)")
+             ->check(rubble::tools::unsigned64())
              ->capture_default_str();
          app.add_option("--out", args->out, "folder for booleans.csv and booleans.png");
          return [args] { return runBench(*args); };

@@ -398,7 +398,7 @@ rubble::tools::Registrar registrar{
          app.add_option("--seconds", args->seconds, "simulated seconds");
          app.add_option("--shots-per-second", args->shotsPerSecond, "projectiles per simulated second");
          app.add_option("--workers", args->workers, "fracture worker threads (-1 automatic)");
-         app.add_option("--seed", args->seed, "random seed");
+         app.add_option("--seed", args->seed, "random seed")->check(rubble::tools::unsigned64());
          app.add_flag("--deterministic", args->deterministic,
                       "adopt results a fixed number of frames after impact");
          app.add_flag("--json", args->json, "JSON on stdout");

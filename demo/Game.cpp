@@ -142,6 +142,7 @@ bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const Game
     rc.impacts.collisionImpulseThreshold = settings.collisionImpulse;
     rc.debris.maxAwakeBodies = settings.maxAwake;
     rc.support.collapseUnsupported = settings.collapseUnsupported;
+    rc.structure.enabled = settings.structure;
     rc.projectileLifetime = 3;
     rc.spentProjectileLifetime = 0;
     physics_ = std::make_unique<rubble::bullet::PhysicsWorld>();
@@ -484,6 +485,18 @@ void Game::draw(Renderer& renderer, float dt) {
                              static_cast<float>((l.rgba >> 16) & 0xFF) / 255.0f,
                              static_cast<float>((l.rgba >> 8) & 0xFF) / 255.0f);
     }
+
+    if (settings_.debugBonds) // each bond: a cross in its interface, coloured by stress / limit
+        for (const rubble::StructureBond& b : runtime_->structureBonds()) {
+            const float u = static_cast<float>(std::clamp(b.utilisation, 0.0, 1.0));
+            const float r = std::min(1.0f, 2 * u), g = std::min(1.0f, 2 - 2 * u);
+            const rubble::Vec3 t = std::abs(b.normal.y) < 0.9 ? rubble::Vec3{0, 1, 0} : rubble::Vec3{1, 0, 0};
+            const double half = 0.5 * std::sqrt(b.area);
+            const rubble::Vec3 e1 = rubble::normalized(rubble::cross(b.normal, t)) * half;
+            const rubble::Vec3 e2 = rubble::normalized(rubble::cross(b.normal, e1)) * half;
+            renderer.addLine(toV3(b.centroid - e1), toV3(b.centroid + e1), r, g, 0.1f);
+            renderer.addLine(toV3(b.centroid - e2), toV3(b.centroid + e2), r, g, 0.1f);
+        }
 
     V3 pos, fwd, up;
     vehicleFrame(pos, fwd, up);

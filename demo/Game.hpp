@@ -51,6 +51,8 @@ struct GameSettings {
     bool debugShapes = false;        ///< draw collision shapes
     bool debugAabbs = false;         ///< draw AABBs
     bool debugImpacts = false;       ///< draw impact points
+    bool structure = false;          ///< stress solver: overstressed bonds break (applied on restart)
+    bool debugBonds = false;         ///< draw the structure's bonds, green (idle) to red (breaking)
     bool shadows = true;             ///< shadow mapping
 };
 
@@ -93,6 +95,8 @@ public:
 
     /// Counters.
     const GameCounters& counters() const { return counters_; }
+    /// The runtime (null before a scene is loaded).
+    const rubble::DestructionRuntime* runtime() const { return runtime_.get(); }
     /// Settings (mutable: panel edits them; some apply on restart).
     GameSettings& settings() { return settings_; }
     /// Camera.

@@ -76,6 +76,9 @@ bool Panel::draw(Game& game, GameSettings& pending, bool paused, const std::stri
         ImGui::Checkbox("impact points", &live.debugImpacts);
         ImGui::SameLine();
         ImGui::Checkbox("shadows", &live.shadows);
+        ImGui::Checkbox("bonds by stress", &live.debugBonds);
+        if (const rubble::DestructionRuntime* rt = game.runtime(); rt && live.structure)
+            ImGui::Text("bonds %zu   broken %lld", rt->structureBonds().size(), rt->counters().bondsBroken);
         ImGui::SliderFloat("shot speed", &live.projectileSpeed, 40.0f, 400.0f, "%.0f m/s");
         ImGui::SliderFloat("shot mass", &live.projectileMass, 0.5f, 40.0f, "%.1f kg");
     }
@@ -112,6 +115,7 @@ bool Panel::draw(Game& game, GameSettings& pending, bool paused, const std::stri
         // live: takes effect at the next fracture, and is kept across restarts
         if (ImGui::Checkbox("collapse unsupported (live)", &live.collapseUnsupported))
             pending.collapseUnsupported = live.collapseUnsupported;
+        ImGui::Checkbox("structure: stress solver", &pending.structure);
         if (ImGui::Button("Apply and restart scene"))
             restart = true;
     }

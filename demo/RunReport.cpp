@@ -64,7 +64,7 @@ bool RunReport::write(const std::filesystem::path& dir, const std::string& scene
     j["screenshots"] = screenshots;
     j["fracture_runtime"] = Game::fractureAvailable();
     std::ofstream js(dir / "report.json");
-    js << j.dump(2) << '\n';
+    js << j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << '\n'; // any scene file name
     std::ostringstream s;
     s.precision(3);
     s << "frames " << frames_.size() << ", fps p50 " << (p50 > 0 ? 1000.0 / p50 : 0.0) << " / p99 "

@@ -60,6 +60,7 @@ struct Options {
     std::string record; // journal file written at exit
     std::string replay; // journal file replayed on the loaded scene instead of playing
     int host = 0;       // port to host loopback multiplayer on
+    bool structure = false;
 };
 
 struct App {
@@ -208,6 +209,8 @@ int main(int argc, char** argv) {
            "host loopback multiplayer on 127.0.0.1:PORT (needs --deterministic); clients: rubble-bench "
            "netplay-client --port PORT")
         ->check(CLI::Range(1, 65535));
+    cli.add_flag("--structure", o.structure,
+                 "stress solver: bonds between static parts break under load; draws them by stress");
     CLI11_PARSE(cli, argc, argv);
 
     const bool haveDisplay = std::getenv("DISPLAY") && *std::getenv("DISPLAY");
@@ -261,6 +264,7 @@ int main(int argc, char** argv) {
     app.pending.fracture.uvScale = 0.25;
     app.pending.shadows = !o.noShadows;
     app.pending.debugShapes = app.pending.debugAabbs = app.pending.debugImpacts = o.debug;
+    app.pending.structure = app.pending.debugBonds = o.structure;
 
     std::string error;
     app.gl = demo::GlContext::create(o.width, o.height, headless, error);

@@ -22,6 +22,9 @@ echo "== booleans"
 echo
 echo "== impact"
 "$bench" impact --out "$results" "$@" || status=1
+echo
+echo "== structure"
+"$bench" structure --out "$results" "$@" || status=1
 if "$bench" --help 2>/dev/null | grep -qE '^ +scene( |$)'; then
     echo
     echo "== scenes (${RUBBLE_SCENE_SECONDS:-60} s each)"

@@ -14,7 +14,8 @@
 # kept) and link with lld when it is installed (links 3x faster); -O1 compiled only 6 % faster but ran the tests
 # and fuzzers 25-60 % slower (docs/robustness.md, section 7). They share ccache with every other tree, so a warm
 # cache rebuilds only what changed.
-# Environment: JOBS (default nproc), RUBBLE_STRESS_IMPACTS (default 300 here: ASan is ~10x slower).
+# Environment: JOBS (default nproc), RUBBLE_STRESS_IMPACTS (default 300 here: ASan is ~10x slower),
+# RUBBLE_SWEEP_SCALE (default 0.1: a tenth of the shatter sweep's CI slice).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 what=${1:-all}
@@ -47,7 +48,7 @@ asan() {
     # Leak checking is on (ASan's default on Linux).
     ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1 \
         UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-        RUBBLE_STRESS_IMPACTS=${RUBBLE_STRESS_IMPACTS:-300} \
+        RUBBLE_STRESS_IMPACTS=${RUBBLE_STRESS_IMPACTS:-300} RUBBLE_SWEEP_SCALE=${RUBBLE_SWEEP_SCALE:-0.1} \
         ctest --test-dir build-asan --output-on-failure -j "$jobs" --timeout 1200 -LE e2e
     echo "sanitize: ASan+UBSan tests took $(elapsed "$t0")"
 }

@@ -10,8 +10,10 @@
 #include <memory>
 #include <vector>
 
+#include "rubble/BondGraph.hpp"
 #include "rubble/DestructionWorld.hpp"
 #include "rubble/PhysicsBinding.hpp"
+#include "rubble/StressSolver.hpp"
 
 namespace rubble {
 
@@ -91,14 +93,41 @@ struct SupportPolicy {
     int maxSearchesPerFrame = 64; ///< support searches per frame; the rest wait for the next frame
 };
 
+/// Structural stress (StructureMonitor, docs/structure.md): bonds between touching static bodies carry their
+/// weight and the contact forces of moving bodies on them; a bond over its material's limit breaks and what
+/// no chain of bonds holds up falls. Set at construction.
+struct StructurePolicy {
+    bool enabled = false;              ///< off: support is connectivity only (SupportPolicy)
+    BondSettings bonds{0.02, 1, 1e-4}; ///< what counts as a bond (gap as SupportPolicy::tolerance)
+    StressSettings stress;             ///< solver iterations (gravity is the binding's)
+    double damageRadius = 1.0;         ///< impacts weaken bonds within this distance (m) of the hit
+    double damagePerImpulse = 1e-4;    ///< health a bond at the hit loses per N·s of impulse
+    bool bondDebris = false; ///< a static object's debris stays in the structure, bonded across its cut faces
+                             ///< until the solver breaks it (a partial crack); false: thrown, no bonds
+};
+
+/// A bond of the structure, for debug drawing.
+struct StructureBond {
+    BodyId a = 0, b = 0;    ///< the bodies it joins
+    Vec3 centroid;          ///< interface centroid (world)
+    Vec3 normal;            ///< interface normal, from a to b
+    double area = 0;        ///< interface area (m²)
+    double utilisation = 0; ///< largest stress / limit ratio (1 = breaking)
+    double health = 1;      ///< remaining fraction of the section
+};
+
 /// Budgets of the debris governor (DebrisGovernor): what keeps thousands of pieces affordable. Every resting
 /// moving body that carries an object may be frozen, but only pieces are ever retired (the game's own objects
 /// leave only by falling out of the world).
 struct DebrisBudget {
-    int maxAwakeBodies = 400;           ///< dynamic debris bodies; beyond it the slowest freeze, then the
-                                        ///< smallest become particles
-    double physicsBudgetMs = 8;         ///< physics step time to hold; above it the awake budget shrinks
-                                        ///< (ignored in deterministic mode, where time must not matter)
+    int maxAwakeBodies = 400;   ///< dynamic debris bodies; beyond it the slowest settling pieces
+                                ///< (below settlingSpeed) freeze, then the smallest become particles
+    double settlingSpeed = 1.0; ///< m/s (and rad/s): a piece this slow for 10 frames in a row may be frozen
+                                ///< to hold the awake budget
+    int awakeOvershoot = 16;    ///< pieces beyond maxAwakeBodies that may stay awake while they settle (new
+                                ///< pieces get 10 frames, slow ones until they freeze); beyond it, hard
+    double physicsBudgetMs = 8; ///< physics step time to hold; above it the awake budget shrinks
+                                ///< (ignored in deterministic mode, where time must not matter)
     std::size_t maxTriangles = 4000000; ///< triangles of all debris bodies (dynamic and frozen); beyond it
                                         ///< the smallest frozen pieces become particles
     bool freezeSleeping = true;         ///< a debris body the engine put to sleep is frozen (made static)
@@ -140,6 +169,8 @@ struct FrameStats {
     int piecesWoken = 0;      ///< frozen bodies woken by a hit
     int supportSearches = 0;  ///< support searches run
     double supportMs = 0;     ///< of adoptMs: support (neighbour tests, searches, collapses)
+    int bondsBroken = 0;      ///< structure bonds broken by stress or damage
+    double structureMs = 0;   ///< of adoptMs: bond graph and stress solve
     double physicsMs = 0;     ///< physics step incl. contact gathering
     double adoptMs = 0;       ///< submit + collect + adoption + governor
 };
@@ -153,6 +184,7 @@ struct RuntimeCounters {
     long long piecesCreated = 0;   ///< piece bodies created
     long long piecesRetired = 0;   ///< bodies and dust turned into particles
     long long piecesCollapsed = 0; ///< static bodies that lost their support
+    long long bondsBroken = 0;     ///< structure bonds broken
     long long piecesFrozen = 0;    ///< debris bodies frozen
     long long piecesWoken = 0;     ///< frozen bodies woken
     long long staleOutcomes = 0;   ///< outcomes whose parent had no body
@@ -187,6 +219,7 @@ public:
         ImpactPolicy impacts;           ///< contacts → impacts
         AdoptionPolicy adoption;        ///< outcomes → piece bodies
         SupportPolicy support;          ///< structural support and collapse
+        StructurePolicy structure;      ///< structural stress
         DebrisBudget debris;            ///< the debris governor
         double projectileLifetime = 6;  ///< seconds before a projectile is removed
         double spentProjectileLifetime = 0.5; ///< seconds a projectile lives after its hit
@@ -262,6 +295,8 @@ public:
     VolumeLedger volumes() const;
     /// Static bodies that touch this one in the support graph (ascending), for debug drawing and tests.
     std::vector<BodyId> supportNeighbours(BodyId id) const;
+    /// The structure's bonds with their stress (empty unless StructurePolicy::enabled), ordered by (a, b).
+    std::vector<StructureBond> structureBonds() const;
     /// The point distant debris fades from (e.g. the camera).
     void setFocus(const Vec3& point);
 

@@ -31,7 +31,8 @@ struct ObjectDesc {
     double impulseThreshold = 0; ///< impacts below this impulse are ignored
     FractureParams fracture;     ///< how it breaks
     std::vector<ConvexPolytope>
-        convexParts; ///< collision parts in local coordinates; empty = decompose on add
+        convexParts;      ///< collision parts in local coordinates; empty = decompose on add
+    std::string material; ///< structural material, a Material.hpp preset (empty: defaultMaterial())
 };
 
 /// A live object as the runtime sees it.

@@ -49,15 +49,19 @@ enum class BooleanKind {
           ///< detail::clipByConvexCells (src/fracture/ConvexCellClipper.hpp), all cells in one pass as a
           ///< complex (adjacent shatter cells share their faces exactly); when it
           ///< declines a near-degenerate configuration, or its split fails verification, the whole split is
-          ///< redone by Corefine (FractureResult::exactFallback). Same seed, same bytes, like the others.
+          ///< redone by Corefine (FractureResult::exactFallback). fracture() first redraws a declined
+          ///< pattern up to twice (FractureResult::redraws). Same seed, same bytes, like the others.
 };
+
+/// The most cells a Shatter pattern has (FractureParams::cells is clamped to it).
+inline constexpr int kMaxShatterCells = 1000;
 
 /// Parameters of one fracture.
 struct FractureParams {
     CellPattern pattern = CellPattern::SingleCell; ///< single cell (thesis) or shatter pattern
-    int seedPoints = 15;                     ///< random Voronoi sites in the domain besides the impact point
-    int cells = 6;                           ///< K, the number of cells of a Shatter pattern
-    CellSizeLaw sizeLaw;                     ///< domain size from impulse
+    int seedPoints = 15; ///< random Voronoi sites in the domain besides the impact point
+    int cells = 6;       ///< K, the number of cells of a Shatter pattern (1..kMaxShatterCells)
+    CellSizeLaw sizeLaw; ///< domain size from impulse
     BooleanKind backend = BooleanKind::Fast; ///< boolean implementation
     double minPieceVolumeFraction = 1e-9;    ///< pieces below this fraction of the input volume are dropped
                                              ///< (their volume is reported in FractureResult::droppedVolume)
@@ -92,7 +96,9 @@ struct FractureResult {
     double inputVolume = 0;            ///< volume of the input mesh
     double droppedVolume = 0;          ///< volume of pieces dropped as too small
     bool exactFallback = false;        ///< Fast declined or failed verification; Corefine made the split
-    FractureTimings timings;           ///< stage durations
+    int redraws = 0; ///< fracture() with Fast: cell patterns redrawn (from derived seeds) because the clipper
+                     ///< declined a near-degenerate one; 0 = the seed's own pattern
+    FractureTimings timings; ///< stage durations
 };
 
 /// Builds the cutting cells for an impact on a mesh with the given bounds. Deterministic in seed.

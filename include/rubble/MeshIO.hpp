@@ -44,6 +44,14 @@ Result<Mesh> parseObj(std::string_view text, const std::string& displayName);
 /// Parses OBJ text keeping objects apart (see NamedMesh); objects without faces are dropped.
 Result<std::vector<NamedMesh>> parseObjObjects(std::string_view text, const std::string& displayName);
 
+/// Parses OFF text (Rubble's own reader: numbers exact to the double, polygons of any size triangulated as in
+/// parseObj, `#` comments anywhere). The header [ST][C][N][4][n]OFF is followed by the vertex, face and
+/// (ignored) edge counts; each vertex is one line `x y z` (`x y z w` for 4OFF, divided by w), each face one
+/// line `n i1 ... in` with 0-based indices; anything after the numbers a line needs (normals, colours) is
+/// ignored. The declared counts must match the file. Unreferenced vertices are dropped. Errors (ParseError,
+/// Unsupported for binary OFF and dimensions other than 3) name displayName and the line.
+Result<Mesh> parseOff(std::string_view text, const std::string& displayName);
+
 /// Reads an OBJ file into one mesh (see parseObj). Errors: IoError when the file cannot be read, ParseError
 /// naming file and line when it is malformed or has no triangles.
 Result<Mesh> readObj(const std::filesystem::path& path);
@@ -52,7 +60,8 @@ Result<std::vector<NamedMesh>> readObjObjects(const std::filesystem::path& path)
 
 /// Writes mesh as OBJ (exact shortest round-trip numbers), with normals and texture coordinates when present,
 /// and, when the mesh has materials, `usemtl` statements and an MTL file (same stem, .mtl) in which
-/// kInteriorMaterial is "interior" with its own colour. Triangles keep their order.
+/// kInteriorMaterial is "interior" with its own colour. Triangles keep their order. Each file is written to a
+/// staging file next to it and renamed, so a failed write (IoError) leaves the previous file as it was.
 Status writeObj(const std::filesystem::path& path, const Mesh& mesh, const ObjWriteOptions& options = {});
 
 /// One node of a glTF scene written by writeGltf.
@@ -69,14 +78,17 @@ struct GltfNode {
 /// (float, relative to the origin), NORMAL (unit; flat face normals when the mesh has none), TEXCOORD_0
 /// (V flipped to glTF's top-left origin; (0, 0) when the mesh has none) and uint32 indices; corners with
 /// equal position, normal and UV share a vertex. Output is byte-identical for identical input. Errors:
-/// InvalidInput for an empty or invalid mesh, IoError naming the file.
+/// InvalidInput for an empty or invalid mesh, IoError naming the file (written through a staging file and a
+/// rename, as writeObj).
 Status writeGltf(const std::filesystem::path& path, const std::vector<GltfNode>& nodes);
 
-/// Reads a mesh by extension: .obj with readObj; .off, .stl, .ply, .3ds, .gltf and .glb through Assimp
-/// (triangulated, positions welded exactly, node transforms applied). Size claims in headers (binary STL
-/// triangle count, PLY element counts, OFF counts, 3DS chunk lengths, glTF buffer/accessor lengths) are
-/// checked against the file before Assimp sees it. Errors: Unsupported for other extensions, IoError,
-/// ParseError; every message names the file.
+/// Reads a mesh by extension: .obj with readObj, .off with parseOff, ASCII .ply and .stl with Rubble's own
+/// readers (exact doubles, file:line errors, equal positions welded); binary .stl and .ply, .3ds, .gltf and
+/// .glb through Assimp (single precision; triangulated, positions welded exactly, node transforms applied).
+/// Size claims in headers (binary STL triangle count, PLY element counts, OFF counts, 3DS chunk lengths, glTF
+/// buffer/accessor lengths) are checked against the file before Assimp sees it, and so are glTF's JSON depth
+/// and node hierarchy (at most 256 and 1024 levels; nodes must form trees). Errors: Unsupported for other
+/// extensions, IoError, ParseError; every message names the file.
 Result<Mesh> readMesh(const std::filesystem::path& path);
 
 /// The extensions readMesh accepts, lower case with the dot (".obj", ".stl", ...).

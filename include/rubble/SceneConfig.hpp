@@ -4,8 +4,10 @@
 ///
 /// Line 1: six skybox images separated by ';' (top, bottom, left, right, front, back). Line 2: the ground,
 /// line 3: the vehicle, every further line an object, all as `model;texture;x;y;z;sx;sy;sz;mass` (mass 0 =
-/// static). Blank lines are ignored, '#' starts a comment that runs to the end of the line, CRLF line ends
-/// and a UTF-8 byte order mark are accepted, spaces around fields are trimmed, one trailing ';' is allowed.
+/// static), optionally followed by `;material` (a preset of Material.hpp: concrete, brick, stone, wood,
+/// glass, steel; objects without one are concrete). Blank lines are ignored, '#' starts a comment that runs
+/// to the end of the line, CRLF line ends and a UTF-8 byte order mark are accepted, spaces around fields are
+/// trimmed, one trailing ';' is allowed.
 
 #include <array>
 #include <cstddef>
@@ -30,6 +32,7 @@ struct SceneObject {
     Vec3 position;                     ///< x;y;z
     Vec3 scale{1, 1, 1};               ///< sx;sy;sz
     double mass = 0;                   ///< mass; 0 means static
+    std::string material;              ///< optional 10th field, a material preset name; empty when not given
 
     /// True when the object does not move (mass 0).
     bool isStatic() const { return mass == 0; }

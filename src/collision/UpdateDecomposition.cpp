@@ -22,10 +22,6 @@ struct Fragment {
 
 /// part − cell as at most one fragment per cell plane: outside plane j and inside planes < j.
 void subtractCell(const ConvexPolytope& part, const ConvexPolytope& cell, std::vector<ConvexPolytope>& out) {
-    if (!part.bounds().overlaps(cell.bounds())) {
-        out.push_back(part);
-        return;
-    }
     ConvexPolytope rest = part;
     for (const PolytopeFace& f : cell.faces()) {
         ConvexPolytope outside = rest.clippedOutside(f.plane);
@@ -131,9 +127,25 @@ void mergeToBudget(std::vector<ConvexPolytope>& parts, const std::vector<std::ui
         slot = {c.vi, c.vj, cost, std::move(h.value())};
         return &slot;
     };
-    for (std::size_t i = 0; i < n; ++i)
-        for (std::size_t j = i + 1; j < n; ++j)
-            consider(i, j);
+    // Pairs whose boxes can touch, by a sweep along x over the current boxes (consider checks the exact
+    // tolerance).
+    auto forEachNearPair = [&](auto&& fn) {
+        double reach = 0;
+        std::vector<std::size_t> byX;
+        for (std::size_t i = 0; i < n; ++i)
+            if (alive[i]) {
+                byX.push_back(i);
+                reach = std::max(reach, 2e-9 * bounds[i].diagonal());
+            }
+        std::sort(byX.begin(), byX.end(), [&](std::size_t a, std::size_t b) {
+            return bounds[a].lo.x < bounds[b].lo.x || (bounds[a].lo.x == bounds[b].lo.x && a < b);
+        });
+        for (std::size_t a = 0; a < byX.size(); ++a)
+            for (std::size_t b = a + 1; b < byX.size() && bounds[byX[b]].lo.x <= bounds[byX[a]].hi.x + reach;
+                 ++b)
+                fn(std::min(byX[a], byX[b]), std::max(byX[a], byX[b]));
+    };
+    forEachNearPair(consider);
     std::size_t count = n;
     std::vector<Candidate> picked;
     while (count > budget) {
@@ -149,10 +161,10 @@ void mergeToBudget(std::vector<ConvexPolytope>& parts, const std::vector<std::ui
             if (!siblingsOnly)
                 break;
             siblingsOnly = false; // siblings were not enough: every touching pair
-            for (std::size_t i = 0; i < n; ++i)
-                for (std::size_t j = i + 1; j < n; ++j)
-                    if (alive[i] && alive[j] && origin[i] != origin[j])
-                        consider(i, j);
+            forEachNearPair([&](std::size_t i, std::size_t j) {
+                if (alive[i] && alive[j] && origin[i] != origin[j])
+                    consider(i, j);
+            });
             continue;
         }
         std::size_t best = picked.size();
@@ -212,12 +224,16 @@ std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<C
     // 1. Fragments: part ∩ cell_i, and what is left outside every cell.
     double parentVolume = 0;
     std::vector<Fragment> fragments;
+    std::vector<Aabb> cellBounds;
+    cellBounds.reserve(cells.size());
+    for (const ConvexPolytope& cell : cells)
+        cellBounds.push_back(cell.bounds());
     for (std::uint32_t partIndex = 0; partIndex < parentParts.size(); ++partIndex) {
         const ConvexPolytope& part = parentParts[partIndex];
         parentVolume += part.volume();
         const Aabb pb = part.bounds();
         for (std::size_t c = 0; c < cells.size(); ++c) {
-            if (!pb.overlaps(cells[c].bounds()))
+            if (!pb.overlaps(cellBounds[c]))
                 continue;
             ConvexPolytope inside = part;
             for (const PolytopeFace& f : cells[c].faces()) {
@@ -228,12 +244,27 @@ std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<C
             if (!inside.empty())
                 fragments.push_back({std::move(inside), static_cast<std::int32_t>(c), partIndex});
         }
+        // part − every cell; a fragment away from a cell is moved on untouched.
         std::vector<ConvexPolytope> rest{part}, next;
-        for (const ConvexPolytope& cell : cells) {
+        std::vector<Aabb> restBounds{pb}, nextBounds;
+        for (std::size_t c = 0; c < cells.size(); ++c) {
+            if (!pb.overlaps(cellBounds[c]))
+                continue;
             next.clear();
-            for (const ConvexPolytope& r : rest)
-                subtractCell(r, cell, next);
+            nextBounds.clear();
+            for (std::size_t r = 0; r < rest.size(); ++r) {
+                if (!restBounds[r].overlaps(cellBounds[c])) {
+                    next.push_back(std::move(rest[r]));
+                    nextBounds.push_back(restBounds[r]);
+                    continue;
+                }
+                const std::size_t first = next.size();
+                subtractCell(rest[r], cells[c], next);
+                for (std::size_t k = first; k < next.size(); ++k)
+                    nextBounds.push_back(next[k].bounds());
+            }
             rest.swap(next);
+            restBounds.swap(nextBounds);
         }
         for (ConvexPolytope& r : rest)
             fragments.push_back({std::move(r), -1, partIndex});

@@ -15,8 +15,9 @@ namespace rubble::detail {
 std::unique_ptr<BooleanBackend> makeCorefineBackend();
 /// CGAL Nef_polyhedron_3 backend (the thesis's method).
 std::unique_ptr<BooleanBackend> makeNefBackend();
-/// Convex-cell clipper backend with a Corefine fallback.
-std::unique_ptr<BooleanBackend> makeFastBackend();
+/// Convex-cell clipper backend; with exactFallback, Corefine makes the splits the clipper declines, else
+/// they are errors.
+std::unique_ptr<BooleanBackend> makeFastBackend(bool exactFallback = true);
 
 /// Source of an output triangle: >= 0 an input triangle, kCutFace a cell face, kUnknownSource not known
 /// (found geometrically by assembleMesh).

@@ -1,11 +1,19 @@
-// Cell generators: the thesis's single randomized Voronoi cell and a Mueller-2013-style shatter pattern.
-// Cells are computed with Voro++ in a local frame (an axis-aligned cubic domain around the impact), then
-// rotated randomly about the impact. Everything is a pure function of the inputs and the seed.
+// Cell generators: the thesis's single randomized Voronoi cell (Voro++) and a Mueller-2013-style shatter
+// pattern (the dual of one exact-predicate Delaunay triangulation, so its cells form a complex by
+// construction; docs/robustness.md). Cells are built in a local frame around the impact, then rotated
+// randomly about it. Everything is a pure function of the inputs and the seed.
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <map>
 #include <numbers>
 
+#include <CGAL/Delaunay_triangulation_3.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Exact_rational.h>
+#include <CGAL/Simple_cartesian.h>
+#include <CGAL/Triangulation_vertex_base_with_info_3.h>
 #include <voro++/voro++.hh>
 
 #include "rubble/Fracture.hpp"
@@ -118,23 +126,114 @@ ConvexPolytope toPolytope(const RawCell& raw) {
     return ConvexPolytope::fromFaces(std::move(faces));
 }
 
-/// Makes vertices that several cells share bit-identical (each cell computes them separately, so they
-/// differ in the last bits) so that neighbouring cells neither overlap nor leave gaps.
-void weldAcrossCells(std::vector<RawCell>& cells, double tolerance) {
-    std::vector<Vec3> canonical;
-    for (RawCell& cell : cells)
-        for (Vec3& p : cell.vertices) {
-            bool found = false;
-            for (const Vec3& q : canonical)
-                if (std::abs(p.x - q.x) <= tolerance && std::abs(p.y - q.y) <= tolerance &&
-                    std::abs(p.z - q.z) <= tolerance) {
-                    p = q;
-                    found = true;
-                    break;
-                }
-            if (!found)
-                canonical.push_back(p);
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using VertexBase = CGAL::Triangulation_vertex_base_with_info_3<int, Kernel>;
+using Delaunay = CGAL::Delaunay_triangulation_3<
+    Kernel,
+    CGAL::Triangulation_data_structure_3<VertexBase, CGAL::Delaunay_triangulation_cell_base_3<Kernel>>>;
+
+/// A tetrahedron's circumcentre, computed exactly and rounded: a flat tetrahedron (nearly cospherical sites)
+/// makes the floating-point formula lose up to half its digits, and the Voronoi faces around it would bend.
+Vec3 circumcentre(const Delaunay::Cell& tet) {
+    using Exact = CGAL::Simple_cartesian<CGAL::Exact_rational>;
+    std::array<Exact::Point_3, 4> p;
+    for (int i = 0; i < 4; ++i) {
+        const Kernel::Point_3& q = tet.vertex(i)->point();
+        p[static_cast<std::size_t>(i)] = Exact::Point_3(q.x(), q.y(), q.z());
+    }
+    const Exact::Point_3 c = CGAL::circumcenter(p[0], p[1], p[2], p[3]);
+    return {CGAL::to_double(c.x()), CGAL::to_double(c.y()), CGAL::to_double(c.z())};
+}
+
+/// The Voronoi cells of sites[wanted[i]] (local coordinates) as one complex: the dual of the Delaunay
+/// triangulation of the sites and 26 ghost sites (ids -1 .. -26) at 2h{-1,0,1}^3 that bound every cell (the
+/// cell of the origin among the ghosts alone is the cube [-h, h]^3). Every Voronoi vertex is the circumcentre
+/// of one tetrahedron, computed once (exactly, then rounded) and shared by all cells around it; edges whose
+/// ends round to the same point are contracted in every cell alike. Vertices are mapped to world coordinates
+/// by p -> impact + rotation * (scale * p). A duplicated site gets an empty cell.
+std::vector<RawCell> voronoiComplex(const std::vector<Vec3>& sites, const std::vector<std::size_t>& wanted,
+                                    double h, const Mat3& rotation, double scale, const Vec3& impact) {
+    std::vector<std::pair<Kernel::Point_3, int>> points;
+    for (std::size_t i = 0; i < sites.size(); ++i)
+        points.emplace_back(Kernel::Point_3(sites[i].x, sites[i].y, sites[i].z), static_cast<int>(i));
+    int ghost = -1;
+    for (int x = -1; x <= 1; ++x)
+        for (int y = -1; y <= 1; ++y)
+            for (int z = -1; z <= 1; ++z)
+                if (x || y || z)
+                    points.emplace_back(Kernel::Point_3(2 * h * x, 2 * h * y, 2 * h * z), ghost--);
+    const Delaunay dt(points.begin(), points.end());
+    std::vector<Delaunay::Vertex_handle> handle(sites.size());
+    for (auto v = dt.finite_vertices_begin(); v != dt.finite_vertices_end(); ++v)
+        if (v->info() >= 0)
+            handle[static_cast<std::size_t>(v->info())] = v;
+
+    // Voronoi vertices by tetrahedron, and the faces of every wanted cell as loops of them.
+    std::map<Delaunay::Cell_handle, std::size_t> vertexOf;
+    std::vector<Vec3> positions;
+    std::vector<std::vector<std::vector<std::size_t>>> faces(wanted.size());
+    for (std::size_t w = 0; w < wanted.size(); ++w) {
+        const Delaunay::Vertex_handle v = handle[wanted[w]];
+        if (v == Delaunay::Vertex_handle() || v->info() != static_cast<int>(wanted[w]))
+            continue;
+        std::vector<Delaunay::Edge> edges;
+        dt.finite_incident_edges(v, std::back_inserter(edges));
+        std::vector<std::pair<int, std::vector<std::size_t>>> byNeighbour;
+        for (const Delaunay::Edge& e : edges) {
+            const Delaunay::Vertex_handle a = e.first->vertex(e.second), b = e.first->vertex(e.third);
+            const Delaunay::Vertex_handle other = a == v ? b : a;
+            std::vector<std::size_t> loop;
+            auto around = dt.incident_cells(e), start = around;
+            do {
+                auto [it, inserted] = vertexOf.emplace(around, positions.size());
+                if (inserted)
+                    positions.push_back(impact + rotation * (circumcentre(*around) * scale));
+                loop.push_back(it->second);
+            } while (++around != start);
+            byNeighbour.emplace_back(other->info(), std::move(loop));
         }
+        // Faces in a fixed order (by neighbour), so the output does not depend on traversal order.
+        std::sort(byNeighbour.begin(), byNeighbour.end(),
+                  [](const auto& x, const auto& y) { return x.first < y.first; });
+        for (auto& [neighbour, loop] : byNeighbour)
+            faces[w].push_back(std::move(loop));
+    }
+
+    // Contract the Voronoi edges of zero length (cospherical sites), the same way in every cell.
+    std::vector<std::size_t> parent(positions.size());
+    for (std::size_t i = 0; i < parent.size(); ++i)
+        parent[i] = i;
+    auto find = [&](std::size_t i) {
+        while (parent[i] != i)
+            i = parent[i] = parent[parent[i]];
+        return i;
+    };
+    for (const auto& cell : faces)
+        for (const auto& loop : cell)
+            for (std::size_t i = 0; i < loop.size(); ++i) {
+                const std::size_t a = loop[i], b = loop[(i + 1) % loop.size()];
+                if (positions[a] == positions[b]) {
+                    const std::size_t ra = find(a), rb = find(b);
+                    parent[std::max(ra, rb)] = std::min(ra, rb);
+                }
+            }
+
+    std::vector<RawCell> out(wanted.size());
+    for (std::size_t w = 0; w < wanted.size(); ++w) {
+        std::map<std::size_t, int> local;
+        for (const auto& loop : faces[w]) {
+            std::vector<int> face;
+            for (std::size_t id : loop) {
+                const std::size_t r = find(id);
+                auto [it, inserted] = local.emplace(r, static_cast<int>(out[w].vertices.size()));
+                if (inserted)
+                    out[w].vertices.push_back(positions[r]);
+                face.push_back(it->second);
+            }
+            out[w].faces.push_back(std::move(face));
+        }
+    }
+    return out;
 }
 
 } // namespace
@@ -164,15 +263,16 @@ std::vector<ConvexPolytope> generateCells(const Aabb& meshBounds, const Impact& 
         return out;
     }
 
-    // Shatter: sites concentrated at the impact (radius ~ u^2), the K sites nearest the impact cut.
+    // Shatter: sites denser near the impact (radius ~ sqrt(u): density ~ 1/r), the K sites nearest the impact
+    // cut.
     const double scale = rng.uniform(0.8, 1.25);
     const double h = size / 2;
-    const int k = std::clamp(params.cells, 1, 256);
+    const int k = std::clamp(params.cells, 1, kMaxShatterCells);
     const int n = std::max(std::clamp(params.seedPoints, 0, 10000), 2 * k);
     std::vector<Vec3> sites{{0, 0, 0}};
     for (int i = 0; i < n; ++i) {
         const double u = rng.uniform();
-        sites.push_back(rng.unitVector() * (h * 0.98 * u * u));
+        sites.push_back(rng.unitVector() * (h * 0.98 * std::sqrt(u)));
     }
     std::vector<std::size_t> order(sites.size());
     for (std::size_t i = 0; i < order.size(); ++i)
@@ -180,16 +280,9 @@ std::vector<ConvexPolytope> generateCells(const Aabb& meshBounds, const Impact& 
     std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
         return lengthSquared(sites[a]) < lengthSquared(sites[b]);
     });
-    std::vector<RawCell> raws;
-    for (int i = 0; i < k && i < static_cast<int>(order.size()); ++i) {
-        RawCell r = voronoiCell(sites, order[static_cast<std::size_t>(i)], h, rotation, scale, impact.point);
-        if (!r.vertices.empty())
-            raws.push_back(std::move(r));
-    }
-    double maxAbs = 0;
-    for (int a = 0; a < 3; ++a)
-        maxAbs = std::max(maxAbs, std::abs(impact.point[a]));
-    weldAcrossCells(raws, std::max(1e-9 * size * scale, 4e-16 * maxAbs));
+    std::vector<std::size_t> wanted(order.begin(),
+                                    order.begin() + std::min<std::ptrdiff_t>(k, std::ssize(order)));
+    std::vector<RawCell> raws = voronoiComplex(sites, wanted, h, rotation, scale, impact.point);
     for (const RawCell& r : raws) {
         ConvexPolytope p = toPolytope(r);
         if (!p.empty())

@@ -23,6 +23,7 @@
 
 #include "BooleanBackends.hpp"
 #include "ExactMesh.hpp"
+#include "rubble/MeshCheck.hpp"
 
 namespace rubble::detail {
 
@@ -103,6 +104,17 @@ auto meshParameters(SourceVisitor& visitor) {
     return PMP::parameters::visitor(visitor).throw_on_self_intersection(true);
 }
 
+/// What CGAL's "self-intersection detected" means here: the input intersects itself, or (the cells being
+/// convex) an intermediate result of the cut does.
+std::string selfIntersectionMessage(const Mesh& mesh) {
+    const SelfIntersectionResult s = findSelfIntersections(mesh, 1);
+    if (s.pairs > 0)
+        return "corefine: the mesh intersects itself (triangles " + std::to_string(s.examples[0].first + 1) +
+               " and " + std::to_string(s.examples[0].second + 1) + "); repair it first";
+    return "corefine: CGAL found intersecting triangles in an intermediate result of the cut (a degenerate "
+           "contact between a cell and the mesh; the mesh itself does not intersect itself)";
+}
+
 class CorefineBackend final : public BooleanBackend {
 public:
     std::string name() const override { return "corefine"; }
@@ -112,6 +124,8 @@ public:
             return run(mesh, cells);
         } catch (const Failure& f) {
             return makeError(ErrorCode::GeometryFailure, "corefine: " + f.why);
+        } catch (const PMP::Corefinement::Self_intersection_exception&) {
+            return makeError(ErrorCode::GeometryFailure, selfIntersectionMessage(mesh));
         } catch (const std::exception& e) {
             return makeError(ErrorCode::GeometryFailure, std::string("corefine: CGAL failed: ") + e.what());
         } catch (...) {
@@ -127,12 +141,17 @@ private:
             if (!cells[i].empty() && cells[i].bounds().overlaps(box))
                 touching.push_back(i);
         if (touching.size() > 1) {
-            if (auto r = runIndependent(mesh, cells, touching))
-                return std::move(*r);
+            try {
+                if (auto r = runIndependent(mesh, cells, touching))
+                    return std::move(*r);
+            } catch (const PMP::Corefinement::Self_intersection_exception&) {
+                // The union of many cells can hold fan triangles that fold by rounding where a cell face
+                // has a near-collinear corner (found by the shatter sweep: 135 cells on building.obj).
+            }
             // Cutting adjacent cells one after the other makes corefinement meet exactly coincident faces,
             // where CGAL 5.5 can crash (a segfault in Face_graph_output_builder, found by the
             // chained-fracture stress test on a valid 110-triangle piece and 5 shatter cells). Nef polyhedra
-            // handle that case.
+            // handle that case, and the one above.
             auto nef = makeNefBackend()->split(mesh, cells);
             if (!nef)
                 throw Failure{nef.error().message};

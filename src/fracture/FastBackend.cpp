@@ -12,6 +12,8 @@ namespace {
 
 class FastBackend final : public BooleanBackend {
 public:
+    explicit FastBackend(bool exactFallback) : exactFallback_(exactFallback) {}
+
     std::string name() const override { return "fast"; }
 
     Result<SplitResult> split(const Mesh& mesh, const std::vector<ConvexPolytope>& cells) const override {
@@ -31,9 +33,13 @@ public:
         } else {
             auto r = clipByConvexCells(mesh, used);
             if (!r) {
+                if (!exactFallback_)
+                    return r.error();
                 auto exact = makeCorefineBackend()->split(mesh, cells);
-                if (exact)
-                    exact->exactFallback = true;
+                if (!exact)
+                    return makeError(exact.error().code,
+                                     r.error().message + "; the exact redo failed: " + exact.error().message);
+                exact->exactFallback = true;
                 return exact;
             }
             for (std::size_t k = 0; k < index.size(); ++k)
@@ -47,12 +53,15 @@ public:
             out.remainder.materials.assign(out.remainder.triangles.size(), 0u);
         return out;
     }
+
+private:
+    bool exactFallback_;
 };
 
 } // namespace
 
-std::unique_ptr<BooleanBackend> makeFastBackend() {
-    return std::make_unique<FastBackend>();
+std::unique_ptr<BooleanBackend> makeFastBackend(bool exactFallback) {
+    return std::make_unique<FastBackend>(exactFallback);
 }
 
 } // namespace rubble::detail

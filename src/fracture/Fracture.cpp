@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <span>
 
 #include "BooleanBackends.hpp"
 #include "FracturePipeline.hpp"
@@ -11,6 +12,7 @@
 #include "rubble/Fracture.hpp"
 #include "rubble/Islands.hpp"
 #include "rubble/MeshSimplify.hpp"
+#include "rubble/Random.hpp"
 
 namespace rubble {
 
@@ -60,8 +62,8 @@ void cutBasis(Vec3 n, Vec3& u, Vec3& v) {
 
 /// Cut faces made by these cells: planar UVs (projection onto the cut plane, scaled by uvScale) and the
 /// plane's normal. Interior faces of earlier fractures (not on a face of these cells, or outside focus) keep
-/// theirs.
-void finishCutFaces(Mesh& m, const std::vector<ConvexPolytope>& cells, double uvScale, const Aabb& focus,
+/// theirs. Only cells whose bounds hold a triangle are searched for its plane.
+void finishCutFaces(Mesh& m, std::span<const ConvexPolytope> cells, double uvScale, const Aabb& focus,
                     double tolerance) {
     if (!m.hasMaterials())
         return;
@@ -77,7 +79,12 @@ void finishCutFaces(Mesh& m, const std::vector<ConvexPolytope>& cells, double uv
         // The cell face the triangle lies on: the plane nearest to its corners with a matching normal.
         const Plane* best = nullptr;
         double bestErr = std::numeric_limits<double>::infinity();
-        for (const ConvexPolytope& cell : cells)
+        Aabb box;
+        for (const Vec3& p : c)
+            box.extend(p);
+        for (const ConvexPolytope& cell : cells) {
+            if (!cell.bounds().overlaps(box, tolerance))
+                continue;
             for (const PolytopeFace& f : cell.faces()) {
                 if (std::abs(dot(f.plane.normal, tn)) < 0.5 * length(tn))
                     continue;
@@ -89,6 +96,7 @@ void finishCutFaces(Mesh& m, const std::vector<ConvexPolytope>& cells, double uv
                     best = &f.plane;
                 }
             }
+        }
         if (!best || bestErr > tolerance)
             continue; // an earlier fracture's face
         Vec3 n = best->normal;
@@ -207,7 +215,8 @@ Result<FractureResult> runPipeline(const Mesh& mesh, std::vector<ConvexPolytope>
     if (!sound)
         return makeError(ErrorCode::GeometryFailure,
                          "fracture: the " + backend.name() +
-                             " backend produced pieces that are not closed or do not conserve volume");
+                             " backend produced pieces that are not closed or do not conserve volume" +
+                             (exactRedo ? ", and so did its exact redo (corefine)" : ""));
     bool hit = false;
     for (const Mesh& m : split->inside)
         hit |= !m.empty();
@@ -226,8 +235,8 @@ Result<FractureResult> runPipeline(const Mesh& mesh, std::vector<ConvexPolytope>
     focus = {focus.lo - grow, focus.hi + grow};
     const double onPlane = 1e-7 * meshBox.diagonal();
     finishCutFaces(split->remainder, cells, params.uvScale, focus, onPlane);
-    for (Mesh& m : split->inside)
-        finishCutFaces(m, cells, params.uvScale, focus, onPlane);
+    for (std::size_t i = 0; i < split->inside.size(); ++i) // a cell's piece is cut by that cell only
+        finishCutFaces(split->inside[i], std::span(cells).subspan(i, 1), params.uvScale, focus, onPlane);
     res.timings.massMs = msSince(t1);
     const double minVolume = std::max(0.0, params.minPieceVolumeFraction) * inputVolume;
     addPieces(std::move(split->remainder), shells[0], -1, minVolume, params.simplifyPieces, focus, res);
@@ -277,19 +286,41 @@ Result<FractureResult> fracture(const Mesh& mesh, const Impact& impact, const Fr
     if (!isFinite(impact.point) || !std::isfinite(impact.impulse))
         return makeError(ErrorCode::InvalidInput, "fracture: the impact point or impulse is not finite");
     const double validateMs = msSince(t0);
-    const auto tc = Clock::now();
-    std::vector<ConvexPolytope> cells = generateCells(mesh.bounds(), impact, params, seed);
-    const double cellMs = msSince(tc);
+    double cellMs = 0;
+    auto cellsFor = [&](std::uint64_t s) {
+        const auto tc = Clock::now();
+        std::vector<ConvexPolytope> cells = generateCells(mesh.bounds(), impact, params, s);
+        cellMs += msSince(tc);
+        return cells;
+    };
+    auto finish = [&](Result<FractureResult> r, int redraws) {
+        if (r) {
+            r->redraws = redraws;
+            r->timings.validateMs = validateMs;
+            r->timings.cellMs = cellMs;
+            r->timings.totalMs = msSince(t0);
+        }
+        return r;
+    };
+    // The pattern is random: one the clipper declines as near-degenerate is redrawn (from derived seeds)
+    // before the exact fallback cuts the seed's own pattern.
+    constexpr int kRedraws = 2;
+    if (params.backend == BooleanKind::Fast)
+        for (int redraw = 0; redraw <= kRedraws; ++redraw) {
+            std::vector<ConvexPolytope> cells = cellsFor(redraw == 0 ? seed : mixSeed(seed, 0xDA7A + redraw));
+            if (cells.empty())
+                break;
+            auto r =
+                runPipeline(mesh, std::move(cells), params, *detail::makeFastBackend(false), false, volume);
+            if (r || r.error().code != ErrorCode::GeometryFailure)
+                return finish(std::move(r), redraw);
+        }
+    std::vector<ConvexPolytope> cells = cellsFor(seed);
     if (cells.empty())
         return makeError(ErrorCode::NoIntersection, "fracture: no cell could be built around the impact");
-    auto r = runPipeline(mesh, std::move(cells), params, *makeBooleanBackend(params.backend),
-                         params.backend == BooleanKind::Fast, volume);
-    if (!r)
-        return r;
-    r->timings.validateMs = validateMs;
-    r->timings.cellMs = cellMs;
-    r->timings.totalMs = msSince(t0);
-    return r;
+    return finish(runPipeline(mesh, std::move(cells), params, *makeBooleanBackend(params.backend),
+                              params.backend == BooleanKind::Fast, volume),
+                  0);
 }
 
 } // namespace rubble

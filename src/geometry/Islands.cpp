@@ -6,7 +6,6 @@
 
 #include "geometry/OrientedShells.hpp"
 #include "geometry/RayParity.hpp"
-#include "geometry/VertexStar.hpp"
 #include "rubble/MassProperties.hpp"
 
 namespace rubble {
@@ -47,8 +46,12 @@ std::size_t labelsFrom(UnionFind& uf, std::vector<std::uint32_t>& triangleShell)
     return count;
 }
 
-/// Insertion sort of a short range (a vertex's neighbours).
+/// Sorts a vertex's neighbours: insertion sort for the usual handful, std::sort around high-valence vertices.
 void sortShort(std::uint64_t* first, std::uint64_t* last) {
+    if (last - first > 32) {
+        std::sort(first, last);
+        return;
+    }
     for (std::uint64_t* i = first + 1; i < last; ++i) {
         const std::uint64_t key = *i;
         std::uint64_t* j = i;
@@ -114,21 +117,39 @@ std::int64_t closedOrientedShells(const Mesh& mesh, std::vector<std::uint32_t>* 
 } // namespace detail
 
 std::size_t labelShells(const Mesh& mesh, std::vector<std::uint32_t>& triangleShell) {
-    const std::size_t n = mesh.triangles.size();
+    const std::size_t n = mesh.triangles.size(), nv = mesh.positions.size();
     UnionFind uf(n);
-    // Triangles sharing an edge (either direction, also non-manifold) are united; each vertex's star is
-    // scanned instead of hashing every edge.
-    const detail::VertexStar star(mesh);
-    for (std::uint32_t a = 0; a < star.vertexCount(); ++a)
-        for (std::uint32_t i = star.begin(a); i < star.end(a); ++i) {
-            const std::uint32_t b = star.target(i), t = star.halfEdge(i) / 3;
-            for (std::uint32_t j = star.begin(a); j < i; ++j)
-                if (star.target(j) == b)
-                    uf.unite(star.halfEdge(j) / 3, t);
-            if (a < b)
-                for (std::uint32_t j = star.begin(b); j < star.end(b); ++j)
-                    if (star.target(j) == a)
-                        uf.unite(star.halfEdge(j) / 3, t);
+    // Triangles sharing an edge (either direction, also non-manifold) are united. Each half-edge is filed
+    // under its smaller end; in one vertex's file, the first triangle seen on each other end is united with
+    // the later ones (a stamp per other end), so the work is linear also around vertices of very high
+    // valence.
+    std::vector<std::uint32_t> first(nv + 1, 0);
+    for (const Triangle& t : mesh.triangles)
+        for (int c = 0; c < 3; ++c)
+            ++first[std::min(t[c], t[(c + 1) % 3]) + 1];
+    for (std::size_t v = 0; v < nv; ++v)
+        first[v + 1] += first[v];
+    std::vector<std::uint32_t> otherEnd(3 * n), triangleOf(3 * n);
+    {
+        std::vector<std::uint32_t> fill(first.begin(), first.end() - 1);
+        for (std::uint32_t t = 0; t < n; ++t)
+            for (int c = 0; c < 3; ++c) {
+                const std::uint32_t a = mesh.triangles[t][c], b = mesh.triangles[t][(c + 1) % 3];
+                const std::uint32_t slot = fill[std::min(a, b)]++;
+                otherEnd[slot] = std::max(a, b);
+                triangleOf[slot] = t;
+            }
+    }
+    std::vector<std::uint32_t> stamp(nv, UINT32_MAX), firstTriangle(nv, 0);
+    for (std::uint32_t a = 0; a < nv; ++a)
+        for (std::uint32_t k = first[a]; k < first[a + 1]; ++k) {
+            const std::uint32_t b = otherEnd[k], t = triangleOf[k];
+            if (stamp[b] == a) {
+                uf.unite(firstTriangle[b], t);
+            } else {
+                stamp[b] = a;
+                firstTriangle[b] = t;
+            }
         }
     return labelsFrom(uf, triangleShell);
 }

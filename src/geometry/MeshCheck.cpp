@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <unordered_map>
 
@@ -53,7 +54,19 @@ bool MeshReport::valid() const {
            badAttributeArrays == 0 && !(selfIntersectionsChecked && selfIntersections > 0);
 }
 
-bool isDegenerateTriangle(const Vec3& a, const Vec3& b, const Vec3& c) {
+bool isDegenerateTriangle(const Vec3& a0, const Vec3& b0, const Vec3& c0) {
+    // Scaled by a power of two (exact) to coordinates below 2, so that huge (1e300) or tiny (1e-300)
+    // triangles neither overflow nor underflow; for ordinary ones the result is the same as without scaling.
+    const double most =
+        std::max({std::abs(a0.x), std::abs(a0.y), std::abs(a0.z), std::abs(b0.x), std::abs(b0.y),
+                  std::abs(b0.z), std::abs(c0.x), std::abs(c0.y), std::abs(c0.z)});
+    if (!std::isfinite(most))
+        return false; // non-finite coordinates are reported as such
+    const int shift = most > 0 ? -std::ilogb(most) : 0;
+    auto scaled = [shift](const Vec3& p) {
+        return Vec3{std::ldexp(p.x, shift), std::ldexp(p.y, shift), std::ldexp(p.z, shift)};
+    };
+    const Vec3 a = scaled(a0), b = scaled(b0), c = scaled(c0);
     const Vec3 e0 = b - a, e1 = c - a, e2 = c - b;
     const double longest = std::max({lengthSquared(e0), lengthSquared(e1), lengthSquared(e2)});
     if (longest == 0)
@@ -312,9 +325,18 @@ MeshReport checkMesh(const Mesh& mesh, const CheckOptions& options) {
                            " used twice in the same direction" + examples(ex, r.misorientedEdges));
     }
     if (!mesh.triangles.empty() && r.badIndices == 0 && r.nonFiniteVertices == 0 && r.closed && r.oriented &&
-        !r.outward)
-        problems.push_back(r.volume < 0 ? "the mesh is inside out (signed volume " + num(r.volume) + ")"
-                                        : "the mesh encloses no volume");
+        !r.outward) {
+        if (!std::isfinite(r.volume)) {
+            double most = 0;
+            for (const Vec3& p : mesh.positions)
+                most = std::max({most, std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+            problems.push_back("the mesh's volume overflows the range of doubles (coordinates up to " +
+                               num(most) + "); scale the mesh down");
+        } else {
+            problems.push_back(r.volume < 0 ? "the mesh is inside out (signed volume " + num(r.volume) + ")"
+                                            : "the mesh encloses no volume");
+        }
+    }
     if (r.degenerateTriangles > 0)
         problems.push_back(plural(r.degenerateTriangles, "triangle is", "triangles are") +
                            " degenerate (repeated vertex or zero area)" +

@@ -4,38 +4,91 @@
 #include <cstring>
 #include <fstream>
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 namespace rubble::io {
 
 std::string displayName(const std::filesystem::path& path) {
     return path.string();
 }
 
-Result<std::string> readFileBytes(const std::filesystem::path& path) {
-    std::error_code ec;
-    if (std::filesystem::is_directory(path, ec))
+namespace {
+const char* fileKind(mode_t mode) {
+    if (S_ISDIR(mode))
+        return "a directory";
+    if (S_ISCHR(mode))
+        return "a character device";
+    if (S_ISBLK(mode))
+        return "a block device";
+    if (S_ISFIFO(mode))
+        return "a FIFO";
+    if (S_ISSOCK(mode))
+        return "a socket";
+    return "not a regular file";
+}
+} // namespace
+
+Result<std::string> readFileBytes(const std::filesystem::path& path, std::uint64_t maxBytes) {
+    // Only regular files (after symbolic links): /dev/zero never ends and a FIFO blocks the open.
+    struct stat st {};
+    if (::stat(path.c_str(), &st) != 0) {
+        const int err = errno;
+        return makeError(ErrorCode::IoError, displayName(path) + ": cannot open: " + std::strerror(err));
+    }
+    if (S_ISDIR(st.st_mode))
         return makeError(ErrorCode::IoError, displayName(path) + ": cannot read: is a directory");
+    if (!S_ISREG(st.st_mode))
+        return makeError(ErrorCode::IoError, displayName(path) + ": cannot read: it is " +
+                                                 fileKind(st.st_mode) + ", not a regular file");
+    if (static_cast<std::uint64_t>(st.st_size) > maxBytes)
+        return makeError(ErrorCode::IoError,
+                         displayName(path) + ": the file has " + std::to_string(st.st_size) +
+                             " bytes, more than the limit of " + std::to_string(maxBytes) + " bytes");
     std::ifstream in(path, std::ios::binary);
     if (!in) {
         const int err = errno;
         return makeError(ErrorCode::IoError, displayName(path) + ": cannot open: " +
                                                  (err ? std::strerror(err) : "unknown error"));
     }
-    std::string bytes;
-    in.seekg(0, std::ios::end);
-    const std::streamoff size = in.tellg();
-    if (size > 0) {
-        bytes.resize(static_cast<std::size_t>(size));
-        in.seekg(0, std::ios::beg);
-        in.read(bytes.data(), size);
-        if (in.gcount() != size)
-            return makeError(ErrorCode::IoError, displayName(path) + ": cannot read the whole file");
-    } else {
-        // Not seekable (a pipe) or empty: read what there is.
-        in.clear();
-        in.seekg(0, std::ios::beg);
-        bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-    }
+    std::string bytes(static_cast<std::size_t>(st.st_size), '\0');
+    in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    if (in.gcount() != static_cast<std::streamsize>(bytes.size()))
+        return makeError(ErrorCode::IoError, displayName(path) + ": cannot read the whole file");
     return bytes;
+}
+
+std::filesystem::path stagingPath(const std::filesystem::path& target) {
+    const std::filesystem::path name = target.filename();
+    return target.parent_path() / ("." + name.string() + ".rubble-tmp-" + std::to_string(::getpid()));
+}
+
+Status writeFileAtomically(const std::filesystem::path& path, std::string_view bytes) {
+    const std::filesystem::path tmp = stagingPath(path);
+    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+    if (fd < 0) {
+        const int err = errno;
+        return makeError(ErrorCode::IoError,
+                         displayName(path) + ": cannot open for writing: " + std::strerror(err));
+    }
+    int err = 0;
+    for (std::size_t done = 0; done < bytes.size() && err == 0;) {
+        const ::ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+        if (n < 0 && errno != EINTR)
+            err = errno;
+        else if (n > 0)
+            done += static_cast<std::size_t>(n);
+    }
+    if (::close(fd) != 0 && err == 0)
+        err = errno;
+    if (err == 0 && ::rename(tmp.c_str(), path.c_str()) != 0)
+        err = errno;
+    if (err != 0) {
+        ::unlink(tmp.c_str());
+        return makeError(ErrorCode::IoError, displayName(path) + ": write failed: " + std::strerror(err));
+    }
+    return {};
 }
 
 } // namespace rubble::io

@@ -204,12 +204,7 @@ Status writeGltf(const std::filesystem::path& path, const std::vector<GltfNode>&
     doc["bufferViews"] = buffer.views();
     doc["accessors"] = buffer.accessors();
     const std::string text = doc.dump(1) + "\n";
-    std::ofstream out(path, std::ios::binary | std::ios::trunc);
-    if (!out)
-        return makeError(ErrorCode::IoError, where + ": cannot open for writing: " + std::strerror(errno));
-    out << text;
-    out.close();
-    return out ? Status{} : makeError(ErrorCode::IoError, where + ": write failed");
+    return io::writeFileAtomically(path, text);
 }
 
 } // namespace rubble

@@ -58,15 +58,7 @@ private:
 };
 
 Status writeText(const std::filesystem::path& path, const std::string& text) {
-    std::ofstream out(path, std::ios::binary | std::ios::trunc);
-    if (!out)
-        return makeError(ErrorCode::IoError,
-                         io::displayName(path) + ": cannot open for writing: " + std::strerror(errno));
-    out.write(text.data(), static_cast<std::streamsize>(text.size()));
-    out.close();
-    if (!out)
-        return makeError(ErrorCode::IoError, io::displayName(path) + ": write failed");
-    return {};
+    return io::writeFileAtomically(path, text);
 }
 } // namespace
 

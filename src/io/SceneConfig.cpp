@@ -6,6 +6,7 @@
 #include <string_view>
 
 #include "io/FileBytes.hpp"
+#include "rubble/Material.hpp"
 
 namespace rubble {
 
@@ -142,9 +143,9 @@ private:
     Status object(std::string_view line, std::size_t entity) {
         const auto f = splitFields(line);
         const char* role = entity == 1 ? "ground" : entity == 2 ? "vehicle" : "object";
-        if (f.size() != 9)
-            return fail(std::string("expected 9 fields for the ") + role +
-                        " (model;texture;x;y;z;sx;sy;sz;mass), got " + std::to_string(f.size()));
+        if (f.size() != 9 && f.size() != 10)
+            return fail(std::string("expected 9 or 10 fields for the ") + role +
+                        " (model;texture;x;y;z;sx;sy;sz;mass[;material]), got " + std::to_string(f.size()));
         SceneObject o;
         o.line = line_;
         o.model = std::string(f[0]);
@@ -162,6 +163,12 @@ private:
                             "): scale must not be 0");
         if (o.mass < 0)
             return fail("field 'mass' (9th): mass must not be negative, got '" + shown(f[8]) + "'");
+        if (f.size() == 10) {
+            if (!findMaterial(f[9]))
+                return fail("field 'material' (10th): unknown material '" + shown(f[9]) +
+                            "'; expected one of " + materialNames());
+            o.material = std::string(f[9]);
+        }
         if (!o.model.empty()) {
             o.modelPath = resolve(o.model);
             o.modelFound = exists(o.modelPath);

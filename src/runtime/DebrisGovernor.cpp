@@ -7,7 +7,8 @@
 namespace rubble::detail {
 namespace {
 
-constexpr double kCellSize = 4.0; // m: frozen pieces are small, so a body's neighbourhood is a few cells
+constexpr int kSettledFrames = 10; // a piece falling from rest passes 1 m/s within 6 frames at 60 Hz
+constexpr double kCellSize = 4.0;  // m: frozen pieces are small, so a body's neighbourhood is a few cells
 
 std::int64_t cellCoord(double x) {
     return static_cast<std::int64_t>(std::floor(x / kCellSize));
@@ -44,6 +45,8 @@ void DebrisGovernor::frozen(BodyId id, const Vec3& center, double radius) {
 
 void DebrisGovernor::thawed(BodyId id) {
     restFrames_.erase(id);
+    settleFrames_.erase(id);
+    awakeFrames_.erase(id);
     auto it = frozen_.find(id);
     if (it == frozen_.end())
         return;
@@ -100,7 +103,13 @@ GovernorActions DebrisGovernor::update(const BodyTable& bodies, const PhysicsBin
             out.wake.push_back(id);
 
     std::set<BodyId> leaving;
-    std::vector<std::pair<double, BodyId>> stillAwake; // pieces: the game's own objects are never retired
+    struct Awake {
+        double volume, speed;
+        bool settled; // slow for kSettledFrames: resting on something, not at the top of a fall
+        bool young;   // awake for fewer frames: it may yet settle, so it is not retired
+        BodyId id;
+    };
+    std::vector<Awake> stillAwake; // pieces: the game's own objects are never retired
     int awakeObjects = 0;
     for (BodyId id : bodies.awakeIds()) {
         const BodyRecord& r = *bodies.find(id);
@@ -121,13 +130,17 @@ GovernorActions DebrisGovernor::update(const BodyTable& bodies, const PhysicsBin
             length(m.linearVelocity) < budget_.freezeSpeed && length(m.angularVelocity) < budget_.freezeSpeed;
         int& rest = restFrames_[id];
         rest = resting ? rest + 1 : 0;
+        const double speed = std::max(length(m.linearVelocity), length(m.angularVelocity));
+        int& settle = settleFrames_[id];
+        settle = speed < budget_.settlingSpeed ? settle + 1 : 0;
+        const int age = ++awakeFrames_[id];
         if ((budget_.freezeSleeping && m.sleeping) || rest >= std::max(1, budget_.freezeAfterFrames)) {
             out.freeze.push_back(id);
             leaving.insert(id);
             continue;
         }
         if (piece)
-            stillAwake.push_back({r.volume, id});
+            stillAwake.push_back({r.volume, speed, settle >= kSettledFrames, age < kSettledFrames, id});
         else
             ++awakeObjects;
     }
@@ -142,12 +155,43 @@ GovernorActions DebrisGovernor::update(const BodyTable& bodies, const PhysicsBin
     } else {
         awakeBudget_ = -1;
     }
-    const int excess = static_cast<int>(stillAwake.size() + out.wake.size()) + awakeObjects - awakeBudget();
+    // Over the awake budget: settled pieces freeze where they are (slowest first), then the smallest of the
+    // moving ones retire. A piece awake for fewer than kSettledFrames, or slow, is left to settle first.
+    int excess = static_cast<int>(stillAwake.size() + out.wake.size()) + awakeObjects - awakeBudget();
     if (excess > 0) {
-        std::sort(stillAwake.begin(), stillAwake.end());
-        for (int i = 0; i < excess && i < static_cast<int>(stillAwake.size()); ++i) {
-            out.retire.push_back({stillAwake[i].second, RetireReason::Budget});
-            leaving.insert(stillAwake[i].second);
+        std::sort(stillAwake.begin(), stillAwake.end(), [](const Awake& a, const Awake& b) {
+            return a.speed < b.speed || (a.speed == b.speed && a.id < b.id);
+        });
+        for (const Awake& a : stillAwake) {
+            if (excess <= 0)
+                break;
+            if (!a.settled)
+                continue;
+            out.freeze.push_back(a.id);
+            leaving.insert(a.id);
+            --excess;
+        }
+        std::sort(stillAwake.begin(), stillAwake.end(), [](const Awake& a, const Awake& b) {
+            return a.volume < b.volume || (a.volume == b.volume && a.id < b.id);
+        });
+        for (const Awake& a : stillAwake) {
+            if (excess <= 0)
+                break;
+            if (leaving.count(a.id) || a.young || a.speed < budget_.settlingSpeed)
+                continue; // a slow piece is about to settle and freeze
+            out.retire.push_back({a.id, RetireReason::Budget});
+            leaving.insert(a.id);
+            --excess;
+        }
+        // Beyond the overshoot the budget is hard: the smallest of the waiting pieces retire too.
+        for (const Awake& a : stillAwake) {
+            if (excess <= std::max(0, budget_.awakeOvershoot))
+                break;
+            if (leaving.count(a.id))
+                continue;
+            out.retire.push_back({a.id, RetireReason::Budget});
+            leaving.insert(a.id);
+            --excess;
         }
     }
 
@@ -162,9 +206,9 @@ GovernorActions DebrisGovernor::update(const BodyTable& bodies, const PhysicsBin
                 candidates.push_back({r->volume, id});
         std::sort(candidates.begin(), candidates.end());
         std::vector<std::pair<double, BodyId>> awake;
-        for (const auto& [v, id] : stillAwake)
-            if (!leaving.count(id))
-                awake.push_back({v, id});
+        for (const Awake& a : stillAwake)
+            if (!leaving.count(a.id))
+                awake.push_back({a.volume, a.id});
         std::sort(awake.begin(), awake.end());
         candidates.insert(candidates.end(), awake.begin(), awake.end());
         for (const auto& [v, id] : candidates) {
@@ -174,8 +218,11 @@ GovernorActions DebrisGovernor::update(const BodyTable& bodies, const PhysicsBin
             out.retire.push_back({id, RetireReason::Budget});
         }
     }
-    for (BodyId id : leaving)
+    for (BodyId id : leaving) {
         restFrames_.erase(id);
+        settleFrames_.erase(id);
+        awakeFrames_.erase(id);
+    }
     return out;
 }
 

@@ -53,7 +53,9 @@ private:
     std::vector<Cell> cellsOf(const Vec3& lo, const Vec3& hi) const;
 
     const DebrisBudget& budget_;
-    std::unordered_map<BodyId, int> restFrames_;
+    std::unordered_map<BodyId, int> restFrames_;   // frames below freezeSpeed in a row
+    std::unordered_map<BodyId, int> settleFrames_; // frames below settlingSpeed in a row
+    std::unordered_map<BodyId, int> awakeFrames_;  // frames awake since adopted or woken
     std::map<BodyId, FrozenEntry> frozen_;
     std::unordered_map<Cell, std::vector<BodyId>> grid_;
     std::vector<BodyId> toWake_;

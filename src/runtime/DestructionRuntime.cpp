@@ -7,12 +7,14 @@
 #include <map>
 #include <set>
 #include <string>
+#include <tuple>
 
 #include "runtime/BodyTable.hpp"
 #include "runtime/DebrisGovernor.hpp"
 #include "runtime/DebrisPool.hpp"
 #include "runtime/ImpactCollector.hpp"
 #include "runtime/PieceAdopter.hpp"
+#include "runtime/StructureMonitor.hpp"
 #include "runtime/SupportGraph.hpp"
 
 namespace rubble {
@@ -51,7 +53,7 @@ std::vector<ConvexPolytope> worldParts(const ObjectState& st, const Frame& objec
 struct DestructionRuntime::Impl {
     Impl(PhysicsBinding& b, const Config& c)
         : binding(b), config(c), world(c.world), collector(config.impacts), support(config.support),
-          governor(config.debris) {}
+          structure(config.structure), governor(config.debris) {}
 
     PhysicsBinding& binding;
     Config config;
@@ -59,6 +61,8 @@ struct DestructionRuntime::Impl {
     detail::BodyTable bodies;
     detail::ImpactCollector collector;
     detail::SupportGraph support;
+    detail::StructureMonitor structure;
+    std::map<ObjectId, const Material*> materials; // of objects (pieces inherit their parent's)
     detail::DebrisGovernor governor;
     std::set<BodyId> projectiles;
     detail::DebrisPool particles;
@@ -99,9 +103,12 @@ struct DestructionRuntime::Impl {
         if (r->role != BodyRole::Projectile)
             governor.wakeNear(boundsOf(*r), config.support.tolerance);
         support.remove(id);
+        structure.remove(id);
         governor.thawed(id);
         projectiles.erase(id);
         binding.removeBody(id);
+        if (r->hasObject)
+            materials.erase(r->object);
         if (r->hasObject && removeObject)
             world.removeObject(r->object);
         bodies.erase(id);
@@ -125,6 +132,7 @@ struct DestructionRuntime::Impl {
         if (!r || r->motion == BodyMotionState::Dynamic)
             return;
         support.remove(id);
+        structure.remove(id);
         governor.thawed(id);
         governor.wakeNear(boundsOf(*r), config.support.tolerance);
         r->structural = false;
@@ -142,7 +150,21 @@ struct DestructionRuntime::Impl {
         governor.frozen(id, binding.motion(id).transform.translation, r->radius);
     }
 
+    const Material& materialOf(ObjectId id) const {
+        const auto it = materials.find(id);
+        return it != materials.end() ? *it->second : defaultMaterial();
+    }
+
+    // A node of the structure (when enabled).
+    void addStructure(BodyId id, const std::vector<ConvexPolytope>& worldParts, const Material& m,
+                      bool root) {
+        if (config.structure.enabled)
+            structure.add(id, worldParts, m, root);
+    }
+
     void submit(const detail::PendingImpact& p, FrameStats& stats) {
+        if (config.structure.enabled)
+            structure.damage(p.worldPoint, p.impact.impulse);
         if (!world.submitImpact(p.object, p.impact))
             return;
         ++stats.impactsSubmitted;
@@ -165,10 +187,12 @@ struct DestructionRuntime::Impl {
             return;
         }
         const BodyRecord parent = *parentPtr;
+        const Material& material = materialOf(outcome.parent);
         const BodyMotion parentMotion = binding.motion(parent.id);
         const bool collapse = config.support.collapseUnsupported;
-        detail::AdoptionPlan plan = detail::planAdoption(outcome, parent, parentMotion, config.adoption,
-                                                         collapse, config.debris.particleLifetime);
+        detail::AdoptionPlan plan = detail::planAdoption(
+            outcome, parent, parentMotion, config.adoption, collapse, config.debris.particleLifetime,
+            config.structure.enabled && config.structure.bondDebris);
         destroy(parent.id, false); // the DestructionWorld removed the parent object already
         ++stats.fractures;
         ++counters.fractures;
@@ -189,8 +213,12 @@ struct DestructionRuntime::Impl {
             rec.anchor = s.anchor;
             rec.structural = s.structural;
             const BodyRecord& made = insert(rec, s.desc);
+            if (&material != &defaultMaterial())
+                materials[s.object] = &material;
             if (s.structural) {
-                support.add(made.id, worldParts(st, s.desc.transform * s.objectToBody.inverse()), s.anchor);
+                const auto parts = worldParts(st, s.desc.transform * s.objectToBody.inverse());
+                addStructure(made.id, parts, material, s.anchor);
+                support.add(made.id, parts, s.anchor);
                 support.queue(made.id);
             }
             ++stats.piecesCreated;
@@ -225,6 +253,40 @@ struct DestructionRuntime::Impl {
                 break;
         }
         stats.supportMs += msSince(t0);
+    }
+
+    // Contact forces of moving bodies on structure nodes (impulse over the frame).
+    void feedContactLoads(double dt) {
+        if (!config.structure.enabled || dt <= 0)
+            return;
+        for (const ContactReport& c : contacts) {
+            const Vec3 onA = c.normalOnB * (c.impulse / dt); // b pushes a away from b
+            for (const auto& [self, other, force, point] :
+                 {std::tuple{c.a, c.b, onA, c.pointOnA}, std::tuple{c.b, c.a, -onA, c.pointOnB}}) {
+                const BodyRecord* o = bodies.find(other);
+                if (o && o->motion == BodyMotionState::Dynamic && structure.contains(self))
+                    structure.addLoad(self, force, point);
+            }
+        }
+    }
+
+    // Solves the structure; what lost its bonded support falls, and what rested on that is re-checked.
+    void settleStructure(FrameStats& stats) {
+        if (!config.structure.enabled)
+            return;
+        const auto t0 = Clock::now();
+        int broken = 0;
+        const std::vector<BodyId> fallen = structure.step(binding.gravity(), broken);
+        stats.bondsBroken += broken;
+        counters.bondsBroken += broken;
+        for (BodyId id : fallen) {
+            makeDynamic(id);
+            ++stats.piecesCollapsed;
+            ++counters.piecesCollapsed;
+        }
+        stats.structureMs += msSince(t0);
+        if (!fallen.empty())
+            settleSupport(stats);
     }
 
     void adoptResults(FrameStats& stats) {
@@ -303,16 +365,24 @@ BodyId DestructionRuntime::addGround(const Vec3& center, const Vec3& halfExtents
     rec.structural = true;
     rec.radius = length(halfExtents);
     const BodyId id = impl_->insert(rec, desc).id;
-    impl_->support.add(id, {ConvexPolytope::fromAabb(Aabb{center - halfExtents, center + halfExtents})},
-                       true);
+    const std::vector<ConvexPolytope> parts{
+        ConvexPolytope::fromAabb(Aabb{center - halfExtents, center + halfExtents})};
+    impl_->addStructure(id, parts, defaultMaterial(), true);
+    impl_->support.add(id, parts, true);
     return id;
 }
 
 Result<ObjectId> DestructionRuntime::addObject(ObjectDesc desc, const Frame& placement, bool isStatic) {
     Impl& im = *impl_;
+    const Material* material = desc.material.empty() ? &defaultMaterial() : findMaterial(desc.material);
+    if (!material)
+        return Error{ErrorCode::InvalidInput,
+                     "unknown material '" + desc.material + "'; expected one of " + materialNames()};
     Result<ObjectId> id = im.world.addObject(std::move(desc));
     if (!id)
         return id;
+    if (material != &defaultMaterial())
+        im.materials[*id] = material;
     const ObjectState& st = *im.world.object(*id);
     detail::PieceSpawn s = detail::describeObjectBody(st, isStatic, 0);
     s.desc.transform = placement * s.objectToBody;
@@ -329,8 +399,11 @@ Result<ObjectId> DestructionRuntime::addObject(ObjectDesc desc, const Frame& pla
     rec.radius = boundingRadius(st.mesh, s.objectToBody);
     rec.structural = isStatic;
     const BodyId body = im.insert(rec, s.desc).id;
-    if (isStatic)
-        im.support.add(body, worldParts(st, placement), false, true);
+    if (isStatic) {
+        const auto parts = worldParts(st, placement);
+        im.addStructure(body, parts, *material, false);
+        im.support.add(body, parts, false, true);
+    }
     return id;
 }
 
@@ -366,8 +439,11 @@ Result<BodyId> DestructionRuntime::addConvexBody(const std::vector<Vec3>& points
     rec.radius = std::sqrt(r2);
     rec.structural = mass <= 0;
     const BodyId id = impl_->insert(rec, desc).id;
-    if (mass <= 0)
-        impl_->support.add(id, {ConvexPolytope::fromAabb(box).transformed(placement)}, true);
+    if (mass <= 0) {
+        const std::vector<ConvexPolytope> parts{ConvexPolytope::fromAabb(box).transformed(placement)};
+        impl_->addStructure(id, parts, defaultMaterial(), true);
+        impl_->support.add(id, parts, true);
+    }
     return id;
 }
 
@@ -443,6 +519,8 @@ FrameStats DestructionRuntime::stepFrame(double dt) {
     im.adoptResults(stats);
     im.govern(batch.frozenHits, stats);
     im.settleSupport(stats);
+    im.feedContactLoads(dt);
+    im.settleStructure(stats);
     im.advance(dt);
     stats.adoptMs = msSince(t1);
     return stats;
@@ -521,6 +599,10 @@ VolumeLedger DestructionRuntime::volumes() const {
         if (r.hasObject)
             v.live += r.volume;
     return v;
+}
+
+std::vector<StructureBond> DestructionRuntime::structureBonds() const {
+    return impl_->structure.bonds();
 }
 
 std::vector<BodyId> DestructionRuntime::supportNeighbours(BodyId id) const {

@@ -44,7 +44,7 @@ PieceSpawn describeObjectBody(const ObjectState& st, bool isStatic, double singl
 
 AdoptionPlan planAdoption(const FractureOutcome& outcome, const BodyRecord& parent,
                           const BodyMotion& parentMotion, const AdoptionPolicy& policy, bool collapse,
-                          double particleLifetime) {
+                          double particleLifetime, bool bondDebris) {
     AdoptionPlan plan;
     const Frame parentObject = parentMotion.transform * parent.objectToBody.inverse();
     const Vec3 v = parentMotion.linearVelocity, w = parentMotion.angularVelocity;
@@ -95,7 +95,7 @@ AdoptionPlan planAdoption(const FractureOutcome& outcome, const BodyRecord& pare
     };
     for (std::size_t i = 0; i < pieces.size(); ++i) {
         const AdoptedPiece& p = pieces[i];
-        const bool checked = collapse && !floating && isRemainder(i);
+        const bool checked = collapse && !floating && (isRemainder(i) || bondDebris);
         const bool isStatic = i == keep || checked;
         PieceSpawn s = describeObjectBody(*p.state, isStatic, policy.singleHullVolume);
         s.desc.transform = parentObject * p.frame * s.objectToBody;

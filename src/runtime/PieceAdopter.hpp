@@ -34,8 +34,9 @@ PieceSpawn describeObjectBody(const ObjectState& state, bool isStatic, double si
 
 /// The bodies and particles of an outcome whose parent body is `parent`, moving as `parentMotion`.
 /// `collapse`: structural support is on (remainder pieces of a static parent stay static and are checked).
+/// `bondDebris`: so do its debris pieces (they stay bonded in the structure).
 AdoptionPlan planAdoption(const FractureOutcome& outcome, const BodyRecord& parent,
                           const BodyMotion& parentMotion, const AdoptionPolicy& policy, bool collapse,
-                          double particleLifetime);
+                          double particleLifetime, bool bondDebris = false);
 
 } // namespace rubble::detail

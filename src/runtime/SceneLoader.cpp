@@ -101,6 +101,7 @@ LoadedScene loadScene(const SceneConfig& scene, DestructionRuntime& runtime,
         ObjectDesc desc;
         desc.density = o.isStatic() || volume <= 0 ? options.staticDensity : o.mass / volume;
         desc.impulseThreshold = options.impulseThreshold;
+        desc.material = o.material;
         desc.fracture = options.fracture;
         desc.mesh = std::move(mesh);
         Result<ObjectId> id =
@@ -114,6 +115,7 @@ LoadedScene loadScene(const SceneConfig& scene, DestructionRuntime& runtime,
             if (options.prepareMesh)
                 options.prepareMesh(box.mesh);
             box.destructible = false;
+            box.material = o.material;
             box.density = o.isStatic() ? options.staticDensity : o.mass / std::max(1e-9, 8 * h.x * h.y * h.z);
             id = runtime.addObject(std::move(box), Frame{Mat3::identity(), o.position}, o.isStatic());
             if (!id)

@@ -14,7 +14,8 @@ check_json() {
     python3 - "$1" <<'PY'
 import json, sys
 d = json.load(open(sys.argv[1]))
-assert set(d) == {"input", "pieces", "timings_ms"}, d.keys()
+assert set(d) == {"input", "cut", "dropped_volume", "pieces", "timings_ms"}, d.keys()
+assert d["cut"] is True and d["dropped_volume"] >= 0, d
 assert set(d["input"]) == {"volume", "triangles", "closed"}, d["input"]
 assert isinstance(d["input"]["volume"], float) and isinstance(d["input"]["triangles"], int)
 assert d["input"]["closed"] is True
@@ -28,7 +29,7 @@ for p in d["pieces"]:
     assert len(p["center_of_mass"]) == 3 and all(isinstance(c, float) for c in p["center_of_mass"]), p
 total = sum(p["volume"] for p in d["pieces"])
 vin = d["input"]["volume"]
-assert abs(total - vin) <= 1e-6 * vin, (total, vin)
+assert abs(total + d["dropped_volume"] - vin) <= 1e-6 * vin, (total, vin)
 print(len(d["pieces"]))
 PY
 }
@@ -136,7 +137,7 @@ d = json.load(open(sys.argv[1]))
 assert set(d) == {"results"} and len(d["results"]) == 3
 assert [r["file"].split("/")[-1] for r in d["results"]] == ["cube_12.obj", "wall.obj", "pyramid.obj"]
 for r in d["results"]:
-    assert set(r) == {"file", "input", "pieces", "timings_ms"}, r.keys()
+    assert set(r) == {"file", "input", "cut", "dropped_volume", "pieces", "timings_ms"}, r.keys()
     assert len(r["pieces"]) >= 2 and abs(sum(p["volume"] for p in r["pieces"]) - r["input"]["volume"]) <= 1e-6 * r["input"]["volume"]
 PY
 [ ! -s "$tmp/batch.err" ] || fail "batch: stderr is not a terminal, expected no progress bar: $(cat "$tmp/batch.err")"

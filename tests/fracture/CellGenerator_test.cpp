@@ -5,6 +5,7 @@
 #include <map>
 
 #include "TestSupport.hpp"
+#include "fracture/ConvexCellClipper.hpp"
 #include "rubble/Fracture.hpp"
 #include "rubble/MassProperties.hpp"
 #include "rubble/Random.hpp"
@@ -125,7 +126,8 @@ TEST(CellGenerator, ShatterCellsAreDisjointConvexAndAroundTheImpact) {
                 if (a != b) {
                     EXPECT_FALSE(cells[b].contains(cells[a].centroid(), -1e-9));
                 }
-        // Shared corners are bit-identical across neighbouring cells (welded): no near-duplicates remain.
+        // Shared corners are bit-identical across neighbouring cells (one Voronoi vertex per Delaunay
+        // tetrahedron, short edges contracted): no near-duplicates remain.
         std::vector<Vec3> all;
         for (const ConvexPolytope& c : cells)
             for (const Vec3& v : c.vertices())
@@ -136,4 +138,39 @@ TEST(CellGenerator, ShatterCellsAreDisjointConvexAndAroundTheImpact) {
                     EXPECT_GT(length(all[a] - all[b]), 1e-9);
                 }
     }
+}
+
+// The issue #20 configurations (unit cube, impact on its top face, 30-1,000 cells, seeds 1-10) and random
+// ones: the cells form a complex, so the clipper splits a box that holds them all without declining, and
+// every cell comes back whole (its piece has the cell's volume).
+TEST(CellGenerator, ShatterCellsFormAComplex) {
+    const Mesh box = makeSubdividedBox({-2, -2, -2}, {3, 3, 3}, 1);
+    std::vector<std::pair<int, std::uint64_t>> cases;
+    for (int cells : {30, 50, 100, 150, 200, 1000})
+        for (std::uint64_t seed = 1; seed <= 10; ++seed)
+            cases.emplace_back(cells, seed);
+    for (const auto& [k, seed] : cases) {
+        FractureParams params;
+        params.pattern = CellPattern::Shatter;
+        params.cells = k;
+        const auto cells = generateCells({}, {{0.5, 0.5, 1}, {0, 0, 1}, 1}, params, seed);
+        ASSERT_EQ(cells.size(), static_cast<std::size_t>(k));
+        auto split = detail::clipByConvexCells(box, cells);
+        ASSERT_TRUE(split.isOk()) << k << " cells, seed " << seed << ": " << split.error().message;
+        double total = 0;
+        for (std::size_t i = 0; i < cells.size(); ++i) {
+            EXPECT_NEAR(signedVolume(split->inside[i]), cells[i].volume(), 1e-9 * cells[i].volume())
+                << k << " cells, seed " << seed << ", cell " << i;
+            total += cells[i].volume();
+        }
+        EXPECT_NEAR(signedVolume(split->outside), 125 - total, 1e-9) << k << " cells, seed " << seed;
+    }
+}
+
+TEST(CellGenerator, ShatterCellCountIsClampedToTheMaximum) {
+    FractureParams params;
+    params.pattern = CellPattern::Shatter;
+    params.cells = kMaxShatterCells + 500;
+    EXPECT_EQ(generateCells({}, {{0, 0, 0}, {0, 0, 1}, 1}, params, 1).size(),
+              static_cast<std::size_t>(kMaxShatterCells));
 }

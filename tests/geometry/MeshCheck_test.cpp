@@ -264,3 +264,50 @@ TEST(MeshCheck, AttributeArraysOfTheWrongSizeAreReported) {
     EXPECT_TRUE(test::mentions(r.problems, "material ids have 3 entries but 12 are needed (1 per triangle)"))
         << test::joinLines(r.problems);
 }
+
+TEST(MeshCheck, SelfIntersectionTestIsSkippedAroundVeryHighValenceVertices) {
+    // CGAL's test is quadratic (and worse) around a shared vertex: a 60k-triangle fan did not finish in 8
+    // min.
+    auto cone = [](std::uint32_t n) {
+        Mesh m;
+        for (std::uint32_t i = 0; i < n; ++i)
+            m.positions.push_back(
+                {std::cos(2 * 3.141592653589793 * i / n), std::sin(2 * 3.141592653589793 * i / n), 0});
+        m.positions.push_back({0, 0, 1});
+        m.positions.push_back({0, 0, 0});
+        for (std::uint32_t i = 0; i < n; ++i) {
+            m.triangles.push_back({i, (i + 1) % n, n});
+            m.triangles.push_back({(i + 1) % n, i, n + 1});
+        }
+        return m;
+    };
+    const MeshReport big = checkMesh(cone(60000));
+    EXPECT_FALSE(big.selfIntersectionsChecked);
+    EXPECT_EQ(big.selfIntersectionNote,
+              "skipped: vertex 60001 is shared by 60000 triangles, more than 2048 (the test "
+              "takes quadratic time around such a vertex)");
+    EXPECT_TRUE(big.valid()); // the other checks still ran
+    EXPECT_TRUE(big.closed && big.manifold() && big.oriented);
+    const MeshReport small = checkMesh(cone(500));
+    EXPECT_TRUE(small.selfIntersectionsChecked);
+    EXPECT_EQ(small.selfIntersections, 0u);
+}
+
+TEST(MeshCheck, HugeAndTinyMeshesAreJudgedWithoutOverflow) {
+    // A cube scaled by 1e300 was reported "encloses no volume" (and its triangles degenerate): it overflowed.
+    const MeshReport huge = checkMesh(makeBox({0, 0, 0}, {1e300, 1e300, 1e300}));
+    EXPECT_FALSE(huge.valid());
+    EXPECT_EQ(huge.degenerateTriangles, 0u);
+    ASSERT_EQ(huge.problems.size(), 1u) << test::joinLines(huge.problems);
+    EXPECT_EQ(
+        huge.problems[0],
+        "the mesh's volume overflows the range of doubles (coordinates up to 1e+300); scale the mesh down");
+    // 1e-100: the squared areas (1e-400) underflowed and every triangle was called degenerate.
+    const MeshReport tiny = checkMesh(makeBox({0, 0, 0}, {1e-100, 1e-100, 1e-100}));
+    EXPECT_TRUE(tiny.valid()) << test::joinLines(tiny.problems);
+    EXPECT_EQ(tiny.degenerateTriangles, 0u);
+    // Scaling by powers of two changes nothing for ordinary triangles.
+    EXPECT_TRUE(isDegenerateTriangle({0, 0, 0}, {1, 0, 0}, {2, 1e-13, 0}));
+    EXPECT_FALSE(isDegenerateTriangle({0, 0, 0}, {1, 0, 0}, {2, 1e-11, 0}));
+    EXPECT_TRUE(isDegenerateTriangle({5, 5, 5}, {5, 5, 5}, {1, 2, 3}));
+}

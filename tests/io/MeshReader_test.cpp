@@ -1,8 +1,11 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <iterator>
+
+#include <sys/stat.h>
 
 #include "TestSupport.hpp"
 #include "rubble/MeshCheck.hpp"
@@ -282,4 +285,250 @@ TEST(MeshReader, BinaryStlWithTrailingBytesAndAsciiStl) {
     ascii += "endsolid tetra\n";
     test::writeFile(dir / "ascii.stl", ascii);
     expectValidTetra(readMesh(dir / "ascii.stl"));
+}
+
+namespace {
+// The tetra glTF with its single node replaced by `nodes` and `extras` added to the top level.
+std::string gltfWithNodes(const std::string& nodes, const std::string& extras = "0") {
+    const std::string entry =
+        R"({"byteLength":72,"uri":"data:application/octet-stream;base64,)" + base64(tetraBuffer()) + R"("})";
+    std::string json = gltfJson(entry);
+    const std::string single = R"("nodes":[{"mesh":0}])";
+    json.replace(json.find(single), single.size(), R"("nodes":)" + nodes);
+    return R"({"extras":)" + extras + "," + json.substr(1);
+}
+
+// A chain of `depth` nodes, each the only child of the one before; the last holds the mesh.
+std::string nodeChain(std::size_t depth) {
+    std::string nodes = "[";
+    for (std::size_t i = 0; i + 1 < depth; ++i)
+        nodes += R"({"children":[)" + std::to_string(i + 1) + "]},";
+    return nodes + R"({"mesh":0}])";
+}
+} // namespace
+
+TEST(MeshReader, DeepGltfNestingIsRefusedBeforeAssimp) {
+    // Assimp recursed once per level and crashed (SIGSEGV) on both of these.
+    const auto dir = test::tempDir("MeshReader_deep_gltf");
+    test::writeFile(dir / "chain.gltf", gltfWithNodes(nodeChain(20000)));
+    Error e = errorOf(dir / "chain.gltf");
+    EXPECT_EQ(e.code, ErrorCode::ParseError);
+    EXPECT_EQ(e.message, (dir / "chain.gltf").string() +
+                             ": the node hierarchy is more than 1024 levels deep (node 1024)");
+    const std::size_t deep = 1000000;
+    test::writeFile(dir / "extras.gltf",
+                    gltfWithNodes(nodeChain(1), std::string(deep, '[') + std::string(deep, ']')));
+    e = errorOf(dir / "extras.gltf");
+    EXPECT_NE(e.message.find("extras.gltf: its JSON is nested more than 256 levels deep (at byte 265)"),
+              std::string::npos)
+        << e.message;
+    // Brackets inside strings do not count.
+    test::writeFile(dir / "strings.gltf",
+                    gltfWithNodes(nodeChain(1), "\"" + std::string(1000, '[') + "\\\"\""));
+    expectValidTetra(readMesh(dir / "strings.gltf"));
+    // Up to the limits the files are read (the node transforms are identities).
+    test::writeFile(dir / "chain1024.gltf", gltfWithNodes(nodeChain(1024)));
+    expectValidTetra(readMesh(dir / "chain1024.gltf"));
+    test::writeFile(dir / "extras250.gltf",
+                    gltfWithNodes(nodeChain(1), std::string(250, '[') + std::string(250, ']')));
+    expectValidTetra(readMesh(dir / "extras250.gltf"));
+    // Cycles, shared children and children out of range (glTF nodes form disjoint trees).
+    test::writeFile(dir / "cycle.gltf", gltfWithNodes(R"([{"mesh":0,"children":[1]},{"children":[0]}])"));
+    EXPECT_NE(errorOf(dir / "cycle.gltf").message.find("is its own ancestor (a cycle)"), std::string::npos);
+    test::writeFile(dir / "self.gltf", gltfWithNodes(R"([{"mesh":0,"children":[0]}])"));
+    EXPECT_NE(errorOf(dir / "self.gltf").message.find("node 0 has more than one parent"), std::string::npos);
+    test::writeFile(dir / "shared.gltf", gltfWithNodes(R"([{"children":[2]},{"children":[2]},{"mesh":0}])"));
+    EXPECT_NE(errorOf(dir / "shared.gltf").message.find("node 2 has more than one parent"),
+              std::string::npos);
+    test::writeFile(dir / "range.gltf", gltfWithNodes(R"([{"mesh":0,"children":[7]}])"));
+    EXPECT_NE(errorOf(dir / "range.gltf").message.find("node 0 has child 7 but there are only 1 nodes"),
+              std::string::npos);
+}
+
+TEST(MeshReader, OnlyRegularFilesOfBoundedSizeAreRead) {
+    // /dev/zero behind a mesh name was read until memory ran out, and a FIFO blocked forever.
+    const auto dir = test::tempDir("MeshReader_special");
+    std::filesystem::create_symlink("/dev/zero", dir / "zero.obj");
+    Error e = errorOf(dir / "zero.obj");
+    EXPECT_EQ(e.code, ErrorCode::IoError);
+    EXPECT_EQ(e.message,
+              (dir / "zero.obj").string() + ": cannot read: it is a character device, not a regular file");
+    ASSERT_EQ(::mkfifo((dir / "pipe.stl").c_str(), 0600), 0);
+    e = errorOf(dir / "pipe.stl"); // returns at once: the FIFO is never opened
+    EXPECT_EQ(e.message, (dir / "pipe.stl").string() + ": cannot read: it is a FIFO, not a regular file");
+    // A (sparse) file one byte over the 2 GiB limit.
+    { std::ofstream big(dir / "big.off"); }
+    std::filesystem::resize_file(dir / "big.off", (std::uint64_t{1} << 31) + 1);
+    e = errorOf(dir / "big.off");
+    EXPECT_EQ(e.message, (dir / "big.off").string() +
+                             ": the file has 2147483649 bytes, more than the limit of 2147483648 bytes");
+    // Symbolic links to regular files are fine.
+    std::filesystem::create_symlink(kData / "tetra.stl", dir / "link.stl");
+    expectValidTetra(readMesh(dir / "link.stl"));
+}
+
+TEST(MeshReader, DeclaredFaceCountsAreComparedWithWhatAssimpRead) {
+    const auto dir = test::tempDir("MeshReader_counts");
+    std::string bin;
+    {
+        std::ifstream in(kData / "tetra.stl", std::ios::binary);
+        bin.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    }
+    // A binary STL whose header says 0 triangles but holds 4 was called "empty".
+    std::string zero = bin;
+    zero.replace(80, 4, std::string(4, '\0'));
+    test::writeFile(dir / "zero.stl", zero);
+    EXPECT_EQ(errorOf(dir / "zero.stl").message,
+              (dir / "zero.stl").string() +
+                  ": binary STL header claims 0 triangles but 200 bytes of facets (4 triangles) follow it");
+}
+
+namespace {
+// The unit cube as ASCII PLY: vertices with a colour, quads; `faces` replaces the face block when given.
+std::string asciiPlyCube(const std::string& faces = "", int declaredFaces = 6) {
+    std::string ply =
+        "ply\nformat ascii 1.0\ncomment cube\nelement vertex 8\nproperty double x\nproperty double y\n"
+        "property double z\nproperty uchar red\nelement face " +
+        std::to_string(declaredFaces) + "\nproperty list uchar int vertex_indices\nend_header\n";
+    for (const char* v : {"0 0 0", "1 0 0", "1 1 0", "0 1 0", "0 0 1", "1 0 1", "1 1 1", "0 1 1"})
+        ply += std::string(v) + " 255\n";
+    return ply +
+           (faces.empty() ? "4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n4 3 7 6 2\n4 0 4 7 3\n4 1 2 6 5\n" : faces);
+}
+} // namespace
+
+TEST(MeshReader, AsciiPlyIsReadExactlyWithLineNumbers) {
+    const auto dir = test::tempDir("MeshReader_ascii_ply");
+    auto read = [&](const std::string& file, const std::string& text) {
+        test::writeFile(dir / file, text);
+        return readMesh(dir / file);
+    };
+    const auto cube = read("cube.ply", asciiPlyCube());
+    ASSERT_TRUE(cube.isOk()) << cube.error().message;
+    EXPECT_EQ(cube->vertexCount(), 8u);
+    EXPECT_TRUE(checkMesh(cube.value()).valid());
+    // Doubles exactly as written (Assimp rounded them to float).
+    std::string exact = asciiPlyCube();
+    exact.replace(exact.find("1 1 1 255"), 9, "10.2041 1 1 255");
+    const auto e = read("exact.ply", exact);
+    ASSERT_TRUE(e.isOk()) << e.error().message;
+    bool found = false;
+    for (const Vec3& p : e->positions)
+        found = found || p.x == 10.2041;
+    EXPECT_TRUE(found);
+    // Vertices split per face (as exporters write them for normals or colours) are welded exactly.
+    std::string split =
+        "ply\nformat ascii 1.0\nelement vertex 12\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 4\nproperty list uchar uint vertex_index\nend_header\n";
+    for (const char* v : {"0 0 0", "0 1 0", "1 0 0", "0 0 0", "1 0 0", "0 0 1", "1 0 0", "0 1 0", "0 0 1",
+                          "0 1 0", "0 0 0", "0 0 1"})
+        split += std::string(v) + "\n";
+    split += "3 0 1 2\n3 3 4 5\n3 6 7 8\n3 9 10 11\n";
+    expectValidTetra(read("split.ply", split));
+    // Truncated lines, a file that ends early, counts that do not match: file:line messages (Assimp's text
+    // had no line, or Assimp silently filled in a face).
+    const std::string faces5 = "4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n4 3 7 6 2\n4 0 4 7 3\n";
+    const std::string p = dir.string() + "/";
+    EXPECT_EQ(read("short.ply", asciiPlyCube(faces5)).error().message,
+              p + "short.ply:24: the file ends after 5 of the 6 declared 'face' elements");
+    EXPECT_EQ(read("trunc.ply", asciiPlyCube(faces5 + "4 1 2 6\n")).error().message,
+              p + "trunc.ply:25: 'face' 5: the line ends before its properties do (4 numbers; truncated?)");
+    EXPECT_EQ(
+        read("long.ply", asciiPlyCube(faces5 + "4 1 2 6 5\n4 1 2 6 5\n")).error().message,
+        p + "long.ply:26: unexpected '4' after the declared elements (the header's counts do not match the "
+            "file)");
+    std::string truncVertex = asciiPlyCube();
+    truncVertex.replace(truncVertex.find("1 1 0 255"), 9, "1 1");
+    EXPECT_EQ(read("tv.ply", truncVertex).error().message,
+              p + "tv.ply:14: 'vertex' 2: the line ends before its properties do (2 numbers; truncated?)");
+    EXPECT_EQ(read("idx.ply", asciiPlyCube(faces5 + "4 1 2 6 8\n")).error().message,
+              p + "idx.ply:25: 'face' 5 refers to vertex 8 but there are 8 (PLY indices start at 0)");
+    EXPECT_EQ(read("two.ply", asciiPlyCube(faces5 + "2 1 2\n")).error().message,
+              p + "two.ply:25: 'face' 5 has 2 corners; at least 3 are needed");
+    std::string bad = asciiPlyCube();
+    bad.replace(bad.find("0 1 1 255"), 9, "0 1 abc 255");
+    EXPECT_EQ(read("bad.ply", bad).error().message,
+              p + "bad.ply:19: 'vertex' 7: expected a number for 'z', got 'abc'");
+    bad.replace(bad.find("abc"), 3, "1e999");
+    EXPECT_EQ(read("big.ply", bad).error().message,
+              p + "big.ply:19: 'vertex' 7: value '1e999' for 'z' is out of range");
+    EXPECT_EQ(read("extra.ply", asciiPlyCube(faces5 + "4 1 2 6 5 7\n")).error().message,
+              p + "extra.ply:25: 'face' 5: 1 more numbers than its properties need");
+    // A 12-gon face (Assimp's OFF importer dropped polygons over 9 corners; PLY polygons are kept whole
+    // here).
+    std::string prism =
+        "ply\nformat ascii 1.0\nelement vertex 24\nproperty double x\nproperty double y\n"
+        "property double z\nelement face 14\nproperty list uchar int vertex_indices\nend_header\n";
+    for (int z = 0; z < 2; ++z)
+        for (int i = 0; i < 12; ++i)
+            prism += std::to_string(std::cos(i * 3.141592653589793 / 6)) + " " +
+                     std::to_string(std::sin(i * 3.141592653589793 / 6)) + " " + std::to_string(z) + "\n";
+    std::string bottom = "12", top = "12";
+    for (int i = 0; i < 12; ++i) {
+        bottom += " " + std::to_string(11 - i);
+        top += " " + std::to_string(12 + i);
+    }
+    prism += bottom + "\n" + top + "\n";
+    for (int i = 0; i < 12; ++i)
+        prism += "4 " + std::to_string(i) + " " + std::to_string((i + 1) % 12) + " " +
+                 std::to_string(12 + (i + 1) % 12) + " " + std::to_string(12 + i) + "\n";
+    const auto pr = read("prism.ply", prism);
+    ASSERT_TRUE(pr.isOk()) << pr.error().message;
+    EXPECT_EQ(pr->triangleCount(), 2u * 10 + 24);
+    EXPECT_TRUE(checkMesh(pr.value()).valid());
+}
+
+TEST(MeshReader, AsciiStlIsReadExactlyWithLineNumbers) {
+    const auto dir = test::tempDir("MeshReader_ascii_stl");
+    auto read = [&](const std::string& file, const std::string& text) {
+        test::writeFile(dir / file, text);
+        return readMesh(dir / file);
+    };
+    const char* p[4] = {"0 0 0", "10.2041 0 0", "0 1 0", "0 0 1"};
+    const int f[4][3] = {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {2, 0, 3}};
+    std::string stl = "solid tetra\n";
+    for (const auto& tri : f) {
+        stl += "  facet normal 0 0 0\n    outer loop\n";
+        for (int k : tri)
+            stl += "      vertex " + std::string(p[k]) + "\n";
+        stl += "    endloop\n  endfacet\n";
+    }
+    const std::string whole = stl + "endsolid tetra\n";
+    const auto r = read("tetra.stl", whole);
+    ASSERT_TRUE(r.isOk()) << r.error().message;
+    EXPECT_EQ(r->vertexCount(), 4u);       // every corner repeated per facet, welded exactly
+    EXPECT_EQ(r->positions[2].x, 10.2041); // Assimp rounded to float: 10.204099655...
+    EXPECT_TRUE(checkMesh(r.value()).valid());
+    // Upper-case keywords, two solids in one file.
+    const auto two =
+        read("two.stl", whole + "SOLID b\nFACET NORMAL 0 0 1\nOUTER LOOP\nVERTEX 5 5 5\nVERTEX 6 5 5\n"
+                                "VERTEX 5 6 5\nENDLOOP\nENDFACET\nENDSOLID b\n");
+    ASSERT_TRUE(two.isOk()) << two.error().message;
+    EXPECT_EQ(two->triangleCount(), 5u);
+    const std::string d = dir.string() + "/";
+    EXPECT_EQ(read("trunc.stl", stl).error().message,
+              d + "trunc.stl:29: the file ends without 'endsolid' (truncated?)");
+    EXPECT_EQ(read("mid.stl", stl.substr(0, stl.rfind("      vertex"))).error().message,
+              d + "mid.stl:26: the file ends inside a facet");
+    std::string bad = whole;
+    bad.replace(bad.find("vertex 0 1 0"), 12, "vertex 0 x 0");
+    EXPECT_EQ(read("bad.stl", bad).error().message,
+              d + "bad.stl:5: vertex: expected a number for y, got 'x'");
+    bad = whole;
+    bad.replace(bad.find("vertex 0 1 0"), 12, "vertex 0 1");
+    EXPECT_EQ(read("short.stl", bad).error().message, d + "short.stl:5: vertex needs 3 numbers, got 2");
+    bad = whole;
+    bad.replace(bad.find("vertex 0 1 0"), 12, "vertex 0 1e999 0");
+    EXPECT_EQ(read("huge.stl", bad).error().message,
+              d + "huge.stl:5: vertex: value '1e999' for y is out of range");
+    EXPECT_EQ(read("two_corners.stl",
+                   "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nendloop\n"
+                   "endfacet\nendsolid\n")
+                  .error()
+                  .message,
+              d + "two_corners.stl:6: facet has 2 vertices; at least 3 are needed");
+    EXPECT_EQ(read("junk.stl", "solid x\nhello\n").error().message,
+              d + "junk.stl:2: expected 'facet' or 'endsolid', got 'hello'");
+    EXPECT_EQ(read("empty_solid.stl", "solid x\nendsolid x\n").error().message,
+              d + "empty_solid.stl: no triangles");
 }

@@ -3,6 +3,11 @@
 #include <fstream>
 #include <sstream>
 
+#include <csignal>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include "TestSupport.hpp"
 #include "rubble/MassProperties.hpp"
 #include "rubble/MeshCheck.hpp"
@@ -114,4 +119,34 @@ TEST(ObjWriter, ErrorsNameTheFile) {
     const Status b = writeObj(test::tempDir("ObjWriter_err") / "b.obj", broken);
     ASSERT_FALSE(b.isOk());
     EXPECT_EQ(b.error().code, ErrorCode::InvalidInput);
+}
+
+TEST(ObjWriter, AFailedWriteLeavesThePreviousFileAndNoStagingFile) {
+    // A full disk left a truncated OBJ whose header promised triangles it did not hold. The child process
+    // below gets a 4 KiB file size limit (with SIGXFSZ ignored, writes beyond it fail with EFBIG).
+    const auto dir = test::tempDir("ObjWriter_failed_write");
+    const auto path = dir / "out.obj";
+    test::writeFile(path, "old content\n");
+    const Mesh big = makeSphere({0, 0, 0}, 1, 48, 24);
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+        std::signal(SIGXFSZ, SIG_IGN);
+        const rlimit limit{4096, 4096};
+        ::setrlimit(RLIMIT_FSIZE, &limit);
+        const Status s = writeObj(path, big);
+        const bool ok = !s && s.error().code == ErrorCode::IoError &&
+                        s.error().message == path.string() + ": write failed: File too large";
+        ::_exit(ok ? 0 : 1);
+    }
+    int status = 0;
+    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 0) << "the write did not fail with the expected message";
+    EXPECT_EQ(slurp(path), "old content\n");
+    for (const auto& e : std::filesystem::directory_iterator(dir))
+        EXPECT_EQ(e.path().filename(), "out.obj") << "left behind: " << e.path();
+    // Without the limit the file is replaced as a whole.
+    ASSERT_TRUE(writeObj(path, big).isOk());
+    EXPECT_EQ(readObj(path).value().triangleCount(), big.triangleCount());
 }

@@ -40,6 +40,19 @@ TEST(SceneConfig, ThesisExampleParses) {
     EXPECT_FALSE(r->objects[1].isStatic());
 }
 
+TEST(SceneConfig, OptionalMaterialField) {
+    const std::string text =
+        std::string(kSky) + kGround + kVehicle +
+        "slab.obj;;0;0;0;1;1;1;0;glass\ncolumn.obj;;0;0;0;1;1;1;0\nbeam.obj;;0;0;0;1;1;1;0; steel ;\n";
+    const auto r = parseSceneConfigText(text, "world.cfg");
+    ASSERT_TRUE(r.isOk()) << r.error().message;
+    ASSERT_EQ(r->objects.size(), 3u);
+    EXPECT_EQ(r->objects[0].material, "glass");
+    EXPECT_EQ(r->objects[1].material, "");
+    EXPECT_EQ(r->objects[2].material, "steel");
+    EXPECT_EQ(r->ground.material, "");
+}
+
 TEST(SceneConfig, MissingFilesAreWarningsNotErrors) {
     const auto dir = test::tempDir("SceneConfig_missing");
     test::writeFile(dir / "building.obj", "v 0 0 0\n");
@@ -70,10 +83,22 @@ TEST(SceneConfig, MalformedLinesNameFileLineAndField) {
     const std::string head = std::string(kSky) + kGround + kVehicle;
     EXPECT_EQ(errorOf(head + "building.obj;;1;2;3;1;abc;1;5\n"),
               "world.cfg:4: field 'sy' (7th): expected a number, got 'abc'");
-    EXPECT_EQ(errorOf(head + "building.obj;;1;2;3;1;1;1\n"),
-              "world.cfg:4: expected 9 fields for the object (model;texture;x;y;z;sx;sy;sz;mass), got 8");
-    EXPECT_EQ(errorOf(head + "building.obj;;1;2;3;1;1;1;5;6\n"),
-              "world.cfg:4: expected 9 fields for the object (model;texture;x;y;z;sx;sy;sz;mass), got 10");
+    EXPECT_EQ(
+        errorOf(head + "building.obj;;1;2;3;1;1;1\n"),
+        "world.cfg:4: expected 9 or 10 fields for the object (model;texture;x;y;z;sx;sy;sz;mass[;material]), "
+        "got 8");
+    EXPECT_EQ(
+        errorOf(head + "building.obj;;1;2;3;1;1;1;5;wood;6\n"),
+        "world.cfg:4: expected 9 or 10 fields for the object (model;texture;x;y;z;sx;sy;sz;mass[;material]), "
+        "got 11");
+    EXPECT_EQ(
+        errorOf(head + "building.obj;;1;2;3;1;1;1;5;6\n"),
+        "world.cfg:4: field 'material' (10th): unknown material '6'; expected one of concrete, brick, stone, "
+        "wood, glass, steel");
+    EXPECT_EQ(
+        errorOf(head + "building.obj;;1;2;3;1;1;1;5;Wood\n"),
+        "world.cfg:4: field 'material' (10th): unknown material 'Wood'; expected one of concrete, brick, "
+        "stone, wood, glass, steel");
     EXPECT_EQ(errorOf(head + "building.obj;;1;2;3;1;1;1;-5\n"),
               "world.cfg:4: field 'mass' (9th): mass must not be negative, got '-5'");
     EXPECT_EQ(errorOf(head + "building.obj;;1;2;3;0;1;1;5\n"),
@@ -88,8 +113,10 @@ TEST(SceneConfig, MalformedLinesNameFileLineAndField) {
                                   "left, right, front, back), got 3 "
                                   "fields");
     EXPECT_EQ(errorOf("a;b;c;;e;f\n"), "world.cfg:1: skybox image 4 (right) is empty");
-    EXPECT_EQ(errorOf(std::string(kSky) + "\n\n;grid.jpg;0;-15;0;1000;10\n"),
-              "world.cfg:4: expected 9 fields for the ground (model;texture;x;y;z;sx;sy;sz;mass), got 7");
+    EXPECT_EQ(
+        errorOf(std::string(kSky) + "\n\n;grid.jpg;0;-15;0;1000;10\n"),
+        "world.cfg:4: expected 9 or 10 fields for the ground (model;texture;x;y;z;sx;sy;sz;mass[;material]), "
+        "got 7");
     EXPECT_EQ(errorOf(""),
               "world.cfg: missing the skybox line (line 1); a scene file needs a skybox, a ground and a "
               "vehicle line");

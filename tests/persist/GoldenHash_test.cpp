@@ -10,7 +10,7 @@
 namespace rubble {
 namespace {
 
-constexpr std::uint64_t kExpectedGeometryHash = 0xF93BA5490D2E0ABBull;
+constexpr std::uint64_t kExpectedGeometryHash = 0x17667C3DD2AEA439ull;
 constexpr std::uint32_t kExpectedJournalCrc = 0x2144DF1Cu;
 
 DestructionWorld::Config goldenConfig(int workers) {

@@ -171,6 +171,8 @@ TEST(DestructionRuntime, AwakeBudgetRetiresTheSmallestPiecesButNeverTheGamesObje
     const std::vector<AdoptedPiece> pieces = rig.breakAndWait(box);
     ASSERT_GE(pieces.size(), 4u);
     rig.step(1);
+    EXPECT_EQ(rig.runtime.counters().piecesRetired, 0) << "new pieces get 10 frames to settle";
+    rig.step(11); // falling, so none settled: the smallest retire
     EXPECT_EQ(rig.runtime.awakeDebris(), 5);
     EXPECT_EQ(rig.runtime.livePieces(), 2) << "the three objects take three of the five";
     EXPECT_EQ(rig.runtime.counters().piecesRetired, static_cast<long long>(pieces.size()) - 2);
@@ -186,6 +188,24 @@ TEST(DestructionRuntime, AwakeBudgetRetiresTheSmallestPiecesButNeverTheGamesObje
     const VolumeLedger v = rig.runtime.volumes();
     EXPECT_GT(v.retired, 0);
     EXPECT_NEAR(v.total(), start, 1e-12 * start);
+}
+
+TEST(DestructionRuntime, AwakeBudgetFreezesSettledPiecesBeforeRetiringAny) {
+    DestructionRuntime::Config c = ToyRig::defaults();
+    c.debris.maxAwakeBodies = 2;
+    c.debris.freezeSleeping = false;
+    c.debris.freezeAfterFrames = 100000; // only the budget freezes here
+    ToyRig rig(c);
+    const ObjectId box = rig.addBox({1, 0.05, 1}, {0, 0.05, 0}, false, shatter(8, 3)); // a tile on the ground
+    ASSERT_TRUE(rig.runtime.world().submitImpact(box, Impact{{0, 0.1, 0}, {0, 1, 0}, 50}));
+    const std::vector<AdoptedPiece> pieces = rig.breakAndWait(box);
+    ASSERT_GE(pieces.size(), 4u);
+    const int live = rig.runtime.livePieces();
+    rig.step(30);
+    EXPECT_EQ(rig.runtime.counters().piecesRetired, 0) << "settled pieces freeze instead of retiring";
+    EXPECT_EQ(rig.runtime.livePieces(), live);
+    EXPECT_LE(rig.runtime.awakeDebris(), 2);
+    EXPECT_GE(rig.runtime.frozenDebris(), live - 2);
 }
 
 TEST(DestructionRuntime, TriangleBudgetAndFadingRetireDebris) {

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "../fuzz/FuzzChecks.hpp"
+#include "RepositoryModels.hpp"
 #include "TestSupport.hpp"
 #include "rubble/Fracture.hpp"
 #include "rubble/MassProperties.hpp"
@@ -25,13 +26,11 @@
 #include "rubble/Random.hpp"
 
 using namespace rubble;
+using rubble::test::surfacePoint;
 
 namespace {
 
-struct Shape {
-    std::string name;
-    Mesh mesh;
-};
+using Shape = test::NamedMesh;
 
 std::vector<Shape> stressShapes() {
     Mesh twoParts = makeSubdividedBox({-1, -1, -1}, {0, 1, 1}, 2);
@@ -42,21 +41,9 @@ std::vector<Shape> stressShapes() {
                               {"plate", makeSubdividedBox({-1, -0.02, -1}, {1, 0.02, 1}, 2)},
                               {"sphere", makeSphere({0, 0, 0}, 1, 16, 8)},
                               {"twoparts", twoParts}};
-    for (const char* name : {"arch", "building", "column", "cube_588", "fighter", "missile", "projectile",
-                             "pyramid", "ship", "wall"}) {
-        auto m = readObj(test::sourceDir() / "assets" / "models" / (std::string(name) + ".obj"));
-        EXPECT_TRUE(m.isOk()) << name << ": " << (m ? "" : m.error().message);
-        if (m)
-            shapes.push_back({name, *m});
-    }
+    test::appendRepositoryModels(shapes, {"arch", "building", "column", "cube_588", "fighter", "missile",
+                                          "projectile", "pyramid", "ship", "wall"});
     return shapes;
-}
-
-// A uniformly distributed point of a random triangle (square-root barycentric sampling).
-Vec3 surfacePoint(const Mesh& m, Rng& rng) {
-    const auto corners = m.corners(static_cast<std::size_t>(rng.below(m.triangleCount())));
-    const double r = std::sqrt(rng.uniform()), s = rng.uniform();
-    return corners[0] * (1 - r) + corners[1] * (r * (1 - s)) + corners[2] * (r * s);
 }
 
 std::uint64_t hashPieces(const FractureResult& r) {

@@ -55,6 +55,17 @@ bool mentions(const std::vector<std::string>& lines, const std::string& text) {
     return false;
 }
 
+Vec3 surfacePoint(const Mesh& m, Rng& rng) {
+    const auto t = static_cast<std::size_t>(rng.below(m.triangleCount()));
+    double a = rng.uniform(), b = rng.uniform();
+    if (a + b > 1) {
+        a = 1 - a;
+        b = 1 - b;
+    }
+    const auto c = m.corners(t);
+    return c[0] + (c[1] - c[0]) * a + (c[2] - c[0]) * b;
+}
+
 Mesh unwelded(const Mesh& m, bool withAttributes) {
     Mesh out;
     for (std::size_t t = 0; t < m.triangles.size(); ++t) {

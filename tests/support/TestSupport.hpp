@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "rubble/Mesh.hpp"
+#include "rubble/Random.hpp"
 
 namespace rubble::test {
 
@@ -30,6 +31,8 @@ Mesh unwelded(const Mesh& m, bool withAttributes = false);
 /// EXPECTs that after is closed, consistently oriented, without degenerate triangles, and encloses before's
 /// volume (relative 1e-9): the contract of a lossless mesh operation.
 void expectSameSolid(const Mesh& before, const Mesh& after);
+/// A random point on the surface: a random triangle, a uniform point in it.
+Vec3 surfacePoint(const Mesh& m, Rng& rng);
 /// Closed, edge-manifold and consistently oriented: every directed edge once, and its reverse once (for
 /// EXPECT_TRUE; the failure names the first bad edge).
 ::testing::AssertionResult closedAndOriented(const Mesh& m);

@@ -1,12 +1,40 @@
 #include "Subcommand.hpp"
 
 #include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
 
 namespace rubble::tools {
 
 std::vector<Subcommand>& registry() {
     static std::vector<Subcommand> all;
     return all;
+}
+
+CLI::Validator finiteNumber() {
+    return CLI::Validator(
+        [](std::string& text) -> std::string {
+            double v = 0;
+            const char* first = text.data() + (!text.empty() && text[0] == '+' ? 1 : 0);
+            const auto [ptr, ec] = std::from_chars(first, text.data() + text.size(), v);
+            if (ec != std::errc() || ptr != text.data() + text.size() || !std::isfinite(v))
+                return "'" + text + "' is not a finite number";
+            return {};
+        },
+        "FINITE");
+}
+
+CLI::Validator unsigned64() {
+    return CLI::Validator(
+        [](std::string& text) -> std::string {
+            std::uint64_t v = 0;
+            const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+            if (text.empty() || ec != std::errc() || ptr != text.data() + text.size())
+                return "'" + text + "' is not a whole number from 0 to 18446744073709551615";
+            return {};
+        },
+        "UINT64");
 }
 
 int runMain(const std::string& description, const std::string& version, int argc, char** argv) {

@@ -26,6 +26,13 @@ struct Registrar {
     explicit Registrar(Subcommand c) { registry().push_back(std::move(c)); }
 };
 
+/// Option check: a finite number (CLI::Range lets "nan" through, since NaN compares false both ways).
+CLI::Validator finiteNumber();
+
+/// Option check: a whole number from 0 to 2^64 - 1 written in decimal digits (CLI11 alone turns "-1" and
+/// "2^64" into 2^64 - 1).
+CLI::Validator unsigned64();
+
 /// Parses argv, runs the chosen subcommand and returns its exit code (2 for usage errors).
 int runMain(const std::string& description, const std::string& version, int argc, char** argv);
 

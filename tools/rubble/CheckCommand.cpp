@@ -2,20 +2,26 @@
 //
 // Exit codes: 0 all meshes valid (after repair, with --repair); 1 some mesh readable but invalid;
 // 2 some mesh unreadable, or a usage error. In --json mode stdout holds only the JSON document
-// {"meshes":[{"file","vertices","triangles","closed","manifold","oriented","self_intersections","volume",
-// "center_of_mass":[x,y,z],"bbox":[[lo],[hi]]}]}, where self_intersections is the number of intersecting
-// triangle pairs or null when the test did not run; an unreadable file appears as {"file","error"}.
-// With --repair the entries describe the repaired meshes, "file" being the path written.
+// {"meshes":[{"file","valid","problems":[...],"vertices","triangles","closed","manifold","oriented",
+// "self_intersections","volume","center_of_mass":[x,y,z],"bbox":[[lo],[hi]]}]}, where self_intersections is
+// the number of intersecting triangle pairs or null when the test did not run; an unreadable file appears as
+// {"file","error"}. With --repair the entries describe the repaired meshes, "file" being the path written (or
+// {"file","error"} when it could not be written; exit 2). Two inputs with the same stem are refused with
+// --repair into a folder. Outputs are written through a staging file and renamed.
 // Problems and repair notes go to stderr in --json mode.
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <set>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
 
+#include "JsonText.hpp"
+#include "Staging.hpp"
 #include "Subcommand.hpp"
 #include "rubble/MeshCheck.hpp"
 #include "rubble/MeshIO.hpp"
@@ -65,7 +71,7 @@ void printStats(std::ostream& out, const rubble::MeshReport& r) {
         out << " (" << r.nonManifoldVertices << " non-manifold "
             << (r.nonManifoldVertices == 1 ? "vertex" : "vertices") << ")";
     out << "\n  oriented            " << yesNo(r.oriented);
-    if (r.oriented && r.closed && r.volume != 0)
+    if (r.oriented && r.closed && r.volume != 0 && std::isfinite(r.volume))
         out << (r.volume > 0 ? " (outward)" : " (inside out)");
     out << "\n  self-intersections  " << selfIntersectionText(r) << "\n";
     out << "  volume              " << num(r.volume) << "\n";
@@ -86,7 +92,11 @@ void printProblems(std::ostream& out, const std::vector<std::string>& problems, 
 
 nlohmann::json jsonOf(const std::string& file, const rubble::MeshReport& r) {
     nlohmann::json j;
-    j["file"] = file;
+    j["file"] = rubble::tools::utf8Escaped(file);
+    j["valid"] = r.valid();
+    j["problems"] = nlohmann::json::array();
+    for (const std::string& p : r.problems)
+        j["problems"].push_back(rubble::tools::utf8Escaped(p));
     j["vertices"] = r.vertices;
     j["triangles"] = r.triangles;
     j["closed"] = r.closed;
@@ -132,8 +142,24 @@ int runCheck(const CheckArgs& args) {
         std::cerr << "rubble check: cannot write '" << args.output << "': only .obj output is supported\n";
         return 2;
     }
-    if (args.repair && outIsDir)
-        fs::create_directories(args.output, ec);
+    // Every input's output path, known before anything is read: two inputs must not share one.
+    std::vector<fs::path> outputs;
+    if (args.repair) {
+        std::set<fs::path> seen;
+        for (const std::string& file : args.files) {
+            outputs.push_back(outIsDir ? fs::path(args.output) / (fs::path(file).stem().string() + ".obj")
+                                       : fs::path(args.output));
+            if (!seen.insert(outputs.back()).second) {
+                std::cerr << "rubble check: two inputs would be repaired into the same file '"
+                          << outputs.back().string() << "' (" << file << "); repair them one at a time\n";
+                return 2;
+            }
+        }
+        if (outIsDir)
+            fs::create_directories(args.output, ec);
+        // Staging files of earlier runs that were killed.
+        rubble::tools::removeStaleStaging(outputs.front().parent_path());
+    }
 
     rubble::CheckOptions checkOptions;
     checkOptions.selfIntersections = !args.noSelfIntersections;
@@ -149,7 +175,8 @@ int runCheck(const CheckArgs& args) {
         if (!mesh) {
             std::cerr << "rubble check: " << mesh.error().message << "\n";
             if (args.json)
-                doc["meshes"].push_back({{"file", file}, {"error", mesh.error().message}});
+                doc["meshes"].push_back({{"file", rubble::tools::utf8Escaped(file)},
+                                         {"error", rubble::tools::utf8Escaped(mesh.error().message)}});
             exitCode = 2;
             continue;
         }
@@ -176,8 +203,7 @@ int runCheck(const CheckArgs& args) {
         rubble::RepairOptions repairOptions;
         repairOptions.checkSelfIntersections = !args.noSelfIntersections;
         const rubble::RepairReport rep = rubble::repairMesh(repaired, repairOptions);
-        const fs::path out = outIsDir ? fs::path(args.output) / (fs::path(file).stem().string() + ".obj")
-                                      : fs::path(args.output);
+        const fs::path& out = outputs[i];
         text << file << ": " << (before.valid() ? "valid" : "INVALID") << " before repair\n";
         printProblems(text, before.problems, "problems");
         if (rep.fixed.empty()) {
@@ -187,9 +213,18 @@ int runCheck(const CheckArgs& args) {
             for (const std::string& f : rep.fixed)
                 text << "    - " << f << "\n";
         }
-        if (const rubble::Status s = rubble::writeObj(out, repaired); !s) {
-            std::cerr << "rubble check: " << s.message() << "\n";
-            return 2;
+        rubble::Status written;
+        {
+            const rubble::tools::DeferSignals
+                deferred; // a kill waits until the staging file is renamed or gone
+            written = rubble::writeObj(out, repaired);
+        }
+        if (!written) {
+            std::cerr << "rubble check: " << written.message() << "\n";
+            doc["meshes"].push_back({{"file", rubble::tools::utf8Escaped(out.string())},
+                                     {"error", rubble::tools::utf8Escaped(written.message())}});
+            exitCode = 2;
+            continue;
         }
         text << "  written to " << out.string() << ": " << (rep.valid() ? "valid" : "still INVALID") << "\n";
         if (!args.json)
@@ -200,7 +235,7 @@ int runCheck(const CheckArgs& args) {
             exitCode = std::max(exitCode, 1);
     }
     if (args.json)
-        std::cout << doc.dump() << "\n";
+        std::cout << rubble::tools::dumpJson(doc) << "\n";
     return exitCode;
 }
 

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "JsonText.hpp"
 #include "Subcommand.hpp"
 #include "rubble/ConvexDecomposition.hpp"
 #include "rubble/MeshIO.hpp"
@@ -47,7 +48,7 @@ int runDecompose(const DecomposeArgs& args) {
         j["hull_volume"] = d->hullVolume;
         j["excess"] = d->excess();
         j["ms"] = ms;
-        std::cout << j.dump() << "\n";
+        std::cout << rubble::tools::dumpJson(j) << "\n";
     } else {
         std::cout << args.file << ": " << d->parts.size()
                   << (d->parts.size() == 1 ? " convex part" : " convex parts") << "\n  mesh volume  "
@@ -69,6 +70,7 @@ const rubble::tools::Registrar registrar{
              ->check(CLI::Range(1, 100000));
          app.add_option("--concavity", args->concavity,
                         "stop splitting below this depth, as a fraction of the bounding-box diagonal")
+             ->check(rubble::tools::finiteNumber())
              ->check(CLI::Range(0.0, 1.0));
          app.add_flag("--json", args->json,
                       "print {\"parts\",\"mesh_volume\",\"hull_volume\",\"excess\",\"ms\"} as JSON");

@@ -8,13 +8,17 @@
 // fractured in parallel (batch pre-fracture), each into DIR/<mesh stem>/.
 //
 // Everything is computed before anything is written, and the output is staged in a sibling folder renamed to
-// DIR at the end, so that an error leaves no partial output. Exit codes: 0 every mesh fractured and written;
-// 1 a fracture or a write failed (the other meshes are written); 2 unreadable or invalid mesh, or a usage
-// error (nothing written); 3 the impact misses a mesh (no pieces for it; the other meshes are written).
-// --json prints {"input":{"volume","triangles","closed"},"pieces":[{"volume","triangles","closed","oriented",
-// "center_of_mass":[x,y,z],"convex_parts"}],"timings_ms":{"cell","boolean","islands","decomposition","total"}}
-// (with "error" added when the fracture failed); with several meshes {"results":[...]} with one such object
-// per mesh plus "file".
+// DIR at the end, so that an error leaves no partial output. SIGINT and SIGTERM are held back while the
+// staging folder exists; staging folders of killed runs (".DIR.rubble-tmp-PID" of a dead PID) are removed.
+// Exit codes: 0 every mesh fractured and written; 1 a fracture or a write failed (the other meshes are
+// written); 2 unreadable or invalid mesh, or a usage error (nothing written); 3 the impact misses a mesh (no
+// pieces for it; the other meshes are written).
+// --json prints
+// {"input":{"volume","triangles","closed"},"cut","dropped_volume","pieces":[{"volume","triangles",
+// "closed","oriented","center_of_mass":[x,y,z],"convex_parts"}],"timings_ms":{"cell","boolean","islands",
+// "decomposition","total"}} (with "error" added when the fracture failed); "cut" is false when no piece has a
+// cut face (the one piece is the input), "dropped_volume" the volume of pieces below the drop fraction. With
+// several meshes {"results":[...]} with one such object per mesh plus "file".
 #include <algorithm>
 #include <charconv>
 #include <chrono>
@@ -34,6 +38,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "JsonText.hpp"
+#include "Staging.hpp"
 #include "Subcommand.hpp"
 #include "rubble/ConvexDecomposition.hpp"
 #include "rubble/Fracture.hpp"
@@ -86,6 +92,8 @@ struct MeshJob {
     rubble::FractureTimings timings;
     double decompositionMs = 0; // the incremental update
     double parentDecompositionMs = 0;
+    double droppedVolume = 0; // pieces below the drop fraction
+    bool cut = false;         // some piece has a cut face (else the one piece is the input itself)
 };
 
 double msSince(Clock::time_point t0) {
@@ -143,6 +151,10 @@ void runJob(MeshJob& job, const rubble::Impact& impact, const rubble::FracturePa
         return;
     }
     job.timings = fr->timings;
+    job.droppedVolume = fr->droppedVolume;
+    for (const rubble::Piece& piece : fr->pieces)
+        job.cut = job.cut || std::find(piece.mesh.materials.begin(), piece.mesh.materials.end(),
+                                       rubble::kInteriorMaterial) != piece.mesh.materials.end();
     const auto td = Clock::now();
     const std::vector<rubble::ConvexPolytope> none;
     const auto parts = rubble::updateDecomposition(parent ? parent->parts : none, *fr);
@@ -164,9 +176,11 @@ void runJob(MeshJob& job, const rubble::Impact& impact, const rubble::FracturePa
 nlohmann::json jsonOf(const MeshJob& job, bool withFile) {
     nlohmann::json j;
     if (withFile)
-        j["file"] = job.file;
+        j["file"] = rubble::tools::utf8Escaped(job.file);
     j["input"] = {
         {"volume", job.inputVolume}, {"triangles", job.input.triangleCount()}, {"closed", job.inputClosed}};
+    j["cut"] = job.cut;
+    j["dropped_volume"] = job.droppedVolume;
     j["pieces"] = nlohmann::json::array();
     for (const PieceOut& p : job.pieces) {
         const rubble::Vec3& c = p.mass.centerOfMass;
@@ -183,7 +197,7 @@ nlohmann::json jsonOf(const MeshJob& job, bool withFile) {
                        {"decomposition", job.decompositionMs},
                        {"total", job.timings.totalMs + job.decompositionMs}};
     if (job.outcome == Outcome::Failed)
-        j["error"] = job.message;
+        j["error"] = rubble::tools::utf8Escaped(job.message);
     return j;
 }
 
@@ -214,8 +228,15 @@ void printSummary(std::ostream& out, const MeshJob& job, const fs::path& dir) {
                       num(c.z).c_str());
         out << line;
     }
-    out << "  volume: input " << num(job.inputVolume) << ", pieces " << num(sum) << " (relative difference "
-        << num(std::abs(sum - job.inputVolume) / job.inputVolume) << ")\n";
+    out << "  volume: input " << num(job.inputVolume) << ", pieces " << num(sum);
+    if (job.droppedVolume > 0)
+        out << ", dropped " << num(job.droppedVolume) << " (pieces below the drop fraction)";
+    out << " (relative difference "
+        << num(std::abs(sum + job.droppedVolume - job.inputVolume) / job.inputVolume) << ")\n";
+    if (!job.cut)
+        out << "  nothing was cut: the piece is the whole input (the impact's cells contain the whole mesh, "
+               "or "
+               "everything they cut off was below the drop fraction)\n";
     out << "  time: cells " << num(job.timings.cellMs) << " ms, booleans " << num(job.timings.booleanMs)
         << " ms, islands " << num(job.timings.islandsMs) << " ms, decomposition update "
         << num(job.decompositionMs) << " ms, total " << num(job.timings.totalMs + job.decompositionMs)
@@ -257,8 +278,10 @@ int commitOutput(const std::vector<MeshJob>& jobs, const fs::path& dir, const st
     std::error_code ec;
     const fs::path parent = dir.has_parent_path() ? dir.parent_path() : fs::path(".");
     fs::create_directories(parent, ec);
-    const fs::path stage =
-        parent / ("." + dir.filename().string() + ".rubble-tmp-" + std::to_string(::getpid()));
+    rubble::tools::removeStaleStaging(parent); // left by earlier runs that were killed
+    // SIGINT / SIGTERM wait until the staging folder is renamed or removed.
+    const rubble::tools::DeferSignals deferred;
+    const fs::path stage = rubble::tools::stagingPath(dir);
     fs::remove_all(stage, ec);
     auto fail = [&](const std::string& message) {
         std::cerr << "rubble fracture: " << message << "\n";
@@ -385,6 +408,8 @@ int runFracture(const FractureArgs& args) {
     for (const MeshJob& job : jobs)
         if (!args.json || job.outcome != Outcome::Fractured)
             printSummary(text, job, batch ? dir / job.folder : dir);
+        else if (!job.cut)
+            text << job.file << ": nothing was cut: the piece is the whole input\n";
     if (args.json) {
         nlohmann::json doc;
         if (batch) {
@@ -394,7 +419,7 @@ int runFracture(const FractureArgs& args) {
         } else {
             doc = jsonOf(jobs[0], false);
         }
-        std::cout << doc.dump() << "\n";
+        std::cout << rubble::tools::dumpJson(doc) << "\n";
     }
     return code;
 }
@@ -427,13 +452,15 @@ const rubble::tools::Registrar registrar{
                         "impact impulse (N s); the cut region's edge is " + num(law.base) + " + " +
                             num(law.scale) + " impulse^" + num(law.exponent) + ", clamped to [" +
                             num(law.minSize) + ", " + num(law.maxSize) + "]")
+             ->check(rubble::tools::finiteNumber())
              ->check(CLI::Range(0.0, 1e12))
              ->capture_default_str();
          app.add_option("--cells", args->cells,
                         "1: the thesis's single Voronoi cell; K > 1: shatter into K cells")
-             ->check(CLI::Range(1, 1000))
+             ->check(CLI::Range(1, rubble::kMaxShatterCells))
              ->capture_default_str();
          app.add_option("--seed", args->seed, "random seed (same seed, same pieces, byte for byte)")
+             ->check(rubble::tools::unsigned64())
              ->capture_default_str();
          app.add_option("--backend", args->backend, "boolean backend (default: the library's default)")
              ->check(CLI::IsMember({"corefine", "nef", "fast"}));

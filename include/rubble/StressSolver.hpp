@@ -1,0 +1,126 @@
+#pragma once
+/// \file StressSolver.hpp
+/// Bond forces of a structure under gravity and contact loads (an iterative, warm-started solve of rigid
+/// bond constraints, as in NVIDIA Blast's stress solver), the stresses they cause over each bond's section,
+/// breaking and damage. Theory and validation in docs/structure.md.
+
+#include <cstdint>
+#include <vector>
+
+#include "rubble/BondGraph.hpp"
+#include "rubble/ConvexPolytope.hpp"
+#include "rubble/Material.hpp"
+#include "rubble/Vec3.hpp"
+
+namespace rubble {
+
+/// One rigid part of a structure.
+struct StructureNode {
+    double mass = 0;   ///< kg
+    Vec3 centroid;     ///< centre of mass
+    Mat3 inertia;      ///< inertia tensor about the centre of mass, kg m^2
+    bool root = false; ///< held in place (ground, scenery)
+};
+
+/// The node of a solid of convex parts with the given density (kg/m^3).
+StructureNode structureNode(const std::vector<ConvexPolytope>& parts, double density, bool root);
+
+/// What a bond withstands, in Pa (0: unlimited).
+struct StrengthLimits {
+    double compressive = 0; ///< Pa
+    double tensile = 0;     ///< Pa
+    double shear = 0;       ///< Pa
+};
+
+/// The limits of a bond between two materials: the weaker of each.
+StrengthLimits bondLimits(const Material& a, const Material& b);
+
+/// The stresses over a bond's section (Pa), at the current health.
+struct BondStress {
+    double compression = 0; ///< largest compressive normal stress (axial plus bending)
+    double tension = 0;     ///< largest tensile normal stress (axial plus bending)
+    double shear = 0;       ///< mean transverse shear plus the largest torsional shear
+};
+
+/// Settings of the stress solver.
+struct StressSettings {
+    int iterations = 25;       ///< Gauss-Seidel sweeps over all bonds per solve()
+    Vec3 gravity{0, -9.81, 0}; ///< m/s^2
+};
+
+/// The stress solver over one structure (nodes joined by bonds).
+class StressSolver {
+public:
+    /// An empty structure.
+    explicit StressSolver(StressSettings settings = {}) : settings_(settings) {}
+
+    /// Replaces the structure; limits[i] belongs to bonds[i]. Accumulated forces and health are reset.
+    void reset(std::vector<StructureNode> nodes, std::vector<Bond> bonds, std::vector<StrengthLimits> limits);
+    /// Settings (may change between solves).
+    StressSettings& settings() { return settings_; }
+
+    /// Adds a load on a node for the next solve (e.g. a contact force), applied at a point.
+    void addLoad(std::uint32_t node, const Vec3& force, const Vec3& point);
+    /// Runs the bounded iterations, starting from the previous solve's bond forces; consumes the loads.
+    void solve();
+
+    /// Bonds.
+    std::size_t bondCount() const { return bonds_.size(); }
+    /// Nodes.
+    std::size_t nodeCount() const { return nodes_.size(); }
+    /// The bond (its section and nodes).
+    const Bond& bond(std::size_t i) const { return bonds_[i].bond; }
+    /// The force that node b exerts on node a through the bond (N).
+    Vec3 bondForce(std::size_t i) const { return bonds_[i].force; }
+    /// The couple that node b exerts on node a through the bond, about the section centroid (N m).
+    Vec3 bondMoment(std::size_t i) const { return bonds_[i].moment; }
+    /// The stresses over the bond's section at its current health.
+    BondStress stress(std::size_t i) const;
+    /// The largest ratio of a stress to its limit (1 = breaking; 0 for a broken bond).
+    double utilisation(std::size_t i) const;
+    /// The bond's remaining fraction of section, 1 when whole.
+    double health(std::size_t i) const { return bonds_[i].health; }
+    /// True when the bond has broken.
+    bool broken(std::size_t i) const { return bonds_[i].broken; }
+
+    /// Weakens bonds whose centroid lies within radius of point: health drops by amount * (1 - d / radius).
+    /// Bonds reaching 0 break.
+    void damage(const Vec3& point, double radius, double amount);
+    /// Breaks every bond whose stress exceeds its limits; returns them, ascending.
+    std::vector<std::size_t> breakOverstressed();
+    /// Sets a bond's health (e.g. carried over from an earlier graph); 0 breaks it.
+    void setHealth(std::size_t i, double health);
+    /// Breaks one bond.
+    void breakBond(std::size_t i);
+    /// Takes a node out of the structure (it fell or was removed); its bonds break.
+    void detach(std::uint32_t node);
+    /// Nodes still in the structure that no chain of intact bonds links to a root, ascending.
+    std::vector<std::uint32_t> unsupported() const;
+
+private:
+    struct NodeState {
+        StructureNode node;
+        double invMass = 0;
+        Mat3 invInertia;
+        Vec3 v, w;          // velocity change this solve
+        Vec3 force, torque; // loads this solve
+        bool detached = false;
+    };
+    struct BondState {
+        Bond bond;
+        StrengthLimits limits;
+        Vec3 ra, rb;       // section centroid relative to each node's centre of mass
+        double kinv[36]{}; // inverse of the 6x6 effective mass
+        bool solvable = false;
+        Vec3 force, moment; // accumulated (warm start)
+        double health = 1;
+        bool broken = false;
+    };
+    void apply(BondState& b, const Vec3& force, const Vec3& moment);
+
+    StressSettings settings_;
+    std::vector<NodeState> nodes_;
+    std::vector<BondState> bonds_;
+};
+
+} // namespace rubble

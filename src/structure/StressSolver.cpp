@@ -1,0 +1,288 @@
+#include "rubble/StressSolver.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <limits>
+
+#include "rubble/MassProperties.hpp"
+
+namespace rubble {
+
+namespace {
+
+using Mat6 = Eigen::Matrix<double, 6, 6>;
+
+Eigen::Matrix3d toEigen(const Mat3& m) {
+    Eigen::Matrix3d r;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            r(i, j) = m.m[i][j];
+    return r;
+}
+
+Eigen::Matrix3d skew(const Vec3& r) {
+    Eigen::Matrix3d s;
+    s << 0, -r.z, r.y, r.z, 0, -r.x, -r.y, r.x, 0;
+    return s;
+}
+
+Mat3 inverse(const Mat3& m) {
+    const Eigen::Matrix3d e = toEigen(m);
+    Mat3 r;
+    if (std::abs(e.determinant()) <= 0)
+        return r;
+    const Eigen::Matrix3d inv = e.inverse();
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            r.m[i][j] = inv(i, j);
+    return r;
+}
+
+} // namespace
+
+StructureNode structureNode(const std::vector<ConvexPolytope>& parts, double density, bool root) {
+    StructureNode n;
+    n.root = root;
+    double volume = 0;
+    Vec3 moment;
+    std::vector<MassProperties> props;
+    for (const ConvexPolytope& p : parts) {
+        props.push_back(computeMassProperties(p.toMesh()));
+        volume += props.back().volume;
+        moment += props.back().centerOfMass * props.back().volume;
+    }
+    if (volume <= 0)
+        return n;
+    n.mass = volume * density;
+    n.centroid = moment / volume;
+    // Parallel-axis theorem: each part's inertia moved to the common centre of mass.
+    for (const MassProperties& p : props) {
+        const Vec3 d = p.centerOfMass - n.centroid;
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j)
+                n.inertia.m[i][j] +=
+                    density * (p.inertia.m[i][j] + p.volume * ((i == j ? dot(d, d) : 0.0) - d[i] * d[j]));
+    }
+    return n;
+}
+
+StrengthLimits bondLimits(const Material& a, const Material& b) {
+    constexpr double mpa = 1e6;
+    return {std::min(a.compressiveStrength, b.compressiveStrength) * mpa,
+            std::min(a.tensileStrength, b.tensileStrength) * mpa,
+            std::min(a.shearStrength, b.shearStrength) * mpa};
+}
+
+void StressSolver::reset(std::vector<StructureNode> nodes, std::vector<Bond> bonds,
+                         std::vector<StrengthLimits> limits) {
+    nodes_.clear();
+    bonds_.clear();
+    for (StructureNode& n : nodes) {
+        NodeState s;
+        s.node = n;
+        if (!n.root && n.mass > 0) {
+            s.invMass = 1 / n.mass;
+            s.invInertia = inverse(n.inertia);
+        }
+        nodes_.push_back(s);
+    }
+    for (std::size_t i = 0; i < bonds.size(); ++i) {
+        BondState s;
+        s.bond = std::move(bonds[i]);
+        s.limits = i < limits.size() ? limits[i] : StrengthLimits{};
+        const NodeState& a = nodes_[s.bond.a];
+        const NodeState& b = nodes_[s.bond.b];
+        s.ra = s.bond.section.centroid - a.node.centroid;
+        s.rb = s.bond.section.centroid - b.node.centroid;
+        // Effective mass of the weld at the section centroid: impulse (P, L) on a, (-P, -L) on b.
+        const Eigen::Matrix3d ia = toEigen(a.invInertia), ib = toEigen(b.invInertia);
+        const Eigen::Matrix3d sa = skew(s.ra), sb = skew(s.rb);
+        Mat6 k;
+        k.topLeftCorner<3, 3>() =
+            (a.invMass + b.invMass) * Eigen::Matrix3d::Identity() - sa * ia * sa - sb * ib * sb;
+        k.topRightCorner<3, 3>() = -sa * ia - sb * ib;
+        k.bottomLeftCorner<3, 3>() = ia * sa + ib * sb;
+        k.bottomRightCorner<3, 3>() = ia + ib;
+        const Eigen::FullPivLU<Mat6> lu(k);
+        if (lu.isInvertible()) {
+            const Mat6 inv = lu.inverse();
+            for (int r = 0; r < 6; ++r)
+                for (int c = 0; c < 6; ++c)
+                    s.kinv[r * 6 + c] = inv(r, c);
+            s.solvable = true;
+        }
+        bonds_.push_back(std::move(s));
+    }
+}
+
+void StressSolver::addLoad(std::uint32_t node, const Vec3& force, const Vec3& point) {
+    NodeState& n = nodes_[node];
+    n.force += force;
+    n.torque += cross(point - n.node.centroid, force);
+}
+
+void StressSolver::apply(BondState& b, const Vec3& force, const Vec3& moment) {
+    NodeState& na = nodes_[b.bond.a];
+    NodeState& nb = nodes_[b.bond.b];
+    na.v += force * na.invMass;
+    na.w += na.invInertia * (cross(b.ra, force) + moment);
+    nb.v -= force * nb.invMass;
+    nb.w -= nb.invInertia * (cross(b.rb, force) + moment);
+}
+
+void StressSolver::solve() {
+    // Unit time step: velocity changes are accelerations and accumulated impulses are forces.
+    for (NodeState& n : nodes_) {
+        if (n.invMass > 0 && !n.detached) {
+            n.v = settings_.gravity + n.force * n.invMass;
+            n.w = n.invInertia * n.torque;
+        } else {
+            n.v = n.w = Vec3{};
+        }
+        n.force = n.torque = Vec3{};
+    }
+    for (BondState& b : bonds_)
+        if (!b.broken && b.solvable)
+            apply(b, b.force, b.moment);
+    for (int it = 0; it < settings_.iterations; ++it)
+        for (BondState& b : bonds_) {
+            if (b.broken || !b.solvable)
+                continue;
+            const NodeState& na = nodes_[b.bond.a];
+            const NodeState& nb = nodes_[b.bond.b];
+            const Vec3 lin = (na.v + cross(na.w, b.ra)) - (nb.v + cross(nb.w, b.rb));
+            const Vec3 ang = na.w - nb.w;
+            const double rel[6] = {lin.x, lin.y, lin.z, ang.x, ang.y, ang.z};
+            double d[6];
+            for (int r = 0; r < 6; ++r) {
+                double sum = 0;
+                for (int c = 0; c < 6; ++c)
+                    sum += b.kinv[r * 6 + c] * rel[c];
+                d[r] = -sum;
+            }
+            const Vec3 df{d[0], d[1], d[2]}, dm{d[3], d[4], d[5]};
+            b.force += df;
+            b.moment += dm;
+            apply(b, df, dm);
+        }
+}
+
+BondStress StressSolver::stress(std::size_t i) const {
+    const BondState& b = bonds_[i];
+    const BondInterface& s = b.bond.section;
+    BondStress out;
+    if (b.broken || s.sectionArea <= 0)
+        return out;
+    const double axial = dot(b.force, s.normal) / s.sectionArea; // > 0: b pulls a (tension)
+    // Linear fibre stress sigma = alpha s + beta t whose moment about the centroid is the bond's couple.
+    const double lu = dot(b.moment, s.u), lv = dot(b.moment, s.v);
+    const double iss = s.ivv, itt = s.iuu, ist = s.iuv;
+    const double det = ist * ist - itt * iss;
+    double lo = axial, hi = axial, rmax = 0;
+    if (std::abs(det) > 0) {
+        const double alpha = (lu * ist + itt * lv) / det;
+        const double beta = (-ist * lv - iss * lu) / det;
+        for (const Vec2& c : s.corners) {
+            const double sigma = axial + alpha * c.x + beta * c.y;
+            lo = std::min(lo, sigma);
+            hi = std::max(hi, sigma);
+        }
+    }
+    for (const Vec2& c : s.corners)
+        rmax = std::max(rmax, std::sqrt(c.x * c.x + c.y * c.y));
+    const double torsion = dot(b.moment, s.normal);
+    const Vec3 transverse = b.force - s.normal * dot(b.force, s.normal);
+    const double polar = iss + itt;
+    out.tension = std::max(0.0, hi) / b.health;
+    out.compression = std::max(0.0, -lo) / b.health;
+    out.shear =
+        (length(transverse) / s.sectionArea + (polar > 0 ? std::abs(torsion) * rmax / polar : 0)) / b.health;
+    return out;
+}
+
+double StressSolver::utilisation(std::size_t i) const {
+    const BondStress s = stress(i);
+    const StrengthLimits& l = bonds_[i].limits;
+    auto ratio = [](double stress, double limit) { return limit > 0 ? stress / limit : 0.0; };
+    return std::max(
+        {ratio(s.compression, l.compressive), ratio(s.tension, l.tensile), ratio(s.shear, l.shear)});
+}
+
+void StressSolver::damage(const Vec3& point, double radius, double amount) {
+    for (std::size_t i = 0; i < bonds_.size(); ++i) {
+        BondState& b = bonds_[i];
+        const double d = length(b.bond.section.centroid - point);
+        if (b.broken || d >= radius)
+            continue;
+        b.health -= amount * (1 - d / radius);
+        if (b.health <= 0) {
+            b.health = 0;
+            breakBond(i);
+        }
+    }
+}
+
+std::vector<std::size_t> StressSolver::breakOverstressed() {
+    std::vector<std::size_t> out;
+    for (std::size_t i = 0; i < bonds_.size(); ++i) {
+        if (bonds_[i].broken)
+            continue;
+        if (utilisation(i) > 1)
+            out.push_back(i);
+    }
+    for (std::size_t i : out)
+        breakBond(i);
+    return out;
+}
+
+void StressSolver::setHealth(std::size_t i, double health) {
+    bonds_[i].health = std::clamp(health, 0.0, 1.0);
+    if (bonds_[i].health <= 0)
+        breakBond(i);
+}
+
+void StressSolver::breakBond(std::size_t i) {
+    bonds_[i].broken = true;
+    bonds_[i].force = bonds_[i].moment = Vec3{};
+}
+
+void StressSolver::detach(std::uint32_t node) {
+    nodes_[node].detached = true;
+    for (std::size_t i = 0; i < bonds_.size(); ++i)
+        if (bonds_[i].bond.a == node || bonds_[i].bond.b == node)
+            breakBond(i);
+}
+
+std::vector<std::uint32_t> StressSolver::unsupported() const {
+    std::vector<std::vector<std::uint32_t>> adjacent(nodes_.size());
+    for (const BondState& b : bonds_)
+        if (!b.broken) {
+            adjacent[b.bond.a].push_back(b.bond.b);
+            adjacent[b.bond.b].push_back(b.bond.a);
+        }
+    std::vector<char> reached(nodes_.size(), 0);
+    std::deque<std::uint32_t> open;
+    for (std::uint32_t i = 0; i < nodes_.size(); ++i)
+        if (nodes_[i].node.root && !nodes_[i].detached) {
+            reached[i] = 1;
+            open.push_back(i);
+        }
+    while (!open.empty()) {
+        const std::uint32_t n = open.front();
+        open.pop_front();
+        for (std::uint32_t m : adjacent[n])
+            if (!reached[m]) {
+                reached[m] = 1;
+                open.push_back(m);
+            }
+    }
+    std::vector<std::uint32_t> out;
+    for (std::uint32_t i = 0; i < nodes_.size(); ++i)
+        if (!reached[i] && !nodes_[i].detached)
+            out.push_back(i);
+    return out;
+}
+
+} // namespace rubble

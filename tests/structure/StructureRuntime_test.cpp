@@ -1,0 +1,218 @@
+// The stress solver in the engine-neutral runtime, on the toy engine of tests/support: overstressed bonds
+// break and what they held falls through the runtime's collapse path; hits weaken bonds near them.
+#include <gtest/gtest.h>
+
+#include "TestSupport.hpp"
+#include "ToyPhysics.hpp"
+#include "rubble/DestructionRuntime.hpp"
+#include "rubble/SceneConfig.hpp"
+#include "rubble/SceneLoader.hpp"
+
+namespace rubble {
+namespace {
+
+struct Rig {
+    explicit Rig(bool structure, int workers = 1, bool bondDebris = false)
+        : runtime(engine, config(structure, workers, bondDebris)) {
+        runtime.addGround({0, -0.5, 0}, {50, 0.5, 50});
+    }
+    static DestructionRuntime::Config config(bool structure, int workers, bool bondDebris) {
+        DestructionRuntime::Config c;
+        c.world.workers = workers;
+        c.world.deterministic = true;
+        c.world.seed = 5;
+        c.world.minPieceVolume = 0;
+        c.structure.enabled = structure;
+        c.structure.bondDebris = bondDebris;
+        return c;
+    }
+    // A static box (indestructible unless fracture is given).
+    ObjectId addBox(const Vec3& lo, const Vec3& hi, const char* material = "", bool destructible = false) {
+        ObjectDesc d;
+        const Vec3 half = (hi - lo) * 0.5;
+        d.mesh = makeBox(-1.0 * half, half);
+        d.density = 500;
+        d.impulseThreshold = 1;
+        d.destructible = destructible;
+        d.material = material;
+        Result<ObjectId> id = runtime.addObject(std::move(d), Frame{Mat3::identity(), (lo + hi) * 0.5}, true);
+        EXPECT_TRUE(id) << (id ? "" : id.error().message);
+        return id ? *id : 0;
+    }
+    BodyMotionState motionOf(ObjectId id) const { return runtime.bodyOf(id)->motion; }
+    test::ToyPhysics engine;
+    DestructionRuntime runtime;
+};
+
+} // namespace
+
+TEST(StructureRuntime, AnOverhangThatConnectivityWouldHoldBreaksUnderItsWeight) {
+    for (const bool structure : {false, true}) {
+        Rig rig(structure);
+        rig.addBox({-0.2, 0, -0.2}, {0.2, 3, 0.2});
+        // A 6 m slab on the column's 0.4 x 0.4 m top, 5.6 m of it to one side.
+        const ObjectId slab = rig.addBox({-0.2, 3, -0.75}, {5.8, 3.2, 0.75});
+        // A slab centred on a second column stays.
+        rig.addBox({9.8, 0, -0.2}, {10.2, 3, 0.2});
+        const ObjectId centred = rig.addBox({9.5, 3, -0.5}, {10.5, 3.2, 0.5});
+        rig.runtime.stepFrame();
+        EXPECT_EQ(rig.motionOf(slab), structure ? BodyMotionState::Dynamic : BodyMotionState::Static);
+        EXPECT_EQ(rig.motionOf(centred), BodyMotionState::Static);
+        EXPECT_EQ(rig.runtime.counters().bondsBroken, structure ? 1 : 0);
+        EXPECT_EQ(rig.runtime.structureBonds().size(), structure ? 3u : 0u)
+            << "ground-column twice, column-slab";
+    }
+}
+
+TEST(StructureRuntime, HitsNearACantileversRootWeakenItUntilItFalls) {
+    Rig rig(true);
+    ASSERT_TRUE(rig.runtime.addConvexBody(makeBox({-1, 0, -2}, {0, 4, 2}).positions, Frame{}, 0));
+    // Concrete, h = 0.2, b = 1.5, L = 2: sigma = 3 rho g L^2 / h = 1.41 MPa < f_t = 2.9 MPa: it holds until
+    // its root's health drops below 1.41 / 2.9 = 0.49.
+    const ObjectId slab = rig.addBox({0, 2, -0.75}, {2, 2.2, 0.75}, "concrete");
+    rig.runtime.stepFrame();
+    ASSERT_EQ(rig.motionOf(slab), BodyMotionState::Static);
+    const BodyId body = rig.runtime.bodyOf(slab)->id;
+    auto root = [&] {
+        for (const StructureBond& b : rig.runtime.structureBonds())
+            if (b.b == body)
+                return b;
+        ADD_FAILURE() << "no bond at the slab's root";
+        return StructureBond{};
+    };
+    ASSERT_EQ(rig.runtime.structureBonds().size(), 2u) << "wall-ground, wall-slab";
+    EXPECT_NEAR(root().area, 0.3, 1e-9);
+    EXPECT_NEAR(root().utilisation, 1.41e6 / 2.9e6, 0.01);
+    // Each hit 5 cm from the root takes 0.19 of its health (2000 N s * 1e-4 * (1 - 0.05 / 1)).
+    int hits = 0;
+    while (rig.motionOf(slab) == BodyMotionState::Static && hits < 6) {
+        rig.runtime.submitImpact(body, {0.05, 2.1, 0}, {0, 1, 0}, 2000);
+        rig.runtime.stepFrame();
+        ++hits;
+        if (hits == 1) // a new static body rebuilds the bond graph: health carries over by body pair
+            rig.addBox({20, 0, 20}, {21, 1, 21});
+        rig.runtime.stepFrame();
+        if (rig.motionOf(slab) == BodyMotionState::Static) {
+            EXPECT_NEAR(root().health, 1 - 0.19 * hits, 1e-9);
+        }
+    }
+    EXPECT_EQ(hits, 3) << "health 0.43 < 0.49";
+    EXPECT_EQ(rig.runtime.counters().bondsBroken, 1);
+}
+
+TEST(StructureRuntime, ABoxDroppedOnACantileversTipBreaksItWhenHeavyEnough) {
+    // The cantilever above (utilisation 0.49) and a box dropped 1 m on its tip: landing at v = 4.4 m/s, the
+    // toy engine reports the impulse m v over the frame, a force of m v / dt at 1.9 m from the root.
+    for (const double mass : {10.0, 200.0}) {
+        Rig rig(true);
+        ASSERT_TRUE(rig.runtime.addConvexBody(makeBox({-1, 0, -2}, {0, 4, 2}).positions, Frame{}, 0));
+        const ObjectId slab = rig.addBox({0, 2, -0.75}, {2, 2.2, 0.75}, "concrete");
+        ASSERT_TRUE(
+            rig.runtime.addConvexBody(makeBox({1.8, 3.2, -0.1}, {2.0, 3.4, 0.1}).positions, Frame{}, mass));
+        for (int i = 0; i < 40; ++i)
+            rig.runtime.stepFrame();
+        // 10 kg: M = 2.6 kN * 1.9 m = 5 kN m adds 0.5 MPa (1.9 < 2.9 MPa); 200 kg: 100 kN m, 10 MPa.
+        EXPECT_EQ(rig.motionOf(slab), mass > 100 ? BodyMotionState::Dynamic : BodyMotionState::Static)
+            << mass;
+    }
+}
+
+TEST(StructureRuntime, TheMaterialFieldOfWorldCfgReachesTheStructure) {
+    // A wall on the ground and a 2 m cantilever slab (h = 0.2 m) off it, stand-in boxes. Brick (f_t 0.4 MPa):
+    // 3 rho g L^2 / h = 1.12 MPa breaks it; wood on the (default concrete) wall: 0.25 MPa < 2.9 MPa holds.
+    for (const char* material : {"brick", "wood"}) {
+        const std::string text = std::string("a;b;c;d;e;f\n;;0;-15;0;100;10;100;0\n;;0;20;0;1;1;1;1\n") +
+                                 "wall.obj;;-0.5;-8;0;1;4;4;0\n" + "slab.obj;;1;-7.9;0;2;0.2;1.5;0;" +
+                                 material + "\n";
+        const Result<SceneConfig> scene = parseSceneConfigText(text, "world.cfg", "/nonexistent");
+        ASSERT_TRUE(scene) << scene.error().message;
+        test::ToyPhysics engine;
+        DestructionRuntime runtime(engine, Rig::config(true, 1, false));
+        SceneLoadOptions options;
+        options.loadVehicle = false;
+        const LoadedScene loaded = loadScene(*scene, runtime, options);
+        ASSERT_EQ(loaded.objects.size(), 2u);
+        runtime.stepFrame();
+        EXPECT_EQ(runtime.bodyOf(loaded.objects[0])->motion, BodyMotionState::Static);
+        EXPECT_EQ(runtime.bodyOf(loaded.objects[1])->motion,
+                  std::string(material) == "brick" ? BodyMotionState::Dynamic : BodyMotionState::Static)
+            << material;
+    }
+}
+
+TEST(StructureRuntime, UnknownMaterialIsRefused) {
+    Rig rig(true);
+    ObjectDesc d;
+    d.mesh = makeBox({-1, -1, -1}, {1, 1, 1});
+    d.material = "cheese";
+    const Result<ObjectId> id = rig.runtime.addObject(std::move(d), Frame{}, true);
+    ASSERT_FALSE(id);
+    EXPECT_EQ(id.error().message,
+              "unknown material 'cheese'; expected one of concrete, brick, stone, wood, glass, steel");
+    EXPECT_EQ(rig.runtime.bodyCount(), 1u);
+}
+
+// The cut-face area of an object's mesh (triangles of the interior material).
+double cutArea(const Mesh& m) {
+    double area = 0;
+    for (std::size_t t = 0; t < m.triangles.size(); ++t)
+        if (m.material(t) == kInteriorMaterial) {
+            const auto& tri = m.triangles[t];
+            area += length(cross(m.positions[tri[1]] - m.positions[tri[0]],
+                                 m.positions[tri[2]] - m.positions[tri[0]])) /
+                    2;
+        }
+    return area;
+}
+
+TEST(StructureRuntime, ChipsStayBondedAcrossTheirCutFacesByPolicyAndTheStructureIsTheSameOnOneAndTwoWorkers) {
+    auto run = [](int workers, bool bondDebris, std::vector<StructureBond>& bonds) {
+        Rig rig(true, workers, bondDebris);
+        FractureParams f;
+        f.seedPoints = 0;
+        f.sizeLaw.base = f.sizeLaw.minSize = f.sizeLaw.maxSize = 2.4;
+        f.sizeLaw.scale = 0;
+        const ObjectId column = rig.addBox({-0.5, 0, -0.5}, {0.5, 8, 0.5}, "concrete", true);
+        rig.addBox({-1.5, 8, -1.5}, {1.5, 8.5, 1.5}, "concrete");
+        rig.runtime.stepFrame();
+        EXPECT_EQ(rig.runtime.structureBonds().size(), 2u);
+        // A hit chips the column: the remainder and one chip (the cell's piece).
+        EXPECT_TRUE(rig.runtime.world().submitImpact(column, Impact{{0.5, 0, 0}, {1, 0, 0}, 100}));
+        for (int i = 0; i < 30; ++i)
+            rig.runtime.stepFrame();
+        EXPECT_EQ(rig.runtime.counters().fractures, 1);
+        EXPECT_EQ(rig.runtime.livePieces(), 2);
+        bonds = rig.runtime.structureBonds();
+        // The chip: the smaller piece. Bonded, its bond is exactly its cut faces (each shared with the
+        // remainder).
+        const BodyRecord* chip = nullptr;
+        for (BodyId b : rig.runtime.bodies())
+            if (const BodyRecord* r = rig.runtime.body(b);
+                r->role == BodyRole::Piece && (!chip || r->volume < chip->volume))
+                chip = r;
+        EXPECT_NE(chip, nullptr);
+        if (chip) {
+            EXPECT_EQ(chip->motion, bondDebris ? BodyMotionState::Static : BodyMotionState::Dynamic);
+            const double cut = cutArea(rig.runtime.world().object(chip->object)->mesh);
+            EXPECT_GT(cut, 0.01);
+            if (bondDebris) {
+                EXPECT_EQ(bonds.size(), 3u);
+                EXPECT_TRUE(bonds.back().b == chip->id || bonds.back().a == chip->id);
+                EXPECT_NEAR(bonds.back().area, cut, 1e-6 * cut) << "every cut face, around the chip's corner";
+            } else {
+                EXPECT_EQ(bonds.size(), 2u) << "thrown debris has no bonds";
+            }
+        }
+        return rig.runtime.stateHash();
+    };
+    std::vector<StructureBond> one, two, thrown;
+    EXPECT_EQ(run(1, true, one), run(2, true, two));
+    ASSERT_EQ(one.size(), two.size());
+    for (std::size_t i = 0; i < one.size(); ++i) {
+        EXPECT_EQ(one[i].area, two[i].area);
+        EXPECT_EQ(one[i].utilisation, two[i].utilisation);
+    }
+    run(1, false, thrown);
+}
+
+} // namespace rubble
