@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <unordered_map>
 
 #include "collision/MeshRegion.hpp"
@@ -65,9 +66,42 @@ double boxVolume(const Aabb& b) {
 /// (fragments of the same parent part, origin[i] == origin[j]) are merged first: they tile their parent part
 /// minus the cells, so their joint hull stays inside that convex part. Only when that does not reach the
 /// budget are all touching pairs considered.
-void mergeToBudget(std::vector<ConvexPolytope>& parts, const std::vector<std::uint32_t>& origin,
-                   int maxParts) {
+/// Replaces the fragments of each parent part by their joint hull (inside that convex part): one hull per
+/// parent part instead of pairwise merges, for patterns that cut a part into thousands of fragments.
+void collapseSiblings(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t>& origin) {
+    std::map<std::uint32_t, std::vector<std::size_t>> byOrigin;
+    for (std::size_t i = 0; i < parts.size(); ++i)
+        byOrigin[origin[i]].push_back(i);
+    std::vector<ConvexPolytope> merged;
+    std::vector<std::uint32_t> mergedOrigin;
+    for (const auto& [o, members] : byOrigin) {
+        if (members.size() > 1) {
+            std::vector<Vec3> pts;
+            for (std::size_t i : members) {
+                const auto v = parts[i].vertices();
+                pts.insert(pts.end(), v.begin(), v.end());
+            }
+            if (auto h = convexHull(pts)) {
+                merged.push_back(std::move(h.value()));
+                mergedOrigin.push_back(o);
+                continue;
+            }
+        }
+        for (std::size_t i : members) { // a single fragment, or a hull that failed: kept as they are
+            merged.push_back(std::move(parts[i]));
+            mergedOrigin.push_back(o);
+        }
+    }
+    parts = std::move(merged);
+    origin = std::move(mergedOrigin);
+}
+
+void mergeToBudget(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t> origin, int maxParts) {
     const std::size_t budget = static_cast<std::size_t>(std::max(1, maxParts));
+    if (parts.size() <= budget)
+        return;
+    if (parts.size() > 4 * budget) // pairwise merging is quadratic in the fragment count
+        collapseSiblings(parts, origin);
     if (parts.size() <= budget)
         return;
     struct Candidate {

@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <numeric>
+
 #include "TestSupport.hpp"
 #include "rubble/ConvexDecomposition.hpp"
 #include "rubble/Fracture.hpp"
@@ -340,6 +342,36 @@ TEST(UpdateDecomposition, ShatterPatternsKeepCoverageAndBudget) {
                 }
             }
         }
+    }
+}
+
+TEST(UpdateDecomposition, ThousandsOfFragmentsCollapseIntoTheirParentPartsAndKeepCoverage) {
+    // 300 cells cut each parent part into far more than four times the budget: the fragments of each parent
+    // part become one hull (inside that convex part) before the pairwise merge.
+    const Mesh start = makeSubdividedBox({-1, -1, -1}, {1, 1, 1}, 3);
+    auto d = decompose(start);
+    ASSERT_TRUE(d);
+    for (std::uint64_t seed = 0; seed < 2; ++seed) {
+        SCOPED_TRACE("seed " + std::to_string(seed));
+        FractureParams fp;
+        fp.pattern = CellPattern::Shatter;
+        fp.cells = 300;
+        fp.sizeLaw.base = 1.2;
+        fp.sizeLaw.scale = 0;
+        auto fr = fracture(start, {{1, 0.1, 0.05}, {1, 0, 0}, 1}, fp, seed);
+        ASSERT_TRUE(fr) << fr.error().message;
+        DecompositionParams params;
+        params.maxParts = 8;
+        auto updated = updateDecomposition(d->parts, *fr, params);
+        ASSERT_EQ(updated.size(), fr->pieces.size());
+        for (std::size_t i = 0; i < updated.size(); ++i) {
+            expectCovers(fr->pieces[i].mesh, updated[i], 1e-6 * diag(start));
+            EXPECT_LE(updated[i].size(), 8u);
+        }
+        const double remainderHulls =
+            std::accumulate(updated[0].begin(), updated[0].end(), 0.0,
+                            [](double v, const ConvexPolytope& p) { return v + p.volume(); });
+        EXPECT_LE(remainderHulls, 8 * (1 + 1e-9)) << "the remainder's parts stay inside the parent's parts";
     }
 }
 
