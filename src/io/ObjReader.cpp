@@ -10,11 +10,19 @@
 
 #include "io/FileBytes.hpp"
 #include "io/PolygonTriangulation.hpp"
+#include "io/TextTokens.hpp"
 #include "rubble/MeshIO.hpp"
 
 namespace rubble {
 
 namespace {
+
+using detail::isSpace;
+using detail::NumberStatus;
+using detail::parseDouble;
+using detail::quoted;
+using detail::tokenize;
+using detail::trim;
 constexpr std::uint32_t kNoMaterial = 0xFFFF'FFFFu;
 constexpr std::uint32_t kUnmapped = 0xFFFF'FFFFu;
 
@@ -28,55 +36,6 @@ struct Tri {
     std::uint32_t oSlot = 0, gSlot = 0;
 };
 
-bool isSpace(char c) {
-    return c == ' ' || c == '\t' || c == '\v' || c == '\f' || c == '\r';
-}
-
-std::vector<std::string_view> tokenize(std::string_view s) {
-    std::vector<std::string_view> out;
-    std::size_t i = 0;
-    while (i < s.size()) {
-        while (i < s.size() && isSpace(s[i]))
-            ++i;
-        const std::size_t start = i;
-        while (i < s.size() && !isSpace(s[i]))
-            ++i;
-        if (i > start)
-            out.push_back(s.substr(start, i - start));
-    }
-    return out;
-}
-
-std::string_view trim(std::string_view s) {
-    while (!s.empty() && isSpace(s.front()))
-        s.remove_prefix(1);
-    while (!s.empty() && isSpace(s.back()))
-        s.remove_suffix(1);
-    return s;
-}
-
-enum class NumberStatus { Ok, NotANumber, OutOfRange };
-
-// Parses a whole token as a double ("nan" and "inf" accepted; underflow becomes 0 or a subnormal).
-NumberStatus parseDouble(std::string_view s, double& out) {
-    if (!s.empty() && s.front() == '+')
-        s.remove_prefix(1);
-    if (s.empty() || s.front() == '+')
-        return NumberStatus::NotANumber;
-    const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
-    if (ptr != s.data() + s.size())
-        return NumberStatus::NotANumber;
-    if (ec == std::errc::result_out_of_range) {
-        const std::string copy(s);
-        const double v = std::strtod(copy.c_str(), nullptr);
-        if (std::isinf(v))
-            return NumberStatus::OutOfRange;
-        out = v;
-        return NumberStatus::Ok;
-    }
-    return ec == std::errc() ? NumberStatus::Ok : NumberStatus::NotANumber;
-}
-
 bool parseInt(std::string_view s, std::int64_t& out) {
     if (!s.empty() && s.front() == '+')
         s.remove_prefix(1);
@@ -84,13 +43,6 @@ bool parseInt(std::string_view s, std::int64_t& out) {
         return false;
     const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
     return ec == std::errc() && ptr == s.data() + s.size();
-}
-
-std::string quoted(std::string_view s) {
-    constexpr std::size_t kMax = 40;
-    std::string q = "'";
-    q += s.size() > kMax ? std::string(s.substr(0, kMax)) + "..." : std::string(s);
-    return q + "'";
 }
 
 class ObjParser {

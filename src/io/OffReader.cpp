@@ -8,57 +8,21 @@
 
 #include "io/FileBytes.hpp"
 #include "io/PolygonTriangulation.hpp"
+#include "io/TextTokens.hpp"
 #include "rubble/MeshIO.hpp"
 
 namespace rubble {
 
 namespace {
-bool isSpace(char c) {
-    return c == ' ' || c == '\t' || c == '\v' || c == '\f' || c == '\r';
-}
 
-std::vector<std::string_view> tokenize(std::string_view s) {
-    std::vector<std::string_view> out;
-    std::size_t i = 0;
-    while (i < s.size()) {
-        while (i < s.size() && isSpace(s[i]))
-            ++i;
-        const std::size_t start = i;
-        while (i < s.size() && !isSpace(s[i]))
-            ++i;
-        if (i > start)
-            out.push_back(s.substr(start, i - start));
-    }
-    return out;
-}
-
-std::string quoted(std::string_view s) {
-    constexpr std::size_t kMax = 40;
-    return "'" + (s.size() > kMax ? std::string(s.substr(0, kMax)) + "..." : std::string(s)) + "'";
-}
-
+using detail::isSpace;
+using detail::NumberStatus;
+using detail::parseDouble;
+using detail::quoted;
+using detail::tokenize;
 bool parseCount(std::string_view s, std::uint64_t& out) {
     const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
     return ec == std::errc() && ptr == s.data() + s.size();
-}
-
-enum class NumberStatus { Ok, NotANumber, OutOfRange };
-
-// A whole token as a double ("nan", "inf" accepted; underflow gives 0 or a subnormal), as the OBJ reader.
-NumberStatus parseDouble(std::string_view s, double& out) {
-    if (!s.empty() && s.front() == '+')
-        s.remove_prefix(1);
-    if (s.empty() || s.front() == '+')
-        return NumberStatus::NotANumber;
-    const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
-    if (ptr != s.data() + s.size())
-        return NumberStatus::NotANumber;
-    if (ec == std::errc::result_out_of_range) {
-        const std::string copy(s);
-        out = std::strtod(copy.c_str(), nullptr);
-        return std::isinf(out) ? NumberStatus::OutOfRange : NumberStatus::Ok;
-    }
-    return ec == std::errc() ? NumberStatus::Ok : NumberStatus::NotANumber;
 }
 
 class OffParser {
