@@ -87,14 +87,11 @@ private:
                 end = text_.size();
             std::string_view ln = text_.substr(pos_, end - pos_);
             pos_ = end + 1;
-            for (char ch : ln) {
-                const auto u = static_cast<unsigned char>(ch);
-                if (u < 0x20 && ch != '\t' && ch != '\r' && ch != '\v' && ch != '\f') {
-                    char hex[8];
-                    std::snprintf(hex, sizeof hex, "0x%02X", u);
-                    return fail(std::string("unexpected binary data (byte ") + hex +
-                                "); this is not an OFF text file");
-                }
+            if (const int u = detail::binaryByte(ln); u >= 0) {
+                char hex[8];
+                std::snprintf(hex, sizeof hex, "0x%02X", u);
+                return fail(std::string("unexpected binary data (byte ") + hex +
+                            "); this is not an OFF text file");
             }
             if (const std::size_t hash = ln.find('#'); hash != std::string_view::npos)
                 ln = ln.substr(0, hash);

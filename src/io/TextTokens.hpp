@@ -15,6 +15,16 @@ inline bool isSpace(char c) {
     return c == ' ' || c == '\t' || c == '\v' || c == '\f' || c == '\r';
 }
 
+/// The first control byte of a line that no text format holds (a sign of a binary file), or -1.
+inline int binaryByte(std::string_view line) {
+    for (char ch : line) {
+        const auto u = static_cast<unsigned char>(ch);
+        if (u < 0x20 && ch != '\t' && ch != '\r' && ch != '\v' && ch != '\f')
+            return u;
+    }
+    return -1;
+}
+
 /// The blank-separated tokens of a line.
 inline std::vector<std::string_view> tokenize(std::string_view s) {
     std::vector<std::string_view> out;
