@@ -396,6 +396,12 @@ std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<C
         }
         mergeToBudget(parts, origins[i], params.maxParts);
     }
+    // 5. Parts kept to a bounded size, so that the next hit clips the same few faces.
+    for (std::vector<ConvexPolytope>& parts : result)
+        for (ConvexPolytope& p : parts)
+            if (p.faces().size() > params.maxPartFaces)
+                if (auto b = boundedHull(p.vertices(), params.maxPartFaces))
+                    p = std::move(b.value());
     return result;
 }
 
