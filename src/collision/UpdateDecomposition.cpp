@@ -34,6 +34,25 @@ void subtractCell(const ConvexPolytope& part, const ConvexPolytope& cell, std::v
     }
 }
 
+/// The points extreme in the 26 directions of a cube's faces, edges and corners (repeats removed).
+std::vector<Vec3> extremePoints(const std::vector<Vec3>& pts) {
+    std::vector<Vec3> out;
+    for (int x = -1; x <= 1; ++x)
+        for (int y = -1; y <= 1; ++y)
+            for (int z = -1; z <= 1; ++z) {
+                if (x == 0 && y == 0 && z == 0)
+                    continue;
+                const Vec3 d{double(x), double(y), double(z)};
+                std::size_t best = 0;
+                for (std::size_t i = 1; i < pts.size(); ++i)
+                    if (dot(d, pts[i]) > dot(d, pts[best]))
+                        best = i;
+                if (!pts.empty() && std::find(out.begin(), out.end(), pts[best]) == out.end())
+                    out.push_back(pts[best]);
+            }
+    return out;
+}
+
 /// The polytope clipped to an axis-aligned box (only by the box planes it crosses).
 ConvexPolytope clippedToBox(ConvexPolytope p, const Aabb& box) {
     const Aabb b = p.bounds();
@@ -244,13 +263,12 @@ void mergeToBudget(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t
     parts = std::move(kept);
 }
 
-} // namespace
-
-std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<ConvexPolytope>& parentParts,
-                                                             const std::vector<ConvexPolytope>& cells,
-                                                             const std::vector<Mesh>& pieces,
-                                                             const std::vector<std::int32_t>& pieceCells,
-                                                             const DecompositionParams& params) {
+/// updateDecomposition on pieces held elsewhere (no copies).
+std::vector<std::vector<ConvexPolytope>> updateParts(const std::vector<ConvexPolytope>& parentParts,
+                                                     const std::vector<ConvexPolytope>& cells,
+                                                     const std::vector<const Mesh*>& pieces,
+                                                     const std::vector<std::int32_t>& pieceCells,
+                                                     const DecompositionParams& params) {
     std::vector<std::vector<ConvexPolytope>> result(pieces.size());
     if (pieces.empty())
         return result;
@@ -316,7 +334,7 @@ std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<C
     };
     std::vector<Aabb> pieceBounds(pieces.size());
     for (std::size_t i = 0; i < pieces.size(); ++i)
-        pieceBounds[i] = pieces[i].bounds();
+        pieceBounds[i] = pieces[i]->bounds();
     for (Fragment& frag : fragments) {
         const double fragVolume = frag.shape.volume();
         if (fragVolume <= sliver)
@@ -344,7 +362,7 @@ std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<C
         if (candidates.size() > 1) {
             // Several islands may share this fragment: give each the hull of its own part inside it.
             for (std::size_t i : candidates) {
-                auto h = detail::hullOfMeshInRegion(pieces[i], frag.shape);
+                auto h = detail::hullOfMeshInRegion(*pieces[i], frag.shape);
                 if (h && h->volume() > sliver)
                     give(i, std::move(h.value()), frag.part);
             }
@@ -374,7 +392,7 @@ std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<C
     for (std::size_t i = 0; i < pieces.size(); ++i) {
         std::vector<ConvexPolytope>& parts = result[i];
         if (parts.empty()) {
-            auto d = decompose(pieces[i], params);
+            auto d = decompose(*pieces[i], params);
             if (d)
                 parts = std::move(d->parts);
             continue;
@@ -386,6 +404,12 @@ std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<C
                 sum += p.volume();
                 const auto v = p.vertices();
                 pts.insert(pts.end(), v.begin(), v.end());
+            }
+            // The hull of the extremes in 26 directions lies inside the full hull: when it is already larger
+            // than the parts together, they do not fill their hull (and the full hull is not computed).
+            if (auto quick = convexHull(extremePoints(pts)); quick && quick->volume() > sum * (1 + 1e-6)) {
+                mergeToBudget(parts, origins[i], params.maxParts);
+                continue;
             }
             auto h = convexHull(pts);
             if (h && h->volume() <= sum * (1 + 1e-6)) {
@@ -405,17 +429,30 @@ std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<C
     return result;
 }
 
+} // namespace
+
+std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<ConvexPolytope>& parentParts,
+                                                             const std::vector<ConvexPolytope>& cells,
+                                                             const std::vector<Mesh>& pieces,
+                                                             const std::vector<std::int32_t>& pieceCells,
+                                                             const DecompositionParams& params) {
+    std::vector<const Mesh*> held;
+    held.reserve(pieces.size());
+    for (const Mesh& m : pieces)
+        held.push_back(&m);
+    return updateParts(parentParts, cells, held, pieceCells, params);
+}
+
 std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<ConvexPolytope>& parentParts,
                                                              const FractureResult& result,
                                                              const DecompositionParams& params) {
-    std::vector<Mesh> meshes;
+    std::vector<const Mesh*> meshes;
     std::vector<std::int32_t> pieceCells;
-    meshes.reserve(result.pieces.size());
     for (const Piece& piece : result.pieces) {
-        meshes.push_back(piece.mesh);
+        meshes.push_back(&piece.mesh);
         pieceCells.push_back(piece.cell);
     }
-    return updateDecomposition(parentParts, result.cells, meshes, pieceCells, params);
+    return updateParts(parentParts, result.cells, meshes, pieceCells, params);
 }
 
 } // namespace rubble
