@@ -73,9 +73,7 @@ public:
             auto b = boundedHull(part.hull.vertices(), params_.maxPartFaces);
             return b ? std::optional<ConvexPolytope>(std::move(b.value())) : std::move(part.hull);
         }
-        std::vector<Vec3> points;
-        for (const detail::Polygon& poly : detail::clipTrianglesToRegion(exact_, part.region))
-            points.insert(points.end(), poly.begin(), poly.end());
+        std::vector<Vec3> points = exactPointsIn(part.region);
         for (const Vec3& v : part.region.vertices())
             if (insideExact(v))
                 points.push_back(v);
@@ -83,6 +81,41 @@ public:
         if (!b)
             return std::nullopt;
         return std::move(b.value());
+    }
+
+    /// The exact mesh's surface points in a region, each vertex once: the vertices inside it and the corners
+    /// of the triangles that cross its boundary, clipped to it.
+    std::vector<Vec3> exactPointsIn(const ConvexPolytope& region) const {
+        const Aabb rb = region.bounds();
+        std::vector<std::uint8_t> in(exact_.positions.size(), 0);
+        std::vector<Vec3> points;
+        for (std::size_t v = 0; v < exact_.positions.size(); ++v)
+            if (rb.contains(exact_.positions[v]) && region.contains(exact_.positions[v])) {
+                in[v] = 1;
+                points.push_back(exact_.positions[v]);
+            }
+        detail::Polygon poly, inner, outer;
+        for (std::size_t t = 0; t < exact_.triangles.size(); ++t) {
+            const Triangle& tri = exact_.triangles[t];
+            if (in[tri[0]] && in[tri[1]] && in[tri[2]])
+                continue;
+            const auto c = exact_.corners(t);
+            Aabb tb;
+            for (const Vec3& p : c)
+                tb.extend(p);
+            if (!tb.overlaps(rb))
+                continue;
+            poly.assign(c.begin(), c.end());
+            for (const PolytopeFace& f : region.faces()) {
+                detail::splitPolygon(poly, f.plane, inner, outer);
+                poly.swap(inner);
+                if (poly.size() < 3)
+                    break;
+            }
+            if (poly.size() >= 3)
+                points.insert(points.end(), poly.begin(), poly.end());
+        }
+        return points;
     }
 
     bool inside(const Vec3& p) {

@@ -360,8 +360,16 @@ std::vector<std::vector<ConvexPolytope>> updateParts(const std::vector<ConvexPol
             continue;
         }
         if (candidates.size() > 1) {
-            // Several islands may share this fragment: give each the hull of its own part inside it.
+            // Several islands may share this fragment: give each the hull of its own part inside it (on a
+            // high-poly island, whose inside test costs a pass over its triangles per point, the fragment
+            // clipped to the island's bounds, which also holds that part).
             for (std::size_t i : candidates) {
+                if (pieces[i]->triangles.size() > params.proxyAboveTriangles) {
+                    ConvexPolytope clipped = clippedToBox(frag.shape, pieceBounds[i]);
+                    if (!clipped.empty() && clipped.volume() > sliver)
+                        give(i, std::move(clipped), frag.part);
+                    continue;
+                }
                 auto h = detail::hullOfMeshInRegion(*pieces[i], frag.shape);
                 if (h && h->volume() > sliver)
                     give(i, std::move(h.value()), frag.part);
