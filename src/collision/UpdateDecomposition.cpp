@@ -405,7 +405,13 @@ std::vector<std::vector<ConvexPolytope>> updateParts(const std::vector<ConvexPol
                 parts = std::move(d->parts);
             continue;
         }
-        if (parts.size() > 1) {
+        // A high-poly remainder island whose fragments all come from one parent part is that part minus
+        // cells: with two or more fragments it has a dent and does not fill its hull (test skipped).
+        const bool dented = i < pieceCells.size() && pieceCells[i] < 0 &&
+                            pieces[i]->triangles.size() > params.proxyAboveTriangles &&
+                            std::all_of(origins[i].begin(), origins[i].end(),
+                                        [&](std::uint32_t o) { return o == origins[i].front(); });
+        if (parts.size() > 1 && !dented) {
             double sum = 0;
             std::vector<Vec3> pts;
             for (const ConvexPolytope& p : parts) {
