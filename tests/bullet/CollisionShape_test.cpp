@@ -18,8 +18,9 @@ TEST(CollisionShape, ErodedHullPlusMarginMatchesThePart) {
     ASSERT_TRUE(shape);
     EXPECT_EQ(shape->childCount(), 1);
     // hull points + margin hug the part's box (centred on the body)
-    auto* compound = static_cast<btCompoundShape*>(shape->shape());
-    auto* hull = static_cast<btConvexHullShape*>(compound->getChildShape(0));
+    // one part: the hull itself, without a compound around it
+    ASSERT_FALSE(shape->shape()->isCompound());
+    auto* hull = static_cast<btConvexHullShape*>(shape->shape());
     const double m = hull->getMargin();
     EXPECT_NEAR(m, 0.05, 1e-6);
     btVector3 lo(1e9f, 1e9f, 1e9f), hi(-1e9f, -1e9f, -1e9f);
