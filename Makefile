@@ -12,6 +12,8 @@
 #   make fuzz-smoke  every libFuzzer target for FUZZ_SECONDS (default 45) each with fresh seeds, in build-asan/
 #   make stress      the chained-fracture stress test with STRESS_IMPACTS (default 10000) impacts
 #   make soak        rubble-bench scene with continuous fire for SOAK_FRAMES (default 100000) frames
+#   make blender-addon  build the Python module, install the Blender add-on integrations/blender/rubble_fracture
+#                    into BLENDER_ADDONS (Blender 3.4's user add-on folder) pointing at it, and enable it
 
 BUILD_DIR  ?= build
 BUILD_TYPE ?= RelWithDebInfo
@@ -23,12 +25,13 @@ PREFIX     ?= /usr/local
 DEPS_STAMP  = .deps/core.stamp
 DEPS_ALL_STAMP = .deps/all.stamp
 
+BLENDER_ADDONS ?= $(HOME)/.config/blender/3.4/scripts/addons
 FUZZ_SECONDS ?= 45
 STRESS_IMPACTS ?= 10000
 SOAK_FRAMES ?= 100000
 
 .PHONY: all deps build release install test demo bench format format-check lint clean deps-clang sanitize sanitize-ci \
-	fuzz-smoke stress soak
+	fuzz-smoke stress soak blender-addon
 
 all: build
 
@@ -86,6 +89,14 @@ stress: build
 
 soak: release
 	@bash scripts/soak.sh $(RELEASE_DIR) $(SOAK_FRAMES)
+
+blender-addon: deps $(BUILD_DIR)/build.ninja
+	cmake --build $(BUILD_DIR) -j $(JOBS) --target rubble_python
+	rm -rf $(BLENDER_ADDONS)/rubble_fracture && mkdir -p $(BLENDER_ADDONS)
+	cp -r integrations/blender/rubble_fracture $(BLENDER_ADDONS)/
+	echo "$(abspath $(BUILD_DIR))/python" > $(BLENDER_ADDONS)/rubble_fracture/rubble_path.txt
+	blender -b --python-exit-code 1 --python-expr "import addon_utils, bpy; \
+	    addon_utils.enable('rubble_fracture', default_set=True, handle_error=None); bpy.ops.wm.save_userpref()"
 
 format:
 	@git ls-files '*.cpp' '*.hpp' | xargs clang-format -i

@@ -215,6 +215,31 @@ std::vector<PyPiece> fractureMesh(const rubble::Mesh& mesh, const py::object& po
     return pieces;
 }
 
+/// Writes pieces as Rubble's engine-ready glTF: nodes (name, mesh, convex parts as point arrays) at their
+/// centres of mass with mass properties in extras and "-convcolonly" children.
+void writeGltfPieces(const std::filesystem::path& path, const py::list& nodes) {
+    std::vector<rubble::GltfNode> out;
+    for (const py::handle item : nodes) {
+        const auto t = item.cast<py::tuple>();
+        if (t.size() != 3)
+            throw py::value_error("nodes: expected (name, mesh, convex_parts) tuples");
+        rubble::GltfNode node;
+        node.name = t[0].cast<std::string>();
+        node.mesh = t[1].cast<rubble::Mesh>();
+        const rubble::MassProperties mass = rubble::computeMassProperties(node.mesh);
+        node.origin = mass.centerOfMass;
+        node.extras = rubble::pieceExtras(mass, 1);
+        for (const py::handle part : t[2].cast<py::list>()) {
+            const DoubleArray points =
+                doubleRows(py::reinterpret_borrow<py::object>(part), 3, "convex_parts");
+            node.collision.push_back(unwrap(rubble::convexHull(fromRows<rubble::Vec3>(points))).toMesh());
+        }
+        out.push_back(std::move(node));
+    }
+    py::gil_scoped_release unlocked;
+    unwrap(rubble::writeGltf(path, out));
+}
+
 py::list decomposeMesh(const rubble::Mesh& mesh, int maxParts, double concavity) {
     if (maxParts < 1)
         throw py::value_error("max_parts: expected at least 1");
@@ -314,6 +339,10 @@ PYBIND11_MODULE(_rubble, m) {
             unwrap(rubble::writeObj(path, mesh));
         },
         py::arg("path"), py::arg("mesh"), "Writes a mesh as OBJ (and an MTL file when it has materials).");
+    m.def(
+        "write_gltf", &writeGltfPieces, py::arg("path"), py::arg("nodes"),
+        "Writes (name, mesh, convex_parts) pieces as glTF: a node per piece at its centre of mass with mass "
+        "properties in extras, its convex parts as '-convcolonly' children.");
     m.def(
         "box",
         [](const py::object& lo, const py::object& hi, int subdivisions) {

@@ -13,6 +13,7 @@ core=(
     pybind11-dev python3-dev python3-numpy python3-pytest
     libglfw3-dev libimgui-dev libepoxy-dev libstb-dev libegl-dev libgl-dev libgl1-mesa-dri
     xvfb xauth xdotool gnuplot-nox
+    blender
 )
 extra=(clang libclang-rt-14-dev)
 

@@ -77,6 +77,12 @@ struct Mesh {
     bool operator==(const Mesh&) const = default;
 };
 
+/// The generalized winding number of a closed mesh around p (1 inside an outward solid, 0 outside; the sum of
+/// the triangles' signed solid angles over 4π).
+double windingNumber(const Mesh& mesh, const Vec3& p);
+/// Distance from p to the nearest point on any triangle of mesh (infinity for an empty mesh).
+double distanceToSurface(const Mesh& mesh, const Vec3& p);
+
 /// An axis-aligned box mesh from lo to hi with 12 triangles, outward oriented.
 Mesh makeBox(const Vec3& lo, const Vec3& hi);
 /// A box from lo to hi whose faces are each split into an n×n grid (12·n² triangles), like the seed's

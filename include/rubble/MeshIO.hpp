@@ -9,8 +9,10 @@
 #include <string_view>
 #include <vector>
 
+#include "rubble/MassProperties.hpp"
 #include "rubble/Mesh.hpp"
 #include "rubble/Result.hpp"
+#include "rubble/SceneIO.hpp"
 
 namespace rubble {
 
@@ -30,6 +32,12 @@ struct ObjWriteOptions {
     bool writeMaterials =
         true;               ///< write `usemtl` and a .mtl file next to the .obj when the mesh has materials
     std::string objectName; ///< an `o` statement with this name when non-empty
+    std::vector<Mesh> collision; ///< convex collision parts, written as objects "UCX_<objectName>_<nn>"
+                                 ///< (Unreal's convention) after the mesh; needs objectName
+    std::vector<AssetMaterial>
+        materials; ///< definitions of the mesh's materials, matched by name (the
+                   ///< interior by "interior"); texture maps are copied next to the
+                   ///< .obj (see writeGltf); materials without one get a palette colour
 };
 
 /// Parses OBJ text into one mesh (all objects merged). `displayName` prefixes error messages.
@@ -60,27 +68,49 @@ Result<std::vector<NamedMesh>> readObjObjects(const std::filesystem::path& path)
 
 /// Writes mesh as OBJ (exact shortest round-trip numbers), with normals and texture coordinates when present,
 /// and, when the mesh has materials, `usemtl` statements and an MTL file (same stem, .mtl) in which
-/// kInteriorMaterial is "interior" with its own colour. Triangles keep their order. Each file is written to a
+/// kInteriorMaterial is "interior" with its own colour (or its definition in options.materials). Collision
+/// parts follow as UCX_ objects. Triangles keep their order. Each file is written to a
 /// staging file next to it and renamed, so a failed write (IoError) leaves the previous file as it was.
 Status writeObj(const std::filesystem::path& path, const Mesh& mesh, const ObjWriteOptions& options = {});
 
 /// One node of a glTF scene written by writeGltf.
 struct GltfNode {
+    GltfNode() = default;
+    /// A node with the given fields.
+    GltfNode(std::string name_, Mesh mesh_, const Vec3& origin_, std::vector<Mesh> collision_ = {},
+             std::string extras_ = {}, int parent_ = -1)
+        : name(std::move(name_)), mesh(std::move(mesh_)), origin(origin_), collision(std::move(collision_)),
+          extras(std::move(extras_)), parent(parent_) {}
+
     std::string name; ///< node and mesh name (e.g. "piece_000")
     Mesh mesh;        ///< closed or open triangles in scene coordinates; must not be empty
     Vec3 origin;      ///< where the node is placed (e.g. the piece's centre of mass); the mesh is stored
                       ///< relative to it, so that a node's translation is `origin`
+    std::vector<Mesh> collision; ///< convex parts in scene coordinates, written as child nodes
+                                 ///< "<name>_hull_<nn>-convcolonly" (Godot's collision-only suffix)
+    std::string extras;          ///< a JSON object stored as the node's "extras" ("" for none)
+    int parent = -1; ///< index of the parent node among those written before it (-1: a root of the scene)
 };
 
-/// Writes a self-contained glTF 2.0 file (one embedded base64 buffer): one node per GltfNode, translated to
-/// its origin, each with a mesh of up to two primitives, one per material: "surface" (every material id but
-/// kInteriorMaterial) and "interior" (kInteriorMaterial, i.e. cut faces). Every primitive has POSITION
-/// (float, relative to the origin), NORMAL (unit; flat face normals when the mesh has none), TEXCOORD_0
-/// (V flipped to glTF's top-left origin; (0, 0) when the mesh has none) and uint32 indices; corners with
-/// equal position, normal and UV share a vertex. Output is byte-identical for identical input. Errors:
-/// InvalidInput for an empty or invalid mesh, IoError naming the file (written through a staging file and a
-/// rename, as writeObj).
-Status writeGltf(const std::filesystem::path& path, const std::vector<GltfNode>& nodes);
+/// Writes a glTF 2.0 file (one embedded base64 buffer): one node per GltfNode, translated to its origin
+/// (relative to its parent's), each with a mesh of one primitive per material id, and its collision parts as
+/// child nodes. Materials are named after Mesh::materialNames ("surface" when a mesh has none;
+/// kInteriorMaterial is "interior", i.e. cut faces) and take base colour and base colour texture from the
+/// AssetMaterial of the same name in `materials`; texture images are copied into a folder "textures" next to
+/// the file (embedded images written out; an image that cannot be read is referenced by its path relative to
+/// the file) and referenced by URI. Every primitive has POSITION (float, relative to the origin), NORMAL
+/// (unit; flat face normals when the mesh has none), TEXCOORD_0 (V flipped to glTF's top-left origin; (0, 0)
+/// when the mesh has none) and uint32 indices; corners with equal position, normal and UV share a vertex.
+/// Output is byte-identical for identical input. Errors: InvalidInput for an empty or invalid mesh, IoError
+/// naming the file (written through a staging file and a rename, as writeObj). sceneExtras, when not empty,
+/// is a JSON object stored as the scene's "extras".
+Status writeGltf(const std::filesystem::path& path, const std::vector<GltfNode>& nodes,
+                 const std::vector<AssetMaterial>& materials = {}, const std::string& sceneExtras = {});
+
+/// The node extras Rubble writes for a piece (docs/authoring.md): {"rubble":{"level","density":1,"mass",
+/// "volume","center_of_mass":[x,y,z],"inertia":[[...],[...],[...]]}} (density 1, so mass = volume), plus
+/// "parent" when parent is not empty.
+std::string pieceExtras(const MassProperties& mass, int level, const std::string& parent = {});
 
 /// Reads a mesh by extension: .obj with readObj, .off with parseOff, ASCII .ply and .stl with Rubble's own
 /// readers (exact doubles, file:line errors, equal positions welded); binary .stl and .ply, .3ds, .gltf and

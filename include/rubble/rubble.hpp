@@ -24,5 +24,6 @@
 #include "rubble/PhysicsBinding.hpp"
 #include "rubble/Random.hpp"
 #include "rubble/Result.hpp"
+#include "rubble/SceneIO.hpp"
 #include "rubble/Snapshot.hpp"
 #include "rubble/Vec3.hpp"

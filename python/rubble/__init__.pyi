@@ -18,6 +18,7 @@ __all__ = [
     "fracture",
     "read_mesh",
     "repair",
+    "write_gltf",
     "write_obj",
 ]
 
@@ -153,6 +154,12 @@ def read_mesh(path: str | os.PathLike[str]) -> Mesh:
 
 def write_obj(path: str | os.PathLike[str], mesh: Mesh) -> None:
     """Writes OBJ (and an MTL file next to it when the mesh has materials)."""
+
+def write_gltf(
+    path: str | os.PathLike[str], nodes: Sequence[tuple[str, Mesh, Sequence[Float64Array]]]
+) -> None:
+    """Writes (name, mesh, convex_parts) pieces as glTF: a node per piece at its centre of mass with mass
+    properties in extras, each convex part (its corner points) as a '-convcolonly' child node."""
 
 def box(lo: Vector3, hi: Vector3, subdivisions: int = 1) -> Mesh:
     """A closed box from lo to hi, each face split into subdivisions x subdivisions squares."""

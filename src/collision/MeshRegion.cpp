@@ -50,18 +50,6 @@ void splitPolygon(const Polygon& poly, const Plane& plane, Polygon& inside, Poly
     }
 }
 
-double windingNumber(const Mesh& mesh, const Vec3& p) {
-    double total = 0;
-    for (const Triangle& t : mesh.triangles) {
-        const Vec3 a = mesh.positions[t[0]] - p, b = mesh.positions[t[1]] - p, c = mesh.positions[t[2]] - p;
-        const double la = length(a), lb = length(b), lc = length(c);
-        const double num = dot(a, cross(b, c));
-        const double den = la * lb * lc + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb;
-        total += std::atan2(num, den);
-    }
-    return total / (2.0 * std::numbers::pi);
-}
-
 std::vector<Polygon> clipTrianglesToRegion(const Mesh& mesh, const ConvexPolytope& region) {
     std::vector<Polygon> out;
     const Aabb rb = region.bounds();

@@ -17,12 +17,9 @@ using Polygon = std::vector<Vec3>;
 /// out with fewer than 3 corners (nothing on that side).
 void splitPolygon(const Polygon& poly, const Plane& plane, Polygon& inside, Polygon& outside);
 
-/// The generalized winding number of p with respect to a closed mesh (1 inside, 0 outside).
-double windingNumber(const Mesh& mesh, const Vec3& p);
-
 /// True when p lies inside the closed mesh (winding number above 1/2).
 inline bool insideMesh(const Mesh& mesh, const Vec3& p) {
-    return windingNumber(mesh, p) > 0.5;
+    return rubble::windingNumber(mesh, p) > 0.5;
 }
 
 /// The mesh's triangles clipped to a convex region (triangles whose bounds miss the region are skipped).

@@ -1,7 +1,11 @@
 #include "rubble/Mesh.hpp"
 
+#include "geometry/ClosestPoint.hpp"
+
+#include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <numbers>
 
 namespace rubble {
@@ -172,6 +176,28 @@ std::uint64_t Mesh::hash() const {
     if (!materials.empty())
         h.bytes(materials.data(), materials.size() * sizeof(materials[0]));
     return h.h;
+}
+
+double windingNumber(const Mesh& mesh, const Vec3& p) {
+    // Van Oosterom and Strackee's solid angle of each triangle seen from p.
+    double total = 0;
+    for (const Triangle& t : mesh.triangles) {
+        const Vec3 a = mesh.positions[t[0]] - p, b = mesh.positions[t[1]] - p, c = mesh.positions[t[2]] - p;
+        const double la = length(a), lb = length(b), lc = length(c);
+        const double num = dot(a, cross(b, c));
+        const double den = la * lb * lc + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb;
+        total += std::atan2(num, den);
+    }
+    return total / (2.0 * std::numbers::pi);
+}
+
+double distanceToSurface(const Mesh& mesh, const Vec3& p) {
+    double best = std::numeric_limits<double>::infinity();
+    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+        const auto [a, b, c] = mesh.corners(t);
+        best = std::min(best, length(p - detail::closestOnTriangle(p, a, b, c)));
+    }
+    return best;
 }
 
 Mesh makeBox(const Vec3& lo, const Vec3& hi) {

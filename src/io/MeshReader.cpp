@@ -20,7 +20,9 @@
 #include "io/MeshFormatReaders.hpp"
 #include "io/PolygonTriangulation.hpp"
 #include "io/ReaderSupport.hpp"
+#include "io/SceneReaders.hpp"
 #include "rubble/MeshIO.hpp"
+#include "rubble/SceneIO.hpp"
 
 namespace rubble {
 
@@ -358,45 +360,158 @@ Status guardGltf(const std::string& b, const std::filesystem::path& path, const 
 
 // --- Assimp -----------------------------------------------------------------------------------------------
 
-Result<Mesh> readWithAssimp(const std::filesystem::path& path, const std::string& name) {
+// An Assimp scene read from a file (or memory), owned with its importer.
+struct AssimpScene {
     Assimp::Importer importer;
-    importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
     const aiScene* scene = nullptr;
+};
+
+Status importWithAssimp(AssimpScene& out, const std::filesystem::path& path, const std::string& name) {
+    out.importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
     try {
         // Polygons are triangulated below, not by aiProcess_Triangulate: Debian's Assimp is built with its
         // assertions on, and TriangulateProcess aborts the process on some malformed polygons.
         const unsigned flags = aiProcess_ValidateDataStructure | aiProcess_JoinIdenticalVertices;
-        scene = importer.ReadFile(path.string(), flags);
+        out.scene = out.importer.ReadFile(path.string(), flags);
     } catch (const std::exception& e) {
         return parseError(name, e.what());
     }
+    const aiScene* scene = out.scene;
     if (!scene) {
-        std::string why = importer.GetErrorString();
+        std::string why = out.importer.GetErrorString();
         while (!why.empty() && (why.back() == '\n' || why.back() == ' ' || why.back() == '.'))
             why.pop_back();
         return parseError(name, why.empty() ? "Assimp could not read the file" : why);
     }
     if (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE || !scene->mRootNode)
         return parseError(name, "the file describes an incomplete scene (no mesh data)");
+    return {};
+}
 
-    bool anyNormals = false, anyUvs = false;
-    for (unsigned i = 0; i < scene->mNumMeshes; ++i) {
-        anyNormals = anyNormals || scene->mMeshes[i]->HasNormals();
-        anyUvs = anyUvs || scene->mMeshes[i]->HasTextureCoords(0);
+// Builds one Mesh from the meshes of the nodes it is given (positions welded exactly).
+class AssimpMeshBuilder {
+public:
+    // materialIds: Assimp material index -> material id (empty: no materials).
+    AssimpMeshBuilder(const aiScene* scene, std::vector<std::uint32_t> materialIds)
+        : scene_(scene), materialIds_(std::move(materialIds)) {
+        for (unsigned i = 0; i < scene->mNumMeshes; ++i) {
+            anyNormals_ = anyNormals_ || scene->mMeshes[i]->HasNormals();
+            anyUvs_ = anyUvs_ || scene->mMeshes[i]->HasTextureCoords(0);
+        }
     }
+
+    // Appends the triangles of node's meshes transformed by xf.
+    void addNode(const aiNode* node, const aiMatrix4x4& xf) {
+        aiMatrix3x3 normalXf(xf);
+        normalXf.Inverse().Transpose();
+        const bool mirrored = aiMatrix3x3(xf).Determinant() < 0;
+        for (unsigned k = 0; k < node->mNumMeshes; ++k) {
+            if (node->mMeshes[k] >= scene_->mNumMeshes)
+                continue;
+            addMesh(scene_->mMeshes[node->mMeshes[k]], xf, normalXf, mirrored);
+        }
+    }
+
+    Mesh& mesh() { return m_; }
+
+private:
+    void addMesh(const aiMesh* am, const aiMatrix4x4& xf, const aiMatrix3x3& normalXf, bool mirrored) {
+        std::vector<std::array<unsigned, 3>> corners;
+        for (unsigned f = 0; f < am->mNumFaces; ++f) {
+            const aiFace& face = am->mFaces[f];
+            if (face.mNumIndices < 3 || !face.mIndices)
+                continue; // points and lines
+            bool inRange = true;
+            for (unsigned c = 0; c < face.mNumIndices; ++c)
+                inRange = inRange && face.mIndices[c] < am->mNumVertices;
+            if (!inRange)
+                continue;
+            if (face.mNumIndices == 3) {
+                corners.push_back({face.mIndices[0], face.mIndices[1], face.mIndices[2]});
+                continue;
+            }
+            std::vector<Vec3> pts;
+            for (unsigned c = 0; c < face.mNumIndices; ++c) {
+                const aiVector3D& p = am->mVertices[face.mIndices[c]];
+                pts.push_back({p.x, p.y, p.z});
+            }
+            for (const auto& t : io::triangulatePolygon(pts))
+                corners.push_back({face.mIndices[t[0]], face.mIndices[t[1]], face.mIndices[t[2]]});
+        }
+        for (std::array<unsigned, 3> ids : corners) {
+            if (mirrored)
+                std::swap(ids[1], ids[2]);
+            Triangle tri;
+            bool ok = true;
+            for (int c = 0; c < 3; ++c) {
+                if (ids[c] >= am->mNumVertices) {
+                    ok = false;
+                    break;
+                }
+                const aiVector3D p = xf * am->mVertices[ids[c]];
+                tri[c] = weld_.add({p.x, p.y, p.z});
+            }
+            if (!ok)
+                continue;
+            m_.triangles.push_back(tri);
+            if (anyNormals_) {
+                for (int c = 0; c < 3; ++c) {
+                    if (am->HasNormals()) {
+                        const aiVector3D n = normalXf * am->mNormals[ids[c]];
+                        m_.normals.push_back(normalized(Vec3{n.x, n.y, n.z}));
+                    } else {
+                        m_.normals.push_back(normalized(m_.triangleNormal(m_.triangles.size() - 1)));
+                    }
+                }
+            }
+            if (anyUvs_)
+                for (int c = 0; c < 3; ++c) {
+                    if (am->HasTextureCoords(0)) {
+                        const aiVector3D t = am->mTextureCoords[0][ids[c]];
+                        m_.uvs.push_back({t.x, t.y});
+                    } else {
+                        m_.uvs.push_back({});
+                    }
+                }
+            if (!materialIds_.empty())
+                m_.materials.push_back(
+                    am->mMaterialIndex < materialIds_.size() ? materialIds_[am->mMaterialIndex] : 0u);
+        }
+    }
+
+    const aiScene* scene_;
+    std::vector<std::uint32_t> materialIds_;
+    bool anyNormals_ = false, anyUvs_ = false;
+    Mesh m_;
+    detail::PositionWelder weld_{m_};
+};
+
+std::string nodeName(const aiNode* node) {
+    return node->mName.C_Str();
+}
+
+Result<Mesh> readWithAssimp(const std::filesystem::path& path, const std::string& name) {
+    AssimpScene imported;
+    if (Status s = importWithAssimp(imported, path, name); !s)
+        return s.error();
+    const aiScene* scene = imported.scene;
     bool useMaterials = false;
     std::vector<std::string> materialNames;
+    std::vector<std::uint32_t> materialIds;
     for (unsigned i = 0; i < scene->mNumMaterials; ++i) {
         aiString s;
         scene->mMaterials[i]->Get(AI_MATKEY_NAME, s);
         materialNames.emplace_back(s.C_Str());
+        materialIds.push_back(i);
         useMaterials =
             useMaterials || (materialNames.back() != AI_DEFAULT_MATERIAL_NAME && scene->mNumMaterials > 0);
     }
     useMaterials = useMaterials && scene->mNumMaterials > 1;
+    if (!useMaterials)
+        materialIds.clear();
 
-    Mesh m;
-    detail::PositionWelder weld(m);
+    // Every node's meshes but collision-only nodes (glTF "-convcolonly" children of pre-fractured pieces).
+    AssimpMeshBuilder builder(scene, materialIds);
     std::vector<std::pair<const aiNode*, aiMatrix4x4>> stack{
         {scene->mRootNode, scene->mRootNode->mTransformation}};
     while (!stack.empty()) {
@@ -404,82 +519,127 @@ Result<Mesh> readWithAssimp(const std::filesystem::path& path, const std::string
         stack.pop_back();
         for (unsigned c = 0; c < node->mNumChildren; ++c)
             stack.emplace_back(node->mChildren[c], xf * node->mChildren[c]->mTransformation);
-        aiMatrix3x3 normalXf(xf);
-        normalXf.Inverse().Transpose();
-        const bool mirrored = aiMatrix3x3(xf).Determinant() < 0;
-        for (unsigned k = 0; k < node->mNumMeshes; ++k) {
-            if (node->mMeshes[k] >= scene->mNumMeshes)
-                continue;
-            const aiMesh* am = scene->mMeshes[node->mMeshes[k]];
-            std::vector<std::array<unsigned, 3>> corners;
-            for (unsigned f = 0; f < am->mNumFaces; ++f) {
-                const aiFace& face = am->mFaces[f];
-                if (face.mNumIndices < 3 || !face.mIndices)
-                    continue; // points and lines
-                bool inRange = true;
-                for (unsigned c = 0; c < face.mNumIndices; ++c)
-                    inRange = inRange && face.mIndices[c] < am->mNumVertices;
-                if (!inRange)
-                    continue;
-                if (face.mNumIndices == 3) {
-                    corners.push_back({face.mIndices[0], face.mIndices[1], face.mIndices[2]});
-                    continue;
-                }
-                std::vector<Vec3> pts;
-                for (unsigned c = 0; c < face.mNumIndices; ++c) {
-                    const aiVector3D& p = am->mVertices[face.mIndices[c]];
-                    pts.push_back({p.x, p.y, p.z});
-                }
-                for (const auto& t : io::triangulatePolygon(pts))
-                    corners.push_back({face.mIndices[t[0]], face.mIndices[t[1]], face.mIndices[t[2]]});
-            }
-            for (std::array<unsigned, 3> ids : corners) {
-                if (mirrored)
-                    std::swap(ids[1], ids[2]);
-                Triangle tri;
-                bool ok = true;
-                for (int c = 0; c < 3; ++c) {
-                    if (ids[c] >= am->mNumVertices) {
-                        ok = false;
-                        break;
-                    }
-                    const aiVector3D p = xf * am->mVertices[ids[c]];
-                    tri[c] = weld.add({p.x, p.y, p.z});
-                }
-                if (!ok)
-                    continue;
-                m.triangles.push_back(tri);
-                if (anyNormals) {
-                    for (int c = 0; c < 3; ++c) {
-                        if (am->HasNormals()) {
-                            const aiVector3D n = normalXf * am->mNormals[ids[c]];
-                            m.normals.push_back(normalized(Vec3{n.x, n.y, n.z}));
-                        } else {
-                            m.normals.push_back(normalized(m.triangleNormal(m.triangles.size() - 1)));
-                        }
-                    }
-                }
-                if (anyUvs)
-                    for (int c = 0; c < 3; ++c) {
-                        if (am->HasTextureCoords(0)) {
-                            const aiVector3D t = am->mTextureCoords[0][ids[c]];
-                            m.uvs.push_back({t.x, t.y});
-                        } else {
-                            m.uvs.push_back({});
-                        }
-                    }
-                if (useMaterials)
-                    m.materials.push_back(am->mMaterialIndex);
-            }
-        }
+        if (!isCollisionName(nodeName(node)))
+            builder.addNode(node, xf);
     }
+    Mesh& m = builder.mesh();
     if (m.triangles.empty())
         return parseError(name, "no triangles");
     if (useMaterials)
         m.materialNames = std::move(materialNames);
-    return m;
+    return std::move(m);
+}
+
+// The materials of an Assimp scene (base colour and base colour texture) and the material id of each.
+void readAssimpMaterials(const aiScene* scene, const std::filesystem::path& folder, AssetScene& out,
+                         std::vector<std::uint32_t>& ids, std::vector<std::string>& names) {
+    for (unsigned i = 0; i < scene->mNumMaterials; ++i) {
+        const aiMaterial* am = scene->mMaterials[i];
+        aiString s;
+        am->Get(AI_MATKEY_NAME, s);
+        AssetMaterial mat;
+        mat.name = s.C_Str();
+        aiColor4D colour;
+        if (am->Get(AI_MATKEY_BASE_COLOR, colour) == aiReturn_SUCCESS ||
+            am->Get(AI_MATKEY_COLOR_DIFFUSE, colour) == aiReturn_SUCCESS)
+            mat.baseColor = {colour.r, colour.g, colour.b};
+        aiString texture;
+        if (am->GetTexture(aiTextureType_BASE_COLOR, 0, &texture) == aiReturn_SUCCESS ||
+            am->GetTexture(aiTextureType_DIFFUSE, 0, &texture) == aiReturn_SUCCESS) {
+            TextureMap map;
+            map.slot = "map_Kd";
+            const std::string uri = texture.C_Str();
+            if (const aiTexture* embedded = scene->GetEmbeddedTexture(uri.c_str())) {
+                if (embedded->mHeight == 0) { // compressed image bytes (PNG, JPEG)
+                    map.bytes.assign(reinterpret_cast<const char*>(embedded->pcData), embedded->mWidth);
+                    const std::string hint = embedded->achFormatHint;
+                    map.extension = "." + (hint.empty() ? std::string("png") : lower(hint));
+                    mat.maps.push_back(std::move(map));
+                } else {
+                    out.warnings.push_back("material '" + mat.name +
+                                           "': uncompressed embedded texture skipped");
+                }
+            } else if (!uri.empty()) {
+                map.file = (folder / uri).lexically_normal();
+                std::error_code ec;
+                if (!std::filesystem::exists(map.file, ec))
+                    out.warnings.push_back("material '" + mat.name + "': image " + map.file.string() +
+                                           " not found");
+                mat.maps.push_back(std::move(map));
+            }
+        }
+        names.push_back(mat.name);
+        ids.push_back(mat.name == kInteriorMaterialName ? kInteriorMaterial : i);
+        out.materials.push_back(std::move(mat));
+    }
+}
+
+// A glTF/GLB file (already guarded) as a scene: one object per node with a mesh, collision nodes attached to
+// their nearest non-collision ancestor object.
+Result<AssetScene> readSceneWithAssimp(const std::filesystem::path& path, const std::string& name) {
+    AssimpScene imported;
+    if (Status s = importWithAssimp(imported, path, name); !s)
+        return s.error();
+    const aiScene* scene = imported.scene;
+    AssetScene out;
+    std::vector<std::uint32_t> ids;
+    std::vector<std::string> names;
+    readAssimpMaterials(scene, path.parent_path(), out, ids, names);
+    if (ids.empty())
+        ids.push_back(0);
+    struct Visit {
+        const aiNode* node;
+        aiMatrix4x4 xf;
+        int object; // index of the nearest ancestor object (-1: none)
+    };
+    // Depth-first in file order (children pushed in reverse).
+    std::vector<Visit> stack{{scene->mRootNode, scene->mRootNode->mTransformation, -1}};
+    while (!stack.empty()) {
+        const Visit v = stack.back();
+        stack.pop_back();
+        int object = v.object;
+        if (v.node->mNumMeshes > 0) {
+            AssimpMeshBuilder builder(scene, ids);
+            builder.addNode(v.node, v.xf);
+            Mesh& m = builder.mesh();
+            if (!m.triangles.empty()) {
+                m.materialNames = names;
+                const std::string nm = nodeName(v.node);
+                if (isCollisionName(nm) && v.object >= 0) {
+                    Mesh part = std::move(m);
+                    part.materials.clear();
+                    part.materialNames.clear();
+                    out.objects[static_cast<std::size_t>(v.object)].collision.push_back(std::move(part));
+                } else {
+                    out.objects.push_back({nm, std::move(m), {}, v.object});
+                    object = static_cast<int>(out.objects.size()) - 1;
+                }
+            }
+        }
+        for (unsigned c = v.node->mNumChildren; c-- > 0;)
+            stack.push_back({v.node->mChildren[c], v.xf * v.node->mChildren[c]->mTransformation, object});
+    }
+    if (out.objects.empty())
+        return parseError(name, "no triangles");
+    return out;
 }
 } // namespace
+
+namespace io {
+Result<AssetScene> readGltfScene(const std::filesystem::path& path) {
+    const std::string name = io::displayName(path);
+    {
+        auto bytes = io::readFileBytes(path);
+        if (!bytes)
+            return bytes.error();
+        if (bytes.value().empty())
+            return parseError(name, "no triangles (the file is empty)");
+        if (Status s = guardGltf(bytes.value(), path, name, lower(path.extension().string()) == ".glb"); !s)
+            return s.error();
+    }
+    return readSceneWithAssimp(path, name);
+}
+} // namespace io
 
 const std::vector<std::string>& supportedMeshExtensions() {
     static const std::vector<std::string> ext = {".obj", ".off", ".stl", ".ply", ".3ds", ".gltf", ".glb"};

@@ -1,12 +1,15 @@
 // OBJ + MTL writer with exact (shortest round-trip) numbers.
+#include <algorithm>
 #include <array>
 #include <charconv>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <map>
 #include <unordered_map>
 
 #include "io/FileBytes.hpp"
+#include "io/TextureFiles.hpp"
 #include "rubble/MeshIO.hpp"
 
 namespace rubble {
@@ -65,6 +68,14 @@ Status writeText(const std::filesystem::path& path, const std::string& text) {
 Status writeObj(const std::filesystem::path& path, const Mesh& mesh, const ObjWriteOptions& options) {
     if (Status s = mesh.validate(); !s && s.error().message.find("non-finite") == std::string::npos)
         return makeError(ErrorCode::InvalidInput, io::displayName(path) + ": cannot write: " + s.message());
+    if (!options.collision.empty() && options.objectName.empty())
+        return makeError(ErrorCode::InvalidInput,
+                         io::displayName(path) + ": cannot write collision parts without an object name");
+    for (const Mesh& part : options.collision)
+        if (Status s = part.validate(); !s || part.empty())
+            return makeError(ErrorCode::InvalidInput, io::displayName(path) +
+                                                          ": cannot write a collision part: " +
+                                                          (s ? std::string("no triangles") : s.message()));
     const bool normals = options.writeNormals && mesh.hasNormals();
     const bool uvs = options.writeUvs && mesh.hasUvs();
     const bool materials = options.writeMaterials && mesh.hasMaterials();
@@ -142,6 +153,27 @@ Status writeObj(const std::filesystem::path& path, const Mesh& mesh, const ObjWr
         }
         out += '\n';
     }
+    // Collision parts: UCX_<object>_<nn>, vertices numbered after the mesh's.
+    std::uint64_t base = mesh.positions.size();
+    for (std::size_t k = 0; k < options.collision.size(); ++k) {
+        const Mesh& part = options.collision[k];
+        char suffix[32];
+        std::snprintf(suffix, sizeof suffix, "_%02zu", k);
+        out += "o UCX_" + sanitizeName(options.objectName) + suffix + "\n";
+        for (const Vec3& p : part.positions) {
+            out += "v ";
+            appendNumber(out, p.x);
+            out += ' ';
+            appendNumber(out, p.y);
+            out += ' ';
+            appendNumber(out, p.z);
+            out += '\n';
+        }
+        for (const Triangle& t : part.triangles)
+            out += "f " + std::to_string(base + t[0] + 1) + ' ' + std::to_string(base + t[1] + 1) + ' ' +
+                   std::to_string(base + t[2] + 1) + '\n';
+        base += part.positions.size();
+    }
     if (Status s = writeText(path, out); !s)
         return s;
     if (!materials)
@@ -152,7 +184,36 @@ Status writeObj(const std::filesystem::path& path, const Mesh& mesh, const ObjWr
                                             {0.5, 0.65, 0.5}, {0.65, 0.5, 0.6}, {0.6, 0.6, 0.45}};
     std::string mtl = "# written by Rubble\n";
     std::size_t k = 0;
+    io::TextureFiles textures(path.has_parent_path() ? path.parent_path() : std::filesystem::path("."));
     for (const auto& [id, name] : used) {
+        const std::string sourceName = id == kInteriorMaterial          ? std::string(kInteriorMaterialName)
+                                       : id < mesh.materialNames.size() ? mesh.materialNames[id]
+                                                                        : std::string();
+        const auto defined = std::find_if(options.materials.begin(), options.materials.end(),
+                                          [&](const AssetMaterial& m) { return m.name == sourceName; });
+        if (!sourceName.empty() && defined != options.materials.end()) {
+            // The source definition: its statements, its colour and its maps with the images copied.
+            if (id != kInteriorMaterial)
+                ++k;
+            mtl += "\nnewmtl " + name + "\n";
+            for (const std::string& statement : defined->statements)
+                if (statement.rfind("Kd", 0) != 0)
+                    mtl += statement + "\n";
+            mtl += "Kd ";
+            appendNumber(mtl, defined->baseColor.x);
+            mtl += ' ';
+            appendNumber(mtl, defined->baseColor.y);
+            mtl += ' ';
+            appendNumber(mtl, defined->baseColor.z);
+            mtl += '\n';
+            for (const TextureMap& map : defined->maps) {
+                auto uri = textures.place(map);
+                if (!uri)
+                    return uri.error();
+                mtl += map.slot + ' ' + (map.options.empty() ? "" : map.options + ' ') + uri.value() + '\n';
+            }
+            continue;
+        }
         const double* kd = id == kInteriorMaterial ? nullptr : palette[k++ % std::size(palette)];
         const double interior[3] = {0.85, 0.45, 0.2};
         if (!kd)

@@ -101,27 +101,44 @@ python3 -c "import json,sys; d=json.load(open(sys.argv[1])); assert d['pieces']=
     || fail "impact outside: pieces in $(cat "$tmp/out.json")"
 [ ! -e "$tmp/out" ] || fail "impact outside: output folder was created"
 
-# glTF: one node per piece, two materials, positions + normals + UVs.
+# glTF: one node per piece at the scene root, each with its convex parts as "-convcolonly" children; the
+# source material (with its texture, copied) and the interior; positions + normals + UVs.
 "$RUBBLE" fracture "$models/column.obj" --impact 1.0,5,0 --impulse 400 --seed 2 --format gltf -o "$tmp/g" \
     --json >"$tmp/g.json" || fail "glTF run should exit 0"
 n=$(check_json "$tmp/g.json") || fail "column JSON: $(cat "$tmp/g.json")"
-python3 - "$tmp/g/pieces.gltf" "$n" <<'PY' || fail "glTF check failed"
+python3 - "$tmp/g/pieces.gltf" "$n" "$tmp/g.json" <<'PY' || fail "glTF check failed"
 import json, sys
 d = json.load(open(sys.argv[1]))
 n = int(sys.argv[2])
+pieces = json.load(open(sys.argv[3]))["pieces"]
 assert d["asset"]["version"] == "2.0"
-assert len(d["nodes"]) == n and len(d["scenes"][0]["nodes"]) == n, (len(d["nodes"]), n)
-assert [m["name"] for m in d["materials"]] == ["surface", "interior"]
-for node in d["nodes"]:
+roots = d["scenes"][0]["nodes"]
+assert len(roots) == n, (len(roots), n)
+names = [m["name"] for m in d["materials"]]
+assert names == ["column", "interior"], names
+assert d["images"] == [{"uri": "textures/concrete.png"}], d.get("images")
+assert d["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] == {"index": 0}
+for r, piece in zip(roots, pieces):
+    node = d["nodes"][r]
     assert len(node["translation"]) == 3
     prims = d["meshes"][node["mesh"]]["primitives"]
     assert {p["material"] for p in prims} <= {0, 1} and len(prims) >= 1
     for p in prims:
         assert {"POSITION", "NORMAL", "TEXCOORD_0"} <= set(p["attributes"]), p
-assert any(p["material"] == 1 for m in d["meshes"] for p in m["primitives"]), "no interior faces"
+    parts = [d["nodes"][c] for c in node["children"]]
+    assert len(parts) == piece["convex_parts"] >= 1, (len(parts), piece)
+    assert all(c["name"].startswith(node["name"] + "_hull_") and c["name"].endswith("-convcolonly") for c in parts)
+    assert all("material" not in p for c in parts for p in d["meshes"][c["mesh"]]["primitives"])
+    extras = node["extras"]["rubble"]
+    assert abs(extras["volume"] - piece["volume"]) <= 1e-12 * piece["volume"], (extras, piece)
+    assert extras["mass"] == extras["volume"] and len(extras["inertia"]) == 3
+    assert all(abs(a - b) <= 1e-12 for a, b in zip(extras["center_of_mass"], node["translation"]))
+assert any(p["material"] == 1 for m in d["meshes"] for p in m["primitives"] if "material" in p), "no interior"
 assert d["buffers"][0]["uri"].startswith("data:application/octet-stream;base64,")
 PY
-[ "$(ls "$tmp/g")" = pieces.gltf ] || fail "glTF output should be one file: $(ls "$tmp/g")"
+[ "$(ls "$tmp/g")" = "pieces.gltf
+textures" ] || fail "glTF output should be the file and its textures: $(ls "$tmp/g")"
+cmp "$tmp/g/textures/concrete.png" "$root/assets/textures/concrete.png" || fail "glTF: texture not copied"
 
 # Batch: three meshes in parallel, one folder each, {"results":[...]} with "file".
 "$RUBBLE" fracture "$models/cube_12.obj" "$models/wall.obj" "$models/pyramid.obj" --impact 0,0.5,0 \

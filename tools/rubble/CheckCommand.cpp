@@ -9,11 +9,16 @@
 // {"file","error"} when it could not be written; exit 2). Two inputs with the same stem are refused with
 // --repair into a folder. Outputs are written through a staging file and renamed.
 // Problems and repair notes go to stderr in --json mode.
+// A file with several objects (a glTF node tree, an OBJ with several `o`) or with collision parts (glTF
+// "-convcolonly" children, OBJ UCX_ objects) is checked object by object: each entry then has "object" (its
+// name) and "collision_parts", and a collision part that is not a closed convex solid is a problem of its
+// object. --repair takes single-object files only.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <set>
 #include <sstream>
@@ -23,9 +28,11 @@
 #include "JsonText.hpp"
 #include "Staging.hpp"
 #include "Subcommand.hpp"
+#include "rubble/ConvexDecomposition.hpp"
 #include "rubble/MeshCheck.hpp"
 #include "rubble/MeshIO.hpp"
 #include "rubble/MeshRepair.hpp"
+#include "rubble/SceneIO.hpp"
 
 namespace {
 
@@ -116,6 +123,45 @@ nlohmann::json jsonOf(const std::string& file, const rubble::MeshReport& r) {
     return j;
 }
 
+// Problems of a collision part: open, or not convex (its volume below that of its vertices' convex hull by
+// more than float storage explains).
+std::vector<std::string> partProblems(const rubble::Mesh& part, std::size_t k) {
+    std::vector<std::string> problems;
+    rubble::CheckOptions quick;
+    quick.selfIntersections = false;
+    const rubble::MeshReport r = rubble::checkMesh(part, quick);
+    const std::string name = "collision part " + std::to_string(k);
+    if (!r.closed || !r.manifold() || !r.oriented || !(r.volume > 0)) {
+        problems.push_back(name + " is not a closed, outward solid");
+        return problems;
+    }
+    auto hull = rubble::convexHull(part.positions);
+    const double hullVolume = hull ? hull->volume() : 0;
+    // Float storage moves every face by up to ~1e-7 of the coordinates' magnitude.
+    double area = 0, magnitude = 1;
+    for (std::size_t t = 0; t < part.triangleCount(); ++t)
+        area += length(part.triangleNormal(t)) / 2;
+    for (const rubble::Vec3& p : part.positions)
+        magnitude = std::max({magnitude, std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+    if (!(hullVolume - r.volume <= 1e-5 * hullVolume + 1e-6 * magnitude * area))
+        problems.push_back(name + " is not convex (volume " + num(r.volume) + ", its convex hull's " +
+                           num(hullVolume) + ")");
+    return problems;
+}
+
+// How far the collision parts reach outside the convex hull of their object (0 when inside).
+double outsideHull(const rubble::Mesh& object, const std::vector<rubble::Mesh>& parts) {
+    auto hull = rubble::convexHull(object.positions);
+    if (!hull)
+        return std::numeric_limits<double>::infinity();
+    double worst = 0;
+    for (const rubble::Mesh& part : parts)
+        for (const rubble::Vec3& p : part.positions)
+            for (const rubble::PolytopeFace& f : hull->faces())
+                worst = std::max(worst, f.plane.signedDistance(p));
+    return worst;
+}
+
 std::string quoteArg(const std::string& s) {
     if (s.find_first_of(" \t'\"$\\") == std::string::npos)
         return s;
@@ -171,15 +217,63 @@ int runCheck(const CheckArgs& args) {
         const std::string& file = args.files[i];
         if (i > 0 && !args.json)
             std::cout << "\n";
-        auto mesh = rubble::readMesh(file);
-        if (!mesh) {
-            std::cerr << "rubble check: " << mesh.error().message << "\n";
+        auto scene = rubble::readScene(file);
+        if (!scene) {
+            std::cerr << "rubble check: " << scene.error().message << "\n";
             if (args.json)
                 doc["meshes"].push_back({{"file", rubble::tools::utf8Escaped(file)},
-                                         {"error", rubble::tools::utf8Escaped(mesh.error().message)}});
+                                         {"error", rubble::tools::utf8Escaped(scene.error().message)}});
             exitCode = 2;
             continue;
         }
+        const auto& objects = scene.value().objects;
+        if (objects.size() > 1 || !objects.front().collision.empty()) {
+            if (args.repair) {
+                std::cerr << "rubble check: " << file << " has " << objects.size()
+                          << " objects or collision parts; --repair takes single-object files\n";
+                exitCode = 2;
+                continue;
+            }
+            bool first = true;
+            for (const rubble::AssetObject& object : objects) {
+                rubble::MeshReport r = rubble::checkMesh(object.mesh, checkOptions);
+                for (std::size_t k = 0; k < object.collision.size(); ++k)
+                    for (std::string& p : partProblems(object.collision[k], k))
+                        r.problems.push_back(std::move(p));
+                // Parts may stand out of the hull as far as the decomposition's concavity allows.
+                const double outside =
+                    object.collision.empty() ? 0 : outsideHull(object.mesh, object.collision);
+                const double diagonal = length(r.bounds.hi - r.bounds.lo);
+                const double allowed = rubble::DecompositionParams{}.concavity * diagonal;
+                if (!(outside <= allowed))
+                    r.problems.push_back("collision parts reach " + num(outside) +
+                                         " outside the object's convex hull (allowed: " + num(allowed) + ")");
+                const bool valid = r.valid() && r.problems.empty();
+                const std::string label = file + " (object '" + object.name + "')";
+                if (!args.json) {
+                    if (!first)
+                        std::cout << "\n";
+                    std::cout << label << ": " << (valid ? "valid" : "INVALID") << "\n";
+                    printStats(std::cout, r);
+                    std::cout << "  collision parts     " << object.collision.size() << "\n";
+                    printProblems(std::cout, r.problems, "problems");
+                } else if (!valid) {
+                    std::cerr << label << ": INVALID\n";
+                    printProblems(std::cerr, r.problems, "problems");
+                }
+                first = false;
+                nlohmann::json j = jsonOf(file, r);
+                j["valid"] = valid;
+                j["object"] = rubble::tools::utf8Escaped(object.name);
+                j["collision_parts"] = object.collision.size();
+                j["collision_outside_hull"] = outside;
+                doc["meshes"].push_back(std::move(j));
+                if (!valid)
+                    exitCode = std::max(exitCode, 1);
+            }
+            continue;
+        }
+        auto mesh = rubble::Result<rubble::Mesh>(objects.front().mesh);
         const rubble::MeshReport before = rubble::checkMesh(mesh.value(), checkOptions);
         if (!args.repair) {
             if (!args.json) {

@@ -1,11 +1,18 @@
-// `rubble fracture MESH... --impact X,Y,Z [--impulse F] [--cells K] [--seed S] [--backend corefine|nef|fast]
-//                  -o DIR [--json] [--format obj|gltf]`
+// `rubble fracture MESH... --impact X,Y,Z [--impulse F] [--cells K] [--depth D] [--seed S]
+//                  [--backend corefine|nef|fast] [--interior-texture IMAGE] -o DIR [--json] [--format
+//                  obj|gltf]`
 //
 // Fractures closed meshes at an impact point (in each mesh's coordinates) like the runtime does: cells around
 // the impact, booleans, islands, mass properties, then each piece's convex parts by the incremental update of
-// the parent's decomposition. Writes DIR/piece_000.obj (+ .mtl, cut faces in the material "interior") ... or,
-// with --format gltf, DIR/pieces.gltf (one node per piece at its centre of mass). Several meshes are
-// fractured in parallel (batch pre-fracture), each into DIR/<mesh stem>/.
+// the parent's decomposition. Writes DIR/piece_000.obj (+ .mtl, cut faces in the material "interior", convex
+// parts as UCX_piece_000_NN objects) ... or, with --format gltf, DIR/pieces.gltf (one node per piece at its
+// centre of mass, mass properties in its extras, convex parts as "-convcolonly" child nodes). Source
+// materials and their textures are carried over (images copied into DIR/textures/). A multi-object input (a
+// glTF node tree, an OBJ with several objects) is read as a scene: the leaf object containing the impact, or
+// nearest to it, is fractured and the set is rewritten with the other objects unchanged. --depth D > 1
+// fractures every piece again, level by level, into a glTF node tree with the bonds between sibling chunks in
+// extras (docs/authoring.md). Several meshes are fractured in parallel (batch pre-fracture), each into
+// DIR/<mesh stem>/.
 //
 // Everything is computed before anything is written, and the output is staged in a sibling folder renamed to
 // DIR at the end, so that an error leaves no partial output. SIGINT and SIGTERM are held back while the
@@ -18,7 +25,9 @@
 // "closed","oriented","center_of_mass":[x,y,z],"convex_parts"}],"timings_ms":{"cell","boolean","islands",
 // "decomposition","total"}} (with "error" added when the fracture failed); "cut" is false when no piece has a
 // cut face (the one piece is the input), "dropped_volume" the volume of pieces below the drop fraction. With
-// several meshes {"results":[...]} with one such object per mesh plus "file".
+// several meshes {"results":[...]} with one such object per mesh plus "file". A multi-object input adds
+// "object" (the name of the object fractured) and "kept" (objects written unchanged); --depth D > 1 adds
+// "levels":[{"level","pieces","volume","dropped_volume","bonds","failed"}] for levels 1..D.
 #include <algorithm>
 #include <charconv>
 #include <chrono>
@@ -26,6 +35,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -41,10 +51,13 @@
 #include "JsonText.hpp"
 #include "Staging.hpp"
 #include "Subcommand.hpp"
+#include "rubble/BondGraph.hpp"
 #include "rubble/ConvexDecomposition.hpp"
 #include "rubble/Fracture.hpp"
+#include "rubble/MassProperties.hpp"
 #include "rubble/MeshCheck.hpp"
 #include "rubble/MeshIO.hpp"
+#include "rubble/SceneIO.hpp"
 #include "rubble/ThreadPool.hpp"
 
 namespace {
@@ -62,7 +75,9 @@ struct FractureArgs {
     std::string impact;
     double impulse = rubble::Impact{}.impulse;
     int cells = 1;
+    int depth = 1;
     std::uint64_t seed = 1;
+    std::string interiorTexture;
     std::string backend; // empty: the library's default
     std::string output;
     bool json = false;
@@ -70,11 +85,30 @@ struct FractureArgs {
 };
 
 struct PieceOut {
+    std::string name;
     rubble::Mesh mesh;
     rubble::MassProperties mass;
     bool closed = false;
     bool oriented = false;
-    std::size_t convexParts = 0;
+    std::vector<rubble::ConvexPolytope> parts; // convex parts (for bonds and the next level)
+    std::vector<rubble::Mesh> partMeshes;      // the parts as written (read from the file for kept objects)
+    int parent = -1;                           // index of the parent chunk in MeshJob::pieces
+    int level = 1;                             // 0: an object of the input written unchanged
+};
+
+// A bond between two sibling chunks (indices into MeshJob::pieces).
+struct BondOut {
+    std::size_t a = 0, b = 0;
+    double area = 0;
+    rubble::Vec3 centroid;
+};
+
+struct LevelStats {
+    std::size_t pieces = 0;
+    double volume = 0;
+    double droppedVolume = 0;
+    std::size_t bonds = 0;
+    std::size_t failed = 0; // chunks of the level above that could not be fractured (kept whole)
 };
 
 enum class Outcome { Fractured, Missed, Failed, Invalid };
@@ -82,13 +116,18 @@ enum class Outcome { Fractured, Missed, Failed, Invalid };
 // Everything one mesh produced; written to disk only after every mesh is done.
 struct MeshJob {
     std::string file;
-    std::string folder; // sub-folder of DIR ("" for a single mesh)
+    std::string folder;       // sub-folder of DIR ("" for a single mesh)
+    rubble::AssetScene scene; // the input as read (materials, other objects)
+    std::size_t target = 0;   // the object fractured
+    bool multiObject = false; // the input has several (leaf) objects
     rubble::Mesh input;
     double inputVolume = 0;
     bool inputClosed = false;
     Outcome outcome = Outcome::Fractured;
     std::string message;
-    std::vector<PieceOut> pieces;
+    std::vector<PieceOut> pieces; // kept objects (level 0), then level 1, 2, ... (parents before children)
+    std::vector<BondOut> bonds;   // between siblings
+    std::vector<LevelStats> levels;
     rubble::FractureTimings timings;
     double decompositionMs = 0; // the incremental update
     double parentDecompositionMs = 0;
@@ -130,17 +169,120 @@ std::string num(double v) {
     return buf;
 }
 
-std::string pieceName(std::size_t i) {
+std::string pieceName(const std::string& prefix, std::size_t i) {
     char buf[32];
-    std::snprintf(buf, sizeof buf, "piece_%03zu", i);
-    return buf;
+    std::snprintf(buf, sizeof buf, "_%03zu", i);
+    return prefix + buf;
 }
 
-// Fractures one validated mesh and updates its decomposition (runs on a worker).
+// The pieces of one fracture with their parts; false when the fracture failed (message set).
+struct Fractured {
+    std::vector<PieceOut> pieces;
+    double droppedVolume = 0;
+    rubble::FractureTimings timings;
+    double decompositionMs = 0;
+    bool cut = false;
+};
+
+Fractured piecesOf(rubble::FractureResult& fr, const std::vector<rubble::ConvexPolytope>& parentParts,
+                   const std::string& prefix, int parent, int level) {
+    Fractured out;
+    out.timings = fr.timings;
+    out.droppedVolume = fr.droppedVolume;
+    for (const rubble::Piece& piece : fr.pieces)
+        out.cut = out.cut || std::find(piece.mesh.materials.begin(), piece.mesh.materials.end(),
+                                       rubble::kInteriorMaterial) != piece.mesh.materials.end();
+    const auto td = Clock::now();
+    // Level 1 updates the parent's parts as the runtime does; deeper chunks get fresh decompositions, since
+    // incremental parts, clipped again on every level, stand out further and further from small chunks.
+    std::vector<std::vector<rubble::ConvexPolytope>> parts;
+    if (level <= 1) {
+        parts = rubble::updateDecomposition(parentParts, fr);
+    } else {
+        for (const rubble::Piece& piece : fr.pieces) {
+            auto d = rubble::decompose(piece.mesh);
+            parts.push_back(d ? d->parts : std::vector<rubble::ConvexPolytope>{});
+        }
+    }
+    out.decompositionMs = msSince(td);
+    rubble::CheckOptions noSelfIntersections;
+    noSelfIntersections.selfIntersections = false;
+    for (std::size_t i = 0; i < fr.pieces.size(); ++i) {
+        PieceOut p;
+        p.name = pieceName(prefix, i);
+        const rubble::MeshReport r = rubble::checkMesh(fr.pieces[i].mesh, noSelfIntersections);
+        p.closed = r.closed && r.manifold();
+        p.oriented = r.oriented && r.outward;
+        if (i < parts.size())
+            p.parts = std::move(parts[i]);
+        for (const rubble::ConvexPolytope& part : p.parts)
+            p.partMeshes.push_back(part.toMesh());
+        p.mass = fr.pieces[i].mass;
+        p.mesh = std::move(fr.pieces[i].mesh);
+        p.parent = parent;
+        p.level = level;
+        out.pieces.push_back(std::move(p));
+    }
+    return out;
+}
+
+// The bonds between the given sibling pieces (indices into pieces).
+void addBonds(MeshJob& job, const std::vector<std::size_t>& siblings) {
+    std::vector<std::vector<rubble::ConvexPolytope>> solids;
+    for (std::size_t i : siblings)
+        solids.push_back(job.pieces[i].parts);
+    for (const rubble::Bond& b : rubble::buildBonds(solids, rubble::BondSettings{}))
+        job.bonds.push_back({siblings[b.a], siblings[b.b], b.section.area, b.section.centroid});
+}
+
+// True when no other object of the scene has this one as its parent.
+bool isLeaf(const rubble::AssetScene& scene, std::size_t i) {
+    return std::none_of(scene.objects.begin(), scene.objects.end(),
+                        [&](const rubble::AssetObject& o) { return o.parent == static_cast<int>(i); });
+}
+
+// The parts of a mesh: its collision parts from the file when it has some, else a fresh decomposition.
+std::vector<rubble::ConvexPolytope> partsOf(const rubble::Mesh& mesh,
+                                            const std::vector<rubble::Mesh>& given) {
+    std::vector<rubble::ConvexPolytope> parts;
+    for (const rubble::Mesh& m : given)
+        if (auto hull = rubble::convexHull(m.positions))
+            parts.push_back(std::move(hull.value()));
+    if (!parts.empty() && parts.size() == given.size())
+        return parts;
+    auto d = rubble::decompose(mesh); // a game computes this once, at load time
+    return d ? d->parts : std::vector<rubble::ConvexPolytope>{};
+}
+
+// Fractures one validated mesh and updates its decomposition, then the pieces level by level down to depth
+// (runs on a worker).
 void runJob(MeshJob& job, const rubble::Impact& impact, const rubble::FractureParams& params,
-            std::uint64_t seed) {
+            std::uint64_t seed, int depth, int cells) {
+    // Objects of a multi-object input other than the one fractured are written unchanged (level 0).
+    std::vector<std::size_t> roots;
+    if (job.multiObject)
+        for (std::size_t i = 0; i < job.scene.objects.size(); ++i) {
+            const rubble::AssetObject& o = job.scene.objects[i];
+            if (i == job.target || !isLeaf(job.scene, i))
+                continue;
+            PieceOut p;
+            p.name = o.name;
+            p.mesh = o.mesh;
+            p.mass = rubble::computeMassProperties(o.mesh);
+            rubble::CheckOptions quick;
+            quick.selfIntersections = false;
+            const rubble::MeshReport r = rubble::checkMesh(o.mesh, quick);
+            p.closed = r.closed && r.manifold();
+            p.oriented = r.oriented && r.outward;
+            p.partMeshes = o.collision;
+            p.parts = partsOf(o.mesh, o.collision);
+            p.level = 0;
+            roots.push_back(job.pieces.size());
+            job.pieces.push_back(std::move(p));
+        }
     const auto tp = Clock::now();
-    auto parent = rubble::decompose(job.input); // a game computes this once, at load time
+    const std::vector<rubble::ConvexPolytope> parent =
+        partsOf(job.input, job.scene.objects[job.target].collision);
     job.parentDecompositionMs = msSince(tp);
     auto fr = rubble::fracture(job.input, impact, params, seed);
     if (!fr) {
@@ -150,26 +292,70 @@ void runJob(MeshJob& job, const rubble::Impact& impact, const rubble::FracturePa
         job.message = fr.error().message;
         return;
     }
-    job.timings = fr->timings;
-    job.droppedVolume = fr->droppedVolume;
-    for (const rubble::Piece& piece : fr->pieces)
-        job.cut = job.cut || std::find(piece.mesh.materials.begin(), piece.mesh.materials.end(),
-                                       rubble::kInteriorMaterial) != piece.mesh.materials.end();
-    const auto td = Clock::now();
-    const std::vector<rubble::ConvexPolytope> none;
-    const auto parts = rubble::updateDecomposition(parent ? parent->parts : none, *fr);
-    job.decompositionMs = msSince(td);
-    rubble::CheckOptions noSelfIntersections;
-    noSelfIntersections.selfIntersections = false;
-    for (std::size_t i = 0; i < fr->pieces.size(); ++i) {
-        PieceOut out;
-        const rubble::MeshReport r = rubble::checkMesh(fr->pieces[i].mesh, noSelfIntersections);
-        out.closed = r.closed && r.manifold();
-        out.oriented = r.oriented && r.outward;
-        out.convexParts = i < parts.size() ? parts[i].size() : 0;
-        out.mass = fr->pieces[i].mass;
-        out.mesh = std::move(fr->pieces[i].mesh);
-        job.pieces.push_back(std::move(out));
+    const std::string prefix = job.multiObject ? job.scene.objects[job.target].name : "piece";
+    Fractured first = piecesOf(*fr, parent, prefix, -1, 1);
+    job.timings = first.timings;
+    job.droppedVolume = first.droppedVolume;
+    job.decompositionMs = first.decompositionMs;
+    job.cut = first.cut;
+    std::vector<std::size_t> level;
+    for (PieceOut& p : first.pieces) {
+        level.push_back(job.pieces.size());
+        roots.push_back(job.pieces.size());
+        job.pieces.push_back(std::move(p));
+    }
+    if (depth <= 1)
+        return;
+    LevelStats stats;
+    stats.pieces = level.size();
+    stats.droppedVolume = first.droppedVolume;
+    for (std::size_t i : level)
+        stats.volume += job.pieces[i].mass.volume;
+    const std::size_t before = job.bonds.size();
+    addBonds(job, roots);
+    stats.bonds = job.bonds.size() - before;
+    job.levels.push_back(stats);
+
+    // Deeper levels: every chunk shattered into `cells` cells around its centre of mass, the cells' domain
+    // as large as the chunk's bounding-box diagonal.
+    for (int l = 2; l <= depth; ++l) {
+        LevelStats ls;
+        std::vector<std::size_t> next;
+        for (std::size_t i : level) {
+            const rubble::Mesh chunk = job.pieces[i].mesh;
+            const double diagonal = length(chunk.bounds().hi - chunk.bounds().lo);
+            rubble::FractureParams deeper = params;
+            deeper.pattern = rubble::CellPattern::Shatter;
+            deeper.cells = std::max(2, cells);
+            deeper.sizeLaw.minSize = deeper.sizeLaw.maxSize = diagonal;
+            rubble::Impact centre;
+            centre.point = job.pieces[i].mass.centerOfMass;
+            const std::uint64_t chunkSeed =
+                seed * 0x9E3779B97F4A7C15ull + i * 1315423911ull + std::uint64_t(l);
+            auto sub = rubble::fracture(chunk, centre, deeper, chunkSeed);
+            if (!sub || sub->pieces.size() < 2) {
+                ++ls.failed; // kept whole: it stands for itself on this level
+                ls.volume += job.pieces[i].mass.volume;
+                next.push_back(i);
+                continue;
+            }
+            Fractured f = piecesOf(*sub, job.pieces[i].parts, job.pieces[i].name, static_cast<int>(i), l);
+            ls.droppedVolume += f.droppedVolume;
+            std::vector<std::size_t> siblings;
+            for (PieceOut& p : f.pieces) {
+                ls.volume += p.mass.volume;
+                siblings.push_back(job.pieces.size());
+                next.push_back(job.pieces.size());
+                job.pieces.push_back(std::move(p));
+            }
+            const std::size_t had = job.bonds.size();
+            addBonds(job, siblings);
+            ls.bonds += job.bonds.size() - had;
+        }
+        ls.pieces = next.size();
+        ls.droppedVolume += job.levels.back().droppedVolume; // dropped on this level and above
+        job.levels.push_back(ls);
+        level = std::move(next);
     }
 }
 
@@ -183,13 +369,32 @@ nlohmann::json jsonOf(const MeshJob& job, bool withFile) {
     j["dropped_volume"] = job.droppedVolume;
     j["pieces"] = nlohmann::json::array();
     for (const PieceOut& p : job.pieces) {
+        if (p.level != 1)
+            continue;
         const rubble::Vec3& c = p.mass.centerOfMass;
         j["pieces"].push_back({{"volume", p.mass.volume},
                                {"triangles", p.mesh.triangleCount()},
                                {"closed", p.closed},
                                {"oriented", p.oriented},
                                {"center_of_mass", {c.x, c.y, c.z}},
-                               {"convex_parts", p.convexParts}});
+                               {"convex_parts", p.partMeshes.size()}});
+    }
+    if (job.multiObject) {
+        j["object"] = rubble::tools::utf8Escaped(job.scene.objects[job.target].name);
+        j["kept"] = std::count_if(job.pieces.begin(), job.pieces.end(),
+                                  [](const PieceOut& p) { return p.level == 0; });
+    }
+    if (!job.levels.empty()) {
+        j["levels"] = nlohmann::json::array();
+        for (std::size_t l = 0; l < job.levels.size(); ++l) {
+            const LevelStats& s = job.levels[l];
+            j["levels"].push_back({{"level", l + 1},
+                                   {"pieces", s.pieces},
+                                   {"volume", s.volume},
+                                   {"dropped_volume", s.droppedVolume},
+                                   {"bonds", s.bonds},
+                                   {"failed", s.failed}});
+        }
     }
     j["timings_ms"] = {{"cell", job.timings.cellMs},
                        {"boolean", job.timings.booleanMs},
@@ -211,19 +416,27 @@ void printSummary(std::ostream& out, const MeshJob& job, const fs::path& dir) {
         return;
     }
     double sum = 0;
+    std::size_t count = 0;
     for (const PieceOut& p : job.pieces)
-        sum += p.mass.volume;
-    out << job.file << ": " << job.pieces.size() << (job.pieces.size() == 1 ? " piece" : " pieces")
-        << " written to " << dir.string() << "\n";
+        if (p.level == 1) {
+            sum += p.mass.volume;
+            ++count;
+        }
+    out << job.file << ": " << count << (count == 1 ? " piece" : " pieces");
+    if (job.multiObject)
+        out << " of object '" << job.scene.objects[job.target].name << "'";
+    out << " written to " << dir.string() << "\n";
     char line[160];
     std::snprintf(line, sizeof line, "  %-10s %9s %12s %6s %7s %9s  %s\n", "piece", "triangles", "volume",
                   "parts", "closed", "oriented", "centre of mass");
     out << line;
     for (std::size_t i = 0; i < job.pieces.size(); ++i) {
         const PieceOut& p = job.pieces[i];
+        if (p.level != 1)
+            continue;
         const rubble::Vec3& c = p.mass.centerOfMass;
-        std::snprintf(line, sizeof line, "  %-10s %9zu %12s %6zu %7s %9s  (%s, %s, %s)\n",
-                      pieceName(i).c_str(), p.mesh.triangleCount(), num(p.mass.volume).c_str(), p.convexParts,
+        std::snprintf(line, sizeof line, "  %-10s %9zu %12s %6zu %7s %9s  (%s, %s, %s)\n", p.name.c_str(),
+                      p.mesh.triangleCount(), num(p.mass.volume).c_str(), p.partMeshes.size(),
                       p.closed ? "yes" : "NO", p.oriented ? "yes" : "NO", num(c.x).c_str(), num(c.y).c_str(),
                       num(c.z).c_str());
         out << line;
@@ -233,6 +446,18 @@ void printSummary(std::ostream& out, const MeshJob& job, const fs::path& dir) {
         out << ", dropped " << num(job.droppedVolume) << " (pieces below the drop fraction)";
     out << " (relative difference "
         << num(std::abs(sum + job.droppedVolume - job.inputVolume) / job.inputVolume) << ")\n";
+    for (std::size_t l = 0; l < job.levels.size(); ++l) {
+        const LevelStats& s = job.levels[l];
+        out << "  level " << l + 1 << ": " << s.pieces << " chunks, volume " << num(s.volume) << " + dropped "
+            << num(s.droppedVolume) << ", " << s.bonds << " bonds between siblings";
+        if (s.failed > 0)
+            out << ", " << s.failed << " chunks kept whole";
+        out << "\n";
+    }
+    if (job.multiObject)
+        out << "  " << std::count_if(job.pieces.begin(), job.pieces.end(), [](const PieceOut& p) {
+            return p.level == 0;
+        }) << " other objects written unchanged\n";
     if (!job.cut)
         out << "  nothing was cut: the piece is the whole input (the impact's cells contain the whole mesh, "
                "or "
@@ -244,18 +469,54 @@ void printSummary(std::ostream& out, const MeshJob& job, const fs::path& dir) {
         << "done once at load time: " << num(job.parentDecompositionMs) << " ms)\n";
 }
 
-rubble::Status writeJob(const MeshJob& job, const fs::path& dir, const std::string& format) {
+nlohmann::json vec3(const rubble::Vec3& v) {
+    return {v.x, v.y, v.z};
+}
+
+// The node extras of a piece: mass properties (density 1), level and parent.
+std::string extrasOf(const MeshJob& job, std::size_t i) {
+    const PieceOut& p = job.pieces[i];
+    return rubble::pieceExtras(p.mass, p.level,
+                               p.parent >= 0 ? job.pieces[static_cast<std::size_t>(p.parent)].name : "");
+}
+
+nlohmann::json bondsOf(const MeshJob& job, int parent) {
+    nlohmann::json bonds = nlohmann::json::array();
+    for (const BondOut& b : job.bonds)
+        if (job.pieces[b.a].parent == parent)
+            bonds.push_back({{"a", job.pieces[b.a].name},
+                             {"b", job.pieces[b.b].name},
+                             {"area", b.area},
+                             {"centroid", vec3(b.centroid)}});
+    return bonds;
+}
+
+rubble::Status writeJob(const MeshJob& job, const fs::path& dir, const std::string& format,
+                        const std::vector<rubble::AssetMaterial>& materials) {
     if (format == "gltf") {
         std::vector<rubble::GltfNode> nodes;
-        for (std::size_t i = 0; i < job.pieces.size(); ++i)
-            nodes.push_back({pieceName(i), job.pieces[i].mesh, job.pieces[i].mass.centerOfMass});
-        return rubble::writeGltf(dir / "pieces.gltf", nodes);
+        for (std::size_t i = 0; i < job.pieces.size(); ++i) {
+            const PieceOut& p = job.pieces[i];
+            rubble::GltfNode node{p.name,       p.mesh,           p.mass.centerOfMass,
+                                  p.partMeshes, extrasOf(job, i), p.parent};
+            if (nlohmann::json bonds = bondsOf(job, static_cast<int>(i)); !bonds.empty()) {
+                nlohmann::json extras = nlohmann::json::parse(node.extras);
+                extras["rubble"]["bonds"] = bonds;
+                node.extras = extras.dump();
+            }
+            nodes.push_back(std::move(node));
+        }
+        std::string sceneExtras;
+        if (!job.levels.empty())
+            sceneExtras = nlohmann::json{{"rubble", {{"bonds", bondsOf(job, -1)}}}}.dump();
+        return rubble::writeGltf(dir / "pieces.gltf", nodes, materials, sceneExtras);
     }
-    for (std::size_t i = 0; i < job.pieces.size(); ++i) {
+    for (const PieceOut& p : job.pieces) {
         rubble::ObjWriteOptions options;
-        options.objectName = pieceName(i);
-        if (rubble::Status s = rubble::writeObj(dir / (pieceName(i) + ".obj"), job.pieces[i].mesh, options);
-            !s)
+        options.objectName = p.name;
+        options.collision = p.partMeshes;
+        options.materials = materials;
+        if (rubble::Status s = rubble::writeObj(dir / (p.name + ".obj"), p.mesh, options); !s)
             return s;
     }
     return {};
@@ -273,8 +534,8 @@ void drawProgress(std::size_t done, std::size_t total) {
 }
 
 // Writes the fractured meshes into a staging folder next to DIR and renames it to DIR.
-int commitOutput(const std::vector<MeshJob>& jobs, const fs::path& dir, const std::string& format,
-                 bool batch) {
+int commitOutput(const std::vector<MeshJob>& jobs, const fs::path& dir, const std::string& format, bool batch,
+                 const std::optional<rubble::AssetMaterial>& interior) {
     std::error_code ec;
     const fs::path parent = dir.has_parent_path() ? dir.parent_path() : fs::path(".");
     fs::create_directories(parent, ec);
@@ -296,7 +557,14 @@ int commitOutput(const std::vector<MeshJob>& jobs, const fs::path& dir, const st
         const fs::path sub = batch ? stage / job.folder : stage;
         if (batch && !fs::create_directory(sub, ec))
             return fail("cannot create " + sub.string() + ": " + ec.message());
-        if (rubble::Status s = writeJob(job, sub, format); !s)
+        std::vector<rubble::AssetMaterial> materials = job.scene.materials;
+        if (interior) {
+            materials.erase(std::remove_if(materials.begin(), materials.end(),
+                                           [&](const auto& m) { return m.name == interior->name; }),
+                            materials.end());
+            materials.push_back(*interior);
+        }
+        if (rubble::Status s = writeJob(job, sub, format, materials); !s)
             return fail(s.message());
     }
     if (fs::exists(dir, ec))
@@ -320,6 +588,19 @@ int runFracture(const FractureArgs& args) {
         dir = dir.parent_path();
     if (dir.empty() || dir.filename() == "." || dir.filename() == "..")
         return usage("-o '" + args.output + "' does not name a folder to create");
+    if (args.depth > 1 && args.format != "gltf")
+        return usage("--depth " + std::to_string(args.depth) +
+                     " writes a node tree: it needs --format gltf (OBJ has no hierarchy)");
+    std::optional<rubble::AssetMaterial> interior;
+    if (!args.interiorTexture.empty()) {
+        std::error_code exists;
+        if (!fs::is_regular_file(args.interiorTexture, exists))
+            return usage("--interior-texture '" + args.interiorTexture + "' is not a readable file");
+        interior.emplace();
+        interior->name = std::string(rubble::kInteriorMaterialName);
+        interior->baseColor = {1, 1, 1};
+        interior->maps.push_back({"map_Kd", "", fs::path(args.interiorTexture), "", ""});
+    }
     std::error_code ec;
     if (fs::exists(dir, ec) && (!fs::is_directory(dir, ec) || !fs::is_empty(dir, ec)))
         return usage("the output folder '" + args.output +
@@ -353,22 +634,47 @@ int runFracture(const FractureArgs& args) {
         if (batch && !folders.insert(job.folder).second)
             return usage("two inputs would be written to the same folder '" + job.folder + "' (" + job.file +
                          ")");
-        auto mesh = rubble::readMesh(job.file);
-        if (!mesh)
-            return usage(mesh.error().message);
-        const rubble::MeshReport r = rubble::checkMesh(mesh.value(), noSelfIntersections);
+        auto scene = rubble::readScene(job.file);
+        if (!scene)
+            return usage(scene.error().message);
+        job.scene = std::move(scene.value());
+        for (const std::string& w : job.scene.warnings)
+            std::cerr << "rubble fracture: warning: " << w << "\n";
+        // Several leaf objects: the one containing the impact, else the one nearest to it.
+        std::vector<std::size_t> leaves;
+        for (std::size_t o = 0; o < job.scene.objects.size(); ++o)
+            if (isLeaf(job.scene, o))
+                leaves.push_back(o);
+        job.multiObject = leaves.size() > 1;
+        job.target = leaves.front();
+        if (job.multiObject) {
+            double best = std::numeric_limits<double>::infinity();
+            for (std::size_t o : leaves) {
+                const rubble::Mesh& m = job.scene.objects[o].mesh;
+                const double d =
+                    rubble::windingNumber(m, *point) > 0.5 ? 0.0 : rubble::distanceToSurface(m, *point);
+                if (d < best) {
+                    best = d;
+                    job.target = o;
+                }
+            }
+        }
+        const rubble::Mesh& mesh = job.scene.objects[job.target].mesh;
+        const std::string what =
+            job.multiObject ? job.file + " (object '" + job.scene.objects[job.target].name + "')" : job.file;
+        const rubble::MeshReport r = rubble::checkMesh(mesh, noSelfIntersections);
         if (!r.valid())
-            return usage(job.file + ": not a valid solid, cannot fracture it: " +
+            return usage(what + ": not a valid solid, cannot fracture it: " +
                          (r.problems.empty() ? std::string("invalid mesh") : r.problems.front()) +
                          " (see rubble check " + job.file + ")");
         job.inputClosed = r.closed;
-        job.inputVolume = rubble::signedVolume(mesh.value());
-        job.input = std::move(mesh.value());
+        job.inputVolume = rubble::signedVolume(mesh);
+        job.input = mesh;
     }
 
     // Fracture: inline for one mesh, on a thread pool for several.
     if (!batch) {
-        runJob(jobs[0], impact, params, args.seed);
+        runJob(jobs[0], impact, params, args.seed, args.depth, args.cells);
     } else {
         const int workers = static_cast<int>(
             std::min<std::size_t>(jobs.size(), std::max(1u, std::thread::hardware_concurrency())));
@@ -380,7 +686,7 @@ int runFracture(const FractureArgs& args) {
             drawProgress(0, jobs.size());
         for (MeshJob& job : jobs)
             pool.submit([&, j = &job] {
-                runJob(*j, impact, params, args.seed);
+                runJob(*j, impact, params, args.seed, args.depth, args.cells);
                 std::lock_guard lock(mutex);
                 ++done;
                 if (progress)
@@ -401,7 +707,7 @@ int runFracture(const FractureArgs& args) {
         anyFractured |= job.outcome == Outcome::Fractured;
     }
     if (anyFractured)
-        if (const int written = commitOutput(jobs, dir, args.format, batch); written != kExitOk)
+        if (const int written = commitOutput(jobs, dir, args.format, batch, interior); written != kExitOk)
             return written;
 
     std::ostream& text = args.json ? std::cerr : std::cout;
@@ -431,11 +737,16 @@ const rubble::tools::Registrar registrar{
          app.footer(
              "The impact point is in each mesh's own coordinates. Pieces are written as DIR/piece_000.obj "
              "... "
-             "(cut faces use the material 'interior' in the .mtl) or DIR/pieces.gltf (--format gltf, one "
-             "node "
-             "per piece at its centre of mass); with several meshes each goes to DIR/<mesh stem>/, fractured "
-             "in "
-             "parallel. DIR must not exist or be empty; nothing is written unless the inputs are valid.\n"
+             "(cut faces in the material 'interior' of the .mtl, convex parts as objects UCX_piece_000_NN "
+             "for "
+             "Unreal) or DIR/pieces.gltf (--format gltf: one node per piece at its centre of mass with mass "
+             "properties in extras, convex parts as child nodes named '-convcolonly' for Godot). Source "
+             "materials and textures are kept (images copied to DIR/textures/). A file with several objects "
+             "(e.g. a pieces.gltf written before) has the object containing, or nearest to, the impact "
+             "fractured and the others written unchanged. With several meshes each goes to DIR/<mesh stem>/, "
+             "fractured in parallel. DIR must not exist or be empty; nothing is written unless the inputs "
+             "are "
+             "valid.\n"
              "Exit codes: 0 every mesh fractured and written; 1 a fracture or a write failed (the other "
              "meshes "
              "are written); 2 unreadable or invalid mesh, or a usage error (nothing written); 3 the impact "
@@ -459,6 +770,14 @@ const rubble::tools::Registrar registrar{
                         "1: the thesis's single Voronoi cell; K > 1: shatter into K cells")
              ->check(CLI::Range(1, rubble::kMaxShatterCells))
              ->capture_default_str();
+         app.add_option(
+                "--depth", args->depth,
+                "levels of pre-fracture: D > 1 shatters every piece again into --cells cells (at least "
+                "2), D-1 times, into a glTF node tree with bonds between sibling chunks (--format gltf)")
+             ->check(CLI::Range(1, 4))
+             ->capture_default_str();
+         app.add_option("--interior-texture", args->interiorTexture,
+                        "image for the material 'interior' of the cut faces (copied to DIR/textures/)");
          app.add_option("--seed", args->seed, "random seed (same seed, same pieces, byte for byte)")
              ->check(rubble::tools::unsigned64())
              ->capture_default_str();

@@ -1,0 +1,30 @@
+#pragma once
+// Private helper of the io module: texture images placed next to a written file.
+
+#include <filesystem>
+#include <map>
+#include <set>
+#include <string>
+
+#include "rubble/Result.hpp"
+#include "rubble/SceneIO.hpp"
+
+namespace rubble::io {
+
+/// Copies the images of texture maps into "textures/" next to a written file and gives their relative URIs.
+class TextureFiles {
+public:
+    /// Images go to folder/textures.
+    explicit TextureFiles(std::filesystem::path folder) : folder_(std::move(folder)) {}
+    /// The URI (relative to the folder, '/' separated) under which map's image is found: a copy in textures/
+    /// (written once per image), or the image's own path relative to the folder when it cannot be read.
+    /// IoError when a copy cannot be written.
+    Result<std::string> place(const TextureMap& map);
+
+private:
+    std::filesystem::path folder_;
+    std::map<std::string, std::string> placed_; // source key -> URI
+    std::set<std::string> names_;               // file names used in textures/
+};
+
+} // namespace rubble::io
