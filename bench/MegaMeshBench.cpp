@@ -146,6 +146,17 @@ std::optional<FractureResult> hitOnce(const Mesh& mesh, const std::vector<Convex
     return std::move(r).value();
 }
 
+// Fills the other_cpu_cores column (the last), prints the table and writes the CSV.
+bool finishTable(const CpuMeter& cpu, const Table& table, Table& csv, const std::string& dir,
+                 const std::string& file) {
+    const std::string other = fixed(cpu.read().other, 2);
+    for (auto& row : csv.rows)
+        row.back() = other;
+    printTable(table);
+    std::cout << "other_cpu_cores " << other << " (the rest of the machine's busy cores during the run)\n";
+    return writeCsv(std::filesystem::path(dir) / file, csv);
+}
+
 } // namespace
 
 /// The table and CSV rows of one impact case; ratios against the median, or against the first hit (chains).
@@ -272,12 +283,7 @@ int runMegaImpact(const MegaArgs& args) {
         std::cout << "  (chain: ratios are max / first hit; the last piece has " << mesh.triangles.size()
                   << " triangles)\n";
     }
-    const std::string other = fixed(cpu.read().other, 2);
-    for (auto& row : csv.rows)
-        row.back() = other;
-    printTable(table);
-    std::cout << "other_cpu_cores " << other << " (the rest of the machine's busy cores during the run)\n";
-    if (!writeCsv(std::filesystem::path(args.out) / "impact_megamesh.csv", csv))
+    if (!finishTable(cpu, table, csv, args.out, "impact_megamesh.csv"))
         return 1;
     plotPng(
         args.out, "impact_megamesh", data.str(),
@@ -339,12 +345,7 @@ int runMegaDecomposition(const MegaArgs& args) {
             std::cout << name << ": initial " << fixed(initialMs) << " ms, update median " << fixed(u.median)
                       << " ms" << std::endl;
         }
-    const std::string other = fixed(cpu.read().other, 2);
-    for (auto& row : csv.rows)
-        row.back() = other;
-    printTable(table);
-    std::cout << "other_cpu_cores " << other << "\n";
-    if (!writeCsv(std::filesystem::path(args.out) / "decomposition_megamesh.csv", csv))
+    if (!finishTable(cpu, table, csv, args.out, "decomposition_megamesh.csv"))
         return 1;
     plotPng(
         args.out, "decomposition_megamesh", data.str(),

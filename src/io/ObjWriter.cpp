@@ -21,6 +21,17 @@ void appendNumber(std::string& out, double v) {
     out.append(buf, ec == std::errc() ? ptr : buf);
 }
 
+// A "v x y z" line.
+void appendVertex(std::string& out, const Vec3& p) {
+    out += "v ";
+    appendNumber(out, p.x);
+    out += ' ';
+    appendNumber(out, p.y);
+    out += ' ';
+    appendNumber(out, p.z);
+    out += '\n';
+}
+
 std::string sanitizeName(const std::string& name) {
     std::string s = name;
     for (char& c : s)
@@ -91,13 +102,7 @@ Status writeObj(const std::filesystem::path& path, const Mesh& mesh, const ObjWr
     if (!options.objectName.empty())
         out += "o " + sanitizeName(options.objectName) + "\n";
     for (const Vec3& p : mesh.positions) {
-        out += "v ";
-        appendNumber(out, p.x);
-        out += ' ';
-        appendNumber(out, p.y);
-        out += ' ';
-        appendNumber(out, p.z);
-        out += '\n';
+        appendVertex(out, p);
     }
     AttributeTable<2> uvTable;
     AttributeTable<3> normalTable;
@@ -161,13 +166,7 @@ Status writeObj(const std::filesystem::path& path, const Mesh& mesh, const ObjWr
         std::snprintf(suffix, sizeof suffix, "_%02zu", k);
         out += "o UCX_" + sanitizeName(options.objectName) + suffix + "\n";
         for (const Vec3& p : part.positions) {
-            out += "v ";
-            appendNumber(out, p.x);
-            out += ' ';
-            appendNumber(out, p.y);
-            out += ' ';
-            appendNumber(out, p.z);
-            out += '\n';
+            appendVertex(out, p);
         }
         for (const Triangle& t : part.triangles)
             out += "f " + std::to_string(base + t[0] + 1) + ' ' + std::to_string(base + t[1] + 1) + ' ' +
