@@ -58,7 +58,7 @@ public:
     bool insideExact(const Vec3& p) {
         if (!proxied())
             return inside(p);
-        const double w = detail::windingNumber(mesh_, p);
+        const double w = windingNumber(mesh_, p);
         if (w < 0.2 || w > 0.8)
             return w > 0.5;
         return detail::insideMesh(exact_, p);
