@@ -134,6 +134,7 @@ bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const Game
     clear(renderer);
     settings_ = settings;
     renderer.shadows = settings.shadows;
+    particles_.dustDensity = renderer.quality().software ? 0.35f : 1.0f;
     rubble::DestructionRuntime::Config rc;
     rc.world.workers = settings.workers;
     rc.world.deterministic = settings.deterministic;

@@ -17,11 +17,13 @@
 #include <CLI/CLI.hpp>
 
 #include "Autopilot.hpp"
+#include "DynamicResolution.hpp"
 #include "Game.hpp"
 #include "GlContext.hpp"
 #include "Panel.hpp"
 #include "Renderer.hpp"
 #include "RunReport.hpp"
+#include "ScaledTarget.hpp"
 #include "rubble/SceneConfig.hpp"
 
 namespace {
@@ -61,12 +63,17 @@ struct Options {
     std::string replay; // journal file replayed on the loaded scene instead of playing
     int host = 0;       // port to host loopback multiplayer on
     bool structure = false;
+    std::string quality = "auto"; // auto (from GL_RENDERER), software or gpu
+    float targetFps = 60;         // dynamic resolution holds this rate (software quality)
+    float minScale = -1;          // smallest internal resolution scale (-1: the quality's)
 };
 
 struct App {
     Options opt;
     std::unique_ptr<demo::GlContext> gl;
+    demo::RenderQuality quality;
     demo::Renderer renderer;
+    demo::ScaledTarget sceneTarget;
     demo::Game game;
     demo::Panel panel;
     demo::GameSettings pending;
@@ -146,7 +153,7 @@ bool loadScene(App& a, std::string& error) {
     a.renderer.shutdown();
     a.renderer = demo::Renderer();
     std::string rerr;
-    if (!a.renderer.init(rerr)) {
+    if (!a.renderer.init(a.quality, rerr)) {
         error = "renderer: " + rerr;
         return false;
     }
@@ -209,6 +216,18 @@ int main(int argc, char** argv) {
            "host loopback multiplayer on 127.0.0.1:PORT (needs --deterministic); clients: rubble-bench "
            "netplay-client --port PORT")
         ->check(CLI::Range(1, 65535));
+    cli.add_option(
+           "--quality", o.quality,
+           "renderer quality: auto (software GL gets the software level), software (per-vertex light, "
+           "no shadows, bilinear textures, fewer dust particles) or gpu (per-pixel light, shadows)")
+        ->check(CLI::IsMember({"auto", "software", "gpu"}));
+    cli.add_option("--target-fps", o.targetFps, "frame rate dynamic resolution holds (default 60)")
+        ->check(CLI::Range(5.0, 1000.0));
+    cli.add_option(
+           "--min-scale", o.minScale,
+           "smallest internal resolution scale per axis dynamic resolution may use to hold --target-fps "
+           "(default 1 = off; 0.667 keeps 1280x720 at 1080p)")
+        ->check(CLI::Range(0.25, 1.0));
     cli.add_flag("--structure", o.structure,
                  "stress solver: bonds between static parts break under load; draws them by stress");
     CLI11_PARSE(cli, argc, argv);
@@ -262,7 +281,6 @@ int main(int argc, char** argv) {
     app.pending.fracture.sizeLaw.exponent = 0.5;
     app.pending.fracture.sizeLaw.maxSize = 30;
     app.pending.fracture.uvScale = 0.25;
-    app.pending.shadows = !o.noShadows;
     app.pending.debugShapes = app.pending.debugAabbs = app.pending.debugImpacts = o.debug;
     app.pending.structure = app.pending.debugBonds = o.structure;
 
@@ -272,6 +290,13 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "error: %s\n", error.c_str());
         return 1;
     }
+    const std::string rendererName = app.gl->renderer();
+    app.quality = demo::RenderQuality::forRenderer(o.quality == "gpu" ? std::string("gpu") : rendererName);
+    if (o.quality == "software" && !app.quality.software)
+        app.quality = demo::RenderQuality::forRenderer("llvmpipe");
+    if (o.minScale > 0)
+        app.quality.minScale = o.minScale;
+    app.pending.shadows = !o.noShadows && app.quality.shadows;
     if (!loadScene(app, error)) {
         std::fprintf(stderr, "error: %s\n", error.c_str());
         return 1;
@@ -322,10 +347,14 @@ int main(int argc, char** argv) {
         std::error_code ec;
         std::filesystem::create_directories(o.out, ec);
     }
-    const std::string rendererName = app.gl->renderer();
-    std::fprintf(stderr, "rubble-demo: %s, %dx%d, %s, fracture DestructionWorld + rubble_bullet\n",
+    std::fprintf(stderr,
+                 "rubble-demo: %s, %dx%d, %s, %s quality (shadows %s, %s lighting, internal scale >= %.2f), "
+                 "fracture DestructionWorld + rubble_bullet\n",
                  headless ? "EGL offscreen" : "window", app.gl->width(), app.gl->height(),
-                 rendererName.c_str());
+                 rendererName.c_str(), app.quality.name(), app.pending.shadows ? "on" : "off",
+                 app.quality.pixelLighting ? "per-pixel" : "per-vertex", app.quality.minScale);
+    demo::DynamicResolution resolution(1000.0f / o.targetFps, app.quality.minScale);
+    float lastFrameMs = 0;
 
     demo::Autopilot pilot;
     demo::RunReport report;
@@ -378,12 +407,18 @@ int main(int argc, char** argv) {
 
         // Scene.
         const int w = app.gl->width(), h = app.gl->height();
+        resolution.update(lastFrameMs);
+        int iw = w, ih = h;
+        resolution.size(w, h, iw, ih);
+        const bool scaled = (iw != w || ih != h) && app.sceneTarget.reserve(w, h);
+        if (!scaled)
+            iw = w, ih = h;
         app.renderer.beginFrame();
         app.game.draw(app.renderer, autopilot ? fixedDt : static_cast<float>(std::min(realDt, 0.1)));
         demo::FrameView fv;
-        fv.width = w;
-        fv.height = h;
-        fv.fbo = app.gl->framebuffer();
+        fv.width = iw;
+        fv.height = ih;
+        fv.fbo = scaled ? app.sceneTarget.framebuffer() : app.gl->framebuffer();
         fv.eye = app.game.camera().eye;
         fv.view = app.game.camera().view();
         fv.proj = demo::perspective(1.05f, static_cast<float>(w) / static_cast<float>(std::max(h, 1)), 0.5f,
@@ -392,6 +427,8 @@ int main(int argc, char** argv) {
         app.game.vehicleFrame(vpos, vfwd, vup);
         fv.focus = vpos + vfwd * 60.0f;
         app.renderer.render(fv);
+        if (scaled)
+            app.sceneTarget.blitTo(app.gl->framebuffer(), iw, ih, w, h);
 
         // UI.
         io.DisplaySize = ImVec2(static_cast<float>(w), static_cast<float>(h));
@@ -451,8 +488,9 @@ int main(int argc, char** argv) {
             std::chrono::duration<double, std::milli>(Clock::now() - frameStart).count() - shotMs;
         app.panel.pushFrameMs(static_cast<float>(frameMs));
         const demo::GameCounters& c = app.game.counters();
-        report.add(
-            {simFrame, static_cast<double>(simFrame) / 60.0, frameMs, stepMs, c, app.renderer.drawCalls()});
+        lastFrameMs = static_cast<float>(frameMs);
+        report.add({simFrame, static_cast<double>(simFrame) / 60.0, frameMs, stepMs, c,
+                    app.renderer.drawCalls(), iw, ih});
         if (o.stats && renderFrame % std::max(1, o.statsEvery) == 0) {
             std::printf(
                 "stats render=%ld frame=%llu paused=%d shots=%d impacts=%d fractures=%d bodies=%d pieces=%d "
@@ -468,8 +506,10 @@ int main(int argc, char** argv) {
     if (!o.out.empty()) {
         std::string summary;
         const auto outDir = std::filesystem::path(o.out);
-        if (report.write(outDir, app.scene.baseDir.string() + "/" + app.sceneName, rendererName,
-                         app.game.latencies(), app.screenshots, summary)) {
+        if (report.write(
+                outDir, app.scene.baseDir.string() + "/" + app.sceneName,
+                {rendererName, app.quality.name(), app.pending.shadows, app.gl->width(), app.gl->height()},
+                app.game.latencies(), app.screenshots, summary)) {
             app.game.writeTimings((outDir / "latency.csv").string());
             std::printf("report: %s\n", summary.c_str());
             std::printf("wrote %s/report.json, %s/frames.csv and %d screenshots\n", o.out.c_str(),
@@ -504,6 +544,7 @@ int main(int argc, char** argv) {
     ImGui::DestroyContext();
     app.game.clear(app.renderer);
     app.renderer.shutdown();
+    app.sceneTarget.release();
     app.gl.reset();
     return status;
 }
