@@ -107,7 +107,10 @@ void keyCallback(GLFWwindow* w, int key, int, int action, int) {
             a.paused = false;
         break;
     case GLFW_KEY_F1:
-        a.panel.visible = !a.panel.visible;
+        a.panel.toggle();
+        break;
+    case GLFW_KEY_H:
+        a.panel.help = !a.panel.help;
         break;
     case GLFW_KEY_F2:
         a.screenshotRequested = true;
@@ -185,7 +188,7 @@ int main(int argc, char** argv) {
     Options& o = app.opt;
     CLI::App cli{"rubble-demo: fly a vehicle through a world.cfg scene and shoot destructible objects.\n"
                  "Keys: W/S pitch, A/D roll, Q/E yaw, Z/X speed, Space fire/unpause, P pause, Esc quit,\n"
-                 "F1 panel, F2 screenshot, F3 debug overlay."};
+                 "F1 panel, F2 screenshot, F3 debug overlay, F5/F9 quick save/load, H key help."};
     cli.add_option("--scene", o.scene, "world.cfg scene (thesis format); default assets/scenes/world.cfg");
     cli.add_flag("-d,--debug", o.debug, "draw collision shapes, AABBs and impact points");
     cli.add_option("--autopilot", o.autopilot, "fly and shoot by script for SECONDS (fixed 1/60 s steps)");
@@ -202,7 +205,9 @@ int main(int argc, char** argv) {
     cli.add_option("--pattern", o.pattern, "fracture pattern: single or shatter")
         ->check(CLI::IsMember({"single", "shatter"}));
     cli.add_option("--cells", o.cells, "cells K of the shatter pattern");
-    cli.add_flag("--no-panel", o.noPanel, "hide the ImGui panel (F1 toggles it)");
+    cli.add_flag(
+        "--no-panel", o.noPanel,
+        "hide the panel's compact HUD line too (F1 shows the full panel; by default it starts collapsed)");
     cli.add_flag("--deterministic", o.deterministic, "adopt fractures a fixed number of frames after impact");
     cli.add_flag("--no-shadows", o.noShadows, "disable shadow mapping");
     cli.add_option("--record", o.record,
@@ -439,6 +444,7 @@ int main(int argc, char** argv) {
         if (autopilot) {
             io.DeltaTime = fixedDt;
         }
+        app.panel.scaleToWindow(h);
         ImGui::NewFrame();
         app.panel.pushLatencies(app.game.takeNewLatencies());
         if (app.panel.draw(app.game, app.pending, app.paused, app.sceneName, rendererName,
