@@ -17,6 +17,8 @@ const std::vector<std::pair<const char*, const char*>>& keyHelp() {
         {"Q / E", "yaw left / right"},
         {"Z / X", "speed up / slow down"},
         {"Space", "fire (hold for continuous fire); unpause"},
+        {"R", "respawn the jet (it also respawns 2 s after a crash)"},
+        {"L", "auto-level assist on/off (wings level when no roll key is held)"},
         {"P", "pause"},
         {"H", "this help"},
         {"F1", "full panel / compact HUD line"},

@@ -112,6 +112,13 @@ void keyCallback(GLFWwindow* w, int key, int, int action, int) {
     case GLFW_KEY_H:
         a.panel.help = !a.panel.help;
         break;
+    case GLFW_KEY_R:
+        a.game.respawn();
+        break;
+    case GLFW_KEY_L:
+        a.game.settings().autoLevel = !a.game.settings().autoLevel;
+        a.pending.autoLevel = a.game.settings().autoLevel;
+        break;
     case GLFW_KEY_F2:
         a.screenshotRequested = true;
         break;
@@ -500,9 +507,10 @@ int main(int argc, char** argv) {
         if (o.stats && renderFrame % std::max(1, o.statsEvery) == 0) {
             std::printf(
                 "stats render=%ld frame=%llu paused=%d shots=%d impacts=%d fractures=%d bodies=%d pieces=%d "
-                "jobs=%d frame_ms=%.2f\n",
+                "jobs=%d crashes=%d respawns=%d turnbacks=%d x=%.0f z=%.0f frame_ms=%.2f\n",
                 renderFrame, static_cast<unsigned long long>(c.frame), app.paused ? 1 : 0, c.shots, c.impacts,
-                c.fractures, c.bodies, c.pieces, c.jobs, frameMs);
+                c.fractures, c.bodies, c.pieces, c.jobs, c.crashes, c.respawns, c.turnBacks,
+                static_cast<double>(vpos.x), static_cast<double>(vpos.z), frameMs);
             std::fflush(stdout);
         }
         if (lastFrame)
