@@ -1,5 +1,5 @@
-// readMesh: OBJ and OFF through Rubble's readers, other formats through Assimp after checking size claims in
-// their headers (Assimp trusts them and may try to allocate what a broken or hostile file claims).
+// readMesh: OBJ, OFF, PLY and STL through Rubble's readers; 3DS and glTF through Assimp after checking size
+// claims in their headers (Assimp trusts them and may try to allocate what a broken or hostile file claims).
 #include <algorithm>
 #include <array>
 #include <cctype>
@@ -17,482 +17,20 @@
 #include <nlohmann/json.hpp>
 
 #include "io/FileBytes.hpp"
+#include "io/MeshFormatReaders.hpp"
 #include "io/PolygonTriangulation.hpp"
-#include "io/TextMeshReaders.hpp"
+#include "io/ReaderSupport.hpp"
 #include "rubble/MeshIO.hpp"
 
 namespace rubble {
 
 namespace {
-std::string lower(std::string s) {
-    for (char& c : s)
-        c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return s;
-}
-
-std::uint32_t readU32(const std::string& b, std::size_t at) {
-    const auto* p = reinterpret_cast<const unsigned char*>(b.data() + at);
-    return std::uint32_t{p[0]} | std::uint32_t{p[1]} << 8 | std::uint32_t{p[2]} << 16 |
-           std::uint32_t{p[3]} << 24;
-}
-
-std::uint16_t readU16(const std::string& b, std::size_t at) {
-    const auto* p = reinterpret_cast<const unsigned char*>(b.data() + at);
-    return static_cast<std::uint16_t>(p[0] | p[1] << 8);
-}
-
-std::string bytesText(long double n) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "%.0Lf", n);
-    return buf;
-}
-
-Error parseError(const std::string& name, const std::string& message) {
-    return makeError(ErrorCode::ParseError, name + ": " + message);
-}
-
-// The face count a header declares, compared with what Assimp read (where: "file:line" or "file").
-struct DeclaredFaces {
-    std::uint64_t count = 0;
-    std::string where;
-    bool known = false;
-};
-
-// --- STL --------------------------------------------------------------------------------------------------
-
-// Binary STL files with bytes after the last facet (padding some exporters add) are cut to their real size,
-// because Assimp only recognises a binary STL whose size matches its triangle count exactly.
-// Starts with "solid" and holds no control bytes but whitespace: ASCII (a binary header may start with
-// "solid" too, but its numbers hold zero bytes).
-bool isAsciiStl(const std::string& b) {
-    if (b.size() < 5 || lower(b.substr(0, 5)) != "solid")
-        return false;
-    for (const char c : b) {
-        const auto u = static_cast<unsigned char>(c);
-        if (u < 0x20 && c != '\t' && c != '\n' && c != '\r' && c != '\v' && c != '\f')
-            return false;
-    }
-    return true;
-}
-
-Status guardStl(const std::string& b, const std::string& name, std::size_t& truncateTo,
-                DeclaredFaces& faces) {
-    const bool solid = b.size() >= 5 && lower(b.substr(0, 5)) == "solid";
-    if (b.size() < 84) {
-        if (solid)
-            return {};
-        return parseError(name, "too short for a binary STL (" + std::to_string(b.size()) +
-                                    " bytes; a binary STL has an 84-byte header)");
-    }
-    const std::uint32_t count = readU32(b, 80);
-    const long double needed = 84.0L + 50.0L * count;
-    if (needed == static_cast<long double>(b.size())) {
-        faces = {count, name, true};
-        return {};
-    }
-    if (solid) // ASCII STL ("solid ..."), read as text
-        return {};
-    if (count == 0 && (b.size() - 84) % 50 == 0)
-        return parseError(name, "binary STL header claims 0 triangles but " + std::to_string(b.size() - 84) +
-                                    " bytes of facets (" + std::to_string((b.size() - 84) / 50) +
-                                    " triangles) follow it");
-    faces = {count, name, true};
-    if (needed > static_cast<long double>(b.size()))
-        return parseError(name, "binary STL header claims " + std::to_string(count) + " triangles (" +
-                                    bytesText(needed) + " bytes) but the file has " +
-                                    std::to_string(b.size()) + " bytes");
-    truncateTo = static_cast<std::size_t>(needed);
-    return {};
-}
-
-struct PosKey {
-    std::array<std::uint64_t, 3> bits;
-    bool operator==(const PosKey&) const = default;
-};
-struct PosKeyHash {
-    std::size_t operator()(const PosKey& k) const {
-        return static_cast<std::size_t>(k.bits[0] * 0x9E3779B97F4A7C15ull ^
-                                        k.bits[1] * 0xC2B2AE3D27D4EB4Full ^
-                                        k.bits[2] * 0x165667B19E3779F9ull);
-    }
-};
-
-PosKey keyOf(const Vec3& p) {
-    PosKey k;
-    const double c[3] = {p.x + 0.0, p.y + 0.0, p.z + 0.0};
-    for (int i = 0; i < 3; ++i)
-        std::memcpy(&k.bits[i], &c[i], sizeof(double));
-    return k;
-}
-
-std::vector<std::string> words(std::string_view s) {
-    std::vector<std::string> out;
-    std::size_t i = 0;
-    while (i < s.size()) {
-        while (i < s.size() && std::isspace(static_cast<unsigned char>(s[i])))
-            ++i;
-        const std::size_t st = i;
-        while (i < s.size() && !std::isspace(static_cast<unsigned char>(s[i])))
-            ++i;
-        if (i > st)
-            out.emplace_back(s.substr(st, i - st));
-    }
-    return out;
-}
-
-// ASCII STL, read by Rubble (exact doubles, file:line errors): solid / facet normal / outer loop / vertex x y
-// z (three or more) / endloop / endfacet / endsolid, several solids allowed; keywords in any case. Normals
-// are not kept; exactly equal positions are welded (STL repeats every corner).
-Result<Mesh> readAsciiStl(const std::string& b, const std::string& name) {
-    std::size_t pos = 0, line = 0;
-    std::vector<std::string> tok;
-    auto fail = [&](const std::string& message) {
-        return makeError(ErrorCode::ParseError, name + ":" + std::to_string(line) + ": " + message);
-    };
-    auto nextLine = [&]() {
-        tok.clear();
-        while (tok.empty() && pos < b.size()) {
-            ++line;
-            std::size_t end = b.find('\n', pos);
-            if (end == std::string::npos)
-                end = b.size();
-            tok = words(std::string_view(b.data() + pos, end - pos));
-            pos = end + 1;
-        }
-        if (!tok.empty())
-            tok[0] = lower(tok[0]);
-        return !tok.empty();
-    };
-    auto shown = [](const std::string& t) { return "'" + t.substr(0, 40) + "'"; };
-    Mesh m;
-    std::unordered_map<PosKey, std::uint32_t, PosKeyHash> index;
-    bool inSolid = false;
-    while (nextLine()) {
-        if (!inSolid) {
-            if (tok[0] != "solid")
-                return fail("expected 'solid', got " + shown(tok[0]));
-            inSolid = true;
-            continue;
-        }
-        if (tok[0] == "endsolid") {
-            inSolid = false;
-            continue;
-        }
-        if (tok[0] != "facet")
-            return fail("expected 'facet' or 'endsolid', got " + shown(tok[0]));
-        if (!nextLine() || tok[0] != "outer" || tok.size() != 2 || lower(tok[1]) != "loop")
-            return fail(tok.empty() ? std::string("the file ends inside a facet")
-                                    : "expected 'outer loop', got " + shown(tok[0]));
-        std::vector<Vec3> corners;
-        while (nextLine() && tok[0] == "vertex") {
-            if (tok.size() != 4)
-                return fail("vertex needs 3 numbers, got " + std::to_string(tok.size() - 1));
-            double c[3];
-            for (int k = 0; k < 3; ++k) {
-                const std::string& t = tok[static_cast<std::size_t>(k) + 1];
-                const char* first = t.data() + (t[0] == '+' ? 1 : 0);
-                const auto [ptr, ec] = std::from_chars(first, t.data() + t.size(), c[k]);
-                if (ptr != t.data() + t.size() || first == ptr)
-                    return fail("vertex: expected a number for " +
-                                std::string(1, static_cast<char>('x' + k)) + ", got " + shown(t));
-                if (ec == std::errc::result_out_of_range) {
-                    c[k] = std::strtod(first, nullptr);
-                    if (std::isinf(c[k]))
-                        return fail("vertex: value " + shown(t) + " for " +
-                                    std::string(1, static_cast<char>('x' + k)) + " is out of range");
-                }
-            }
-            corners.push_back({c[0], c[1], c[2]});
-        }
-        if (tok.empty())
-            return fail("the file ends inside a facet");
-        if (tok[0] != "endloop")
-            return fail("expected 'vertex' or 'endloop', got " + shown(tok[0]));
-        if (corners.size() < 3)
-            return fail("facet has " + std::to_string(corners.size()) +
-                        (corners.size() == 1 ? " vertex" : " vertices") + "; at least 3 are needed");
-        if (!nextLine() || tok[0] != "endfacet")
-            return fail(tok.empty() ? std::string("the file ends inside a facet")
-                                    : "expected 'endfacet', got " + shown(tok[0]));
-        std::vector<std::uint32_t> ids;
-        for (const Vec3& p : corners) {
-            auto [it, inserted] = index.emplace(keyOf(p), static_cast<std::uint32_t>(m.positions.size()));
-            if (inserted)
-                m.positions.push_back(p);
-            ids.push_back(it->second);
-        }
-        for (const auto& t : io::triangulatePolygon(corners))
-            m.triangles.push_back({ids[t[0]], ids[t[1]], ids[t[2]]});
-        if (m.positions.size() >= 0xFFFF'FFF0u)
-            return fail("too many vertices");
-    }
-    if (inSolid)
-        return fail("the file ends without 'endsolid' (truncated?)");
-    if (m.triangles.empty())
-        return parseError(name, "no triangles");
-    return m;
-}
-
-// --- PLY --------------------------------------------------------------------------------------------------
-
-int plyTypeSize(const std::string& t) {
-    static const std::unordered_map<std::string, int> sizes = {
-        {"char", 1},   {"int8", 1},    {"uchar", 1},  {"uint8", 1},  {"short", 2}, {"int16", 2},
-        {"ushort", 2}, {"uint16", 2},  {"int", 4},    {"int32", 4},  {"uint", 4},  {"uint32", 4},
-        {"float", 4},  {"float32", 4}, {"double", 8}, {"float64", 8}};
-    const auto it = sizes.find(t);
-    return it == sizes.end() ? 0 : it->second;
-}
-
-bool parseCount(const std::string& s, std::uint64_t& out) {
-    const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
-    return ec == std::errc() && ptr == s.data() + s.size();
-}
-
-struct PlyProperty {
-    std::string name;
-    bool list = false;
-};
-
-struct PlyElement {
-    std::string name;
-    std::uint64_t count = 0;
-    std::size_t line = 0;
-    long double minBinary = 0; // bytes per element, at least
-    std::size_t properties = 0;
-    std::vector<PlyProperty> props;
-};
-
-// A parsed PLY header: the format, the elements and where the body starts.
-struct PlyHeader {
-    std::string format;
-    std::vector<PlyElement> elements;
-    std::size_t bodyPos = 0, bodyLine = 0;
-};
-
-Status guardPly(const std::string& b, const std::string& name, DeclaredFaces& faces, PlyHeader& header) {
-    constexpr std::size_t kMaxHeader = 1 << 20;
-    using Element = PlyElement;
-    std::vector<Element> elements;
-    std::string format;
-    std::size_t pos = 0, line = 0;
-    bool ended = false;
-    while (pos < b.size() && pos < kMaxHeader) {
-        ++line;
-        std::size_t end = b.find('\n', pos);
-        if (end == std::string::npos)
-            end = b.size();
-        const std::string_view ln(b.data() + pos, end - pos);
-        pos = end + 1;
-        const auto w = words(ln);
-        if (line == 1) {
-            if (w.size() != 1 || w[0] != "ply")
-                return parseError(name, "not a PLY file (the first line is not 'ply')");
-            continue;
-        }
-        if (w.empty() || w[0] == "comment" || w[0] == "obj_info")
-            continue;
-        const std::string where = name + ":" + std::to_string(line) + ": ";
-        if (w[0] == "end_header") {
-            ended = true;
-            break;
-        }
-        if (w[0] == "format") {
-            if (w.size() < 2 ||
-                (w[1] != "ascii" && w[1] != "binary_little_endian" && w[1] != "binary_big_endian"))
-                return makeError(ErrorCode::ParseError,
-                                 where + "unknown PLY format '" + (w.size() > 1 ? w[1] : "") + "'");
-            format = w[1];
-        } else if (w[0] == "element") {
-            Element e;
-            e.line = line;
-            if (w.size() != 3 || !parseCount(w[2], e.count))
-                return makeError(ErrorCode::ParseError, where + "expected 'element <name> <count>'");
-            e.name = w[1];
-            elements.push_back(e);
-        } else if (w[0] == "property") {
-            if (elements.empty())
-                return makeError(ErrorCode::ParseError, where + "property before any element");
-            Element& e = elements.back();
-            if (w.size() >= 2 && w[1] == "list") {
-                if (w.size() != 5 || plyTypeSize(w[2]) == 0 || plyTypeSize(w[3]) == 0)
-                    return makeError(ErrorCode::ParseError,
-                                     where + "expected 'property list <count type> <item type> <name>'");
-                e.minBinary += plyTypeSize(w[2]);
-                e.props.push_back({w[4], true});
-            } else {
-                if (w.size() != 3 || plyTypeSize(w[1]) == 0)
-                    return makeError(ErrorCode::ParseError, where + "expected 'property <type> <name>'");
-                e.minBinary += plyTypeSize(w[1]);
-                e.props.push_back({w[2], false});
-            }
-            ++e.properties;
-        } else {
-            return makeError(ErrorCode::ParseError, where + "unknown header keyword '" + w[0] + "'");
-        }
-    }
-    if (!ended)
-        return parseError(name, "PLY header has no 'end_header' line");
-    if (format.empty())
-        return parseError(name, "PLY header has no 'format' line");
-    const long double body = pos >= b.size() ? 0.0L : static_cast<long double>(b.size() - pos);
-    long double total = 0;
-    for (const Element& e : elements)
-        if (e.name == "face")
-            faces = {e.count, name + ":" + std::to_string(e.line), true};
-    for (const Element& e : elements) {
-        const long double per = format == "ascii" ? std::max<long double>(1, 2.0L * e.properties)
-                                                  : std::max<long double>(1, e.minBinary);
-        total += per * static_cast<long double>(e.count);
-        if (total > body + 1)
-            return makeError(ErrorCode::ParseError, name + ":" + std::to_string(e.line) + ": header claims " +
-                                                        std::to_string(e.count) + " '" + e.name +
-                                                        "' elements (at least " + bytesText(total) +
-                                                        " bytes of data) but only " + bytesText(body) +
-                                                        " bytes follow the header");
-    }
-    header = {format, std::move(elements), pos, line};
-    return {};
-}
-
-// ASCII PLY, read by Rubble (exact doubles, file:line errors): one element per line; vertex x, y, z and the
-// face list vertex_indices (or vertex_index) are used, every other property is checked to be a number and
-// ignored. Exactly equal positions are welded (exporters split vertices per face for normals and colours).
-Result<Mesh> readAsciiPly(const std::string& b, const std::string& name, const PlyHeader& h) {
-    std::size_t pos = h.bodyPos, line = h.bodyLine;
-    auto fail = [&](const std::string& message) {
-        return makeError(ErrorCode::ParseError, name + ":" + std::to_string(line) + ": " + message);
-    };
-    std::vector<std::string> tok;
-    auto nextLine = [&]() {
-        tok.clear();
-        while (tok.empty() && pos < b.size()) {
-            ++line;
-            std::size_t end = b.find('\n', pos);
-            if (end == std::string::npos)
-                end = b.size();
-            tok = words(std::string_view(b.data() + pos, end - pos));
-            pos = end + 1;
-        }
-    };
-    // 0: a number; 1: not a number; 2: beyond the double range (underflow gives 0 or a subnormal).
-    auto number = [](const std::string& t, double& v) {
-        const char* first = t.data() + (!t.empty() && t[0] == '+' ? 1 : 0);
-        const auto [ptr, ec] = std::from_chars(first, t.data() + t.size(), v);
-        if (ptr != t.data() + t.size() || first == t.data() + t.size())
-            return 1;
-        if (ec == std::errc::result_out_of_range) {
-            v = std::strtod(first, nullptr);
-            return std::isinf(v) ? 2 : 0;
-        }
-        return ec == std::errc() ? 0 : 1;
-    };
-    std::vector<Vec3> positions;
-    std::vector<Triangle> triangles;
-    std::size_t vertexCount = 0;
-    for (const PlyElement& e : h.elements) {
-        const bool isVertex = e.name == "vertex", isFace = e.name == "face";
-        int xyz[3] = {-1, -1, -1};
-        if (isVertex) {
-            for (std::size_t k = 0; k < e.props.size(); ++k)
-                for (int c = 0; c < 3; ++c)
-                    if (!e.props[k].list && e.props[k].name == std::string(1, static_cast<char>('x' + c)))
-                        xyz[c] = static_cast<int>(k);
-            if (xyz[0] < 0 || xyz[1] < 0 || xyz[2] < 0) {
-                line = e.line;
-                return fail("the vertex element has no x, y and z properties");
-            }
-            vertexCount = static_cast<std::size_t>(e.count);
-        }
-        for (std::uint64_t i = 0; i < e.count; ++i) {
-            nextLine();
-            if (tok.empty())
-                return fail("the file ends after " + std::to_string(i) + " of the " +
-                            std::to_string(e.count) + " declared '" + e.name + "' elements");
-            const std::string what = "'" + e.name + "' " + std::to_string(i);
-            std::size_t t = 0;
-            double c[3] = {0, 0, 0};
-            std::vector<std::uint32_t> corners;
-            for (std::size_t k = 0; k < e.props.size(); ++k) {
-                const PlyProperty& p = e.props[k];
-                std::uint64_t n = 1;
-                if (p.list) {
-                    if (t >= tok.size() || !parseCount(tok[t], n))
-                        return fail(
-                            what + ": expected the length of the list '" + p.name + "', got " +
-                            (t < tok.size() ? "'" + tok[t].substr(0, 40) + "'" : "the end of the line"));
-                    ++t;
-                }
-                if (n > tok.size() - t)
-                    return fail(what + ": the line ends before its properties do (" +
-                                std::to_string(tok.size()) + " numbers; truncated?)");
-                const bool indices =
-                    isFace && p.list && (p.name == "vertex_indices" || p.name == "vertex_index");
-                for (std::uint64_t m = 0; m < n; ++m, ++t) {
-                    double v = 0;
-                    const int kind = number(tok[t], v);
-                    if (kind == 1)
-                        return fail(what + ": expected a number for '" + p.name + "', got '" +
-                                    tok[t].substr(0, 40) + "'");
-                    if (kind == 2)
-                        return fail(what + ": value '" + tok[t].substr(0, 40) + "' for '" + p.name +
-                                    "' is out of range");
-                    for (int a = 0; a < 3; ++a)
-                        if (isVertex && static_cast<int>(k) == xyz[a])
-                            c[a] = v;
-                    if (indices) {
-                        if (!(v >= 0 && v < static_cast<double>(vertexCount)) || v != std::floor(v))
-                            return fail(what + " refers to vertex " + tok[t].substr(0, 40) +
-                                        " but there are " + std::to_string(vertexCount) +
-                                        " (PLY indices start at 0)");
-                        corners.push_back(static_cast<std::uint32_t>(v));
-                    }
-                }
-                if (indices && corners.size() < 3)
-                    return fail(what + " has " + std::to_string(corners.size()) +
-                                (corners.size() == 1 ? " corner" : " corners") + "; at least 3 are needed");
-            }
-            if (t != tok.size())
-                return fail(what + ": " + std::to_string(tok.size() - t) +
-                            " more numbers than its properties need");
-            if (isVertex)
-                positions.push_back({c[0], c[1], c[2]});
-            if (corners.size() == 3) {
-                triangles.push_back({corners[0], corners[1], corners[2]});
-            } else if (!corners.empty()) {
-                std::vector<Vec3> pts;
-                for (std::uint32_t v : corners)
-                    pts.push_back(positions[v]);
-                for (const auto& tri : io::triangulatePolygon(pts))
-                    triangles.push_back({corners[tri[0]], corners[tri[1]], corners[tri[2]]});
-            }
-        }
-    }
-    nextLine();
-    if (!tok.empty())
-        return fail("unexpected '" + tok[0].substr(0, 40) +
-                    "' after the declared elements (the header's counts do not match the file)");
-    if (triangles.empty())
-        return parseError(name, "no triangles");
-    // Weld exactly equal positions (first occurrence wins); unreferenced vertices are dropped.
-    Mesh m;
-    std::unordered_map<PosKey, std::uint32_t, PosKeyHash> index;
-    std::vector<std::uint32_t> remap(positions.size(), UINT32_MAX);
-    for (Triangle& tri : triangles) {
-        for (std::uint32_t& v : tri) {
-            if (remap[v] == UINT32_MAX) {
-                auto [it, inserted] =
-                    index.emplace(keyOf(positions[v]), static_cast<std::uint32_t>(m.positions.size()));
-                if (inserted)
-                    m.positions.push_back(positions[v]);
-                remap[v] = it->second;
-            }
-            v = remap[v];
-        }
-        m.triangles.push_back(tri);
-    }
-    return m;
-}
+using detail::bytesText;
+using detail::lower;
+using detail::parseCount;
+using detail::parseError;
+using detail::readU16;
+using detail::readU32;
 
 // --- OFF --------------------------------------------------------------------------------------------------
 
@@ -820,9 +358,7 @@ Status guardGltf(const std::string& b, const std::filesystem::path& path, const 
 
 // --- Assimp -----------------------------------------------------------------------------------------------
 
-Result<Mesh> readWithAssimp(const std::filesystem::path& path, const std::string& name,
-                            const DeclaredFaces& declared, const std::string* memory = nullptr,
-                            const char* hint = "") {
+Result<Mesh> readWithAssimp(const std::filesystem::path& path, const std::string& name) {
     Assimp::Importer importer;
     importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
     const aiScene* scene = nullptr;
@@ -830,8 +366,7 @@ Result<Mesh> readWithAssimp(const std::filesystem::path& path, const std::string
         // Polygons are triangulated below, not by aiProcess_Triangulate: Debian's Assimp is built with its
         // assertions on, and TriangulateProcess aborts the process on some malformed polygons.
         const unsigned flags = aiProcess_ValidateDataStructure | aiProcess_JoinIdenticalVertices;
-        scene = memory ? importer.ReadFileFromMemory(memory->data(), memory->size(), flags, hint)
-                       : importer.ReadFile(path.string(), flags);
+        scene = importer.ReadFile(path.string(), flags);
     } catch (const std::exception& e) {
         return parseError(name, e.what());
     }
@@ -843,15 +378,6 @@ Result<Mesh> readWithAssimp(const std::filesystem::path& path, const std::string
     }
     if (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE || !scene->mRootNode)
         return parseError(name, "the file describes an incomplete scene (no mesh data)");
-    if (declared.known) {
-        std::uint64_t read = 0;
-        for (unsigned i = 0; i < scene->mNumMeshes; ++i)
-            read += scene->mMeshes[i]->mNumFaces;
-        if (read != declared.count)
-            return makeError(ErrorCode::ParseError, declared.where + ": the header declares " +
-                                                        std::to_string(declared.count) + " faces but " +
-                                                        std::to_string(read) + " were read");
-    }
 
     bool anyNormals = false, anyUvs = false;
     for (unsigned i = 0; i < scene->mNumMeshes; ++i) {
@@ -870,7 +396,7 @@ Result<Mesh> readWithAssimp(const std::filesystem::path& path, const std::string
     useMaterials = useMaterials && scene->mNumMaterials > 1;
 
     Mesh m;
-    std::unordered_map<PosKey, std::uint32_t, PosKeyHash> index;
+    detail::PositionWelder weld(m);
     std::vector<std::pair<const aiNode*, aiMatrix4x4>> stack{
         {scene->mRootNode, scene->mRootNode->mTransformation}};
     while (!stack.empty()) {
@@ -918,12 +444,7 @@ Result<Mesh> readWithAssimp(const std::filesystem::path& path, const std::string
                         break;
                     }
                     const aiVector3D p = xf * am->mVertices[ids[c]];
-                    const Vec3 v{p.x, p.y, p.z};
-                    auto [it, inserted] =
-                        index.emplace(keyOf(v), static_cast<std::uint32_t>(m.positions.size()));
-                    if (inserted)
-                        m.positions.push_back(v);
-                    tri[c] = it->second;
+                    tri[c] = weld.add({p.x, p.y, p.z});
                 }
                 if (!ok)
                     continue;
@@ -960,22 +481,6 @@ Result<Mesh> readWithAssimp(const std::filesystem::path& path, const std::string
 }
 } // namespace
 
-namespace io {
-Result<Mesh> parseAsciiPly(const std::string& bytes, const std::string& displayName) {
-    DeclaredFaces declared;
-    PlyHeader header;
-    if (Status s = guardPly(bytes, displayName, declared, header); !s)
-        return s.error();
-    if (header.format != "ascii")
-        return makeError(ErrorCode::Unsupported, displayName + ": not an ASCII PLY file");
-    return readAsciiPly(bytes, displayName, header);
-}
-
-Result<Mesh> parseAsciiStl(const std::string& bytes, const std::string& displayName) {
-    return readAsciiStl(bytes, displayName);
-}
-} // namespace io
-
 const std::vector<std::string>& supportedMeshExtensions() {
     static const std::vector<std::string> ext = {".obj", ".off", ".stl", ".ply", ".3ds", ".gltf", ".glb"};
     return ext;
@@ -995,8 +500,6 @@ Result<Mesh> readMesh(const std::filesystem::path& path) {
                          name + ": unsupported mesh format '" + ext + "' (supported: " + list + ")");
     }
     Status guard;
-    DeclaredFaces declared;
-    std::string truncated; // a binary STL cut to its real size, read from memory
     {
         auto bytes = io::readFileBytes(path);
         if (!bytes)
@@ -1009,28 +512,18 @@ Result<Mesh> readMesh(const std::filesystem::path& path) {
                 return s.error();
             return parseOff(b, name);
         }
-        std::size_t truncateTo = 0;
-        if (ext == ".stl") {
-            if (isAsciiStl(b))
-                return readAsciiStl(b, name);
-            guard = guardStl(b, name, truncateTo, declared);
-            if (guard && truncateTo > 0 && truncateTo < b.size())
-                truncated = b.substr(0, truncateTo);
-        } else if (ext == ".ply") {
-            PlyHeader header;
-            guard = guardPly(b, name, declared, header);
-            if (guard && header.format == "ascii")
-                return readAsciiPly(b, name, header);
-        } else if (ext == ".3ds")
+        if (ext == ".stl")
+            return io::parseStl(b, name);
+        if (ext == ".ply")
+            return io::parsePly(b, name);
+        if (ext == ".3ds")
             guard = guard3ds(b, name);
         else
             guard = guardGltf(b, path, name, ext == ".glb");
     }
     if (!guard)
         return guard.error();
-    if (!truncated.empty())
-        return readWithAssimp(path, name, declared, &truncated, "stl");
-    return readWithAssimp(path, name, declared);
+    return readWithAssimp(path, name);
 }
 
 } // namespace rubble

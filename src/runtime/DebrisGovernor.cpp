@@ -7,8 +7,9 @@
 namespace rubble::detail {
 namespace {
 
-constexpr int kSettledFrames = 10; // a piece falling from rest passes 1 m/s within 6 frames at 60 Hz
-constexpr double kCellSize = 4.0;  // m: frozen pieces are small, so a body's neighbourhood is a few cells
+constexpr int kSettledFrames = 10;     // a piece falling from rest passes 1 m/s within 6 frames at 60 Hz
+constexpr double kCellSize = 4.0;      // m: frozen pieces are small, so a body's neighbourhood is a few cells
+constexpr double kMovedFraction = 0.1; // a woken body this far (times its radius) from its place has left it
 
 std::int64_t cellCoord(double x) {
     return static_cast<std::int64_t>(std::floor(x / kCellSize));
@@ -37,6 +38,7 @@ std::vector<DebrisGovernor::Cell> DebrisGovernor::cellsOf(const Vec3& lo, const 
 
 void DebrisGovernor::frozen(BodyId id, const Vec3& center, double radius) {
     thawed(id);
+    watched_.erase(id);
     frozen_[id] = {center, radius};
     const Vec3 r{radius, radius, radius};
     for (Cell c : cellsOf(center - r, center + r))
@@ -60,6 +62,15 @@ void DebrisGovernor::thawed(BodyId id) {
             grid_.erase(g);
     }
     frozen_.erase(it);
+}
+
+void DebrisGovernor::woken(BodyId id, const Vec3& center, double radius, double margin) {
+    watched_[id] = {center, radius, margin};
+}
+
+void DebrisGovernor::removed(BodyId id) {
+    thawed(id);
+    watched_.erase(id);
 }
 
 void DebrisGovernor::wakeNear(const Aabb& box, double margin) {
@@ -96,6 +107,16 @@ GovernorActions DebrisGovernor::update(const BodyTable& bodies, const PhysicsBin
     for (const auto& [id, impulse] : frozenHits)
         if (impulse >= budget_.wakeImpulse)
             woken.insert(id);
+    for (auto it = watched_.begin(); it != watched_.end();) { // woken bodies that left their place
+        const WokenEntry& w = it->second;
+        if (length(binding.motion(it->first).transform.translation - w.center) <= kMovedFraction * w.radius) {
+            ++it;
+            continue;
+        }
+        const Vec3 r{w.radius, w.radius, w.radius};
+        wakeNear(Aabb{w.center - r, w.center + r}, w.margin);
+        it = watched_.erase(it);
+    }
     woken.insert(toWake_.begin(), toWake_.end());
     toWake_.clear();
     for (BodyId id : woken)

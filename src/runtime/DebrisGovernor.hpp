@@ -38,6 +38,11 @@ public:
     void frozen(BodyId id, const Vec3& center, double radius);
     /// A body stopped being frozen (woken or removed).
     void thawed(BodyId id);
+    /// A frozen body was woken at center: once it moves farther than `radius`·kMovedFraction from there, the
+    /// frozen bodies within `margin` of its old place are woken too (they may have rested on it).
+    void woken(BodyId id, const Vec3& center, double radius, double margin);
+    /// A body left the simulation.
+    void removed(BodyId id);
     /// Frozen bodies whose bounds come within `margin` of the box (they lose what they rest on when a body
     /// there moves or breaks); they are woken at the next update.
     void wakeNear(const Aabb& box, double margin);
@@ -56,7 +61,12 @@ private:
     std::unordered_map<BodyId, int> restFrames_;   // frames below freezeSpeed in a row
     std::unordered_map<BodyId, int> settleFrames_; // frames below settlingSpeed in a row
     std::unordered_map<BodyId, int> awakeFrames_;  // frames awake since adopted or woken
+    struct WokenEntry {
+        Vec3 center;
+        double radius = 0, margin = 0;
+    };
     std::map<BodyId, FrozenEntry> frozen_;
+    std::map<BodyId, WokenEntry> watched_; // woken bodies whose old neighbourhood still rests on their place
     std::unordered_map<Cell, std::vector<BodyId>> grid_;
     std::vector<BodyId> toWake_;
     int awakeBudget_ = -1; // < 0: the configured maximum

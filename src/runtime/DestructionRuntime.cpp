@@ -87,24 +87,33 @@ struct DestructionRuntime::Impl {
         return bodies.insert(rec);
     }
 
+    // A dynamic body faster than the settling speed.
+    bool moving(const BodyRecord& r) const {
+        if (r.motion != BodyMotionState::Dynamic)
+            return false;
+        const BodyMotion m = binding.motion(r.id);
+        return std::max(length(m.linearVelocity), length(m.angularVelocity)) >= config.debris.settlingSpeed;
+    }
+
     Aabb boundsOf(const BodyRecord& r) const {
         const Vec3 c = binding.motion(r.id).transform.translation;
         const Vec3 e{r.radius, r.radius, r.radius};
         return Aabb{c - e, c + e};
     }
 
-    // Removes a body; what rested on it is re-checked (support) or woken (frozen debris).
-    void destroy(BodyId id, bool removeObject) {
+    // Removes a body; what rested on it is re-checked (support) or woken (frozen debris). A body in motion
+    // holds nothing up, so its removal wakes nothing.
+    void destroy(BodyId id, bool removeObject, bool wakeResting = true) {
         BodyRecord* r = bodies.find(id);
         if (!r)
             return;
         if (onRemoved)
             onRemoved(*r);
-        if (r->role != BodyRole::Projectile)
+        if (wakeResting && r->role != BodyRole::Projectile && !moving(*r))
             governor.wakeNear(boundsOf(*r), config.support.tolerance);
         support.remove(id);
         structure.remove(id);
-        governor.thawed(id);
+        governor.removed(id);
         projectiles.erase(id);
         binding.removeBody(id);
         if (r->hasObject)
@@ -127,6 +136,8 @@ struct DestructionRuntime::Impl {
         destroy(id, true);
     }
 
+    // A static or frozen body becomes dynamic. What rests on a collapsing part is woken at once; what rests
+    // on a woken frozen piece only once that piece leaves its place.
     void makeDynamic(BodyId id) {
         BodyRecord* r = bodies.find(id);
         if (!r || r->motion == BodyMotionState::Dynamic)
@@ -134,7 +145,10 @@ struct DestructionRuntime::Impl {
         support.remove(id);
         structure.remove(id);
         governor.thawed(id);
-        governor.wakeNear(boundsOf(*r), config.support.tolerance);
+        if (r->motion == BodyMotionState::Frozen)
+            governor.woken(id, binding.motion(id).transform.translation, r->radius, config.support.tolerance);
+        else
+            governor.wakeNear(boundsOf(*r), config.support.tolerance);
         r->structural = false;
         r->anchor = false;
         binding.setMass(id, r->mass, r->inertia);
@@ -193,7 +207,10 @@ struct DestructionRuntime::Impl {
         detail::AdoptionPlan plan = detail::planAdoption(
             outcome, parent, parentMotion, config.adoption, collapse, config.debris.particleLifetime,
             config.structure.enabled && config.structure.bondDebris);
-        destroy(parent.id, false); // the DestructionWorld removed the parent object already
+        const bool parentResting = !moving(parent);
+        // The DestructionWorld removed the parent object already. What rested on the parent is woken where
+        // debris leaves (below), not across the parent's whole bounds: the remainder still holds the rest.
+        destroy(parent.id, false, false);
         ++stats.fractures;
         ++counters.fractures;
         for (std::size_t i = 0; i < plan.spawns.size(); ++i) {
@@ -221,6 +238,8 @@ struct DestructionRuntime::Impl {
                 support.add(made.id, parts, s.anchor);
                 support.queue(made.id);
             }
+            if (parentResting && !s.isStatic)
+                governor.wakeNear(boundsOf(made), config.support.tolerance);
             ++stats.piecesCreated;
             ++counters.piecesCreated;
         }

@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 
 #include "TestSupport.hpp"
+#include "rubble/MassProperties.hpp"
 #include "rubble/MeshCheck.hpp"
 #include "rubble/MeshIO.hpp"
 #include "rubble/Random.hpp"
@@ -367,7 +368,7 @@ TEST(MeshReader, OnlyRegularFilesOfBoundedSizeAreRead) {
     expectValidTetra(readMesh(dir / "link.stl"));
 }
 
-TEST(MeshReader, DeclaredFaceCountsAreComparedWithWhatAssimpRead) {
+TEST(MeshReader, BinaryStlCountsAreCheckedAndFloatsWidenedExactly) {
     const auto dir = test::tempDir("MeshReader_counts");
     std::string bin;
     {
@@ -381,6 +382,105 @@ TEST(MeshReader, DeclaredFaceCountsAreComparedWithWhatAssimpRead) {
     EXPECT_EQ(errorOf(dir / "zero.stl").message,
               (dir / "zero.stl").string() +
                   ": binary STL header claims 0 triangles but 200 bytes of facets (4 triangles) follow it");
+    std::string more = bin;
+    more[80] = 5;
+    test::writeFile(dir / "more.stl", more);
+    EXPECT_EQ(errorOf(dir / "more.stl").message,
+              (dir / "more.stl").string() +
+                  ": binary STL header claims 5 triangles (334 bytes) but the file has " +
+                  std::to_string(bin.size()) + " bytes");
+    // A corner at a float that is not a short decimal is kept exactly as the float.
+    const float odd = 0.1f;
+    std::string shifted = bin;
+    for (int f = 0; f < 4; ++f)
+        for (int c = 0; c < 3; ++c) {
+            float x = 0;
+            std::memcpy(&x, shifted.data() + 84 + 50 * f + 12 + 12 * c, 4);
+            x += odd;
+            std::memcpy(shifted.data() + 84 + 50 * f + 12 + 12 * c, &x, 4);
+        }
+    test::writeFile(dir / "shifted.stl", shifted);
+    const auto m = readMesh(dir / "shifted.stl");
+    ASSERT_TRUE(m.isOk()) << m.error().message;
+    ASSERT_EQ(m->vertexCount(), 4u);
+    EXPECT_EQ(m->bounds().lo.x, static_cast<double>(odd));
+    EXPECT_EQ(m->bounds().hi.x, static_cast<double>(1.0f + odd));
+}
+
+namespace {
+// The unit cube as binary PLY with double coordinates, a colour per vertex and quads; `big` writes
+// big-endian.
+std::string binaryPlyCube(bool big, int declaredFaces = 6,
+                          const std::vector<std::vector<int>>& extraFaces = {}) {
+    std::string ply = std::string("ply\nformat ") + (big ? "binary_big_endian" : "binary_little_endian") +
+                      " 1.0\nelement vertex 8\nproperty double x\nproperty double y\nproperty double z\n"
+                      "property uchar red\nelement face " +
+                      std::to_string(declaredFaces) +
+                      "\nproperty list uchar int vertex_indices\nend_header\n";
+    auto put = [&](const void* p, std::size_t n) {
+        const auto* c = static_cast<const char*>(p);
+        for (std::size_t i = 0; i < n; ++i)
+            ply += c[big ? n - 1 - i : i];
+    };
+    const double third = 1.0 / 3.0;
+    const double v[8][3] = {{0, 0, 0},     {1, 0, 0},     {1, 1, 0},     {0, 1, 0},
+                            {0, 0, third}, {1, 0, third}, {1, 1, third}, {0, 1, third}};
+    for (const auto& p : v) {
+        put(&p[0], 8);
+        put(p + 1, 8);
+        put(p + 2, 8);
+        ply += '\xff';
+    }
+    std::vector<std::vector<int>> faces = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
+                                           {3, 7, 6, 2}, {0, 4, 7, 3}, {1, 2, 6, 5}};
+    faces.insert(faces.end(), extraFaces.begin(), extraFaces.end());
+    for (const auto& f : faces) {
+        ply += static_cast<char>(f.size());
+        for (int i : f) {
+            const std::int32_t k = i;
+            put(&k, 4);
+        }
+    }
+    return ply;
+}
+} // namespace
+
+TEST(MeshReader, BinaryPlyIsReadExactlyWithByteOffsets) {
+    const auto dir = test::tempDir("MeshReader_binary_ply");
+    auto read = [&](const std::string& file, const std::string& bytes) {
+        test::writeFile(dir / file, bytes);
+        return readMesh(dir / file);
+    };
+    for (bool big : {false, true}) {
+        const auto cube = read(big ? "big.ply" : "little.ply", binaryPlyCube(big));
+        ASSERT_TRUE(cube.isOk()) << cube.error().message;
+        EXPECT_EQ(cube->vertexCount(), 8u);
+        EXPECT_TRUE(checkMesh(cube.value()).valid());
+        EXPECT_EQ(cube->bounds().hi.z, 1.0 / 3.0); // a double, not rounded to float
+        EXPECT_NEAR(signedVolume(cube.value()), 1.0 / 3.0, 1e-15);
+    }
+    const std::string p = (dir / "").string();
+    const std::size_t header = binaryPlyCube(false).find("end_header\n") + 11;
+    const std::size_t faces = header + 8 * 25;
+    // The header declares one face more than the file holds: the missing one is named, not dropped.
+    EXPECT_EQ(read("short.ply", binaryPlyCube(false, 7)).error().message,
+              p + "short.ply: byte " + std::to_string(faces + 6 * 17) +
+                  ": the file ends after 6 of the 7 declared 'face' elements");
+    EXPECT_EQ(read("more.ply", binaryPlyCube(false, 5)).error().message,
+              p + "more.ply: byte " + std::to_string(faces + 5 * 17) +
+                  ": 17 bytes after the declared elements (the header's counts do not match the file)");
+    EXPECT_TRUE(read("newline.ply", binaryPlyCube(false) + "\n").isOk()) << "a final newline is fine";
+    EXPECT_EQ(read("line.ply", binaryPlyCube(false, 7, {{0, 1}})).error().message,
+              p + "line.ply: byte " + std::to_string(faces + 6 * 17) +
+                  ": 'face' 6 has 2 corners; at least 3 are needed");
+    EXPECT_EQ(read("index.ply", binaryPlyCube(false, 7, {{0, 1, 8}})).error().message,
+              p + "index.ply: byte " + std::to_string(faces + 6 * 17) +
+                  ": 'face' 6 refers to vertex 8 but there are 8 (PLY indices start at 0)");
+    std::string cut = binaryPlyCube(false);
+    cut.resize(cut.size() - 2);
+    EXPECT_EQ(read("cut.ply", cut).error().message,
+              p + "cut.ply: byte " + std::to_string(faces + 5 * 17) +
+                  ": 'face' 5: the file ends inside 'vertex_indices' (truncated?)");
 }
 
 namespace {

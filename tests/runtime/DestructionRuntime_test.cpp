@@ -45,9 +45,10 @@ struct ToyRig {
         c.world.minPieceVolume = 0;
         return c;
     }
-    ObjectId addBox(const Vec3& half, const Vec3& centre, bool isStatic,
-                    const FractureParams& fracture = {}) {
+    ObjectId addBox(const Vec3& half, const Vec3& centre, bool isStatic, const FractureParams& fracture = {},
+                    bool destructible = true) {
         ObjectDesc d;
+        d.destructible = destructible;
         d.mesh = makeBox(-1.0 * half, half);
         d.density = 500;
         d.impulseThreshold = 1;
@@ -157,6 +158,44 @@ TEST(DestructionRuntime, FrozenDebrisWakesWhenWhatItRestsOnFalls) {
     EXPECT_GE(rig.runtime.counters().piecesWoken, 1);
     rig.step(240);
     EXPECT_LT(rig.heightOf(brick), 8) << "the brick fell with the slab instead of hanging in the air";
+}
+
+// Waking a frozen body does not wake what rests against it while it stays in place (a hit that does not move
+// it), only once it leaves its place: otherwise one hit on a pile wakes the whole pile, frame after frame.
+TEST(DestructionRuntime, AWokenFrozenBodyWakesItsNeighboursOnlyOnceItLeavesItsPlace) {
+    ToyRig rig;
+    const ObjectId a = rig.addBox({0.2, 0.2, 0.2}, {0, 0.5, 0}, false, {}, false);
+    const ObjectId b = rig.addBox({0.2, 0.2, 0.2}, {0.41, 0.5, 0}, false, {}, false); // 1 cm beside a
+    rig.step(90);
+    ASSERT_EQ(rig.motionOf(a), BodyMotionState::Frozen);
+    ASSERT_EQ(rig.motionOf(b), BodyMotionState::Frozen);
+    const BodyId aBody = rig.runtime.bodyOf(a)->id;
+    rig.runtime.fireProjectile({-5, 0.2, 0}, {100, 0, 0}, 1, 0.05); // hits a, which cannot break
+    for (int i = 0; i < 10 && rig.motionOf(a) == BodyMotionState::Frozen; ++i)
+        rig.step(1);
+    ASSERT_EQ(rig.motionOf(a), BodyMotionState::Dynamic) << "the hit woke a";
+    rig.step(2);
+    EXPECT_EQ(rig.motionOf(b), BodyMotionState::Frozen) << "a has not moved: b still rests where it did";
+    rig.engine.setVelocity(aBody, {0, 0, 3}, {}); // a slides away
+    rig.step(3);
+    EXPECT_EQ(rig.motionOf(b), BodyMotionState::Dynamic) << "a left its place: b is woken";
+}
+
+// Breaking a static object wakes the frozen debris near the pieces that fly off, not everything inside the
+// object's bounds: the remainder still holds what rests on it.
+TEST(DestructionRuntime, BreakingAStaticObjectWakesOnlyTheDebrisNearWhatLeaves) {
+    ToyRig rig;
+    const ObjectId wall = rig.addBox({4, 2, 0.25}, {0, 2, 0}, true, cubeCell(1.0));
+    const ObjectId near = rig.addBox({0.2, 0.2, 0.2}, {3.5, 0.2, 0.5}, false, {}, false);
+    const ObjectId far = rig.addBox({0.2, 0.2, 0.2}, {-3.5, 0.2, 0.5}, false, {}, false);
+    rig.step(90);
+    ASSERT_EQ(rig.motionOf(near), BodyMotionState::Frozen);
+    ASSERT_EQ(rig.motionOf(far), BodyMotionState::Frozen);
+    ASSERT_TRUE(rig.runtime.world().submitImpact(wall, Impact{{3.6, -1.7, 0.25}, {0, 0, 1}, 100})); // local
+    ASSERT_FALSE(rig.breakAndWait(wall).empty());
+    rig.step(2);
+    EXPECT_EQ(rig.motionOf(near), BodyMotionState::Dynamic) << "debris left beside it";
+    EXPECT_EQ(rig.motionOf(far), BodyMotionState::Frozen) << "7 m away, within the wall's bounds";
 }
 
 TEST(DestructionRuntime, AwakeBudgetRetiresTheSmallestPiecesButNeverTheGamesObjects) {

@@ -38,6 +38,7 @@ std::vector<Shape> sweepShapes() {
 }
 
 // RUBBLE_SWEEP_SHATTERS=N: N per backend; else the CI count times RUBBLE_SWEEP_SCALE (sanitizer builds: 0.1).
+// RUBBLE_SWEEP_FIRST=K: draw but skip the shatters before K (to resume a long run).
 int sweepCount(int ciDefault) {
     if (const char* env = std::getenv("RUBBLE_SWEEP_SHATTERS"); env && std::atoi(env) > 0)
         return std::atoi(env);
@@ -55,6 +56,8 @@ Sweep runSweep(BooleanKind backend, int count, std::uint64_t seed) {
     const std::vector<Shape> shapes = sweepShapes();
     Sweep s;
     Rng rng(seed);
+    const char* firstEnv = std::getenv("RUBBLE_SWEEP_FIRST");
+    const int first = firstEnv ? std::max(0, std::atoi(firstEnv)) : 0;
     for (int i = 0; i < count; ++i) {
         const Shape& shape = shapes[static_cast<std::size_t>(i) % shapes.size()];
         const double d = shape.mesh.bounds().diagonal();
@@ -70,6 +73,10 @@ Sweep runSweep(BooleanKind backend, int count, std::uint64_t seed) {
         const std::string what = shape.name + " shatter " + std::to_string(i) + " (" +
                                  std::to_string(params.cells) + " cells, seed " + std::to_string(cellSeed) +
                                  ")";
+        if (i < first)
+            continue;
+        if (i > first && (i - first) % 100 == 0)
+            std::printf("%d shatters done, %d failed\n", i - first, s.failures);
         ++s.shatters;
         auto r = fracture(shape.mesh, impact, params, cellSeed);
         if (!r) {

@@ -38,7 +38,9 @@ ConvexPolytope eroded(const ConvexPolytope& part, double margin) {
 CollisionShape::~CollisionShape() = default;
 
 int CollisionShape::childCount() const {
-    return compound_ ? compound_->getNumChildShapes() : 0;
+    if (compound_)
+        return compound_->getNumChildShapes();
+    return root_ && root_->getShapeType() == CONVEX_HULL_SHAPE_PROXYTYPE ? 1 : 0;
 }
 
 std::unique_ptr<CollisionShape> CollisionShape::fromParts(const std::vector<ConvexPolytope>& parts,
@@ -110,6 +112,10 @@ std::unique_ptr<CollisionShape> CollisionShape::fromParts(const std::vector<Conv
         s->children_.push_back(std::move(hull));
     }
     s->root_ = s->compound_.get();
+    if (s->children_.size() == 1) { // one hull collides without the compound's per-pair bookkeeping
+        s->compound_.reset();
+        s->root_ = s->children_.front().get();
+    }
     return s;
 }
 

@@ -14,9 +14,9 @@
 
 namespace rubble::bullet {
 
-/// Owns a btCompoundShape and its children. Child hulls are given in the body's frame (centre of mass,
-/// principal axes). Each hull is eroded by its collision margin, so that hull + margin matches the part and
-/// neighbouring pieces do not start out overlapping.
+/// Owns a btCompoundShape and its children (a single hull is used without the compound). Child hulls are
+/// given in the body's frame (centre of mass, principal axes). Each hull is eroded by its collision margin,
+/// so that hull + margin matches the part and neighbouring pieces do not start out overlapping.
 class CollisionShape {
 public:
     /// Compound of the convex parts (object coordinates); objectToBody maps body → object coordinates
@@ -37,7 +37,7 @@ public:
 
     /// The shape to give a btRigidBody.
     btCollisionShape* shape() const { return root_; }
-    /// Number of compound children (0 for a plain box or sphere).
+    /// Number of convex hulls (0 for a plain box or sphere).
     int childCount() const;
     /// Edges of the parts in body coordinates (for debug drawing).
     const std::vector<std::array<Vec3, 2>>& edges() const { return edges_; }

@@ -1,10 +1,10 @@
-// Fuzz target: Rubble's ASCII PLY and ASCII STL readers (first byte even: PLY, odd: STL; the rest is the
-// file), then check and repair of whatever they produced.
+// Fuzz target: Rubble's PLY and STL readers (ASCII and binary) (first byte even: PLY, odd: STL; the rest is
+// the file), then check and repair of whatever they produced.
 #include <cstdint>
 #include <string>
 
 #include "FuzzChecks.hpp"
-#include "io/TextMeshReaders.hpp"
+#include "io/MeshFormatReaders.hpp"
 #include "rubble/MeshCheck.hpp"
 #include "rubble/MeshRepair.hpp"
 
@@ -14,7 +14,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const bool ply = data[0] % 2 == 0;
     const std::string text(reinterpret_cast<const char*>(data + 1), size - 1);
     const std::string name = ply ? "fuzz.ply" : "fuzz.stl";
-    auto mesh = ply ? rubble::io::parseAsciiPly(text, name) : rubble::io::parseAsciiStl(text, name);
+    auto mesh = ply ? rubble::io::parsePly(text, name) : rubble::io::parseStl(text, name);
     if (!mesh) {
         if (mesh.error().message.rfind(name, 0) != 0)
             __builtin_trap(); // errors must name the file
