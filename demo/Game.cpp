@@ -462,7 +462,9 @@ void Game::emitEffects(long long impactsBefore, long long retiredBefore) {
                                                 static_cast<long long>(marks.size()));
     for (long long k = 0; k < fresh; ++k) {
         const auto& m = marks[marks.size() - 1 - static_cast<size_t>(k)];
-        particles_.impactBurst(toV3(m.point), toV3(m.normal), 1.0f, burstSeed_++);
+        // sized by the hit: a 4 kg shell at 170 m/s (680 N*s) is 1, a crash's blast about 2.4
+        const float strength = std::clamp(std::sqrt(static_cast<float>(m.impulse) / 680.0f), 0.4f, 3.0f);
+        particles_.impactBurst(toV3(m.point), toV3(m.normal), strength, burstSeed_++);
     }
     // a puff of dust for every piece retired into a debris particle this frame (the newest particles)
     const auto& debris = runtime_->particles();

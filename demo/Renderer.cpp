@@ -70,8 +70,10 @@ void main() {
     s2 *= s2; s2 *= s2; s2 *= s2; s2 *= s2; s2 *= s2;
     vec3 sun = vec3(1.6, 1.49, 1.31);
     vec3 c = albedo * (amb + sun * (ndl * sh)) + sun * (s2 * 0.2 * ndl * sh);
+    // fresh cuts: embers in the material's grain, white-hot cooling to dark red, fading to the lit interior
     float heat = vHeatFade.x * float(uInterior);
-    c += heat * heat * vec3(1.5, 0.5, 0.12);
+    vec3 ember = mix(vec3(0.9, 0.12, 0.02), vec3(1.7, 0.85, 0.35), heat);
+    c += ember * (heat * heat) * (0.3 + 1.4 * dot(t, vec3(0.3, 0.5, 0.2)));
     vec3 dv = uCamPos - vWorld;
     float fog = 1.0 - exp(-dot(dv, dv) * 2.5e-6);
     c = mix(c, uFogColor * uFogColor, fog);
@@ -104,8 +106,8 @@ void main() {
     // sqrt(t * t * L) = t * sqrt(L)
     vec3 L = tint * (amb + vec3(1.6, 1.49, 1.31) * ndl);
     vLit = sqrt(L / (1.0 + L * 0.15));
-    float heat = heatFade.x * float(uInterior);
-    vGlow = heat * vec3(1.2, 0.7, 0.35);
+    float heat = heatFade.x * float(uInterior); // embers in the texture's grain, cooling to dark red
+    vGlow = heat * mix(vec3(0.9, 0.2, 0.05), vec3(1.5, 0.9, 0.5), heat);
     vFade = heatFade.y;
     vDv = uCamPos - w.xyz;
     vUv = aUv;
@@ -118,7 +120,7 @@ uniform sampler2D uTex;
 uniform vec3 uFogColor;
 out vec4 oColor;
 void main() {
-    vec3 c = texture(uTex, vUv).rgb * vLit + vGlow;
+    vec3 c = texture(uTex, vUv).rgb * (vLit + vGlow);
     float x = dot(vDv, vDv) * 2.5e-6;
     oColor = vec4(mix(c, uFogColor, x / (1.0 + x)), vFade);
 })";
