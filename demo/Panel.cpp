@@ -19,6 +19,7 @@ const std::vector<std::pair<const char*, const char*>>& keyHelp() {
         {"Space", "fire (hold for continuous fire); unpause"},
         {"R", "respawn the jet (it also respawns 2 s after a crash)"},
         {"L", "auto-level assist on/off (wings level when no roll key is held)"},
+        {"N", "next scene (the demolition, the thesis's scenes, world.cfg)"},
         {"P", "pause"},
         {"H", "this help"},
         {"F1", "full panel / compact HUD line"},

@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <iostream>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -79,6 +80,9 @@ struct App {
     demo::GameSettings pending;
     rubble::SceneConfig scene;
     std::string sceneName;
+    std::vector<std::filesystem::path> scenes; // what N cycles through: the demolition, the thesis's scenes
+    std::size_t sceneIndex = 0;
+    bool nextScene = false; // N pressed
     bool paused = false;
     bool quit = false;
     bool screenshotRequested = false;
@@ -114,6 +118,9 @@ void keyCallback(GLFWwindow* w, int key, int, int action, int) {
         break;
     case GLFW_KEY_R:
         a.game.respawn();
+        break;
+    case GLFW_KEY_N:
+        a.nextScene = true;
         break;
     case GLFW_KEY_L:
         a.game.settings().autoLevel = !a.game.settings().autoLevel;
@@ -196,7 +203,10 @@ int main(int argc, char** argv) {
     CLI::App cli{"rubble-demo: fly a vehicle through a world.cfg scene and shoot destructible objects.\n"
                  "Keys: W/S pitch, A/D roll, Q/E yaw, Z/X speed, Space fire/unpause, P pause, Esc quit,\n"
                  "F1 panel, F2 screenshot, F3 debug overlay, F5/F9 quick save/load, H key help."};
-    cli.add_option("--scene", o.scene, "world.cfg scene (thesis format); default assets/scenes/world.cfg");
+    cli.add_option(
+        "--scene", o.scene,
+        "world.cfg scene (thesis format); default assets/scenes/demolition.cfg (N cycles to the "
+        "thesis's scenes in ../shared/seed/media or RUBBLE_SEED_MEDIA, and assets/scenes/world.cfg)");
     cli.add_flag("-d,--debug", o.debug, "draw collision shapes, AABBs and impact points");
     cli.add_option("--autopilot", o.autopilot, "fly and shoot by script for SECONDS (fixed 1/60 s steps)");
     cli.add_option("--screenshot-every", o.screenshotEvery,
@@ -259,9 +269,11 @@ int main(int argc, char** argv) {
     }
 
     // Scene.
+    const std::filesystem::path assets = std::filesystem::path(RUBBLE_SOURCE_DIR) / "assets/scenes";
     std::filesystem::path scenePath =
-        o.scene.empty() ? std::filesystem::path(RUBBLE_SOURCE_DIR) / "assets/scenes/world.cfg"
-                        : std::filesystem::path(o.scene);
+        o.scene.empty() ? assets / "demolition.cfg" : std::filesystem::path(o.scene);
+    if (o.scene.empty() && !std::filesystem::exists(scenePath))
+        scenePath = assets / "world.cfg";
     if (o.scene.empty() && !std::filesystem::exists(scenePath)) {
         std::fprintf(stderr, "warning: %s not found; using the built-in fallback scene\n",
                      scenePath.string().c_str());
@@ -281,6 +293,24 @@ int main(int argc, char** argv) {
         }
         app.scene = r.value();
         app.sceneName = scenePath.filename().string();
+        app.scenes.push_back(scenePath);
+    }
+    { // N cycles: this scene, the demolition, the thesis's scenes (when its media folder is there), world.cfg
+        const char* seedEnv = std::getenv("RUBBLE_SEED_MEDIA");
+        const std::filesystem::path seed =
+            seedEnv ? std::filesystem::path(seedEnv)
+                    : std::filesystem::path(RUBBLE_SOURCE_DIR) / "../shared/seed/media";
+        for (const auto& p : {assets / "demolition.cfg", seed / "world.cfg", seed / "performance_test.cfg",
+                              seed / "cube_test.cfg", assets / "world.cfg"}) {
+            std::error_code ec;
+            if (!std::filesystem::exists(p, ec))
+                continue;
+            bool known = false;
+            for (const auto& q : app.scenes)
+                known = known || std::filesystem::equivalent(p, q, ec);
+            if (!known)
+                app.scenes.push_back(p);
+        }
     }
 
     app.pending.workers = o.workers;
@@ -450,6 +480,24 @@ int main(int argc, char** argv) {
             ImGui_ImplGlfw_NewFrame();
         if (autopilot) {
             io.DeltaTime = fixedDt;
+        }
+        if (app.nextScene &&
+            !app.scenes.empty()) { // N: the next scene; a scene that does not parse is skipped
+            app.nextScene = false;
+            app.sceneIndex = (app.sceneIndex + 1) % app.scenes.size();
+            const auto& next = app.scenes[app.sceneIndex];
+            if (auto r = rubble::parseSceneConfig(next); r) {
+                app.scene = r.value();
+                app.sceneName = next.filename().string();
+                if (!loadScene(app, error)) {
+                    std::fprintf(stderr, "error: %s\n", error.c_str());
+                    break;
+                }
+                std::printf("scene: %s\n", next.string().c_str());
+            } else {
+                std::fprintf(stderr, "error: %s\n", r.error().message.c_str());
+            }
+            std::fflush(stdout);
         }
         app.panel.scaleToWindow(h);
         ImGui::NewFrame();

@@ -2,7 +2,7 @@
 # End-to-end test of rubble-demo under Xvfb: real window, real key events (xdotool), assertions on the
 # demo's --stats output and on its screenshots.
 #   Space fires and impacts follow; P freezes the frame counter and Space resumes it; H shows and hides the
-#   key help; Esc exits with 0;
+#   key help; N loads the next scene; Esc exits with 0;
 #   a screenshot is not blank and differs before and after a hit.
 # Usage: demo_e2e.sh PATH/TO/rubble-demo      Exit 77 = skipped (Xvfb or xdotool missing).
 set -uo pipefail
@@ -145,6 +145,15 @@ f3=$(field frame)
 moving() { [ "$(field frame)" -gt "$f3" ]; }
 wait_for 20 moving || fail "the game stopped after F9"
 echo "ok: $(grep '^F9' "$work/log" | tail -n 1)"
+
+# N loads the next scene (the demolition scene after e2e.cfg) and the game plays on in it.
+key n
+next_scene() { grep -q '^scene: .*demolition.cfg' "$work/log"; }
+wait_for 60 next_scene || fail "N did not load the next scene: $(grep -E '^(scene|error)' "$work/log")"
+f4=$(field frame)
+moving_on() { [ "$(field frame)" -gt "$f4" ]; }
+wait_for 30 moving_on || fail "the game stopped after N"
+echo "ok: N loaded $(grep '^scene: ' "$work/log" | tail -n 1 | cut -d' ' -f2-)"
 
 # Esc quits with status 0.
 key Escape
