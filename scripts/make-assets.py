@@ -1237,6 +1237,10 @@ def scenes():
     return out
 
 
+# The material presets a world.cfg line may name in its optional 10th field (include/rubble/Material.hpp).
+MATERIALS = ("concrete", "brick", "stone", "wood", "glass", "steel")
+
+
 def check_scene(path):
     """Checks a written scene against appendix A.3: field counts, numbers, and that every file exists."""
     problems = []
@@ -1253,11 +1257,14 @@ def check_scene(path):
             problems.append("line 1: missing %s" % name)
     for k, ln in enumerate(lines[1:], start=2):
         fields = ln.split(";")
-        if len(fields) != 9:
-            problems.append("line %d: expected 9 fields, got %d" % (k, len(fields)))
+        if len(fields) not in (9, 10):
+            problems.append("line %d: expected 9 fields (or 10 with a material), got %d" % (k, len(fields)))
+            continue
+        if len(fields) == 10 and fields[9] not in MATERIALS:
+            problems.append("line %d: unknown material '%s'" % (k, fields[9]))
             continue
         try:
-            nums = [float(x) for x in fields[2:]]
+            nums = [float(x) for x in fields[2:9]]
         except ValueError:
             problems.append("line %d: a number does not parse" % k)
             continue

@@ -60,7 +60,7 @@ inline constexpr int kMaxShatterCells = 1000;
 struct FractureParams {
     CellPattern pattern = CellPattern::SingleCell; ///< single cell (thesis) or shatter pattern
     int seedPoints = 15; ///< random Voronoi sites in the domain besides the impact point
-    int cells = 6;       ///< K, the number of cells of a Shatter pattern (1..kMaxShatterCells)
+    int cells = 16;      ///< K, the number of cells of a Shatter pattern (1..kMaxShatterCells)
     CellSizeLaw sizeLaw; ///< domain size from impulse
     BooleanKind backend = BooleanKind::Fast; ///< boolean implementation
     double minPieceVolumeFraction = 1e-9;    ///< pieces below this fraction of the input volume are dropped

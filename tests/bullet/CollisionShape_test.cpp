@@ -17,9 +17,9 @@ TEST(CollisionShape, ErodedHullPlusMarginMatchesThePart) {
     auto shape = CollisionShape::fromParts({part}, {}, objectToBody, 0.05);
     ASSERT_TRUE(shape);
     EXPECT_EQ(shape->childCount(), 1);
-    // hull points + margin hug the part's box (centred on the body)
-    auto* compound = static_cast<btCompoundShape*>(shape->shape());
-    auto* hull = static_cast<btConvexHullShape*>(compound->getChildShape(0));
+    // one part collides as its hull, without a compound; hull points + margin hug the part's box
+    ASSERT_EQ(shape->shape()->getShapeType(), CONVEX_HULL_SHAPE_PROXYTYPE);
+    auto* hull = static_cast<btConvexHullShape*>(shape->shape());
     const double m = hull->getMargin();
     EXPECT_NEAR(m, 0.05, 1e-6);
     btVector3 lo(1e9f, 1e9f, 1e9f), hi(-1e9f, -1e9f, -1e9f);
@@ -31,6 +31,16 @@ TEST(CollisionShape, ErodedHullPlusMarginMatchesThePart) {
     EXPECT_NEAR(hi.y() + m, 0.5, 1e-5);
     EXPECT_NEAR(hi.z() + m, 2.0, 1e-5);
     EXPECT_EQ(shape->edges().size(), 12u);
+}
+
+TEST(CollisionShape, SeveralPartsMakeACompound) {
+    const ConvexPolytope a = ConvexPolytope::fromAabb(Aabb{{0, 0, 0}, {1, 1, 1}});
+    const ConvexPolytope b = ConvexPolytope::fromAabb(Aabb{{1, 0, 0}, {2, 1, 1}});
+    auto shape = CollisionShape::fromParts({a, b}, {}, Frame{}, 0.02);
+    ASSERT_TRUE(shape);
+    EXPECT_EQ(shape->childCount(), 2);
+    ASSERT_EQ(shape->shape()->getShapeType(), COMPOUND_SHAPE_PROXYTYPE);
+    EXPECT_EQ(static_cast<btCompoundShape*>(shape->shape())->getNumChildShapes(), 2);
 }
 
 TEST(CollisionShape, ThinPartsStillGetAHull) {
