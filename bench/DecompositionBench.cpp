@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "BenchUtil.hpp"
+#include "MegaMeshes.hpp"
 #include "Subcommand.hpp"
 #include "rubble/ConvexDecomposition.hpp"
 #include "rubble/Fracture.hpp"
@@ -188,7 +189,26 @@ const rubble::tools::Registrar registrar{
          app.add_flag("--quick", args->quick, "one repetition, small cubes only (CI smoke run)");
          app.add_option("--runs", args->runs, "repetitions per case")->check(CLI::Range(1, 10000));
          app.add_option("--out", args->out, "folder for decomposition.csv and decomposition.png");
-         return [args] { return runBench(*args); };
+         auto mega = std::make_shared<rubble::bench::MegaArgs>();
+         auto megaOn = std::make_shared<bool>(false);
+         app.add_flag("--mega", *megaOn,
+                      "only the million-triangle rows (sphere, torus, subdivided arch at 100k, 250k, 1M; "
+                      "decomposition_megamesh.csv/.png)");
+         app.add_option("--mega-sizes", mega->sizes, "triangle counts of the --mega rows");
+         app.add_option("--mega-kinds", mega->kinds, "meshes of the --mega rows")
+             ->check(CLI::IsMember(rubble::bench::kMegaKinds));
+         app.add_option("--hits", mega->hits, "random hits per --mega mesh")->check(CLI::Range(1, 10000));
+         auto writeDir = std::make_shared<std::string>();
+         app.add_option("--write-mega", *writeDir,
+                        "write the --mega meshes as OBJ into this folder (kind_triangles.obj) and stop");
+         return [args, mega, megaOn, writeDir] {
+             if (!writeDir->empty())
+                 return rubble::bench::writeMegaMeshes(*mega, *writeDir);
+             if (!*megaOn)
+                 return runBench(*args);
+             mega->out = args->out;
+             return rubble::bench::runMegaDecomposition(*mega);
+         };
      }}};
 
 } // namespace

@@ -22,6 +22,7 @@
 #include <memory>
 
 #include "BenchUtil.hpp"
+#include "MegaMeshes.hpp"
 #include "Subcommand.hpp"
 #include "rubble/ConvexDecomposition.hpp"
 #include "rubble/Fracture.hpp"
@@ -386,7 +387,23 @@ const rubble::tools::Registrar registrar{
                         "triangles)")
              ->check(CLI::IsMember({"corefine", "fast", "nef"}));
          app.add_option("--out", args->out, "folder for impact.csv and impact.png");
-         return [args] { return runBench(*args); };
+         auto mega = std::make_shared<rubble::bench::MegaArgs>();
+         auto megaOn = std::make_shared<bool>(false);
+         app.add_flag("--mega", *megaOn,
+                      "only the million-triangle rows (sphere, torus, subdivided arch at 100k, 250k, 1M; "
+                      "impact_megamesh.csv/.png)");
+         app.add_option("--mega-sizes", mega->sizes, "triangle counts of the --mega rows");
+         app.add_option("--mega-kinds", mega->kinds, "meshes of the --mega rows")
+             ->check(CLI::IsMember(rubble::bench::kMegaKinds));
+         app.add_option("--hits", mega->hits, "random hits per --mega mesh")->check(CLI::Range(1, 10000));
+         app.add_option("--chain", mega->chain, "chained hits on the 250k sphere in --mega (0: none)")
+             ->check(CLI::Range(0, 100000));
+         return [args, mega, megaOn] {
+             if (!*megaOn)
+                 return runBench(*args);
+             mega->out = args->out;
+             return rubble::bench::runMegaImpact(*mega);
+         };
      }}};
 
 } // namespace

@@ -23,6 +23,12 @@ struct DecompositionParams {
     double concavity = 0.02; ///< stop splitting a part whose concavity is below this fraction of the
                              ///< mesh's bounding-box diagonal
     double minPartVolumeFraction = 1e-6; ///< parts below this fraction of the mesh volume are dropped
+    /// Meshes with more triangles are decomposed through a bounded proxy (vertices clustered on a grid);
+    /// the parts are then the hulls of the exact mesh inside the proxy's regions (docs/megamesh.md).
+    std::size_t proxyAboveTriangles = 20000;
+    /// A part with more faces is replaced by a bounded polytope around it (about half as many faces, never
+    /// smaller than the part), so that clipping a part costs the same whatever the mesh's triangle count.
+    std::size_t maxPartFaces = 512;
 };
 
 /// A set of convex parts approximating a closed mesh.
@@ -36,6 +42,11 @@ struct Decomposition {
 
 /// The convex hull of a point set (Qhull). Fails for fewer than 4 non-coplanar points.
 Result<ConvexPolytope> convexHull(const std::vector<Vec3>& points);
+
+/// A convex polytope containing every point with at most about maxFaces / 2 faces: the planes of the hull of
+/// the points' extremes in maxFaces / 4 fixed directions, each pushed out to the farthest point. When the
+/// exact hull has at most maxFaces faces it is returned instead. Fails for flat or too few points.
+Result<ConvexPolytope> boundedHull(const std::vector<Vec3>& points, std::size_t maxFaces);
 
 /// Decomposes a closed mesh into at most params.maxParts convex parts; a convex mesh gives exactly one part.
 Result<Decomposition> decompose(const Mesh& mesh, const DecompositionParams& params = {});

@@ -53,6 +53,14 @@ enum class BooleanKind {
           ///< pattern up to twice (FractureResult::redraws). Same seed, same bytes, like the others.
 };
 
+/// Where a Shatter pattern's cells lie around the impact (a material's fracture pattern, Material.hpp).
+enum class ShatterLayout : std::uint8_t {
+    Clustered, ///< fine cells near the impact, coarse further away (concrete, stone, brick)
+    Radial,    ///< wedges between radial cracks, in rings, in the plane across the impact normal (glass)
+    Splinter,  ///< cells long along the grain, the longest axis of the mesh's bounds (wood)
+    Uniform,   ///< evenly sized cells (steel)
+};
+
 /// The most cells a Shatter pattern has (FractureParams::cells is clamped to it).
 inline constexpr int kMaxShatterCells = 1000;
 
@@ -61,14 +69,15 @@ struct FractureParams {
     CellPattern pattern = CellPattern::SingleCell; ///< single cell (thesis) or shatter pattern
     int seedPoints = 15; ///< random Voronoi sites in the domain besides the impact point
     int cells = 16;      ///< K, the number of cells of a Shatter pattern (1..kMaxShatterCells)
-    CellSizeLaw sizeLaw; ///< domain size from impulse
-    BooleanKind backend = BooleanKind::Fast; ///< boolean implementation
-    double minPieceVolumeFraction = 1e-9;    ///< pieces below this fraction of the input volume are dropped
-                                             ///< (their volume is reported in FractureResult::droppedVolume)
-    double uvScale = 1.0;                    ///< texture repeats per unit length on cut faces
-    bool simplifyPieces = true;              ///< remove the vertices that carry no shape from every piece
-                                ///< (simplifyPlanarRegions, lossless): bounds the triangle count of
-                                ///< pieces that are hit again and again
+    ShatterLayout layout = ShatterLayout::Clustered; ///< where a Shatter pattern's cells lie
+    CellSizeLaw sizeLaw;                             ///< domain size from impulse
+    BooleanKind backend = BooleanKind::Fast;         ///< boolean implementation
+    double minPieceVolumeFraction = 1e-9; ///< pieces below this fraction of the input volume are dropped
+                                          ///< (their volume is reported in FractureResult::droppedVolume)
+    double uvScale = 1.0;                 ///< texture repeats per unit length on cut faces
+    bool simplifyPieces = true;           ///< remove the vertices that carry no shape from every piece
+                                          ///< (simplifyPlanarRegions, lossless): bounds the triangle count of
+                                          ///< pieces that are hit again and again
 };
 
 /// One output piece: a closed, outward-oriented mesh in the input's coordinates.

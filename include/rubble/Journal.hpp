@@ -26,7 +26,7 @@ struct JournalEvent {
     std::array<float, 3> point{};                     ///< impact point (object coordinates)
     std::array<float, 3> normal{};                    ///< impact normal (object coordinates)
     float impulse = 0;                                ///< impulse (N·s)
-    std::uint8_t pattern = 0;                         ///< the object's CellPattern (checked on replay)
+    std::uint8_t pattern = 0;                         ///< the object's patternByte() (checked on replay)
     std::uint16_t cells = 0;                          ///< the object's shatter cell count (checked on replay)
     std::uint64_t seed = 0; ///< the seed of the object's next fracture job (checked on replay)
 
@@ -37,6 +37,17 @@ struct JournalEvent {
     /// Same fields.
     bool operator==(const JournalEvent&) const = default;
 };
+
+/// A fracture's pattern as one byte: the CellPattern in the low four bits, the ShatterLayout above them.
+inline std::uint8_t patternByte(const FractureParams& f) {
+    return static_cast<std::uint8_t>(static_cast<unsigned>(f.pattern) | static_cast<unsigned>(f.layout) << 4);
+}
+
+/// Whether a pattern byte names a known CellPattern and ShatterLayout.
+inline bool validPatternByte(std::uint8_t b) {
+    return (b & 15u) <= static_cast<unsigned>(CellPattern::Shatter) &&
+           (b >> 4) <= static_cast<unsigned>(ShatterLayout::Uniform);
+}
 
 /// An impact rounded to the journal's precision (what DestructionWorld::submitImpact fractures with).
 inline Impact journalPrecision(const Impact& i) {

@@ -7,6 +7,7 @@
 /// ThreadPool.hpp) are included on their own. The C API is rubble/rubble.h.
 
 #include "rubble/ConvexDecomposition.hpp"
+#include "rubble/DecompositionFile.hpp"
 #include "rubble/DestructionRuntime.hpp"
 #include "rubble/DestructionWorld.hpp"
 #include "rubble/Fracture.hpp"

@@ -5,7 +5,10 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
+#include <numbers>
 #include <string>
+#include <tuple>
 
 extern "C" {
 #include <libqhull_r/qhull_ra.h>
@@ -117,6 +120,56 @@ Result<ConvexPolytope> convexHull(const std::vector<Vec3>& points) {
     int curlong = 0, totlong = 0;
     qh_memfreeshort(qh, &curlong, &totlong);
     return result;
+}
+
+Result<ConvexPolytope> boundedHull(const std::vector<Vec3>& points, std::size_t maxFaces) {
+    const std::size_t directions = std::max<std::size_t>(8, maxFaces / 4);
+    if (points.size() <= 4 * maxFaces) { // few points: the exact hull, when it is small enough
+        auto exact = convexHull(points);
+        if (!exact || exact->faces().size() <= maxFaces)
+            return exact;
+    }
+    Aabb box;
+    for (const Vec3& p : points)
+        box.extend(p);
+    // Fibonacci directions on the sphere, stretched by the box's extents so that a long part gets as many
+    // extremes along its length as across it.
+    const Vec3 half = box.size() * 0.5 + Vec3{1, 1, 1} * (1e-12 * (box.diagonal() + 1));
+    std::vector<Vec3> extremes;
+    for (std::size_t k = 0; k < directions; ++k) {
+        const double z = 1 - (2 * static_cast<double>(k) + 1) / static_cast<double>(directions);
+        const double r = std::sqrt(std::max(0.0, 1 - z * z));
+        const double phi = static_cast<double>(k) * std::numbers::pi * (3 - std::sqrt(5.0));
+        const Vec3 u{r * std::cos(phi), r * std::sin(phi), z};
+        const Vec3 n{u.x / half.x, u.y / half.y, u.z / half.z};
+        std::size_t best = 0;
+        double bestDot = -std::numeric_limits<double>::infinity();
+        for (std::size_t i = 0; i < points.size(); ++i) {
+            const double d = dot(n, points[i]);
+            if (d > bestDot) {
+                bestDot = d;
+                best = i;
+            }
+        }
+        extremes.push_back(points[best]);
+    }
+    std::sort(extremes.begin(), extremes.end(),
+              [](const Vec3& a, const Vec3& b) { return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z); });
+    extremes.erase(std::unique(extremes.begin(), extremes.end()), extremes.end());
+    auto inner = convexHull(extremes);
+    if (!inner)
+        return convexHull(points);
+    // Each face plane of the inner hull pushed out to the farthest point: the polytope contains them all.
+    ConvexPolytope out = ConvexPolytope::fromAabb(box);
+    for (const PolytopeFace& f : inner->faces()) {
+        double offset = -std::numeric_limits<double>::infinity();
+        for (const Vec3& p : points)
+            offset = std::max(offset, dot(f.plane.normal, p));
+        out = out.clipped(Plane{f.plane.normal, offset});
+        if (out.empty())
+            return convexHull(points);
+    }
+    return out;
 }
 
 } // namespace rubble

@@ -6,6 +6,11 @@
 // away from the mesh (rays cast inward from its hull faces) is split next, by the candidate plane (axis and
 // principal-axis planes through the deepest pocket) that gives the smallest total hull volume, until
 // params.maxParts or every part is within params.concavity · diagonal of the mesh.
+//
+// A mesh above params.proxyAboveTriangles is searched through a bounded proxy (its vertices clustered on a
+// grid): the regions come from the proxy, and each part is then the bounded hull of the exact mesh inside
+// its region, so the cost of the search does not grow with the triangle count and parts still cover the
+// solid (docs/megamesh.md).
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -30,10 +35,87 @@ struct Part {
     Vec3 pocketDir;   // inward hull normal there
 };
 
+/// Cells of the proxy grid along each axis of the bounding box (a finer grid is tried once when the proxy's
+/// volume is off by more than kProxyVolumeError).
+constexpr int kProxyCells = 16;
+constexpr double kProxyVolumeError = 0.25;
+/// Hull faces whose depth is sampled per part when searching a proxy.
+constexpr std::size_t kProxyDepthFaces = 64;
+
 class Decomposer {
 public:
-    Decomposer(const Mesh& mesh, const DecompositionParams& params) : mesh_(mesh), params_(params) {
+    /// mesh: what the regions are searched on; exact: the mesh the parts must cover (mesh or its proxy's
+    /// original).
+    Decomposer(const Mesh& mesh, const Mesh& exact, const DecompositionParams& params)
+        : mesh_(mesh), exact_(exact), params_(params) {
         diag_ = mesh.bounds().diagonal();
+    }
+
+    bool proxied() const { return &mesh_ != &exact_; }
+
+    /// Inside the exact mesh: the proxy's winding number decides away from the surface, the exact mesh's
+    /// near it.
+    bool insideExact(const Vec3& p) {
+        if (!proxied())
+            return inside(p);
+        const double w = detail::windingNumber(mesh_, p);
+        if (w < 0.2 || w > 0.8)
+            return w > 0.5;
+        return detail::insideMesh(exact_, p);
+    }
+
+    /// The final shape of a part: its hull, or with a proxy the bounded hull of the exact mesh in its region;
+    /// either bounded to params.maxPartFaces faces.
+    std::optional<ConvexPolytope> finalShape(Part& part) {
+        if (!proxied()) {
+            if (part.hull.faces().size() <= params_.maxPartFaces)
+                return std::move(part.hull);
+            auto b = boundedHull(part.hull.vertices(), params_.maxPartFaces);
+            return b ? std::optional<ConvexPolytope>(std::move(b.value())) : std::move(part.hull);
+        }
+        std::vector<Vec3> points = exactPointsIn(part.region);
+        for (const Vec3& v : part.region.vertices())
+            if (insideExact(v))
+                points.push_back(v);
+        auto b = boundedHull(points, params_.maxPartFaces);
+        if (!b)
+            return std::nullopt;
+        return std::move(b.value());
+    }
+
+    /// The exact mesh's surface points in a region, each vertex once: the vertices inside it and the corners
+    /// of the triangles that cross its boundary, clipped to it.
+    std::vector<Vec3> exactPointsIn(const ConvexPolytope& region) const {
+        const Aabb rb = region.bounds();
+        std::vector<std::uint8_t> in(exact_.positions.size(), 0);
+        std::vector<Vec3> points;
+        for (std::size_t v = 0; v < exact_.positions.size(); ++v)
+            if (rb.contains(exact_.positions[v]) && region.contains(exact_.positions[v])) {
+                in[v] = 1;
+                points.push_back(exact_.positions[v]);
+            }
+        detail::Polygon poly, inner, outer;
+        for (std::size_t t = 0; t < exact_.triangles.size(); ++t) {
+            const Triangle& tri = exact_.triangles[t];
+            if (in[tri[0]] && in[tri[1]] && in[tri[2]])
+                continue;
+            const auto c = exact_.corners(t);
+            Aabb tb;
+            for (const Vec3& p : c)
+                tb.extend(p);
+            if (!tb.overlaps(rb))
+                continue;
+            poly.assign(c.begin(), c.end());
+            for (const PolytopeFace& f : region.faces()) {
+                detail::splitPolygon(poly, f.plane, inner, outer);
+                poly.swap(inner);
+                if (poly.size() < 3)
+                    break;
+            }
+            if (poly.size() >= 3)
+                points.insert(points.end(), poly.begin(), poly.end());
+        }
+        return points;
     }
 
     bool inside(const Vec3& p) {
@@ -70,7 +152,27 @@ public:
             if (f.tag >= 0)
                 cuts.push_back(&f);
         std::vector<Vec3> samples;
-        for (const PolytopeFace& hf : part.hull.faces()) {
+        // Through a proxy, only the kProxyDepthFaces largest hull faces are sampled (pockets lie under large
+        // faces that bridge them).
+        const std::vector<PolytopeFace>& hullFaces = part.hull.faces();
+        std::vector<std::size_t> order(hullFaces.size());
+        for (std::size_t i = 0; i < order.size(); ++i)
+            order[i] = i;
+        if (proxied() && order.size() > kProxyDepthFaces) {
+            std::vector<double> area(hullFaces.size(), 0);
+            for (std::size_t i = 0; i < hullFaces.size(); ++i) {
+                const auto& c = hullFaces[i].corners;
+                for (std::size_t k = 1; k + 1 < c.size(); ++k)
+                    area[i] += length(cross(c[k] - c[0], c[k + 1] - c[0]));
+            }
+            std::partial_sort(order.begin(), order.begin() + kProxyDepthFaces, order.end(),
+                              [&](std::size_t a, std::size_t b) {
+                                  return area[a] > area[b] || (area[a] == area[b] && a < b);
+                              });
+            order.resize(kProxyDepthFaces);
+        }
+        for (std::size_t fi : order) {
+            const PolytopeFace& hf = hullFaces[fi];
             bool onCut = false;
             for (const PolytopeFace* c : cuts)
                 if (dot(c->plane.normal, hf.plane.normal) > 1 - 1e-9 &&
@@ -237,12 +339,14 @@ public:
 
     Result<Decomposition> run() {
         Decomposition out;
-        out.meshVolume = signedVolume(mesh_);
-        if (mesh_.empty() || !(out.meshVolume > 0))
+        out.meshVolume = signedVolume(exact_);
+        const double searchVolume = proxied() ? signedVolume(mesh_) : out.meshVolume;
+        if (exact_.empty() || !(out.meshVolume > 0) || mesh_.triangles.size() < 4 || !(searchVolume > 0))
             return makeError(ErrorCode::InvalidInput,
                              "decompose: the mesh must be closed with positive volume (volume " +
                                  std::to_string(out.meshVolume) + ")");
         Aabb box = mesh_.bounds();
+        box.extend(exact_.bounds());
         const Vec3 pad = Vec3{1, 1, 1} * (0.01 * diag_ + 1e-9);
         box.lo -= pad;
         box.hi += pad;
@@ -255,9 +359,15 @@ public:
                 area += 0.5 * length(cross(f.corners[i] - f.corners[0], f.corners[i + 1] - f.corners[0]));
         const double threshold = params_.concavity * diag_;
         minPartVolume_ = params_.minPartVolumeFraction * out.meshVolume;
-        if (params_.maxParts <= 1 || hull->volume() - out.meshVolume <= 0.01 * threshold * area) {
-            out.hullVolume = hull->volume();
-            out.parts.push_back(std::move(hull.value()));
+        if (params_.maxParts <= 1 || hull->volume() - searchVolume <= 0.01 * threshold * area) {
+            Part whole;
+            whole.region = ConvexPolytope::fromAabb(box);
+            whole.hull = std::move(hull.value());
+            auto shape = finalShape(whole);
+            if (!shape)
+                return makeError(ErrorCode::InvalidInput, "decompose: the mesh is flat");
+            out.hullVolume = shape->volume();
+            out.parts.push_back(std::move(*shape));
             return out;
         }
         std::vector<Polygon> surface;
@@ -307,17 +417,22 @@ public:
         }
         const double minVol = params_.minPartVolumeFraction * out.meshVolume;
         for (Part& p : parts) {
-            const double v = p.hull.volume();
-            if (v < minVol && parts.size() > 1)
+            if (p.hull.volume() < minVol && parts.size() > 1)
                 continue;
-            out.hullVolume += v;
-            out.parts.push_back(std::move(p.hull));
+            auto shape = finalShape(p);
+            if (!shape)
+                continue;
+            out.hullVolume += shape->volume();
+            out.parts.push_back(std::move(*shape));
         }
+        if (out.parts.empty())
+            return makeError(ErrorCode::GeometryFailure, "decompose: no part holds any of the mesh");
         return out;
     }
 
 private:
     const Mesh& mesh_;
+    const Mesh& exact_;
     DecompositionParams params_;
     double diag_ = 0;
     std::int32_t nextTag_ = 0;
@@ -332,7 +447,17 @@ Result<Decomposition> decompose(const Mesh& mesh, const DecompositionParams& par
         return s.error();
     if (mesh.triangles.size() < 4)
         return makeError(ErrorCode::InvalidInput, "decompose: a closed mesh needs at least 4 triangles");
-    Decomposer d(mesh, params);
+    if (mesh.triangles.size() > params.proxyAboveTriangles) {
+        const double volume = signedVolume(mesh);
+        for (int cells : {kProxyCells, 2 * kProxyCells}) {
+            const Mesh proxy = detail::clusteredProxy(mesh, cells);
+            if (std::abs(signedVolume(proxy) - volume) > kProxyVolumeError * std::abs(volume))
+                continue; // too coarse for a thin feature: finer, else the exact search
+            Decomposer d(proxy, mesh, params);
+            return d.run();
+        }
+    }
+    Decomposer d(mesh, mesh, params);
     return d.run();
 }
 

@@ -31,6 +31,8 @@ std::uint64_t keyOf(const Mesh& mesh, const DecompositionParams& p) {
     mix(bits);
     std::memcpy(&bits, &p.minPartVolumeFraction, 8);
     mix(bits);
+    mix(static_cast<std::uint64_t>(p.proxyAboveTriangles));
+    mix(static_cast<std::uint64_t>(p.maxPartFaces));
     return h;
 }
 

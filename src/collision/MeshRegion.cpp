@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <numbers>
+#include <unordered_map>
 
 #include "rubble/ConvexDecomposition.hpp"
 
@@ -83,6 +85,66 @@ std::vector<Polygon> clipTrianglesToRegion(const Mesh& mesh, const ConvexPolytop
             out.push_back(std::move(poly));
     }
     return out;
+}
+
+Mesh clusteredProxy(const Mesh& mesh, int cellsPerAxis) {
+    const Aabb box = mesh.bounds();
+    const double floor = 1e-9 * box.diagonal() + 1e-300;
+    const Vec3 size = box.size();
+    const double n = std::max(cellsPerAxis, 1);
+    const Vec3 h{std::max(size.x, floor) / n, std::max(size.y, floor) / n, std::max(size.z, floor) / n};
+    std::unordered_map<std::uint64_t, std::uint32_t> cluster; // cell key -> proxy vertex
+    std::vector<Vec3> sum;
+    std::vector<double> count;
+    std::vector<std::uint32_t> of(mesh.positions.size());
+    for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+        const Vec3 d = mesh.positions[v] - box.lo;
+        const Vec3 q{d.x / h.x, d.y / h.y, d.z / h.z};
+        const auto cell = [](double x) { return static_cast<std::uint64_t>(std::max(0.0, std::floor(x))); };
+        const std::uint64_t key = (cell(q.x) << 42) | (cell(q.y) << 21) | cell(q.z);
+        auto [it, fresh] = cluster.try_emplace(key, static_cast<std::uint32_t>(sum.size()));
+        if (fresh) {
+            sum.emplace_back();
+            count.push_back(0);
+        }
+        sum[it->second] += mesh.positions[v];
+        count[it->second] += 1;
+        of[v] = it->second;
+    }
+    Mesh proxy;
+    proxy.positions.reserve(sum.size());
+    for (std::size_t i = 0; i < sum.size(); ++i)
+        proxy.positions.push_back(sum[i] / count[i]);
+    // Net count of each triangle (rotated to start at its smallest vertex) against its reverse.
+    std::map<std::array<std::uint32_t, 3>, int> net;
+    std::vector<std::array<std::uint32_t, 3>> order; // first appearance, so the output is deterministic
+    const auto canonical = [](std::uint32_t a, std::uint32_t b,
+                              std::uint32_t c) -> std::array<std::uint32_t, 3> {
+        if (a < b && a < c)
+            return {a, b, c};
+        if (b < c)
+            return {b, c, a};
+        return {c, a, b};
+    };
+    for (const Triangle& t : mesh.triangles) {
+        const std::uint32_t a = of[t[0]], b = of[t[1]], c = of[t[2]];
+        if (a == b || b == c || a == c)
+            continue;
+        auto reverse = net.find(canonical(a, c, b));
+        if (reverse != net.end() && reverse->second > 0) {
+            --reverse->second;
+            continue;
+        }
+        auto [it, fresh] = net.try_emplace(canonical(a, b, c), 0);
+        if (fresh)
+            order.push_back(it->first);
+        ++it->second;
+    }
+    for (const auto& key : order)
+        for (int k = net[key]; k > 0; --k)
+            proxy.triangles.push_back({key[0], key[1], key[2]});
+    proxy.removeUnreferencedVertices();
+    return proxy;
 }
 
 Result<ConvexPolytope> hullOfPolygons(const std::vector<Polygon>& polys, const std::vector<Vec3>& extra) {

@@ -32,6 +32,12 @@ std::vector<Polygon> clipTrianglesToRegion(const Mesh& mesh, const ConvexPolytop
 /// corners that lie inside the mesh. Fails when that set is empty or flat.
 Result<ConvexPolytope> hullOfMeshInRegion(const Mesh& mesh, const ConvexPolytope& region);
 
+/// A bounded stand-in for a closed mesh: its vertices clustered on a grid of cellsPerAxis cells along each
+/// axis of its bounding box (each cluster at its vertices' mean), triangles that collapse dropped and
+/// pairs of opposite triangles cancelled. Closed (every edge used as often in both directions) but not
+/// necessarily manifold; its winding number follows the mesh's away from the surface.
+Mesh clusteredProxy(const Mesh& mesh, int cellsPerAxis);
+
 /// Hull of polygons' corners plus extra points.
 Result<ConvexPolytope> hullOfPolygons(const std::vector<Polygon>& polys, const std::vector<Vec3>& extra);
 

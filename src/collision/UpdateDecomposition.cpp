@@ -34,6 +34,25 @@ void subtractCell(const ConvexPolytope& part, const ConvexPolytope& cell, std::v
     }
 }
 
+/// The points extreme in the 26 directions of a cube's faces, edges and corners (repeats removed).
+std::vector<Vec3> extremePoints(const std::vector<Vec3>& pts) {
+    std::vector<Vec3> out;
+    for (int x = -1; x <= 1; ++x)
+        for (int y = -1; y <= 1; ++y)
+            for (int z = -1; z <= 1; ++z) {
+                if (x == 0 && y == 0 && z == 0)
+                    continue;
+                const Vec3 d{double(x), double(y), double(z)};
+                std::size_t best = 0;
+                for (std::size_t i = 1; i < pts.size(); ++i)
+                    if (dot(d, pts[i]) > dot(d, pts[best]))
+                        best = i;
+                if (!pts.empty() && std::find(out.begin(), out.end(), pts[best]) == out.end())
+                    out.push_back(pts[best]);
+            }
+    return out;
+}
+
 /// The polytope clipped to an axis-aligned box (only by the box planes it crosses).
 ConvexPolytope clippedToBox(ConvexPolytope p, const Aabb& box) {
     const Aabb b = p.bounds();
@@ -244,13 +263,12 @@ void mergeToBudget(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t
     parts = std::move(kept);
 }
 
-} // namespace
-
-std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<ConvexPolytope>& parentParts,
-                                                             const std::vector<ConvexPolytope>& cells,
-                                                             const std::vector<Mesh>& pieces,
-                                                             const std::vector<std::int32_t>& pieceCells,
-                                                             const DecompositionParams& params) {
+/// updateDecomposition on pieces held elsewhere (no copies).
+std::vector<std::vector<ConvexPolytope>> updateParts(const std::vector<ConvexPolytope>& parentParts,
+                                                     const std::vector<ConvexPolytope>& cells,
+                                                     const std::vector<const Mesh*>& pieces,
+                                                     const std::vector<std::int32_t>& pieceCells,
+                                                     const DecompositionParams& params) {
     std::vector<std::vector<ConvexPolytope>> result(pieces.size());
     if (pieces.empty())
         return result;
@@ -316,7 +334,7 @@ std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<C
     };
     std::vector<Aabb> pieceBounds(pieces.size());
     for (std::size_t i = 0; i < pieces.size(); ++i)
-        pieceBounds[i] = pieces[i].bounds();
+        pieceBounds[i] = pieces[i]->bounds();
     for (Fragment& frag : fragments) {
         const double fragVolume = frag.shape.volume();
         if (fragVolume <= sliver)
@@ -342,9 +360,17 @@ std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<C
             continue;
         }
         if (candidates.size() > 1) {
-            // Several islands may share this fragment: give each the hull of its own part inside it.
+            // Several islands may share this fragment: give each the hull of its own part inside it (on a
+            // high-poly island, whose inside test costs a pass over its triangles per point, the fragment
+            // clipped to the island's bounds, which also holds that part).
             for (std::size_t i : candidates) {
-                auto h = detail::hullOfMeshInRegion(pieces[i], frag.shape);
+                if (pieces[i]->triangles.size() > params.proxyAboveTriangles) {
+                    ConvexPolytope clipped = clippedToBox(frag.shape, pieceBounds[i]);
+                    if (!clipped.empty() && clipped.volume() > sliver)
+                        give(i, std::move(clipped), frag.part);
+                    continue;
+                }
+                auto h = detail::hullOfMeshInRegion(*pieces[i], frag.shape);
                 if (h && h->volume() > sliver)
                     give(i, std::move(h.value()), frag.part);
             }
@@ -374,18 +400,30 @@ std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<C
     for (std::size_t i = 0; i < pieces.size(); ++i) {
         std::vector<ConvexPolytope>& parts = result[i];
         if (parts.empty()) {
-            auto d = decompose(pieces[i], params);
+            auto d = decompose(*pieces[i], params);
             if (d)
                 parts = std::move(d->parts);
             continue;
         }
-        if (parts.size() > 1) {
+        // A high-poly remainder island whose fragments all come from one parent part is that part minus
+        // cells: with two or more fragments it has a dent and does not fill its hull (test skipped).
+        const bool dented = i < pieceCells.size() && pieceCells[i] < 0 &&
+                            pieces[i]->triangles.size() > params.proxyAboveTriangles &&
+                            std::all_of(origins[i].begin(), origins[i].end(),
+                                        [&](std::uint32_t o) { return o == origins[i].front(); });
+        if (parts.size() > 1 && !dented) {
             double sum = 0;
             std::vector<Vec3> pts;
             for (const ConvexPolytope& p : parts) {
                 sum += p.volume();
                 const auto v = p.vertices();
                 pts.insert(pts.end(), v.begin(), v.end());
+            }
+            // The hull of the extremes in 26 directions lies inside the full hull: when it is already larger
+            // than the parts together, they do not fill their hull (and the full hull is not computed).
+            if (auto quick = convexHull(extremePoints(pts)); quick && quick->volume() > sum * (1 + 1e-6)) {
+                mergeToBudget(parts, origins[i], params.maxParts);
+                continue;
             }
             auto h = convexHull(pts);
             if (h && h->volume() <= sum * (1 + 1e-6)) {
@@ -396,20 +434,39 @@ std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<C
         }
         mergeToBudget(parts, origins[i], params.maxParts);
     }
+    // 5. Parts kept to a bounded size, so that the next hit clips the same few faces.
+    for (std::vector<ConvexPolytope>& parts : result)
+        for (ConvexPolytope& p : parts)
+            if (p.faces().size() > params.maxPartFaces)
+                if (auto b = boundedHull(p.vertices(), params.maxPartFaces))
+                    p = std::move(b.value());
     return result;
+}
+
+} // namespace
+
+std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<ConvexPolytope>& parentParts,
+                                                             const std::vector<ConvexPolytope>& cells,
+                                                             const std::vector<Mesh>& pieces,
+                                                             const std::vector<std::int32_t>& pieceCells,
+                                                             const DecompositionParams& params) {
+    std::vector<const Mesh*> held;
+    held.reserve(pieces.size());
+    for (const Mesh& m : pieces)
+        held.push_back(&m);
+    return updateParts(parentParts, cells, held, pieceCells, params);
 }
 
 std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<ConvexPolytope>& parentParts,
                                                              const FractureResult& result,
                                                              const DecompositionParams& params) {
-    std::vector<Mesh> meshes;
+    std::vector<const Mesh*> meshes;
     std::vector<std::int32_t> pieceCells;
-    meshes.reserve(result.pieces.size());
     for (const Piece& piece : result.pieces) {
-        meshes.push_back(piece.mesh);
+        meshes.push_back(&piece.mesh);
         pieceCells.push_back(piece.cell);
     }
-    return updateDecomposition(parentParts, result.cells, meshes, pieceCells, params);
+    return updateParts(parentParts, result.cells, meshes, pieceCells, params);
 }
 
 } // namespace rubble

@@ -238,9 +238,60 @@ std::vector<RawCell> voronoiComplex(const std::vector<Vec3>& sites, const std::v
 
 } // namespace
 
+namespace {
+constexpr double kSplinterAlong = 2.5;  // a splinter layout's cells: stretch along the grain
+constexpr double kSplinterAcross = 0.6; // and squeeze across it
+
+// A rotation whose local z is `axis` (any non-zero vector; else the world z), turned by `angle` about it.
+Mat3 frameAround(const Vec3& axis, double angle) {
+    const double len = length(axis);
+    const Vec3 z = len > 0 && std::isfinite(len) ? axis / len : Vec3{0, 0, 1};
+    const Vec3 helper = std::abs(z.x) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
+    const Vec3 x0 = normalized(cross(helper, z));
+    const Vec3 y0 = cross(z, x0);
+    const Vec3 x = x0 * std::cos(angle) + y0 * std::sin(angle);
+    const Vec3 y = cross(z, x);
+    Mat3 r;
+    for (int i = 0; i < 3; ++i) {
+        r.m[i][0] = x[i];
+        r.m[i][1] = y[i];
+        r.m[i][2] = z[i];
+    }
+    return r;
+}
+
+// The longest edge direction of a box (x on ties; x for an empty box).
+Vec3 longestAxis(const Aabb& b) {
+    if (b.empty())
+        return {1, 0, 0};
+    const Vec3 d = b.size();
+    if (d.x >= d.y && d.x >= d.z)
+        return {1, 0, 0};
+    return d.y >= d.z ? Vec3{0, 1, 0} : Vec3{0, 0, 1};
+}
+
+// Sites on jittered rings in the local xy plane around the centre site (ring j holds 6j sites, the rings
+// denser near the centre): Voronoi cells that are wedges between radial cracks, in concentric bands.
+void radialSites(std::vector<Vec3>& sites, int n, double h, Rng& rng) {
+    int rings = 1;
+    while (1 + 3 * rings * (rings + 1) < n + 1)
+        ++rings;
+    for (int j = 1; j <= rings; ++j) {
+        const double radius = h * 0.98 * std::pow(static_cast<double>(j) / rings, 1.3);
+        const double band = radius - h * 0.98 * std::pow(static_cast<double>(j - 1) / rings, 1.3);
+        const int m = 6 * j;
+        const double step = 2.0 * std::numbers::pi / m, offset = rng.uniform(0.0, step);
+        for (int i = 0; i < m; ++i) {
+            const double a = offset + step * (i + rng.uniform(-0.2, 0.2));
+            const double r = radius - band * rng.uniform(0.0, 0.25);
+            sites.push_back({r * std::cos(a), r * std::sin(a), h * rng.uniform(-0.002, 0.002)});
+        }
+    }
+}
+} // namespace
+
 std::vector<ConvexPolytope> generateCells(const Aabb& meshBounds, const Impact& impact,
                                           const FractureParams& params, std::uint64_t seed) {
-    (void)meshBounds;
     std::vector<ConvexPolytope> out;
     if (!isFinite(impact.point))
         return out;
@@ -263,16 +314,37 @@ std::vector<ConvexPolytope> generateCells(const Aabb& meshBounds, const Impact& 
         return out;
     }
 
-    // Shatter: sites denser near the impact (radius ~ sqrt(u): density ~ 1/r), the K sites nearest the impact
-    // cut.
+    // Shatter: the K sites nearest the impact cut; where the others lie shapes the cells (ShatterLayout).
     const double scale = rng.uniform(0.8, 1.25);
     const double h = size / 2;
     const int k = std::clamp(params.cells, 1, kMaxShatterCells);
     const int n = std::max(std::clamp(params.seedPoints, 0, 10000), 2 * k);
     std::vector<Vec3> sites{{0, 0, 0}};
-    for (int i = 0; i < n; ++i) {
-        const double u = rng.uniform();
-        sites.push_back(rng.unitVector() * (h * 0.98 * std::sqrt(u)));
+    Mat3 frame = rotation;
+    switch (params.layout) {
+    case ShatterLayout::Clustered: // radius ~ sqrt(u): density ~ 1/r
+    case ShatterLayout::Uniform:   // radius ~ cbrt(u): uniform in the ball
+        for (int i = 0; i < n; ++i) {
+            const double u = rng.uniform();
+            const double r = params.layout == ShatterLayout::Clustered ? std::sqrt(u) : std::cbrt(u);
+            sites.push_back(rng.unitVector() * (h * 0.98 * r));
+        }
+        break;
+    case ShatterLayout::Radial:
+        frame = frameAround(impact.normal, rng.uniform(0.0, 2.0 * std::numbers::pi));
+        radialSites(sites, n, h, rng);
+        break;
+    case ShatterLayout::Splinter: { // clustered cells, stretched along the grain (local z), squeezed across
+        frame = frameAround(longestAxis(meshBounds), rng.uniform(0.0, 2.0 * std::numbers::pi));
+        for (int c = 0; c < 3; ++c)
+            for (int r = 0; r < 3; ++r)
+                frame.m[r][c] *= c == 2 ? kSplinterAlong : kSplinterAcross;
+        for (int i = 0; i < n; ++i) {
+            const double u = rng.uniform();
+            sites.push_back(rng.unitVector() * (h * 0.98 * std::sqrt(u)));
+        }
+        break;
+    }
     }
     std::vector<std::size_t> order(sites.size());
     for (std::size_t i = 0; i < order.size(); ++i)
@@ -282,7 +354,7 @@ std::vector<ConvexPolytope> generateCells(const Aabb& meshBounds, const Impact& 
     });
     std::vector<std::size_t> wanted(order.begin(),
                                     order.begin() + std::min<std::ptrdiff_t>(k, std::ssize(order)));
-    std::vector<RawCell> raws = voronoiComplex(sites, wanted, h, rotation, scale, impact.point);
+    std::vector<RawCell> raws = voronoiComplex(sites, wanted, h, frame, scale, impact.point);
     for (const RawCell& r : raws) {
         ConvexPolytope p = toPolytope(r);
         if (!p.empty())

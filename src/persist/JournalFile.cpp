@@ -32,7 +32,7 @@ JournalEvent readEvent(persist::ByteReader& r) {
         r.fail(start, "kind", "unknown event kind " + std::to_string(kind));
     e.kind = static_cast<JournalEventKind>(kind);
     e.pattern = r.u8("pattern");
-    if (r.ok() && e.pattern > static_cast<std::uint8_t>(CellPattern::Shatter))
+    if (r.ok() && !validPatternByte(e.pattern))
         r.fail(start + 1, "pattern", "unknown pattern " + std::to_string(e.pattern));
     e.cells = r.u16("cells");
     e.object = r.u32("object");

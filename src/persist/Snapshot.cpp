@@ -138,7 +138,7 @@ void writeObject(ByteWriter& w, const ObjectState& o) {
     w.f64(o.impulseThreshold);
     w.u64(o.crumbleAbove);
     const FractureParams& f = o.fracture;
-    w.u8(static_cast<std::uint8_t>(f.pattern));
+    w.u8(patternByte(f));
     w.i32(f.seedPoints);
     w.i32(f.cells);
     for (double x :
@@ -194,9 +194,10 @@ ObjectState readObject(ByteReader& r, const std::uint8_t* data) {
     FractureParams& f = o.fracture;
     std::size_t pos = r.offset();
     const std::uint8_t pattern = r.u8("fracture.pattern");
-    if (r.ok() && pattern > static_cast<std::uint8_t>(CellPattern::Shatter))
+    if (r.ok() && !validPatternByte(pattern))
         r.fail(pos, "fracture.pattern", "unknown pattern " + std::to_string(pattern));
-    f.pattern = static_cast<CellPattern>(pattern);
+    f.pattern = static_cast<CellPattern>(pattern & 15u);
+    f.layout = static_cast<ShatterLayout>(pattern >> 4);
     f.seedPoints = r.i32("fracture.seedPoints");
     f.cells = r.i32("fracture.cells");
     f.sizeLaw.base = real(r, "fracture.sizeLaw.base");

@@ -14,6 +14,7 @@
 #include "geometry/ClosestPoint.hpp"
 #include "rubble/Log.hpp"
 #include "rubble/MassProperties.hpp"
+#include "rubble/Material.hpp"
 #include "rubble/MeshCheck.hpp"
 #include "rubble/MeshRepair.hpp"
 #include "rubble/Random.hpp"
@@ -337,6 +338,23 @@ DestructionWorld::~DestructionWorld() {
     impl_->ownedPool.reset(); // finishes running jobs, drops queued ones (they only hold shared state)
 }
 
+namespace {
+// The shatter layout of a material's fracture pattern.
+ShatterLayout shatterLayout(FracturePattern p) {
+    switch (p) {
+    case FracturePattern::Radial:
+        return ShatterLayout::Radial;
+    case FracturePattern::Splinter:
+        return ShatterLayout::Splinter;
+    case FracturePattern::Uniform:
+        return ShatterLayout::Uniform;
+    case FracturePattern::Clustered:
+        break;
+    }
+    return ShatterLayout::Clustered;
+}
+} // namespace
+
 Result<ObjectId> DestructionWorld::addObject(ObjectDesc desc) {
     if (desc.mesh.triangles.empty() || desc.mesh.positions.empty())
         return Error{ErrorCode::InvalidInput, "addObject: empty mesh"};
@@ -347,6 +365,8 @@ Result<ObjectId> DestructionWorld::addObject(ObjectDesc desc) {
     s.destructible = desc.destructible;
     s.impulseThreshold = desc.impulseThreshold;
     s.fracture = desc.fracture;
+    if (const Material* m = desc.material.empty() ? nullptr : findMaterial(desc.material))
+        s.fracture.layout = shatterLayout(m->pattern);
     s.crumbleAbove = impl_->config.crumbleTriangles == 0
                          ? std::numeric_limits<std::size_t>::max()
                          : std::max(impl_->config.crumbleTriangles, 2 * desc.mesh.triangleCount());
@@ -429,7 +449,7 @@ bool DestructionWorld::submitImpact(ObjectId id, const Impact& impact) {
     e.normal = {static_cast<float>(rounded.normal.x), static_cast<float>(rounded.normal.y),
                 static_cast<float>(rounded.normal.z)};
     e.impulse = static_cast<float>(rounded.impulse);
-    e.pattern = static_cast<std::uint8_t>(o.fracture.pattern);
+    e.pattern = patternByte(o.fracture);
     e.cells = static_cast<std::uint16_t>(std::clamp(o.fracture.cells, 0, 65535));
     e.seed = impl_->jobSeed(o);
     impl_->journal(e);
@@ -463,7 +483,7 @@ Status DestructionWorld::applyJournalEvent(const JournalEvent& e) {
     if (e.kind != JournalEventKind::Impact)
         return Error{ErrorCode::InvalidInput, where + "unknown kind " + std::to_string(int(e.kind))};
     const ObjectState& o = *it->second;
-    if (e.pattern != static_cast<std::uint8_t>(o.fracture.pattern) ||
+    if (e.pattern != patternByte(o.fracture) ||
         e.cells != static_cast<std::uint16_t>(std::clamp(o.fracture.cells, 0, 65535)))
         return Error{ErrorCode::InvalidInput,
                      where + "pattern differs from the object's fracture parameters"};

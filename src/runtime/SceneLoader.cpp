@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "rubble/DecompositionFile.hpp"
 #include "rubble/MassProperties.hpp"
 #include "rubble/MeshIO.hpp"
 
@@ -14,12 +15,49 @@ std::string where(const SceneConfig& scene, const SceneObject& o) {
     return "line " + std::to_string(o.line);
 }
 
-// The model's mesh scaled, or a stand-in box with a warning.
-Mesh modelOrStandIn(const SceneConfig& scene, const SceneObject& o, std::vector<std::string>& warnings) {
+// A polytope scaled per axis by s (all positive).
+ConvexPolytope scaledPolytope(const ConvexPolytope& p, const Vec3& s) {
+    std::vector<PolytopeFace> faces = p.faces();
+    for (PolytopeFace& f : faces) {
+        for (Vec3& c : f.corners)
+            c = {c.x * s.x, c.y * s.y, c.z * s.z};
+        const Vec3 n = f.plane.normal;
+        f.plane.normal = normalized(Vec3{n.x / s.x, n.y / s.y, n.z / s.z});
+        f.plane.offset = dot(f.plane.normal, f.corners.front());
+    }
+    return ConvexPolytope::fromFaces(std::move(faces));
+}
+
+// A model's mesh and, when MODEL.parts.json beside it was made for this mesh, its cached convex parts.
+struct Model {
+    Mesh mesh;
+    std::vector<ConvexPolytope> parts;
+};
+
+// The model's mesh scaled (with its cached parts), or a stand-in box with a warning.
+Model modelOrStandIn(const SceneConfig& scene, const SceneObject& o, std::vector<std::string>& warnings) {
     if (!o.model.empty() && o.modelFound) {
         Result<Mesh> mesh = readMesh(o.modelPath);
-        if (mesh && !mesh->empty())
-            return mesh->transformed(Mat3::identity(), o.scale, Vec3{});
+        if (mesh && !mesh->empty()) {
+            Model m;
+            const std::filesystem::path cached = decompositionPathFor(o.modelPath);
+            std::error_code ec;
+            const bool positive = o.scale.x > 0 && o.scale.y > 0 && o.scale.z > 0;
+            if (positive && std::filesystem::exists(cached, ec)) {
+                auto file = readDecompositionFile(cached);
+                if (!file)
+                    warnings.push_back(where(scene, o) + ": " + file.error().message +
+                                       "; decomposing at load");
+                else if (file->meshHash != mesh->hash())
+                    warnings.push_back(where(scene, o) + ": " + cached.string() +
+                                       " was made for another mesh; decomposing at load");
+                else
+                    for (const ConvexPolytope& p : file->parts)
+                        m.parts.push_back(scaledPolytope(p, o.scale));
+            }
+            m.mesh = mesh->transformed(Mat3::identity(), o.scale, Vec3{});
+            return m;
+        }
         warnings.push_back(where(scene, o) + ": model '" + o.model + "' unreadable (" +
                            (mesh ? std::string("no triangles") : mesh.error().message) +
                            "); using a stand-in box");
@@ -27,7 +65,7 @@ Mesh modelOrStandIn(const SceneConfig& scene, const SceneObject& o, std::vector<
         warnings.push_back(where(scene, o) + ": model '" + o.model + "' not found; using a stand-in box");
     }
     const Vec3 h = o.scale * 0.5;
-    return makeBox(-h, h);
+    return {makeBox(-h, h), {}};
 }
 
 // Volume of the intersection of two boxes (0 when they do not overlap).
@@ -59,7 +97,7 @@ LoadedScene loadScene(const SceneConfig& scene, DestructionRuntime& runtime,
     }
     if (options.loadVehicle && scene.vehicle.line != 0) {
         std::vector<std::string> vehicleWarnings;
-        const Mesh mesh = modelOrStandIn(scene, scene.vehicle, vehicleWarnings);
+        const Mesh mesh = modelOrStandIn(scene, scene.vehicle, vehicleWarnings).mesh;
         for (std::string& w : vehicleWarnings)
             out.warnings.push_back(std::move(w));
         Result<BodyId> body = runtime.addConvexBody(
@@ -78,7 +116,8 @@ LoadedScene loadScene(const SceneConfig& scene, DestructionRuntime& runtime,
     std::vector<Placed> placed;
     for (std::size_t index = 0; index < scene.objects.size(); ++index) {
         const SceneObject& o = scene.objects[index];
-        Mesh mesh = modelOrStandIn(scene, o, out.warnings);
+        Model model = modelOrStandIn(scene, o, out.warnings);
+        Mesh& mesh = model.mesh;
         if (options.prepareMesh)
             options.prepareMesh(mesh);
         // Bodies placed inside each other would push apart in one physics step of unbounded cost (600
@@ -104,6 +143,7 @@ LoadedScene loadScene(const SceneConfig& scene, DestructionRuntime& runtime,
         desc.material = o.material;
         desc.fracture = options.fracture;
         desc.mesh = std::move(mesh);
+        desc.convexParts = std::move(model.parts);
         Result<ObjectId> id =
             runtime.addObject(std::move(desc), Frame{Mat3::identity(), o.position}, o.isStatic());
         if (!id) {

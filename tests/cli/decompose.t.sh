@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# `rubble decompose`: JSON fields, convex input gives one part, --max-parts, exit codes.
+# `rubble decompose`: JSON fields, convex input gives one part, --max-parts, -o parts file, exit codes.
 set -eu
 data="$(cd "$(dirname "$0")/../data/meshes" && pwd)"
 tmp="$(mktemp -d)"
@@ -48,6 +48,20 @@ OBJ
 python3 -c "import json,sys; d=json.load(open(sys.argv[1])); assert d['parts']>=2 and d['excess']<1e-6, d" \
     "$tmp/l.json" || fail "L JSON: $(cat "$tmp/l.json")"
 "$RUBBLE" decompose --json --max-parts 1 "$tmp/l.obj" | grep -qF '"parts":1' || fail "--max-parts 1"
+
+# -o writes the parts beside the asset (the file a scene loads); an unwritable path exits 1.
+"$RUBBLE" decompose --json -o "$tmp/l.parts.json" "$tmp/l.obj" >/dev/null || fail "-o should exit 0"
+python3 - "$tmp/l.parts.json" <<'PY' || fail "parts file: $(head -c 300 "$tmp/l.parts.json")"
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert d["format"] == "rubble-decomposition" and d["version"] == 1 and len(d["mesh_hash"]) == 16, d.keys()
+assert len(d["parts"]) >= 2 and all(len(p["faces"]) >= 4 for p in d["parts"]), d["parts"]
+PY
+set +e
+"$RUBBLE" decompose -o "$tmp/no/such/dir/x.parts.json" "$tmp/l.obj" >/dev/null 2>"$tmp/err.txt"; code=$?
+set -e
+[ "$code" -eq 1 ] || fail "unwritable -o should exit 1, got $code"
+grep -q "x.parts.json" "$tmp/err.txt" || fail "write error does not name the file: $(cat "$tmp/err.txt")"
 
 # Unreadable input: exit 2 with the file named.
 set +e

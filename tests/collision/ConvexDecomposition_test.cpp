@@ -481,6 +481,90 @@ TEST(UpdateDecomposition, PartBudgetIsKept) {
     expectCovers(box, updated[0], 1e-9);
 }
 
+TEST(BoundedHull, ContainsEveryPointWithFewFacesAndLittleExcess) {
+    Rng rng(11);
+    std::vector<Vec3> points;
+    for (int i = 0; i < 20000; ++i) { // an ellipsoid's surface, long in x and flat in z
+        const Vec3 u = rng.unitVector();
+        points.push_back({3 * u.x + 2, u.y + 1, 0.4 * u.z});
+    }
+    auto exact = convexHull(points);
+    ASSERT_TRUE(exact);
+    ASSERT_GT(exact->faces().size(), 512u);
+    auto b = boundedHull(points, 512);
+    ASSERT_TRUE(b) << b.error().message;
+    EXPECT_LE(b->faces().size(), 256u + 6u);
+    for (const Vec3& p : points)
+        ASSERT_TRUE(b->contains(p, 1e-9));
+    EXPECT_LT(b->volume(), 1.05 * exact->volume());
+    // Few points: the exact hull.
+    const std::vector<Vec3> cube = makeBox({0, 0, 0}, {1, 1, 1}).positions;
+    auto small = boundedHull(cube, 512);
+    ASSERT_TRUE(small);
+    EXPECT_NEAR(small->volume(), 1.0, 1e-12);
+}
+
+TEST(Decompose, HighPolyMeshGoesThroughABoundedProxyAndStillCoversIt) {
+    // 19,200 triangles; the proxy path is forced by a low threshold.
+    const Mesh m = makeTorus({0, 0, 0}, 2, 0.5, 160, 60);
+    DecompositionParams p;
+    p.proxyAboveTriangles = 5000;
+    auto d = decompose(m, p);
+    ASSERT_TRUE(d) << d.error().message;
+    EXPECT_GE(d->parts.size(), 4u);
+    EXPECT_LE(d->parts.size(), 24u);
+    EXPECT_LE(d->excess(), 0.5);
+    expectCovers(m, d->parts, 1e-9 * diag(m));
+    for (const ConvexPolytope& part : d->parts)
+        EXPECT_LE(part.faces().size(), p.maxPartFaces);
+    // Deterministic: the same parts again.
+    auto again = decompose(m, p);
+    ASSERT_TRUE(again);
+    ASSERT_EQ(again->parts.size(), d->parts.size());
+    for (std::size_t i = 0; i < d->parts.size(); ++i)
+        EXPECT_EQ(again->parts[i].vertices(), d->parts[i].vertices());
+    // A convex high-poly mesh: one bounded part.
+    const Mesh ball = makeSphere({0, 0, 0}, 1, 120, 60);
+    auto one = decompose(ball, p);
+    ASSERT_TRUE(one);
+    EXPECT_EQ(one->parts.size(), 1u);
+    EXPECT_LE(one->parts[0].faces().size(), p.maxPartFaces);
+    EXPECT_LT(one->excess(), 0.05);
+    expectCovers(ball, one->parts, 1e-9);
+}
+
+TEST(Decompose, ThinPlateIsNotLostByTheProxy) {
+    // A plate far thinner than its extent, above the proxy threshold: the grid is per axis.
+    const Mesh plate = makeSubdividedBox({-5, -5, -0.02}, {5, 5, 0.02}, 30);
+    DecompositionParams p;
+    p.proxyAboveTriangles = 1000;
+    auto d = decompose(plate, p);
+    ASSERT_TRUE(d) << d.error().message;
+    EXPECT_LT(d->excess(), 0.01);
+    expectCovers(plate, d->parts, 1e-9 * diag(plate));
+}
+
+TEST(UpdateDecomposition, PartsStayBoundedAfterHits) {
+    // A sphere of 14,160 faces: its single hull is bounded, and so is every updated part.
+    const Mesh ball = makeSphere({0, 0, 0}, 1, 120, 60);
+    DecompositionParams p;
+    std::vector<ConvexPolytope> exactHull{convexHull(ball.positions).value()};
+    ASSERT_GT(exactHull[0].faces().size(), p.maxPartFaces);
+    Impact impact{{0.9, 0.1, 0}, {1, 0, 0}, 5};
+    FractureParams fp;
+    fp.sizeLaw.base = 0.5;
+    fp.sizeLaw.scale = 0;
+    auto fr = fracture(ball, impact, fp, 7);
+    ASSERT_TRUE(fr) << fr.error().message;
+    const auto updated = updateDecomposition(exactHull, *fr, p);
+    ASSERT_EQ(updated.size(), fr->pieces.size());
+    for (std::size_t i = 0; i < updated.size(); ++i) {
+        expectCovers(fr->pieces[i].mesh, updated[i], 1e-6);
+        for (const ConvexPolytope& part : updated[i])
+            EXPECT_LE(part.faces().size(), p.maxPartFaces);
+    }
+}
+
 TEST(DecompositionCache, MemoryAndDiskHitsAndCorruptFiles) {
     const std::filesystem::path dir = test::tempDir("decomposition_cache");
     const Mesh l = makeLPrism();

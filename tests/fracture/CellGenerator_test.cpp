@@ -167,6 +167,110 @@ TEST(CellGenerator, ShatterCellsFormAComplex) {
     }
 }
 
+// Every layout's cells form a complex that clips a box exactly (no gaps, no overlaps), at every size.
+TEST(CellGenerator, EveryShatterLayoutFormsAComplex) {
+    const Mesh box = makeSubdividedBox({-2, -2, -2}, {3, 3, 3}, 1);
+    for (ShatterLayout layout : {ShatterLayout::Radial, ShatterLayout::Splinter, ShatterLayout::Uniform})
+        for (int k : {2, 16, 100, 400})
+            for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+                FractureParams params;
+                params.pattern = CellPattern::Shatter;
+                params.layout = layout;
+                params.cells = k;
+                const std::string what = "layout " + std::to_string(static_cast<int>(layout)) + ", " +
+                                         std::to_string(k) + " cells, seed " + std::to_string(seed);
+                const auto cells = generateCells(box.bounds(), {{0.5, 0.5, 1}, {0, 0, 1}, 1}, params, seed);
+                ASSERT_EQ(cells.size(), static_cast<std::size_t>(k)) << what;
+                auto split = detail::clipByConvexCells(box, cells);
+                ASSERT_TRUE(split.isOk()) << what << ": " << split.error().message;
+                double total = 0;
+                for (std::size_t i = 0; i < cells.size(); ++i) {
+                    EXPECT_NEAR(signedVolume(split->inside[i]), cells[i].volume(), 1e-9 * cells[i].volume())
+                        << what << ", cell " << i;
+                    total += cells[i].volume();
+                }
+                EXPECT_NEAR(signedVolume(split->outside), 125 - total, 1e-9) << what;
+            }
+}
+
+namespace {
+// Extent of a polytope along a unit direction.
+double extent(const ConvexPolytope& p, const Vec3& d) {
+    double lo = 1e300, hi = -1e300;
+    for (const Vec3& v : p.vertices()) {
+        lo = std::min(lo, dot(v, d));
+        hi = std::max(hi, dot(v, d));
+    }
+    return hi - lo;
+}
+} // namespace
+
+// Glass: the cut faces between radial cells stand across the pane (their normals lie in the pane's plane), so
+// a hit on a pane breaks it into wedges through its whole thickness.
+TEST(CellGenerator, RadialCellsAreWedgesThroughThePane) {
+    FractureParams params;
+    params.pattern = CellPattern::Shatter;
+    params.layout = ShatterLayout::Radial;
+    params.cells = 24;
+    const Vec3 normal = normalized(Vec3{1, 2, 3});
+    for (std::uint64_t seed = 1; seed <= 5; ++seed) {
+        const auto cells = generateCells({}, {{0, 0, 0}, normal, 1}, params, seed);
+        ASSERT_EQ(cells.size(), 24u);
+        int across = 0, caps = 0, faces = 0;
+        for (const ConvexPolytope& c : cells)
+            for (const PolytopeFace& f : c.faces()) {
+                const double along = std::abs(dot(f.plane.normal, normal));
+                ++faces;
+                across += along < 0.3 ? 1 : 0;
+                caps += along > 0.9 ? 1 : 0; // where the domain ends above and below the pane
+            }
+        EXPECT_EQ(across + caps, faces) << "seed " << seed << ": a face neither across the pane nor a cap";
+        EXPECT_GT(across, 2 * caps) << "seed " << seed;
+    }
+}
+
+// Wood: cells are long along the grain (the longest axis of the mesh's bounds), short across it.
+TEST(CellGenerator, SplinterCellsAreLongAlongTheGrain) {
+    FractureParams params;
+    params.pattern = CellPattern::Shatter;
+    params.cells = 16;
+    const Aabb beam{{-0.1, -0.1, -2}, {0.1, 0.1, 2}}; // grain along z
+    auto meanRatio = [&](ShatterLayout layout) {
+        params.layout = layout;
+        double ratio = 0;
+        for (std::uint64_t seed = 1; seed <= 5; ++seed)
+            for (const ConvexPolytope& c : generateCells(beam, {{0, 0.1, 0}, {0, 1, 0}, 1}, params, seed))
+                ratio += extent(c, {0, 0, 1}) / std::max(extent(c, {1, 0, 0}), extent(c, {0, 1, 0}));
+        return ratio / (5 * 16);
+    };
+    const double splinter = meanRatio(ShatterLayout::Splinter),
+                 clustered = meanRatio(ShatterLayout::Clustered);
+    EXPECT_GT(splinter, 1.5) << "splinters: mean length over width";
+    EXPECT_GT(splinter, 3 * clustered) << "clustered cells are not elongated";
+}
+
+// Steel: uniform cells vary less in size than clustered ones (fine at the impact, coarse further out).
+TEST(CellGenerator, UniformCellsVaryLessInSizeThanClusteredOnes) {
+    auto spread = [](ShatterLayout layout) {
+        FractureParams params;
+        params.pattern = CellPattern::Shatter;
+        params.layout = layout;
+        params.cells = 32;
+        double total = 0;
+        for (std::uint64_t seed = 1; seed <= 8; ++seed) {
+            const auto cells = generateCells({}, {{0, 0, 0}, {0, 0, 1}, 1}, params, seed);
+            double lo = 1e300, hi = 0;
+            for (const ConvexPolytope& c : cells) {
+                lo = std::min(lo, c.volume());
+                hi = std::max(hi, c.volume());
+            }
+            total += std::log(hi / lo);
+        }
+        return total / 8;
+    };
+    EXPECT_LT(spread(ShatterLayout::Uniform), spread(ShatterLayout::Clustered) - 0.5);
+}
+
 TEST(CellGenerator, ShatterCellCountIsClampedToTheMaximum) {
     FractureParams params;
     params.pattern = CellPattern::Shatter;

@@ -101,6 +101,28 @@ TEST(Journal, DecodingRefusesUnknownKindsAndNonFiniteNumbers) {
     EXPECT_NE(bad.error().message.find("offset 36, field impulse"), std::string::npos) << bad.error().message;
 }
 
+// The pattern byte holds the CellPattern (low four bits) and the ShatterLayout (high four bits); a byte
+// naming neither a known pattern nor a known layout is refused at its offset.
+TEST(Journal, ThePatternByteCarriesTheLayout) {
+    FractureParams f;
+    f.pattern = CellPattern::Shatter;
+    f.layout = ShatterLayout::Splinter;
+    JournalEvent e;
+    e.pattern = patternByte(f);
+    EXPECT_EQ(e.pattern, 0x21);
+    auto bytes = encodeJournalEvent(e);
+    Result<JournalEvent> back = decodeJournalEvent(bytes.data());
+    ASSERT_TRUE(back) << back.error().message;
+    EXPECT_EQ(back->pattern, 0x21);
+    for (std::uint8_t bad : {0x02, 0x41, 0xF0}) {
+        bytes[1] = bad;
+        Result<JournalEvent> refused = decodeJournalEvent(bytes.data(), 48);
+        ASSERT_FALSE(refused) << int(bad);
+        EXPECT_NE(refused.error().message.find("offset 49, field pattern"), std::string::npos)
+            << refused.error().message;
+    }
+}
+
 TEST(Journal, AcceptedImpactsAreRoundedToTheJournalPrecision) {
     auto world = test::journalWorld(1);
     std::vector<JournalEvent> events;

@@ -57,6 +57,26 @@ TEST(Snapshot, LoadThenSaveGivesIdenticalBytesAndGeometry) {
     EXPECT_EQ(encodeSnapshot(takeSnapshot(world, placements)), bytes);
 }
 
+// An object's shatter layout (from its material) survives a save and a load.
+TEST(Snapshot, KeepsTheShatterLayoutOfEveryObject) {
+    DestructionWorld world(kConfig);
+    ObjectDesc d;
+    d.mesh = makeBox({-1, -1, -1}, {1, 1, 1});
+    d.density = 2;
+    d.material = "glass";
+    d.fracture.pattern = CellPattern::Shatter;
+    ASSERT_TRUE(world.addObject(std::move(d)));
+    ObjectPlacement placement;
+    placement.object = world.objects().front();
+    const Snapshot s = takeSnapshot(world, {placement});
+    const std::vector<std::uint8_t> bytes = encodeSnapshot(s);
+    Result<Snapshot> decoded = decodeSnapshot(bytes.data(), bytes.size(), "glass.rsnap");
+    ASSERT_TRUE(decoded) << decoded.error().message;
+    ASSERT_EQ(decoded->world.objects.size(), 1u);
+    EXPECT_EQ(decoded->world.objects[0].fracture.layout, ShatterLayout::Radial);
+    EXPECT_EQ(decoded->world.objects[0].fracture.pattern, CellPattern::Shatter);
+}
+
 TEST(Snapshot, RestoresARuntimeWithTheBodiesOfItsObjects) {
     MidFire m;
     test::JournalRig other(2);

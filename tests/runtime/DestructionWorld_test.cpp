@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "TestSupport.hpp"
+#include "rubble/Journal.hpp"
 #include "rubble/Log.hpp"
 #include "rubble/MassProperties.hpp"
 #include "rubble/Random.hpp"
@@ -61,6 +62,31 @@ Impact centreHit() {
     i.normal = {0, 0, 1};
     i.impulse = 10;
     return i;
+}
+
+// An object that names a material breaks in that material's pattern: glass radially, wood in splinters,
+// steel evenly; concrete (and an object without a material) keeps the layout its parameters name.
+TEST(DestructionWorld, AMaterialChoosesTheShatterLayout) {
+    HeldJobs jobs;
+    DestructionWorld world(heldConfig(jobs));
+    const std::pair<const char*, ShatterLayout> cases[] = {{"glass", ShatterLayout::Radial},
+                                                           {"wood", ShatterLayout::Splinter},
+                                                           {"steel", ShatterLayout::Uniform},
+                                                           {"concrete", ShatterLayout::Clustered},
+                                                           {"", ShatterLayout::Clustered}};
+    for (const auto& [material, layout] : cases) {
+        ObjectDesc d = boxDesc();
+        d.material = material;
+        d.fracture.pattern = CellPattern::Shatter;
+        Result<ObjectId> id = world.addObject(std::move(d));
+        ASSERT_TRUE(id) << material;
+        EXPECT_EQ(world.object(*id)->fracture.layout, layout) << material;
+    }
+    ObjectDesc d = boxDesc();
+    d.fracture.layout = ShatterLayout::Radial;
+    const ObjectId id = *world.addObject(std::move(d));
+    EXPECT_EQ(world.object(id)->fracture.layout, ShatterLayout::Radial) << "no material: the parameters' own";
+    EXPECT_EQ(patternByte(world.object(id)->fracture), 0x10) << "single cell, radial layout";
 }
 
 TEST(DestructionWorld, ImpactBelowThresholdIgnored) {

@@ -1,9 +1,11 @@
-// `rubble decompose MESH [--max-parts N] [--concavity C] [--json]`
+// `rubble decompose MESH [--max-parts N] [--concavity C] [--json] [-o PARTS.json]`
 //
 // Approximate convex decomposition of a closed mesh. Prints the number of convex parts, the mesh and hull
 // volumes, the excess (hull − mesh) / mesh and the time taken; --json prints
-// {"parts","mesh_volume","hull_volume","excess","ms"}. Exit codes: 0 success, 1 the mesh cannot be
-// decomposed (e.g. open or inside out), 2 unreadable file or usage error.
+// {"parts","mesh_volume","hull_volume","excess","ms"}. -o writes the parts (rubble/DecompositionFile.hpp);
+// as MESH's stem.parts.json beside it, a scene loads them instead of decomposing. Exit codes: 0 success,
+// 1 the mesh cannot be decomposed (e.g. open or inside out) or the parts cannot be written, 2 unreadable file
+// or usage error.
 #include <chrono>
 #include <iostream>
 #include <memory>
@@ -13,6 +15,7 @@
 #include "JsonText.hpp"
 #include "Subcommand.hpp"
 #include "rubble/ConvexDecomposition.hpp"
+#include "rubble/DecompositionFile.hpp"
 #include "rubble/MeshIO.hpp"
 
 namespace {
@@ -22,6 +25,9 @@ struct DecomposeArgs {
     int maxParts = rubble::DecompositionParams{}.maxParts;
     double concavity = rubble::DecompositionParams{}.concavity;
     bool json = false;
+    std::string output;
+    std::size_t proxyAbove = rubble::DecompositionParams{}.proxyAboveTriangles;
+    std::size_t maxPartFaces = rubble::DecompositionParams{}.maxPartFaces;
 };
 
 int runDecompose(const DecomposeArgs& args) {
@@ -33,6 +39,8 @@ int runDecompose(const DecomposeArgs& args) {
     rubble::DecompositionParams params;
     params.maxParts = args.maxParts;
     params.concavity = args.concavity;
+    params.proxyAboveTriangles = args.proxyAbove;
+    params.maxPartFaces = args.maxPartFaces;
     const auto t0 = std::chrono::steady_clock::now();
     auto d = rubble::decompose(mesh.value(), params);
     const double ms =
@@ -40,6 +48,13 @@ int runDecompose(const DecomposeArgs& args) {
     if (!d) {
         std::cerr << "rubble decompose: " << args.file << ": " << d.error().message << "\n";
         return 1;
+    }
+    if (!args.output.empty()) {
+        const rubble::DecompositionFile file{mesh->hash(), d->meshVolume, d->parts};
+        if (const rubble::Status s = rubble::writeDecompositionFile(args.output, file); !s) {
+            std::cerr << "rubble decompose: " << s.message() << "\n";
+            return 1;
+        }
     }
     if (args.json) {
         nlohmann::json j;
@@ -62,8 +77,8 @@ const rubble::tools::Registrar registrar{
     {"decompose", "Approximate convex decomposition of a closed mesh (collision shapes)", [](CLI::App& app) {
          auto args = std::make_shared<DecomposeArgs>();
          app.footer(
-             "Exit codes: 0 success, 1 the mesh cannot be decomposed (open or inside out), 2 unreadable "
-             "file or usage error.");
+             "Exit codes: 0 success, 1 the mesh cannot be decomposed (open or inside out) or the parts "
+             "cannot be written, 2 unreadable file or usage error.");
          app.add_option("mesh", args->file, "mesh file (.obj, .off, .stl, .ply, .3ds, .gltf, .glb)")
              ->required();
          app.add_option("--max-parts", args->maxParts, "at most this many convex parts")
@@ -72,6 +87,12 @@ const rubble::tools::Registrar registrar{
                         "stop splitting below this depth, as a fraction of the bounding-box diagonal")
              ->check(rubble::tools::finiteNumber())
              ->check(CLI::Range(0.0, 1.0));
+         app.add_option("--proxy-above", args->proxyAbove,
+                        "search meshes with more triangles through a bounded proxy (default 20000)");
+         app.add_option("--max-part-faces", args->maxPartFaces, "bound parts with more faces (default 512)")
+             ->check(CLI::Range(std::size_t{8}, std::size_t{1} << 30));
+         app.add_option("-o,--output", args->output,
+                        "write the parts as JSON (MESH-stem.parts.json beside the mesh is loaded by scenes)");
          app.add_flag("--json", args->json,
                       "print {\"parts\",\"mesh_volume\",\"hull_volume\",\"excess\",\"ms\"} as JSON");
          return [args] { return runDecompose(*args); };

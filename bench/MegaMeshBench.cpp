@@ -1,0 +1,360 @@
+// The million-triangle rows (issue #14), run by `rubble-bench impact --mega` and `rubble-bench decomposition
+// --mega`: a sphere, a torus and the arch asset subdivided, at 100k, 250k and 1M triangles. Every hit is a
+// single cell of edge a quarter of the mesh's largest extent at a random surface point (seed = hit index).
+// The clip-only bound is the time to clip just the triangles whose bounds meet the cell by its planes (found
+// beforehand, untimed): what a fracture must at least do.
+#include <algorithm>
+#include <chrono>
+#include <iostream>
+#include <optional>
+#include <sstream>
+
+#include <time.h>
+
+#include "BenchUtil.hpp"
+#include "MegaMeshes.hpp"
+#include "rubble/ConvexDecomposition.hpp"
+#include "rubble/Fracture.hpp"
+#include "rubble/Random.hpp"
+
+namespace rubble::bench {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+/// This thread's CPU time in ms (the machine is shared: wall time includes waiting for a core).
+double threadCpuMs() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
+}
+
+std::string str(double v) {
+    std::ostringstream o;
+    o << v;
+    return o.str();
+}
+
+/// A hit on a random triangle of mesh (seed), just inside the surface, pushing inward.
+Impact randomHit(const Mesh& mesh, std::uint64_t seed) {
+    Rng rng(mixSeed(0x5EED, seed));
+    const std::size_t t = rng.below(mesh.triangles.size());
+    const auto c = mesh.corners(t);
+    const Vec3 n = normalized(cross(c[1] - c[0], c[2] - c[0]));
+    const double size = mesh.bounds().diagonal();
+    return {(c[0] + c[1] + c[2]) / 3.0 - n * (1e-3 * size), n, 100};
+}
+
+FractureParams hitParams(const Mesh& mesh) {
+    FractureParams p;
+    const Vec3 s = mesh.bounds().size();
+    p.sizeLaw.base = 0.25 * std::max({s.x, s.y, s.z});
+    p.sizeLaw.scale = 0;
+    return p;
+}
+
+/// Clip-only bound: the triangles whose bounds meet a cell (found beforehand, not timed: a spatial index
+/// would give them) clipped by every plane of that cell (ms), and how many there were.
+double clipOnly(const Mesh& mesh, const std::vector<ConvexPolytope>& cells, std::size_t& touched) {
+    std::vector<std::pair<std::size_t, std::size_t>> work; // (cell, triangle)
+    for (std::size_t k = 0; k < cells.size(); ++k) {
+        const Aabb cb = cells[k].bounds();
+        for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+            Aabb tb;
+            for (const Vec3& p : mesh.corners(t))
+                tb.extend(p);
+            if (tb.overlaps(cb))
+                work.emplace_back(k, t);
+        }
+    }
+    touched = work.size();
+    const auto t0 = Clock::now();
+    std::size_t kept = 0;
+    std::vector<Vec3> poly, next;
+    for (const auto& [k, t] : work) {
+        const auto c = mesh.corners(t);
+        poly.assign(c.begin(), c.end());
+        for (const PolytopeFace& f : cells[k].faces()) {
+            next.clear();
+            for (std::size_t i = 0; i < poly.size(); ++i) {
+                const Vec3& a = poly[i];
+                const Vec3& b = poly[(i + 1) % poly.size()];
+                const double da = f.plane.signedDistance(a), db = f.plane.signedDistance(b);
+                if (da <= 0)
+                    next.push_back(a);
+                if ((da < 0 && db > 0) || (da > 0 && db < 0))
+                    next.push_back(a + (b - a) * (da / (da - db)));
+            }
+            poly.swap(next);
+            if (poly.size() < 3)
+                break;
+        }
+        kept += poly.size();
+    }
+    const double ms = msSince(t0);
+    if (kept == 1) // keeps the loop from being optimised away
+        std::cout << "";
+    return ms;
+}
+
+struct HitSamples {
+    std::vector<double> withParts, withPartsCpu, pieces, validate, cell, boolean, islands, mass, simplify,
+        parts, clip;
+    std::vector<double> touched, excess;
+    int failures = 0, fallbacks = 0;
+};
+
+/// One fracture and its decomposition update, into s.
+std::optional<FractureResult> hitOnce(const Mesh& mesh, const std::vector<ConvexPolytope>& parentParts,
+                                      const Impact& impact, std::uint64_t seed, HitSamples& s,
+                                      std::vector<std::vector<ConvexPolytope>>* partsOut = nullptr) {
+    const double c0 = threadCpuMs();
+    const auto t0 = Clock::now();
+    auto r = fracture(mesh, impact, hitParams(mesh), seed);
+    const double piecesMs = msSince(t0);
+    if (!r) {
+        ++s.failures;
+        return std::nullopt;
+    }
+    const auto t1 = Clock::now();
+    auto parts = updateDecomposition(parentParts, *r);
+    const double partsMs = msSince(t1);
+    s.withPartsCpu.push_back(threadCpuMs() - c0);
+    s.withParts.push_back(piecesMs + partsMs);
+    s.pieces.push_back(piecesMs);
+    s.validate.push_back(r->timings.validateMs);
+    s.cell.push_back(r->timings.cellMs);
+    s.boolean.push_back(r->timings.booleanMs);
+    s.islands.push_back(r->timings.islandsMs - r->timings.massMs - r->timings.simplifyMs);
+    s.mass.push_back(r->timings.massMs);
+    s.simplify.push_back(r->timings.simplifyMs);
+    s.parts.push_back(partsMs);
+    s.fallbacks += r->exactFallback ? 1 : 0;
+    std::size_t touched = 0;
+    s.clip.push_back(clipOnly(mesh, r->cells, touched));
+    s.touched.push_back(static_cast<double>(touched));
+    double partVolume = 0, pieceVolume = 0;
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+        for (const ConvexPolytope& p : parts[i])
+            partVolume += p.volume();
+        pieceVolume += r->pieces[i].mass.volume;
+    }
+    s.excess.push_back(pieceVolume > 0 ? partVolume / pieceVolume - 1 : -1);
+    if (partsOut)
+        *partsOut = std::move(parts);
+    return std::move(r).value();
+}
+
+} // namespace
+
+/// The table and CSV rows of one impact case; ratios against the median, or against the first hit (chains).
+void addImpactRows(const std::string& name, const std::string& kind, std::size_t triangles,
+                   const HitSamples& s, bool againstFirst, Table& table, Table& csv,
+                   std::ostringstream& data) {
+    const Stats w = stats(s.withParts), c = stats(s.withPartsCpu);
+    const double base = againstFirst ? (s.withParts.empty() ? -1 : s.withParts.front()) : w.median;
+    const double cpuBase = againstFirst ? (s.withPartsCpu.empty() ? -1 : s.withPartsCpu.front()) : c.median;
+    const double ratio = base > 0 ? w.max / base : -1, cpuRatio = cpuBase > 0 ? c.max / cpuBase : -1;
+    double excessMax = -1;
+    for (double e : s.excess)
+        excessMax = std::max(excessMax, e);
+    const auto med = [](const std::vector<double>& v) { return stats(v).median; };
+    table.rows.push_back({name, std::to_string(triangles), std::to_string(s.withParts.size()),
+                          fixed(w.median), fixed(w.max), fixed(ratio, 2), fixed(c.median), fixed(c.max),
+                          fixed(cpuRatio, 2), fixed(med(s.validate)), fixed(med(s.boolean)),
+                          fixed(med(s.islands)), fixed(med(s.mass)), fixed(med(s.simplify)),
+                          fixed(med(s.parts)), fixed(med(s.clip)), fixed(med(s.touched), 0)});
+    csv.rows.push_back({name,
+                        kind,
+                        std::to_string(triangles),
+                        std::to_string(s.withParts.size()),
+                        std::to_string(s.failures),
+                        std::to_string(s.fallbacks),
+                        againstFirst ? "first" : "median",
+                        str(w.median),
+                        str(w.max),
+                        str(ratio),
+                        str(c.median),
+                        str(c.max),
+                        str(cpuRatio),
+                        str(med(s.pieces)),
+                        str(med(s.validate)),
+                        str(med(s.cell)),
+                        str(med(s.boolean)),
+                        str(med(s.islands)),
+                        str(med(s.mass)),
+                        str(med(s.simplify)),
+                        str(med(s.parts)),
+                        str(stats(s.parts).max),
+                        str(excessMax),
+                        str(med(s.clip)),
+                        str(med(s.touched)),
+                        ""});
+    if (!againstFirst)
+        data << kind << " " << triangles << " " << w.median << " " << w.max << " " << med(s.clip) << " "
+             << c.median << "\n";
+    std::cout << name << ": with parts median " << fixed(w.median) << " ms, max " << fixed(w.max)
+              << " ms; CPU median " << fixed(c.median) << " ms, max " << fixed(c.max) << " ms" << std::endl;
+}
+
+int runMegaImpact(const MegaArgs& args) {
+    const CpuMeter cpu;
+    Table table{{"mesh", "tris", "hits", "with parts med ms", "max", "worst/base", "cpu med", "cpu max",
+                 "cpu w/b", "validate", "boolean", "islands", "mass", "simplify", "parts", "clip-only",
+                 "touched"},
+                {}};
+    Table csv{{"mesh",
+               "kind",
+               "triangles",
+               "hits",
+               "failures",
+               "fallbacks",
+               "ratio_base",
+               "with_parts_median_ms",
+               "with_parts_max_ms",
+               "worst_over_base",
+               "with_parts_cpu_median_ms",
+               "with_parts_cpu_max_ms",
+               "cpu_worst_over_base",
+               "pieces_median_ms",
+               "validate_median_ms",
+               "cell_median_ms",
+               "boolean_median_ms",
+               "islands_median_ms",
+               "mass_median_ms",
+               "simplify_median_ms",
+               "parts_median_ms",
+               "parts_max_ms",
+               "parts_excess_max",
+               "clip_only_median_ms",
+               "touched_triangles_median",
+               "other_cpu_cores"},
+              {}};
+    std::ostringstream data;
+    for (const std::string& kind : args.kinds)
+        for (std::size_t size : args.sizes) {
+            const Mesh mesh = megaMesh(kind, size);
+            const std::string name = kind + "_" + std::to_string(mesh.triangles.size());
+            auto d = decompose(mesh);
+            if (!d) {
+                std::cerr << name << ": " << d.error().message << "\n";
+                continue;
+            }
+            HitSamples s;
+            for (int h = 0; h < args.hits; ++h)
+                hitOnce(mesh, d->parts, randomHit(mesh, static_cast<std::uint64_t>(h)),
+                        static_cast<std::uint64_t>(h), s);
+            addImpactRows(name, kind, mesh.triangles.size(), s, false, table, csv, data);
+        }
+    // Chained hits: the largest piece of each hit is hit again, with the parts its update gave it.
+    if (args.chain > 0) {
+        Mesh mesh = megaMesh("sphere", 250000);
+        const std::size_t startTriangles = mesh.triangles.size();
+        auto d = decompose(mesh);
+        std::vector<ConvexPolytope> parts = d ? d->parts : std::vector<ConvexPolytope>{};
+        HitSamples s;
+        for (int h = 0; h < args.chain; ++h) {
+            std::vector<std::vector<ConvexPolytope>> pieceParts;
+            auto r = hitOnce(mesh, parts, randomHit(mesh, static_cast<std::uint64_t>(1000 + h)),
+                             static_cast<std::uint64_t>(1000 + h), s, &pieceParts);
+            if (!r)
+                continue;
+            std::size_t largest = 0;
+            for (std::size_t i = 1; i < r->pieces.size(); ++i)
+                if (r->pieces[i].mass.volume > r->pieces[largest].mass.volume)
+                    largest = i;
+            mesh = std::move(r->pieces[largest].mesh);
+            parts = std::move(pieceParts[largest]);
+        }
+        addImpactRows("sphere_" + std::to_string(startTriangles) + "_chain" + std::to_string(args.chain),
+                      "sphere_chain", startTriangles, s, true, table, csv, data);
+        std::cout << "  (chain: ratios are max / first hit; the last piece has " << mesh.triangles.size()
+                  << " triangles)\n";
+    }
+    const std::string other = fixed(cpu.read().other, 2);
+    for (auto& row : csv.rows)
+        row.back() = other;
+    printTable(table);
+    std::cout << "other_cpu_cores " << other << " (the rest of the machine's busy cores during the run)\n";
+    if (!writeCsv(std::filesystem::path(args.out) / "impact_megamesh.csv", csv))
+        return 1;
+    plotPng(
+        args.out, "impact_megamesh", data.str(),
+        "set logscale xy\nset xlabel 'triangles'\nset ylabel 'time (ms)'\nset grid\nset key top left\n"
+        "set title 'Impact to pieces with convex parts (20 random hits) vs triangles'\n"
+        "plot for [k in 'sphere torus arch'] $DATA u ((strcol(1) eq k) ? $2 : 1/0):3 w lp t k.' median', "
+        "for [k in 'sphere torus arch'] $DATA u ((strcol(1) eq k) ? $2 : 1/0):4 w p t k.' worst', "
+        "for [k in 'sphere torus arch'] $DATA u ((strcol(1) eq k) ? $2 : 1/0):6 w lp dt 3 t k.' CPU median', "
+        "for [k in 'sphere torus arch'] $DATA u ((strcol(1) eq k) ? $2 : 1/0):5 w l dt 2 t k.' clip-only'");
+    return 0;
+}
+
+int runMegaDecomposition(const MegaArgs& args) {
+    const CpuMeter cpu;
+    Table table{{"mesh", "tris", "parts", "excess", "initial ms", "cpu", "update med ms", "max", "cpu med",
+                 "max", "hits"},
+                {}};
+    Table csv{{"mesh", "kind", "triangles", "parts", "excess", "initial_ms", "initial_cpu_ms",
+               "update_median_ms", "update_max_ms", "update_cpu_median_ms", "update_cpu_max_ms", "hits",
+               "other_cpu_cores"},
+              {}};
+    std::ostringstream data;
+    for (const std::string& kind : args.kinds)
+        for (std::size_t size : args.sizes) {
+            const Mesh mesh = megaMesh(kind, size);
+            const std::string name = kind + "_" + std::to_string(mesh.triangles.size());
+            const double c0 = threadCpuMs();
+            const auto t0 = Clock::now();
+            auto d = decompose(mesh);
+            const double initialMs = msSince(t0);
+            const double initialCpuMs = threadCpuMs() - c0;
+            if (!d) {
+                std::cerr << name << ": " << d.error().message << "\n";
+                continue;
+            }
+            std::vector<double> updates, updatesCpu;
+            for (int h = 0; h < args.hits; ++h) {
+                auto r = fracture(mesh, randomHit(mesh, static_cast<std::uint64_t>(h)), hitParams(mesh),
+                                  static_cast<std::uint64_t>(h));
+                if (!r)
+                    continue;
+                const double c1 = threadCpuMs();
+                const auto t1 = Clock::now();
+                const auto parts = updateDecomposition(d->parts, *r);
+                updates.push_back(msSince(t1));
+                updatesCpu.push_back(threadCpuMs() - c1);
+            }
+            const Stats u = stats(updates), uc = stats(updatesCpu);
+            table.rows.push_back({name, std::to_string(mesh.triangles.size()),
+                                  std::to_string(d->parts.size()), fixed(d->excess(), 4), fixed(initialMs),
+                                  fixed(initialCpuMs), fixed(u.median), fixed(u.max), fixed(uc.median),
+                                  fixed(uc.max), std::to_string(updates.size())});
+            csv.rows.push_back({name, kind, std::to_string(mesh.triangles.size()),
+                                std::to_string(d->parts.size()), str(d->excess()), str(initialMs),
+                                str(initialCpuMs), str(u.median), str(u.max), str(uc.median), str(uc.max),
+                                std::to_string(updates.size()), ""});
+            data << kind << " " << mesh.triangles.size() << " " << initialMs << " " << u.median << " "
+                 << initialCpuMs << " " << uc.median << "\n";
+            std::cout << name << ": initial " << fixed(initialMs) << " ms, update median " << fixed(u.median)
+                      << " ms" << std::endl;
+        }
+    const std::string other = fixed(cpu.read().other, 2);
+    for (auto& row : csv.rows)
+        row.back() = other;
+    printTable(table);
+    std::cout << "other_cpu_cores " << other << "\n";
+    if (!writeCsv(std::filesystem::path(args.out) / "decomposition_megamesh.csv", csv))
+        return 1;
+    plotPng(
+        args.out, "decomposition_megamesh", data.str(),
+        "set logscale xy\nset xlabel 'triangles'\nset ylabel 'time (ms)'\nset grid\nset key top left\n"
+        "set title 'Convex decomposition of high-poly meshes vs triangles'\n"
+        "plot for [k in 'sphere torus arch'] $DATA u ((strcol(1) eq k) ? $2 : 1/0):3 w lp t k.' initial', "
+        "for [k in 'sphere torus arch'] $DATA u ((strcol(1) eq k) ? $2 : 1/0):4 w lp t k.' update', "
+        "for [k in 'sphere torus arch'] $DATA u ((strcol(1) eq k) ? $2 : 1/0):5 w p t k.' initial CPU', "
+        "for [k in 'sphere torus arch'] $DATA u ((strcol(1) eq k) ? $2 : 1/0):6 w p t k.' update CPU'");
+    return 0;
+}
+
+} // namespace rubble::bench

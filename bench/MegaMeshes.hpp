@@ -1,0 +1,48 @@
+#pragma once
+// High-poly test meshes of the million-triangle rows (issue #14): a sphere, a torus and the arch asset
+// subdivided, at a given triangle count.
+
+#include <string>
+#include <vector>
+
+#include "rubble/Mesh.hpp"
+
+namespace rubble::bench {
+
+/// Every triangle split into n² by an n-way split of its edges (shared edges split alike, so a closed mesh
+/// stays closed; the shape does not change).
+Mesh subdivideTriangles(const Mesh& mesh, int n);
+
+/// One high-poly mesh: kind "sphere", "torus" or "arch" (the repository's arch subdivided) with about
+/// `triangles` triangles (exactly for the sphere and torus at 100k, 250k and 1M).
+Mesh megaMesh(const std::string& kind, std::size_t triangles);
+
+/// The kinds of megaMesh.
+inline const std::vector<std::string> kMegaKinds = {"sphere", "torus", "arch"};
+
+} // namespace rubble::bench
+
+namespace rubble::bench {
+
+/// Options of the million-triangle rows (`--mega` of the impact and decomposition suites).
+struct MegaArgs {
+    std::vector<std::size_t> sizes{100000, 250000, 1000000}; ///< triangle counts
+    std::vector<std::string> kinds = kMegaKinds;             ///< which meshes
+    int hits = 20;                                           ///< random hits per mesh
+    int chain = 100;                                         ///< chained hits on the 250k sphere (0: none)
+    std::string out;                                         ///< results folder
+};
+
+/// `rubble-bench impact --mega`: impact → pieces with convex parts per mesh over random hits, the stages, the
+/// clip-only bound, and chained hits; impact_megamesh.csv / .png in args.out.
+int runMegaImpact(const MegaArgs& args);
+
+/// Writes each mesh of args as OBJ into dir (kind_triangles.obj), for `rubble decompose` and `rubble
+/// fracture`.
+int writeMegaMeshes(const MegaArgs& args, const std::string& dir);
+
+/// `rubble-bench decomposition --mega`: initial decomposition and update after a hit per mesh;
+/// decomposition_megamesh.csv / .png in args.out.
+int runMegaDecomposition(const MegaArgs& args);
+
+} // namespace rubble::bench

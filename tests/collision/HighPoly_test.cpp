@@ -1,0 +1,113 @@
+// High-poly meshes (issue #14), at sizes CI can afford: chained hits on a 100k-triangle torus keep mass
+// properties equal to a recomputation, conserve volume and keep the collision parts bounded; a ring cut twice
+// falls into two arcs far from the second impact.
+#include <gtest/gtest.h>
+
+#include "rubble/ConvexDecomposition.hpp"
+#include "rubble/Fracture.hpp"
+#include "rubble/MassProperties.hpp"
+
+namespace rubble {
+namespace {
+
+void expectSameMass(const MassProperties& a, const MassProperties& b, double scale) {
+    EXPECT_NEAR(a.volume, b.volume, 1e-12 * scale * scale * scale);
+    EXPECT_NEAR(length(a.centerOfMass - b.centerOfMass), 0.0, 1e-12 * scale);
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            EXPECT_NEAR(a.inertia.m[i][j], b.inertia.m[i][j], 1e-9 * std::abs(b.inertia.m[i][i]) + 1e-15);
+}
+
+/// Some vertices of mesh (every stride-th) lie in a part.
+void expectSampleCovered(const Mesh& mesh, const std::vector<ConvexPolytope>& parts, std::size_t stride) {
+    const double eps = 1e-7 * mesh.bounds().diagonal();
+    for (std::size_t v = 0; v < mesh.positions.size(); v += stride) {
+        bool in = false;
+        for (const ConvexPolytope& p : parts)
+            in = in || p.contains(mesh.positions[v], eps);
+        ASSERT_TRUE(in) << "vertex " << v << " is in no part";
+    }
+}
+
+TEST(HighPoly, ChainedHitsOnA100kTorusKeepMassVolumeAndBoundedParts) {
+    Mesh mesh = makeTorus({0, 0, 0}, 1.0, 0.3, 500, 100); // 100,000 triangles
+    ASSERT_EQ(mesh.triangles.size(), 100000u);
+    const DecompositionParams dp;
+    auto d = decompose(mesh, dp);
+    ASSERT_TRUE(d) << d.error().message;
+    EXPECT_LE(d->excess(), 0.15);
+    std::vector<ConvexPolytope> parts = d->parts;
+    const double scale = mesh.bounds().diagonal();
+    const Vec3 points[] = {
+        {1.25, 0.1, 0.3}, {-0.2, -0.2, 1.2}, {-1.0, 0.25, -0.5}, {0.6, 0.0, -0.9}, {-1.2, -0.1, 0.2}};
+    int hits = 0;
+    for (int hit = 0; hit < 5; ++hit) {
+        SCOPED_TRACE("hit " + std::to_string(hit));
+        FractureParams fp;
+        fp.sizeLaw.base = 0.5;
+        fp.sizeLaw.scale = 0;
+        auto fr = fracture(mesh, Impact{points[hit], normalized(points[hit]), 10}, fp, 40 + hit);
+        if (!fr)
+            continue; // the remainder may no longer reach this point
+        ++hits;
+        double volume = fr->droppedVolume;
+        for (const Piece& p : fr->pieces) {
+            expectSameMass(p.mass, computeMassProperties(p.mesh), scale);
+            volume += p.mass.volume;
+        }
+        EXPECT_NEAR(volume, fr->inputVolume, 1e-7 * fr->inputVolume);
+        const auto updated = updateDecomposition(parts, *fr, dp);
+        ASSERT_EQ(updated.size(), fr->pieces.size());
+        std::size_t largest = 0;
+        for (std::size_t i = 0; i < updated.size(); ++i) {
+            // The work of the next update is bounded whatever the hits: few parts of few faces.
+            EXPECT_LE(updated[i].size(), static_cast<std::size_t>(dp.maxParts));
+            for (const ConvexPolytope& p : updated[i])
+                EXPECT_LE(p.faces().size(), dp.maxPartFaces);
+            expectSampleCovered(fr->pieces[i].mesh, updated[i], 37);
+            if (fr->pieces[i].mass.volume > fr->pieces[largest].mass.volume)
+                largest = i;
+        }
+        mesh = fr->pieces[largest].mesh;
+        parts = updated[largest];
+    }
+    EXPECT_GE(hits, 4);
+}
+
+TEST(HighPoly, ARingCutTwiceFallsIntoTwoArcs) {
+    // The first cut opens the ring at +x; the second, at -x, disconnects the two arcs from each other far
+    // from where it hit: each arc must come out as its own closed piece.
+    const Mesh ring = makeTorus({0, 0, 0}, 1.0, 0.25, 96, 24);
+    FractureParams fp;
+    auto first = fractureWithCells(ring, {ConvexPolytope::fromAabb({{0.6, -1, -0.2}, {1.5, 1, 0.2}})}, fp);
+    ASSERT_TRUE(first) << first.error().message;
+    std::size_t open = first->pieces.size();
+    for (std::size_t i = 0; i < first->pieces.size(); ++i)
+        if (first->pieces[i].cell < 0)
+            open = i;
+    ASSERT_LT(open, first->pieces.size());
+    const Mesh opened = first->pieces[open].mesh;
+    auto second =
+        fractureWithCells(opened, {ConvexPolytope::fromAabb({{-1.5, -1, -0.2}, {-0.6, 1, 0.2}})}, fp);
+    ASSERT_TRUE(second) << second.error().message;
+    std::vector<const Piece*> arcs;
+    double volume = second->droppedVolume;
+    for (const Piece& p : second->pieces) {
+        volume += p.mass.volume;
+        if (p.cell < 0)
+            arcs.push_back(&p);
+    }
+    EXPECT_NEAR(volume, computeMassProperties(opened).volume, 1e-7 * volume);
+    ASSERT_EQ(arcs.size(), 2u);
+    // One arc on each side of z = 0, each a closed solid of about half the remaining volume.
+    EXPECT_LT(arcs[0]->mass.centerOfMass.z * arcs[1]->mass.centerOfMass.z, 0.0);
+    for (const Piece* a : arcs) {
+        EXPECT_NEAR(a->mass.volume, arcs[0]->mass.volume, 1e-6 * a->mass.volume);
+        const Aabb b = a->mesh.bounds();
+        EXPECT_TRUE(b.lo.z > -1e-9 || b.hi.z < 1e-9) << "an arc crosses z = 0";
+        expectSameMass(a->mass, computeMassProperties(a->mesh), 2.5);
+    }
+}
+
+} // namespace
+} // namespace rubble
