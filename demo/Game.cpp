@@ -134,6 +134,7 @@ bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const Game
     clear(renderer);
     settings_ = settings;
     renderer.shadows = settings.shadows;
+    particles_.dustDensity = renderer.quality().software ? 0.35f : 1.0f;
     rubble::DestructionRuntime::Config rc;
     rc.world.workers = settings.workers;
     rc.world.deterministic = settings.deterministic;
@@ -194,6 +195,11 @@ bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const Game
         look.tint = {0.95f, 1.0f, 0.92f};
         addVisual(loaded.ground, box, look, 0, renderer);
         groundTop_ = static_cast<float>(loaded.groundTop);
+        groundBody_ = loaded.ground;
+        boundsMinX_ = static_cast<float>(g.position.x - half.x);
+        boundsMaxX_ = static_cast<float>(g.position.x + half.x);
+        boundsMinZ_ = static_cast<float>(g.position.z - half.z);
+        boundsMaxZ_ = static_cast<float>(g.position.z + half.z);
     }
     runtime_->config().debris.killBelowY = groundTop_ - 60.0;
 
@@ -235,7 +241,9 @@ bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const Game
                                           : renderer.proceduralTexture("metal");
             look.tint = {0.85f, 0.9f, 1.0f};
             addVisual(vehicle_, mesh, look, 0, renderer);
-            speed_ = v.mass > 0 ? 30.0f : 0.0f;
+            hover_ = v.mass <= 0; // the thesis's static vehicle (mass 0) hovers: no stall floor
+            speed_ = hover_ ? 0.0f : 30.0f;
+            spawnPos_ = toV3(v.position);
             rb->setLinearVelocity(btVector3(0, 0, -speed_));
         } else {
             warnings.push_back(scene.baseDir.string() + ":" + std::to_string(v.line) + ": vehicle skipped (" +
@@ -299,22 +307,134 @@ void Game::vehicleFrame(V3& pos, V3& forward, V3& up) const {
     up = toV3(t.getBasis() * btVector3(0, 1, 0));
 }
 
-void Game::controlVehicle(const ControlInput& in, float dt) {
+void Game::respawn() {
     if (!vehicle_)
         return;
     btRigidBody* rb = binding_->rigid(vehicle_);
+    rb->setCollisionFlags(rb->getCollisionFlags() & ~btCollisionObject::CF_NO_CONTACT_RESPONSE);
+    btTransform t;
+    t.setIdentity();
+    t.setOrigin(btVector3(spawnPos_.x, std::max(spawnPos_.y, groundTop_ + 25.0f), spawnPos_.z));
+    rb->setWorldTransform(t);
+    rb->setInterpolationWorldTransform(t);
+    if (rb->getMotionState())
+        rb->getMotionState()->setWorldTransform(t);
+    speed_ = hover_ ? 0.0f : 30.0f;
+    rb->setLinearVelocity(btVector3(0, 0, -speed_));
+    rb->setAngularVelocity(btVector3(0, 0, 0));
+    rb->activate(true);
+    crashTimer_ = 0;
+    ++counters_.respawns;
+    V3 pos, fwd, up;
+    vehicleFrame(pos, fwd, up);
+    camera_.snap(pos, fwd, up);
+}
+
+void Game::blast(const V3& point, float radius, float impulse) {
+    const rubble::Vec3 p{point.x, point.y, point.z};
+    for (BodyId id : runtime_->bodies()) {
+        const BodyRecord* b = runtime_->body(id);
+        if (!b->hasObject)
+            continue;
+        const rubble::Vec3 c = runtime_->motion(id).transform.translation;
+        const rubble::Vec3 d = p - c;
+        const double dist = rubble::length(d);
+        if (dist > radius + b->radius)
+            continue;
+        // the point of the body's bounding sphere nearest the blast, pushed in (a cell centred there cuts)
+        const rubble::Vec3 n = dist > 1e-6 ? d * (1.0 / dist) : rubble::Vec3{0, 1, 0};
+        const rubble::Vec3 at = c + n * std::min(dist, b->radius * 0.7);
+        const double falloff = 1.0 - 0.6 * std::clamp((dist - b->radius) / radius, 0.0, 1.0);
+        runtime_->submitImpact(id, at, n, impulse * falloff);
+    }
+    particles_.impactBurst(point, V3{0, 1, 0}, 3.0f, burstSeed_++);
+    particles_.impactBurst(point, V3{0, 1, 0}, 2.0f, burstSeed_++);
+}
+
+void Game::checkCrash() {
+    if (!vehicle_ || crashTimer_ > 0)
+        return;
+    const btRigidBody* jet = binding_->rigid(vehicle_);
+    btCollisionDispatcher& d = physics_->dispatcher();
+    for (int i = 0; i < d.getNumManifolds(); ++i) {
+        const btPersistentManifold* m = d.getManifoldByIndexInternal(i);
+        if (m->getNumContacts() == 0 || (m->getBody0() != jet && m->getBody1() != jet))
+            continue;
+        const btCollisionObject* other = m->getBody0() == jet ? m->getBody1() : m->getBody0();
+        bool hard = groundBody_ && other == binding_->rigid(groundBody_);
+        if (!hard)
+            for (BodyId id : runtime_->bodies()) { // objects, and pieces bigger than a car
+                const BodyRecord* b = runtime_->body(id);
+                if (binding_->rigid(id) == other)
+                    hard = b->role == BodyRole::Object || (b->role == BodyRole::Piece && b->volume > 2.0);
+            }
+        bool touching = false;
+        btVector3 at(0, 0, 0);
+        for (int c = 0; c < m->getNumContacts(); ++c)
+            if (m->getContactPoint(c).getDistance() < 0.05f) {
+                touching = true;
+                at = m->getContactPoint(c).getPositionWorldOnA();
+            }
+        if (!hard || !touching)
+            continue;
+        // Crash: the wreck stops, explodes (damaging what it hit and what is near) and respawns in 2 s.
+        ++counters_.crashes;
+        crashTimer_ = 2.0f;
+        btRigidBody* rb = binding_->rigid(vehicle_);
+        rb->setCollisionFlags(rb->getCollisionFlags() | btCollisionObject::CF_NO_CONTACT_RESPONSE);
+        rb->setLinearVelocity(btVector3(0, 0, 0));
+        rb->setAngularVelocity(btVector3(0, 0, 0));
+        blast(toV3(at), 10.0f, 4000.0f);
+        return;
+    }
+}
+
+void Game::controlVehicle(const ControlInput& input, float dt) {
+    if (!vehicle_)
+        return;
+    btRigidBody* rb = binding_->rigid(vehicle_);
+    if (crashTimer_ > 0) { // wrecked: stays put until the respawn
+        rb->setLinearVelocity(btVector3(0, 0, 0));
+        rb->setAngularVelocity(btVector3(0, 0, 0));
+        crashTimer_ -= dt;
+        if (crashTimer_ <= 0)
+            respawn();
+        return;
+    }
+    ControlInput in = input;
     const btMatrix3x3& R = rb->getWorldTransform().getBasis();
-    speed_ = std::clamp(speed_ + in.throttle * 25.0f * dt, 0.0f, 90.0f);
+    const btVector3 pos = rb->getWorldTransform().getOrigin();
+    const btVector3 fwd = R * btVector3(0, 0, -1);
+    // World bounds: within 150 m of the ground's edge (or 350 m above it) the controls blend into a turn
+    // back toward the middle, the harder the farther out.
+    const float margin = 150.0f;
+    const float cx = 0.5f * (boundsMinX_ + boundsMaxX_), cz = 0.5f * (boundsMinZ_ + boundsMaxZ_);
+    const float out = std::max({boundsMinX_ + margin - pos.x(), pos.x() - (boundsMaxX_ - margin),
+                                boundsMinZ_ + margin - pos.z(), pos.z() - (boundsMaxZ_ - margin), 0.0f});
+    const btVector3 toCentre = btVector3(cx - pos.x(), 0, cz - pos.z()).safeNormalize();
+    const bool wasTurning = turningBack_;
+    turningBack_ = out > 0 && btVector3(fwd.x(), 0, fwd.z()).dot(toCentre) < 0.7f;
+    if (turningBack_) {
+        const float w = std::clamp(0.35f + out / margin, 0.0f, 1.0f);
+        const float side = (R * btVector3(1, 0, 0)).dot(toCentre); // > 0: the centre is to the right
+        in.yaw = in.yaw * (1 - w) + (side > 0 ? -1.0f : 1.0f) * w;
+        in.roll = in.roll * (1 - w);
+        if (!wasTurning)
+            ++counters_.turnBacks;
+    }
+    if (pos.y() > groundTop_ + 350.0f && fwd.y() > -0.2f)
+        in.pitch = 1.0f;
+    speed_ = std::clamp(speed_ + in.throttle * 25.0f * dt, hover_ ? 0.0f : kStallSpeed, 90.0f);
     const btVector3 right = R * btVector3(1, 0, 0);
-    // Stabilising assist: without roll input the wings level themselves.
-    const float level = -right.y() * 1.6f * (1.0f - std::min(1.0f, std::fabs(in.roll)));
-    const btVector3 localRate(-in.pitch * 1.25f, in.yaw * 0.85f, in.roll * 2.0f + level);
+    // Stabilising assist (auto-level, L): without roll input the wings level themselves.
+    const float level =
+        settings_.autoLevel ? -right.y() * 1.6f * (1.0f - std::min(1.0f, std::fabs(in.roll))) : 0.0f;
+    const btVector3 localRate(-in.pitch * 1.1f, in.yaw * 1.0f, in.roll * 2.0f + level);
     const btVector3 target = R * localRate;
     btVector3 w = rb->getAngularVelocity();
     // Angular velocity is driven to the commanded rate: a collision cannot leave the vehicle spinning.
     w += (target - w) * (1.0f - std::exp(-10.0f * dt));
     rb->setAngularVelocity(w);
-    const btVector3 fwd = R * btVector3(0, 0, -1);
     btVector3 v = rb->getLinearVelocity();
     v += (fwd * speed_ - v) * (1.0f - std::exp(-2.5f * dt));
     rb->setLinearVelocity(v);
@@ -342,7 +462,9 @@ void Game::emitEffects(long long impactsBefore, long long retiredBefore) {
                                                 static_cast<long long>(marks.size()));
     for (long long k = 0; k < fresh; ++k) {
         const auto& m = marks[marks.size() - 1 - static_cast<size_t>(k)];
-        particles_.impactBurst(toV3(m.point), toV3(m.normal), 1.0f, burstSeed_++);
+        // sized by the hit: a 4 kg shell at 170 m/s (680 N*s) is 1, a crash's blast about 2.4
+        const float strength = std::clamp(std::sqrt(static_cast<float>(m.impulse) / 680.0f), 0.4f, 3.0f);
+        particles_.impactBurst(toV3(m.point), toV3(m.normal), strength, burstSeed_++);
     }
     // a puff of dust for every piece retired into a debris particle this frame (the newest particles)
     const auto& debris = runtime_->particles();
@@ -361,7 +483,7 @@ void Game::step(const ControlInput& input, float dt, Renderer& renderer) {
     ++counters_.frame;
     controlVehicle(input, dt);
     fireCooldown_ -= dt;
-    if (input.fire && vehicle_ && (!fireWasDown_ || fireCooldown_ <= 0)) {
+    if (input.fire && vehicle_ && crashTimer_ <= 0 && (!fireWasDown_ || fireCooldown_ <= 0)) {
         fire();
         fireCooldown_ = settings_.fireInterval;
     }
@@ -377,6 +499,7 @@ void Game::step(const ControlInput& input, float dt, Renderer& renderer) {
     const long long retiredBefore = runtime_->counters().piecesRetired;
     runtime_->setFocus({camera_.eye.x, camera_.eye.y, camera_.eye.z}); // distant tiny debris fades
     runtime_->stepFrame(dt);
+    checkCrash();
     emitEffects(impactsBefore, retiredBefore);
     if (net_) { // clients follow by journal events and placements (10 Hz)
         net_->publish();
@@ -444,14 +567,14 @@ void Game::draw(Renderer& renderer, float dt) {
             continue;
         }
         auto it = visuals_.find(id);
-        if (it == visuals_.end() || it->second.mesh < 0)
+        if (it == visuals_.end() || it->second.mesh < 0 || (id == vehicle_ && crashTimer_ > 0))
             continue;
         M4 m;
         // render meshes are in object coordinates; the body sits at the centre of mass
         (rb->getWorldTransform() * rubble::bullet::toBt(b->objectToBody).inverse()).getOpenGLMatrix(m.m);
         renderer.drawMesh(it->second.mesh, m, it->second.heat);
     }
-    if (vehicle_) {
+    if (vehicle_ && crashTimer_ <= 0) {
         // Engine glow at the tail.
         const btTransform& t = binding_->rigid(vehicle_)->getWorldTransform();
         Particle p;

@@ -54,6 +54,7 @@ struct GameSettings {
     bool structure = false;          ///< stress solver: overstressed bonds break (applied on restart)
     bool debugBonds = false;         ///< draw the structure's bonds, green (idle) to red (breaking)
     bool shadows = true;             ///< shadow mapping
+    bool autoLevel = true;           ///< wings level themselves when no roll key is held (L toggles)
 };
 
 /// Counters shown in the panel and printed by --stats.
@@ -69,6 +70,9 @@ struct GameCounters {
     int pieces = 0;          ///< live piece bodies
     int jobs = 0;            ///< fracture jobs queued or running
     int warnings = 0;        ///< scene warnings
+    int crashes = 0;         ///< the jet hit the ground or an object
+    int respawns = 0;        ///< the jet came back (2 s after a crash, or R)
+    int turnBacks = 0;       ///< times the world bounds started turning the jet back
 };
 
 /// The game world.
@@ -105,6 +109,16 @@ public:
     void vehicleFrame(V3& pos, V3& forward, V3& up) const;
     /// Current vehicle speed setting (m/s).
     float speed() const { return speed_; }
+    /// Puts the jet back at its start, flying (R; also 2 s after a crash).
+    void respawn();
+    /// True while the jet is wrecked (between a crash and the respawn).
+    bool crashed() const { return crashTimer_ > 0; }
+    /// True while the world bounds steer the jet back inside.
+    bool turningBack() const { return turningBack_; }
+    /// Slowest speed the jet flies at (m/s): X cannot stop it in the air.
+    static constexpr float kStallSpeed = 15.0f;
+    /// Crash or blast: impacts on every destructible body within radius of point, sparks and dust.
+    void blast(const V3& point, float radius, float impulse);
     /// Latencies (impact → adopted, ms) of results adopted since the last call.
     std::vector<double> takeNewLatencies();
     /// All adopted latencies so far (ms).
@@ -157,6 +171,7 @@ private:
     void addVisual(rubble::BodyId body, const rubble::Mesh& mesh, const Look& look, float heat,
                    Renderer& renderer);
     void controlVehicle(const ControlInput& input, float dt);
+    void checkCrash();
     void emitEffects(long long impactsBefore, long long retiredBefore);
     void updateCounters();
 
@@ -183,6 +198,12 @@ private:
     std::uint64_t nextTiming_ = 0; // sequence number of the next timing record to read
     std::uint32_t burstSeed_ = 1;
     float noseOffset_ = 3;
+    V3 spawnPos_{0, 20, 0};    // where the jet starts and respawns
+    float crashTimer_ = 0;     // s until the respawn (0: flying)
+    bool turningBack_ = false; // the bounds steer this step
+    bool hover_ = false;       // a mass-0 vehicle (thesis: static) hovers and has no stall floor
+    float boundsMinX_ = -500, boundsMaxX_ = 500, boundsMinZ_ = -500, boundsMaxZ_ = 500; // ground's extent
+    rubble::BodyId groundBody_ = 0;
 };
 
 } // namespace demo

@@ -3,11 +3,38 @@
 #include <imgui.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 #include "RunReport.hpp"
 
 namespace demo {
+
+const std::vector<std::pair<const char*, const char*>>& keyHelp() {
+    static const std::vector<std::pair<const char*, const char*>> keys = {
+        {"W / S", "pitch down / up"},
+        {"A / D", "roll left / right"},
+        {"Q / E", "yaw left / right"},
+        {"Z / X", "speed up / slow down"},
+        {"Space", "fire (hold for continuous fire); unpause"},
+        {"R", "respawn the jet (it also respawns 2 s after a crash)"},
+        {"L", "auto-level assist on/off (wings level when no roll key is held)"},
+        {"N", "next scene (the demolition, the thesis's scenes, world.cfg)"},
+        {"P", "pause"},
+        {"H", "this help"},
+        {"F1", "full panel / compact HUD line"},
+        {"F2", "screenshot (needs --out)"},
+        {"F3", "debug overlay (shapes, AABBs, impacts)"},
+        {"F5 / F9", "quick save / quick load"},
+        {"Esc", "quit"},
+    };
+    return keys;
+}
+
+void Panel::scaleToWindow(int height) {
+    scale_ = std::clamp(std::round(static_cast<float>(height) / 720.0f * 4.0f) / 4.0f, 1.0f, 4.0f);
+    ImGui::GetIO().FontGlobalScale = scale_;
+}
 
 void Panel::pushFrameMs(float ms) {
     frameMs_[static_cast<size_t>(frameCursor_)] = ms;
@@ -27,8 +54,39 @@ bool Panel::draw(Game& game, GameSettings& pending, bool paused, const std::stri
         return false;
     bool restart = false;
     const ImGuiIO& io = ImGui::GetIO();
-    ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x - 330, 10), ImGuiCond_FirstUseEver);
-    ImGui::SetNextWindowSize(ImVec2(320, 0), ImGuiCond_FirstUseEver);
+    if (!expanded) { // one line in the top right corner: fps, pieces, last fracture latency
+        float avg = 0;
+        int n = 0;
+        for (int i = 1; i <= 30; ++i) {
+            const float v =
+                frameMs_[(static_cast<size_t>(frameCursor_) + frameMs_.size() - static_cast<size_t>(i)) %
+                         frameMs_.size()];
+            if (v > 0)
+                avg += v, ++n;
+        }
+        avg = n > 0 ? avg / static_cast<float>(n) : 0.0f;
+        char line[160];
+        const int pieces = game.counters().pieces;
+        if (latency_.empty())
+            std::snprintf(line, sizeof line, "%.0f fps   pieces %d   last fracture -   F1 panel  H help",
+                          avg > 0 ? 1000.0 / static_cast<double>(avg) : 0.0, pieces);
+        else
+            std::snprintf(line, sizeof line,
+                          "%.0f fps   pieces %d   last fracture %.0f ms   F1 panel  H help",
+                          avg > 0 ? 1000.0 / static_cast<double>(avg) : 0.0, pieces,
+                          static_cast<double>(latency_.back()));
+        ImDrawList* dl = ImGui::GetForegroundDrawList();
+        const float size = ImGui::GetFontSize();
+        const ImVec2 ts = ImGui::GetFont()->CalcTextSizeA(size, 1e9f, 0.0f, line);
+        const ImVec2 at(io.DisplaySize.x - ts.x - 18 * scale_, 10 * scale_);
+        dl->AddRectFilled(ImVec2(at.x - 8 * scale_, at.y - 4 * scale_),
+                          ImVec2(at.x + ts.x + 8 * scale_, at.y + ts.y + 4 * scale_), IM_COL32(0, 0, 0, 110),
+                          5 * scale_);
+        dl->AddText(ImGui::GetFont(), size, at, IM_COL32(255, 255, 255, 230), line);
+        return false;
+    }
+    ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x - 330 * scale_, 10), ImGuiCond_Appearing);
+    ImGui::SetNextWindowSize(ImVec2(320 * scale_, 0), ImGuiCond_Appearing);
     ImGui::SetNextWindowBgAlpha(0.78f);
     ImGui::Begin("Rubble", nullptr, ImGuiWindowFlags_AlwaysAutoResize);
     const GameCounters& c = game.counters();
@@ -49,7 +107,7 @@ bool Panel::draw(Game& game, GameSettings& pending, bool paused, const std::stri
     std::snprintf(label, sizeof label, "%.1f ms  (%.0f fps)", static_cast<double>(avg),
                   avg > 0 ? 1000.0 / static_cast<double>(avg) : 0.0);
     ImGui::PlotLines("frame", ordered.data(), static_cast<int>(ordered.size()), 0, label, 0.0f, 50.0f,
-                     ImVec2(230, 50));
+                     ImVec2(230 * scale_, 50 * scale_));
     if (latency_.empty()) {
         ImGui::TextDisabled("impact -> adopted: no fracture yet");
     } else {
@@ -57,7 +115,7 @@ bool Panel::draw(Game& game, GameSettings& pending, bool paused, const std::stri
         std::snprintf(label, sizeof label, "p50 %.1f ms  p99 %.1f", quantile(d, 0.5), quantile(d, 0.99));
         const float mx = *std::max_element(latency_.begin(), latency_.end());
         ImGui::PlotHistogram("latency", latency_.data(), static_cast<int>(latency_.size()), 0, label, 0.0f,
-                             std::max(mx, 20.0f), ImVec2(230, 50));
+                             std::max(mx, 20.0f), ImVec2(230 * scale_, 50 * scale_));
     }
 
     if (ImGui::CollapsingHeader("Counters", ImGuiTreeNodeFlags_DefaultOpen)) {
@@ -125,30 +183,54 @@ bool Panel::draw(Game& game, GameSettings& pending, bool paused, const std::stri
 
 void Panel::drawHud(const Game& game, bool paused, int width, int height) {
     ImDrawList* dl = ImGui::GetForegroundDrawList();
-    const float cx = static_cast<float>(width) * 0.5f, cy = static_cast<float>(height) * 0.42f;
+    ImFont* font = ImGui::GetFont();
+    const float fs = ImGui::GetFontSize(), k = scale_;
+    const float h = static_cast<float>(height);
+    const float cx = static_cast<float>(width) * 0.5f, cy = h * 0.42f;
     const ImU32 col = IM_COL32(255, 255, 255, 170);
-    dl->AddCircle(ImVec2(cx, cy), 9.0f, col, 24, 1.5f);
-    dl->AddLine(ImVec2(cx - 18, cy), ImVec2(cx - 11, cy), col, 1.5f);
-    dl->AddLine(ImVec2(cx + 11, cy), ImVec2(cx + 18, cy), col, 1.5f);
-    dl->AddLine(ImVec2(cx, cy - 18), ImVec2(cx, cy - 11), col, 1.5f);
-    dl->AddLine(ImVec2(cx, cy + 11), ImVec2(cx, cy + 18), col, 1.5f);
+    dl->AddCircle(ImVec2(cx, cy), 9.0f * k, col, 24, 1.5f * k);
+    dl->AddLine(ImVec2(cx - 18 * k, cy), ImVec2(cx - 11 * k, cy), col, 1.5f * k);
+    dl->AddLine(ImVec2(cx + 11 * k, cy), ImVec2(cx + 18 * k, cy), col, 1.5f * k);
+    dl->AddLine(ImVec2(cx, cy - 18 * k), ImVec2(cx, cy - 11 * k), col, 1.5f * k);
+    dl->AddLine(ImVec2(cx, cy + 11 * k), ImVec2(cx, cy + 18 * k), col, 1.5f * k);
     char buf[160];
     V3 pos, fwd, up;
     game.vehicleFrame(pos, fwd, up);
     std::snprintf(buf, sizeof buf, "SPEED %3.0f m/s   ALT %4.0f m   HITS %d   FRACTURES %d",
                   static_cast<double>(game.speed()), static_cast<double>(pos.y - game.groundY()),
                   game.counters().impacts, game.counters().fractures);
-    dl->AddRectFilled(ImVec2(12, static_cast<float>(height) - 40),
-                      ImVec2(470, static_cast<float>(height) - 12), IM_COL32(0, 0, 0, 110), 6.0f);
-    dl->AddText(ImVec2(22, static_cast<float>(height) - 33), IM_COL32(255, 255, 255, 230), buf);
-    dl->AddText(ImVec2(12, 10), IM_COL32(255, 255, 255, 190),
-                "W/S pitch  A/D roll  Q/E yaw  Z/X speed  Space fire  P pause  F1 panel  Esc quit");
+    const ImVec2 ts = font->CalcTextSizeA(fs, 1e9f, 0.0f, buf);
+    dl->AddRectFilled(ImVec2(12 * k, h - ts.y - 26 * k), ImVec2(32 * k + ts.x, h - 12 * k),
+                      IM_COL32(0, 0, 0, 110), 6.0f * k);
+    dl->AddText(font, fs, ImVec2(22 * k, h - ts.y - 19 * k), IM_COL32(255, 255, 255, 230), buf);
+    dl->AddText(font, fs, ImVec2(12 * k, 10 * k), IM_COL32(255, 255, 255, 190),
+                "W/S pitch  A/D roll  Q/E yaw  Z/X speed  Space fire  H help");
     if (paused) {
         const char* msg = "PAUSED - press Space";
-        const ImVec2 ts = ImGui::CalcTextSize(msg);
-        dl->AddRectFilled(ImVec2(cx - ts.x * 0.5f - 16, cy - 60), ImVec2(cx + ts.x * 0.5f + 16, cy - 30),
-                          IM_COL32(0, 0, 0, 150), 6.0f);
-        dl->AddText(ImVec2(cx - ts.x * 0.5f, cy - 52), IM_COL32(255, 230, 120, 255), msg);
+        const ImVec2 ms = font->CalcTextSizeA(fs, 1e9f, 0.0f, msg);
+        dl->AddRectFilled(ImVec2(cx - ms.x * 0.5f - 16 * k, cy - 60 * k - ms.y),
+                          ImVec2(cx + ms.x * 0.5f + 16 * k, cy - 44 * k), IM_COL32(0, 0, 0, 150), 6.0f * k);
+        dl->AddText(font, fs, ImVec2(cx - ms.x * 0.5f, cy - 52 * k - ms.y), IM_COL32(255, 230, 120, 255),
+                    msg);
+    }
+    if (help) { // every key, in a box in the middle of the screen
+        float keyW = 0, rowH = fs * 1.35f, textW = 0;
+        for (const auto& [key, what] : keyHelp()) {
+            keyW = std::max(keyW, font->CalcTextSizeA(fs, 1e9f, 0.0f, key).x);
+            textW = std::max(textW, font->CalcTextSizeA(fs, 1e9f, 0.0f, what).x);
+        }
+        const float boxW = keyW + textW + 60 * k;
+        const float boxH = rowH * static_cast<float>(keyHelp().size() + 2) + 24 * k;
+        const ImVec2 a(cx - boxW * 0.5f, h * 0.5f - boxH * 0.5f);
+        dl->AddRectFilled(a, ImVec2(a.x + boxW, a.y + boxH), IM_COL32(10, 14, 22, 215), 8 * k);
+        dl->AddText(font, fs, ImVec2(a.x + 20 * k, a.y + 12 * k), IM_COL32(255, 230, 120, 255),
+                    "Keys (H closes)");
+        float y = a.y + 12 * k + rowH * 1.5f;
+        for (const auto& [key, what] : keyHelp()) {
+            dl->AddText(font, fs, ImVec2(a.x + 20 * k, y), IM_COL32(255, 230, 120, 255), key);
+            dl->AddText(font, fs, ImVec2(a.x + 40 * k + keyW, y), IM_COL32(235, 235, 235, 255), what);
+            y += rowH;
+        }
     }
 }
 

@@ -37,16 +37,16 @@ void ParticleSystem::impactBurst(const V3& point, const V3& normal, float streng
     for (int i = 0; i < sparks; ++i) {
         V3 d{rnd(s) * 2 - 1, rnd(s) * 2 - 1, rnd(s) * 2 - 1};
         d = norm(d + n * 1.2f);
-        emit(Kind::Spark, point, d * (12 + 22 * rnd(s)), 0.25f + 0.35f * rnd(s), 0.25f + 0.25f * rnd(s), 1.0f,
-             0.55f + 0.3f * rnd(s), 0.15f);
+        emit(Kind::Spark, point, d * ((12 + 22 * rnd(s)) * std::sqrt(strength)), 0.25f + 0.35f * rnd(s),
+             (0.25f + 0.25f * rnd(s)) * std::sqrt(strength), 1.0f, 0.55f + 0.3f * rnd(s), 0.15f);
     }
-    const int dust = 10 + static_cast<int>(strength * 8);
+    const int dust = std::max(1, static_cast<int>(std::lround((10 + strength * 8) * dustDensity)));
     for (int i = 0; i < dust; ++i) {
         V3 d{rnd(s) * 2 - 1, rnd(s) * 2 - 1, rnd(s) * 2 - 1};
         d = norm(d + n);
         const float grey = 0.55f + 0.2f * rnd(s);
-        emit(Kind::Dust, point + d * 0.5f, d * (1.5f + 4 * rnd(s)), 1.6f + 1.6f * rnd(s),
-             1.2f + 1.8f * rnd(s), grey, grey * 0.95f, grey * 0.88f);
+        emit(Kind::Dust, point + d * 0.5f * strength, d * ((1.5f + 4 * rnd(s)) * strength),
+             1.6f + 1.6f * rnd(s), (1.2f + 1.8f * rnd(s)) * strength, grey, grey * 0.95f, grey * 0.88f);
     }
     const int chunks = 6 + static_cast<int>(strength * 6);
     for (int i = 0; i < chunks; ++i) {
@@ -66,7 +66,8 @@ void ParticleSystem::debrisPuff(const V3& center, const V3& vel, float radius, s
         emit(Kind::Chunk, center + d * radius, vel + d * 3.0f, 2 + 2 * rnd(s),
              std::clamp(radius * 0.5f, 0.1f, 0.35f), grey, grey * 0.9f, grey * 0.85f);
     }
-    for (int i = 0; i < 3; ++i) {
+    const int dust = std::max(1, static_cast<int>(std::lround(3 * dustDensity)));
+    for (int i = 0; i < dust; ++i) {
         V3 d{rnd(s) * 2 - 1, rnd(s), rnd(s) * 2 - 1};
         emit(Kind::Dust, center + d * radius, vel * 0.3f + d, 1.5f + rnd(s), 1.0f + radius * 2, 0.6f, 0.58f,
              0.55f);
@@ -123,7 +124,7 @@ void ParticleSystem::draw(Renderer& renderer) const {
             renderer.addParticle(q, true);
             break;
         case Kind::Dust:
-            q.a = 0.55f * (1.0f - t) * std::min(1.0f, t * 8.0f);
+            q.a = std::min(0.9f, 0.55f / std::sqrt(dustDensity)) * (1.0f - t) * std::min(1.0f, t * 8.0f);
             renderer.addParticle(q, false);
             break;
         case Kind::Chunk:

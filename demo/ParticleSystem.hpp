@@ -31,6 +31,9 @@ public:
     void clear() { parts_.clear(); }
     /// Maximum number of live particles.
     std::size_t cap = 6000;
+    /// Share of dust particles emitted (software GL: fewer, denser puffs, since blended overdraw is its
+    /// cost).
+    float dustDensity = 1.0f;
 
 private:
     struct P {

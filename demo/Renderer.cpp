@@ -12,19 +12,19 @@ namespace demo {
 
 namespace {
 
-constexpr int kFloatsPerVertex = 10; // pos3 normal3 uv2 slot interior
-constexpr int kTexelsPerSlot = 6;    // mat4 columns, (heat, fade), tint
+constexpr int kFloatsPerVertex = 9; // pos3 normal3 uv2 slot
+constexpr int kTexelsPerSlot = 6;   // mat4 columns, (heat, fade), tint
 
+// Per-pixel lighting (GPUs): sun with specular and shadow map, hemisphere ambient, fog.
 const char* kMeshVs = R"(#version 330 core
 layout(location=0) in vec3 aPos;
 layout(location=1) in vec3 aNormal;
 layout(location=2) in vec2 aUv;
 layout(location=3) in float aSlot;
-layout(location=4) in float aInterior;
 uniform samplerBuffer uSlots;
 uniform mat4 uViewProj;
 uniform mat4 uLightVP;
-out vec3 vWorld; out vec3 vNormal; out vec2 vUv; out float vInterior; out vec2 vHeatFade; out vec3 vTint;
+out vec3 vWorld; out vec3 vNormal; out vec2 vUv; out vec2 vHeatFade; out vec3 vTint;
 out vec4 vLight;
 void main() {
     int b = int(aSlot + 0.5) * 6;
@@ -35,17 +35,16 @@ void main() {
     vWorld = w.xyz;
     vNormal = mat3(M) * aNormal;
     vUv = aUv;
-    vInterior = aInterior;
     vLight = uLightVP * w;
     gl_Position = uViewProj * w;
 })";
 
 const char* kMeshFs = R"(#version 330 core
-in vec3 vWorld; in vec3 vNormal; in vec2 vUv; in float vInterior; in vec2 vHeatFade; in vec3 vTint; in vec4 vLight;
+in vec3 vWorld; in vec3 vNormal; in vec2 vUv; in vec2 vHeatFade; in vec3 vTint; in vec4 vLight;
 uniform sampler2D uTex;
-uniform sampler2D uInterior;
 uniform sampler2DShadow uShadow;
 uniform int uUseShadow;
+uniform int uInterior;
 uniform vec3 uSunDir;
 uniform vec3 uCamPos;
 uniform vec3 uFogColor;
@@ -59,9 +58,8 @@ float shadowAt() {
 void main() {
     vec3 n = normalize(vNormal);
     if (!gl_FrontFacing) n = -n;
-    vec3 albedo;
-    if (vInterior > 0.5) { vec3 t = texture(uInterior, vUv).rgb; albedo = t * t * vec3(0.85, 0.78, 0.70); }
-    else { vec3 t = texture(uTex, vUv).rgb; albedo = t * t * vTint; }
+    vec3 t = texture(uTex, vUv).rgb;
+    vec3 albedo = uInterior == 1 ? t * t * vec3(0.85, 0.78, 0.70) : t * t * vTint;
     vec3 L = -uSunDir;
     float ndl = max(dot(n, L), 0.0);
     float sh = ndl > 0.0 ? shadowAt() : 0.0;
@@ -72,13 +70,59 @@ void main() {
     s2 *= s2; s2 *= s2; s2 *= s2; s2 *= s2; s2 *= s2;
     vec3 sun = vec3(1.6, 1.49, 1.31);
     vec3 c = albedo * (amb + sun * (ndl * sh)) + sun * (s2 * 0.2 * ndl * sh);
-    float heat = vHeatFade.x * vInterior;
-    c += heat * heat * vec3(1.5, 0.5, 0.12);
+    // fresh cuts: embers in the material's grain, white-hot cooling to dark red, fading to the lit interior
+    float heat = vHeatFade.x * float(uInterior);
+    vec3 ember = mix(vec3(0.9, 0.12, 0.02), vec3(1.7, 0.85, 0.35), heat);
+    c += ember * (heat * heat) * (0.3 + 1.4 * dot(t, vec3(0.3, 0.5, 0.2)));
     vec3 dv = uCamPos - vWorld;
     float fog = 1.0 - exp(-dot(dv, dv) * 2.5e-6);
     c = mix(c, uFogColor * uFogColor, fog);
     c = c / (1.0 + c * 0.15);
     oColor = vec4(sqrt(c), vHeatFade.y);
+})";
+
+// Per-vertex lighting (software GL): the fragment shader samples one texture, multiplies and applies fog.
+const char* kLiteVs = R"(#version 330 core
+layout(location=0) in vec3 aPos;
+layout(location=1) in vec3 aNormal;
+layout(location=2) in vec2 aUv;
+layout(location=3) in float aSlot;
+uniform samplerBuffer uSlots;
+uniform mat4 uViewProj;
+uniform int uInterior;
+uniform vec3 uSunDir;
+uniform vec3 uCamPos;
+out vec2 vUv; out vec3 vLit; out vec3 vGlow; out vec3 vDv; out float vFade;
+void main() {
+    int b = int(aSlot + 0.5) * 6;
+    mat4 M = mat4(texelFetch(uSlots, b), texelFetch(uSlots, b + 1), texelFetch(uSlots, b + 2), texelFetch(uSlots, b + 3));
+    vec2 heatFade = texelFetch(uSlots, b + 4).xy;
+    vec3 tint = uInterior == 1 ? vec3(0.85, 0.78, 0.70) : texelFetch(uSlots, b + 5).rgb;
+    vec4 w = M * vec4(aPos, 1.0);
+    vec3 n = normalize(mat3(M) * aNormal);
+    float ndl = max(dot(n, -uSunDir), 0.0);
+    vec3 amb = mix(vec3(0.11, 0.094, 0.077), vec3(0.20, 0.25, 0.34), n.y * 0.5 + 0.5);
+    // the per-pixel path's light, tone map and gamma folded into one factor on the texture's colour:
+    // sqrt(t * t * L) = t * sqrt(L)
+    vec3 L = tint * (amb + vec3(1.6, 1.49, 1.31) * ndl);
+    vLit = sqrt(L / (1.0 + L * 0.15));
+    float heat = heatFade.x * float(uInterior); // embers in the texture's grain, cooling to dark red
+    vGlow = heat * mix(vec3(0.9, 0.2, 0.05), vec3(1.5, 0.9, 0.5), heat);
+    vFade = heatFade.y;
+    vDv = uCamPos - w.xyz;
+    vUv = aUv;
+    gl_Position = uViewProj * w;
+})";
+
+const char* kLiteFs = R"(#version 330 core
+in vec2 vUv; in vec3 vLit; in vec3 vGlow; in vec3 vDv; in float vFade;
+uniform sampler2D uTex;
+uniform vec3 uFogColor;
+out vec4 oColor;
+void main() {
+    vec3 c = texture(uTex, vUv).rgb * (vLit + vGlow);
+    float x = dot(vDv, vDv) * 2.5e-6;
+    oColor = vec4(mix(c, uFogColor, x / (1.0 + x)), vFade);
 })";
 
 const char* kDepthVs = R"(#version 330 core
@@ -97,40 +141,22 @@ void main() {})";
 
 const char* kSkyVs = R"(#version 330 core
 layout(location=0) in vec3 aDir;
-layout(location=1) in vec3 aColor;
+layout(location=1) in vec3 aColor; // procedural dome: colour; image cube: (u, v, layer)
 uniform mat4 uViewProj;
-out vec3 vDir; out vec3 vColor;
+out vec3 vColor;
 void main() {
-    vDir = aDir;
     vColor = aColor;
     gl_Position = (uViewProj * vec4(aDir, 1.0)).xyww;
 })";
 
 const char* kSkyFs = R"(#version 330 core
-in vec3 vDir; in vec3 vColor;
-uniform sampler2DArray uFaces; // world.cfg order: top, bottom, left, right, front, back
+in vec3 vColor;
+uniform sampler2D uFaces; // the face's image
 uniform int uHasCube;
 out vec4 oColor;
 void main() {
     if (uHasCube == 0) { oColor = vec4(vColor, 1.0); return; }
-    // Face selection and UVs exactly as Irrlicht's CSkyBoxSceneNode maps the six images.
-    vec3 d = vDir;
-    vec3 a = abs(d);
-    vec2 uv; float layer;
-    if (a.y >= a.x && a.y >= a.z) {
-        vec3 p = d / a.y;
-        if (d.y > 0.0) { uv = vec2(1.0 - p.z, 1.0 + p.x) * 0.5; layer = 0.0; }
-        else { uv = vec2(1.0 - p.z, 1.0 - p.x) * 0.5; layer = 1.0; }
-    } else if (a.x >= a.z) {
-        vec3 p = d / a.x;
-        if (d.x > 0.0) { uv = vec2(1.0 - p.z, 1.0 - p.y) * 0.5; layer = 2.0; }
-        else { uv = vec2(1.0 + p.z, 1.0 - p.y) * 0.5; layer = 3.0; }
-    } else {
-        vec3 p = d / a.z;
-        if (d.z < 0.0) { uv = vec2(1.0 - p.x, 1.0 - p.y) * 0.5; layer = 4.0; }
-        else { uv = vec2(1.0 + p.x, 1.0 - p.y) * 0.5; layer = 5.0; }
-    }
-    oColor = vec4(texture(uFaces, vec3(uv, layer)).rgb, 1.0);
+    oColor = vec4(texture(uFaces, vColor.xy).rgb, 1.0);
 })";
 
 const char* kParticleVs = R"(#version 330 core
@@ -140,9 +166,12 @@ layout(location=2) in vec4 aColor;
 uniform mat4 uViewProj;
 uniform vec3 uRight;
 uniform vec3 uUp;
+uniform float uMaxSize; // largest size per metre of depth (a cap on the screen share of one particle)
 out vec2 vCorner; out vec4 vColor;
 void main() {
-    vec3 p = aPosSize.xyz + (uRight * aCorner.x + uUp * aCorner.y) * aPosSize.w;
+    float depth = max((uViewProj * vec4(aPosSize.xyz, 1.0)).w, 0.1);
+    float size = min(aPosSize.w, uMaxSize * depth);
+    vec3 p = aPosSize.xyz + (uRight * aCorner.x + uUp * aCorner.y) * size;
     vCorner = aCorner * 2.0;
     vColor = aColor;
     gl_Position = uViewProj * vec4(p, 1.0);
@@ -153,9 +182,9 @@ in vec2 vCorner; in vec4 vColor;
 uniform int uAdditive;
 out vec4 oColor;
 void main() {
-    float r2 = dot(vCorner, vCorner);
-    if (r2 > 1.0) discard;
-    float f = uAdditive == 1 ? pow(1.0 - r2, 1.5) : (1.0 - r2 * 0.6);
+    // no discard and no pow: outside the disc the weight is 0 (blending leaves the pixel as it was)
+    float k = max(1.0 - dot(vCorner, vCorner), 0.0);
+    float f = uAdditive == 1 ? k * k : min(k * 8.0, 1.0) * (0.4 + 0.6 * k);
     oColor = vec4(vColor.rgb, vColor.a * f);
 })";
 
@@ -244,13 +273,14 @@ float fbm(float x, float y, int period, int seed) {
     return s;
 }
 
-GLuint uploadRgba(const unsigned char* data, int w, int h) {
+GLuint uploadRgba(const unsigned char* data, int w, int h, bool trilinear) {
     GLuint t = 0;
     glGenTextures(1, &t);
     glBindTexture(GL_TEXTURE_2D, t);
     glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, w, h, 0, GL_RGBA, GL_UNSIGNED_BYTE, data);
     glGenerateMipmap(GL_TEXTURE_2D);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER,
+                    trilinear ? GL_LINEAR_MIPMAP_LINEAR : GL_LINEAR_MIPMAP_NEAREST);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
@@ -259,8 +289,27 @@ GLuint uploadRgba(const unsigned char* data, int w, int h) {
 
 } // namespace
 
-bool Renderer::init(std::string& error) {
-    meshProg_ = program(kMeshVs, kMeshFs, error);
+RenderQuality RenderQuality::forRenderer(const std::string& glRenderer) {
+    RenderQuality q;
+    for (const char* soft : {"llvmpipe", "softpipe", "swrast", "Software Rasterizer"})
+        if (glRenderer.find(soft) != std::string::npos)
+            q.software = true;
+    if (q.software) {
+        q.shadows = false;
+        q.pixelLighting = false;
+        q.trilinear = false;
+        // Dynamic resolution stays off: with per-vertex lighting a pixel costs about what the upscale pass
+        // costs per output pixel, so on llvmpipe 2/3 scale saved nothing (docs/rendering.md).
+        q.minScale = 1.0f;
+    }
+    return q;
+}
+
+bool Renderer::init(const RenderQuality& quality, std::string& error) {
+    quality_ = quality;
+    shadows = quality.shadows;
+    shadowSize_ = quality.shadowSize;
+    meshProg_ = quality.pixelLighting ? program(kMeshVs, kMeshFs, error) : program(kLiteVs, kLiteFs, error);
     depthProg_ = program(kDepthVs, kDepthFs, error);
     skyProg_ = program(kSkyVs, kSkyFs, error);
     particleProg_ = program(kParticleVs, kParticleFs, error);
@@ -333,6 +382,9 @@ void Renderer::shutdown() {
     for (GLuint t : textures_)
         glDeleteTextures(1, &t);
     textures_.clear();
+    for (GLuint& t : skyFaces_)
+        if (t)
+            glDeleteTextures(1, &t), t = 0;
     GLuint progs[] = {meshProg_, depthProg_, skyProg_, particleProg_, lineProg_};
     for (GLuint p : progs)
         if (p)
@@ -402,7 +454,7 @@ int Renderer::proceduralTexture(const std::string& kind) {
             p[2] = static_cast<unsigned char>(std::clamp(b, 0.0f, 1.0f) * 255);
             p[3] = 255;
         }
-    textures_.push_back(uploadRgba(px.data(), n, n));
+    textures_.push_back(uploadRgba(px.data(), n, n, quality_.trilinear));
     texturePaths_.push_back("procedural:" + kind);
     return static_cast<int>(textures_.size()) - 1;
 }
@@ -435,7 +487,7 @@ int Renderer::loadTexture(const std::filesystem::path& path, const std::string& 
                 return static_cast<int>(i);
         return proceduralTexture(kind);
     }
-    textures_.push_back(uploadRgba(data, w, h));
+    textures_.push_back(uploadRgba(data, w, h, quality_.trilinear));
     texturePaths_.push_back(path.string());
     stbi_image_free(data);
     return static_cast<int>(textures_.size()) - 1;
@@ -443,8 +495,8 @@ int Renderer::loadTexture(const std::filesystem::path& path, const std::string& 
 
 void Renderer::setSkybox(const std::array<std::filesystem::path, 6>& faces,
                          std::vector<std::string>& warnings) {
-    // world.cfg order: top, bottom, left, right, front, back; one layer each of a 2D array texture, sampled
-    // with Irrlicht's face mapping (see kSkyFs) so the thesis's images meet without seams.
+    // world.cfg order: top, bottom, left, right, front, back; one texture each, drawn on a cube with
+    // Irrlicht's face mapping (see bakeSkyCube) so the thesis's images meet without seams.
     std::vector<unsigned char*> data(6, nullptr);
     int w[6], h[6];
     bool ok = true;
@@ -473,18 +525,16 @@ void Renderer::setSkybox(const std::array<std::filesystem::path, 6>& faces,
             w[i] = h[i] = n;
         }
     }
-    if (ok) {
-        glGenTextures(1, &skyCube_);
-        glBindTexture(GL_TEXTURE_2D_ARRAY, skyCube_);
-        glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_RGBA8, w[0], w[0], 6, 0, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
-        for (int i = 0; i < 6; ++i)
-            glTexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, 0, 0, i, w[0], w[0], 1, GL_RGBA, GL_UNSIGNED_BYTE,
-                            data[i]);
-        glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-        glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-        glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-        glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    }
+    if (ok)
+        for (int i = 0; i < 6; ++i) { // one 2D texture per face: llvmpipe samples these faster than an array
+            glGenTextures(1, &skyFaces_[i]);
+            glBindTexture(GL_TEXTURE_2D, skyFaces_[i]);
+            glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, w[0], w[0], 0, GL_RGBA, GL_UNSIGNED_BYTE, data[i]);
+            glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+            glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+            glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+            glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+        }
     for (auto* d : data)
         if (d)
             stbi_image_free(d);
@@ -537,20 +587,77 @@ void Renderer::bakeProceduralSky() {
     glBindVertexArray(0);
 }
 
-int Renderer::batchFor(int texture) {
+void Renderer::bakeSkyCube() {
+    // The six images on a cube, with the face and UVs of Irrlicht's CSkyBoxSceneNode at every corner: a cube
+    // face is planar, so interpolated UVs equal the per-pixel mapping.
+    struct Face {
+        int axis;   // 0 x, 1 y, 2 z
+        float sign; // which side
+        int layer;  // world.cfg order: top, bottom, left, right, front, back
+    };
+    const Face faces[6] = {{1, 1, 0},  {1, -1, 1}, {0, 1, 2},
+                           {0, -1, 3}, {2, -1, 4}, {2, 1, 5}}; // layer order
+    auto uvOf = [](const Face& f, const float p[3]) -> std::array<float, 2> {
+        switch (f.layer) {
+        case 0:
+            return {(1 - p[2]) * 0.5f, (1 + p[0]) * 0.5f};
+        case 1:
+            return {(1 - p[2]) * 0.5f, (1 - p[0]) * 0.5f};
+        case 2:
+            return {(1 - p[2]) * 0.5f, (1 - p[1]) * 0.5f};
+        case 3:
+            return {(1 + p[2]) * 0.5f, (1 - p[1]) * 0.5f};
+        case 4:
+            return {(1 - p[0]) * 0.5f, (1 - p[1]) * 0.5f};
+        default:
+            return {(1 + p[0]) * 0.5f, (1 - p[1]) * 0.5f};
+        }
+    };
+    std::vector<float> v;
+    for (const Face& f : faces) {
+        const int a = (f.axis + 1) % 3, b = (f.axis + 2) % 3;
+        const float corners[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+        for (int k : {0, 1, 2, 0, 2, 3}) {
+            float p[3];
+            p[f.axis] = f.sign;
+            p[a] = corners[k][0];
+            p[b] = corners[k][1];
+            const auto uv = uvOf(f, p);
+            const float vert[6] = {p[0], p[1], p[2], uv[0], uv[1], 0.0f};
+            v.insert(v.end(), vert, vert + 6);
+        }
+    }
+    glGenVertexArrays(1, &cubeVao_);
+    glBindVertexArray(cubeVao_);
+    glGenBuffers(1, &cubeVbo_);
+    glBindBuffer(GL_ARRAY_BUFFER, cubeVbo_);
+    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(v.size() * sizeof(float)), v.data(),
+                 GL_STATIC_DRAW);
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), nullptr);
+    glEnableVertexAttribArray(1);
+    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float),
+                          reinterpret_cast<void*>(3 * sizeof(float)));
+    glBindVertexArray(0);
+}
+
+int Renderer::batchFor(int texture, bool interior) {
+    if (interior)
+        texture = -1; // one batch for every cut face: drawn with the interior texture
     for (size_t i = 0; i < batches_.size(); ++i)
-        if (batches_[i].texture == texture)
+        if (batches_[i].texture == texture && batches_[i].interior == interior)
             return static_cast<int>(i);
     Batch b;
     b.texture = texture;
+    b.interior = interior;
     glGenVertexArrays(1, &b.vao);
     glGenBuffers(1, &b.vbo);
     glBindVertexArray(b.vao);
     glBindBuffer(GL_ARRAY_BUFFER, b.vbo);
     const GLsizei stride = kFloatsPerVertex * sizeof(float);
-    const int sizes[] = {3, 3, 2, 1, 1};
+    const int sizes[] = {3, 3, 2, 1};
     size_t off = 0;
-    for (int a = 0; a < 5; ++a) {
+    for (int a = 0; a < 4; ++a) {
         glEnableVertexAttribArray(static_cast<GLuint>(a));
         glVertexAttribPointer(static_cast<GLuint>(a), sizes[a], GL_FLOAT, GL_FALSE, stride,
                               reinterpret_cast<void*>(off * sizeof(float)));
@@ -570,30 +677,39 @@ int Renderer::addMesh(const rubble::Mesh& mesh, int texture, float r, float g, f
         id = static_cast<int>(meshes_.size());
         meshes_.emplace_back();
     }
-    const int bi = batchFor(texture);
-    Batch& batch = batches_[bi];
     MeshRec& rec = meshes_[id];
-    rec.batch = bi;
-    rec.first = static_cast<int>(batch.cpu.size() / kFloatsPerVertex);
-    rec.count = static_cast<int>(mesh.triangles.size() * 3);
     rec.alive = true;
-    batch.cpu.reserve(batch.cpu.size() + static_cast<size_t>(rec.count) * kFloatsPerVertex);
-    for (size_t t = 0; t < mesh.triangles.size(); ++t) {
-        const rubble::Vec3 fn = rubble::normalized(mesh.triangleNormal(t));
-        const bool interior = mesh.material(t) == rubble::kInteriorMaterial;
-        for (int c = 0; c < 3; ++c) {
-            const rubble::Vec3& p = mesh.positions[mesh.triangles[t][static_cast<size_t>(c)]];
-            const rubble::Vec3 n = mesh.hasNormals() ? mesh.normals[3 * t + static_cast<size_t>(c)] : fn;
-            const rubble::Vec2 uv = mesh.hasUvs() ? mesh.uvs[3 * t + static_cast<size_t>(c)] : rubble::Vec2{};
-            const float v[kFloatsPerVertex] = {static_cast<float>(p.x),  static_cast<float>(p.y),
-                                               static_cast<float>(p.z),  static_cast<float>(n.x),
-                                               static_cast<float>(n.y),  static_cast<float>(n.z),
-                                               static_cast<float>(uv.x), static_cast<float>(uv.y),
-                                               static_cast<float>(id),   interior ? 1.0f : 0.0f};
-            batch.cpu.insert(batch.cpu.end(), v, v + kFloatsPerVertex);
+    for (int range = 0; range < 2; ++range) {
+        const bool interior = range == 1;
+        const int bi = batchFor(texture, interior);
+        Batch& batch = batches_[bi];
+        rec.batch[range] = bi;
+        rec.first[range] = static_cast<int>(batch.cpu.size() / kFloatsPerVertex);
+        for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+            if ((mesh.material(t) == rubble::kInteriorMaterial) != interior)
+                continue;
+            const rubble::Vec3 fn = rubble::normalized(mesh.triangleNormal(t));
+            for (int c = 0; c < 3; ++c) {
+                const rubble::Vec3& p = mesh.positions[mesh.triangles[t][static_cast<size_t>(c)]];
+                const rubble::Vec3 n = mesh.hasNormals() ? mesh.normals[3 * t + static_cast<size_t>(c)] : fn;
+                const rubble::Vec2 uv =
+                    mesh.hasUvs() ? mesh.uvs[3 * t + static_cast<size_t>(c)] : rubble::Vec2{};
+                const float v[kFloatsPerVertex] = {
+                    static_cast<float>(p.x),  static_cast<float>(p.y),  static_cast<float>(p.z),
+                    static_cast<float>(n.x),  static_cast<float>(n.y),  static_cast<float>(n.z),
+                    static_cast<float>(uv.x), static_cast<float>(uv.y), static_cast<float>(id)};
+                batch.cpu.insert(batch.cpu.end(), v, v + kFloatsPerVertex);
+            }
         }
+        rec.count[range] = static_cast<int>(batch.cpu.size() / kFloatsPerVertex) - rec.first[range];
+        batch.dirty = batch.dirty || rec.count[range] > 0;
     }
-    batch.dirty = true;
+    {
+        const rubble::Aabb box = mesh.bounds();
+        const rubble::Vec3 c = box.center(), h = box.size() * 0.5;
+        rec.centre = {static_cast<float>(c.x), static_cast<float>(c.y), static_cast<float>(c.z)};
+        rec.radius = static_cast<float>(std::sqrt(h.x * h.x + h.y * h.y + h.z * h.z));
+    }
     ++liveMeshes_;
     const size_t need = static_cast<size_t>(id + 1) * kTexelsPerSlot * 4;
     if (slotData_.size() < need)
@@ -610,25 +726,29 @@ void Renderer::removeMesh(int id) {
         return;
     MeshRec& rec = meshes_[id];
     rec.alive = false;
-    Batch& b = batches_[rec.batch];
-    b.dead += rec.count;
     freeIds_.push_back(id);
     --liveMeshes_;
-    if (b.dead > 30000 && b.dead * 2 > static_cast<int>(b.cpu.size() / kFloatsPerVertex))
-        compact(b, rec.batch);
+    for (int range = 0; range < 2; ++range) {
+        Batch& b = batches_[rec.batch[range]];
+        b.dead += rec.count[range];
+        if (b.dead > 30000 && b.dead * 2 > static_cast<int>(b.cpu.size() / kFloatsPerVertex))
+            compact(b, rec.batch[range]);
+    }
 }
 
 void Renderer::compact(Batch& b, int batchIndex) {
     std::vector<float> fresh;
     fresh.reserve(b.cpu.size() / 2);
-    for (auto& rec : meshes_) {
-        if (!rec.alive || rec.batch != batchIndex)
-            continue;
-        const int first = static_cast<int>(fresh.size() / kFloatsPerVertex);
-        fresh.insert(fresh.end(), b.cpu.begin() + static_cast<long>(rec.first) * kFloatsPerVertex,
-                     b.cpu.begin() + static_cast<long>(rec.first + rec.count) * kFloatsPerVertex);
-        rec.first = first;
-    }
+    for (auto& rec : meshes_)
+        for (int range = 0; range < 2; ++range) {
+            if (!rec.alive || rec.batch[range] != batchIndex)
+                continue;
+            const int first = static_cast<int>(fresh.size() / kFloatsPerVertex);
+            fresh.insert(fresh.end(), b.cpu.begin() + static_cast<long>(rec.first[range]) * kFloatsPerVertex,
+                         b.cpu.begin() +
+                             static_cast<long>(rec.first[range] + rec.count[range]) * kFloatsPerVertex);
+            rec.first[range] = first;
+        }
     b.cpu.swap(fresh);
     b.dead = 0;
     b.dirty = true;
@@ -650,7 +770,10 @@ void Renderer::beginFrame() {
     for (auto& b : batches_) {
         b.firsts.clear();
         b.counts.clear();
+        b.shadowFirsts.clear();
+        b.shadowCounts.clear();
     }
+    queued_.clear();
     dust_.clear();
     sparks_.clear();
     lines_.clear();
@@ -660,10 +783,7 @@ void Renderer::beginFrame() {
 void Renderer::drawMesh(int id, const M4& model, float heat, float fade) {
     if (id < 0 || id >= static_cast<int>(meshes_.size()) || !meshes_[id].alive)
         return;
-    const MeshRec& rec = meshes_[id];
-    Batch& b = batches_[rec.batch];
-    b.firsts.push_back(rec.first);
-    b.counts.push_back(rec.count);
+    queued_.push_back(id);
     float* s = &slotData_[static_cast<size_t>(id) * kTexelsPerSlot * 4];
     std::copy(model.m, model.m + 16, s);
     s[16] = heat;
@@ -682,20 +802,71 @@ void Renderer::addLine(const V3& a, const V3& b, float r, float g, float bl) {
     lines_.insert(lines_.end(), d, d + 12);
 }
 
-void Renderer::drawBatches(bool depthOnly) {
+void Renderer::cullAndBatch(const M4& vp) {
+    // Frustum planes of the view-projection (Gribb-Hartmann), tested against each mesh's bounding sphere.
+    float planes[6][4];
+    for (int i = 0; i < 6; ++i) {
+        const int row = i / 2;
+        const float sign = i % 2 == 0 ? 1.0f : -1.0f;
+        float len2 = 0;
+        for (int c = 0; c < 4; ++c) {
+            planes[i][c] = vp.m[c * 4 + 3] + sign * vp.m[c * 4 + row];
+            if (c < 3)
+                len2 += planes[i][c] * planes[i][c];
+        }
+        const float inv = 1.0f / std::sqrt(std::max(len2, 1e-12f));
+        for (float& v : planes[i])
+            v *= inv;
+    }
+    culled_ = 0;
+    for (int id : queued_) {
+        const MeshRec& rec = meshes_[id];
+        const float* s = &slotData_[static_cast<size_t>(id) * kTexelsPerSlot * 4];
+        M4 model;
+        std::copy(s, s + 16, model.m);
+        const V3 c = model.point(rec.centre);
+        const float scale =
+            std::max({len(V3{s[0], s[1], s[2]}), len(V3{s[4], s[5], s[6]}), len(V3{s[8], s[9], s[10]})});
+        bool inside = true;
+        for (const auto& p : planes)
+            if (p[0] * c.x + p[1] * c.y + p[2] * c.z + p[3] < -rec.radius * scale) {
+                inside = false;
+                break;
+            }
+        culled_ += inside ? 0 : 1;
+        for (int range = 0; range < 2; ++range) {
+            if (rec.count[range] == 0)
+                continue;
+            Batch& b = batches_[rec.batch[range]];
+            b.shadowFirsts.push_back(rec.first[range]);
+            b.shadowCounts.push_back(rec.count[range]);
+            if (inside) {
+                b.firsts.push_back(rec.first[range]);
+                b.counts.push_back(rec.count[range]);
+            }
+        }
+    }
+    queued_.clear();
+}
+
+void Renderer::drawBatches(bool depthOnly, GLuint program) {
+    const GLint interiorLoc = depthOnly ? -1 : loc(program, "uInterior");
     for (auto& b : batches_) {
-        if (b.firsts.empty())
+        const auto& firsts = depthOnly ? b.shadowFirsts : b.firsts;
+        const auto& counts = depthOnly ? b.shadowCounts : b.counts;
+        if (firsts.empty())
             continue;
         if (!depthOnly) {
             glActiveTexture(GL_TEXTURE0);
-            glBindTexture(GL_TEXTURE_2D, textures_[static_cast<size_t>(b.texture)]);
+            glBindTexture(GL_TEXTURE_2D,
+                          textures_[static_cast<size_t>(b.interior ? interiorTex_ : b.texture)]);
+            glUniform1i(interiorLoc, b.interior ? 1 : 0);
         }
         glBindVertexArray(b.vao);
-        glMultiDrawArrays(GL_TRIANGLES, b.firsts.data(), b.counts.data(),
-                          static_cast<GLsizei>(b.firsts.size()));
+        glMultiDrawArrays(GL_TRIANGLES, firsts.data(), counts.data(), static_cast<GLsizei>(firsts.size()));
         ++drawCalls_;
         if (!depthOnly)
-            for (GLsizei c : b.counts)
+            for (GLsizei c : counts)
                 triangles_ += c / 3;
     }
 }
@@ -708,6 +879,7 @@ void Renderer::render(const FrameView& fv) {
     for (auto& b : batches_)
         if (b.dirty)
             uploadBatch(b);
+    cullAndBatch(fv.proj * fv.view);
 
     // Per-object transforms → buffer texture.
     const size_t floats = static_cast<size_t>(std::max(maxSlotUsed_, 1)) * kTexelsPerSlot * 4;
@@ -742,7 +914,7 @@ void Renderer::render(const FrameView& fv) {
         glUseProgram(depthProg_);
         glUniform1i(loc(depthProg_, "uSlots"), 3);
         glUniformMatrix4fv(loc(depthProg_, "uViewProj"), 1, GL_FALSE, lightVP.m);
-        drawBatches(true);
+        drawBatches(true, depthProg_);
         glDisable(GL_POLYGON_OFFSET_FILL);
     }
 
@@ -756,7 +928,6 @@ void Renderer::render(const FrameView& fv) {
     glUseProgram(meshProg_);
     glUniform1i(loc(meshProg_, "uSlots"), 3);
     glUniform1i(loc(meshProg_, "uTex"), 0);
-    glUniform1i(loc(meshProg_, "uInterior"), 1);
     glUniform1i(loc(meshProg_, "uShadow"), 2);
     glUniform1i(loc(meshProg_, "uUseShadow"), shadows ? 1 : 0);
     glUniformMatrix4fv(loc(meshProg_, "uViewProj"), 1, GL_FALSE, viewProj.m);
@@ -764,14 +935,12 @@ void Renderer::render(const FrameView& fv) {
     glUniform3f(loc(meshProg_, "uSunDir"), sun.x, sun.y, sun.z);
     glUniform3f(loc(meshProg_, "uCamPos"), fv.eye.x, fv.eye.y, fv.eye.z);
     glUniform3f(loc(meshProg_, "uFogColor"), fog.x, fog.y, fog.z);
-    glActiveTexture(GL_TEXTURE1);
-    glBindTexture(GL_TEXTURE_2D, textures_[static_cast<size_t>(interiorTex_)]);
     glActiveTexture(GL_TEXTURE2);
     glBindTexture(GL_TEXTURE_2D, shadowTex_);
     glEnable(GL_CULL_FACE);
     glCullFace(GL_BACK);
     if (skip.find("mesh") == std::string::npos)
-        drawBatches(false);
+        drawBatches(false, meshProg_);
     glDisable(GL_CULL_FACE);
 
     // Sky behind everything (drawn last among opaque passes so early depth rejects covered pixels).
@@ -780,16 +949,27 @@ void Renderer::render(const FrameView& fv) {
     const M4 vp = fv.proj * viewNoT;
     if (!skyVao_)
         bakeProceduralSky();
+    const bool cube = skyFaces_[0] != 0;
+    if (cube && !cubeVao_)
+        bakeSkyCube();
     glUseProgram(skyProg_);
     glUniformMatrix4fv(loc(skyProg_, "uViewProj"), 1, GL_FALSE, vp.m);
-    glUniform1i(loc(skyProg_, "uHasCube"), skyCube_ ? 1 : 0);
+    glUniform1i(loc(skyProg_, "uHasCube"), cube ? 1 : 0);
     glUniform1i(loc(skyProg_, "uFaces"), 4);
     glActiveTexture(GL_TEXTURE4);
-    glBindTexture(GL_TEXTURE_2D_ARRAY, skyCube_);
+
     glDepthMask(GL_FALSE);
-    glBindVertexArray(skyVao_);
-    if (skip.find("sky") == std::string::npos)
+    glBindVertexArray(cube ? cubeVao_ : skyVao_);
+    if (skip.find("sky") != std::string::npos) {
+    } else if (cube) {
+        for (int i = 0; i < 6; ++i) { // faces in layer order, six vertices each
+            glBindTexture(GL_TEXTURE_2D, skyFaces_[i]);
+            glDrawArrays(GL_TRIANGLES, 6 * i, 6);
+        }
+        drawCalls_ += 5;
+    } else {
         glDrawArrays(GL_TRIANGLES, 0, skyVertices_);
+    }
     ++drawCalls_;
     glDepthMask(GL_TRUE);
 
@@ -812,12 +992,15 @@ void Renderer::render(const FrameView& fv) {
     const V3 up{fv.view.m[1], fv.view.m[5], fv.view.m[9]};
     glUniform3f(loc(particleProg_, "uRight"), right.x, right.y, right.z);
     glUniform3f(loc(particleProg_, "uUp"), up.x, up.y, up.z);
+    // one particle covers at most a fifth (software GL: a tenth) of the screen height
+    const float maxShare = quality_.software ? 0.1f : 0.2f;
+    glUniform1f(loc(particleProg_, "uMaxSize"), maxShare * 2.0f / std::max(fv.proj.m[5], 1e-3f));
     glBindVertexArray(particleVao_);
     glEnable(GL_BLEND);
     glDepthMask(GL_FALSE);
     for (int pass = 0; pass < 2; ++pass) {
         const auto& v = pass == 0 ? dust_ : sparks_;
-        if (v.empty())
+        if (v.empty() || skip.find("particles") != std::string::npos)
             continue;
         if (pass == 0)
             glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);

@@ -1,8 +1,9 @@
 #pragma once
 /// \file Renderer.hpp
 /// Batched forward renderer: lit, textured, shadowed meshes drawn with one multi-draw per texture (object
-/// transforms come from a buffer texture indexed per vertex), an instanced particle pass, debug lines and a
-/// skybox (cube map from the scene's six images, or a procedural sky).
+/// transforms come from a buffer texture indexed per vertex; cut faces in batches of their own), an instanced
+/// particle pass, debug lines and a skybox (the scene's six images on a cube, or a procedural sky). Two
+/// quality levels: per-pixel lighting with shadows (GPUs), per-vertex lighting without (software GL).
 
 #include <array>
 #include <filesystem>
@@ -24,6 +25,20 @@ struct Particle {
     float a = 1;               ///< opacity (additive particles: brightness)
 };
 
+/// How much the renderer does per pixel; chosen from GL_RENDERER by forRenderer.
+struct RenderQuality {
+    bool software = false;     ///< a software rasteriser (llvmpipe, softpipe, swrast)
+    bool shadows = true;       ///< shadow map
+    int shadowSize = 1024;     ///< shadow map edge in texels
+    bool pixelLighting = true; ///< per-pixel sun, specular and shadows (else per-vertex sun, no specular)
+    bool trilinear = true;     ///< mipmaps blended (else nearest mip level, bilinear)
+    float minScale = 1.0f;     ///< smallest internal resolution scale dynamic resolution may use (1 = off)
+    /// GPUs: everything on; software GL: shadows off, per-vertex lighting, bilinear, fewer dust particles.
+    static RenderQuality forRenderer(const std::string& glRenderer);
+    /// "software" or "gpu".
+    const char* name() const { return software ? "software" : "gpu"; }
+};
+
 /// Camera and light for one frame.
 struct FrameView {
     M4 view;        ///< view matrix
@@ -38,8 +53,10 @@ struct FrameView {
 /// The renderer. All calls need the GL context current.
 class Renderer {
 public:
-    /// Compiles shaders and creates buffers. Returns false with a message on failure.
-    bool init(std::string& error);
+    /// Compiles shaders and creates buffers for the given quality. Returns false with a message on failure.
+    bool init(const RenderQuality& quality, std::string& error);
+    /// The quality chosen at init.
+    const RenderQuality& quality() const { return quality_; }
     /// Frees GL objects.
     void shutdown();
 
@@ -78,6 +95,8 @@ public:
     int drawCalls() const { return drawCalls_; }
     /// Triangles drawn in the last render().
     long long triangles() const { return triangles_; }
+    /// Meshes left out of the last render() by frustum culling.
+    int culled() const { return culled_; }
     /// Shadows on/off.
     bool shadows = true;
     /// Sun direction (pointing from the sun).
@@ -86,26 +105,36 @@ public:
 private:
     struct Batch {
         GLuint vao = 0, vbo = 0;
-        int texture = 0;
+        int texture = 0;       ///< texture of exterior batches
+        bool interior = false; ///< cut faces: drawn with the interior texture
         std::vector<float> cpu;
         size_t gpuCapacity = 0;
         bool dirty = false;
         int dead = 0;
-        std::vector<GLint> firsts;
-        std::vector<GLsizei> counts;
+        std::vector<GLint> firsts;         ///< ranges drawn this frame (inside the view frustum)
+        std::vector<GLsizei> counts;       ///< their vertex counts
+        std::vector<GLint> shadowFirsts;   ///< ranges casting shadows (every queued mesh)
+        std::vector<GLsizei> shadowCounts; ///< their vertex counts
     };
+    /// A mesh: its exterior triangles (range 0) and its cut faces (range 1), each in its own batch.
     struct MeshRec {
-        int batch = -1;
-        int first = 0;
-        int count = 0;
+        int batch[2] = {-1, -1};
+        int first[2] = {0, 0};
+        int count[2] = {0, 0};
         bool alive = false;
+        V3 centre;        ///< bounding sphere in mesh coordinates
+        float radius = 0; ///< bounding sphere radius
     };
-    int batchFor(int texture);
+    int batchFor(int texture, bool interior);
+    void bakeSkyCube();
     void bakeProceduralSky();
     void uploadBatch(Batch& b);
     void compact(Batch& b, int batchIndex);
-    void drawBatches(bool depthOnly);
+    void drawBatches(bool depthOnly, GLuint program);
+    void cullAndBatch(const M4& viewProj);
+    void applyFilter(GLenum target);
 
+    RenderQuality quality_;
     GLuint meshProg_ = 0, depthProg_ = 0, skyProg_ = 0, particleProg_ = 0, lineProg_ = 0;
     GLuint slotBuf_ = 0, slotTex_ = 0;
     size_t slotCapacity_ = 0;
@@ -115,11 +144,14 @@ private:
     std::vector<MeshRec> meshes_;
     std::vector<int> freeIds_;
     int liveMeshes_ = 0;
+    std::vector<int> queued_; ///< meshes drawn this frame (drawMesh), culled in render()
+    int culled_ = 0;
     std::vector<GLuint> textures_;
     std::vector<std::string> texturePaths_;
-    GLuint skyCube_ = 0;
+    GLuint skyFaces_[6] = {}; ///< the scene's six sky images (0: procedural sky)
     GLuint skyVao_ = 0, skyVbo_ = 0;
     int skyVertices_ = 0;
+    GLuint cubeVao_ = 0, cubeVbo_ = 0;
     GLuint emptyVao_ = 0;
     GLuint particleVao_ = 0, particleQuad_ = 0, particleInst_ = 0;
     std::vector<float> dust_, sparks_;

@@ -23,30 +23,44 @@ bool writePng(const std::filesystem::path& path, const std::string& rgb, int w, 
     return stbi_write_png(path.string().c_str(), w, h, 3, rgb.data(), w * 3) != 0;
 }
 
-bool RunReport::write(const std::filesystem::path& dir, const std::string& scene, const std::string& renderer,
+bool RunReport::write(const std::filesystem::path& dir, const std::string& scene, const RenderInfo& render,
                       const std::vector<double>& latencies, int screenshots, std::string& summary) const {
     std::error_code ec;
     std::filesystem::create_directories(dir, ec);
     std::ofstream csv(dir / "frames.csv");
     if (!csv)
         return false;
-    csv << "frame,sim_time_s,frame_ms,step_ms,draw_calls,bodies,pieces,jobs,shots,impacts,fractures\n";
-    std::vector<double> ms;
+    csv << "frame,sim_time_s,frame_ms,step_ms,draw_calls,bodies,pieces,jobs,shots,impacts,fractures,render_w,"
+           "render_h\n";
+    std::vector<double> ms, widths, heights;
     for (const auto& f : frames_) {
         csv << f.frame << ',' << f.simTime << ',' << f.frameMs << ',' << f.stepMs << ',' << f.drawCalls << ','
             << f.counters.bodies << ',' << f.counters.pieces << ',' << f.counters.jobs << ','
-            << f.counters.shots << ',' << f.counters.impacts << ',' << f.counters.fractures << '\n';
+            << f.counters.shots << ',' << f.counters.impacts << ',' << f.counters.fractures << ','
+            << f.renderWidth << ',' << f.renderHeight << '\n';
         ms.push_back(f.frameMs);
+        widths.push_back(f.renderWidth);
+        heights.push_back(f.renderHeight);
     }
     // Skip the first frames (shader compilation, first uploads) for the summary.
     std::vector<double> steady(ms.begin() + static_cast<long>(std::min<size_t>(ms.size(), 10)), ms.end());
     if (steady.empty())
         steady = ms;
     const double p50 = quantile(steady, 0.5), p99 = quantile(steady, 0.99);
+    const double minW = widths.empty() ? 0 : *std::min_element(widths.begin(), widths.end());
+    const double minH = heights.empty() ? 0 : *std::min_element(heights.begin(), heights.end());
     const GameCounters last = frames_.empty() ? GameCounters{} : frames_.back().counters;
     nlohmann::json j;
     j["scene"] = scene;
-    j["renderer"] = renderer;
+    j["renderer"] = render.renderer;
+    j["quality"] = render.quality;
+    j["shadows"] = render.shadows;
+    j["output"] = {{"width", render.outputWidth}, {"height", render.outputHeight}};
+    // internal render resolution (dynamic resolution): median and smallest over the run
+    j["internal_resolution"] = {{"width_p50", quantile(widths, 0.5)},
+                                {"height_p50", quantile(heights, 0.5)},
+                                {"width_min", minW},
+                                {"height_min", minH}};
     j["frames"] = frames_.size();
     j["sim_seconds"] = frames_.empty() ? 0.0 : frames_.back().simTime;
     j["frame_ms"] = {{"p50", p50}, {"p99", p99}, {"max", quantile(steady, 1.0)}};
@@ -70,7 +84,8 @@ bool RunReport::write(const std::filesystem::path& dir, const std::string& scene
     s << "frames " << frames_.size() << ", fps p50 " << (p50 > 0 ? 1000.0 / p50 : 0.0) << " / p99 "
       << (p99 > 0 ? 1000.0 / p99 : 0.0) << " (frame ms p50 " << p50 << ", p99 " << p99 << "), shots "
       << last.shots << ", impacts " << last.impacts << ", fractures " << last.fractures << ", latency ms p50 "
-      << quantile(latencies, 0.5) << " p99 " << quantile(latencies, 0.99);
+      << quantile(latencies, 0.5) << " p99 " << quantile(latencies, 0.99) << ", internal resolution p50 "
+      << quantile(widths, 0.5) << 'x' << quantile(heights, 0.5) << " (min " << minW << 'x' << minH << ")";
     summary = s.str();
     return static_cast<bool>(js);
 }

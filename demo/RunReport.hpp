@@ -22,13 +22,23 @@ public:
         double stepMs = 0;       ///< wall-clock time of the simulation step
         GameCounters counters;   ///< counters after the frame
         int drawCalls = 0;       ///< draw calls
+        int renderWidth = 0;     ///< internal render resolution (dynamic resolution)
+        int renderHeight = 0;    ///< internal render height
+    };
+    /// What drew the run.
+    struct RenderInfo {
+        std::string renderer; ///< GL_RENDERER
+        std::string quality;  ///< "software" or "gpu"
+        bool shadows = false; ///< shadow map on
+        int outputWidth = 0;  ///< window / framebuffer size
+        int outputHeight = 0; ///< window / framebuffer height
     };
     /// Adds a frame.
     void add(const Frame& f) { frames_.push_back(f); }
     /// Number of frames recorded.
     std::size_t size() const { return frames_.size(); }
     /// Writes frames.csv and report.json into dir; latencies are impact → adopted in ms.
-    bool write(const std::filesystem::path& dir, const std::string& scene, const std::string& renderer,
+    bool write(const std::filesystem::path& dir, const std::string& scene, const RenderInfo& render,
                const std::vector<double>& latencies, int screenshots, std::string& summary) const;
 
 private:

@@ -13,15 +13,18 @@
 #include <filesystem>
 #include <iostream>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
 #include "Autopilot.hpp"
+#include "DynamicResolution.hpp"
 #include "Game.hpp"
 #include "GlContext.hpp"
 #include "Panel.hpp"
 #include "Renderer.hpp"
 #include "RunReport.hpp"
+#include "ScaledTarget.hpp"
 #include "rubble/SceneConfig.hpp"
 
 namespace {
@@ -61,17 +64,25 @@ struct Options {
     std::string replay; // journal file replayed on the loaded scene instead of playing
     int host = 0;       // port to host loopback multiplayer on
     bool structure = false;
+    std::string quality = "auto"; // auto (from GL_RENDERER), software or gpu
+    float targetFps = 60;         // dynamic resolution holds this rate (software quality)
+    float minScale = -1;          // smallest internal resolution scale (-1: the quality's)
 };
 
 struct App {
     Options opt;
     std::unique_ptr<demo::GlContext> gl;
+    demo::RenderQuality quality;
     demo::Renderer renderer;
+    demo::ScaledTarget sceneTarget;
     demo::Game game;
     demo::Panel panel;
     demo::GameSettings pending;
     rubble::SceneConfig scene;
     std::string sceneName;
+    std::vector<std::filesystem::path> scenes; // what N cycles through: the demolition, the thesis's scenes
+    std::size_t sceneIndex = 0;
+    bool nextScene = false; // N pressed
     bool paused = false;
     bool quit = false;
     bool screenshotRequested = false;
@@ -100,7 +111,20 @@ void keyCallback(GLFWwindow* w, int key, int, int action, int) {
             a.paused = false;
         break;
     case GLFW_KEY_F1:
-        a.panel.visible = !a.panel.visible;
+        a.panel.toggle();
+        break;
+    case GLFW_KEY_H:
+        a.panel.help = !a.panel.help;
+        break;
+    case GLFW_KEY_R:
+        a.game.respawn();
+        break;
+    case GLFW_KEY_N:
+        a.nextScene = true;
+        break;
+    case GLFW_KEY_L:
+        a.game.settings().autoLevel = !a.game.settings().autoLevel;
+        a.pending.autoLevel = a.game.settings().autoLevel;
         break;
     case GLFW_KEY_F2:
         a.screenshotRequested = true;
@@ -146,7 +170,7 @@ bool loadScene(App& a, std::string& error) {
     a.renderer.shutdown();
     a.renderer = demo::Renderer();
     std::string rerr;
-    if (!a.renderer.init(rerr)) {
+    if (!a.renderer.init(a.quality, rerr)) {
         error = "renderer: " + rerr;
         return false;
     }
@@ -178,8 +202,11 @@ int main(int argc, char** argv) {
     Options& o = app.opt;
     CLI::App cli{"rubble-demo: fly a vehicle through a world.cfg scene and shoot destructible objects.\n"
                  "Keys: W/S pitch, A/D roll, Q/E yaw, Z/X speed, Space fire/unpause, P pause, Esc quit,\n"
-                 "F1 panel, F2 screenshot, F3 debug overlay."};
-    cli.add_option("--scene", o.scene, "world.cfg scene (thesis format); default assets/scenes/world.cfg");
+                 "F1 panel, F2 screenshot, F3 debug overlay, F5/F9 quick save/load, H key help."};
+    cli.add_option(
+        "--scene", o.scene,
+        "world.cfg scene (thesis format); default assets/scenes/demolition.cfg (N cycles to the "
+        "thesis's scenes in ../shared/seed/media or RUBBLE_SEED_MEDIA, and assets/scenes/world.cfg)");
     cli.add_flag("-d,--debug", o.debug, "draw collision shapes, AABBs and impact points");
     cli.add_option("--autopilot", o.autopilot, "fly and shoot by script for SECONDS (fixed 1/60 s steps)");
     cli.add_option("--screenshot-every", o.screenshotEvery,
@@ -195,7 +222,9 @@ int main(int argc, char** argv) {
     cli.add_option("--pattern", o.pattern, "fracture pattern: single or shatter")
         ->check(CLI::IsMember({"single", "shatter"}));
     cli.add_option("--cells", o.cells, "cells K of the shatter pattern");
-    cli.add_flag("--no-panel", o.noPanel, "hide the ImGui panel (F1 toggles it)");
+    cli.add_flag(
+        "--no-panel", o.noPanel,
+        "hide the panel's compact HUD line too (F1 shows the full panel; by default it starts collapsed)");
     cli.add_flag("--deterministic", o.deterministic, "adopt fractures a fixed number of frames after impact");
     cli.add_flag("--no-shadows", o.noShadows, "disable shadow mapping");
     cli.add_option("--record", o.record,
@@ -209,6 +238,18 @@ int main(int argc, char** argv) {
            "host loopback multiplayer on 127.0.0.1:PORT (needs --deterministic); clients: rubble-bench "
            "netplay-client --port PORT")
         ->check(CLI::Range(1, 65535));
+    cli.add_option(
+           "--quality", o.quality,
+           "renderer quality: auto (software GL gets the software level), software (per-vertex light, "
+           "no shadows, bilinear textures, fewer dust particles) or gpu (per-pixel light, shadows)")
+        ->check(CLI::IsMember({"auto", "software", "gpu"}));
+    cli.add_option("--target-fps", o.targetFps, "frame rate dynamic resolution holds (default 60)")
+        ->check(CLI::Range(5.0, 1000.0));
+    cli.add_option(
+           "--min-scale", o.minScale,
+           "smallest internal resolution scale per axis dynamic resolution may use to hold --target-fps "
+           "(default 1 = off; 0.667 keeps 1280x720 at 1080p)")
+        ->check(CLI::Range(0.25, 1.0));
     cli.add_flag("--structure", o.structure,
                  "stress solver: bonds between static parts break under load; draws them by stress");
     CLI11_PARSE(cli, argc, argv);
@@ -228,9 +269,11 @@ int main(int argc, char** argv) {
     }
 
     // Scene.
+    const std::filesystem::path assets = std::filesystem::path(RUBBLE_SOURCE_DIR) / "assets/scenes";
     std::filesystem::path scenePath =
-        o.scene.empty() ? std::filesystem::path(RUBBLE_SOURCE_DIR) / "assets/scenes/world.cfg"
-                        : std::filesystem::path(o.scene);
+        o.scene.empty() ? assets / "demolition.cfg" : std::filesystem::path(o.scene);
+    if (o.scene.empty() && !std::filesystem::exists(scenePath))
+        scenePath = assets / "world.cfg";
     if (o.scene.empty() && !std::filesystem::exists(scenePath)) {
         std::fprintf(stderr, "warning: %s not found; using the built-in fallback scene\n",
                      scenePath.string().c_str());
@@ -250,6 +293,24 @@ int main(int argc, char** argv) {
         }
         app.scene = r.value();
         app.sceneName = scenePath.filename().string();
+        app.scenes.push_back(scenePath);
+    }
+    { // N cycles: this scene, the demolition, the thesis's scenes (when its media folder is there), world.cfg
+        const char* seedEnv = std::getenv("RUBBLE_SEED_MEDIA");
+        const std::filesystem::path seed =
+            seedEnv ? std::filesystem::path(seedEnv)
+                    : std::filesystem::path(RUBBLE_SOURCE_DIR) / "../shared/seed/media";
+        for (const auto& p : {assets / "demolition.cfg", seed / "world.cfg", seed / "performance_test.cfg",
+                              seed / "cube_test.cfg", assets / "world.cfg"}) {
+            std::error_code ec;
+            if (!std::filesystem::exists(p, ec))
+                continue;
+            bool known = false;
+            for (const auto& q : app.scenes)
+                known = known || std::filesystem::equivalent(p, q, ec);
+            if (!known)
+                app.scenes.push_back(p);
+        }
     }
 
     app.pending.workers = o.workers;
@@ -262,7 +323,6 @@ int main(int argc, char** argv) {
     app.pending.fracture.sizeLaw.exponent = 0.5;
     app.pending.fracture.sizeLaw.maxSize = 30;
     app.pending.fracture.uvScale = 0.25;
-    app.pending.shadows = !o.noShadows;
     app.pending.debugShapes = app.pending.debugAabbs = app.pending.debugImpacts = o.debug;
     app.pending.structure = app.pending.debugBonds = o.structure;
 
@@ -272,6 +332,13 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "error: %s\n", error.c_str());
         return 1;
     }
+    const std::string rendererName = app.gl->renderer();
+    app.quality = demo::RenderQuality::forRenderer(o.quality == "gpu" ? std::string("gpu") : rendererName);
+    if (o.quality == "software" && !app.quality.software)
+        app.quality = demo::RenderQuality::forRenderer("llvmpipe");
+    if (o.minScale > 0)
+        app.quality.minScale = o.minScale;
+    app.pending.shadows = !o.noShadows && app.quality.shadows;
     if (!loadScene(app, error)) {
         std::fprintf(stderr, "error: %s\n", error.c_str());
         return 1;
@@ -322,10 +389,14 @@ int main(int argc, char** argv) {
         std::error_code ec;
         std::filesystem::create_directories(o.out, ec);
     }
-    const std::string rendererName = app.gl->renderer();
-    std::fprintf(stderr, "rubble-demo: %s, %dx%d, %s, fracture DestructionWorld + rubble_bullet\n",
+    std::fprintf(stderr,
+                 "rubble-demo: %s, %dx%d, %s, %s quality (shadows %s, %s lighting, internal scale >= %.2f), "
+                 "fracture DestructionWorld + rubble_bullet\n",
                  headless ? "EGL offscreen" : "window", app.gl->width(), app.gl->height(),
-                 rendererName.c_str());
+                 rendererName.c_str(), app.quality.name(), app.pending.shadows ? "on" : "off",
+                 app.quality.pixelLighting ? "per-pixel" : "per-vertex", app.quality.minScale);
+    demo::DynamicResolution resolution(1000.0f / o.targetFps, app.quality.minScale);
+    float lastFrameMs = 0;
 
     demo::Autopilot pilot;
     demo::RunReport report;
@@ -378,12 +449,18 @@ int main(int argc, char** argv) {
 
         // Scene.
         const int w = app.gl->width(), h = app.gl->height();
+        resolution.update(lastFrameMs);
+        int iw = w, ih = h;
+        resolution.size(w, h, iw, ih);
+        const bool scaled = (iw != w || ih != h) && app.sceneTarget.reserve(w, h);
+        if (!scaled)
+            iw = w, ih = h;
         app.renderer.beginFrame();
         app.game.draw(app.renderer, autopilot ? fixedDt : static_cast<float>(std::min(realDt, 0.1)));
         demo::FrameView fv;
-        fv.width = w;
-        fv.height = h;
-        fv.fbo = app.gl->framebuffer();
+        fv.width = iw;
+        fv.height = ih;
+        fv.fbo = scaled ? app.sceneTarget.framebuffer() : app.gl->framebuffer();
         fv.eye = app.game.camera().eye;
         fv.view = app.game.camera().view();
         fv.proj = demo::perspective(1.05f, static_cast<float>(w) / static_cast<float>(std::max(h, 1)), 0.5f,
@@ -392,6 +469,8 @@ int main(int argc, char** argv) {
         app.game.vehicleFrame(vpos, vfwd, vup);
         fv.focus = vpos + vfwd * 60.0f;
         app.renderer.render(fv);
+        if (scaled)
+            app.sceneTarget.blitTo(app.gl->framebuffer(), iw, ih, w, h);
 
         // UI.
         io.DisplaySize = ImVec2(static_cast<float>(w), static_cast<float>(h));
@@ -402,6 +481,25 @@ int main(int argc, char** argv) {
         if (autopilot) {
             io.DeltaTime = fixedDt;
         }
+        if (app.nextScene &&
+            !app.scenes.empty()) { // N: the next scene; a scene that does not parse is skipped
+            app.nextScene = false;
+            app.sceneIndex = (app.sceneIndex + 1) % app.scenes.size();
+            const auto& next = app.scenes[app.sceneIndex];
+            if (auto r = rubble::parseSceneConfig(next); r) {
+                app.scene = r.value();
+                app.sceneName = next.filename().string();
+                if (!loadScene(app, error)) {
+                    std::fprintf(stderr, "error: %s\n", error.c_str());
+                    break;
+                }
+                std::printf("scene: %s\n", next.string().c_str());
+            } else {
+                std::fprintf(stderr, "error: %s\n", r.error().message.c_str());
+            }
+            std::fflush(stdout);
+        }
+        app.panel.scaleToWindow(h);
         ImGui::NewFrame();
         app.panel.pushLatencies(app.game.takeNewLatencies());
         if (app.panel.draw(app.game, app.pending, app.paused, app.sceneName, rendererName,
@@ -451,14 +549,16 @@ int main(int argc, char** argv) {
             std::chrono::duration<double, std::milli>(Clock::now() - frameStart).count() - shotMs;
         app.panel.pushFrameMs(static_cast<float>(frameMs));
         const demo::GameCounters& c = app.game.counters();
-        report.add(
-            {simFrame, static_cast<double>(simFrame) / 60.0, frameMs, stepMs, c, app.renderer.drawCalls()});
+        lastFrameMs = static_cast<float>(frameMs);
+        report.add({simFrame, static_cast<double>(simFrame) / 60.0, frameMs, stepMs, c,
+                    app.renderer.drawCalls(), iw, ih});
         if (o.stats && renderFrame % std::max(1, o.statsEvery) == 0) {
             std::printf(
                 "stats render=%ld frame=%llu paused=%d shots=%d impacts=%d fractures=%d bodies=%d pieces=%d "
-                "jobs=%d frame_ms=%.2f\n",
+                "jobs=%d crashes=%d respawns=%d turnbacks=%d x=%.0f z=%.0f frame_ms=%.2f\n",
                 renderFrame, static_cast<unsigned long long>(c.frame), app.paused ? 1 : 0, c.shots, c.impacts,
-                c.fractures, c.bodies, c.pieces, c.jobs, frameMs);
+                c.fractures, c.bodies, c.pieces, c.jobs, c.crashes, c.respawns, c.turnBacks,
+                static_cast<double>(vpos.x), static_cast<double>(vpos.z), frameMs);
             std::fflush(stdout);
         }
         if (lastFrame)
@@ -468,8 +568,10 @@ int main(int argc, char** argv) {
     if (!o.out.empty()) {
         std::string summary;
         const auto outDir = std::filesystem::path(o.out);
-        if (report.write(outDir, app.scene.baseDir.string() + "/" + app.sceneName, rendererName,
-                         app.game.latencies(), app.screenshots, summary)) {
+        if (report.write(
+                outDir, app.scene.baseDir.string() + "/" + app.sceneName,
+                {rendererName, app.quality.name(), app.pending.shadows, app.gl->width(), app.gl->height()},
+                app.game.latencies(), app.screenshots, summary)) {
             app.game.writeTimings((outDir / "latency.csv").string());
             std::printf("report: %s\n", summary.c_str());
             std::printf("wrote %s/report.json, %s/frames.csv and %d screenshots\n", o.out.c_str(),
@@ -504,6 +606,7 @@ int main(int argc, char** argv) {
     ImGui::DestroyContext();
     app.game.clear(app.renderer);
     app.renderer.shutdown();
+    app.sceneTarget.release();
     app.gl.reset();
     return status;
 }

@@ -65,6 +65,32 @@ PY
 fi
 echo "ok: headless autopilot, report and deterministic screenshots"
 
+# Render quality: both levels draw a picture and the report names the level, the renderer and the internal
+# resolution. Dynamic resolution under an unreachable target falls to its floor (2/3 per axis) and no lower.
+run gpu --scene "$here/e2e.cfg" --autopilot 1 --screenshot-every 1 --quality gpu --width 480 --height 270
+run soft --scene "$here/e2e.cfg" --autopilot 1 --screenshot-every 1 --quality software --width 480 --height 270
+run drs --scene "$here/e2e.cfg" --autopilot 1 --quality software --min-scale 0.667 --target-fps 1000 \
+    --width 480 --height 270
+python3 - "$work" "$here/png_stats.py" <<'PY' || fail "render quality levels"
+import json, subprocess, sys
+work = sys.argv[1]
+for name, quality, shadows in (("gpu", "gpu", True), ("soft", "software", False)):
+    r = json.load(open(f"{work}/{name}/report.json"))
+    assert r["quality"] == quality and r["shadows"] == shadows, (name, r["quality"], r["shadows"])
+    assert r["renderer"], r
+    ir = r["internal_resolution"]
+    assert (ir["width_p50"], ir["height_p50"]) == (480, 270), ir
+    out = subprocess.run([sys.executable, sys.argv[2], f"{work}/{name}/shot_0001.png"], capture_output=True, text=True)
+    assert out.returncode == 0, out.stdout + out.stderr
+    var = float(out.stdout.split("var=")[1].split()[0])
+    assert var > 50, (name, "blank picture", out.stdout)
+r = json.load(open(f"{work}/drs/report.json"))
+ir = r["internal_resolution"]
+assert (ir["width_min"], ir["height_min"]) == (320, 180), ir  # 2/3 of 480x270, even sizes
+assert ir["width_p50"] < 480, ir
+print("ok: gpu and software quality render; dynamic resolution floors at %dx%d" % (ir["width_min"], ir["height_min"]))
+PY
+
 media=${RUBBLE_SEED_MEDIA:-$here/../../../shared/seed/media}
 if [ -d "$media" ]; then
     for cfg in world performance_test cube_test; do

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # End-to-end test of rubble-demo under Xvfb: real window, real key events (xdotool), assertions on the
 # demo's --stats output and on its screenshots.
-#   Space fires and impacts follow; P freezes the frame counter and Space resumes it; Esc exits with 0;
+#   Space fires and impacts follow; P freezes the frame counter and Space resumes it; H shows and hides the
+#   key help; N loads the next scene; Esc exits with 0;
 #   a screenshot is not blank and differs before and after a hit.
 # Usage: demo_e2e.sh PATH/TO/rubble-demo      Exit 77 = skipped (Xvfb or xdotool missing).
 set -uo pipefail
@@ -102,6 +103,23 @@ f2=$(field frame)
 [ "$f1" = "$f2" ] || fail "frame counter moved while paused ($f1 -> $f2)"
 [ "$(field paused)" = "1" ] || fail "paused flag dropped"
 echo "ok: P froze the frame counter at $f1"
+
+# H shows the key help over the (frozen) picture and hides it again.
+key F2
+wait_for 20 shots_taken 3 || fail "screenshot 3 missing"
+key h
+sleep 0.5
+key F2
+wait_for 20 shots_taken 4 || fail "screenshot 4 missing"
+key h
+sleep 0.5
+key F2
+wait_for 20 shots_taken 5 || fail "screenshot 5 missing"
+help_on=$(python3 "$here/png_stats.py" "$work/out/shot_0003.png" "$work/out/shot_0004.png" | sed -n 's/.*diff=\([0-9.]*\).*/\1/p')
+help_off=$(python3 "$here/png_stats.py" "$work/out/shot_0003.png" "$work/out/shot_0005.png" | sed -n 's/.*diff=\([0-9.]*\).*/\1/p')
+python3 -c "import sys; sys.exit(0 if float('$help_on') > 0.5 and float('$help_on') > 5 * float('$help_off') else 1)" ||
+    fail "H did not show and hide the help overlay (diff with help $help_on, after closing it $help_off)"
+echo "ok: H showed the key help (picture diff $help_on) and hid it ($help_off)"
 key space
 resumed() { [ "$(field paused)" = "0" ] && [ "$(field frame)" -gt "$f2" ]; }
 wait_for 20 resumed || fail "Space did not unpause"
@@ -127,6 +145,15 @@ f3=$(field frame)
 moving() { [ "$(field frame)" -gt "$f3" ]; }
 wait_for 20 moving || fail "the game stopped after F9"
 echo "ok: $(grep '^F9' "$work/log" | tail -n 1)"
+
+# N loads the next scene (the demolition scene after e2e.cfg) and the game plays on in it.
+key n
+next_scene() { grep -q '^scene: .*demolition.cfg' "$work/log"; }
+wait_for 60 next_scene || fail "N did not load the next scene: $(grep -E '^(scene|error)' "$work/log")"
+f4=$(field frame)
+moving_on() { [ "$(field frame)" -gt "$f4" ]; }
+wait_for 30 moving_on || fail "the game stopped after N"
+echo "ok: N loaded $(grep '^scene: ' "$work/log" | tail -n 1 | cut -d' ' -f2-)"
 
 # Esc quits with status 0.
 key Escape
