@@ -15,57 +15,12 @@ for tool in Xvfb xdotool python3; do
     fi
 done
 
-work=$(mktemp -d /tmp/rubble-e2e.XXXXXX)
-xvfb_pid=""
-demo_pid=""
-cleanup() {
-    [ -n "$demo_pid" ] && kill "$demo_pid" 2>/dev/null
-    [ -n "$xvfb_pid" ] && kill "$xvfb_pid" 2>/dev/null
-    wait 2>/dev/null
-    rm -rf "$work"
-}
-trap cleanup EXIT
-fail() {
-    echo "FAIL: $*"
-    echo "--- demo output (last 30 lines) ---"
-    tail -n 30 "$work/log" 2>/dev/null
-    exit 1
-}
-
-# A free display number.
-disp=""
-for n in $(seq 91 140); do
-    if [ ! -e "/tmp/.X11-unix/X$n" ] && [ ! -e "/tmp/.X$n-lock" ]; then
-        disp=":$n"
-        break
-    fi
-done
-[ -n "$disp" ] || fail "no free X display number"
-Xvfb "$disp" -screen 0 1280x720x24 -r -nolisten tcp >"$work/xvfb.log" 2>&1 &
-xvfb_pid=$!
-for _ in $(seq 1 100); do
-    [ -e "/tmp/.X11-unix/X${disp#:}" ] && break
-    sleep 0.1
-done
-[ -e "/tmp/.X11-unix/X${disp#:}" ] || fail "Xvfb did not start on $disp"
-export DISPLAY=$disp
+source "$here/../support/e2e.sh" rubble-e2e 30
+start_xvfb 91 140 -screen 0 1280x720x24 -r
 
 "$demo" --scene "$here/e2e.cfg" --stats --stats-every 5 --out "$work/out" --no-panel >"$work/log" 2>&1 &
 demo_pid=$!
 
-# Last value of a field (frame, shots, impacts, paused, ...) in the stats lines.
-field() { grep '^stats ' "$work/log" | tail -n 1 | tr ' ' '\n' | grep "^$1=" | cut -d= -f2; }
-wait_for() { # wait_for SECONDS COMMAND...: polls until COMMAND succeeds
-    local limit=$1
-    shift
-    for _ in $(seq 1 $((limit * 10))); do
-        if "$@"; then return 0; fi
-        kill -0 "$demo_pid" 2>/dev/null || fail "rubble-demo exited early"
-        sleep 0.1
-    done
-    return 1
-}
-have_stats() { grep -q '^stats ' "$work/log"; }
 wait_for 60 have_stats || fail "no stats line within 60 s"
 
 win=$(xdotool search --sync --onlyvisible --name "Rubble" 2>/dev/null | head -n 1)

@@ -13,52 +13,11 @@ for tool in Xvfb xdotool; do
         exit 77
     fi
 done
-work=$(mktemp -d /tmp/rubble-flight.XXXXXX)
-xvfb_pid=""
-demo_pid=""
-cleanup() {
-    [ -n "$demo_pid" ] && kill "$demo_pid" 2>/dev/null
-    [ -n "$xvfb_pid" ] && kill "$xvfb_pid" 2>/dev/null
-    wait 2>/dev/null
-    rm -rf "$work"
-}
-trap cleanup EXIT
-fail() {
-    echo "FAIL: $*"
-    echo "--- demo output (last 20 lines) ---"
-    tail -n 20 "$work/log" 2>/dev/null
-    exit 1
-}
-disp=""
-for n in $(seq 141 190); do
-    if [ ! -e "/tmp/.X11-unix/X$n" ] && [ ! -e "/tmp/.X$n-lock" ]; then
-        disp=":$n"
-        break
-    fi
-done
-[ -n "$disp" ] || fail "no free X display number"
-Xvfb "$disp" -screen 0 640x360x24 -nolisten tcp >"$work/xvfb.log" 2>&1 &
-xvfb_pid=$!
-for _ in $(seq 1 100); do
-    [ -e "/tmp/.X11-unix/X${disp#:}" ] && break
-    sleep 0.1
-done
-export DISPLAY=$disp
+source "$here/../support/e2e.sh" rubble-flight 20
+start_xvfb 141 190 -screen 0 640x360x24
 "$demo" --scene "$here/bounds.cfg" --stats --stats-every 5 --no-panel --width 640 --height 360 >"$work/log" 2>&1 &
 demo_pid=$!
 
-field() { grep '^stats ' "$work/log" | tail -n 1 | tr ' ' '\n' | grep "^$1=" | cut -d= -f2; }
-wait_for() { # wait_for SECONDS COMMAND...
-    local limit=$1
-    shift
-    for _ in $(seq 1 $((limit * 10))); do
-        if "$@"; then return 0; fi
-        kill -0 "$demo_pid" 2>/dev/null || fail "rubble-demo exited early"
-        sleep 0.1
-    done
-    return 1
-}
-have_stats() { grep -q '^stats ' "$work/log"; }
 wait_for 60 have_stats || fail "no stats line within 60 s"
 win=$(xdotool search --sync --onlyvisible --name "Rubble" 2>/dev/null | head -n 1)
 [ -n "$win" ] || fail "demo window not found"
