@@ -287,6 +287,24 @@ GLuint uploadRgba(const unsigned char* data, int w, int h, bool trilinear) {
     return t;
 }
 
+// A vertex array of interleaved float triples (position, then a second attribute) in a new buffer holding
+// `data` (nothing yet when empty); leaves nothing bound.
+void makeTripleArray(GLuint& vao, GLuint& vbo, const std::vector<float>& data) {
+    glGenVertexArrays(1, &vao);
+    glBindVertexArray(vao);
+    glGenBuffers(1, &vbo);
+    glBindBuffer(GL_ARRAY_BUFFER, vbo);
+    if (!data.empty())
+        glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(data.size() * sizeof(float)), data.data(),
+                     GL_STATIC_DRAW);
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), nullptr);
+    glEnableVertexAttribArray(1);
+    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float),
+                          reinterpret_cast<void*>(3 * sizeof(float)));
+    glBindVertexArray(0);
+}
+
 } // namespace
 
 RenderQuality RenderQuality::forRenderer(const std::string& glRenderer) {
@@ -339,16 +357,7 @@ bool Renderer::init(const RenderQuality& quality, std::string& error) {
                           reinterpret_cast<void*>(4 * sizeof(float)));
     glVertexAttribDivisor(2, 1);
 
-    glGenVertexArrays(1, &lineVao_);
-    glBindVertexArray(lineVao_);
-    glGenBuffers(1, &lineVbo_);
-    glBindBuffer(GL_ARRAY_BUFFER, lineVbo_);
-    glEnableVertexAttribArray(0);
-    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), nullptr);
-    glEnableVertexAttribArray(1);
-    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float),
-                          reinterpret_cast<void*>(3 * sizeof(float)));
-    glBindVertexArray(0);
+    makeTripleArray(lineVao_, lineVbo_, {});
 
     glGenFramebuffers(1, &shadowFbo_);
     glGenTextures(1, &shadowTex_);
@@ -573,18 +582,7 @@ void Renderer::bakeProceduralSky() {
             push(a), push(b), push(c), push(a), push(c), push(d);
         }
     skyVertices_ = static_cast<int>(v.size() / 6);
-    glGenVertexArrays(1, &skyVao_);
-    glBindVertexArray(skyVao_);
-    glGenBuffers(1, &skyVbo_);
-    glBindBuffer(GL_ARRAY_BUFFER, skyVbo_);
-    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(v.size() * sizeof(float)), v.data(),
-                 GL_STATIC_DRAW);
-    glEnableVertexAttribArray(0);
-    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), nullptr);
-    glEnableVertexAttribArray(1);
-    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float),
-                          reinterpret_cast<void*>(3 * sizeof(float)));
-    glBindVertexArray(0);
+    makeTripleArray(skyVao_, skyVbo_, v);
 }
 
 void Renderer::bakeSkyCube() {
@@ -627,18 +625,7 @@ void Renderer::bakeSkyCube() {
             v.insert(v.end(), vert, vert + 6);
         }
     }
-    glGenVertexArrays(1, &cubeVao_);
-    glBindVertexArray(cubeVao_);
-    glGenBuffers(1, &cubeVbo_);
-    glBindBuffer(GL_ARRAY_BUFFER, cubeVbo_);
-    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(v.size() * sizeof(float)), v.data(),
-                 GL_STATIC_DRAW);
-    glEnableVertexAttribArray(0);
-    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), nullptr);
-    glEnableVertexAttribArray(1);
-    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float),
-                          reinterpret_cast<void*>(3 * sizeof(float)));
-    glBindVertexArray(0);
+    makeTripleArray(cubeVao_, cubeVbo_, v);
 }
 
 int Renderer::batchFor(int texture, bool interior) {
