@@ -2,10 +2,11 @@
 #   cd bench/results && gnuplot demolition.gp
 if (!exists("csv")) csv = 'demolition_frames.csv'
 if (!exists("png")) png = 'demolition.png'
+if (!exists("build")) build = 'Release'
 set terminal pngcairo size 1100,700
 set output png
 set datafile separator ','
-set multiplot layout 2,1 title "rubble-bench scene --pattern shatter, 10 shots/s, 60 Hz (Release, 2-core VM): per half second"
+set multiplot layout 2,1 title "rubble-bench scene --pattern shatter, 10 shots/s, 60 Hz (".build.", 2-core VM): per half second"
 set key top left
 set grid
 set xlabel 's'
