@@ -270,8 +270,7 @@ Vec3 longestAxis(const Aabb& b) {
     return d.y >= d.z ? Vec3{0, 1, 0} : Vec3{0, 0, 1};
 }
 
-// Sites on jittered rings in the local xy plane around the centre site (ring j holds 6j sites, the rings
-// denser near the centre): Voronoi cells that are wedges between radial cracks, in concentric bands.
+// Sites on jittered rings in the local xy plane, ring j holding 6j (docs/structure.md, radial layout).
 void radialSites(std::vector<Vec3>& sites, int n, double h, Rng& rng) {
     int rings = 1;
     while (1 + 3 * rings * (rings + 1) < n + 1)

@@ -38,8 +38,7 @@ public:
     void frozen(BodyId id, const Vec3& center, double radius);
     /// A body stopped being frozen (woken or removed).
     void thawed(BodyId id);
-    /// A frozen body was woken at center: once it moves farther than `radius`·kMovedFraction from there, the
-    /// frozen bodies within `margin` of its old place are woken too (they may have rested on it).
+    /// A frozen body was woken at center; its old neighbourhood (within margin) wakes once it leaves there.
     void woken(BodyId id, const Vec3& center, double radius, double margin);
     /// A body left the simulation.
     void removed(BodyId id);

@@ -48,6 +48,23 @@ std::vector<ConvexPolytope> worldParts(const ObjectState& st, const Frame& objec
     return out;
 }
 
+// The record of an object's body as its spawn describes it (role, motion and object given; no support flags).
+BodyRecord objectRecord(ObjectId object, BodyRole role, BodyMotionState motion, const detail::PieceSpawn& s,
+                        const ObjectState& st) {
+    BodyRecord rec;
+    rec.role = role;
+    rec.motion = motion;
+    rec.hasObject = true;
+    rec.object = object;
+    rec.objectToBody = s.objectToBody;
+    rec.volume = s.volume;
+    rec.mass = s.mass;
+    rec.inertia = s.inertia;
+    rec.triangles = s.triangles;
+    rec.radius = boundingRadius(st.mesh, s.objectToBody);
+    return rec;
+}
+
 } // namespace
 
 struct DestructionRuntime::Impl {
@@ -101,8 +118,7 @@ struct DestructionRuntime::Impl {
         return Aabb{c - e, c + e};
     }
 
-    // Removes a body; what rested on it is re-checked (support) or woken (frozen debris). A body in motion
-    // holds nothing up, so its removal wakes nothing.
+    // Removes a body; what a resting body held is re-checked (support) or woken (frozen debris).
     void destroy(BodyId id, bool removeObject, bool wakeResting = true) {
         BodyRecord* r = bodies.find(id);
         if (!r)
@@ -136,8 +152,7 @@ struct DestructionRuntime::Impl {
         destroy(id, true);
     }
 
-    // A static or frozen body becomes dynamic. What rests on a collapsing part is woken at once; what rests
-    // on a woken frozen piece only once that piece leaves its place.
+    // A static or frozen body becomes dynamic (wake rules: docs/architecture.md).
     void makeDynamic(BodyId id) {
         BodyRecord* r = bodies.find(id);
         if (!r || r->motion == BodyMotionState::Dynamic)
@@ -208,25 +223,16 @@ struct DestructionRuntime::Impl {
             outcome, parent, parentMotion, config.adoption, collapse, config.debris.particleLifetime,
             config.structure.enabled && config.structure.bondDebris);
         const bool parentResting = !moving(parent);
-        // The DestructionWorld removed the parent object already. What rested on the parent is woken where
-        // debris leaves (below), not across the parent's whole bounds: the remainder still holds the rest.
+        // The world removed the parent object already; what it held wakes near its flying debris (below).
         destroy(parent.id, false, false);
         ++stats.fractures;
         ++counters.fractures;
         for (std::size_t i = 0; i < plan.spawns.size(); ++i) {
             const detail::PieceSpawn& s = plan.spawns[i];
             const ObjectState& st = *outcome.pieces[i].state;
-            BodyRecord rec;
-            rec.role = BodyRole::Piece;
-            rec.motion = s.isStatic ? BodyMotionState::Static : BodyMotionState::Dynamic;
-            rec.hasObject = true;
-            rec.object = s.object;
-            rec.objectToBody = s.objectToBody;
-            rec.volume = s.volume;
-            rec.mass = s.mass;
-            rec.inertia = s.inertia;
-            rec.triangles = s.triangles;
-            rec.radius = boundingRadius(st.mesh, s.objectToBody);
+            BodyRecord rec =
+                objectRecord(s.object, BodyRole::Piece,
+                             s.isStatic ? BodyMotionState::Static : BodyMotionState::Dynamic, s, st);
             rec.anchor = s.anchor;
             rec.structural = s.structural;
             const BodyRecord& made = insert(rec, s.desc);
@@ -405,17 +411,8 @@ Result<ObjectId> DestructionRuntime::addObject(ObjectDesc desc, const Frame& pla
     const ObjectState& st = *im.world.object(*id);
     detail::PieceSpawn s = detail::describeObjectBody(st, isStatic, 0);
     s.desc.transform = placement * s.objectToBody;
-    BodyRecord rec;
-    rec.role = BodyRole::Object;
-    rec.motion = isStatic ? BodyMotionState::Static : BodyMotionState::Dynamic;
-    rec.hasObject = true;
-    rec.object = *id;
-    rec.objectToBody = s.objectToBody;
-    rec.volume = s.volume;
-    rec.mass = s.mass;
-    rec.inertia = s.inertia;
-    rec.triangles = s.triangles;
-    rec.radius = boundingRadius(st.mesh, s.objectToBody);
+    BodyRecord rec = objectRecord(*id, BodyRole::Object,
+                                  isStatic ? BodyMotionState::Static : BodyMotionState::Dynamic, s, st);
     rec.structural = isStatic;
     const BodyId body = im.insert(rec, s.desc).id;
     if (isStatic) {
@@ -683,17 +680,7 @@ Status DestructionRuntime::restore(WorldState state, const std::vector<ObjectPla
             s.desc.friction = im.config.adoption.friction;
             s.desc.restitution = im.config.adoption.restitution;
         }
-        BodyRecord rec;
-        rec.role = p.role;
-        rec.motion = p.motion;
-        rec.hasObject = true;
-        rec.object = id;
-        rec.objectToBody = s.objectToBody;
-        rec.volume = s.volume;
-        rec.mass = s.mass;
-        rec.inertia = s.inertia;
-        rec.triangles = s.triangles;
-        rec.radius = boundingRadius(st.mesh, s.objectToBody);
+        BodyRecord rec = objectRecord(id, p.role, p.motion, s, st);
         rec.structural = p.motion == BodyMotionState::Static;
         const BodyId body = im.insert(rec, s.desc).id;
         if (p.motion == BodyMotionState::Static)
