@@ -82,7 +82,7 @@ struct DestructionRuntime::Impl {
     detail::SupportGraph support;
     detail::StructureMonitor structure;
     std::map<ObjectId, const Material*> materials; // of objects (pieces inherit their parent's)
-    std::map<ObjectId, std::uint64_t> solids;       // pieces: the scene object they were cut from
+    std::map<ObjectId, std::uint64_t> solids;      // pieces: the scene object they were cut from
     detail::DebrisGovernor governor;
     std::set<BodyId> projectiles;
     detail::DebrisPool particles;
