@@ -758,7 +758,7 @@ bool Game::saveSnapshot(const std::string& path, std::string& message) const {
         message = "no scene loaded";
         return false;
     }
-    const rubble::Snapshot snapshot = rubble::takeSnapshot(runtime_->world(), runtime_->placements());
+    const rubble::Snapshot snapshot = rubble::takeSnapshot(*runtime_);
     if (rubble::Status s = rubble::saveSnapshot(path, snapshot); !s) {
         message = s.message();
         return false;
