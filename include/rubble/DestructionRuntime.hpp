@@ -309,10 +309,12 @@ public:
     /// Replaces the world's state and every body that carries an object by a saved world (a snapshot): each
     /// object gets a body at its placement with its velocities and motion state (static ones join the support
     /// graph, frozen ones the governor's grid). Bodies without objects (ground, scenery, projectiles) stay.
-    /// The volume ledger restarts (retired, dust and dropped are not saved). Fails, changing nothing, when
-    /// the state is inconsistent (DestructionWorld::loadState) or an object has no placement or a placement
-    /// no object, or a placement's role is neither Object nor Piece.
-    Status restore(WorldState state, const std::vector<ObjectPlacement>& placements);
+    /// The volume ledger continues from volumes' retired, dust and dropped (live is the objects'). Fails,
+    /// changing nothing, when the state is inconsistent (DestructionWorld::loadState), an object has no
+    /// placement or a placement no object, a placement's role is neither Object nor Piece, or a volume is
+    /// negative or not finite.
+    Status restore(WorldState state, const std::vector<ObjectPlacement>& placements,
+                   const VolumeLedger& volumes = {});
 
     /// Hash of the live body set (id, role, motion, object version and mesh hash, transform bits) and of the
     /// volume ledger: equal runs give equal hashes.

@@ -655,8 +655,13 @@ std::vector<ObjectPlacement> DestructionRuntime::placements() const {
     return out;
 }
 
-Status DestructionRuntime::restore(WorldState state, const std::vector<ObjectPlacement>& placements) {
+Status DestructionRuntime::restore(WorldState state, const std::vector<ObjectPlacement>& placements,
+                                   const VolumeLedger& volumes) {
     Impl& im = *impl_;
+    for (double v : {volumes.retired, volumes.dust, volumes.dropped})
+        if (!(v >= 0 && v < 1e300))
+            return Error{ErrorCode::InvalidInput,
+                         "volume ledger: " + std::to_string(v) + " is negative or not finite"};
     std::map<ObjectId, const ObjectPlacement*> where;
     for (const ObjectPlacement& p : placements) {
         const std::string which = "placement of object " + std::to_string(p.object);
@@ -680,7 +685,7 @@ Status DestructionRuntime::restore(WorldState state, const std::vector<ObjectPla
         return s;
     for (BodyId id : old)
         im.destroy(id, false);
-    im.ledger = VolumeLedger{};
+    im.ledger = VolumeLedger{0, volumes.retired, volumes.dust, volumes.dropped};
     for (ObjectId id : im.world.objects()) {
         const ObjectState& st = *im.world.object(id);
         const ObjectPlacement& p = *where.at(id);
