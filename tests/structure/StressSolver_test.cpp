@@ -252,23 +252,33 @@ TEST(StressSolver, BearingSlabTipsExactlyWhenItsCentreOfMassLeavesTheContact) {
     EXPECT_GT(tipped, 3);
 }
 
+// A 2 x 0.2 x 2 m concrete slab (node 1) on a pier (node 0, root) of the same top, after 40 solves with a
+// load at a point; friction > 0: a bearing.
+namespace {
+constexpr std::uint32_t kSlab = 1;
+StressSolver loadedSlabOnPier(double friction, const Vec3& load, const Vec3& at) {
+    Scene scene;
+    scene.add(box({-1, 0, -1}, {1, 1, 1}), "concrete", true);
+    scene.add(box({-1, 1, -1}, {1, 1.2, 1}), "concrete");
+    StressSolver s = scene.solver({}, friction);
+    for (int i = 0; i < 40; ++i) {
+        s.addLoad(kSlab, load, at);
+        s.solve();
+    }
+    return s;
+}
+} // namespace
+
 // A bearing carries no tension: a slab lifted by more than its weight is not held; a welded one is.
 TEST(StressSolver, BearingLetsGoWhenPulledApartAndAWeldDoesNot) {
     for (const double friction : {0.6, 0.0})
         for (const double lift : {0.5, 1.5}) {
-            Scene scene;
-            scene.add(box({-1, 0, -1}, {1, 1, 1}), "concrete", true);
-            const std::uint32_t slab = scene.add(box({-1, 1, -1}, {1, 1.2, 1}), "concrete");
-            StressSolver s = scene.solver({}, friction);
-            const double weight = scene.materials[slab]->density * 0.8 * kG;
-            for (int i = 0; i < 40; ++i) {
-                s.addLoad(slab, {0, lift * weight, 0}, {0, 1.1, 0});
-                s.solve();
-            }
+            const double weight = findMaterial("concrete")->density * 0.8 * kG;
+            StressSolver s = loadedSlabOnPier(friction, {0, lift * weight, 0}, {0, 1.1, 0});
             EXPECT_TRUE(s.breakOverstressed().empty());
             const bool letsGo = friction > 0 && lift > 1;
             EXPECT_EQ(s.unsupported(),
-                      letsGo ? std::vector<std::uint32_t>{slab} : std::vector<std::uint32_t>{})
+                      letsGo ? std::vector<std::uint32_t>{kSlab} : std::vector<std::uint32_t>{})
                 << "friction " << friction << " lift " << lift;
         }
 }
@@ -277,18 +287,11 @@ TEST(StressSolver, BearingLetsGoWhenPulledApartAndAWeldDoesNot) {
 TEST(StressSolver, BearingSlidesWhenThePushExceedsFrictionTimesWeight) {
     const double mu = 0.6;
     for (const double push : {0.9, 1.1}) {
-        Scene scene;
-        scene.add(box({-1, 0, -1}, {1, 1, 1}), "concrete", true);
-        const std::uint32_t slab = scene.add(box({-1, 1, -1}, {1, 1.2, 1}), "concrete");
-        StressSolver s = scene.solver({}, mu);
-        const double weight = scene.materials[slab]->density * 0.8 * kG;
-        for (int i = 0; i < 40; ++i) {
-            s.addLoad(slab, {push * mu * weight, 0, 0}, {0, 1, 0});
-            s.solve();
-        }
+        const double weight = findMaterial("concrete")->density * 0.8 * kG;
+        StressSolver s = loadedSlabOnPier(mu, {push * mu * weight, 0, 0}, {0, 1, 0});
         EXPECT_NEAR(s.utilisation(0), std::min(push, 1.0), 0.01 * push);
         EXPECT_EQ(s.unsupported(),
-                  push > 1 ? std::vector<std::uint32_t>{slab} : std::vector<std::uint32_t>{});
+                  push > 1 ? std::vector<std::uint32_t>{kSlab} : std::vector<std::uint32_t>{});
     }
 }
 
