@@ -69,7 +69,8 @@ struct ImpactCut {
     double size = 0;                               ///< domain edge length
 };
 
-/// CellPattern::Adaptive: a hit shatters when its law size is at least this many times a touch's (sizeFor(0)).
+/// CellPattern::Adaptive: a hit shatters when its law size is at least this many times a touch's
+/// (sizeFor(0)).
 inline constexpr double kShatterGrowth = 3.0;
 /// CellPattern::Adaptive: objects with a bounds diagonal above this lose cuts larger by sqrt(diagonal / it).
 inline constexpr double kAdaptiveReferenceSize = 10.0;
@@ -126,7 +127,7 @@ struct FractureResult {
 /// The cut of one impact on a mesh with the given bounds. SingleCell and Shatter: the params' pattern and
 /// sizeLaw.sizeFor(impulse). Adaptive: Shatter when sizeFor(impulse) >= kShatterGrowth * sizeFor(0), else
 /// SingleCell; the size is sizeFor(impulse) * max(1, sqrt(diagonal / kAdaptiveReferenceSize)), at most
-/// sizeLaw.maxSize (docs/rendering.md, weapons). Pure; a function of the journaled impulse and the geometry.
+/// sizeLaw.maxSize (demo/README.md, weapons). Pure; a function of the journaled impulse and the geometry.
 ImpactCut impactCut(const FractureParams& params, const Aabb& meshBounds, double impulse);
 
 /// Builds the cutting cells for an impact on a mesh with the given bounds. Deterministic in seed.

@@ -58,8 +58,8 @@ TEST(ImpactCut, AdaptiveChipsWeakHitsShattersStrongOnesAndGrowsWithTheObject) {
     p.sizeLaw.scale = 0.04;
     p.sizeLaw.exponent = 0.5;
     p.sizeLaw.maxSize = 30;
-    const Aabb small{{0, 0, 0}, {4, 4, 4}};                  // diagonal 6.9 < reference
-    const Aabb large{{0, 0, 0}, {40, 40, 40}};               // diagonal 69.3
+    const Aabb small{{0, 0, 0}, {4, 4, 4}};    // diagonal 6.9 < reference
+    const Aabb large{{0, 0, 0}, {40, 40, 40}}; // diagonal 69.3
     for (CellPattern fixed : {CellPattern::SingleCell, CellPattern::Shatter}) {
         p.pattern = fixed;
         const ImpactCut c = impactCut(p, large, 9000);
@@ -77,7 +77,8 @@ TEST(ImpactCut, AdaptiveChipsWeakHitsShattersStrongOnesAndGrowsWithTheObject) {
     EXPECT_DOUBLE_EQ(impactCut(p, Aabb{}, 680).size, p.sizeLaw.sizeFor(680)) << "empty bounds: the law";
     const double growth = std::sqrt(large.diagonal() / kAdaptiveReferenceSize);
     EXPECT_NEAR(impactCut(p, large, 680).size, p.sizeLaw.sizeFor(680) * growth, 1e-12);
-    EXPECT_EQ(impactCut(p, large, 680).pattern, CellPattern::SingleCell) << "strength does not depend on size";
+    EXPECT_EQ(impactCut(p, large, 680).pattern, CellPattern::SingleCell)
+        << "strength does not depend on size";
     EXPECT_DOUBLE_EQ(impactCut(p, large, 1e12).size, p.sizeLaw.maxSize);
     double last = 0;
     for (double i = 0; i < 20000; i += 250) { // monotone in the impulse

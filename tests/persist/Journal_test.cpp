@@ -196,14 +196,16 @@ TEST(Journal, AdaptiveHitsReplayToTheSameGeometry) {
     world->setJournalSink([&](const JournalEvent& e) { events.push_back(e); });
     JournalPlayer recorder(*world);
     std::size_t maxPieces = 0;
-    recorder.setOnOutcome([&](const FractureOutcome& o) { maxPieces = std::max(maxPieces, o.pieces.size()); });
+    recorder.setOnOutcome(
+        [&](const FractureOutcome& o) { maxPieces = std::max(maxPieces, o.pieces.size()); });
     const double impulses[] = {100, 4000, 150, 6000}; // chip, shatter, chip, shatter (sizeFor: 0.7, 1.8, ...)
     for (int i = 0; i < 4; ++i) {
         ASSERT_TRUE(recorder.advanceTo(static_cast<std::uint64_t>(3 * i)));
         const std::vector<ObjectId> ids = world->objects();
         const ObjectId target = ids[static_cast<std::size_t>(i) % ids.size()];
         const Aabb b = world->object(target)->mesh.bounds();
-        ASSERT_TRUE(world->submitImpact(target, Impact{b.center() + Vec3{0, 0, -1}, {0, 0, -1}, impulses[i]}));
+        ASSERT_TRUE(
+            world->submitImpact(target, Impact{b.center() + Vec3{0, 0, -1}, {0, 0, -1}, impulses[i]}));
     }
     ASSERT_TRUE(recorder.drain());
     ASSERT_EQ(events.size(), 4u);
