@@ -128,7 +128,7 @@ void Game::clear(Renderer& renderer) {
 void Game::addVisual(BodyId body, const rubble::Mesh& mesh, const Look& look, float heat,
                      Renderer& renderer) {
     Visual v;
-    v.mesh = renderer.addMesh(mesh, look.texture, look.tint.x, look.tint.y, look.tint.z);
+    v.mesh = renderer.addMesh(mesh, look.texture, look.tint.x, look.tint.y, look.tint.z, look.interior);
     v.heat = heat;
     v.tint = look.tint;
     visuals_[body] = v;
@@ -276,10 +276,24 @@ bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const Game
         Look look;
         look.texture = o.textureFound ? renderer.loadTexture(o.texturePath, "concrete", warnings)
                                       : renderer.proceduralTexture("concrete");
+        if (!o.material.empty()) // cut faces show the material's grain
+            look.interior = renderer.materialInterior(o.material);
         looks_[id] = look;
         addVisual(body->id, st->mesh, look, 0, renderer);
     }
     counters_.warnings = static_cast<int>(warnings.size());
+    { // showcase camera: in front of the objects' centre, at a distance that frames their spread
+        const std::vector<V3> t = targets();
+        V3 c{};
+        for (const V3& p : t)
+            c = c + p * (1.0f / static_cast<float>(std::max<std::size_t>(t.size(), 1)));
+        float r = 5;
+        for (const V3& p : t)
+            r = std::max(r, len(p - c));
+        showcaseAt_ = c;
+        showcaseEye_ = c + V3{0.9f, 0.45f, 1.6f} * (1.1f * r + 6);
+        showcaseEye_.y = std::max(showcaseEye_.y, groundTop_ + 3);
+    }
     V3 pos, fwd, up;
     vehicleFrame(pos, fwd, up);
     camera_.snap(pos, fwd, up);
@@ -704,6 +718,10 @@ void Game::draw(Renderer& renderer, float dt) {
     vehicleFrame(pos, fwd, up);
     camera_.update(pos, fwd, up, dt);
     camera_.eye.y = std::max(camera_.eye.y, groundTop_ + 1.5f);
+    if (settings_.showcase) {
+        camera_.eye = showcaseEye_;
+        camera_.target = showcaseAt_;
+    }
 }
 
 std::vector<double> Game::takeNewLatencies() {

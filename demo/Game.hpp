@@ -58,6 +58,7 @@ struct GameSettings {
     bool debugBonds = false;         ///< draw the structure's bonds, green (idle) to red (breaking)
     bool shadows = true;             ///< shadow mapping
     bool autoLevel = true;           ///< wings level themselves when no roll key is held (L toggles)
+    bool showcase = false; ///< the camera frames the scene's objects from a fixed point (screenshots)
 };
 
 /// Counters shown in the panel and printed by --stats.
@@ -175,8 +176,9 @@ private:
     };
     /// Texture and tint an object passes on to its pieces.
     struct Look {
-        int texture = 0;  ///< renderer texture
-        V3 tint{1, 1, 1}; ///< colour multiplier
+        int texture = 0;   ///< renderer texture
+        V3 tint{1, 1, 1};  ///< colour multiplier
+        int interior = -1; ///< cut faces' texture, by the object's material (-1: the default)
     };
     void fire();
     void journaled(const rubble::JournalEvent& e);
@@ -219,6 +221,7 @@ private:
     float boundsMinX_ = -500, boundsMaxX_ = 500, boundsMinZ_ = -500, boundsMaxZ_ = 500; // ground's extent
     rubble::BodyId groundBody_ = 0;
     Weapon weapon_ = Weapon::Cannon;
+    V3 showcaseEye_{}, showcaseAt_{}; // the showcase camera, framing the objects as loaded
     /// A shell in flight, and where a spent one was removed.
     struct Shell {
         Weapon weapon = Weapon::Cannon;

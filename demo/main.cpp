@@ -60,6 +60,8 @@ struct Options {
     bool noPanel = false;
     bool deterministic = false;
     bool noShadows = false;
+    bool bilinear = false;
+    bool showcase = false;
     std::string record; // journal file written at exit
     std::string replay; // journal file replayed on the loaded scene instead of playing
     int host = 0;       // port to host loopback multiplayer on
@@ -233,6 +235,8 @@ int main(int argc, char** argv) {
         "hide the panel's compact HUD line too (F1 shows the full panel; by default it starts collapsed)");
     cli.add_flag("--deterministic", o.deterministic, "adopt fractures a fixed number of frames after impact");
     cli.add_flag("--no-shadows", o.noShadows, "disable shadow mapping");
+    cli.add_flag("--showcase", o.showcase, "the camera frames the scene's objects from a fixed point");
+    cli.add_flag("--bilinear", o.bilinear, "software quality: bilinear textures instead of nearest texels");
     cli.add_option("--record", o.record,
                    "write the destruction journal (every impact and removal, 48 bytes each) to FILE at exit");
     cli.add_option(
@@ -247,7 +251,7 @@ int main(int argc, char** argv) {
     cli.add_option(
            "--quality", o.quality,
            "renderer quality: auto (software GL gets the software level), software (per-vertex light, "
-           "no shadows, bilinear textures, fewer dust particles) or gpu (per-pixel light, shadows)")
+           "no shadows, nearest texels, fewer dust particles) or gpu (per-pixel light, shadows)")
         ->check(CLI::IsMember({"auto", "software", "gpu"}));
     cli.add_option("--target-fps", o.targetFps, "frame rate dynamic resolution holds (default 60)")
         ->check(CLI::Range(5.0, 1000.0));
@@ -335,6 +339,7 @@ int main(int argc, char** argv) {
     app.pending.fracture.uvScale = 0.25;
     app.pending.debugShapes = app.pending.debugAabbs = app.pending.debugImpacts = o.debug;
     app.pending.structure = app.pending.debugBonds = o.structure;
+    app.pending.showcase = o.showcase;
 
     std::string error;
     app.gl = demo::GlContext::create(o.width, o.height, headless, error);
@@ -348,6 +353,8 @@ int main(int argc, char** argv) {
         app.quality = demo::RenderQuality::forRenderer("llvmpipe");
     if (o.minScale > 0)
         app.quality.minScale = o.minScale;
+    if (o.bilinear)
+        app.quality.nearestTexels = false;
     app.pending.shadows = !o.noShadows && app.quality.shadows;
     if (!loadScene(app, error)) {
         std::fprintf(stderr, "error: %s\n", error.c_str());
