@@ -10,6 +10,8 @@ namespace {
 constexpr int kSettledFrames = 10;     // a piece falling from rest passes 1 m/s within 6 frames at 60 Hz
 constexpr double kCellSize = 4.0;      // m: frozen pieces are small, so a body's neighbourhood is a few cells
 constexpr double kMovedFraction = 0.1; // a woken body this far (times its radius) from its place has left it
+constexpr double kHoldLow = 0.55;  // the average physics step is held in this band (fractions of the budget)
+constexpr double kHoldHigh = 0.75; // so that single frames stay under the budget
 
 std::int64_t cellCoord(double x) {
     return static_cast<std::int64_t>(std::floor(x / kCellSize));
@@ -167,10 +169,12 @@ GovernorActions DebrisGovernor::update(const BodyTable& bodies, const PhysicsBin
     }
 
     if (!deterministic && budget_.physicsBudgetMs > 0) { // shrink fast, grow back slowly
+        smoothedMs_ = smoothedMs_ <= 0 ? physicsMs : 0.9 * smoothedMs_ + 0.1 * physicsMs;
+        const double limit = budget_.physicsBudgetMs;
         int b = awakeBudget();
-        if (physicsMs > budget_.physicsBudgetMs)
+        if (physicsMs > limit || smoothedMs_ > kHoldHigh * limit)
             b = std::min(b, static_cast<int>(0.9 * static_cast<double>(bodies.awake())));
-        else if (physicsMs < 0.7 * budget_.physicsBudgetMs)
+        else if (smoothedMs_ < kHoldLow * limit && physicsMs < kHoldHigh * limit)
             b += std::max(1, b / 50);
         awakeBudget_ = std::clamp(b, std::min(32, budget_.maxAwakeBodies), budget_.maxAwakeBodies);
     } else {

@@ -68,7 +68,8 @@ private:
     std::map<BodyId, WokenEntry> watched_; // woken bodies whose old neighbourhood still rests on their place
     std::unordered_map<Cell, std::vector<BodyId>> grid_;
     std::vector<BodyId> toWake_;
-    int awakeBudget_ = -1; // < 0: the configured maximum
+    int awakeBudget_ = -1;  // < 0: the configured maximum
+    double smoothedMs_ = 0; // moving average of the physics step
 };
 
 } // namespace rubble::detail
