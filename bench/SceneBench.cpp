@@ -76,8 +76,11 @@ struct SceneArgs {
     std::string framesCsv;
     std::string appendCsv;
     std::string pattern = "single";
-    int cells = 0;    // shatter cells (0: the library's default)
-    int maxAwake = 0; // awake debris budget (0: the runtime's default)
+    int cells = 0;                // shatter cells (0: the library's default)
+    int maxAwake = 0;             // awake debris budget (0: the runtime's default)
+    bool structure = false;       // the stress solver on
+    double bearingFriction = 0.6; // with structure: objects rest on each other as bearings (0: welded)
+    int structureIterations = 0;  // with structure: solver sweeps per frame (0: the library's)
     double projectileSpeed = 120;
     double projectileMass = 2;
     double projectileRadius = 0.25;
@@ -164,6 +167,10 @@ int runScene(const SceneArgs& a) {
     rc.world.seed = a.seed;
     if (a.maxAwake > 0)
         rc.debris.maxAwakeBodies = a.maxAwake;
+    rc.structure.enabled = a.structure;
+    rc.structure.bearingFriction = a.bearingFriction;
+    if (a.structureIterations > 0)
+        rc.structure.stress.iterations = a.structureIterations;
     PhysicsWorld physics;
     BulletBinding binding(physics);
     DestructionRuntime runtime(binding, rc);
@@ -195,7 +202,9 @@ int runScene(const SceneArgs& a) {
     Rng rng(mixSeed(a.seed, 0x5CE7E));
     const double dt = 1.0 / 60;
     const long frames = a.frames > 0 ? a.frames : std::max(1L, std::lround(a.seconds * 60));
-    std::vector<double> frameMs, physicsMs, adoptMs, supportMs, idleAdoptMs;
+    std::vector<double> frameMs, physicsMs, adoptMs, supportMs, idleAdoptMs, structureMs;
+    const std::size_t bondsAtStart = a.structure ? runtime.structureBonds().size() : 0;
+    long bondsBroken = 0, bondsBrokenFirstSecond = 0;
     frameMs.reserve(static_cast<std::size_t>(frames));
     idleAdoptMs.reserve(static_cast<std::size_t>(frames));
     std::ofstream framesOut;
@@ -231,6 +240,10 @@ int runScene(const SceneArgs& a) {
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         physicsMs.push_back(fs.physicsMs);
         adoptMs.push_back(fs.adoptMs);
+        structureMs.push_back(fs.structureMs);
+        bondsBroken += fs.bondsBroken;
+        if (f < 60)
+            bondsBrokenFirstSecond += fs.bondsBroken;
         if (fs.fractures > 0) // structural-collapse checks, per adopted outcome
             supportMs.push_back(fs.supportMs / fs.fractures);
         frameMs.push_back(ms);
@@ -332,6 +345,15 @@ int runScene(const SceneArgs& a) {
                        {"dropped", v.dropped}};
         j["shots"] = shots;
         j["pieces_retired"] = c.piecesRetired;
+        if (a.structure)
+            j["structure"] = {
+                {"bearing_friction", a.bearingFriction},
+                {"bonds_at_start", bondsAtStart},
+                {"bonds_at_end", runtime.structureBonds().size()},
+                {"bonds_broken", bondsBroken},
+                {"bonds_broken_first_second", bondsBrokenFirstSecond},
+                {"solve_ms",
+                 {{"p50", percentile(structureMs, 0.5)}, {"p99", percentile(structureMs, 0.99)}}}};
         // what the long-lived containers hold at the end (a soak checks that they stay bounded)
         j["bodies"] = runtime.bodyCount();
         j["world_objects"] = destruction.objects().size();
@@ -416,6 +438,12 @@ rubble::tools::Registrar registrar{
              ->check(CLI::IsMember({"single", "shatter"}));
          app.add_option("--cells", args->cells, "cells of a shatter pattern (default: the library's)");
          app.add_option("--max-awake", args->maxAwake, "awake debris budget (default: the runtime's)");
+         app.add_flag("--structure", args->structure, "stress solver on (bonds, breaking under load)");
+         app.add_option("--bearing-friction", args->bearingFriction,
+                        "with --structure: objects rest on each other as bearings with this friction "
+                        "coefficient (0: welded joints)");
+         app.add_option("--structure-iterations", args->structureIterations,
+                        "with --structure: solver sweeps per frame (default: the library's)");
          app.add_option("--projectile-speed", args->projectileSpeed, "m/s");
          app.add_option("--projectile-mass", args->projectileMass, "kg");
          return [args] { return runScene(*args); };

@@ -1,5 +1,7 @@
 #include "Game.hpp"
 
+#include "GroundMesh.hpp"
+
 #include "rubble/JournalFile.hpp"
 #include "rubble/JournalPlayer.hpp"
 #include "rubble/Snapshot.hpp"
@@ -191,14 +193,7 @@ bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const Game
         const auto& g = scene.ground;
         const rubble::Vec3 half{std::abs(g.scale.x) * 0.5, std::abs(g.scale.y) * 0.5,
                                 std::abs(g.scale.z) * 0.5};
-        rubble::Mesh box = rubble::makeBox(-half, half);
-        box.uvs.assign(box.triangles.size() * 3, {});
-        for (size_t t = 0; t < box.triangles.size(); ++t)
-            for (int c = 0; c < 3; ++c) {
-                const auto& p = box.positions[box.triangles[t][static_cast<size_t>(c)]];
-                box.uvs[3 * t + static_cast<size_t>(c)] = {(p.x + g.position.x) / 16.0,
-                                                           (p.z + g.position.z) / 16.0};
-            }
+        const rubble::Mesh box = groundMesh(g);
         binding_->rigid(loaded.ground)->setFriction(0.9f);
         Look look;
         look.texture = g.textureFound ? renderer.loadTexture(g.texturePath, "grid", warnings)
@@ -819,6 +814,11 @@ bool Game::host(std::uint16_t port, std::string& message) {
     return true;
 }
 
+void Game::finishHosting() {
+    if (net_)
+        net_->finish(5000);
+}
+
 bool Game::loadSnapshot(const std::string& path, Renderer& renderer, std::string& message) {
     if (!runtime_) {
         message = "no scene loaded";
@@ -852,7 +852,7 @@ bool Game::saveSnapshot(const std::string& path, std::string& message) const {
         message = "no scene loaded";
         return false;
     }
-    const rubble::Snapshot snapshot = rubble::takeSnapshot(runtime_->world(), runtime_->placements());
+    const rubble::Snapshot snapshot = rubble::takeSnapshot(*runtime_);
     if (rubble::Status s = rubble::saveSnapshot(path, snapshot); !s) {
         message = s.message();
         return false;

@@ -157,6 +157,8 @@ public:
     /// Hosts loopback multiplayer on 127.0.0.1:port (docs/netplay.md): clients get a snapshot, then the
     /// journal and the bodies' placements every step. Needs deterministic settings; false with a message.
     bool host(std::uint16_t port, std::string& message);
+    /// Waits (at most 5 s) until every client confirmed the last sync; no-op when not hosting.
+    void finishHosting();
     /// The host's totals, or null when not hosting.
     const rubble::net::HostStats* hostStats() const { return net_ ? &net_->stats() : nullptr; }
     /// The world's geometry hash.

@@ -21,6 +21,7 @@
 #include "DynamicResolution.hpp"
 #include "Game.hpp"
 #include "GlContext.hpp"
+#include "JoinSession.hpp"
 #include "Panel.hpp"
 #include "Renderer.hpp"
 #include "RunReport.hpp"
@@ -65,6 +66,7 @@ struct Options {
     std::string record; // journal file written at exit
     std::string replay; // journal file replayed on the loaded scene instead of playing
     int host = 0;       // port to host loopback multiplayer on
+    std::string join;   // HOST:PORT of a host to follow
     bool structure = false;
     std::string quality = "auto"; // auto (from GL_RENDERER), software or gpu
     float targetFps = 60;         // dynamic resolution holds this rate (software quality)
@@ -172,7 +174,8 @@ demo::ControlInput readKeys(GLFWwindow* w, bool& spaceHeld) {
     return in;
 }
 
-bool loadScene(App& a, std::string& error) {
+/// A fresh renderer with the scene's sky and interior texture.
+bool prepareRenderer(App& a, std::string& error) {
     std::vector<std::string> warnings;
     a.renderer.shutdown();
     a.renderer = demo::Renderer();
@@ -192,12 +195,21 @@ bool loadScene(App& a, std::string& error) {
         skyOk = skyOk && !p.empty() && std::filesystem::exists(p);
     if (skyOk)
         a.renderer.setSkybox(a.scene.skyboxPaths, warnings);
-    if (!a.game.load(a.scene, a.renderer, a.pending, warnings, error))
-        return false;
     for (const auto& w : warnings)
         std::fprintf(stderr, "warning: %s\n", w.c_str());
     if (!skyOk)
         std::fprintf(stderr, "warning: skybox images missing; drawing the procedural sky\n");
+    return true;
+}
+
+bool loadScene(App& a, std::string& error) {
+    if (!prepareRenderer(a, error))
+        return false;
+    std::vector<std::string> warnings;
+    if (!a.game.load(a.scene, a.renderer, a.pending, warnings, error))
+        return false;
+    for (const auto& w : warnings)
+        std::fprintf(stderr, "warning: %s\n", w.c_str());
     return true;
 }
 
@@ -248,6 +260,11 @@ int main(int argc, char** argv) {
            "host loopback multiplayer on 127.0.0.1:PORT (needs --deterministic); clients: rubble-bench "
            "netplay-client --port PORT")
         ->check(CLI::Range(1, 65535));
+    cli.add_option(
+           "--join", o.join,
+           "follow a --host game at HOST:PORT (loopback) in a window: the client cuts the pieces from "
+           "the host's journal and draws them at the host's placements; A/D orbit, W/S zoom")
+        ->excludes("--host");
     cli.add_option(
            "--quality", o.quality,
            "renderer quality: auto (software GL gets the software level), software (per-vertex light, "
@@ -356,6 +373,18 @@ int main(int argc, char** argv) {
     if (o.bilinear)
         app.quality.nearestTexels = false;
     app.pending.shadows = !o.noShadows && app.quality.shadows;
+    if (!o.join.empty()) { // a follower: no game of its own, the host's world drawn
+        demo::JoinOptions j{{}, 0, o.workers, o.out, o.screenshotEvery, o.stats, o.statsEvery};
+        if (!demo::parseHostPort(o.join, j.address, j.port, error) || !prepareRenderer(app, error)) {
+            std::fprintf(stderr, "error: %s\n", error.c_str());
+            return 1;
+        }
+        app.renderer.shadows = app.pending.shadows;
+        const int status = demo::runJoin(j, *app.gl, app.renderer, app.scene);
+        app.renderer.shutdown();
+        app.gl.reset();
+        return status;
+    }
     if (!loadScene(app, error)) {
         std::fprintf(stderr, "error: %s\n", error.c_str());
         return 1;
@@ -599,6 +628,7 @@ int main(int argc, char** argv) {
         }
     }
     int status = 0;
+    app.game.finishHosting(); // the clients confirm the last sync before the connections close
     if (const rubble::net::HostStats* h = app.game.hostStats())
         std::printf("host: %lld clients joined, %lld syncs sent, %lld acknowledged, %lld mismatched hashes, "
                     "geometry hash %016llx\n",

@@ -3,7 +3,8 @@
 # is present) run by `rubble-bench scene` for SECONDS (default 60) at 10 shots/s with the default worker count,
 # paced at 60 Hz with idle adoption; one row each in a fresh scene.csv, then scene.png (bench/results/scene.gp).
 # The demolition scenes (assets/scenes/demolition*.cfg) run the same way with --pattern shatter; their frames
-# are summarised per half second in demolition_frames.csv and drawn over time in demolition.png.
+# are summarised per half second in demolition_frames.csv and drawn over time in demolition.png. A last row
+# is the stretch toward 20,000 pieces: the 500k scene for twice SECONDS at 20 shots/s of 32 cells.
 # Usage: scripts/scene-bench.sh BUILD_DIR [SECONDS]
 # RUBBLE_BENCH_RESULTS=DIR writes somewhere else than bench/results/; RUBBLE_SEED_MEDIA overrides the seed
 # media folder. Each row's other_cpu_cores says how much else ran meanwhile: re-run rows where it is not ~0.
@@ -30,16 +31,18 @@ done
 csv="$results/scene.csv"
 frames="$results/demolition_frames.csv"
 rm -f "$csv" "$frames"
-run() { # scene, extra options...
+run() { # scene, extra options... (RUN_SECONDS, RUN_RATE and RUN_TAG override the length, the shot rate, the name)
     local s=$1
     shift
-    echo "== $s ($seconds s) $*"
+    local secs="${RUN_SECONDS:-$seconds}" rate="${RUN_RATE:-10}"
+    echo "== $s ($secs s, $rate shots/s) $*"
     # the row names the scene relative to the repository (or seed: for the thesis's own)
     name="${s#"$root/"}"
     case "$s" in "$root"/*) ;; *) name="seed:$(basename "$s")" ;; esac
+    name="$name${RUN_TAG:-}"
     tmp="$results/.scene-row.csv"
     rm -f "$tmp" "$tmp.frames"
-    "$bench" scene "$s" --seconds "$seconds" --shots-per-second 10 --append-csv "$tmp" --frames-csv "$tmp.frames" "$@"
+    "$bench" scene "$s" --seconds "$secs" --shots-per-second "$rate" --append-csv "$tmp" --frames-csv "$tmp.frames" "$@"
     [ -f "$csv" ] || head -n 1 "$tmp" >"$csv"
     tail -n +2 "$tmp" | sed "s#^[^,]*#$name#" >>"$csv"
     if [ "$*" != "" ]; then # per half second: worst and mean frame, worst physics step, pieces at its end
@@ -60,6 +63,8 @@ done
 for s in demolition.cfg demolition_block.cfg; do
     run "$root/assets/scenes/$s" --pattern shatter
 done
+RUN_SECONDS=$((2 * seconds)) RUN_RATE=20 RUN_TAG=" (stretch)" run "$root/assets/scenes/demolition_block.cfg" \
+    --pattern shatter --cells 32
 echo "CSV: $csv, $frames"
 if command -v gnuplot >/dev/null 2>&1; then
     (cd "$results" && gnuplot "$root/bench/results/scene.gp" && gnuplot "$root/bench/results/demolition.gp") &&

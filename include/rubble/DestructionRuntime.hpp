@@ -104,6 +104,9 @@ struct StructurePolicy {
     double damagePerImpulse = 1e-4;    ///< health a bond at the hit loses per N·s of impulse
     bool bondDebris = false; ///< a static object's debris stays in the structure, bonded across its cut faces
                              ///< until the solver breaks it (a partial crack); false: thrown, no bonds
+    double bearingFriction = 0; ///< > 0: objects (and what is cut from them) rest on each other as bearings
+                                ///< with this friction coefficient (compression and friction only); 0:
+                                ///< welded. Cut faces within one object stay welded
 };
 
 /// A bond of the structure, for debug drawing.
@@ -126,8 +129,9 @@ struct DebrisBudget {
                                 ///< to hold the awake budget
     int awakeOvershoot = 16;    ///< pieces beyond maxAwakeBodies that may stay awake while they settle (new
                                 ///< pieces get 10 frames, slow ones until they freeze); beyond it, hard
-    double physicsBudgetMs = 8; ///< physics step time to hold; above it the awake budget shrinks
-                                ///< (ignored in deterministic mode, where time must not matter)
+    double physicsBudgetMs = 8; ///< physics step time no frame should exceed: the awake budget shrinks on a
+                                ///< frame over it and holds the average at 55-75 % of it (ignored in
+                                ///< deterministic mode, where time must not matter)
     std::size_t maxTriangles = 4000000; ///< triangles of all debris bodies (dynamic and frozen); beyond it
                                         ///< the smallest frozen pieces become particles
     bool freezeSleeping = true;         ///< a debris body the engine put to sleep is frozen (made static)
@@ -305,10 +309,12 @@ public:
     /// Replaces the world's state and every body that carries an object by a saved world (a snapshot): each
     /// object gets a body at its placement with its velocities and motion state (static ones join the support
     /// graph, frozen ones the governor's grid). Bodies without objects (ground, scenery, projectiles) stay.
-    /// The volume ledger restarts (retired, dust and dropped are not saved). Fails, changing nothing, when
-    /// the state is inconsistent (DestructionWorld::loadState) or an object has no placement or a placement
-    /// no object, or a placement's role is neither Object nor Piece.
-    Status restore(WorldState state, const std::vector<ObjectPlacement>& placements);
+    /// The volume ledger continues from volumes' retired, dust and dropped (live is the objects'). Fails,
+    /// changing nothing, when the state is inconsistent (DestructionWorld::loadState), an object has no
+    /// placement or a placement no object, a placement's role is neither Object nor Piece, or a volume is
+    /// negative or not finite.
+    Status restore(WorldState state, const std::vector<ObjectPlacement>& placements,
+                   const VolumeLedger& volumes = {});
 
     /// Hash of the live body set (id, role, motion, object version and mesh hash, transform bits) and of the
     /// volume ledger: equal runs give equal hashes.

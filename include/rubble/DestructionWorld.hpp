@@ -49,7 +49,8 @@ struct ObjectState {
     std::string warning;                     ///< why it is indestructible, when it had to be made so
     std::size_t crumbleAbove = 0; ///< a hit on it crumbles it once its mesh has more triangles than this
                                   ///< (see Config::crumbleTriangles; pieces inherit their parent's)
-    std::uint64_t meshHash = 0;   ///< mesh.hash(), computed once when the object is made
+    std::uint64_t meshHash = 0;   ///< mesh.hash(), computed once when the object is made (loadState takes
+                                  ///< a saved one as it is; 0 there: computed)
 };
 
 /// Wall-clock timing of one impact from submission to adoption, in milliseconds. For an adopted job the
@@ -130,6 +131,7 @@ struct WorldState {
     std::uint64_t crumbleTriangles = 0; ///< Config::crumbleTriangles
     std::int32_t crumbleCells = 0;      ///< Config::crumbleCells
     double minPieceVolume = 0;          ///< Config::minPieceVolume
+    DecompositionParams decomposition;  ///< Config::decomposition (convex parts of new pieces)
     std::uint64_t frame = 0;            ///< DestructionWorld::frame()
     ObjectId nextId = 1;                ///< the id the next new object gets
     std::uint64_t journalPosition = 0;  ///< journal events so far

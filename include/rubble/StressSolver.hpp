@@ -30,6 +30,7 @@ struct StrengthLimits {
     double compressive = 0; ///< Pa
     double tensile = 0;     ///< Pa
     double shear = 0;       ///< Pa
+    double friction = 0;    ///< > 0: a bearing (dry contact) with this friction coefficient, not a weld
 };
 
 /// The limits of a bond between two materials: the weaker of each.
@@ -46,6 +47,8 @@ struct BondStress {
 struct StressSettings {
     int iterations = 25;       ///< Gauss-Seidel sweeps over all bonds per solve()
     Vec3 gravity{0, -9.81, 0}; ///< m/s^2
+    double unbalanced = 0.5;   ///< m/s^2 (and rad/s^2): a node left accelerating this much is not held
+    int unbalancedSolves = 30; ///< ... after this many solves in a row (the warm-started solve converges)
 };
 
 /// The stress solver over one structure (nodes joined by bonds).
@@ -76,7 +79,10 @@ public:
     Vec3 bondMoment(std::size_t i) const { return bonds_[i].moment; }
     /// The stresses over the bond's section at its current health.
     BondStress stress(std::size_t i) const;
-    /// The largest ratio of a stress to its limit (1 = breaking; 0 for a broken bond).
+    /// The largest ratio of a stress to its limit (1 = breaking; 0 for a broken bond). A bearing carries
+    /// compression only, its resultant inside the contact patch and its transverse force within friction: the
+    /// solve keeps it there (a body it cannot hold is unbalanced, see unsupported()), and it breaks only by
+    /// crushing.
     double utilisation(std::size_t i) const;
     /// The bond's remaining fraction of section, 1 when whole.
     double health(std::size_t i) const { return bonds_[i].health; }
@@ -94,7 +100,9 @@ public:
     void breakBond(std::size_t i);
     /// Takes a node out of the structure (it fell or was removed); its bonds break.
     void detach(std::uint32_t node);
-    /// Nodes still in the structure that no chain of intact bonds links to a root, ascending.
+    /// Nodes still in the structure that no chain of intact bonds links to a root, or that bearings have not
+    /// held in equilibrium for `StressSettings::unbalancedSolves` solves in a row (tipping or sliding),
+    /// ascending.
     std::vector<std::uint32_t> unsupported() const;
 
 private:
@@ -105,6 +113,15 @@ private:
         Vec3 v, w;          // velocity change this solve
         Vec3 force, torque; // loads this solve
         bool detached = false;
+        int unbalanced = 0;   // solves in a row that left it accelerating
+        bool bearing = false; // rests on (or carries) a bearing
+    };
+    struct BearingCorner {
+        Vec3 offset;                   // from the section centroid (world)
+        Vec3 ra, rb;                   // from each node's centre of mass
+        double kn = 0, ku = 0, kv = 0; // inverse effective masses along the normal and the in-plane axes
+        double press = 0;              // accumulated normal force (>= 0: compression)
+        double gu = 0, gv = 0;         // accumulated friction along u and v (|g| <= friction * press)
     };
     struct BondState {
         Bond bond;
@@ -115,8 +132,11 @@ private:
         Vec3 force, moment; // accumulated (warm start)
         double health = 1;
         bool broken = false;
+        std::vector<BearingCorner> corners; // bearing: contact points at the patch's hull corners
     };
     void apply(BondState& b, const Vec3& force, const Vec3& moment);
+    double bearingUtilisation(const BondState& b) const;
+    void solveBearing(BondState& b);
 
     StressSettings settings_;
     std::vector<NodeState> nodes_;

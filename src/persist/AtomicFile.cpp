@@ -1,6 +1,8 @@
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 
@@ -59,10 +61,16 @@ Result<std::vector<std::uint8_t>> readFileBinary(const std::filesystem::path& pa
     const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
     if (fd < 0)
         return ioError(path, "cannot open");
-    std::vector<std::uint8_t> out;
-    std::uint8_t buf[1 << 16];
+    // Read straight into a buffer of the file's size (one allocation, no copies); a file that grows meanwhile
+    // is read to its end all the same.
+    struct stat st {};
+    std::vector<std::uint8_t> out(
+        ::fstat(fd, &st) == 0 && st.st_size > 0 ? static_cast<std::size_t>(st.st_size) : 0);
+    std::size_t done = 0;
     for (;;) {
-        const ssize_t n = ::read(fd, buf, sizeof buf);
+        if (done == out.size())
+            out.resize(std::max<std::size_t>(out.size() * 2, 1 << 16));
+        const ssize_t n = ::read(fd, out.data() + done, out.size() - done);
         if (n < 0 && errno == EINTR)
             continue;
         if (n < 0) {
@@ -72,9 +80,10 @@ Result<std::vector<std::uint8_t>> readFileBinary(const std::filesystem::path& pa
         }
         if (n == 0)
             break;
-        out.insert(out.end(), buf, buf + n);
+        done += static_cast<std::size_t>(n);
     }
     ::close(fd);
+    out.resize(done);
     return out;
 }
 

@@ -1,5 +1,10 @@
 #include "rubble/Snapshot.hpp"
 
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <bit>
 
 #include "persist/Bytes.hpp"
@@ -60,7 +65,8 @@ void checkFinite(ByteReader& r, const std::vector<Vec2>& v, std::size_t start, c
     }
 }
 
-constexpr std::uint16_t kVersion = 1;
+// 2: decomposition settings, each object's mesh hash, the volume ledger.
+constexpr std::uint16_t kVersion = 2;
 
 void vec(ByteWriter& w, const Vec3& v) {
     w.f64(v.x);
@@ -133,6 +139,7 @@ std::string text(ByteReader& r, const std::uint8_t* data, const char* lengthFiel
 void writeObject(ByteWriter& w, const ObjectState& o) {
     w.u32(o.id);
     w.u32(o.version);
+    w.u64(o.meshHash);
     w.u8(o.destructible ? 1 : 0);
     w.f64(o.density);
     w.f64(o.impulseThreshold);
@@ -187,6 +194,10 @@ ObjectState readObject(ByteReader& r, const std::uint8_t* data) {
     ObjectState o;
     o.id = r.u32("id");
     o.version = r.u32("version");
+    const std::size_t hashAt = r.offset();
+    o.meshHash = r.u64("meshHash");
+    if (r.ok() && o.meshHash == 0)
+        r.fail(hashAt, "meshHash", "is 0");
     o.destructible = flag(r, "destructible");
     o.density = real(r, "density");
     o.impulseThreshold = real(r, "impulseThreshold");
@@ -308,8 +319,15 @@ Status restoreSnapshot(DestructionWorld& world, Snapshot snapshot) {
     return world.loadState(std::move(snapshot.world));
 }
 
+Snapshot takeSnapshot(const DestructionRuntime& runtime) {
+    Snapshot s = takeSnapshot(runtime.world(), runtime.placements());
+    s.volumes = runtime.volumes();
+    s.volumes.live = 0;
+    return s;
+}
+
 Status restoreSnapshot(DestructionRuntime& runtime, Snapshot snapshot) {
-    return runtime.restore(std::move(snapshot.world), snapshot.placements);
+    return runtime.restore(std::move(snapshot.world), snapshot.placements, snapshot.volumes);
 }
 
 std::vector<std::uint8_t> encodeSnapshot(const Snapshot& s) {
@@ -328,6 +346,12 @@ std::vector<std::uint8_t> encodeSnapshot(const Snapshot& s) {
     w.u64(s.world.crumbleTriangles);
     w.i32(s.world.crumbleCells);
     w.f64(s.world.minPieceVolume);
+    const DecompositionParams& d = s.world.decomposition;
+    w.i32(d.maxParts);
+    w.f64(d.concavity);
+    w.f64(d.minPartVolumeFraction);
+    w.u64(d.proxyAboveTriangles);
+    w.u64(d.maxPartFaces);
     w.u64(s.world.frame);
     w.u32(s.world.nextId);
     w.u64(s.world.journalPosition);
@@ -357,6 +381,9 @@ std::vector<std::uint8_t> encodeSnapshot(const Snapshot& s) {
             w.u64(i < p.ticks.size() ? p.ticks[i] : 0);
         }
     }
+    w.f64(s.volumes.retired);
+    w.f64(s.volumes.dust);
+    w.f64(s.volumes.dropped);
     w.u32(persist::crc32(w.data().data(), w.size()));
     return std::move(w.data());
 }
@@ -372,8 +399,12 @@ Result<Snapshot> decodeSnapshot(const std::uint8_t* data, std::size_t size, cons
     const std::uint16_t version = r.u16("version");
     if (r.ok() && version != kVersion)
         r.fail(4, "version",
-               "version " + std::to_string(version) + " is not supported (this build reads " +
-                   std::to_string(kVersion) + ")");
+               "version " + std::to_string(version) + " is not supported (this build reads version " +
+                   std::to_string(kVersion) + " only" +
+                   (version < kVersion ? "; the file was saved by an older build: load it there, or replay "
+                                         "its journal on the scene"
+                                       : "; the file was saved by a newer build") +
+                   ")");
     if (const std::uint16_t reserved = r.u16("reserved"); r.ok() && reserved != 0)
         r.fail(6, "reserved", "is " + std::to_string(reserved) + ", expected 0");
     if (!r.ok())
@@ -398,6 +429,12 @@ Result<Snapshot> decodeSnapshot(const std::uint8_t* data, std::size_t size, cons
     s.world.crumbleTriangles = body.u64("crumbleTriangles");
     s.world.crumbleCells = body.i32("crumbleCells");
     s.world.minPieceVolume = real(body, "minPieceVolume");
+    DecompositionParams& d = s.world.decomposition;
+    d.maxParts = body.i32("decomposition.maxParts");
+    d.concavity = real(body, "decomposition.concavity");
+    d.minPartVolumeFraction = real(body, "decomposition.minPartVolumeFraction");
+    d.proxyAboveTriangles = static_cast<std::size_t>(body.u64("decomposition.proxyAboveTriangles"));
+    d.maxPartFaces = static_cast<std::size_t>(body.u64("decomposition.maxPartFaces"));
     s.world.frame = body.u64("frame");
     s.world.nextId = body.u32("nextId");
     s.world.journalPosition = body.u64("journalPosition");
@@ -452,6 +489,14 @@ Result<Snapshot> decodeSnapshot(const std::uint8_t* data, std::size_t size, cons
         s.world.work.push_back(std::move(p));
     }
     body.setContext("");
+    for (auto [field, v] : {std::pair{"volumes.retired", &s.volumes.retired},
+                            {"volumes.dust", &s.volumes.dust},
+                            {"volumes.dropped", &s.volumes.dropped}}) {
+        const std::size_t at = body.offset();
+        *v = real(body, field);
+        if (body.ok() && *v < 0)
+            body.fail(at, field, "is negative");
+    }
     if (body.ok() && body.remaining() != 0)
         body.fail(body.offset(), "crc32", std::to_string(body.remaining()) + " unexpected bytes before it");
     if (!body.ok())
@@ -464,6 +509,24 @@ Status saveSnapshot(const std::filesystem::path& path, const Snapshot& snapshot)
 }
 
 Result<Snapshot> loadSnapshot(const std::filesystem::path& path) {
+    // A regular file is mapped (no copy, pages populated in one go); snapshots are replaced by rename, never
+    // rewritten in place, so the mapped file does not change under the reader. Anything else is read.
+    if (const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC); fd >= 0) {
+        struct stat st {};
+        if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0) {
+            const auto size = static_cast<std::size_t>(st.st_size);
+            void* map = ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
+            ::close(fd);
+            if (map != MAP_FAILED) {
+                Result<Snapshot> s =
+                    decodeSnapshot(static_cast<const std::uint8_t*>(map), size, path.string());
+                ::munmap(map, size);
+                return s;
+            }
+        } else {
+            ::close(fd);
+        }
+    }
     Result<std::vector<std::uint8_t>> bytes = readFileBinary(path);
     if (!bytes)
         return bytes.error();

@@ -22,6 +22,8 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+constexpr std::uint64_t kSceneryBit = 1ull << 63; // structure solids of ground and scenery (never objects)
+
 double msSince(Clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
@@ -80,6 +82,7 @@ struct DestructionRuntime::Impl {
     detail::SupportGraph support;
     detail::StructureMonitor structure;
     std::map<ObjectId, const Material*> materials; // of objects (pieces inherit their parent's)
+    std::map<ObjectId, std::uint64_t> solids;      // pieces: the scene object they were cut from
     detail::DebrisGovernor governor;
     std::set<BodyId> projectiles;
     detail::DebrisPool particles;
@@ -132,8 +135,10 @@ struct DestructionRuntime::Impl {
         governor.removed(id);
         projectiles.erase(id);
         binding.removeBody(id);
-        if (r->hasObject)
+        if (r->hasObject) {
             materials.erase(r->object);
+            solids.erase(r->object);
+        }
         if (r->hasObject && removeObject)
             world.removeObject(r->object);
         bodies.erase(id);
@@ -185,10 +190,16 @@ struct DestructionRuntime::Impl {
     }
 
     // A node of the structure (when enabled).
-    void addStructure(BodyId id, const std::vector<ConvexPolytope>& worldParts, const Material& m,
-                      bool root) {
+    void addStructure(BodyId id, const std::vector<ConvexPolytope>& worldParts, const Material& m, bool root,
+                      std::uint64_t solid) {
         if (config.structure.enabled)
-            structure.add(id, worldParts, m, root);
+            structure.add(id, worldParts, m, root, solid);
+    }
+
+    // The solid an object was cut from: its own id for a scene object, its ancestor's for a piece.
+    std::uint64_t solidOf(ObjectId id) const {
+        const auto it = solids.find(id);
+        return it != solids.end() ? it->second : id;
     }
 
     void submit(const detail::PendingImpact& p, FrameStats& stats) {
@@ -223,6 +234,7 @@ struct DestructionRuntime::Impl {
             outcome, parent, parentMotion, config.adoption, collapse, config.debris.particleLifetime,
             config.structure.enabled && config.structure.bondDebris);
         const bool parentResting = !moving(parent);
+        const std::uint64_t parentSolid = solidOf(parent.object);
         // The world removed the parent object already; what it held wakes near its flying debris (below).
         destroy(parent.id, false, false);
         ++stats.fractures;
@@ -238,9 +250,11 @@ struct DestructionRuntime::Impl {
             const BodyRecord& made = insert(rec, s.desc);
             if (&material != &defaultMaterial())
                 materials[s.object] = &material;
+            if (parentSolid != s.object)
+                solids[s.object] = parentSolid;
             if (s.structural) {
                 const auto parts = worldParts(st, s.desc.transform * s.objectToBody.inverse());
-                addStructure(made.id, parts, material, s.anchor);
+                addStructure(made.id, parts, material, s.anchor, parentSolid);
                 support.add(made.id, parts, s.anchor);
                 support.queue(made.id);
             }
@@ -392,7 +406,7 @@ BodyId DestructionRuntime::addGround(const Vec3& center, const Vec3& halfExtents
     const BodyId id = impl_->insert(rec, desc).id;
     const std::vector<ConvexPolytope> parts{
         ConvexPolytope::fromAabb(Aabb{center - halfExtents, center + halfExtents})};
-    impl_->addStructure(id, parts, defaultMaterial(), true);
+    impl_->addStructure(id, parts, defaultMaterial(), true, kSceneryBit | id);
     impl_->support.add(id, parts, true);
     return id;
 }
@@ -417,7 +431,7 @@ Result<ObjectId> DestructionRuntime::addObject(ObjectDesc desc, const Frame& pla
     const BodyId body = im.insert(rec, s.desc).id;
     if (isStatic) {
         const auto parts = worldParts(st, placement);
-        im.addStructure(body, parts, *material, false);
+        im.addStructure(body, parts, *material, false, *id);
         im.support.add(body, parts, false, true);
     }
     return id;
@@ -457,7 +471,7 @@ Result<BodyId> DestructionRuntime::addConvexBody(const std::vector<Vec3>& points
     const BodyId id = impl_->insert(rec, desc).id;
     if (mass <= 0) {
         const std::vector<ConvexPolytope> parts{ConvexPolytope::fromAabb(box).transformed(placement)};
-        impl_->addStructure(id, parts, defaultMaterial(), true);
+        impl_->addStructure(id, parts, defaultMaterial(), true, kSceneryBit | id);
         impl_->support.add(id, parts, true);
     }
     return id;
@@ -641,8 +655,13 @@ std::vector<ObjectPlacement> DestructionRuntime::placements() const {
     return out;
 }
 
-Status DestructionRuntime::restore(WorldState state, const std::vector<ObjectPlacement>& placements) {
+Status DestructionRuntime::restore(WorldState state, const std::vector<ObjectPlacement>& placements,
+                                   const VolumeLedger& volumes) {
     Impl& im = *impl_;
+    for (double v : {volumes.retired, volumes.dust, volumes.dropped})
+        if (!(v >= 0 && v < 1e300))
+            return Error{ErrorCode::InvalidInput,
+                         "volume ledger: " + std::to_string(v) + " is negative or not finite"};
     std::map<ObjectId, const ObjectPlacement*> where;
     for (const ObjectPlacement& p : placements) {
         const std::string which = "placement of object " + std::to_string(p.object);
@@ -666,7 +685,7 @@ Status DestructionRuntime::restore(WorldState state, const std::vector<ObjectPla
         return s;
     for (BodyId id : old)
         im.destroy(id, false);
-    im.ledger = VolumeLedger{};
+    im.ledger = VolumeLedger{0, volumes.retired, volumes.dust, volumes.dropped};
     for (ObjectId id : im.world.objects()) {
         const ObjectState& st = *im.world.object(id);
         const ObjectPlacement& p = *where.at(id);

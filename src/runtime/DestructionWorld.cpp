@@ -503,6 +503,7 @@ WorldState DestructionWorld::saveState() const {
     w.crumbleTriangles = im.config.crumbleTriangles;
     w.crumbleCells = im.config.crumbleCells;
     w.minPieceVolume = im.config.minPieceVolume;
+    w.decomposition = im.config.decomposition;
     w.frame = im.frame;
     w.nextId = im.nextId;
     w.journalPosition = im.journalLength;
@@ -533,6 +534,13 @@ Status DestructionWorld::loadState(WorldState w) {
         return bad("settings out of range (delayFrames " + std::to_string(w.delayFrames) + ", crumbleCells " +
                    std::to_string(w.crumbleCells) + ", minPieceVolume " + std::to_string(w.minPieceVolume) +
                    ")");
+    const DecompositionParams& d = w.decomposition;
+    if (d.maxParts < 1 || !(d.concavity >= 0 && d.concavity < 1e300) ||
+        !(d.minPartVolumeFraction >= 0 && d.minPartVolumeFraction <= 1) || d.maxPartFaces < 4)
+        return bad("decomposition settings out of range (maxParts " + std::to_string(d.maxParts) +
+                   ", concavity " + std::to_string(d.concavity) + ", minPartVolumeFraction " +
+                   std::to_string(d.minPartVolumeFraction) + ", maxPartFaces " +
+                   std::to_string(d.maxPartFaces) + ")");
     ObjectId last = 0;
     std::map<ObjectId, std::uint32_t> versions;
     for (const ObjectState& o : w.objects) {
@@ -564,7 +572,8 @@ Status DestructionWorld::loadState(WorldState w) {
     im.objects.clear();
     im.geometrySum = 0;
     for (ObjectState& o : w.objects) {
-        o.meshHash = o.mesh.hash();
+        if (o.meshHash == 0) // a saved state brings its hashes: hashing every mesh again is most of a load
+            o.meshHash = o.mesh.hash();
         im.insertObject(std::make_shared<const ObjectState>(std::move(o)));
     }
     im.config.seed = w.seed;
@@ -572,6 +581,7 @@ Status DestructionWorld::loadState(WorldState w) {
     im.config.crumbleTriangles = static_cast<std::size_t>(w.crumbleTriangles);
     im.config.crumbleCells = w.crumbleCells;
     im.config.minPieceVolume = w.minPieceVolume;
+    im.config.decomposition = w.decomposition;
     im.frame = w.frame;
     im.nextId = w.nextId;
     im.journalLength = w.journalPosition;

@@ -6,8 +6,9 @@
 namespace rubble::detail {
 
 void StructureMonitor::add(BodyId id, const std::vector<ConvexPolytope>& worldParts, const Material& material,
-                           bool root) {
+                           bool root, std::uint64_t solid) {
     Node n;
+    n.solid = solid;
     n.parts = worldParts;
     n.material = &material;
     n.node = structureNode(worldParts, material.density, root);
@@ -58,7 +59,11 @@ void StructureMonitor::rebuild() {
     for (Bond& b : all) {
         if (broken_.count({order_[b.a], order_[b.b]}))
             continue;
-        limits.push_back(bondLimits(*nodes_.at(order_[b.a]).material, *nodes_.at(order_[b.b]).material));
+        const Node& na = nodes_.at(order_[b.a]);
+        const Node& nb = nodes_.at(order_[b.b]);
+        limits.push_back(bondLimits(*na.material, *nb.material));
+        if (na.solid != nb.solid)
+            limits.back().friction = policy_.bearingFriction;
         bonds.push_back(std::move(b));
     }
     // Components that reach no root hold themselves up (anchors).

@@ -19,8 +19,10 @@ public:
     /// Reads the policy at every call.
     explicit StructureMonitor(const StructurePolicy& policy) : policy_(policy) {}
 
-    /// Adds a node (parts in world coordinates).
-    void add(BodyId id, const std::vector<ConvexPolytope>& worldParts, const Material& material, bool root);
+    /// Adds a node (parts in world coordinates); `solid` names the object it was cut from (bonds between
+    /// different solids are bearings when the policy says so).
+    void add(BodyId id, const std::vector<ConvexPolytope>& worldParts, const Material& material, bool root,
+             std::uint64_t solid);
     /// Removes a node; its bonds go with it.
     void remove(BodyId id);
     /// True when id is a node.
@@ -42,6 +44,7 @@ private:
         std::vector<ConvexPolytope> parts;
         const Material* material = nullptr;
         StructureNode node;
+        std::uint64_t solid = 0;
     };
     using Pair = std::pair<BodyId, BodyId>;
     void rebuild();

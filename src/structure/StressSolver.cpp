@@ -40,6 +40,55 @@ Mat3 inverse(const Mat3& m) {
     return r;
 }
 
+// Counter-clockwise convex hull (Andrew's monotone chain).
+std::vector<Vec2> convexHull(std::vector<Vec2> pts) {
+    std::sort(pts.begin(), pts.end(),
+              [](const Vec2& a, const Vec2& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
+    if (pts.size() < 3)
+        return pts;
+    auto turn = [](const Vec2& o, const Vec2& a, const Vec2& b) {
+        return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
+    };
+    std::vector<Vec2> h(2 * pts.size());
+    std::size_t k = 0;
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+        while (k >= 2 && turn(h[k - 2], h[k - 1], pts[i]) <= 0)
+            --k;
+        h[k++] = pts[i];
+    }
+    for (std::size_t i = pts.size() - 1, t = k + 1; i > 0; --i) {
+        while (k >= t && turn(h[k - 2], h[k - 1], pts[i - 1]) <= 0)
+            --k;
+        h[k++] = pts[i - 1];
+    }
+    h.resize(k - 1);
+    return h;
+}
+
+// At most 8 corners of the patch's hull (the extremes in 8 directions), counter-clockwise: a bearing's
+// contact points. Exact for a rectangle; inside the hull otherwise, so tipping is judged conservatively.
+std::vector<Vec2> bearingCorners(const std::vector<Vec2>& corners) {
+    const std::vector<Vec2> hull = convexHull(corners);
+    if (hull.size() <= 8)
+        return hull;
+    std::vector<std::size_t> picked;
+    for (int k = 0; k < 8; ++k) {
+        const double a = k * 3.14159265358979323846 / 4;
+        const Vec2 d{std::cos(a), std::sin(a)};
+        std::size_t best = 0;
+        for (std::size_t i = 1; i < hull.size(); ++i)
+            if (hull[i].x * d.x + hull[i].y * d.y > hull[best].x * d.x + hull[best].y * d.y)
+                best = i;
+        picked.push_back(best);
+    }
+    std::sort(picked.begin(), picked.end());
+    picked.erase(std::unique(picked.begin(), picked.end()), picked.end());
+    std::vector<Vec2> out;
+    for (std::size_t i : picked)
+        out.push_back(hull[i]);
+    return out;
+}
+
 } // namespace
 
 StructureNode structureNode(const std::vector<ConvexPolytope>& parts, double density, bool root) {
@@ -96,6 +145,27 @@ void StressSolver::reset(std::vector<StructureNode> nodes, std::vector<Bond> bon
         const NodeState& b = nodes_[s.bond.b];
         s.ra = s.bond.section.centroid - a.node.centroid;
         s.rb = s.bond.section.centroid - b.node.centroid;
+        if (s.limits.friction > 0) {
+            nodes_[s.bond.a].bearing = nodes_[s.bond.b].bearing = true;
+            const BondInterface& x = s.bond.section;
+            auto inverseMass = [&](const Vec3& ra, const Vec3& rb, const Vec3& d) {
+                const Vec3 ca = cross(ra, d), cb = cross(rb, d);
+                return a.invMass + b.invMass + dot(ca, a.invInertia * ca) + dot(cb, b.invInertia * cb);
+            };
+            for (const Vec2& c : bearingCorners(x.corners)) {
+                BearingCorner k;
+                k.offset = x.u * c.x + x.v * c.y;
+                k.ra = s.ra + k.offset;
+                k.rb = s.rb + k.offset;
+                k.kn = inverseMass(k.ra, k.rb, x.normal);
+                k.ku = inverseMass(k.ra, k.rb, x.u);
+                k.kv = inverseMass(k.ra, k.rb, x.v);
+                s.corners.push_back(k);
+            }
+            s.solvable = !s.corners.empty() && s.corners.front().kn > 0;
+            bonds_.push_back(std::move(s));
+            continue;
+        }
         // Effective mass of the weld at the section centroid: impulse (P, L) on a, (-P, -L) on b.
         const Eigen::Matrix3d ia = toEigen(a.invInertia), ib = toEigen(b.invInertia);
         const Eigen::Matrix3d sa = skew(s.ra), sb = skew(s.rb);
@@ -150,6 +220,10 @@ void StressSolver::solve() {
         for (BondState& b : bonds_) {
             if (b.broken || !b.solvable)
                 continue;
+            if (!b.corners.empty()) {
+                solveBearing(b);
+                continue;
+            }
             const NodeState& na = nodes_[b.bond.a];
             const NodeState& nb = nodes_[b.bond.b];
             const Vec3 lin = (na.v + cross(na.w, b.ra)) - (nb.v + cross(nb.w, b.rb));
@@ -167,6 +241,10 @@ void StressSolver::solve() {
             b.moment += dm;
             apply(b, df, dm);
         }
+    for (NodeState& n : nodes_) {
+        const bool moving = length(n.v) > settings_.unbalanced || length(n.w) > settings_.unbalanced;
+        n.unbalanced = n.bearing && n.invMass > 0 && !n.detached && moving ? n.unbalanced + 1 : 0;
+    }
 }
 
 BondStress StressSolver::stress(std::size_t i) const {
@@ -202,7 +280,75 @@ BondStress StressSolver::stress(std::size_t i) const {
     return out;
 }
 
+void StressSolver::solveBearing(BondState& b) {
+    const BondInterface& x = b.bond.section;
+    const NodeState& na = nodes_[b.bond.a];
+    const NodeState& nb = nodes_[b.bond.b];
+    auto push = [&](const BearingCorner& k, const Vec3& f) {
+        b.force += f;
+        b.moment += cross(k.offset, f);
+        apply(b, f, cross(k.offset, f));
+    };
+    auto relative = [&](const BearingCorner& k) {
+        return (na.v + cross(na.w, k.ra)) - (nb.v + cross(nb.w, k.rb));
+    };
+    for (BearingCorner& k : b.corners) {
+        // a corner's force acts on a (its opposite on b): b pushing a away is -normal * press
+        const double press = std::max(0.0, k.press + dot(relative(k), x.normal) / k.kn);
+        push(k, x.normal * -(press - k.press));
+        k.press = press;
+        const Vec3 rel = relative(k);
+        double gu = k.gu - dot(rel, x.u) / k.ku, gv = k.gv - dot(rel, x.v) / k.kv;
+        const double grip = b.limits.friction * k.press, g = std::sqrt(gu * gu + gv * gv);
+        if (g > grip) {
+            gu *= grip / g;
+            gv *= grip / g;
+        }
+        push(k, x.u * (gu - k.gu) + x.v * (gv - k.gv));
+        k.gu = gu;
+        k.gv = gv;
+    }
+}
+
+double StressSolver::bearingUtilisation(const BondState& b) const {
+    const BondInterface& s = b.bond.section;
+    double press = 0, gu = 0, gv = 0;
+    Vec2 e{0, 0};
+    std::vector<Vec2> hull; // the corners, counter-clockwise about the centroid
+    for (const BearingCorner& k : b.corners) {
+        const Vec2 c{dot(k.offset, s.u), dot(k.offset, s.v)};
+        hull.push_back(c);
+        press += k.press;
+        e.x += k.press * c.x;
+        e.y += k.press * c.y;
+        gu += k.gu;
+        gv += k.gv;
+    }
+    if (press <= 0)
+        return 0;
+    e.x /= press;
+    e.y /= press;
+    double tip = 0; // the resultant against each hull edge: 1 on the edge (about to tip)
+    for (std::size_t k = 0; hull.size() >= 3 && k < hull.size(); ++k) {
+        const Vec2& a = hull[k];
+        const Vec2& c = hull[(k + 1) % hull.size()];
+        const Vec2 m{c.y - a.y, a.x - c.x}; // outward
+        const double h = m.x * a.x + m.y * a.y;
+        if (h > 0)
+            tip = std::max(tip, (m.x * e.x + m.y * e.y) / h);
+    }
+    const double slide = std::sqrt(gu * gu + gv * gv) / (b.limits.friction * press);
+    const double crush = b.limits.compressive > 0 && s.sectionArea > 0
+                             ? press / (s.sectionArea * b.health) / b.limits.compressive
+                             : 0.0;
+    return std::max({std::min(tip, 1.0), std::min(slide, 1.0), crush}); // only crushing exceeds 1
+}
+
 double StressSolver::utilisation(std::size_t i) const {
+    if (bonds_[i].broken)
+        return 0;
+    if (bonds_[i].limits.friction > 0)
+        return bearingUtilisation(bonds_[i]);
     const BondStress s = stress(i);
     const StrengthLimits& l = bonds_[i].limits;
     auto ratio = [](double stress, double limit) { return limit > 0 ? stress / limit : 0.0; };
@@ -280,7 +426,7 @@ std::vector<std::uint32_t> StressSolver::unsupported() const {
     }
     std::vector<std::uint32_t> out;
     for (std::uint32_t i = 0; i < nodes_.size(); ++i)
-        if (!reached[i] && !nodes_[i].detached)
+        if ((!reached[i] || nodes_[i].unbalanced >= settings_.unbalancedSolves) && !nodes_[i].detached)
             out.push_back(i);
     return out;
 }

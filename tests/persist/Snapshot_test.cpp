@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <random>
 
 #include "JournalScene.hpp"
@@ -124,6 +125,93 @@ TEST(Snapshot, RestoresARuntimeWithTheBodiesOfItsObjects) {
     EXPECT_LT(std::abs(other.runtime.volumes().total() - start) / start, 1e-9);
 }
 
+// Version 2 holds the decomposition settings (the loading world adopts them), each object's mesh hash (taken
+// as saved, so a load does not hash every mesh again) and the runtime's volume ledger (the ledger continues).
+TEST(Snapshot, KeepsDecompositionSettingsMeshHashesAndTheVolumeLedger) {
+    MidFire m;
+    Snapshot s = takeSnapshot(m.rig.runtime);
+    EXPECT_EQ(s.placements.size(), s.world.objects.size());
+    const VolumeLedger saved = m.rig.runtime.volumes();
+    EXPECT_GT(saved.retired + saved.dust + saved.dropped, 0) << "the rig removed some volume";
+    s.world.decomposition.maxParts = 7;
+    s.world.decomposition.concavity = 0.125;
+    s.world.decomposition.maxPartFaces = 96;
+    const std::vector<std::uint8_t> bytes = encodeSnapshot(s);
+    Result<Snapshot> decoded = decodeSnapshot(bytes.data(), bytes.size(), "v2.rsnap");
+    ASSERT_TRUE(decoded) << decoded.error().message;
+    EXPECT_EQ(decoded->volumes.retired, saved.retired);
+    EXPECT_EQ(decoded->volumes.dust, saved.dust);
+    EXPECT_EQ(decoded->volumes.dropped, saved.dropped);
+    for (std::size_t i = 0; i < s.world.objects.size(); ++i)
+        EXPECT_EQ(decoded->world.objects[i].meshHash, s.world.objects[i].mesh.hash());
+    test::JournalRig other(2);
+    other.play(30);
+    ASSERT_TRUE(restoreSnapshot(other.runtime, std::move(*decoded)));
+    EXPECT_EQ(other.runtime.world().geometryHash(), m.rig.runtime.world().geometryHash());
+    const WorldState loaded = other.runtime.world().saveState();
+    EXPECT_EQ(loaded.decomposition.maxParts, 7);
+    EXPECT_EQ(loaded.decomposition.concavity, 0.125);
+    EXPECT_EQ(loaded.decomposition.maxPartFaces, 96u);
+    const VolumeLedger now = other.runtime.volumes();
+    EXPECT_EQ(now.retired, saved.retired);
+    EXPECT_EQ(now.dust, saved.dust);
+    EXPECT_EQ(now.dropped, saved.dropped);
+    EXPECT_LT(std::abs(now.total() - saved.total()) / saved.total(), 1e-9)
+        << "volume conserved across a load";
+    Snapshot again = takeSnapshot(other.runtime);
+    again.placements = s.placements; // bodies are remade: their placements agree to 1e-9, not bit for bit
+    EXPECT_EQ(encodeSnapshot(again), bytes) << "load then save: the same bytes";
+
+    // Refused, the runtime untouched: decomposition settings out of range, a negative ledger entry.
+    const std::uint64_t before = other.runtime.stateHash();
+    Snapshot broken = s;
+    broken.world.decomposition.maxParts = 0;
+    Status st = restoreSnapshot(other.runtime, broken);
+    EXPECT_FALSE(st);
+    EXPECT_NE(st.message().find("decomposition settings out of range"), std::string::npos) << st.message();
+    broken = s;
+    broken.volumes.dust = -1;
+    st = restoreSnapshot(other.runtime, broken);
+    EXPECT_FALSE(st);
+    EXPECT_NE(st.message().find("volume ledger"), std::string::npos) << st.message();
+    EXPECT_EQ(other.runtime.stateHash(), before);
+}
+
+// A snapshot saved by the previous format (version 1, tests/data/snapshot/v1-box.rsnap: a box shattered into
+// 4 pieces) is refused naming the version and what to do; the world stays as it was.
+TEST(Snapshot, AnOlderVersionIsRefusedWithAClearError) {
+    const std::filesystem::path v1 =
+        std::filesystem::path(RUBBLE_SOURCE_DIR) / "tests/data/snapshot/v1-box.rsnap";
+    Result<Snapshot> r = loadSnapshot(v1);
+    ASSERT_FALSE(r);
+    EXPECT_NE(r.error().message.find("v1-box.rsnap: offset 4, field version: version 1 is not supported"),
+              std::string::npos)
+        << r.error().message;
+    EXPECT_NE(r.error().message.find("older build"), std::string::npos) << r.error().message;
+    // A hostile v2: a zero mesh hash and a negative ledger entry, each named by offset and field.
+    MidFire m;
+    std::vector<std::uint8_t> b = encodeSnapshot(takeSnapshot(m.rig.runtime));
+    const std::size_t firstObject = 4 + 2 + 2 + 8 + 4 + 8 + 4 + 8 + 36 + 8 + 4 + 8 + 4;
+    std::fill(b.begin() + static_cast<std::ptrdiff_t>(firstObject + 8),
+              b.begin() + static_cast<std::ptrdiff_t>(firstObject + 16), 0);
+    refix(b);
+    r = decodeSnapshot(b.data(), b.size(), "bad.rsnap");
+    ASSERT_FALSE(r);
+    EXPECT_NE(r.error().message.find("offset " + std::to_string(firstObject + 8) +
+                                     ", field objects[0].meshHash: is 0"),
+              std::string::npos)
+        << r.error().message;
+    b = encodeSnapshot(takeSnapshot(m.rig.runtime));
+    b[b.size() - 4 - 24 + 7] = 0xBF; // volumes.retired < 0
+    refix(b);
+    r = decodeSnapshot(b.data(), b.size(), "bad.rsnap");
+    ASSERT_FALSE(r);
+    EXPECT_NE(r.error().message.find("offset " + std::to_string(b.size() - 4 - 24) +
+                                     ", field volumes.retired: is negative"),
+              std::string::npos)
+        << r.error().message;
+}
+
 TEST(Snapshot, SnapshotPlusJournalTailConvergesWithTheHost) {
     MidFire m;
     std::vector<JournalEvent> tail;
@@ -174,7 +262,7 @@ TEST(Snapshot, DamagedFilesAreRefusedNamingOffsetAndFieldAndTheWorldStaysAsItWas
     refused(b, "field crc32: checksum mismatch");
     // Another version, another format.
     b = bytes;
-    b[4] = 2;
+    b[4] = 3;
     refused(b, "offset 4, field version");
     b = bytes;
     b[0] = 'X';
@@ -182,13 +270,13 @@ TEST(Snapshot, DamagedFilesAreRefusedNamingOffsetAndFieldAndTheWorldStaysAsItWas
     // Hostile but checksummed: a huge count, an out-of-range vertex index, a NaN.
     b = bytes;
     const std::size_t objectsCount =
-        4 + 2 + 2 + 8 + 4 + 8 + 4 + 8 + 8 + 4 + 8; // header, settings, frame, ids
+        4 + 2 + 2 + 8 + 4 + 8 + 4 + 8 + 36 + 8 + 4 + 8; // header, settings, decomposition, frame, ids
     b[objectsCount + 3] = 0x7F;
     refix(b);
     refused(b, "offset " + std::to_string(objectsCount) + ", field objects.count: count");
     const std::size_t firstObject = objectsCount + 4;
-    const std::size_t meshAt = firstObject + 4 + 4 + 1 + 8 + 8 + 8 + 1 + 4 + 4 + 40 + 1 + 8 + 8 + 1 + 8 + 24 +
-                               72 + 24 + 72; // positions.count
+    const std::size_t meshAt = firstObject + 4 + 4 + 8 + 1 + 8 + 8 + 8 + 1 + 4 + 4 + 40 + 1 + 8 + 8 + 1 + 8 +
+                               24 + 72 + 24 + 72; // positions.count
     const std::uint32_t nPos = m.snapshot.world.objects[0].mesh.positions.size();
     const std::size_t firstIndex = meshAt + 4 + 24 * nPos + 4;
     b = bytes;

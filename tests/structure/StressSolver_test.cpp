@@ -30,14 +30,17 @@ struct Scene {
         return static_cast<std::uint32_t>(solids.size() - 1);
     }
 
-    StressSolver solver(StressSettings settings = {}) const {
+    // friction > 0: every bond is a bearing.
+    StressSolver solver(StressSettings settings = {}, double friction = 0) const {
         std::vector<StructureNode> nodes;
         for (std::size_t i = 0; i < solids.size(); ++i)
             nodes.push_back(structureNode(solids[i], materials[i]->density, roots[i]));
         std::vector<Bond> bonds = buildBonds(solids, {});
         std::vector<StrengthLimits> limits;
-        for (const Bond& b : bonds)
+        for (const Bond& b : bonds) {
             limits.push_back(bondLimits(*materials[b.a], *materials[b.b]));
+            limits.back().friction = friction;
+        }
         StressSolver s(settings);
         s.reset(std::move(nodes), std::move(bonds), std::move(limits));
         return s;
@@ -219,4 +222,95 @@ TEST(StressSolver, SolvesAreDeterministic) {
         EXPECT_EQ(s1.bondForce(i), s2.bondForce(i));
         EXPECT_EQ(s1.bondMoment(i), s2.bondMoment(i));
     }
+}
+
+// A slab resting (not welded) on a pier: it stands while its centre of mass is above the contact (the
+// resultant's offset over the contact's half-width, e / (w / 2), is its utilisation); beyond, the bearing
+// cannot hold it in equilibrium and it is unsupported: it tips.
+TEST(StressSolver, BearingSlabTipsExactlyWhenItsCentreOfMassLeavesTheContact) {
+    const double span = 2;
+    int stood = 0, tipped = 0;
+    for (double start = -1.9; start <= 0.9; start += 0.2) {
+        Scene scene;
+        scene.add(box({0, 0, -1}, {1, 1, 1}), "concrete", true);
+        const std::uint32_t slab = scene.add(box({start, 1, -0.5}, {start + span, 1.2, 0.5}), "concrete");
+        StressSolver s = scene.solver({}, 0.6);
+        for (int i = 0; i < 40; ++i)
+            s.solve();
+        ASSERT_EQ(s.bondCount(), 1u);
+        const double lo = std::max(0.0, start), hi = std::min(1.0, start + span);
+        const double ratio = std::abs(start + span / 2 - (lo + hi) / 2) / ((hi - lo) / 2);
+        const double cg = start + span / 2;
+        const bool tips = cg < 0 || cg > 1;
+        EXPECT_NEAR(s.utilisation(0), std::min(ratio, 1.0), 0.01 * ratio + 1e-3) << "slab from x = " << start;
+        EXPECT_TRUE(s.breakOverstressed().empty()) << "a bearing breaks only by crushing";
+        EXPECT_EQ(s.unsupported(), tips ? std::vector<std::uint32_t>{slab} : std::vector<std::uint32_t>{})
+            << "slab from x = " << start;
+        (tips ? tipped : stood)++;
+    }
+    EXPECT_GT(stood, 3);
+    EXPECT_GT(tipped, 3);
+}
+
+// A 2 x 0.2 x 2 m concrete slab (node 1) on a pier (node 0, root) of the same top, after 40 solves with a
+// load at a point; friction > 0: a bearing.
+namespace {
+constexpr std::uint32_t kSlab = 1;
+StressSolver loadedSlabOnPier(double friction, const Vec3& load, const Vec3& at) {
+    Scene scene;
+    scene.add(box({-1, 0, -1}, {1, 1, 1}), "concrete", true);
+    scene.add(box({-1, 1, -1}, {1, 1.2, 1}), "concrete");
+    StressSolver s = scene.solver({}, friction);
+    for (int i = 0; i < 40; ++i) {
+        s.addLoad(kSlab, load, at);
+        s.solve();
+    }
+    return s;
+}
+} // namespace
+
+// A bearing carries no tension: a slab lifted by more than its weight is not held; a welded one is.
+TEST(StressSolver, BearingLetsGoWhenPulledApartAndAWeldDoesNot) {
+    for (const double friction : {0.6, 0.0})
+        for (const double lift : {0.5, 1.5}) {
+            const double weight = findMaterial("concrete")->density * 0.8 * kG;
+            StressSolver s = loadedSlabOnPier(friction, {0, lift * weight, 0}, {0, 1.1, 0});
+            EXPECT_TRUE(s.breakOverstressed().empty());
+            const bool letsGo = friction > 0 && lift > 1;
+            EXPECT_EQ(s.unsupported(),
+                      letsGo ? std::vector<std::uint32_t>{kSlab} : std::vector<std::uint32_t>{})
+                << "friction " << friction << " lift " << lift;
+        }
+}
+
+// A bearing slides when the transverse force exceeds friction times compression (a push at the contact).
+TEST(StressSolver, BearingSlidesWhenThePushExceedsFrictionTimesWeight) {
+    const double mu = 0.6;
+    for (const double push : {0.9, 1.1}) {
+        const double weight = findMaterial("concrete")->density * 0.8 * kG;
+        StressSolver s = loadedSlabOnPier(mu, {push * mu * weight, 0, 0}, {0, 1, 0});
+        EXPECT_NEAR(s.utilisation(0), std::min(push, 1.0), 0.01 * push);
+        EXPECT_EQ(s.unsupported(),
+                  push > 1 ? std::vector<std::uint32_t>{kSlab} : std::vector<std::uint32_t>{});
+    }
+}
+
+// Statically indeterminate: a slab on two piers with bearings stands; the pier forces sum to its weight and
+// balance its moment with each resultant inside its pier's top: W (2 - x1) / (x2 - x1), x1 in [0, 0.5] and
+// x2 in [3, 3.5], puts F2 between W / 2 and 2 W / 3.
+TEST(StressSolver, BearingSlabOnTwoPiersStandsWithTheLeverRuleForces) {
+    Scene scene;
+    scene.add(box({0, 0, -0.5}, {0.5, 2, 0.5}), "concrete", true);
+    scene.add(box({3, 0, -0.5}, {3.5, 2, 0.5}), "concrete", true);
+    const std::uint32_t slab = scene.add(box({0, 2, -0.5}, {4, 2.3, 0.5}), "concrete");
+    StressSolver s = scene.solver({}, 0.6);
+    for (int i = 0; i < 60; ++i)
+        s.solve();
+    EXPECT_TRUE(s.unsupported().empty());
+    const double weight = scene.materials[slab]->density * 4 * 0.3 * kG;
+    const double f1 = length(s.bondForce(bondBetween(s, 0, slab)));
+    const double f2 = length(s.bondForce(bondBetween(s, 1, slab)));
+    EXPECT_NEAR(f1 + f2, weight, 0.01 * weight);
+    EXPECT_GE(f2, 0.5 * weight * 0.99);
+    EXPECT_LE(f2, 2 * weight / 3 * 1.01);
 }

@@ -1,5 +1,7 @@
 #include "rubble/enet/NetHost.hpp"
 
+#include <algorithm>
+#include <chrono>
 #include <map>
 #include <vector>
 
@@ -19,6 +21,8 @@ struct NetHost::Impl {
     std::vector<JournalEvent> journal;             // events since base
     std::uint64_t base = 0;                        // journal position of journal.front()
     std::map<ENetPeer*, std::uint64_t> peers;      // journal position each client has been sent up to
+    std::map<ENetPeer*, std::uint64_t> acked;      // the latest frame each client confirmed
+    std::uint64_t lastSync = 0;                    // frame of the latest sync sent
     std::map<std::uint64_t, std::uint64_t> hashes; // frame → geometry hash sent in its sync (recent ones)
     HostStats stats;
     std::function<std::vector<ObjectPlacement>()> placementSource;
@@ -44,6 +48,7 @@ struct NetHost::Impl {
             return; // clients send nothing else
         ++stats.acks;
         const std::uint64_t frame = detail::readU64(d + 1), hash = detail::readU64(d + 9);
+        acked[peer] = std::max(acked[peer], frame);
         if (auto it = hashes.find(frame); it != hashes.end() && it->second != hash)
             ++stats.mismatchedHashes;
     }
@@ -94,6 +99,7 @@ void NetHost::publish() {
     const std::uint64_t end = im.world.journalPosition();
     const std::uint64_t frame = im.world.frame(), hash = im.world.geometryHash();
     im.hashes[frame] = hash;
+    im.lastSync = frame;
     while (im.hashes.size() > 4096)
         im.hashes.erase(im.hashes.begin());
     for (auto& [peer, position] : im.peers) {
@@ -156,6 +162,20 @@ void NetHost::publishPlacements(const std::vector<ObjectPlacement>& placements) 
     enet_host_flush(im.host);
 }
 
+bool NetHost::finish(int timeoutMs) {
+    Impl& im = *impl_;
+    const auto confirmed = [&im] {
+        for (const auto& [peer, position] : im.peers)
+            if (auto a = im.acked.find(peer); a == im.acked.end() || a->second < im.lastSync)
+                return false;
+        return true;
+    };
+    const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeoutMs);
+    while (!confirmed() && std::chrono::steady_clock::now() < end)
+        service(5);
+    return confirmed();
+}
+
 void NetHost::setPlacementSource(std::function<std::vector<ObjectPlacement>()> source) {
     impl_->placementSource = std::move(source);
 }
@@ -175,6 +195,7 @@ void NetHost::service(int timeoutMs) {
             break;
         case ENET_EVENT_TYPE_DISCONNECT:
             im.peers.erase(e.peer);
+            im.acked.erase(e.peer);
             break;
         default:
             break;

@@ -54,6 +54,9 @@ public:
     /// Sends every client the placements of the dynamic bodies among placements (unreliable, unsequenced,
     /// on channel 1, at most 37 per packet): the host is authoritative for motion. Call at a modest rate.
     void publishPlacements(const std::vector<ObjectPlacement>& placements);
+    /// Handles the network until every connected client confirmed the latest sync (or timeoutMs passed);
+    /// true when they all did. Call before closing, so that the clients end in the host's state.
+    bool finish(int timeoutMs);
     /// Where joining clients' snapshots get the bodies' placements from (e.g. the runtime's placements()).
     void setPlacementSource(std::function<std::vector<ObjectPlacement>()> source);
     /// Handles the network (joins, leaves, clients' hash reports) for up to timeoutMs.
