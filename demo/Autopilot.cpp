@@ -11,6 +11,7 @@ ControlInput Autopilot::update(const Game& game, float dt) {
     game.vehicleFrame(pos, fwd, up);
     const V3 right = norm(cross(fwd, up));
     const float alt = pos.y - game.groundY();
+    in.weapon = static_cast<int>(autopilotWeapon(game.counters().shots)); // two shots of each in turn
     in.throttle = game.speed() < 34 ? 1.0f : (game.speed() > 40 ? -1.0f : 0.0f);
 
     retarget_ -= dt;
@@ -49,7 +50,15 @@ ControlInput Autopilot::update(const Game& game, float dt) {
             in.yaw = x < 0 ? 1.0f : -1.0f;
         }
         const float dist = len(target_ - pos);
-        in.fire = (z > 0.985f && dist < 300) || (z > 0.96f && dist < 150);
+        // fire when the line of fire passes within 3 m of the centre of a standing object clear of the ground
+        const V3 shot = norm(game.shotVelocity()); // the jet's velocity lags its nose in turns
+        for (const V3& t : game.targets()) {
+            if (t.y < game.groundY() + 5)
+                continue;
+            const float along = dot(t - pos, shot);
+            const float miss = len(t - pos - shot * along);
+            in.fire = in.fire || (along > 20 && along < 260 && miss < 3.0f);
+        }
         if (dist < 55) {
             evade_ = 2.2f;
             evadeYaw_ = x < 0 ? -1.0f : 1.0f;

@@ -1,7 +1,8 @@
 #pragma once
 /// \file Autopilot.hpp
 /// Scripted pilot for headless runs: flies toward the nearest standing object, shoots when lined up,
-/// pulls away before a collision and keeps clear of the ground. Deterministic given the game state.
+/// pulls away before a collision and keeps clear of the ground; cycles the weapons, two shots each.
+/// Deterministic given the game state.
 
 #include "Game.hpp"
 

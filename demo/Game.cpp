@@ -120,12 +120,17 @@ void Game::clear(Renderer& renderer) {
     latencies_.clear();
     latencyCursor_ = 0;
     nextTiming_ = 0;
+    shells_.clear();
+    landed_.clear();
+    stepImpacts_.clear();
+    hitBy_.clear();
+    blastBy_ = -1;
 }
 
 void Game::addVisual(BodyId body, const rubble::Mesh& mesh, const Look& look, float heat,
                      Renderer& renderer) {
     Visual v;
-    v.mesh = renderer.addMesh(mesh, look.texture, look.tint.x, look.tint.y, look.tint.z);
+    v.mesh = renderer.addMesh(mesh, look.texture, look.tint.x, look.tint.y, look.tint.z, look.interior);
     v.heat = heat;
     v.tint = look.tint;
     visuals_[body] = v;
@@ -153,8 +158,14 @@ bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const Game
     runtime_ = std::make_unique<rubble::DestructionRuntime>(*binding_, rc);
     worldConfig_ = rc.world;
     journal_.clear();
-    runtime_->world().setJournalSink([this](const rubble::JournalEvent& e) { journal_.push_back(e); });
+    runtime_->world().setJournalSink([this](const rubble::JournalEvent& e) { journaled(e); });
     runtime_->setOnRemoved([this, &renderer](const BodyRecord& b) {
+        if (auto shell = shells_.find(b.id); shell != shells_.end()) { // a shell's hit is known when it goes
+            if (b.spent)
+                landed_.push_back(
+                    {shell->second.weapon, toV3(runtime_->motion(b.id).transform.translation), true});
+            shells_.erase(shell);
+        }
         auto it = visuals_.find(b.id);
         if (it == visuals_.end())
             return;
@@ -260,10 +271,24 @@ bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const Game
         Look look;
         look.texture = o.textureFound ? renderer.loadTexture(o.texturePath, "concrete", warnings)
                                       : renderer.proceduralTexture("concrete");
+        if (!o.material.empty()) // cut faces show the material's grain
+            look.interior = renderer.materialInterior(o.material);
         looks_[id] = look;
         addVisual(body->id, st->mesh, look, 0, renderer);
     }
     counters_.warnings = static_cast<int>(warnings.size());
+    { // showcase camera: in front of the objects' centre, at a distance that frames their spread
+        const std::vector<V3> t = targets();
+        V3 c{};
+        for (const V3& p : t)
+            c = c + p * (1.0f / static_cast<float>(std::max<std::size_t>(t.size(), 1)));
+        float r = 5;
+        for (const V3& p : t)
+            r = std::max(r, len(p - c));
+        showcaseAt_ = c;
+        showcaseEye_ = c + V3{0.9f, 0.45f, 1.6f} * (1.1f * r + 6);
+        showcaseEye_.y = std::max(showcaseEye_.y, groundTop_ + 3);
+    }
     V3 pos, fwd, up;
     vehicleFrame(pos, fwd, up);
     camera_.snap(pos, fwd, up);
@@ -272,6 +297,10 @@ bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const Game
 }
 
 void Game::onAdopted(const rubble::FractureOutcome& o, Renderer& renderer) {
+    if (auto hit = hitBy_.find(o.parent); hit != hitBy_.end()) {
+        ++counters_.weaponFractures[static_cast<std::size_t>(hit->second)];
+        hitBy_.erase(hit);
+    }
     Look look;
     if (auto it = looks_.find(o.parent); it != looks_.end()) {
         look = it->second;
@@ -325,7 +354,8 @@ void Game::respawn() {
     camera_.snap(pos, fwd, up);
 }
 
-void Game::blast(const V3& point, float radius, float impulse) {
+void Game::blast(const V3& point, float radius, float impulse, int by) {
+    blastBy_ = by;
     const rubble::Vec3 p{point.x, point.y, point.z};
     for (BodyId id : runtime_->bodies()) {
         const BodyRecord* b = runtime_->body(id);
@@ -342,6 +372,7 @@ void Game::blast(const V3& point, float radius, float impulse) {
         const double falloff = 1.0 - 0.6 * std::clamp((dist - b->radius) / radius, 0.0, 1.0);
         runtime_->submitImpact(id, at, n, impulse * falloff);
     }
+    blastBy_ = -1;
     particles_.impactBurst(point, V3{0, 1, 0}, 3.0f, burstSeed_++);
     particles_.impactBurst(point, V3{0, 1, 0}, 2.0f, burstSeed_++);
 }
@@ -436,18 +467,77 @@ void Game::controlVehicle(const ControlInput& input, float dt) {
     rb->activate(true);
 }
 
+V3 Game::shotVelocity() const {
+    if (!vehicle_)
+        return {};
+    const btRigidBody* vehicle = binding_->rigid(vehicle_);
+    const btVector3 fwd = vehicle->getWorldTransform().getBasis() * btVector3(0, 0, -1);
+    const bool cannon = weapon_ == Weapon::Cannon; // the cannon follows the panel's projectile settings
+    return toV3(vehicle->getLinearVelocity() +
+                fwd * (cannon ? settings_.projectileSpeed : weaponSpec(weapon_).speed));
+}
+
 void Game::fire() {
     const btRigidBody* vehicle = binding_->rigid(vehicle_);
     const btTransform& vt = vehicle->getWorldTransform();
     const btVector3 fwd = vt.getBasis() * btVector3(0, 0, -1);
     const btVector3 from = vt.getOrigin() + fwd * noseOffset_;
-    const btVector3 vel = vehicle->getLinearVelocity() + fwd * settings_.projectileSpeed;
+    const WeaponSpec& w = weaponSpec(weapon_);
+    const bool cannon = weapon_ == Weapon::Cannon;
+    const V3 v = shotVelocity();
+    const btVector3 vel(v.x, v.y, v.z);
     const BodyId p = runtime_->fireProjectile(rubble::bullet::fromBt(from), rubble::bullet::fromBt(vel),
-                                              settings_.projectileMass, 0.35);
+                                              cannon ? settings_.projectileMass : w.mass, w.radius);
     btRigidBody* rb = binding_->rigid(p);
     rb->setFlags(rb->getFlags() | BT_DISABLE_WORLD_GRAVITY);
     rb->setGravity(btVector3(0, -2.0f, 0));
+    shells_[p] = {weapon_, {}, false};
     ++counters_.shots;
+    ++counters_.weaponShots[static_cast<std::size_t>(weapon_)];
+}
+
+void Game::journaled(const rubble::JournalEvent& e) {
+    journal_.push_back(e);
+    if (net_)
+        net_->journaled(e);
+    if (e.kind != rubble::JournalEventKind::Impact)
+        return;
+    if (blastBy_ >= 0)
+        hitBy_[e.object] = blastBy_;
+    else
+        stepImpacts_.push_back(e);
+}
+
+void Game::creditHits() {
+    // Each impact of the step goes to the weapon of the nearest shell that hit something in it; impacts
+    // without a shell (falling pieces, a crash) count for no weapon.
+    for (const rubble::JournalEvent& e : stepImpacts_) {
+        if (landed_.empty())
+            break;
+        const Shell* best = landed_.size() == 1 ? &landed_.front() : nullptr;
+        if (const BodyRecord* b = runtime_->bodyOf(e.object)) {
+            const btTransform objectToWorld =
+                binding_->rigid(b->id)->getWorldTransform() * rubble::bullet::toBt(b->objectToBody).inverse();
+            const V3 at = toV3(objectToWorld * btVector3(e.point[0], e.point[1], e.point[2]));
+            float nearest = 1e30f;
+            for (const Shell& s : landed_)
+                if (len(s.at - at) < nearest) {
+                    nearest = len(s.at - at);
+                    best = &s;
+                }
+        }
+        if (best)
+            hitBy_[e.object] = static_cast<int>(best->weapon);
+    }
+    stepImpacts_.clear();
+    // A demolition charge blasts where it landed.
+    std::vector<Shell> landed;
+    landed.swap(landed_);
+    for (const Shell& s : landed) {
+        const WeaponSpec& w = weaponSpec(s.weapon);
+        if (w.blastRadius > 0)
+            blast(s.at, w.blastRadius, w.blastImpulse, static_cast<int>(s.weapon));
+    }
 }
 
 void Game::emitEffects(long long impactsBefore, long long retiredBefore) {
@@ -477,10 +567,12 @@ void Game::step(const ControlInput& input, float dt, Renderer& renderer) {
         return;
     ++counters_.frame;
     controlVehicle(input, dt);
+    if (input.weapon >= 0 && input.weapon < kWeaponCount)
+        weapon_ = static_cast<Weapon>(input.weapon);
     fireCooldown_ -= dt;
     if (input.fire && vehicle_ && crashTimer_ <= 0 && (!fireWasDown_ || fireCooldown_ <= 0)) {
         fire();
-        fireCooldown_ = settings_.fireInterval;
+        fireCooldown_ = weapon_ == Weapon::Cannon ? settings_.fireInterval : weaponSpec(weapon_).interval;
     }
     fireWasDown_ = input.fire;
 
@@ -494,6 +586,7 @@ void Game::step(const ControlInput& input, float dt, Renderer& renderer) {
     const long long retiredBefore = runtime_->counters().piecesRetired;
     runtime_->setFocus({camera_.eye.x, camera_.eye.y, camera_.eye.z}); // distant tiny debris fades
     runtime_->stepFrame(dt);
+    creditHits();
     checkCrash();
     emitEffects(impactsBefore, retiredBefore);
     if (net_) { // clients follow by journal events and placements (10 Hz)
@@ -620,6 +713,10 @@ void Game::draw(Renderer& renderer, float dt) {
     vehicleFrame(pos, fwd, up);
     camera_.update(pos, fwd, up, dt);
     camera_.eye.y = std::max(camera_.eye.y, groundTop_ + 1.5f);
+    if (settings_.showcase) {
+        camera_.eye = showcaseEye_;
+        camera_.target = showcaseAt_;
+    }
 }
 
 std::vector<double> Game::takeNewLatencies() {
@@ -712,10 +809,7 @@ bool Game::host(std::uint16_t port, std::string& message) {
     net_ = std::move(*server);
     net_->setPlacementSource([this] { return runtime_->placements(); });
     // One journal sink: the recording and the clients both get every event.
-    runtime_->world().setJournalSink([this](const rubble::JournalEvent& e) {
-        journal_.push_back(e);
-        net_->journaled(e);
-    });
+    runtime_->world().setJournalSink([this](const rubble::JournalEvent& e) { journaled(e); });
     message = "127.0.0.1:" + std::to_string(net_->port());
     return true;
 }

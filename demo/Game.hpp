@@ -4,6 +4,7 @@
 /// the flying vehicle with a stabilising assist, projectiles from its nose, and the renderer's meshes kept in
 /// step with the runtime's bodies.
 
+#include <array>
 #include <cstdint>
 #include <deque>
 #include <map>
@@ -16,6 +17,7 @@
 #include "Math.hpp"
 #include "ParticleSystem.hpp"
 #include "Renderer.hpp"
+#include "Weapons.hpp"
 #include "rubble/DestructionRuntime.hpp"
 #include "rubble/Fracture.hpp"
 #include "rubble/SceneConfig.hpp"
@@ -32,6 +34,7 @@ struct ControlInput {
     float yaw = 0;      ///< +1 = left (Q), -1 = right (E)
     float throttle = 0; ///< +1 = speed up (Z), -1 = slow down (X)
     bool fire = false;  ///< Space held
+    int weapon = -1;    ///< 0..2: switch to that weapon (keys 1-3); -1 keeps the current one
 };
 
 /// Tunables edited from the ImGui panel.
@@ -55,24 +58,27 @@ struct GameSettings {
     bool debugBonds = false;         ///< draw the structure's bonds, green (idle) to red (breaking)
     bool shadows = true;             ///< shadow mapping
     bool autoLevel = true;           ///< wings level themselves when no roll key is held (L toggles)
+    bool showcase = false; ///< the camera frames the scene's objects from a fixed point (screenshots)
 };
 
 /// Counters shown in the panel and printed by --stats.
 struct GameCounters {
-    std::uint64_t frame = 0; ///< simulation frames (frozen while paused)
-    int shots = 0;           ///< projectiles fired
-    int impacts = 0;         ///< projectile hits (on objects or the ground)
-    int submitted = 0;       ///< impacts accepted by the DestructionWorld
-    int fractures = 0;       ///< fracture results adopted
-    int piecesCreated = 0;   ///< piece bodies created
-    int retired = 0;         ///< pieces turned into particles
-    int bodies = 0;          ///< rigid bodies in the physics world
-    int pieces = 0;          ///< live piece bodies
-    int jobs = 0;            ///< fracture jobs queued or running
-    int warnings = 0;        ///< scene warnings
-    int crashes = 0;         ///< the jet hit the ground or an object
-    int respawns = 0;        ///< the jet came back (2 s after a crash, or R)
-    int turnBacks = 0;       ///< times the world bounds started turning the jet back
+    std::uint64_t frame = 0;                         ///< simulation frames (frozen while paused)
+    int shots = 0;                                   ///< projectiles fired
+    int impacts = 0;                                 ///< projectile hits (on objects or the ground)
+    int submitted = 0;                               ///< impacts accepted by the DestructionWorld
+    int fractures = 0;                               ///< fracture results adopted
+    int piecesCreated = 0;                           ///< piece bodies created
+    int retired = 0;                                 ///< pieces turned into particles
+    int bodies = 0;                                  ///< rigid bodies in the physics world
+    int pieces = 0;                                  ///< live piece bodies
+    int jobs = 0;                                    ///< fracture jobs queued or running
+    int warnings = 0;                                ///< scene warnings
+    int crashes = 0;                                 ///< the jet hit the ground or an object
+    int respawns = 0;                                ///< the jet came back (2 s after a crash, or R)
+    int turnBacks = 0;                               ///< times the world bounds started turning the jet back
+    std::array<int, kWeaponCount> weaponShots{};     ///< shots fired, by weapon
+    std::array<int, kWeaponCount> weaponFractures{}; ///< fractures adopted whose impact came from the weapon
 };
 
 /// The game world.
@@ -107,6 +113,12 @@ public:
     const ChaseCamera& camera() const { return camera_; }
     /// Vehicle position, forward and up (world).
     void vehicleFrame(V3& pos, V3& forward, V3& up) const;
+    /// The weapon fired by Space.
+    Weapon weapon() const { return weapon_; }
+    /// Selects the weapon (keys 1-3).
+    void setWeapon(Weapon w) { weapon_ = w; }
+    /// Velocity (world, m/s) of a shell the current weapon would fire now: the jet's plus the muzzle speed.
+    V3 shotVelocity() const;
     /// Current vehicle speed setting (m/s).
     float speed() const { return speed_; }
     /// Puts the jet back at its start, flying (R; also 2 s after a crash).
@@ -117,8 +129,9 @@ public:
     bool turningBack() const { return turningBack_; }
     /// Slowest speed the jet flies at (m/s): X cannot stop it in the air.
     static constexpr float kStallSpeed = 15.0f;
-    /// Crash or blast: impacts on every destructible body within radius of point, sparks and dust.
-    void blast(const V3& point, float radius, float impulse);
+    /// Crash or blast: impacts on every destructible body within radius of point, sparks and dust; the
+    /// fractures they cause count for `by` (a weapon index, or -1 for a crash).
+    void blast(const V3& point, float radius, float impulse, int by = -1);
     /// Latencies (impact → adopted, ms) of results adopted since the last call.
     std::vector<double> takeNewLatencies();
     /// All adopted latencies so far (ms).
@@ -165,10 +178,13 @@ private:
     };
     /// Texture and tint an object passes on to its pieces.
     struct Look {
-        int texture = 0;  ///< renderer texture
-        V3 tint{1, 1, 1}; ///< colour multiplier
+        int texture = 0;   ///< renderer texture
+        V3 tint{1, 1, 1};  ///< colour multiplier
+        int interior = -1; ///< cut faces' texture, by the object's material (-1: the default)
     };
     void fire();
+    void journaled(const rubble::JournalEvent& e);
+    void creditHits();
     void onAdopted(const rubble::FractureOutcome& outcome, Renderer& renderer);
     void addVisual(rubble::BodyId body, const rubble::Mesh& mesh, const Look& look, float heat,
                    Renderer& renderer);
@@ -206,6 +222,19 @@ private:
     bool hover_ = false;       // a mass-0 vehicle (thesis: static) hovers and has no stall floor
     float boundsMinX_ = -500, boundsMaxX_ = 500, boundsMinZ_ = -500, boundsMaxZ_ = 500; // ground's extent
     rubble::BodyId groundBody_ = 0;
+    Weapon weapon_ = Weapon::Cannon;
+    V3 showcaseEye_{}, showcaseAt_{}; // the showcase camera, framing the objects as loaded
+    /// A shell in flight, and where a spent one was removed.
+    struct Shell {
+        Weapon weapon = Weapon::Cannon;
+        V3 at{};
+        bool spent = false;
+    };
+    std::unordered_map<rubble::BodyId, Shell> shells_; // shells in flight
+    std::vector<Shell> landed_;                        // shells that hit something this step
+    std::vector<rubble::JournalEvent> stepImpacts_;    // impacts journaled this step, credited after it
+    int blastBy_ = -1;                                 // weapon whose blast is submitting impacts
+    std::map<rubble::ObjectId, int> hitBy_;            // object -> weapon whose impact will fracture it
 };
 
 } // namespace demo

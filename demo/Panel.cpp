@@ -17,6 +17,7 @@ const std::vector<std::pair<const char*, const char*>>& keyHelp() {
         {"Q / E", "yaw left / right"},
         {"Z / X", "speed up / slow down"},
         {"Space", "fire (hold for continuous fire); unpause"},
+        {"1 / 2 / 3", "weapon: cannon / heavy shell / demolition charge"},
         {"R", "respawn the jet (it also respawns 2 s after a crash)"},
         {"L", "auto-level assist on/off (wings level when no roll key is held)"},
         {"N", "next scene (the demolition, the thesis's scenes, world.cfg)"},
@@ -141,11 +142,13 @@ bool Panel::draw(Game& game, GameSettings& pending, bool paused, const std::stri
         ImGui::SliderFloat("shot mass", &live.projectileMass, 0.5f, 40.0f, "%.1f kg");
     }
     if (ImGui::CollapsingHeader("Fracture (applies on restart)")) {
-        int pattern = pending.fracture.pattern == rubble::CellPattern::Shatter ? 1 : 0;
+        int pattern = static_cast<int>(pending.fracture.pattern);
         ImGui::RadioButton("single cell", &pattern, 0);
         ImGui::SameLine();
         ImGui::RadioButton("shatter", &pattern, 1);
-        pending.fracture.pattern = pattern ? rubble::CellPattern::Shatter : rubble::CellPattern::SingleCell;
+        ImGui::SameLine();
+        ImGui::RadioButton("adaptive", &pattern, 2);
+        pending.fracture.pattern = static_cast<rubble::CellPattern>(pattern);
         ImGui::SliderInt("cells K", &pending.fracture.cells, 2, 32);
         ImGui::SliderInt("seed points", &pending.fracture.seedPoints, 4, 64);
         float base = static_cast<float>(pending.fracture.sizeLaw.base);
@@ -196,7 +199,8 @@ void Panel::drawHud(const Game& game, bool paused, int width, int height) {
     char buf[160];
     V3 pos, fwd, up;
     game.vehicleFrame(pos, fwd, up);
-    std::snprintf(buf, sizeof buf, "SPEED %3.0f m/s   ALT %4.0f m   HITS %d   FRACTURES %d",
+    std::snprintf(buf, sizeof buf, "[%d] %s   SPEED %3.0f m/s   ALT %4.0f m   HITS %d   FRACTURES %d",
+                  static_cast<int>(game.weapon()) + 1, weaponSpec(game.weapon()).name,
                   static_cast<double>(game.speed()), static_cast<double>(pos.y - game.groundY()),
                   game.counters().impacts, game.counters().fractures);
     const ImVec2 ts = font->CalcTextSizeA(fs, 1e9f, 0.0f, buf);
@@ -204,7 +208,7 @@ void Panel::drawHud(const Game& game, bool paused, int width, int height) {
                       IM_COL32(0, 0, 0, 110), 6.0f * k);
     dl->AddText(font, fs, ImVec2(22 * k, h - ts.y - 19 * k), IM_COL32(255, 255, 255, 230), buf);
     dl->AddText(font, fs, ImVec2(12 * k, 10 * k), IM_COL32(255, 255, 255, 190),
-                "W/S pitch  A/D roll  Q/E yaw  Z/X speed  Space fire  H help");
+                "W/S pitch  A/D roll  Q/E yaw  Z/X speed  Space fire  1-3 weapon  H help");
     if (paused) {
         const char* msg = "PAUSED - press Space";
         const ImVec2 ms = font->CalcTextSizeA(fs, 1e9f, 0.0f, msg);

@@ -273,15 +273,17 @@ float fbm(float x, float y, int period, int seed) {
     return s;
 }
 
-GLuint uploadRgba(const unsigned char* data, int w, int h, bool trilinear) {
+GLuint uploadRgba(const unsigned char* data, int w, int h, const RenderQuality& q) {
     GLuint t = 0;
     glGenTextures(1, &t);
     glBindTexture(GL_TEXTURE_2D, t);
     glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, w, h, 0, GL_RGBA, GL_UNSIGNED_BYTE, data);
     glGenerateMipmap(GL_TEXTURE_2D);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER,
-                    trilinear ? GL_LINEAR_MIPMAP_LINEAR : GL_LINEAR_MIPMAP_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+                    q.trilinear       ? GL_LINEAR_MIPMAP_LINEAR
+                    : q.nearestTexels ? GL_NEAREST_MIPMAP_NEAREST
+                                      : GL_LINEAR_MIPMAP_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, q.nearestTexels ? GL_NEAREST : GL_LINEAR);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
     return t;
@@ -316,6 +318,7 @@ RenderQuality RenderQuality::forRenderer(const std::string& glRenderer) {
         q.shadows = false;
         q.pixelLighting = false;
         q.trilinear = false;
+        q.nearestTexels = true; // about 4 of 30 CPU ms a frame at 1080p (docs/rendering.md)
         // Dynamic resolution stays off: with per-vertex lighting a pixel costs about what the upscale pass
         // costs per output pixel, so on llvmpipe 2/3 scale saved nothing (docs/rendering.md).
         q.minScale = 1.0f;
@@ -425,12 +428,26 @@ int Renderer::proceduralTexture(const std::string& kind) {
                     g = 0.75f;
                     b = 0.35f;
                 }
-            } else if (kind == "interior") {
-                const float grain = fbm(fx * 2, fy * 2, 16, 31);
-                const float speck = hashNoise(x, y, 5) > 0.93f ? 0.12f : 0.0f;
-                r = 0.55f + 0.25f * grain - speck;
-                g = 0.50f + 0.22f * grain - speck;
-                b = 0.45f + 0.18f * grain - speck;
+            } else if (kind.rfind("interior", 0) == 0) { // interior[-material]: the cut faces' grain
+                const std::string m = kind.size() > 9 ? kind.substr(9) : "concrete";
+                const bool wood = m == "wood";
+                const float grain = wood ? fbm(fx * 0.4f, fy * 6, 16, 31) : fbm(fx * 2, fy * 2, 16, 31);
+                const float speck = !wood && hashNoise(x, y, 5) > 0.93f ? 0.12f : 0.0f;
+                struct Tone {
+                    const char* name;
+                    float r, g, b, k;
+                };
+                static const Tone tones[] = {
+                    {"concrete", 0.55f, 0.50f, 0.45f, 0.25f}, {"brick", 0.62f, 0.34f, 0.24f, 0.22f},
+                    {"stone", 0.52f, 0.52f, 0.50f, 0.28f},    {"wood", 0.58f, 0.40f, 0.22f, 0.35f},
+                    {"glass", 0.72f, 0.84f, 0.86f, 0.10f},    {"steel", 0.46f, 0.48f, 0.52f, 0.12f}};
+                Tone t = tones[0];
+                for (const Tone& c : tones)
+                    if (m == c.name)
+                        t = c;
+                r = t.r + t.k * grain - speck;
+                g = t.g + t.k * 0.9f * grain - speck;
+                b = t.b + t.k * 0.75f * grain - speck;
             } else if (kind == "metal") {
                 const bool panel = (x % 64) < 2 || (y % 128) < 2;
                 r = 0.55f + 0.1f * nz;
@@ -463,9 +480,17 @@ int Renderer::proceduralTexture(const std::string& kind) {
             p[2] = static_cast<unsigned char>(std::clamp(b, 0.0f, 1.0f) * 255);
             p[3] = 255;
         }
-    textures_.push_back(uploadRgba(px.data(), n, n, quality_.trilinear));
+    textures_.push_back(uploadRgba(px.data(), n, n, quality_));
     texturePaths_.push_back("procedural:" + kind);
     return static_cast<int>(textures_.size()) - 1;
+}
+
+int Renderer::materialInterior(const std::string& material) {
+    const std::string kind = "interior-" + material;
+    for (size_t i = 0; i < texturePaths_.size(); ++i)
+        if (texturePaths_[i] == "procedural:" + kind)
+            return static_cast<int>(i);
+    return proceduralTexture(kind);
 }
 
 bool Renderer::setInteriorTexture(const std::filesystem::path& path) {
@@ -496,7 +521,7 @@ int Renderer::loadTexture(const std::filesystem::path& path, const std::string& 
                 return static_cast<int>(i);
         return proceduralTexture(kind);
     }
-    textures_.push_back(uploadRgba(data, w, h, quality_.trilinear));
+    textures_.push_back(uploadRgba(data, w, h, quality_));
     texturePaths_.push_back(path.string());
     stbi_image_free(data);
     return static_cast<int>(textures_.size()) - 1;
@@ -539,8 +564,9 @@ void Renderer::setSkybox(const std::array<std::filesystem::path, 6>& faces,
             glGenTextures(1, &skyFaces_[i]);
             glBindTexture(GL_TEXTURE_2D, skyFaces_[i]);
             glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, w[0], w[0], 0, GL_RGBA, GL_UNSIGNED_BYTE, data[i]);
-            glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-            glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+            const GLint filter = quality_.nearestTexels ? GL_NEAREST : GL_LINEAR;
+            glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, filter);
+            glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, filter);
             glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
             glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
         }
@@ -629,8 +655,7 @@ void Renderer::bakeSkyCube() {
 }
 
 int Renderer::batchFor(int texture, bool interior) {
-    if (interior)
-        texture = -1; // one batch for every cut face: drawn with the interior texture
+    // cut faces: one batch per interior texture (-1: the default interior texture)
     for (size_t i = 0; i < batches_.size(); ++i)
         if (batches_[i].texture == texture && batches_[i].interior == interior)
             return static_cast<int>(i);
@@ -655,7 +680,7 @@ int Renderer::batchFor(int texture, bool interior) {
     return static_cast<int>(batches_.size()) - 1;
 }
 
-int Renderer::addMesh(const rubble::Mesh& mesh, int texture, float r, float g, float b) {
+int Renderer::addMesh(const rubble::Mesh& mesh, int texture, float r, float g, float b, int interiorTexture) {
     int id;
     if (!freeIds_.empty()) {
         id = freeIds_.back();
@@ -668,7 +693,7 @@ int Renderer::addMesh(const rubble::Mesh& mesh, int texture, float r, float g, f
     rec.alive = true;
     for (int range = 0; range < 2; ++range) {
         const bool interior = range == 1;
-        const int bi = batchFor(texture, interior);
+        const int bi = batchFor(interior ? interiorTexture : texture, interior);
         Batch& batch = batches_[bi];
         rec.batch[range] = bi;
         rec.first[range] = static_cast<int>(batch.cpu.size() / kFloatsPerVertex);
@@ -845,8 +870,9 @@ void Renderer::drawBatches(bool depthOnly, GLuint program) {
             continue;
         if (!depthOnly) {
             glActiveTexture(GL_TEXTURE0);
-            glBindTexture(GL_TEXTURE_2D,
-                          textures_[static_cast<size_t>(b.interior ? interiorTex_ : b.texture)]);
+            glBindTexture(
+                GL_TEXTURE_2D,
+                textures_[static_cast<size_t>(b.interior && b.texture < 0 ? interiorTex_ : b.texture)]);
             glUniform1i(interiorLoc, b.interior ? 1 : 0);
         }
         glBindVertexArray(b.vao);

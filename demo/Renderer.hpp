@@ -27,13 +27,15 @@ struct Particle {
 
 /// How much the renderer does per pixel; chosen from GL_RENDERER by forRenderer.
 struct RenderQuality {
-    bool software = false;     ///< a software rasteriser (llvmpipe, softpipe, swrast)
-    bool shadows = true;       ///< shadow map
-    int shadowSize = 1024;     ///< shadow map edge in texels
-    bool pixelLighting = true; ///< per-pixel sun, specular and shadows (else per-vertex sun, no specular)
-    bool trilinear = true;     ///< mipmaps blended (else nearest mip level, bilinear)
-    float minScale = 1.0f;     ///< smallest internal resolution scale dynamic resolution may use (1 = off)
-    /// GPUs: everything on; software GL: shadows off, per-vertex lighting, bilinear, fewer dust particles.
+    bool software = false;      ///< a software rasteriser (llvmpipe, softpipe, swrast)
+    bool shadows = true;        ///< shadow map
+    int shadowSize = 1024;      ///< shadow map edge in texels
+    bool pixelLighting = true;  ///< per-pixel sun, specular and shadows (else per-vertex sun, no specular)
+    bool trilinear = true;      ///< mipmaps blended (else nearest mip level, bilinear)
+    bool nearestTexels = false; ///< nearest texel of the nearest mip level, sky included (no filtering)
+    float minScale = 1.0f;      ///< smallest internal resolution scale dynamic resolution may use (1 = off)
+    /// GPUs: everything on; software GL: shadows off, per-vertex lighting, nearest texels, fewer dust
+    /// particles.
     static RenderQuality forRenderer(const std::string& glRenderer);
     /// "software" or "gpu".
     const char* name() const { return software ? "software" : "gpu"; }
@@ -64,6 +66,9 @@ public:
     /// given kind ("grid", "concrete", "metal", "interior"). Cached by path.
     int loadTexture(const std::filesystem::path& path, const std::string& kind,
                     std::vector<std::string>& warnings);
+    /// The procedural cut-face texture of a material preset (concrete, brick, stone, wood, glass, steel;
+    /// others look like concrete), made once.
+    int materialInterior(const std::string& material);
     /// Uses the image at path for cut faces (kInteriorMaterial); false (procedural kept) when unreadable.
     bool setInteriorTexture(const std::filesystem::path& path);
     /// A procedural texture of the given kind.
@@ -73,7 +78,8 @@ public:
     void setSkybox(const std::array<std::filesystem::path, 6>& faces, std::vector<std::string>& warnings);
 
     /// Uploads a mesh to the batch of its texture; returns its id. uvScale multiplies existing UVs.
-    int addMesh(const rubble::Mesh& mesh, int texture, float r = 1, float g = 1, float b = 1);
+    int addMesh(const rubble::Mesh& mesh, int texture, float r = 1, float g = 1, float b = 1,
+                int interiorTexture = -1);
     /// Frees a mesh id.
     void removeMesh(int id);
     /// Number of live meshes.

@@ -75,6 +75,10 @@ bool RunReport::write(const std::filesystem::path& dir, const std::string& scene
                        {"p50", quantile(latencies, 0.5)},
                        {"p99", quantile(latencies, 0.99)},
                        {"max", quantile(latencies, 1.0)}};
+    for (int w = 0; w < kWeaponCount; ++w) // fractures credited to the weapon whose impact caused them
+        j["weapons"][weaponSpec(static_cast<Weapon>(w)).name] = {
+            {"shots", last.weaponShots[static_cast<std::size_t>(w)]},
+            {"fractures", last.weaponFractures[static_cast<std::size_t>(w)]}};
     j["screenshots"] = screenshots;
     j["fracture_runtime"] = Game::fractureAvailable();
     std::ofstream js(dir / "report.json");

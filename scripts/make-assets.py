@@ -836,8 +836,8 @@ def building_lines(x0, z0, storeys, ground):
             suffix = "_window" if window else ""
             tex = "brick.png" if s == 0 else "facade.png"
             for side in (0, 2):
-                lines.append(obj_line("facade_x" + suffix, tex, x0 + mid, y, z0 + side * BAY, 1, 0))
-                lines.append(obj_line("facade_z" + suffix, tex, x0 + side * BAY, y, z0 + mid, 1, 0))
+                lines.append(obj_line("facade_x" + suffix, tex, x0 + mid, y, z0 + side * BAY, 1, 0, "brick"))
+                lines.append(obj_line("facade_z" + suffix, tex, x0 + side * BAY, y, z0 + mid, 1, 0, "brick"))
         for a in (0, 1):
             for b in (0, 1):
                 lines.append(obj_line("slab", "concrete.png", x0 + (a + 0.5) * BAY, y + WALL_H,
@@ -1138,10 +1138,11 @@ GROUND_LINE = ";../textures/ground.png;0;-15;0;1000;10;1000;0"  # unit box scale
 VEHICLE_LINE = "../models/fighter.obj;../textures/metal.png;0;20;0;1;1;1;100"
 
 
-def obj_line(model, texture, x, y, z, s, mass):
+def obj_line(model, texture, x, y, z, s, mass, material=None):
     sx, sy, sz = s if isinstance(s, tuple) else (s, s, s)
     vals = [x, y, z, sx, sy, sz, mass]
-    return "../models/%s.obj;../textures/%s;%s" % (model, texture, ";".join("%g" % v for v in vals))
+    line = "../models/%s.obj;../textures/%s;%s" % (model, texture, ";".join("%g" % v for v in vals))
+    return line + ";" + material if material else line
 
 
 def scenes():

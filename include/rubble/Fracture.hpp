@@ -39,6 +39,8 @@ struct CellSizeLaw {
 enum class CellPattern {
     SingleCell, ///< the thesis: the Voronoi cell of the impact point among random seeds in a box domain
     Shatter,    ///< K Voronoi cells around the impact, denser near it, randomly rotated and scaled
+    Adaptive,   ///< per impact (impactCut): a weak hit chips one cell, a strong hit shatters; the cut grows
+                ///< with the object's size
 };
 
 /// Which boolean implementation runs.
@@ -60,6 +62,18 @@ enum class ShatterLayout : std::uint8_t {
     Splinter,  ///< cells long along the grain, the longest axis of the mesh's bounds (wood)
     Uniform,   ///< evenly sized cells (steel)
 };
+
+/// What one impact cuts: the pattern and the edge of its cubic domain (impactCut).
+struct ImpactCut {
+    CellPattern pattern = CellPattern::SingleCell; ///< SingleCell or Shatter
+    double size = 0;                               ///< domain edge length
+};
+
+/// CellPattern::Adaptive: a hit shatters when its law size is at least this many times a touch's
+/// (sizeFor(0)).
+inline constexpr double kShatterGrowth = 3.0;
+/// CellPattern::Adaptive: objects with a bounds diagonal above this lose cuts larger by sqrt(diagonal / it).
+inline constexpr double kAdaptiveReferenceSize = 10.0;
 
 /// The most cells a Shatter pattern has (FractureParams::cells is clamped to it).
 inline constexpr int kMaxShatterCells = 1000;
@@ -109,6 +123,12 @@ struct FractureResult {
                      ///< declined a near-degenerate one; 0 = the seed's own pattern
     FractureTimings timings; ///< stage durations
 };
+
+/// The cut of one impact on a mesh with the given bounds. SingleCell and Shatter: the params' pattern and
+/// sizeLaw.sizeFor(impulse). Adaptive: Shatter when sizeFor(impulse) >= kShatterGrowth * sizeFor(0), else
+/// SingleCell; the size is sizeFor(impulse) * max(1, sqrt(diagonal / kAdaptiveReferenceSize)), at most
+/// sizeLaw.maxSize (demo/README.md, weapons). Pure; a function of the journaled impulse and the geometry.
+ImpactCut impactCut(const FractureParams& params, const Aabb& meshBounds, double impulse);
 
 /// Builds the cutting cells for an impact on a mesh with the given bounds. Deterministic in seed.
 std::vector<ConvexPolytope> generateCells(const Aabb& meshBounds, const Impact& impact,

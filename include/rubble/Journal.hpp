@@ -45,7 +45,7 @@ inline std::uint8_t patternByte(const FractureParams& f) {
 
 /// Whether a pattern byte names a known CellPattern and ShatterLayout.
 inline bool validPatternByte(std::uint8_t b) {
-    return (b & 15u) <= static_cast<unsigned>(CellPattern::Shatter) &&
+    return (b & 15u) <= static_cast<unsigned>(CellPattern::Adaptive) &&
            (b >> 4) <= static_cast<unsigned>(ShatterLayout::Uniform);
 }
 

@@ -295,12 +295,13 @@ std::vector<ConvexPolytope> generateCells(const Aabb& meshBounds, const Impact& 
     if (!isFinite(impact.point))
         return out;
     Rng rng(seed);
-    const double size = params.sizeLaw.sizeFor(impact.impulse);
+    const ImpactCut cut = impactCut(params, meshBounds, impact.impulse);
+    const double size = cut.size;
     if (!(size > 0) || !std::isfinite(size))
         return out;
     const Mat3 rotation = rng.rotation();
 
-    if (params.pattern == CellPattern::SingleCell) {
+    if (cut.pattern == CellPattern::SingleCell) {
         // The thesis: the impact's Voronoi cell among random sites in a cube centred at the impact.
         const double h = size / 2;
         std::vector<Vec3> sites{{0, 0, 0}};

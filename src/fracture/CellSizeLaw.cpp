@@ -12,4 +12,15 @@ double CellSizeLaw::sizeFor(double impulse) const {
     return std::isfinite(s) ? std::clamp(s, lo, hi) : hi;
 }
 
+ImpactCut impactCut(const FractureParams& params, const Aabb& meshBounds, double impulse) {
+    const double size = params.sizeLaw.sizeFor(impulse);
+    if (params.pattern != CellPattern::Adaptive)
+        return {params.pattern, size};
+    const bool strong = size >= kShatterGrowth * params.sizeLaw.sizeFor(0);
+    const double diagonal = meshBounds.diagonal();
+    const double growth = std::max(1.0, std::sqrt(diagonal / kAdaptiveReferenceSize));
+    const double hi = std::max(params.sizeLaw.minSize, params.sizeLaw.maxSize);
+    return {strong ? CellPattern::Shatter : CellPattern::SingleCell, std::min(size * growth, hi)};
+}
+
 } // namespace rubble

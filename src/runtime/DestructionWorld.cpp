@@ -98,7 +98,8 @@ Impact onSurface(const Mesh& mesh, Impact impact, const FractureParams& params) 
             closest = q;
         }
     }
-    const double reach = std::max(params.sizeLaw.sizeFor(impact.impulse), mesh.bounds().diagonal());
+    const Aabb bounds = mesh.bounds();
+    const double reach = std::max(impactCut(params, bounds, impact.impulse).size, bounds.diagonal());
     if (best <= reach * reach)
         impact.point = closest;
     return impact;

@@ -34,6 +34,14 @@ shots_taken() { [ "$(ls "$work/out"/shot_*.png 2>/dev/null | wc -l)" -ge "$1" ];
 key F2
 wait_for 20 shots_taken 1 || fail "F2 did not write a screenshot"
 
+# 1-3 pick the weapon (the stats line names it, 1-based).
+for k in 3 2 1; do
+    picked() { [ "$(field weapon)" = "$k" ]; }
+    key "$k"
+    wait_for 20 picked || fail "key $k did not pick weapon $k (weapon=$(field weapon))"
+done
+echo "ok: keys 3, 2, 1 picked the demolition charge, the heavy shell and the cannon"
+
 # Space fires; impacts follow.
 s0=$(field shots)
 xdotool keydown space

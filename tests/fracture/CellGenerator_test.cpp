@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <map>
 
 #include "TestSupport.hpp"
@@ -47,6 +48,60 @@ TEST(CellSizeLaw, ClampsAndGrows) {
     EXPECT_DOUBLE_EQ(law.sizeFor(1e300), law.maxSize);
     EXPECT_DOUBLE_EQ(law.sizeFor(-5), 0.5);
     EXPECT_DOUBLE_EQ(law.sizeFor(std::nan("")), 0.5);
+}
+
+// SingleCell and Shatter keep the law's size; Adaptive chips below kShatterGrowth times a touch's size and
+// shatters above, and cuts larger objects larger (sqrt of the diagonal over the reference), within maxSize.
+TEST(ImpactCut, AdaptiveChipsWeakHitsShattersStrongOnesAndGrowsWithTheObject) {
+    FractureParams p;
+    p.sizeLaw.base = 0.8;
+    p.sizeLaw.scale = 0.04;
+    p.sizeLaw.exponent = 0.5;
+    p.sizeLaw.maxSize = 30;
+    const Aabb small{{0, 0, 0}, {4, 4, 4}};    // diagonal 6.9 < reference
+    const Aabb large{{0, 0, 0}, {40, 40, 40}}; // diagonal 69.3
+    for (CellPattern fixed : {CellPattern::SingleCell, CellPattern::Shatter}) {
+        p.pattern = fixed;
+        const ImpactCut c = impactCut(p, large, 9000);
+        EXPECT_EQ(c.pattern, fixed);
+        EXPECT_DOUBLE_EQ(c.size, p.sizeLaw.sizeFor(9000)) << "the object's size does not count";
+    }
+    p.pattern = CellPattern::Adaptive;
+    // threshold: base + scale * sqrt(i) = 3 * base  <=>  i = (2 * 0.8 / 0.04)^2 = 1600
+    EXPECT_EQ(impactCut(p, small, 680).pattern, CellPattern::SingleCell) << "a cannon shell chips";
+    EXPECT_EQ(impactCut(p, small, 1599).pattern, CellPattern::SingleCell);
+    EXPECT_EQ(impactCut(p, small, 1601).pattern, CellPattern::Shatter);
+    EXPECT_EQ(impactCut(p, small, 8000).pattern, CellPattern::Shatter) << "a heavy shell shatters";
+    EXPECT_EQ(impactCut(p, small, std::nan("")).pattern, CellPattern::SingleCell);
+    EXPECT_DOUBLE_EQ(impactCut(p, small, 680).size, p.sizeLaw.sizeFor(680)) << "small objects: the law";
+    EXPECT_DOUBLE_EQ(impactCut(p, Aabb{}, 680).size, p.sizeLaw.sizeFor(680)) << "empty bounds: the law";
+    const double growth = std::sqrt(large.diagonal() / kAdaptiveReferenceSize);
+    EXPECT_NEAR(impactCut(p, large, 680).size, p.sizeLaw.sizeFor(680) * growth, 1e-12);
+    EXPECT_EQ(impactCut(p, large, 680).pattern, CellPattern::SingleCell)
+        << "strength does not depend on size";
+    EXPECT_DOUBLE_EQ(impactCut(p, large, 1e12).size, p.sizeLaw.maxSize);
+    double last = 0;
+    for (double i = 0; i < 20000; i += 250) { // monotone in the impulse
+        const double s = impactCut(p, large, i).size;
+        EXPECT_GE(s, last);
+        last = s;
+    }
+}
+
+TEST(CellGenerator, AdaptiveCutsOneCellForAWeakHitAndKForAStrongOne) {
+    FractureParams p;
+    p.pattern = CellPattern::Adaptive;
+    p.cells = 9;
+    p.sizeLaw.base = 0.8;
+    p.sizeLaw.scale = 0.04;
+    const Aabb bounds{{-3, -3, -3}, {3, 3, 3}};
+    for (std::uint64_t seed = 0; seed < 20; ++seed) {
+        EXPECT_EQ(generateCells(bounds, {{0, 0, 3}, {0, 0, 1}, 400}, p, seed).size(), 1u);
+        const auto strong = generateCells(bounds, {{0, 0, 3}, {0, 0, 1}, 5000}, p, seed);
+        EXPECT_EQ(strong.size(), 9u);
+        for (const ConvexPolytope& c : strong)
+            checkConvexCell(c, 10);
+    }
 }
 
 TEST(CellGenerator, SingleCellIsTheImpactsConvexVoronoiCell) {

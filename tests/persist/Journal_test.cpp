@@ -114,7 +114,12 @@ TEST(Journal, ThePatternByteCarriesTheLayout) {
     Result<JournalEvent> back = decodeJournalEvent(bytes.data());
     ASSERT_TRUE(back) << back.error().message;
     EXPECT_EQ(back->pattern, 0x21);
-    for (std::uint8_t bad : {0x02, 0x41, 0xF0}) {
+    f.pattern = CellPattern::Adaptive;
+    f.layout = ShatterLayout::Radial;
+    EXPECT_EQ(patternByte(f), 0x12);
+    bytes[1] = patternByte(f);
+    EXPECT_TRUE(decodeJournalEvent(bytes.data(), 48)) << "the adaptive pattern is a known one";
+    for (std::uint8_t bad : {0x03, 0x41, 0xF0}) {
         bytes[1] = bad;
         Result<JournalEvent> refused = decodeJournalEvent(bytes.data(), 48);
         ASSERT_FALSE(refused) << int(bad);
@@ -167,6 +172,56 @@ TEST(Journal, ReplayRebuildsTheSameGeometryOnOneAndTwoWorkers) {
     (void)player.advanceTo(rec.frame);
     (void)player.drain();
     EXPECT_NE(world->geometryHash(), rec.geometry);
+}
+
+// The adaptive pattern decides per impact from the journaled impulse and the geometry (impactCut), so a
+// journal of weak and strong hits (chips and shatters, on pieces too) replays to the same geometry; nothing
+// per impact travels beyond the 48 bytes.
+TEST(Journal, AdaptiveHitsReplayToTheSameGeometry) {
+    auto makeWorld = [](int workers) {
+        auto world = std::make_unique<DestructionWorld>(test::journalConfig(workers).world);
+        ObjectDesc d;
+        d.mesh = makeBox({-3, 0, -0.3}, {3, 4, 0.3});
+        d.density = 400;
+        d.impulseThreshold = 1;
+        d.fracture.pattern = CellPattern::Adaptive;
+        d.fracture.cells = 8;
+        d.fracture.sizeLaw.base = 0.5;
+        d.fracture.sizeLaw.scale = 0.02;
+        EXPECT_TRUE(world->addObject(std::move(d)));
+        return world;
+    };
+    auto world = makeWorld(1);
+    std::vector<JournalEvent> events;
+    world->setJournalSink([&](const JournalEvent& e) { events.push_back(e); });
+    JournalPlayer recorder(*world);
+    std::size_t maxPieces = 0;
+    recorder.setOnOutcome(
+        [&](const FractureOutcome& o) { maxPieces = std::max(maxPieces, o.pieces.size()); });
+    const double impulses[] = {100, 4000, 150, 6000}; // chip, shatter, chip, shatter (sizeFor: 0.7, 1.8, ...)
+    for (int i = 0; i < 4; ++i) {
+        ASSERT_TRUE(recorder.advanceTo(static_cast<std::uint64_t>(3 * i)));
+        const std::vector<ObjectId> ids = world->objects();
+        const ObjectId target = ids[static_cast<std::size_t>(i) % ids.size()];
+        const Aabb b = world->object(target)->mesh.bounds();
+        ASSERT_TRUE(
+            world->submitImpact(target, Impact{b.center() + Vec3{0, 0, -1}, {0, 0, -1}, impulses[i]}));
+    }
+    ASSERT_TRUE(recorder.drain());
+    ASSERT_EQ(events.size(), 4u);
+    for (const JournalEvent& e : events)
+        EXPECT_EQ(e.pattern & 15u, static_cast<unsigned>(CellPattern::Adaptive));
+    EXPECT_GE(maxPieces, 3u) << "a strong hit shatters";
+    const std::uint64_t frame = world->frame(), geometry = world->geometryHash();
+    for (int workers : {1, 2}) {
+        auto replayed = makeWorld(workers);
+        JournalPlayer player(*replayed);
+        for (const JournalEvent& e : events)
+            ASSERT_TRUE(player.receive(e));
+        ASSERT_TRUE(player.advanceTo(frame));
+        ASSERT_TRUE(player.drain());
+        EXPECT_EQ(replayed->geometryHash(), geometry) << workers << " workers";
+    }
 }
 
 TEST(Journal, ReplayRefusesEventsOfAnotherWorldOrOutOfOrder) {
