@@ -67,7 +67,9 @@ RUN_SECONDS=$((2 * seconds)) RUN_RATE=20 RUN_TAG=" (stretch)" run "$root/assets/
     --pattern shatter --cells 32
 echo "CSV: $csv, $frames"
 if command -v gnuplot >/dev/null 2>&1; then
-    (cd "$results" && gnuplot "$root/bench/results/scene.gp" && gnuplot "$root/bench/results/demolition.gp") &&
+    type="$(sed -n 's/^CMAKE_BUILD_TYPE:STRING=//p' "$build/CMakeCache.txt" 2>/dev/null)"
+    (cd "$results" && gnuplot -e "build='${type:-Release}'" "$root/bench/results/scene.gp" &&
+        gnuplot -e "build='${type:-Release}'" "$root/bench/results/demolition.gp") &&
         echo "plots: $results/scene.png, $results/demolition.png"
 else
     echo "scene-bench: no gnuplot: scene.png not redrawn"
