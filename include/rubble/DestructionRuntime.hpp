@@ -135,13 +135,14 @@ struct DebrisBudget {
     std::size_t maxTriangles = 4000000; ///< triangles of all debris bodies (dynamic and frozen); beyond it
                                         ///< the smallest frozen pieces become particles
     bool freezeSleeping = true;         ///< a debris body the engine put to sleep is frozen (made static)
-    int freezeAfterFrames = 30;         ///< ... or one that moved slower than freezeSpeed this many frames
-    double freezeSpeed = 0.15;          ///< m/s (and rad/s) below which a body counts as resting
-    double wakeImpulse = 100;           ///< a contact impulse (N·s) on a frozen piece that wakes it
-    double fadeVolume = 0.02;           ///< debris below this volume (m³) ...
-    double fadeDistance = 150;          ///< ... farther than this from the focus point fades into particles
-    double killBelowY = -500;           ///< debris falling below this height retires
-    double particleLifetime = 3.0;      ///< seconds a particle is drawn
+    int freezeAfterFrames = 10;         ///< ... or one that moved slower than freezeSpeed this many frames
+    double freezeSpeed = 0.5;      ///< m/s (and rad/s) below which a body counts as resting (Bullet's own
+                                   ///< sleeping threshold is 0.8 m/s for 2 s)
+    double wakeImpulse = 100;      ///< a contact impulse (N·s) on a frozen piece that wakes it
+    double fadeVolume = 0.02;      ///< debris below this volume (m³) ...
+    double fadeDistance = 150;     ///< ... farther than this from the focus point fades into particles
+    double killBelowY = -500;      ///< debris falling below this height retires
+    double particleLifetime = 3.0; ///< seconds a particle is drawn
 };
 
 /// A particle: a piece too small (or one too many) to simulate, drawn for a while. Its volume stays counted.

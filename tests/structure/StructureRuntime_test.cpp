@@ -80,9 +80,13 @@ TEST(StructureRuntime, BearingsHoldWhatRestsOnThemAndLetGoOfWhatTipsOrHangs) {
     const ObjectId side = rig.addBox({20.2, 2, -0.2}, {20.6, 2.4, 0.2}, "concrete");
     for (int i = 0; i < 45; ++i)
         rig.runtime.stepFrame();
+    auto height = [&](ObjectId id) {
+        return rig.runtime.motion(rig.runtime.bodyOf(id)->id).transform.translation.y;
+    };
     EXPECT_EQ(rig.motionOf(bridge), BodyMotionState::Static);
-    EXPECT_EQ(rig.motionOf(overhang), BodyMotionState::Dynamic) << "centre of mass 1.3 m past the column";
-    EXPECT_EQ(rig.motionOf(side), BodyMotionState::Dynamic) << "held only by friction with no compression";
+    EXPECT_NE(rig.motionOf(overhang), BodyMotionState::Static) << "centre of mass 1.3 m past the column";
+    EXPECT_NE(rig.motionOf(side), BodyMotionState::Static) << "held only by friction with no compression";
+    EXPECT_LT(height(side), 2) << "it fell";
     EXPECT_EQ(rig.runtime.counters().bondsBroken, 0) << "bearings fail by letting go, not by breaking";
 }
 
