@@ -1,5 +1,7 @@
 #include "Renderer.hpp"
 
+#include "GlProgram.hpp"
+
 #include <stb_image.h>
 
 #include <algorithm>
@@ -199,44 +201,6 @@ const char* kLineFs = R"(#version 330 core
 in vec3 vColor; out vec4 oColor;
 void main() { oColor = vec4(vColor, 1.0); })";
 
-GLuint compile(GLenum type, const char* src, std::string& error) {
-    GLuint s = glCreateShader(type);
-    glShaderSource(s, 1, &src, nullptr);
-    glCompileShader(s);
-    GLint ok = 0;
-    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        char log[2048];
-        glGetShaderInfoLog(s, sizeof log, nullptr, log);
-        error += log;
-        glDeleteShader(s);
-        return 0;
-    }
-    return s;
-}
-
-GLuint program(const char* vs, const char* fs, std::string& error) {
-    GLuint v = compile(GL_VERTEX_SHADER, vs, error);
-    GLuint f = compile(GL_FRAGMENT_SHADER, fs, error);
-    if (!v || !f)
-        return 0;
-    GLuint p = glCreateProgram();
-    glAttachShader(p, v);
-    glAttachShader(p, f);
-    glLinkProgram(p);
-    glDeleteShader(v);
-    glDeleteShader(f);
-    GLint ok = 0;
-    glGetProgramiv(p, GL_LINK_STATUS, &ok);
-    if (!ok) {
-        char log[2048];
-        glGetProgramInfoLog(p, sizeof log, nullptr, log);
-        error += log;
-        return 0;
-    }
-    return p;
-}
-
 GLint loc(GLuint p, const char* name) {
     return glGetUniformLocation(p, name);
 }
@@ -330,11 +294,12 @@ bool Renderer::init(const RenderQuality& quality, std::string& error) {
     quality_ = quality;
     shadows = quality.shadows;
     shadowSize_ = quality.shadowSize;
-    meshProg_ = quality.pixelLighting ? program(kMeshVs, kMeshFs, error) : program(kLiteVs, kLiteFs, error);
-    depthProg_ = program(kDepthVs, kDepthFs, error);
-    skyProg_ = program(kSkyVs, kSkyFs, error);
-    particleProg_ = program(kParticleVs, kParticleFs, error);
-    lineProg_ = program(kLineVs, kLineFs, error);
+    meshProg_ =
+        quality.pixelLighting ? linkProgram(kMeshVs, kMeshFs, error) : linkProgram(kLiteVs, kLiteFs, error);
+    depthProg_ = linkProgram(kDepthVs, kDepthFs, error);
+    skyProg_ = linkProgram(kSkyVs, kSkyFs, error);
+    particleProg_ = linkProgram(kParticleVs, kParticleFs, error);
+    lineProg_ = linkProgram(kLineVs, kLineFs, error);
     if (!meshProg_ || !depthProg_ || !skyProg_ || !particleProg_ || !lineProg_)
         return false;
 

@@ -1,5 +1,9 @@
 #include "ScaledTarget.hpp"
 
+#include <string>
+
+#include "GlProgram.hpp"
+
 namespace demo {
 
 namespace {
@@ -19,13 +23,6 @@ uniform sampler2D uColor;
 out vec4 oColor;
 void main() { oColor = texture(uColor, vUv); })";
 
-GLuint shader(GLenum type, const char* src) {
-    GLuint s = glCreateShader(type);
-    glShaderSource(s, 1, &src, nullptr);
-    glCompileShader(s);
-    return s;
-}
-
 } // namespace
 
 ScaledTarget::~ScaledTarget() {
@@ -38,10 +35,10 @@ void ScaledTarget::release() {
         glDeleteTextures(1, &color_);
         glDeleteRenderbuffers(1, &depth_);
     }
-    if (program_) {
+    if (program_)
         glDeleteProgram(program_);
+    if (vao_)
         glDeleteVertexArrays(1, &vao_);
-    }
     fbo_ = color_ = depth_ = program_ = vao_ = 0;
     w_ = h_ = 0;
 }
@@ -50,15 +47,9 @@ bool ScaledTarget::reserve(int w, int h) {
     if (fbo_ && w <= w_ && h <= h_)
         return true;
     release();
-    const GLuint vs = shader(GL_VERTEX_SHADER, kVs), fs = shader(GL_FRAGMENT_SHADER, kFs);
-    program_ = glCreateProgram();
-    glAttachShader(program_, vs);
-    glAttachShader(program_, fs);
-    glLinkProgram(program_);
-    glDeleteShader(vs);
-    glDeleteShader(fs);
-    GLint linked = 0;
-    glGetProgramiv(program_, GL_LINK_STATUS, &linked);
+    std::string error;
+    program_ = linkProgram(kVs, kFs, error);
+    const bool linked = program_ != 0;
     glGenVertexArrays(1, &vao_);
     glGenFramebuffers(1, &fbo_);
     glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
