@@ -312,12 +312,11 @@ void StressSolver::solveBearing(BondState& b) {
 
 double StressSolver::bearingUtilisation(const BondState& b) const {
     const BondInterface& s = b.bond.section;
+    auto plane = [&](const BearingCorner& k) { return Vec2{dot(k.offset, s.u), dot(k.offset, s.v)}; };
     double press = 0, gu = 0, gv = 0;
     Vec2 e{0, 0};
-    std::vector<Vec2> hull; // the corners, counter-clockwise about the centroid
     for (const BearingCorner& k : b.corners) {
-        const Vec2 c{dot(k.offset, s.u), dot(k.offset, s.v)};
-        hull.push_back(c);
+        const Vec2 c = plane(k);
         press += k.press;
         e.x += k.press * c.x;
         e.y += k.press * c.y;
@@ -328,10 +327,10 @@ double StressSolver::bearingUtilisation(const BondState& b) const {
         return 0;
     e.x /= press;
     e.y /= press;
-    double tip = 0; // the resultant against each hull edge: 1 on the edge (about to tip)
-    for (std::size_t k = 0; hull.size() >= 3 && k < hull.size(); ++k) {
-        const Vec2& a = hull[k];
-        const Vec2& c = hull[(k + 1) % hull.size()];
+    double tip = 0; // the resultant against each hull edge (the corners run counter-clockwise): 1 on the edge
+    const std::size_t n = b.corners.size();
+    for (std::size_t k = 0; n >= 3 && k < n; ++k) {
+        const Vec2 a = plane(b.corners[k]), c = plane(b.corners[(k + 1) % n]);
         const Vec2 m{c.y - a.y, a.x - c.x}; // outward
         const double h = m.x * a.x + m.y * a.y;
         if (h > 0)
