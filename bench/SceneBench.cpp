@@ -407,9 +407,10 @@ int runScene(const SceneArgs& a) {
     std::printf("%-28s %10d\n", "failed (geometry)", ts.failed);
     std::printf("%-28s %10d (max %d; %d awake, %d frozen)\n", "pieces alive", runtime.livePieces(), maxPieces,
                 runtime.awakeDebris(), runtime.frozenDebris());
-    std::printf("%-28s %10lld (dust %lld, awake budget %lld, triangle budget %lld, faded %lld, fell out %lld)\n",
-                "pieces retired", c.piecesRetired, c.retired.dust, c.retired.awake, c.retired.triangles,
-                c.retired.faded, c.retired.fellOut);
+    std::printf(
+        "%-28s %10lld (dust %lld, awake budget %lld, triangle budget %lld, faded %lld, fell out %lld)\n",
+        "pieces retired", c.piecesRetired, c.retired.dust, c.retired.awake, c.retired.triangles,
+        c.retired.faded, c.retired.fellOut);
     std::printf("%-28s %10lld\n", "pieces collapsed", c.piecesCollapsed);
     std::printf("%-28s %10lld (%lld woken)\n", "pieces frozen", c.piecesFrozen, c.piecesWoken);
     std::printf("%-28s %10.3g\n", "volume error", volumeError);

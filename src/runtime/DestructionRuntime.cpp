@@ -155,10 +155,18 @@ struct DestructionRuntime::Impl {
         ++stats.piecesRetired;
         ++counters.piecesRetired;
         switch (reason) {
-        case detail::RetireReason::Budget: ++counters.retired.awake; break;
-        case detail::RetireReason::Triangles: ++counters.retired.triangles; break;
-        case detail::RetireReason::Fade: ++counters.retired.faded; break;
-        case detail::RetireReason::FellOut: ++counters.retired.fellOut; break;
+        case detail::RetireReason::Budget:
+            ++counters.retired.awake;
+            break;
+        case detail::RetireReason::Triangles:
+            ++counters.retired.triangles;
+            break;
+        case detail::RetireReason::Fade:
+            ++counters.retired.faded;
+            break;
+        case detail::RetireReason::FellOut:
+            ++counters.retired.fellOut;
+            break;
         }
         destroy(id, true);
     }
@@ -535,7 +543,8 @@ int DestructionRuntime::blast(const Vec3& center, double radius, double impulse,
     if (!(radius > 0) || !(impulse > 0))
         return 0;
     int accepted = 0;
-    for (BodyId id : bodies()) { // a copy: an accepted impact does not change the bodies before the next frame
+    for (BodyId id :
+         bodies()) { // a copy: an accepted impact does not change the bodies before the next frame
         const BodyRecord* b = body(id);
         if (!b || !b->hasObject)
             continue;
