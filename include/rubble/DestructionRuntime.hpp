@@ -135,9 +135,10 @@ struct DebrisBudget {
     std::size_t maxTriangles = 4000000; ///< triangles of all debris bodies (dynamic and frozen); beyond it
                                         ///< the smallest frozen pieces become particles
     bool freezeSleeping = true;         ///< a debris body the engine put to sleep is frozen (made static)
-    int freezeAfterFrames = 10;         ///< ... or one that moved slower than freezeSpeed this many frames
-    double freezeSpeed = 0.5;      ///< m/s (and rad/s) below which a body counts as resting (Bullet's own
-                                   ///< sleeping threshold is 0.8 m/s for 2 s)
+    int freezeAfterFrames = 6;          ///< ... or one that rested this many frames in a row
+    double freezeSpeed = 1.0;           ///< m/s (and rad/s) below which a body that is not gaining speed (its
+                              ///< velocity changes by less than g·dt / 2 a frame) rests (Bullet's own
+                              ///< sleeping threshold is 0.8 m/s for 2 s)
     double wakeImpulse = 100;      ///< a contact impulse (N·s) on a frozen piece that wakes it
     double fadeVolume = 0.02;      ///< debris below this volume (m³) ...
     double fadeDistance = 150;     ///< ... farther than this from the focus point fades into particles

@@ -349,9 +349,9 @@ struct DestructionRuntime::Impl {
         settleSupport(stats);
     }
 
-    void govern(const std::map<BodyId, double>& frozenHits, FrameStats& stats) {
+    void govern(const std::map<BodyId, double>& frozenHits, double dt, FrameStats& stats) {
         const detail::GovernorActions a =
-            governor.update(bodies, binding, frozenHits, stats.physicsMs, deterministic(), focus);
+            governor.update(bodies, binding, frozenHits, stats.physicsMs, deterministic(), focus, dt);
         for (BodyId id : a.wake) {
             makeDynamic(id);
             ++stats.piecesWoken;
@@ -584,7 +584,7 @@ FrameStats DestructionRuntime::stepFrame(double dt) {
             r->anchor = true;
     stats.supportMs += msSince(t2);
     im.adoptResults(stats);
-    im.govern(batch.frozenHits, stats);
+    im.govern(batch.frozenHits, dt, stats);
     im.settleSupport(stats);
     im.feedContactLoads(dt);
     im.settleStructure(stats);
