@@ -101,6 +101,7 @@ double clipOnly(const Mesh& mesh, const std::vector<ConvexPolytope>& cells, std:
 struct HitSamples {
     std::vector<double> withParts, withPartsCpu, pieces, validate, cell, boolean, islands, mass, simplify,
         parts, clip;
+    std::vector<double> cpuValidate, cpuBoolean, cpuVerify, cpuIslands, cpuMass, cpuSimplify, cpuParts;
     std::vector<double> touched, excess;
     int failures = 0, fallbacks = 0;
 };
@@ -118,8 +119,17 @@ std::optional<FractureResult> hitOnce(const Mesh& mesh, const std::vector<Convex
         return std::nullopt;
     }
     const auto t1 = Clock::now();
+    const double c1 = threadCpuMs();
     auto parts = updateDecomposition(parentParts, *r);
     const double partsMs = msSince(t1);
+    s.cpuParts.push_back(threadCpuMs() - c1);
+    const FractureTimings& ct = r->cpuTimings;
+    s.cpuValidate.push_back(ct.validateMs);
+    s.cpuBoolean.push_back(ct.booleanMs - ct.verifyMs);
+    s.cpuVerify.push_back(ct.verifyMs);
+    s.cpuIslands.push_back(ct.islandsMs - ct.massMs - ct.simplifyMs);
+    s.cpuMass.push_back(ct.massMs);
+    s.cpuSimplify.push_back(ct.simplifyMs);
     s.withPartsCpu.push_back(threadCpuMs() - c0);
     s.withParts.push_back(piecesMs + partsMs);
     s.pieces.push_back(piecesMs);
@@ -171,11 +181,11 @@ void addImpactRows(const std::string& name, const std::string& kind, std::size_t
     for (double e : s.excess)
         excessMax = std::max(excessMax, e);
     const auto med = [](const std::vector<double>& v) { return stats(v).median; };
-    table.rows.push_back({name, std::to_string(triangles), std::to_string(s.withParts.size()),
-                          fixed(w.median), fixed(w.max), fixed(ratio, 2), fixed(c.median), fixed(c.max),
-                          fixed(cpuRatio, 2), fixed(med(s.validate)), fixed(med(s.boolean)),
-                          fixed(med(s.islands)), fixed(med(s.mass)), fixed(med(s.simplify)),
-                          fixed(med(s.parts)), fixed(med(s.clip)), fixed(med(s.touched), 0)});
+    table.rows.push_back(
+        {name, std::to_string(triangles), std::to_string(s.withParts.size()), fixed(w.median), fixed(w.max),
+         fixed(ratio, 2), fixed(c.median), fixed(c.max), fixed(cpuRatio, 2), fixed(med(s.cpuValidate)),
+         fixed(med(s.cpuBoolean)), fixed(med(s.cpuVerify)), fixed(med(s.cpuIslands)), fixed(med(s.cpuMass)),
+         fixed(med(s.cpuSimplify)), fixed(med(s.cpuParts)), fixed(med(s.clip)), fixed(med(s.touched), 0)});
     csv.rows.push_back({name,
                         kind,
                         std::to_string(triangles),
@@ -201,6 +211,13 @@ void addImpactRows(const std::string& name, const std::string& kind, std::size_t
                         str(excessMax),
                         str(med(s.clip)),
                         str(med(s.touched)),
+                        str(med(s.cpuValidate)),
+                        str(med(s.cpuBoolean)),
+                        str(med(s.cpuVerify)),
+                        str(med(s.cpuIslands)),
+                        str(med(s.cpuMass)),
+                        str(med(s.cpuSimplify)),
+                        str(med(s.cpuParts)),
                         ""});
     if (!againstFirst)
         data << kind << " " << triangles << " " << w.median << " " << w.max << " " << med(s.clip) << " "
@@ -212,8 +229,8 @@ void addImpactRows(const std::string& name, const std::string& kind, std::size_t
 int runMegaImpact(const MegaArgs& args) {
     const CpuMeter cpu;
     Table table{{"mesh", "tris", "hits", "with parts med ms", "max", "worst/base", "cpu med", "cpu max",
-                 "cpu w/b", "validate", "boolean", "islands", "mass", "simplify", "parts", "clip-only",
-                 "touched"},
+                 "cpu w/b", "cpu validate", "clip", "verify", "islands", "mass", "simplify", "parts",
+                 "clip-only", "touched"},
                 {}};
     Table csv{{"mesh",
                "kind",
@@ -240,6 +257,13 @@ int runMegaImpact(const MegaArgs& args) {
                "parts_excess_max",
                "clip_only_median_ms",
                "touched_triangles_median",
+               "validate_cpu_median_ms",
+               "clip_cpu_median_ms",
+               "verify_cpu_median_ms",
+               "islands_cpu_median_ms",
+               "mass_cpu_median_ms",
+               "simplify_cpu_median_ms",
+               "parts_cpu_median_ms",
                "other_cpu_cores"},
               {}};
     std::ostringstream data;

@@ -101,11 +101,12 @@ struct Piece {
     std::int32_t cell = -1; ///< -1: part of the damaged remainder (input − cells); i ≥ 0: debris of cell i
 };
 
-/// Wall-clock durations of the stages of one fracture, in milliseconds.
+/// Durations of the stages of one fracture, in milliseconds.
 struct FractureTimings {
     double validateMs = 0; ///< checking that the input mesh is a valid closed, oriented solid
     double cellMs = 0;     ///< building the cells
     double booleanMs = 0;  ///< difference and intersections
+    double verifyMs = 0;   ///< of booleanMs: checking that the split's outputs are closed and keep the volume
     double islandsMs = 0;  ///< splitting into islands and mass properties (includes massMs)
     double massMs = 0;     ///< of islandsMs: mass properties of the pieces and interior UVs
     double simplifyMs = 0; ///< of islandsMs: simplifying the pieces' flat regions
@@ -121,7 +122,8 @@ struct FractureResult {
     bool exactFallback = false;        ///< Fast declined or failed verification; Corefine made the split
     int redraws = 0; ///< fracture() with Fast: cell patterns redrawn (from derived seeds) because the clipper
                      ///< declined a near-degenerate one; 0 = the seed's own pattern
-    FractureTimings timings; ///< stage durations
+    FractureTimings timings;    ///< stage durations, wall clock
+    FractureTimings cpuTimings; ///< the same stages in the calling thread's CPU time (on a shared machine)
 };
 
 /// The cut of one impact on a mesh with the given bounds. SingleCell and Shatter: the params' pattern and

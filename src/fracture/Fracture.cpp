@@ -6,6 +6,8 @@
 #include <limits>
 #include <span>
 
+#include <time.h>
+
 #include "BooleanBackends.hpp"
 #include "FracturePipeline.hpp"
 #include "geometry/OrientedShells.hpp"
@@ -20,9 +22,31 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double msSince(Clock::time_point t0) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+/// This thread's CPU time in ms.
+double threadCpuMs() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
 }
+
+/// A start on the wall clock and on this thread's CPU clock; a stage's time goes into both timings of a
+/// result (FractureResult::timings and cpuTimings).
+struct Stopwatch {
+    Clock::time_point wall = Clock::now();
+    double cpu = threadCpuMs();
+
+    double wallMs() const { return std::chrono::duration<double, std::milli>(Clock::now() - wall).count(); }
+    /// Sets the stage to the time since the start.
+    void set(FractureResult& r, double FractureTimings::*stage) const {
+        r.timings.*stage = wallMs();
+        r.cpuTimings.*stage = threadCpuMs() - cpu;
+    }
+    /// Adds the time since the start to the stage.
+    void add(FractureResult& r, double FractureTimings::*stage) const {
+        r.timings.*stage += wallMs();
+        r.cpuTimings.*stage += threadCpuMs() - cpu;
+    }
+};
 
 /// Checks that mesh is a valid closed, oriented solid; its volume out.
 Status validateInput(const Mesh& mesh, double& volume) {
@@ -120,15 +144,15 @@ void addPieces(Mesh&& m, const detail::OutputShells& shells, std::int32_t cell, 
         return;
     for (Mesh& island : splitIntoIslands(std::move(m), shells.triangleShell, shells.count)) {
         if (simplify) {
-            const auto ts = Clock::now();
+            const Stopwatch ts;
             PlanarSimplifyParams sp;
             sp.focus = focus;
             island = simplifyPlanarRegions(island, sp);
-            out.timings.simplifyMs += msSince(ts);
+            ts.add(out, &FractureTimings::simplifyMs);
         }
-        const auto tm = Clock::now();
+        const Stopwatch tm;
         MassProperties mp = computeMassProperties(island);
-        out.timings.massMs += msSince(tm);
+        tm.add(out, &FractureTimings::massMs);
         if (!(mp.volume > minVolume)) {
             out.droppedVolume += mp.volume;
             continue;
@@ -189,7 +213,7 @@ namespace {
 Result<FractureResult> runPipeline(const Mesh& mesh, std::vector<ConvexPolytope> cells,
                                    const FractureParams& params, const BooleanBackend& backend,
                                    bool exactRedo, double inputVolume) {
-    const auto t0 = Clock::now();
+    const Stopwatch t0;
     FractureResult res;
     res.inputVolume = inputVolume;
     const Aabb meshBox = mesh.bounds();
@@ -203,7 +227,9 @@ Result<FractureResult> runPipeline(const Mesh& mesh, std::vector<ConvexPolytope>
     // The result must close up and conserve volume; a failed fast split is redone exactly. The check labels
     // the shells of every output on the way; the islands below reuse them.
     std::vector<detail::OutputShells> shells;
+    const Stopwatch tv;
     bool sound = split && detail::splitIsSound(*split, inputVolume, &shells);
+    tv.set(res, &FractureTimings::verifyMs);
     if (split && !sound && exactRedo) {
         split = detail::makeCorefineBackend()->split(mesh, cells);
         if (split)
@@ -225,9 +251,9 @@ Result<FractureResult> runPipeline(const Mesh& mesh, std::vector<ConvexPolytope>
             ErrorCode::NoIntersection,
             "fracture: the impact's cells do not intersect the mesh (is the impact outside it?)");
     res.exactFallback = split->exactFallback;
-    res.timings.booleanMs = msSince(t0);
+    t0.set(res, &FractureTimings::booleanMs);
 
-    const auto t1 = Clock::now();
+    const Stopwatch t1;
     Aabb focus; // where the cut made new faces and vertices (the cells, a little larger)
     for (const ConvexPolytope& c : cells)
         focus.extend(c.bounds());
@@ -237,15 +263,15 @@ Result<FractureResult> runPipeline(const Mesh& mesh, std::vector<ConvexPolytope>
     finishCutFaces(split->remainder, cells, params.uvScale, focus, onPlane);
     for (std::size_t i = 0; i < split->inside.size(); ++i) // a cell's piece is cut by that cell only
         finishCutFaces(split->inside[i], std::span(cells).subspan(i, 1), params.uvScale, focus, onPlane);
-    res.timings.massMs = msSince(t1);
+    t1.set(res, &FractureTimings::massMs);
     const double minVolume = std::max(0.0, params.minPieceVolumeFraction) * inputVolume;
     addPieces(std::move(split->remainder), shells[0], -1, minVolume, params.simplifyPieces, focus, res);
     for (std::size_t i = 0; i < split->inside.size(); ++i)
         addPieces(std::move(split->inside[i]), shells[i + 1], static_cast<std::int32_t>(i), minVolume,
                   params.simplifyPieces, focus, res);
-    res.timings.islandsMs = msSince(t1);
+    t1.set(res, &FractureTimings::islandsMs);
     res.cells = std::move(cells);
-    res.timings.totalMs = msSince(t0);
+    t0.set(res, &FractureTimings::totalMs);
     return res;
 }
 
@@ -256,15 +282,17 @@ namespace detail {
 Result<FractureResult> fractureWithBackend(const Mesh& mesh, std::vector<ConvexPolytope> cells,
                                            const FractureParams& params, const BooleanBackend& backend,
                                            bool exactRedo) {
-    const auto t0 = Clock::now();
+    const Stopwatch t0;
     double volume = 0;
     if (Status s = validateInput(mesh, volume); !s)
         return s.error();
-    const double validateMs = msSince(t0);
+    FractureResult pre; // the stages before the pipeline
+    t0.set(pre, &FractureTimings::validateMs);
     auto r = runPipeline(mesh, std::move(cells), params, backend, exactRedo, volume);
     if (r) {
-        r->timings.validateMs = validateMs;
-        r->timings.totalMs = msSince(t0);
+        r->timings.validateMs = pre.timings.validateMs;
+        r->cpuTimings.validateMs = pre.cpuTimings.validateMs;
+        t0.set(*r, &FractureTimings::totalMs);
     }
     return r;
 }
@@ -279,26 +307,29 @@ Result<FractureResult> fractureWithCells(const Mesh& mesh, std::vector<ConvexPol
 
 Result<FractureResult> fracture(const Mesh& mesh, const Impact& impact, const FractureParams& params,
                                 std::uint64_t seed) {
-    const auto t0 = Clock::now();
+    const Stopwatch t0;
     double volume = 0;
     if (Status s = validateInput(mesh, volume); !s)
         return s.error();
     if (!isFinite(impact.point) || !std::isfinite(impact.impulse))
         return makeError(ErrorCode::InvalidInput, "fracture: the impact point or impulse is not finite");
-    const double validateMs = msSince(t0);
-    double cellMs = 0;
+    FractureResult pre; // the stages before the pipeline
+    t0.set(pre, &FractureTimings::validateMs);
     auto cellsFor = [&](std::uint64_t s) {
-        const auto tc = Clock::now();
+        const Stopwatch tc;
         std::vector<ConvexPolytope> cells = generateCells(mesh.bounds(), impact, params, s);
-        cellMs += msSince(tc);
+        tc.add(pre, &FractureTimings::cellMs);
         return cells;
     };
     auto finish = [&](Result<FractureResult> r, int redraws) {
         if (r) {
             r->redraws = redraws;
-            r->timings.validateMs = validateMs;
-            r->timings.cellMs = cellMs;
-            r->timings.totalMs = msSince(t0);
+            for (auto [to, from] :
+                 {std::pair{&r->timings, &pre.timings}, {&r->cpuTimings, &pre.cpuTimings}}) {
+                to->validateMs = from->validateMs;
+                to->cellMs = from->cellMs;
+            }
+            t0.set(*r, &FractureTimings::totalMs);
         }
         return r;
     };
