@@ -107,12 +107,13 @@ struct HitSamples {
 };
 
 /// One fracture and its decomposition update, into s.
-std::optional<FractureResult> hitOnce(const Mesh& mesh, const std::vector<ConvexPolytope>& parentParts,
-                                      const Impact& impact, std::uint64_t seed, HitSamples& s,
+std::optional<FractureResult> hitOnce(const Mesh& mesh, const MeshFacts& facts,
+                                      const std::vector<ConvexPolytope>& parentParts, const Impact& impact,
+                                      std::uint64_t seed, HitSamples& s,
                                       std::vector<std::vector<ConvexPolytope>>* partsOut = nullptr) {
     const double c0 = threadCpuMs();
     const auto t0 = Clock::now();
-    auto r = fracture(mesh, impact, hitParams(mesh), seed);
+    auto r = fracture(mesh, impact, hitParams(mesh), seed, facts);
     const double piecesMs = msSince(t0);
     if (!r) {
         ++s.failures;
@@ -276,9 +277,11 @@ int runMegaImpact(const MegaArgs& args) {
                 std::cerr << name << ": " << d.error().message << "\n";
                 continue;
             }
+            // What an object knows of its mesh once it is added (checked and measured once, untimed).
+            const MeshFacts facts = args.facts ? analyzeMesh(mesh).value() : MeshFacts{};
             HitSamples s;
             for (int h = 0; h < args.hits; ++h)
-                hitOnce(mesh, d->parts, randomHit(mesh, static_cast<std::uint64_t>(h)),
+                hitOnce(mesh, facts, d->parts, randomHit(mesh, static_cast<std::uint64_t>(h)),
                         static_cast<std::uint64_t>(h), s);
             addImpactRows(name, kind, mesh.triangles.size(), s, false, table, csv, data);
         }
@@ -288,10 +291,11 @@ int runMegaImpact(const MegaArgs& args) {
         const std::size_t startTriangles = mesh.triangles.size();
         auto d = decompose(mesh);
         std::vector<ConvexPolytope> parts = d ? d->parts : std::vector<ConvexPolytope>{};
+        MeshFacts facts = args.facts ? analyzeMesh(mesh).value() : MeshFacts{};
         HitSamples s;
         for (int h = 0; h < args.chain; ++h) {
             std::vector<std::vector<ConvexPolytope>> pieceParts;
-            auto r = hitOnce(mesh, parts, randomHit(mesh, static_cast<std::uint64_t>(1000 + h)),
+            auto r = hitOnce(mesh, facts, parts, randomHit(mesh, static_cast<std::uint64_t>(1000 + h)),
                              static_cast<std::uint64_t>(1000 + h), s, &pieceParts);
             if (!r)
                 continue;
@@ -300,6 +304,8 @@ int runMegaImpact(const MegaArgs& args) {
                 if (r->pieces[i].mass.volume > r->pieces[largest].mass.volume)
                     largest = i;
             mesh = std::move(r->pieces[largest].mesh);
+            if (args.facts)
+                facts = r->pieces[largest].facts;
             parts = std::move(pieceParts[largest]);
         }
         addImpactRows("sphere_" + std::to_string(startTriangles) + "_chain" + std::to_string(args.chain),

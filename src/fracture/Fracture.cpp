@@ -48,8 +48,8 @@ struct Stopwatch {
     }
 };
 
-/// Checks that mesh is a valid closed, oriented solid; its volume out.
-Status validateInput(const Mesh& mesh, double& volume) {
+/// Checks that mesh is a valid closed, oriented solid.
+Status checkSolid(const Mesh& mesh) {
     if (mesh.empty())
         return makeError(ErrorCode::InvalidInput, "fracture: the mesh has no triangles");
     if (Status s = mesh.validate(); !s)
@@ -59,10 +59,29 @@ Status validateInput(const Mesh& mesh, double& volume) {
             ErrorCode::InvalidInput,
             "fracture: the mesh is not closed and consistently oriented (every edge must be shared "
             "by exactly two triangles in opposite directions); repair it first");
-    volume = signedVolume(mesh);
+    return {};
+}
+
+Status positiveVolume(double volume) {
     if (!(volume > 0))
         return makeError(ErrorCode::InvalidInput, "fracture: the mesh does not enclose a positive volume");
     return {};
+}
+
+/// The input's volume and, when known facts fit it, its integrals (then nothing is scanned); else the mesh is
+/// validated and integrals is null.
+Status prepareInput(const Mesh& mesh, const MeshFacts& known, double& volume,
+                    const VolumeIntegrals*& integrals) {
+    integrals = nullptr;
+    if (known.fit(mesh) && !mesh.empty()) {
+        integrals = &known.integrals;
+        volume = known.integrals.volume;
+        return positiveVolume(volume);
+    }
+    if (Status s = checkSolid(mesh); !s)
+        return s;
+    volume = signedVolume(mesh);
+    return positiveVolume(volume);
 }
 
 /// An orthonormal basis (u, v) of the plane with normal n, the same for n and -n (so both sides of a cut
@@ -138,26 +157,51 @@ void finishCutFaces(Mesh& m, std::span<const ConvexPolytope> cells, double uvSca
 }
 
 /// The pieces of one split output. simplify: remove the vertices that carry no shape near the cells (focus).
+/// With whole (the output's integrals), the largest island's integrals are whole minus the other islands'
+/// plus what simplification changed, so it is not scanned; the others are measured.
 void addPieces(Mesh&& m, const detail::OutputShells& shells, std::int32_t cell, double minVolume,
-               bool simplify, const Aabb& focus, FractureResult& out) {
+               bool simplify, const Aabb& focus, const VolumeIntegrals* whole, FractureResult& out) {
     if (m.empty())
         return;
-    for (Mesh& island : splitIntoIslands(std::move(m), shells.triangleShell, shells.count)) {
+    std::vector<Mesh> islands = splitIntoIslands(std::move(m), shells.triangleShell, shells.count);
+    std::size_t largest = islands.size();
+    VolumeIntegrals rest;
+    if (whole) {
+        const Stopwatch tm;
+        largest = 0;
+        for (std::size_t i = 1; i < islands.size(); ++i)
+            if (islands[i].triangles.size() > islands[largest].triangles.size())
+                largest = i;
+        rest = *whole;
+        for (std::size_t i = 0; i < islands.size(); ++i)
+            if (i != largest)
+                rest.accumulate(volumeIntegrals(islands[i], whole->reference), -1.0);
+        tm.add(out, &FractureTimings::massMs);
+    }
+    for (std::size_t i = 0; i < islands.size(); ++i) {
+        Mesh& island = islands[i];
+        const bool byDifference = i == largest;
         if (simplify) {
             const Stopwatch ts;
             PlanarSimplifyParams sp;
             sp.focus = focus;
-            island = simplifyPlanarRegions(island, sp);
+            sp.integralsReference = rest.reference;
+            PlanarSimplifyReport report;
+            island = simplifyPlanarRegions(island, sp, &report);
+            if (byDifference && !report.unchanged)
+                rest.accumulate(report.integralsChange, 1.0);
             ts.add(out, &FractureTimings::simplifyMs);
         }
         const Stopwatch tm;
-        MassProperties mp = computeMassProperties(island);
+        MeshFacts facts{true, island.triangles.size(), island.positions.size(),
+                        byDifference ? rest : volumeIntegrals(island)};
+        MassProperties mp = massProperties(facts.integrals);
         tm.add(out, &FractureTimings::massMs);
         if (!(mp.volume > minVolume)) {
             out.droppedVolume += mp.volume;
             continue;
         }
-        out.pieces.push_back({std::move(island), mp, cell});
+        out.pieces.push_back({std::move(island), mp, cell, std::move(facts)});
     }
 }
 
@@ -168,7 +212,7 @@ std::unique_ptr<BooleanBackend> makeBooleanBackend(BooleanKind kind) {
     case BooleanKind::Nef:
         return detail::makeNefBackend();
     case BooleanKind::Fast:
-        return detail::makeFastBackend();
+        return detail::makeFastBackend(true);
     case BooleanKind::Corefine:
         break;
     }
@@ -193,7 +237,8 @@ bool splitIsSound(const SplitResult& s, double inputVolume, std::vector<OutputSh
             return false;
         if (out)
             out->count = static_cast<std::size_t>(count);
-        const double mv = signedVolume(m);
+        const double mv =
+            &m == &s.remainder && s.remainderIntegrals ? s.remainderIntegrals->volume : signedVolume(m);
         v += mv;
         return mv > 0;
     };
@@ -265,10 +310,12 @@ Result<FractureResult> runPipeline(const Mesh& mesh, std::vector<ConvexPolytope>
         finishCutFaces(split->inside[i], std::span(cells).subspan(i, 1), params.uvScale, focus, onPlane);
     t1.set(res, &FractureTimings::massMs);
     const double minVolume = std::max(0.0, params.minPieceVolumeFraction) * inputVolume;
-    addPieces(std::move(split->remainder), shells[0], -1, minVolume, params.simplifyPieces, focus, res);
+    const VolumeIntegrals* whole = split->remainderIntegrals ? &*split->remainderIntegrals : nullptr;
+    addPieces(std::move(split->remainder), shells[0], -1, minVolume, params.simplifyPieces, focus, whole,
+              res);
     for (std::size_t i = 0; i < split->inside.size(); ++i)
         addPieces(std::move(split->inside[i]), shells[i + 1], static_cast<std::int32_t>(i), minVolume,
-                  params.simplifyPieces, focus, res);
+                  params.simplifyPieces, focus, nullptr, res);
     t1.set(res, &FractureTimings::islandsMs);
     res.cells = std::move(cells);
     t0.set(res, &FractureTimings::totalMs);
@@ -281,10 +328,11 @@ namespace detail {
 
 Result<FractureResult> fractureWithBackend(const Mesh& mesh, std::vector<ConvexPolytope> cells,
                                            const FractureParams& params, const BooleanBackend& backend,
-                                           bool exactRedo) {
+                                           bool exactRedo, const MeshFacts& known) {
     const Stopwatch t0;
     double volume = 0;
-    if (Status s = validateInput(mesh, volume); !s)
+    const VolumeIntegrals* integrals = nullptr;
+    if (Status s = prepareInput(mesh, known, volume, integrals); !s)
         return s.error();
     FractureResult pre; // the stages before the pipeline
     t0.set(pre, &FractureTimings::validateMs);
@@ -299,17 +347,41 @@ Result<FractureResult> fractureWithBackend(const Mesh& mesh, std::vector<ConvexP
 
 } // namespace detail
 
+Result<MeshFacts> analyzeMesh(const Mesh& mesh) {
+    if (Status s = checkSolid(mesh); !s)
+        return s.error();
+    MeshFacts facts{true, mesh.triangles.size(), mesh.positions.size(), volumeIntegrals(mesh)};
+    if (Status s = positiveVolume(facts.integrals.volume); !s)
+        return s.error();
+    return facts;
+}
+
+namespace {
+
+/// The backend of params, given the input's integrals when they are known (Fast uses them).
+std::unique_ptr<BooleanBackend> backendFor(BooleanKind kind, bool exactFallback,
+                                           const VolumeIntegrals* integrals) {
+    if (kind == BooleanKind::Fast)
+        return detail::makeFastBackend(exactFallback, integrals);
+    return makeBooleanBackend(kind);
+}
+
+} // namespace
+
 Result<FractureResult> fractureWithCells(const Mesh& mesh, std::vector<ConvexPolytope> cells,
-                                         const FractureParams& params) {
-    return detail::fractureWithBackend(mesh, std::move(cells), params, *makeBooleanBackend(params.backend),
-                                       params.backend == BooleanKind::Fast);
+                                         const FractureParams& params, const MeshFacts& known) {
+    const VolumeIntegrals* integrals = known.fit(mesh) ? &known.integrals : nullptr;
+    return detail::fractureWithBackend(mesh, std::move(cells), params,
+                                       *backendFor(params.backend, true, integrals),
+                                       params.backend == BooleanKind::Fast, known);
 }
 
 Result<FractureResult> fracture(const Mesh& mesh, const Impact& impact, const FractureParams& params,
-                                std::uint64_t seed) {
+                                std::uint64_t seed, const MeshFacts& known) {
     const Stopwatch t0;
     double volume = 0;
-    if (Status s = validateInput(mesh, volume); !s)
+    const VolumeIntegrals* integrals = nullptr;
+    if (Status s = prepareInput(mesh, known, volume, integrals); !s)
         return s.error();
     if (!isFinite(impact.point) || !std::isfinite(impact.impulse))
         return makeError(ErrorCode::InvalidInput, "fracture: the impact point or impulse is not finite");
@@ -341,15 +413,15 @@ Result<FractureResult> fracture(const Mesh& mesh, const Impact& impact, const Fr
             std::vector<ConvexPolytope> cells = cellsFor(redraw == 0 ? seed : mixSeed(seed, 0xDA7A + redraw));
             if (cells.empty())
                 break;
-            auto r =
-                runPipeline(mesh, std::move(cells), params, *detail::makeFastBackend(false), false, volume);
+            auto r = runPipeline(mesh, std::move(cells), params, *detail::makeFastBackend(false, integrals),
+                                 false, volume);
             if (r || r.error().code != ErrorCode::GeometryFailure)
                 return finish(std::move(r), redraw);
         }
     std::vector<ConvexPolytope> cells = cellsFor(seed);
     if (cells.empty())
         return makeError(ErrorCode::NoIntersection, "fracture: no cell could be built around the impact");
-    return finish(runPipeline(mesh, std::move(cells), params, *makeBooleanBackend(params.backend),
+    return finish(runPipeline(mesh, std::move(cells), params, *backendFor(params.backend, true, integrals),
                               params.backend == BooleanKind::Fast, volume),
                   0);
 }

@@ -434,12 +434,15 @@ bool Simplifier::run(Mesh& result, PlanarSimplifyReport& report) {
                 out.normals.push_back(m_.normals[c]);
         }
     };
+    report.integralsChange = {};
+    report.integralsChange.reference = params_.integralsReference;
     for (std::uint32_t t = 0; t < nt; ++t) {
         const std::uint32_t p = patchOf[t];
         if (p == kNone) {
             emit(m_.triangles[t], t, nullptr);
             continue;
         }
+        report.integralsChange.remove(m_, t);
         if (patches[p].front() != t)
             continue;
         for (auto it = patches[p].rbegin(); it != patches[p].rend(); ++it) // the first corner wins
@@ -448,6 +451,7 @@ bool Simplifier::run(Mesh& result, PlanarSimplifyReport& report) {
         for (const Tri& tri : fresh[p]) {
             const std::uint32_t corner[3] = {cornerOf[tri[0]], cornerOf[tri[1]], cornerOf[tri[2]]};
             emit(tri, t, corner);
+            report.integralsChange.add(m_.positions[tri[0]], m_.positions[tri[1]], m_.positions[tri[2]]);
         }
         ++report.regionsRetriangulated;
     }
