@@ -50,5 +50,8 @@ struct PlanarSimplifyReport {
 /// Deterministic.
 Mesh simplifyPlanarRegions(const Mesh& mesh, const PlanarSimplifyParams& params = {},
                            PlanarSimplifyReport* report = nullptr);
+/// As above; a mesh left as it is is moved into the result, not copied.
+Mesh simplifyPlanarRegions(Mesh&& mesh, const PlanarSimplifyParams& params = {},
+                           PlanarSimplifyReport* report = nullptr);
 
 } // namespace rubble

@@ -187,7 +187,7 @@ void addPieces(Mesh&& m, const detail::OutputShells& shells, std::int32_t cell, 
             sp.focus = focus;
             sp.integralsReference = rest.reference;
             PlanarSimplifyReport report;
-            island = simplifyPlanarRegions(island, sp, &report);
+            island = simplifyPlanarRegions(std::move(island), sp, &report);
             if (byDifference && !report.unchanged)
                 rest.accumulate(report.integralsChange, 1.0);
             ts.add(out, &FractureTimings::simplifyMs);

@@ -411,58 +411,77 @@ bool Simplifier::run(Mesh& result, PlanarSimplifyReport& report) {
     }
 
     // Assemble: other triangles in input order; each patch's new triangles where its first triangle was.
-    std::vector<std::uint32_t> patchOf(nt, kNone);
+    // The triangles between patch triangles are copied in runs.
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> patchOf; // (triangle, patch), by triangle
     for (std::size_t p = 0; p < patches.size(); ++p)
         for (std::uint32_t t : patches[p])
-            patchOf[t] = static_cast<std::uint32_t>(p);
+            patchOf.emplace_back(t, static_cast<std::uint32_t>(p));
+    std::sort(patchOf.begin(), patchOf.end());
     Mesh out;
     out.materialNames = m_.materialNames;
     out.triangles.reserve(nt);
     out.materials.reserve(m_.materials.size());
     out.uvs.reserve(m_.uvs.size());
     out.normals.reserve(m_.normals.size());
-    std::vector<std::uint32_t> cornerOf(nv, kNone); // a corner of the patch at each vertex
+    std::unordered_map<std::uint32_t, std::uint32_t> cornerOf; // a corner of the patch at each vertex
     auto emit = [&](const Tri& tri, std::uint32_t source, const std::uint32_t* corner) {
         out.triangles.push_back(tri);
         if (m_.hasMaterials())
             out.materials.push_back(m_.materials[source]);
         for (std::size_t k = 0; k < 3; ++k) {
-            const std::size_t c = corner ? corner[k] : 3 * source + k;
+            const std::size_t c = corner[k];
             if (m_.hasUvs())
                 out.uvs.push_back(m_.uvs[c]);
             if (m_.hasNormals())
                 out.normals.push_back(m_.normals[c]);
         }
     };
+    auto copyRun = [&](std::size_t from, std::size_t to) { // input triangles [from, to) as they are
+        auto range = [&](auto& dst, const auto& src, std::size_t per) {
+            if (!src.empty())
+                dst.insert(dst.end(), src.begin() + static_cast<std::ptrdiff_t>(per * from),
+                           src.begin() + static_cast<std::ptrdiff_t>(per * to));
+        };
+        range(out.triangles, m_.triangles, 1);
+        range(out.materials, m_.materials, 1);
+        range(out.uvs, m_.uvs, 3);
+        range(out.normals, m_.normals, 3);
+    };
     report.integralsChange = {};
     report.integralsChange.reference = params_.integralsReference;
-    for (std::uint32_t t = 0; t < nt; ++t) {
-        const std::uint32_t p = patchOf[t];
-        if (p == kNone) {
-            emit(m_.triangles[t], t, nullptr);
-            continue;
-        }
+    std::size_t pending = 0; // first triangle not yet copied
+    for (const auto& [t, p] : patchOf) {
+        copyRun(pending, t);
+        pending = t + 1;
         report.integralsChange.remove(m_, t);
         if (patches[p].front() != t)
             continue;
+        cornerOf.clear();
         for (auto it = patches[p].rbegin(); it != patches[p].rend(); ++it) // the first corner wins
             for (std::uint32_t k = 0; k < 3; ++k)
                 cornerOf[m_.triangles[*it][k]] = 3 * *it + k;
         for (const Tri& tri : fresh[p]) {
-            const std::uint32_t corner[3] = {cornerOf[tri[0]], cornerOf[tri[1]], cornerOf[tri[2]]};
+            const std::uint32_t corner[3] = {cornerOf.at(tri[0]), cornerOf.at(tri[1]), cornerOf.at(tri[2])};
             emit(tri, t, corner);
             report.integralsChange.add(m_.positions[tri[0]], m_.positions[tri[1]], m_.positions[tri[2]]);
         }
         ++report.regionsRetriangulated;
     }
+    copyRun(pending, nt);
     // Drop the removed vertices (only those: the input's own unreferenced vertices stay).
-    std::vector<std::uint32_t> remap(nv, kNone);
-    out.positions.reserve(nv - removed_.size());
-    for (std::uint32_t v = 0; v < nv; ++v)
-        if (!removed_.count(v)) {
-            remap[v] = static_cast<std::uint32_t>(out.positions.size());
-            out.positions.push_back(m_.positions[v]);
+    std::vector<std::uint32_t> gone(removed_.begin(), removed_.end());
+    std::sort(gone.begin(), gone.end());
+    std::vector<std::uint32_t> remap(nv);
+    out.positions.reserve(nv - gone.size());
+    for (std::uint32_t v = 0, g = 0; v < nv; ++v) {
+        if (g < gone.size() && gone[g] == v) {
+            ++g;
+            remap[v] = kNone;
+            continue;
         }
+        remap[v] = static_cast<std::uint32_t>(out.positions.size());
+        out.positions.push_back(m_.positions[v]);
+    }
     for (Tri& tri : out.triangles)
         for (std::uint32_t& v : tri)
             v = remap[v];
@@ -473,20 +492,39 @@ bool Simplifier::run(Mesh& result, PlanarSimplifyReport& report) {
 
 } // namespace
 
-Mesh simplifyPlanarRegions(const Mesh& mesh, const PlanarSimplifyParams& params,
-                           PlanarSimplifyReport* report) {
+namespace {
+
+/// Simplifies mesh into out; false (and a report saying so) when it stays as it is.
+bool simplifyInto(const Mesh& mesh, const PlanarSimplifyParams& params, PlanarSimplifyReport* report,
+                  Mesh& out) {
     PlanarSimplifyReport local;
     PlanarSimplifyReport& rep = report ? *report : local;
     rep = {};
     rep.trianglesBefore = mesh.triangles.size();
-    Mesh out;
     if (!Simplifier(mesh, params).run(out, rep)) {
         rep = {};
         rep.trianglesBefore = rep.trianglesAfter = mesh.triangles.size();
         rep.unchanged = true;
-        return mesh;
+        return false;
     }
     rep.trianglesAfter = out.triangles.size();
+    return true;
+}
+
+} // namespace
+
+Mesh simplifyPlanarRegions(const Mesh& mesh, const PlanarSimplifyParams& params,
+                           PlanarSimplifyReport* report) {
+    Mesh out;
+    if (!simplifyInto(mesh, params, report, out))
+        return mesh;
+    return out;
+}
+
+Mesh simplifyPlanarRegions(Mesh&& mesh, const PlanarSimplifyParams& params, PlanarSimplifyReport* report) {
+    Mesh out;
+    if (!simplifyInto(mesh, params, report, out))
+        return std::move(mesh);
     return out;
 }
 
