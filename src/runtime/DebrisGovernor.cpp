@@ -240,7 +240,7 @@ GovernorActions DebrisGovernor::update(const BodyTable& bodies, const PhysicsBin
             if (triangles <= budget_.maxTriangles)
                 break;
             triangles -= std::min(triangles, bodies.find(id)->triangles);
-            out.retire.push_back({id, RetireReason::Budget});
+            out.retire.push_back({id, RetireReason::Triangles});
         }
     }
     for (BodyId id : leaving) {

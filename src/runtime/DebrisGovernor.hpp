@@ -13,7 +13,7 @@
 namespace rubble::detail {
 
 /// Why a debris body leaves the simulation.
-enum class RetireReason { Budget, Fade, FellOut };
+enum class RetireReason { Budget, Triangles, Fade, FellOut };
 
 /// What the governor decided for one frame, in a deterministic order.
 struct GovernorActions {
