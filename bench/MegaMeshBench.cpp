@@ -211,15 +211,11 @@ void addImpactRows(const std::string& name, const std::string& kind, std::size_t
                         str(stats(s.parts).max),
                         str(excessMax),
                         str(med(s.clip)),
-                        str(med(s.touched)),
-                        str(med(s.cpuValidate)),
-                        str(med(s.cpuBoolean)),
-                        str(med(s.cpuVerify)),
-                        str(med(s.cpuIslands)),
-                        str(med(s.cpuMass)),
-                        str(med(s.cpuSimplify)),
-                        str(med(s.cpuParts)),
-                        ""});
+                        str(med(s.touched))});
+    for (const auto* cpuStage : {&s.cpuValidate, &s.cpuBoolean, &s.cpuVerify, &s.cpuIslands, &s.cpuMass,
+                                 &s.cpuSimplify, &s.cpuParts})
+        csv.rows.back().push_back(str(med(*cpuStage)));
+    csv.rows.back().push_back(""); // other_cpu_cores, filled by finishTable
     if (!againstFirst)
         data << kind << " " << triangles << " " << w.median << " " << w.max << " " << med(s.clip) << " "
              << c.median << "\n";
