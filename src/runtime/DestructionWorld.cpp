@@ -50,6 +50,7 @@ struct Job {
     std::vector<PendingImpact> impacts;
     std::vector<Impact> submitted;             // the impacts as submitted (runJob moves `impacts`)
     std::shared_ptr<const ObjectState> object; // its mesh and convex parts (object states never change)
+    MeshFacts facts; // analyzeMesh(object->mesh) when the world knows it; else the worker finds it
     FractureParams params;
     bool crumble = false; // over its triangle limit: a shatter as large as the object
     DecompositionParams decomposition;
@@ -69,6 +70,7 @@ struct Job {
     std::vector<Frame> frames;
     std::vector<Mesh> localMeshes;
     std::vector<MassProperties> localMass;
+    std::vector<MeshFacts> localFacts; // analyzeMesh(localMeshes[i]) (not validated again: fracture's output)
     std::vector<std::vector<ConvexPolytope>> localParts;
     std::vector<std::uint64_t> meshHashes; // localMeshes[i].hash(), computed by the worker
     double queueMs = 0;
@@ -109,10 +111,21 @@ void runJob(Job& job) {
     const Mesh& mesh = job.object->mesh;
     for (PendingImpact& p : job.impacts)
         p.impact = onSurface(mesh, p.impact, job.params);
+    // Every fracture runs with the facts analyzeMesh finds (a function of the mesh alone), whether the world
+    // kept them or not (a loaded world does not), so that both cut the same bits (docs/megamesh.md).
+    if (!job.facts.fit(mesh)) {
+        auto facts = analyzeMesh(mesh);
+        if (!facts) {
+            job.errorCode = facts.error().code;
+            job.error = facts.error().message;
+            return;
+        }
+        job.facts = facts.value();
+    }
     job.prepareMs = msBetween(job.started, Clock::now());
     Result<FractureResult> r = Error{ErrorCode::NoIntersection, "no cells"};
     if (job.impacts.size() == 1) {
-        r = fracture(mesh, job.impacts.front().impact, job.params, mixSeed(job.seed, 0));
+        r = fracture(mesh, job.impacts.front().impact, job.params, mixSeed(job.seed, 0), job.facts);
     } else {
         // Union of the cells of every merged impact; a cell overlapping an accepted one is skipped so that
         // the cells stay disjoint (the overlapping region is already cut by the earlier impact's cells).
@@ -131,7 +144,7 @@ void runJob(Job& job) {
             }
         }
         job.cellMs = msBetween(tc, Clock::now());
-        r = fractureWithCells(mesh, std::move(cells), job.params);
+        r = fractureWithCells(mesh, std::move(cells), job.params, job.facts);
     }
     if (!r) {
         job.errorCode = r.error().code;
@@ -153,13 +166,18 @@ void runJob(Job& job) {
     job.finishStart = Clock::now();
     job.decompositionMs = msBetween(t1, job.finishStart);
     // Each piece in its principal frame, with the mass properties of that mesh (computed here, not by the
-    // main thread at adoption).
+    // main thread at adoption). The remainder's mass properties found by difference may differ from a full
+    // sum in the last bits: its frame comes from the full sum, so that facts change no piece's bytes.
     for (std::size_t i = 0; i < meshes.size(); ++i) {
-        const auto& m = job.result.pieces[i].mass;
+        const Piece& piece = job.result.pieces[i];
+        const MassProperties m = piece.cell < 0 ? computeMassProperties(meshes[i]) : piece.mass;
         Frame f{m.principalAxes, m.centerOfMass};
         const Mat3 rt = f.rotation.transposed();
         meshes[i].transform(rt, Vec3{1, 1, 1}, rt * (-1.0 * f.translation));
-        job.localMass.push_back(computeMassProperties(meshes[i]));
+        MeshFacts facts{true, meshes[i].triangles.size(), meshes[i].positions.size(),
+                        volumeIntegrals(meshes[i])};
+        job.localMass.push_back(massProperties(facts.integrals));
+        job.localFacts.push_back(std::move(facts));
         job.meshHashes.push_back(meshes[i].hash());
         std::vector<ConvexPolytope> lp;
         if (i < parts.size())
@@ -203,6 +221,8 @@ struct DestructionWorld::Impl {
     std::function<void(const JournalEvent&)> journalSink;
     std::uint64_t journalLength = 0;
     std::uint64_t geometrySum = 0; // Σ geometryTerm over live objects (wrapping)
+    // analyzeMesh of live objects' meshes where known (not saved: a function of the mesh, found again)
+    std::map<ObjectId, MeshFacts> facts;
 
     static std::uint64_t geometryTerm(const ObjectState& o) {
         return mixSeed(mixSeed(o.id, o.version), o.meshHash);
@@ -214,6 +234,7 @@ struct DestructionWorld::Impl {
     }
     void eraseObject(std::map<ObjectId, std::shared_ptr<const ObjectState>>::iterator it) {
         geometrySum -= geometryTerm(*it->second);
+        facts.erase(it->first);
         objects.erase(it);
     }
     std::uint64_t jobSeed(const ObjectState& o) const {
@@ -266,6 +287,8 @@ struct DestructionWorld::Impl {
         for (const PendingImpact& p : job->impacts)
             job->submitted.push_back(p.impact);
         job->object = object;
+        if (auto f = facts.find(id); f != facts.end())
+            job->facts = f->second;
         job->params = o.fracture;
         if (o.mesh.triangleCount() > o.crumbleAbove) { // too much detail: break it up instead of a crater
             job->crumble = true;
@@ -392,7 +415,10 @@ Result<ObjectId> DestructionWorld::addObject(ObjectDesc desc) {
             s.warning += ": " + report.problems.front();
         logMessage(LogLevel::Warning, "object " + std::to_string(s.id) + " is indestructible: " + s.warning);
     }
-    s.mass = computeMassProperties(desc.mesh);
+    Result<MeshFacts> facts = Error{ErrorCode::InvalidInput, "not destructible"};
+    if (s.destructible && report.valid())
+        facts = analyzeMesh(desc.mesh);
+    s.mass = facts ? massProperties(facts.value().integrals) : computeMassProperties(desc.mesh);
     s.convexParts = std::move(desc.convexParts);
     if (s.convexParts.empty() && report.valid()) {
         auto d = impl_->cache.get(desc.mesh, impl_->config.decomposition);
@@ -403,6 +429,8 @@ Result<ObjectId> DestructionWorld::addObject(ObjectDesc desc) {
     s.meshHash = s.mesh.hash();
     const ObjectId id = s.id;
     impl_->insertObject(std::move(state));
+    if (facts)
+        impl_->facts[id] = std::move(facts).value();
     return id;
 }
 
@@ -570,6 +598,7 @@ Status DestructionWorld::loadState(WorldState w) {
     im.waiting.clear();
     im.handedOut.clear();
     im.objects.clear();
+    im.facts.clear();
     im.geometrySum = 0;
     for (ObjectState& o : w.objects) {
         if (o.meshHash == 0) // a saved state brings its hashes: hashing every mesh again is most of a load
@@ -683,6 +712,7 @@ std::vector<FractureOutcome> DestructionWorld::collect() {
                 s->convexParts = std::move(job->localParts[i]);
                 s->meshHash = job->meshHashes[i];
                 o.pieces.push_back({s->id, job->frames[i], cell, s});
+                im.facts[s->id] = std::move(job->localFacts[i]);
                 im.insertObject(std::move(s));
             }
             // Impacts that arrived while this job ran go to the piece nearest to their point.
@@ -717,6 +747,8 @@ std::vector<FractureOutcome> DestructionWorld::collect() {
             out.push_back(std::move(o));
             adopted = true;
         } else if (job->errorCode == ErrorCode::NoIntersection) {
+            if (job->facts.fit(it->second->mesh)) // what the worker found, for the next hit
+                im.facts[job->id] = job->facts;
             rec.missed = true; // nothing of the mesh inside the cells: a miss, not a failure
         } else {
             rec.failed = true;

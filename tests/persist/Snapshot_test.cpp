@@ -235,6 +235,70 @@ TEST(Snapshot, SnapshotPlusJournalTailConvergesWithTheHost) {
     }
 }
 
+// The world keeps each object's MeshFacts (not saved) and fractures with them; a loaded world finds them
+// again. Hits on pieces of pieces, with a job in flight at the save: the loaded world must continue bit for
+// bit as the original (every mesh and mass property in the saved bytes), on 1 and 2 workers.
+TEST(Snapshot, ALoadedWorldFracturesPiecesOfPiecesBitForBitAsTheOriginal) {
+    auto config = [](int workers) {
+        DestructionWorld::Config c;
+        c.workers = workers;
+        c.deterministic = true;
+        c.seed = 77;
+        return c;
+    };
+    auto hitLargest = [](DestructionWorld& w) { // the largest live object, at a corner of its bounds
+        ObjectId largest = 0;
+        double volume = 0;
+        for (ObjectId id : w.objects())
+            if (w.object(id)->mass.volume > volume) {
+                volume = w.object(id)->mass.volume;
+                largest = id;
+            }
+        const ObjectState& o = *w.object(largest);
+        const Aabb b = o.mesh.bounds();
+        EXPECT_TRUE(w.submitImpact(largest, Impact{0.3 * b.lo + 0.7 * b.hi, {0.577, 0.577, 0.577}, 1200}));
+    };
+    auto frames = [](DestructionWorld& w, int n) {
+        for (int i = 0; i < n; ++i) {
+            w.beginFrame();
+            (void)w.collect();
+        }
+    };
+    DestructionWorld host(config(1));
+    ObjectDesc wall;
+    wall.mesh = makeSubdividedBox({-2, 0, -0.3}, {2, 3, 0.3}, 5);
+    wall.fracture.pattern = CellPattern::Shatter;
+    wall.fracture.cells = 5;
+    ASSERT_TRUE(host.addObject(std::move(wall)));
+    ObjectDesc ball;
+    ball.mesh = makeSphere({4, 1, 0}, 1.0, 24, 16);
+    ASSERT_TRUE(host.addObject(std::move(ball)));
+    hitLargest(host);
+    frames(host, 4);
+    hitLargest(host); // a piece: fractured with the facts its parent's job found
+    const std::vector<std::uint8_t> saved = encodeSnapshot(takeSnapshot(host));
+    ASSERT_EQ(host.jobsInFlight(), 1);
+    auto game = [&](DestructionWorld& w) {
+        frames(w, 4);
+        hitLargest(w);
+        frames(w, 4);
+        hitLargest(w);
+        frames(w, 4);
+    };
+    game(host);
+    const std::vector<std::uint8_t> end = encodeSnapshot(takeSnapshot(host));
+    ASSERT_GE(host.objects().size(), 8u);
+    for (int workers : {1, 2}) {
+        Result<Snapshot> s = decodeSnapshot(saved.data(), saved.size(), "facts.rsnap");
+        ASSERT_TRUE(s) << s.error().message;
+        DestructionWorld loaded(config(workers));
+        ASSERT_TRUE(restoreSnapshot(loaded, std::move(*s)));
+        game(loaded);
+        EXPECT_EQ(loaded.geometryHash(), host.geometryHash()) << workers << " workers";
+        EXPECT_TRUE(encodeSnapshot(takeSnapshot(loaded)) == end) << workers << " workers";
+    }
+}
+
 TEST(Snapshot, DamagedFilesAreRefusedNamingOffsetAndFieldAndTheWorldStaysAsItWas) {
     MidFire m;
     const std::vector<std::uint8_t> bytes = encodeSnapshot(m.snapshot);
