@@ -3,6 +3,7 @@
 // value is a change of every saved journal's meaning: update it only on purpose (docs/journal.md).
 #include <gtest/gtest.h>
 
+#include "JournalScene.hpp"
 #include "persist/Bytes.hpp"
 #include "rubble/JournalFile.hpp"
 #include "rubble/JournalPlayer.hpp"
@@ -54,13 +55,7 @@ std::vector<JournalEvent> recordGoldenJournal() {
             EXPECT_TRUE(world.submitImpact(3, Impact{{1.9, 0.0, 0.0}, {1, 0, 0}, 700}));
         }
         if (frame == 10 || frame == 20) { // the largest live object is hit near its centre, then removed
-            ObjectId largest = 0;
-            double volume = 0;
-            for (ObjectId id : world.objects())
-                if (world.object(id)->mass.volume > volume) {
-                    volume = world.object(id)->mass.volume;
-                    largest = id;
-                }
+            const ObjectId largest = test::largestObject(world);
             const Aabb b = world.object(largest)->mesh.bounds();
             EXPECT_TRUE(world.submitImpact(largest, Impact{b.hi, {0.577, 0.577, 0.577}, 1500}));
             if (frame == 20)

@@ -246,14 +246,8 @@ TEST(Snapshot, ALoadedWorldFracturesPiecesOfPiecesBitForBitAsTheOriginal) {
         c.seed = 77;
         return c;
     };
-    auto hitLargest = [](DestructionWorld& w) { // the largest live object, at a corner of its bounds
-        ObjectId largest = 0;
-        double volume = 0;
-        for (ObjectId id : w.objects())
-            if (w.object(id)->mass.volume > volume) {
-                volume = w.object(id)->mass.volume;
-                largest = id;
-            }
+    auto hitLargest = [](DestructionWorld& w) { // the largest live object, near a corner of its bounds
+        const ObjectId largest = test::largestObject(w);
         const ObjectState& o = *w.object(largest);
         const Aabb b = o.mesh.bounds();
         EXPECT_TRUE(w.submitImpact(largest, Impact{0.3 * b.lo + 0.7 * b.hi, {0.577, 0.577, 0.577}, 1200}));

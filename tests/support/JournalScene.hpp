@@ -90,4 +90,16 @@ inline std::unique_ptr<DestructionWorld> journalWorld(int workers) {
     return world;
 }
 
+/// The live object of the largest volume (the first of equals; 0 in an empty world).
+inline ObjectId largestObject(const DestructionWorld& world) {
+    ObjectId largest = 0;
+    double volume = 0;
+    for (ObjectId id : world.objects())
+        if (world.object(id)->mass.volume > volume) {
+            volume = world.object(id)->mass.volume;
+            largest = id;
+        }
+    return largest;
+}
+
 } // namespace rubble::test
