@@ -12,8 +12,11 @@ namespace rubble {
 
 namespace {
 struct UnionFind {
-    std::vector<std::uint32_t> parent;
-    explicit UnionFind(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0u); }
+    std::vector<std::uint32_t>& parent; // its storage (reused between calls by closedOrientedShells)
+    UnionFind(std::vector<std::uint32_t>& storage, std::size_t n) : parent(storage) {
+        parent.resize(n);
+        std::iota(parent.begin(), parent.end(), 0u);
+    }
     std::uint32_t find(std::uint32_t x) {
         while (parent[x] != x)
             x = parent[x] = parent[parent[x]];
@@ -32,10 +35,11 @@ struct UnionFind {
 namespace {
 
 /// Labels by the smallest triangle index of each union-find class, numbered in order of first appearance.
-std::size_t labelsFrom(UnionFind& uf, std::vector<std::uint32_t>& triangleShell) {
+std::size_t labelsFrom(UnionFind& uf, std::vector<std::uint32_t>& triangleShell,
+                       std::vector<std::uint32_t>& rootToLabel) {
     const std::size_t n = uf.parent.size();
     triangleShell.assign(n, 0);
-    std::vector<std::uint32_t> rootToLabel(n, UINT32_MAX);
+    rootToLabel.assign(n, UINT32_MAX);
     std::uint32_t count = 0;
     for (std::uint32_t t = 0; t < n; ++t) {
         const std::uint32_t r = uf.find(t);
@@ -61,14 +65,53 @@ void sortShort(std::uint64_t* first, std::uint64_t* last) {
     }
 }
 
+/// The work arrays of closedOrientedShells, kept by each thread between calls: a million-triangle mesh needs
+/// ~60 MB of them, and fresh allocations that large are mapped and faulted in again on every hit
+/// (docs/megamesh.md). A thread keeps at most kKeepBytes; a larger call frees its arrays when it ends.
+struct ShellScratch {
+    static constexpr std::size_t kKeepBytes = std::size_t{96} << 20;
+    std::vector<std::uint32_t> outFirst, inFirst, o, i, parent, rootToLabel;
+    std::vector<std::uint64_t> out, in;
+    std::size_t bytes() const {
+        std::size_t b = 8 * (out.capacity() + in.capacity());
+        for (const auto* v : {&outFirst, &inFirst, &o, &i, &parent, &rootToLabel})
+            b += 4 * v->capacity();
+        return b;
+    }
+};
+
+/// Lends the calling thread's scratch for one call.
+class ScratchLease {
+public:
+    ScratchLease() : s_(scratch()) {}
+    ~ScratchLease() {
+        if (s_.bytes() > ShellScratch::kKeepBytes)
+            s_ = ShellScratch{};
+    }
+    ScratchLease(const ScratchLease&) = delete;
+    ScratchLease& operator=(const ScratchLease&) = delete;
+    ShellScratch& operator*() { return s_; }
+
+private:
+    static ShellScratch& scratch() {
+        thread_local ShellScratch s;
+        return s;
+    }
+    ShellScratch& s_;
+};
+
 } // namespace
 
 namespace detail {
 
 std::int64_t closedOrientedShells(const Mesh& mesh, std::vector<std::uint32_t>* triangleShell) {
     const std::size_t nv = mesh.positions.size(), nt = mesh.triangles.size();
+    ScratchLease lease;
+    ShellScratch& s = *lease;
     // Per vertex: outgoing (neighbour << 32 | triangle) and incoming (neighbour << 32 | triangle) entries.
-    std::vector<std::uint32_t> outFirst(nv + 1, 0), inFirst(nv + 1, 0);
+    std::vector<std::uint32_t>&outFirst = s.outFirst, &inFirst = s.inFirst;
+    outFirst.assign(nv + 1, 0);
+    inFirst.assign(nv + 1, 0);
     for (const Triangle& t : mesh.triangles)
         for (int c = 0; c < 3; ++c) {
             if (t[c] >= nv)
@@ -80,10 +123,13 @@ std::int64_t closedOrientedShells(const Mesh& mesh, std::vector<std::uint32_t>* 
         outFirst[v + 1] += outFirst[v];
         inFirst[v + 1] += inFirst[v];
     }
-    std::vector<std::uint64_t> out(3 * nt), in(3 * nt);
+    std::vector<std::uint64_t>&out = s.out, &in = s.in;
+    out.resize(3 * nt); // every entry is written below
+    in.resize(3 * nt);
     {
-        std::vector<std::uint32_t> o(outFirst.begin(), outFirst.end() - 1),
-            i(inFirst.begin(), inFirst.end() - 1);
+        std::vector<std::uint32_t>&o = s.o, &i = s.i;
+        o.assign(outFirst.begin(), outFirst.end() - 1);
+        i.assign(inFirst.begin(), inFirst.end() - 1);
         for (std::uint32_t t = 0; t < nt; ++t)
             for (int c = 0; c < 3; ++c) {
                 const std::uint32_t a = mesh.triangles[t][c], b = mesh.triangles[t][(c + 1) % 3];
@@ -91,7 +137,7 @@ std::int64_t closedOrientedShells(const Mesh& mesh, std::vector<std::uint32_t>* 
                 in[i[b]++] = std::uint64_t(a) << 32 | t;
             }
     }
-    UnionFind uf(triangleShell ? nt : 0);
+    UnionFind uf(s.parent, triangleShell ? nt : 0);
     for (std::size_t v = 0; v < nv; ++v) {
         const std::uint32_t o0 = outFirst[v], o1 = outFirst[v + 1], i0 = inFirst[v];
         if (o1 - o0 != inFirst[v + 1] - i0)
@@ -111,14 +157,15 @@ std::int64_t closedOrientedShells(const Mesh& mesh, std::vector<std::uint32_t>* 
     }
     if (!triangleShell)
         return 0;
-    return static_cast<std::int64_t>(labelsFrom(uf, *triangleShell));
+    return static_cast<std::int64_t>(labelsFrom(uf, *triangleShell, s.rootToLabel));
 }
 
 } // namespace detail
 
 std::size_t labelShells(const Mesh& mesh, std::vector<std::uint32_t>& triangleShell) {
     const std::size_t n = mesh.triangles.size(), nv = mesh.positions.size();
-    UnionFind uf(n);
+    std::vector<std::uint32_t> parent, rootToLabel;
+    UnionFind uf(parent, n);
     // Triangles sharing an edge (either direction, also non-manifold) are united. Each half-edge is filed
     // under its smaller end; in one vertex's file, the first triangle seen on each other end is united with
     // the later ones (a stamp per other end), so the work is linear also around vertices of very high
@@ -151,7 +198,7 @@ std::size_t labelShells(const Mesh& mesh, std::vector<std::uint32_t>& triangleSh
                 firstTriangle[b] = t;
             }
         }
-    return labelsFrom(uf, triangleShell);
+    return labelsFrom(uf, triangleShell, rootToLabel);
 }
 
 namespace {
