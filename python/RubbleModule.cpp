@@ -179,9 +179,21 @@ rubble::BooleanKind backendOf(const std::string& name) {
     throw py::value_error("backend: expected 'fast', 'corefine' or 'nef', got '" + name + "'");
 }
 
+rubble::CellPattern patternOf(const std::optional<std::string>& name, int cells) {
+    if (!name)
+        return cells > 1 ? rubble::CellPattern::Shatter : rubble::CellPattern::SingleCell;
+    if (*name == "single")
+        return rubble::CellPattern::SingleCell;
+    if (*name == "shatter")
+        return rubble::CellPattern::Shatter;
+    if (*name == "adaptive")
+        return rubble::CellPattern::Adaptive;
+    throw py::value_error("pattern: expected 'single', 'shatter' or 'adaptive', got '" + *name + "'");
+}
+
 std::vector<PyPiece> fractureMesh(const rubble::Mesh& mesh, const py::object& point, const py::object& normal,
                                   double impulse, int cells, std::uint64_t seed, const std::string& backend,
-                                  bool convexParts, int maxParts) {
+                                  bool convexParts, int maxParts, const std::optional<std::string>& pattern) {
     rubble::Impact impact;
     impact.point = toVec3(point, "point");
     impact.normal = toVec3(normal, "normal");
@@ -192,7 +204,7 @@ std::vector<PyPiece> fractureMesh(const rubble::Mesh& mesh, const py::object& po
         throw py::value_error("max_parts: expected at least 1");
     rubble::FractureParams params;
     params.backend = backendOf(backend);
-    params.pattern = cells > 1 ? rubble::CellPattern::Shatter : rubble::CellPattern::SingleCell;
+    params.pattern = patternOf(pattern, cells);
     params.cells = cells;
     std::vector<PyPiece> pieces;
     py::gil_scoped_release unlocked;
@@ -370,8 +382,10 @@ PYBIND11_MODULE(_rubble, m) {
     m.def("fracture", &fractureMesh, py::arg("mesh"), py::kw_only(), py::arg("point"),
           py::arg("normal") = py::make_tuple(0.0, 1.0, 0.0), py::arg("impulse") = 1.0, py::arg("cells") = 1,
           py::arg("seed") = 1, py::arg("backend") = "fast", py::arg("convex_parts") = true,
-          py::arg("max_parts") = 24,
-          "Breaks a closed mesh at an impact into pieces (cells > 1: a shatter pattern of that many cells).");
+          py::arg("max_parts") = 24, py::arg("pattern") = py::none(),
+          "Breaks a closed mesh at an impact into pieces (by default cells > 1 is a shatter pattern of that "
+          "many "
+          "cells; pattern='adaptive' chips on a weak hit and shatters on a strong one).");
     m.def("decompose", &decomposeMesh, py::arg("mesh"), py::kw_only(), py::arg("max_parts") = 24,
           py::arg("concavity") = 0.02, "Convex parts of a closed mesh, each as its corner points.");
 }

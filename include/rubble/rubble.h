@@ -132,6 +132,8 @@ RUBBLE_C_API rubble_status rubble_mesh_mass_properties(const rubble_mesh* mesh, 
 typedef RUBBLE_C_ENUM(rubble_pattern){
     RUBBLE_PATTERN_SINGLE_CELL = 0, ///< one Voronoi cell at the impact (the thesis's method)
     RUBBLE_PATTERN_SHATTER = 1,     ///< `cells` Voronoi cells around the impact, denser near it
+    RUBBLE_PATTERN_ADAPTIVE = 2,    ///< per impact: a weak hit chips one cell, one of 400 N s or more
+                                    ///< shatters into `cells`; the cut grows with the mesh's size
 } rubble_pattern;
 
 /// Which boolean implementation cuts.
@@ -150,7 +152,7 @@ typedef struct rubble_impact {
 
 /// How a mesh breaks; rubble_fracture_params_init sets the defaults.
 typedef struct rubble_fracture_params {
-    rubble_pattern pattern; ///< single cell or shatter
+    rubble_pattern pattern; ///< single cell, shatter or adaptive
     int cells;              ///< cells of a shatter pattern (>= 1)
     rubble_backend backend; ///< boolean implementation
     uint64_t seed;          ///< same seed, same pieces

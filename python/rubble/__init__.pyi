@@ -26,6 +26,7 @@ Float64Array = npt.NDArray[np.float64]
 UInt32Array = npt.NDArray[np.uint32]
 Vector3 = Sequence[float] | Float64Array
 Backend = Literal["fast", "corefine", "nef"]
+Pattern = Literal["single", "shatter", "adaptive"]
 
 INTERIOR_MATERIAL: int
 """Material id of faces created by a cut (the inside of an object)."""
@@ -181,9 +182,11 @@ def fracture(
     backend: Backend = "fast",
     convex_parts: bool = True,
     max_parts: int = 24,
+    pattern: Pattern | None = None,
 ) -> list[Piece]:
     """Breaks a closed mesh at an impact (point and outward normal in the mesh's coordinates; bigger impulses cut
-    bigger cells). cells=1 cuts the thesis's single Voronoi cell, cells>1 a shatter pattern of that many cells.
+    bigger cells). cells=1 cuts the thesis's single Voronoi cell, cells>1 a shatter pattern of that many cells;
+    pattern='adaptive' chips one cell on a weak hit and shatters into cells on one of 400 N s or more.
     The same seed gives the same pieces. With convex_parts, every piece gets convex collision parts (the input
     is decomposed into at most max_parts first). Raises Error (e.g. "invalid input" for an open mesh,
     "no intersection" when the cells miss it)."""

@@ -146,7 +146,8 @@ rubble_status newMesh(rubble::Mesh mesh, rubble_mesh** out) {
 
 /// Checks params and turns them into FractureParams; writes the message of what is wrong.
 rubble_status toParams(const char* function, const rubble_fracture_params& in, rubble::FractureParams& out) {
-    if (in.pattern != RUBBLE_PATTERN_SINGLE_CELL && in.pattern != RUBBLE_PATTERN_SHATTER)
+    if (in.pattern != RUBBLE_PATTERN_SINGLE_CELL && in.pattern != RUBBLE_PATTERN_SHATTER &&
+        in.pattern != RUBBLE_PATTERN_ADAPTIVE)
         return invalid(function, "unknown pattern");
     if (in.backend != RUBBLE_BACKEND_FAST && in.backend != RUBBLE_BACKEND_COREFINE &&
         in.backend != RUBBLE_BACKEND_NEF)
@@ -155,8 +156,9 @@ rubble_status toParams(const char* function, const rubble_fracture_params& in, r
         return invalid(function, "cells must be at least 1");
     if (in.max_convex_parts < 1)
         return invalid(function, "max_convex_parts must be at least 1");
-    out.pattern =
-        in.pattern == RUBBLE_PATTERN_SHATTER ? rubble::CellPattern::Shatter : rubble::CellPattern::SingleCell;
+    out.pattern = in.pattern == RUBBLE_PATTERN_SHATTER    ? rubble::CellPattern::Shatter
+                  : in.pattern == RUBBLE_PATTERN_ADAPTIVE ? rubble::CellPattern::Adaptive
+                                                          : rubble::CellPattern::SingleCell;
     out.cells = in.cells;
     out.backend = in.backend == RUBBLE_BACKEND_COREFINE ? rubble::BooleanKind::Corefine
                   : in.backend == RUBBLE_BACKEND_NEF    ? rubble::BooleanKind::Nef

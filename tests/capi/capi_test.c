@@ -283,6 +283,31 @@ static void test_fracture(void) {
     CHECK_OK(rubble_fracture_get_piece(shattered, 0, &piece));
     CHECK(piece.convex_part_count == 0);
 
+    /* Adaptive: a weak hit chips one cell, a strong one shatters into `cells`. */
+    {
+        rubble_fracture *chip = NULL, *burst = NULL;
+        rubble_fracture_info chip_info, burst_info;
+        rubble_impact weak = impact, strong = impact;
+        weak.impulse = 10;
+        strong.impulse = 2000;
+        params.pattern = RUBBLE_PATTERN_ADAPTIVE;
+        params.cells = 8;
+        params.backend = RUBBLE_BACKEND_FAST;
+        CHECK_OK(rubble_fracture_mesh(cube, &weak, &params, &chip));
+        CHECK_OK(rubble_fracture_mesh(cube, &strong, &params, &burst));
+        CHECK_OK(rubble_fracture_get_info(chip, &chip_info));
+        CHECK_OK(rubble_fracture_get_info(burst, &burst_info));
+        CHECK(chip_info.piece_count <= 3);
+        CHECK(burst_info.piece_count >= 4 && burst_info.piece_count > chip_info.piece_count);
+        CHECK(fabs(sum_piece_volumes(chip) - 8) < 1e-9 * 8);
+        CHECK(fabs(sum_piece_volumes(burst) - 8) < 1e-9 * 8);
+        CHECK_OK(rubble_fracture_destroy(chip));
+        CHECK_OK(rubble_fracture_destroy(burst));
+        params.pattern = RUBBLE_PATTERN_SHATTER;
+        params.cells = 4;
+        params.backend = RUBBLE_BACKEND_COREFINE;
+    }
+
     /* Errors: bad parameters, an impact whose cells miss the mesh, an open mesh. */
     params.cells = 0;
     CHECK(rubble_fracture_mesh(cube, &impact, &params, &missed) == RUBBLE_ERROR_INVALID_ARGUMENT);

@@ -147,6 +147,20 @@ def test_shatter_and_backends_conserve_volume():
         assert max(p.cell for p in pieces) >= 1
 
 
+def test_adaptive_pattern_chips_weak_hits_and_shatters_strong_ones():
+    cube = rubble.box((-1, -1, -1), (1, 1, 1))
+    weak = rubble.fracture(cube, point=(0, 1, 0), impulse=10, cells=8, pattern="adaptive", convex_parts=False)
+    strong = rubble.fracture(cube, point=(0, 1, 0), impulse=2000, cells=8, pattern="adaptive", convex_parts=False)
+    assert max(p.cell for p in weak) == 0, "one cell"
+    assert max(p.cell for p in strong) >= 3, "a shatter"
+    for pieces in (weak, strong):
+        assert sum(p.volume for p in pieces) == pytest.approx(8, rel=1e-9)
+    single = rubble.fracture(cube, point=(0, 1, 0), impulse=2000, cells=8, pattern="single", convex_parts=False)
+    assert max(p.cell for p in single) == 0
+    with pytest.raises(ValueError, match="pattern"):
+        rubble.fracture(cube, point=(0, 1, 0), pattern="voxel")
+
+
 def test_fracture_of_a_file():
     mesh = rubble.read_mesh(CUBE)
     pieces = rubble.fracture(mesh, point=(0.3, 1, 0.2), impulse=40, seed=2)
