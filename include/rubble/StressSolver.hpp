@@ -59,6 +59,21 @@ public:
 
     /// Replaces the structure; limits[i] belongs to bonds[i]. Accumulated forces and health are reset.
     void reset(std::vector<StructureNode> nodes, std::vector<Bond> bonds, std::vector<StrengthLimits> limits);
+    /// Adds a node (in a free slot when there is one); returns its index.
+    std::uint32_t addNode(const StructureNode& node);
+    /// Removes a node and its bonds; its index is free for a later addNode.
+    void removeNode(std::uint32_t node);
+    /// Adds a bond between present nodes (in a free slot when there is one); returns its index. The other
+    /// bonds keep their forces and health.
+    std::size_t addBond(Bond bond, StrengthLimits limits);
+    /// Makes a node a root (held) or not; its bonds' effective masses follow.
+    void setRoot(std::uint32_t node, bool root);
+    /// True when the node is present (added and not removed).
+    bool present(std::uint32_t node) const { return node < nodes_.size() && !nodes_[node].removed; }
+    /// True when the node is held (a root).
+    bool root(std::uint32_t node) const { return nodes_[node].node.root; }
+    /// The bonds of a node (broken ones included), ascending.
+    const std::vector<std::size_t>& bondsOf(std::uint32_t node) const { return nodes_[node].bonds; }
     /// Settings (may change between solves).
     StressSettings& settings() { return settings_; }
 
@@ -67,9 +82,9 @@ public:
     /// Runs the bounded iterations, starting from the previous solve's bond forces; consumes the loads.
     void solve();
 
-    /// Bonds.
+    /// Bond slots (removed bonds leave free slots, which count as broken).
     std::size_t bondCount() const { return bonds_.size(); }
-    /// Nodes.
+    /// Node slots (removed nodes leave free slots, never unsupported).
     std::size_t nodeCount() const { return nodes_.size(); }
     /// The bond (its section and nodes).
     const Bond& bond(std::size_t i) const { return bonds_[i].bond; }
@@ -113,8 +128,10 @@ private:
         Vec3 v, w;          // velocity change this solve
         Vec3 force, torque; // loads this solve
         bool detached = false;
-        int unbalanced = 0;   // solves in a row that left it accelerating
-        bool bearing = false; // rests on (or carries) a bearing
+        bool removed = false;           // a free slot
+        int unbalanced = 0;             // solves in a row that left it accelerating
+        int bearings = 0;               // bearings it rests on (or carries)
+        std::vector<std::size_t> bonds; // ascending
     };
     struct BearingCorner {
         Vec3 offset;                   // from the section centroid (world)
@@ -132,8 +149,11 @@ private:
         Vec3 force, moment; // accumulated (warm start)
         double health = 1;
         bool broken = false;
+        bool removed = false;               // a free slot
         std::vector<BearingCorner> corners; // bearing: contact points at the patch's hull corners
     };
+    void prepare(BondState& b);
+    void removeBond(std::size_t i);
     void apply(BondState& b, const Vec3& force, const Vec3& moment);
     double bearingUtilisation(const BondState& b) const;
     void solveBearing(BondState& b);
@@ -141,6 +161,8 @@ private:
     StressSettings settings_;
     std::vector<NodeState> nodes_;
     std::vector<BondState> bonds_;
+    std::vector<std::uint32_t> freeNodes_; // descending pops give the lowest slot first
+    std::vector<std::size_t> freeBonds_;
 };
 
 } // namespace rubble
