@@ -45,7 +45,10 @@ struct BondStress {
 
 /// Settings of the stress solver.
 struct StressSettings {
-    int iterations = 25;       ///< Gauss-Seidel sweeps over all bonds per solve()
+    int iterations = 25;       ///< Gauss-Seidel sweeps over all bonds per solve(), at most
+    double tolerance = 0.01;   ///< m/s^2 (and rad/s^2): fewer sweeps once every bonded node's remaining
+                               ///< acceleration is below it (a warm-started, unchanged structure needs none);
+                               ///< 0: always `iterations`
     Vec3 gravity{0, -9.81, 0}; ///< m/s^2
     double unbalanced = 0.5;   ///< m/s^2 (and rad/s^2): a node left accelerating this much is not held
     int unbalancedSolves = 30; ///< ... after this many solves in a row (the warm-started solve converges)
@@ -82,6 +85,8 @@ public:
     /// Runs the bounded iterations, starting from the previous solve's bond forces; consumes the loads.
     void solve();
 
+    /// Sweeps the last solve() ran.
+    int sweeps() const { return sweeps_; }
     /// Bond slots (removed bonds leave free slots, which count as broken).
     std::size_t bondCount() const { return bonds_.size(); }
     /// Node slots (removed nodes leave free slots, never unsupported).
@@ -139,6 +144,8 @@ private:
         double kn = 0, ku = 0, kv = 0; // inverse effective masses along the normal and the in-plane axes
         double press = 0;              // accumulated normal force (>= 0: compression)
         double gu = 0, gv = 0;         // accumulated friction along u and v (|g| <= friction * press)
+        Vec3 ca[3], cb[3];             // ra x d and rb x d for d = normal, u, v
+        Vec3 ia[3], ib[3];             // the inverse inertias times those: the spin an impulse along d gives
     };
     struct BondState {
         Bond bond;
@@ -157,11 +164,14 @@ private:
     void apply(BondState& b, const Vec3& force, const Vec3& moment);
     double bearingUtilisation(const BondState& b) const;
     void solveBearing(BondState& b);
+    void gatherBearing(BondState& b);
 
     StressSettings settings_;
     std::vector<NodeState> nodes_;
     std::vector<BondState> bonds_;
     std::vector<std::uint32_t> freeNodes_; // descending pops give the lowest slot first
+    std::vector<std::uint32_t> checked_;   // solve(): the nodes whose rest ends the sweeps
+    int sweeps_ = 0;
     std::vector<std::size_t> freeBonds_;
 };
 

@@ -232,6 +232,13 @@ void StressSolver::prepare(BondState& s) {
             k.kn = inverseMass(k.ra, k.rb, x.normal);
             k.ku = inverseMass(k.ra, k.rb, x.u);
             k.kv = inverseMass(k.ra, k.rb, x.v);
+            const Vec3 dir[3] = {x.normal, x.u, x.v};
+            for (int j = 0; j < 3; ++j) {
+                k.ca[j] = cross(k.ra, dir[j]);
+                k.cb[j] = cross(k.rb, dir[j]);
+                k.ia[j] = a.invInertia * k.ca[j];
+                k.ib[j] = b.invInertia * k.cb[j];
+            }
             if (s.corners.size() < old.size()) { // keep the warm start
                 k.press = old[s.corners.size()].press;
                 k.gu = old[s.corners.size()].gu;
@@ -290,9 +297,33 @@ void StressSolver::solve() {
     for (BondState& b : bonds_)
         if (!b.broken && b.solvable)
             apply(b, b.force, b.moment);
-    for (int it = 0; it < settings_.iterations; ++it)
+    // Sweeps stop early once every node a bond can still move is at rest within the tolerance.
+    checked_.clear();
+    for (std::uint32_t i = 0; i < nodes_.size(); ++i)
+        if (nodes_[i].invMass > 0 && !nodes_[i].detached)
+            for (std::size_t k : nodes_[i].bonds)
+                if (!bonds_[k].broken && bonds_[k].solvable) {
+                    checked_.push_back(i);
+                    break;
+                }
+    const double tolerance2 = settings_.tolerance * settings_.tolerance;
+    auto converged = [&] {
+        if (settings_.tolerance <= 0)
+            return false;
+        for (std::uint32_t i : checked_)
+            if (lengthSquared(nodes_[i].v) > tolerance2 || lengthSquared(nodes_[i].w) > tolerance2)
+                return false;
+        return true;
+    };
+    // A bond between two nodes at rest within a quarter of the tolerance would change by less: it is skipped
+    // (within the whole tolerance, the nodes just below it would never be corrected, and the sweeps not end).
+    const double quiet2 = tolerance2 / 16;
+    auto resting = [&](const NodeState& n) {
+        return settings_.tolerance > 0 && lengthSquared(n.v) <= quiet2 && lengthSquared(n.w) <= quiet2;
+    };
+    for (sweeps_ = 0; sweeps_ < settings_.iterations && !converged(); ++sweeps_)
         for (BondState& b : bonds_) {
-            if (b.broken || !b.solvable)
+            if (b.broken || !b.solvable || (resting(nodes_[b.bond.a]) && resting(nodes_[b.bond.b])))
                 continue;
             if (!b.corners.empty()) {
                 solveBearing(b);
@@ -315,6 +346,9 @@ void StressSolver::solve() {
             b.moment += dm;
             apply(b, df, dm);
         }
+    for (BondState& b : bonds_)
+        if (!b.broken && b.solvable && !b.corners.empty())
+            gatherBearing(b);
     for (NodeState& n : nodes_) {
         const bool moving = length(n.v) > settings_.unbalanced || length(n.w) > settings_.unbalanced;
         n.unbalanced = n.bearings > 0 && n.invMass > 0 && !n.detached && moving ? n.unbalanced + 1 : 0;
@@ -356,31 +390,45 @@ BondStress StressSolver::stress(std::size_t i) const {
 
 void StressSolver::solveBearing(BondState& b) {
     const BondInterface& x = b.bond.section;
-    const NodeState& na = nodes_[b.bond.a];
-    const NodeState& nb = nodes_[b.bond.b];
-    auto push = [&](const BearingCorner& k, const Vec3& f) {
-        b.force += f;
-        b.moment += cross(k.offset, f);
-        apply(b, f, cross(k.offset, f));
+    NodeState& na = nodes_[b.bond.a];
+    NodeState& nb = nodes_[b.bond.b];
+    const Vec3 dir[3] = {x.normal, x.u, x.v};
+    // The corner's relative velocity along dir[j], and an impulse l along dir[j] on a (-l on b), through the
+    // corner's precomputed lever arms (no matrix products in the sweep).
+    auto relative = [&](const BearingCorner& k, int j) {
+        return dot(na.v - nb.v, dir[j]) + dot(na.w, k.ca[j]) - dot(nb.w, k.cb[j]);
     };
-    auto relative = [&](const BearingCorner& k) {
-        return (na.v + cross(na.w, k.ra)) - (nb.v + cross(nb.w, k.rb));
+    auto push = [&](const BearingCorner& k, int j, double l) {
+        na.v += dir[j] * (l * na.invMass);
+        na.w += k.ia[j] * l;
+        nb.v -= dir[j] * (l * nb.invMass);
+        nb.w -= k.ib[j] * l;
     };
     for (BearingCorner& k : b.corners) {
         // a corner's force acts on a (its opposite on b): b pushing a away is -normal * press
-        const double press = std::max(0.0, k.press + dot(relative(k), x.normal) / k.kn);
-        push(k, x.normal * -(press - k.press));
+        const double press = std::max(0.0, k.press + relative(k, 0) / k.kn);
+        push(k, 0, -(press - k.press));
         k.press = press;
-        const Vec3 rel = relative(k);
-        double gu = k.gu - dot(rel, x.u) / k.ku, gv = k.gv - dot(rel, x.v) / k.kv;
+        double gu = k.gu - relative(k, 1) / k.ku, gv = k.gv - relative(k, 2) / k.kv;
         const double grip = b.limits.friction * k.press, g = std::sqrt(gu * gu + gv * gv);
         if (g > grip) {
             gu *= grip / g;
             gv *= grip / g;
         }
-        push(k, x.u * (gu - k.gu) + x.v * (gv - k.gv));
+        push(k, 1, gu - k.gu);
+        push(k, 2, gv - k.gv);
         k.gu = gu;
         k.gv = gv;
+    }
+}
+
+void StressSolver::gatherBearing(BondState& b) {
+    const BondInterface& x = b.bond.section;
+    b.force = b.moment = Vec3{};
+    for (const BearingCorner& k : b.corners) {
+        const Vec3 f = x.normal * -k.press + x.u * k.gu + x.v * k.gv;
+        b.force += f;
+        b.moment += cross(k.offset, f);
     }
 }
 
