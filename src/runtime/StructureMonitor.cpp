@@ -87,7 +87,9 @@ void StructureMonitor::classify() {
 }
 
 std::vector<BodyId> StructureMonitor::step(const Vec3& gravity, int& broken) {
-    if (!unclassified_.empty())
+    // Objects just placed have no warm start: their first solve may sweep ten times as often.
+    const bool settle = !unclassified_.empty();
+    if (settle)
         classify();
     const auto before = [&] {
         std::size_t n = 0;
@@ -105,6 +107,8 @@ std::vector<BodyId> StructureMonitor::step(const Vec3& gravity, int& broken) {
     pendingLoads_.clear();
     solver_.settings() = policy_.stress;
     solver_.settings().gravity = gravity;
+    if (settle)
+        solver_.settings().iterations *= 10;
     solver_.solve();
     (void)solver_.breakOverstressed();
     broken += static_cast<int>(before() - brokenBefore);
