@@ -396,6 +396,10 @@ const rubble::tools::Registrar registrar{
          app.add_option("--mega-kinds", mega->kinds, "meshes of the --mega rows")
              ->check(CLI::IsMember(rubble::bench::kMegaKinds));
          app.add_option("--hits", mega->hits, "random hits per --mega mesh")->check(CLI::Range(1, 10000));
+         app.add_flag(
+             "--no-facts", [mega](std::int64_t) { mega->facts = false; },
+             "--mega: fracture without the meshes' known facts (every hit validates and measures the "
+             "whole mesh)");
          app.add_option("--chain", mega->chain, "chained hits on the 250k sphere in --mega (0: none)")
              ->check(CLI::Range(0, 100000));
          return [args, mega, megaOn] {

@@ -101,25 +101,36 @@ double clipOnly(const Mesh& mesh, const std::vector<ConvexPolytope>& cells, std:
 struct HitSamples {
     std::vector<double> withParts, withPartsCpu, pieces, validate, cell, boolean, islands, mass, simplify,
         parts, clip;
+    std::vector<double> cpuValidate, cpuBoolean, cpuVerify, cpuIslands, cpuMass, cpuSimplify, cpuParts;
     std::vector<double> touched, excess;
     int failures = 0, fallbacks = 0;
 };
 
 /// One fracture and its decomposition update, into s.
-std::optional<FractureResult> hitOnce(const Mesh& mesh, const std::vector<ConvexPolytope>& parentParts,
-                                      const Impact& impact, std::uint64_t seed, HitSamples& s,
+std::optional<FractureResult> hitOnce(const Mesh& mesh, const MeshFacts& facts,
+                                      const std::vector<ConvexPolytope>& parentParts, const Impact& impact,
+                                      std::uint64_t seed, HitSamples& s,
                                       std::vector<std::vector<ConvexPolytope>>* partsOut = nullptr) {
     const double c0 = threadCpuMs();
     const auto t0 = Clock::now();
-    auto r = fracture(mesh, impact, hitParams(mesh), seed);
+    auto r = fracture(mesh, impact, hitParams(mesh), seed, facts);
     const double piecesMs = msSince(t0);
     if (!r) {
         ++s.failures;
         return std::nullopt;
     }
     const auto t1 = Clock::now();
+    const double c1 = threadCpuMs();
     auto parts = updateDecomposition(parentParts, *r);
     const double partsMs = msSince(t1);
+    s.cpuParts.push_back(threadCpuMs() - c1);
+    const FractureTimings& ct = r->cpuTimings;
+    s.cpuValidate.push_back(ct.validateMs);
+    s.cpuBoolean.push_back(ct.booleanMs - ct.verifyMs);
+    s.cpuVerify.push_back(ct.verifyMs);
+    s.cpuIslands.push_back(ct.islandsMs - ct.massMs - ct.simplifyMs);
+    s.cpuMass.push_back(ct.massMs);
+    s.cpuSimplify.push_back(ct.simplifyMs);
     s.withPartsCpu.push_back(threadCpuMs() - c0);
     s.withParts.push_back(piecesMs + partsMs);
     s.pieces.push_back(piecesMs);
@@ -171,11 +182,11 @@ void addImpactRows(const std::string& name, const std::string& kind, std::size_t
     for (double e : s.excess)
         excessMax = std::max(excessMax, e);
     const auto med = [](const std::vector<double>& v) { return stats(v).median; };
-    table.rows.push_back({name, std::to_string(triangles), std::to_string(s.withParts.size()),
-                          fixed(w.median), fixed(w.max), fixed(ratio, 2), fixed(c.median), fixed(c.max),
-                          fixed(cpuRatio, 2), fixed(med(s.validate)), fixed(med(s.boolean)),
-                          fixed(med(s.islands)), fixed(med(s.mass)), fixed(med(s.simplify)),
-                          fixed(med(s.parts)), fixed(med(s.clip)), fixed(med(s.touched), 0)});
+    table.rows.push_back(
+        {name, std::to_string(triangles), std::to_string(s.withParts.size()), fixed(w.median), fixed(w.max),
+         fixed(ratio, 2), fixed(c.median), fixed(c.max), fixed(cpuRatio, 2), fixed(med(s.cpuValidate)),
+         fixed(med(s.cpuBoolean)), fixed(med(s.cpuVerify)), fixed(med(s.cpuIslands)), fixed(med(s.cpuMass)),
+         fixed(med(s.cpuSimplify)), fixed(med(s.cpuParts)), fixed(med(s.clip)), fixed(med(s.touched), 0)});
     csv.rows.push_back({name,
                         kind,
                         std::to_string(triangles),
@@ -200,8 +211,11 @@ void addImpactRows(const std::string& name, const std::string& kind, std::size_t
                         str(stats(s.parts).max),
                         str(excessMax),
                         str(med(s.clip)),
-                        str(med(s.touched)),
-                        ""});
+                        str(med(s.touched))});
+    for (const auto* cpuStage : {&s.cpuValidate, &s.cpuBoolean, &s.cpuVerify, &s.cpuIslands, &s.cpuMass,
+                                 &s.cpuSimplify, &s.cpuParts})
+        csv.rows.back().push_back(str(med(*cpuStage)));
+    csv.rows.back().push_back(""); // other_cpu_cores, filled by finishTable
     if (!againstFirst)
         data << kind << " " << triangles << " " << w.median << " " << w.max << " " << med(s.clip) << " "
              << c.median << "\n";
@@ -212,8 +226,8 @@ void addImpactRows(const std::string& name, const std::string& kind, std::size_t
 int runMegaImpact(const MegaArgs& args) {
     const CpuMeter cpu;
     Table table{{"mesh", "tris", "hits", "with parts med ms", "max", "worst/base", "cpu med", "cpu max",
-                 "cpu w/b", "validate", "boolean", "islands", "mass", "simplify", "parts", "clip-only",
-                 "touched"},
+                 "cpu w/b", "cpu validate", "clip", "verify", "islands", "mass", "simplify", "parts",
+                 "clip-only", "touched"},
                 {}};
     Table csv{{"mesh",
                "kind",
@@ -240,6 +254,13 @@ int runMegaImpact(const MegaArgs& args) {
                "parts_excess_max",
                "clip_only_median_ms",
                "touched_triangles_median",
+               "validate_cpu_median_ms",
+               "clip_cpu_median_ms",
+               "verify_cpu_median_ms",
+               "islands_cpu_median_ms",
+               "mass_cpu_median_ms",
+               "simplify_cpu_median_ms",
+               "parts_cpu_median_ms",
                "other_cpu_cores"},
               {}};
     std::ostringstream data;
@@ -252,9 +273,11 @@ int runMegaImpact(const MegaArgs& args) {
                 std::cerr << name << ": " << d.error().message << "\n";
                 continue;
             }
+            // What an object knows of its mesh once it is added (checked and measured once, untimed).
+            const MeshFacts facts = args.facts ? analyzeMesh(mesh).value() : MeshFacts{};
             HitSamples s;
             for (int h = 0; h < args.hits; ++h)
-                hitOnce(mesh, d->parts, randomHit(mesh, static_cast<std::uint64_t>(h)),
+                hitOnce(mesh, facts, d->parts, randomHit(mesh, static_cast<std::uint64_t>(h)),
                         static_cast<std::uint64_t>(h), s);
             addImpactRows(name, kind, mesh.triangles.size(), s, false, table, csv, data);
         }
@@ -264,10 +287,11 @@ int runMegaImpact(const MegaArgs& args) {
         const std::size_t startTriangles = mesh.triangles.size();
         auto d = decompose(mesh);
         std::vector<ConvexPolytope> parts = d ? d->parts : std::vector<ConvexPolytope>{};
+        MeshFacts facts = args.facts ? analyzeMesh(mesh).value() : MeshFacts{};
         HitSamples s;
         for (int h = 0; h < args.chain; ++h) {
             std::vector<std::vector<ConvexPolytope>> pieceParts;
-            auto r = hitOnce(mesh, parts, randomHit(mesh, static_cast<std::uint64_t>(1000 + h)),
+            auto r = hitOnce(mesh, facts, parts, randomHit(mesh, static_cast<std::uint64_t>(1000 + h)),
                              static_cast<std::uint64_t>(1000 + h), s, &pieceParts);
             if (!r)
                 continue;
@@ -276,6 +300,8 @@ int runMegaImpact(const MegaArgs& args) {
                 if (r->pieces[i].mass.volume > r->pieces[largest].mass.volume)
                     largest = i;
             mesh = std::move(r->pieces[largest].mesh);
+            if (args.facts)
+                facts = r->pieces[largest].facts;
             parts = std::move(pieceParts[largest]);
         }
         addImpactRows("sphere_" + std::to_string(startTriangles) + "_chain" + std::to_string(args.chain),

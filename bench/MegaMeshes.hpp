@@ -31,6 +31,7 @@ struct MegaArgs {
     int hits = 20;                                           ///< random hits per mesh
     int chain = 100;                                         ///< chained hits on the 250k sphere (0: none)
     std::string out;                                         ///< results folder
+    bool facts = true; ///< pass each mesh's known facts to fracture (analyzeMesh once, then Piece::facts)
 };
 
 /// `rubble-bench impact --mega`: impact → pieces with convex parts per mesh over random hits, the stages, the

@@ -78,6 +78,7 @@ struct SceneArgs {
     std::string pattern = "single";
     int cells = 0;                // shatter cells (0: the library's default)
     int maxAwake = 0;             // awake debris budget (0: the runtime's default)
+    double physicsBudgetMs = 0;   // physics step budget (0: the runtime's default)
     bool structure = false;       // the stress solver on
     double bearingFriction = 0.6; // with structure: objects rest on each other as bearings (0: welded)
     int structureIterations = 0;  // with structure: solver sweeps per frame (0: the library's)
@@ -167,6 +168,8 @@ int runScene(const SceneArgs& a) {
     rc.world.seed = a.seed;
     if (a.maxAwake > 0)
         rc.debris.maxAwakeBodies = a.maxAwake;
+    if (a.physicsBudgetMs > 0)
+        rc.debris.physicsBudgetMs = a.physicsBudgetMs;
     rc.structure.enabled = a.structure;
     rc.structure.bearingFriction = a.bearingFriction;
     if (a.structureIterations > 0)
@@ -345,6 +348,13 @@ int runScene(const SceneArgs& a) {
                        {"dropped", v.dropped}};
         j["shots"] = shots;
         j["pieces_retired"] = c.piecesRetired;
+        j["debris_budget"] = {{"max_awake_bodies", runtime.config().debris.maxAwakeBodies},
+                              {"physics_ms", runtime.config().debris.physicsBudgetMs}};
+        j["retired_by"] = {{"dust", c.retired.dust},
+                           {"awake_budget", c.retired.awake},
+                           {"triangle_budget", c.retired.triangles},
+                           {"faded", c.retired.faded},
+                           {"fell_out", c.retired.fellOut}};
         if (a.structure)
             j["structure"] = {
                 {"bearing_friction", a.bearingFriction},
@@ -402,7 +412,10 @@ int runScene(const SceneArgs& a) {
     std::printf("%-28s %10d\n", "failed (geometry)", ts.failed);
     std::printf("%-28s %10d (max %d; %d awake, %d frozen)\n", "pieces alive", runtime.livePieces(), maxPieces,
                 runtime.awakeDebris(), runtime.frozenDebris());
-    std::printf("%-28s %10lld\n", "pieces retired", c.piecesRetired);
+    std::printf(
+        "%-28s %10lld (dust %lld, awake budget %lld, triangle budget %lld, faded %lld, fell out %lld)\n",
+        "pieces retired", c.piecesRetired, c.retired.dust, c.retired.awake, c.retired.triangles,
+        c.retired.faded, c.retired.fellOut);
     std::printf("%-28s %10lld\n", "pieces collapsed", c.piecesCollapsed);
     std::printf("%-28s %10lld (%lld woken)\n", "pieces frozen", c.piecesFrozen, c.piecesWoken);
     std::printf("%-28s %10.3g\n", "volume error", volumeError);
@@ -438,6 +451,8 @@ rubble::tools::Registrar registrar{
              ->check(CLI::IsMember({"single", "shatter"}));
          app.add_option("--cells", args->cells, "cells of a shatter pattern (default: the library's)");
          app.add_option("--max-awake", args->maxAwake, "awake debris budget (default: the runtime's)");
+         app.add_option("--physics-budget-ms", args->physicsBudgetMs,
+                        "physics step time the debris governor holds (default: the runtime's, for 60 Hz)");
          app.add_flag("--structure", args->structure, "stress solver on (bonds, breaking under load)");
          app.add_option("--bearing-friction", args->bearingFriction,
                         "with --structure: objects rest on each other as bearings with this friction "

@@ -356,22 +356,7 @@ void Game::respawn() {
 
 void Game::blast(const V3& point, float radius, float impulse, int by) {
     blastBy_ = by;
-    const rubble::Vec3 p{point.x, point.y, point.z};
-    for (BodyId id : runtime_->bodies()) {
-        const BodyRecord* b = runtime_->body(id);
-        if (!b->hasObject)
-            continue;
-        const rubble::Vec3 c = runtime_->motion(id).transform.translation;
-        const rubble::Vec3 d = p - c;
-        const double dist = rubble::length(d);
-        if (dist > radius + b->radius)
-            continue;
-        // the point of the body's bounding sphere nearest the blast, pushed in (a cell centred there cuts)
-        const rubble::Vec3 n = dist > 1e-6 ? d * (1.0 / dist) : rubble::Vec3{0, 1, 0};
-        const rubble::Vec3 at = c + n * std::min(dist, b->radius * 0.7);
-        const double falloff = 1.0 - 0.6 * std::clamp((dist - b->radius) / radius, 0.0, 1.0);
-        runtime_->submitImpact(id, at, n, impulse * falloff);
-    }
+    runtime_->blast(rubble::Vec3{point.x, point.y, point.z}, radius, impulse);
     blastBy_ = -1;
     particles_.impactBurst(point, V3{0, 1, 0}, 3.0f, burstSeed_++);
     particles_.impactBurst(point, V3{0, 1, 0}, 2.0f, burstSeed_++);

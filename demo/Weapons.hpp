@@ -4,6 +4,8 @@
 
 #include <array>
 
+#include "rubble/Fracture.hpp"
+
 namespace demo {
 
 /// A weapon; the value is its index (key 1 + index).
@@ -33,6 +35,18 @@ inline constexpr std::array<WeaponSpec, kWeaponCount> kWeapons{{
     {"heavy shell", 40, 150, 0.6f, 0.6f},
     {"demolition charge", 20, 120, 0.5f, 1.0f, 8, 3500},
 }};
+
+/// The demo's cell-size law: adaptive, a cannon shell (under 1,600 N·s) chips a domain of 2-6 m and a
+/// heavy shell or a charge shatters; the fixed patterns keep the thesis-sized law.
+inline rubble::CellSizeLaw demoSizeLaw(rubble::CellPattern pattern) {
+    const bool adaptive = pattern == rubble::CellPattern::Adaptive;
+    rubble::CellSizeLaw law;
+    law.base = adaptive ? 2.0 : 3.0;
+    law.scale = adaptive ? 0.1 : 0.35;
+    law.exponent = 0.5;
+    law.maxSize = 30;
+    return law;
+}
 
 /// The weapon's specification.
 inline const WeaponSpec& weaponSpec(Weapon w) {

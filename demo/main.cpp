@@ -26,6 +26,7 @@
 #include "Renderer.hpp"
 #include "RunReport.hpp"
 #include "ScaledTarget.hpp"
+#include "Weapons.hpp"
 #include "rubble/SceneConfig.hpp"
 
 namespace {
@@ -349,13 +350,7 @@ int main(int argc, char** argv) {
                                    : o.pattern == "single" ? rubble::CellPattern::SingleCell
                                                            : rubble::CellPattern::Adaptive;
     app.pending.fracture.cells = o.cells;
-    // adaptive: a cannon shell (~800 N*s) chips a 5 m domain, hits from 1,600 N*s (heavy shell, charge)
-    // shatter; the fixed patterns keep the thesis-sized law
-    const bool adaptive = app.pending.fracture.pattern == rubble::CellPattern::Adaptive;
-    app.pending.fracture.sizeLaw.base = adaptive ? 2.0 : 3.0;
-    app.pending.fracture.sizeLaw.scale = adaptive ? 0.1 : 0.35;
-    app.pending.fracture.sizeLaw.exponent = 0.5;
-    app.pending.fracture.sizeLaw.maxSize = 30;
+    app.pending.fracture.sizeLaw = demo::demoSizeLaw(app.pending.fracture.pattern);
     app.pending.fracture.uvScale = 0.25;
     app.pending.debugShapes = app.pending.debugAabbs = app.pending.debugImpacts = o.debug;
     app.pending.structure = o.structure;

@@ -138,9 +138,10 @@ struct DebrisBudget {
     std::size_t maxTriangles = 4000000; ///< triangles of all debris bodies (dynamic and frozen); beyond it
                                         ///< the smallest frozen pieces become particles
     bool freezeSleeping = true;         ///< a debris body the engine put to sleep is frozen (made static)
-    int freezeAfterFrames = 10;         ///< ... or one that moved slower than freezeSpeed this many frames
-    double freezeSpeed = 0.5;      ///< m/s (and rad/s) below which a body counts as resting (Bullet's own
-                                   ///< sleeping threshold is 0.8 m/s for 2 s)
+    int freezeAfterFrames = 6;          ///< ... or one that rested this many frames in a row
+    double freezeSpeed = 1.0;           ///< m/s (and rad/s) below which a body that is not gaining speed (its
+                              ///< velocity changes by less than g·dt / 2 a frame) rests (Bullet's own
+                              ///< sleeping threshold is 0.8 m/s for 2 s)
     double wakeImpulse = 100;      ///< a contact impulse (N·s) on a frozen piece that wakes it
     double fadeVolume = 0.02;      ///< debris below this volume (m³) ...
     double fadeDistance = 150;     ///< ... farther than this from the focus point fades into particles
@@ -183,6 +184,17 @@ struct FrameStats {
     double adoptMs = 0;       ///< submit + collect + adoption + governor
 };
 
+/// Pieces turned into particles, by reason.
+struct RetiredPieces {
+    long long dust = 0;      ///< below DestructionWorld::Config::minPieceVolume when adopted
+    long long awake = 0;     ///< over the awake-body budget (or the physics time budget)
+    long long triangles = 0; ///< over the triangle budget
+    long long faded = 0;     ///< tiny and far from the focus
+    long long fellOut = 0;   ///< below DebrisBudget::killBelowY
+    /// The sum.
+    long long total() const { return dust + awake + triangles + faded + fellOut; }
+};
+
 /// Totals since construction.
 struct RuntimeCounters {
     std::uint64_t frames = 0;      ///< frames stepped
@@ -190,7 +202,8 @@ struct RuntimeCounters {
     long long projectileHits = 0;  ///< projectile hits on anything
     long long fractures = 0;       ///< outcomes adopted
     long long piecesCreated = 0;   ///< piece bodies created
-    long long piecesRetired = 0;   ///< bodies and dust turned into particles
+    long long piecesRetired = 0;   ///< bodies and dust turned into particles (retired.total())
+    RetiredPieces retired;         ///< the same, by reason
     long long piecesCollapsed = 0; ///< static bodies that lost their support
     long long bondsBroken = 0;     ///< structure bonds broken
     long long piecesFrozen = 0;    ///< debris bodies frozen
@@ -266,6 +279,11 @@ public:
     /// Submits an impact on a body's object at a world point with a world normal (out of the object) and an
     /// impulse, e.g. for a blast. False when ignored (no destructible object, below its threshold).
     bool submitImpact(BodyId id, const Vec3& worldPoint, const Vec3& worldNormal, double impulse);
+    /// A blast: an impact on every destructible object whose bounding sphere meets the sphere of `radius`
+    /// around `center`, at the point of its bounding sphere nearest the centre (pushed in), its normal toward
+    /// the centre, the impulse falling off linearly from `impulse` to `edgeShare` of it across the radius.
+    /// Returns the impacts accepted.
+    int blast(const Vec3& center, double radius, double impulse, double edgeShare = 0.4);
 
     /// One frame: physics step, contacts → impacts, outcomes adopted, support settled, debris governed,
     /// particles and projectiles advanced.

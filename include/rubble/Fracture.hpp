@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -94,18 +95,40 @@ struct FractureParams {
                                           ///< pieces that are hit again and again
 };
 
+/// What is known of a mesh, so that fracturing it skips the passes over the whole mesh that would find it
+/// again: that it is a valid closed, consistently oriented solid, and its volume integrals. analyzeMesh finds
+/// them once (e.g. when an object is added); every Piece carries them for its own mesh, so a piece that is
+/// hit again is not scanned again. They belong to one mesh, unchanged: facts whose counts do not match the
+/// mesh are ignored, and facts of another mesh with the same counts give wrong results.
+struct MeshFacts {
+    bool known = false;        ///< false: nothing is known (fracture checks and measures everything)
+    std::size_t triangles = 0; ///< the mesh's triangle count
+    std::size_t vertices = 0;  ///< the mesh's vertex count
+    VolumeIntegrals integrals; ///< of the mesh (its mass properties are massProperties(integrals))
+    /// True when these are facts of a mesh with mesh's counts.
+    bool fit(const Mesh& mesh) const {
+        return known && triangles == mesh.triangles.size() && vertices == mesh.positions.size();
+    }
+};
+
+/// Checks that mesh is a valid closed, consistently oriented solid of positive volume (as fracture does) and
+/// returns its facts; InvalidInput otherwise.
+Result<MeshFacts> analyzeMesh(const Mesh& mesh);
+
 /// One output piece: a closed, outward-oriented mesh in the input's coordinates.
 struct Piece {
     Mesh mesh;              ///< closed mesh; cut faces have material kInteriorMaterial and planar UVs
     MassProperties mass;    ///< exact mass properties of mesh (density 1)
     std::int32_t cell = -1; ///< -1: part of the damaged remainder (input − cells); i ≥ 0: debris of cell i
+    MeshFacts facts;        ///< what is known of mesh: pass it to the next fracture of this piece
 };
 
-/// Wall-clock durations of the stages of one fracture, in milliseconds.
+/// Durations of the stages of one fracture, in milliseconds.
 struct FractureTimings {
     double validateMs = 0; ///< checking that the input mesh is a valid closed, oriented solid
     double cellMs = 0;     ///< building the cells
     double booleanMs = 0;  ///< difference and intersections
+    double verifyMs = 0;   ///< of booleanMs: checking that the split's outputs are closed and keep the volume
     double islandsMs = 0;  ///< splitting into islands and mass properties (includes massMs)
     double massMs = 0;     ///< of islandsMs: mass properties of the pieces and interior UVs
     double simplifyMs = 0; ///< of islandsMs: simplifying the pieces' flat regions
@@ -121,7 +144,8 @@ struct FractureResult {
     bool exactFallback = false;        ///< Fast declined or failed verification; Corefine made the split
     int redraws = 0; ///< fracture() with Fast: cell patterns redrawn (from derived seeds) because the clipper
                      ///< declined a near-degenerate one; 0 = the seed's own pattern
-    FractureTimings timings; ///< stage durations
+    FractureTimings timings;    ///< stage durations, wall clock
+    FractureTimings cpuTimings; ///< the same stages in the calling thread's CPU time (on a shared machine)
 };
 
 /// The cut of one impact on a mesh with the given bounds. SingleCell and Shatter: the params' pattern and
@@ -139,6 +163,9 @@ struct SplitResult {
     Mesh remainder;             ///< mesh − ∪ cells (may be empty)
     std::vector<Mesh> inside;   ///< inside[i] = mesh ∩ cells[i] (may be empty)
     bool exactFallback = false; ///< a fast backend declined and an exact backend made this split
+    /// The remainder's volume integrals when the backend derived them from the input's (Fast, given known
+    /// facts): the input's minus the triangles the cut removed plus those it created.
+    std::optional<VolumeIntegrals> remainderIntegrals;
 };
 
 /// A boolean implementation: splits a closed mesh by disjoint convex cells.
@@ -157,11 +184,14 @@ std::unique_ptr<BooleanBackend> makeBooleanBackend(BooleanKind kind);
 
 /// Fractures a closed mesh at an impact: cells, booleans, islands, mass properties, interior UVs.
 /// Returns ErrorCode::NoIntersection when the cells miss the mesh, InvalidInput for an open or invalid mesh.
+/// With known facts of mesh (analyzeMesh, Piece::facts), the mesh is not validated again and, with the Fast
+/// backend, the remainder's mass properties follow from the mesh's by difference (equal to a full
+/// recomputation up to rounding; docs/megamesh.md); the pieces' meshes are the same either way.
 Result<FractureResult> fracture(const Mesh& mesh, const Impact& impact, const FractureParams& params,
-                                std::uint64_t seed);
+                                std::uint64_t seed, const MeshFacts& known = {});
 
-/// Fractures a closed mesh with explicitly given cells (for merged impacts and tests).
+/// Fractures a closed mesh with explicitly given cells (for merged impacts and tests); known as for fracture.
 Result<FractureResult> fractureWithCells(const Mesh& mesh, std::vector<ConvexPolytope> cells,
-                                         const FractureParams& params);
+                                         const FractureParams& params, const MeshFacts& known = {});
 
 } // namespace rubble

@@ -5,6 +5,7 @@
 #include <cstddef>
 
 #include "rubble/Aabb.hpp"
+#include "rubble/MassProperties.hpp"
 #include "rubble/Mesh.hpp"
 
 namespace rubble {
@@ -20,6 +21,8 @@ struct PlanarSimplifyParams {
     /// Only vertices inside this box may be removed (e.g. the cells of the fracture that made the mesh, so
     /// the cost follows what changed); an empty box means everywhere.
     Aabb focus;
+    /// Reference point of PlanarSimplifyReport::integralsChange.
+    Vec3 integralsReference;
 };
 
 /// What simplifyPlanarRegions did.
@@ -30,6 +33,9 @@ struct PlanarSimplifyReport {
     std::size_t regionsRetriangulated = 0; ///< flat regions that were triangulated anew
     std::size_t regionsKept = 0;           ///< flat regions left as they were because re-triangulating failed
     bool unchanged = false; ///< the input was returned as it was (not closed, or nothing to do)
+    /// The volume integrals of the new triangles minus those of the triangles they replaced, about
+    /// params.integralsReference: the output's integrals are the input's plus this.
+    VolumeIntegrals integralsChange;
 };
 
 /// Removes the vertices that carry no shape: those inside a flat region of the surface and those in the
@@ -43,6 +49,9 @@ struct PlanarSimplifyReport {
 /// boundaries, where the surface touches itself, or next to a repeated edge stay where they are.
 /// Deterministic.
 Mesh simplifyPlanarRegions(const Mesh& mesh, const PlanarSimplifyParams& params = {},
+                           PlanarSimplifyReport* report = nullptr);
+/// As above; a mesh left as it is is moved into the result, not copied.
+Mesh simplifyPlanarRegions(Mesh&& mesh, const PlanarSimplifyParams& params = {},
                            PlanarSimplifyReport* report = nullptr);
 
 } // namespace rubble

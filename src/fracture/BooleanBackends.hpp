@@ -16,8 +16,10 @@ std::unique_ptr<BooleanBackend> makeCorefineBackend();
 /// CGAL Nef_polyhedron_3 backend (the thesis's method).
 std::unique_ptr<BooleanBackend> makeNefBackend();
 /// Convex-cell clipper backend; with exactFallback, Corefine makes the splits the clipper declines, else
-/// they are errors.
-std::unique_ptr<BooleanBackend> makeFastBackend(bool exactFallback = true);
+/// they are errors. With inputIntegrals (the split mesh's, which must outlive the backend), its splits carry
+/// the remainder's integrals by difference (SplitResult::remainderIntegrals).
+std::unique_ptr<BooleanBackend> makeFastBackend(bool exactFallback = true,
+                                                const VolumeIntegrals* inputIntegrals = nullptr);
 
 /// Source of an output triangle: >= 0 an input triangle, kCutFace a cell face, kUnknownSource not known
 /// (found geometrically by assembleMesh).

@@ -195,8 +195,9 @@ public:
         tris_.resize(k_ + 1);
     }
 
-    /// Region k < K: mesh ∩ cell k; region K: the rest.
-    std::vector<Mesh> run();
+    /// Region k < K: mesh ∩ cell k; region K: the rest. With known (the mesh's integrals), outside gets the
+    /// rest's integrals by difference.
+    std::vector<Mesh> run(const VolumeIntegrals* known, std::optional<VolumeIntegrals>& restIntegrals);
 
 private:
     const Mesh& mesh_;
@@ -724,7 +725,7 @@ void checkNewEdgesClosed(const std::vector<std::array<std::uint32_t, 3>>& tris, 
         }
 }
 
-std::vector<Mesh> Clipper::run() {
+std::vector<Mesh> Clipper::run(const VolumeIntegrals* known, std::optional<VolumeIntegrals>& restIntegrals) {
     distSlot_.assign(nV_, -1);
     const std::size_t nT = mesh_.triangles.size();
     std::vector<std::pair<std::uint32_t, std::vector<std::uint32_t>>> cut; // triangle, cells it may cross
@@ -766,6 +767,9 @@ std::vector<Mesh> Clipper::run() {
         else
             cut.emplace_back(t, candidates);
     }
+    std::vector<std::size_t> scanned; // per region, the triangles the scan kept whole
+    for (const auto& kept : untouched_)
+        scanned.push_back(kept.size());
     for (const auto& [t, cells] : cut)
         cutTriangle(t, cells);
     buildCaps();
@@ -773,6 +777,25 @@ std::vector<Mesh> Clipper::run() {
     std::vector<Mesh> result;
     for (std::uint32_t r = 0; r <= k_; ++r)
         result.push_back(assemble(r));
+    // The rest's integrals: the input's minus the triangles it lost (inside a cell, or cut) plus its new
+    // ones. A candidate the cut left whole joined the untouched triangles of its region after the scan.
+    if (known) {
+        VolumeIntegrals rest = *known;
+        std::vector<std::uint32_t> leftWhole;
+        for (std::uint32_t r = 0; r <= k_; ++r)
+            leftWhole.insert(leftWhole.end(), untouched_[r].begin() + static_cast<std::ptrdiff_t>(scanned[r]),
+                             untouched_[r].end());
+        std::sort(leftWhole.begin(), leftWhole.end());
+        for (const auto& [t, cells] : cut)
+            if (!std::binary_search(leftWhole.begin(), leftWhole.end(), t))
+                rest.remove(mesh_, t);
+        for (std::uint32_t r = 0; r < k_; ++r)
+            for (std::uint32_t t : untouched_[r])
+                rest.remove(mesh_, t);
+        for (const OutTri& o : tris_[k_])
+            rest.add(pos(o.v[0]), pos(o.v[1]), pos(o.v[2]));
+        restIntegrals = rest;
+    }
     // Verify: the new faces close up, and no volume is created or lost.
     double sum = 0;
     for (std::uint32_t r = 0; r <= k_; ++r) {
@@ -781,12 +804,14 @@ std::vector<Mesh> Clipper::run() {
         for (const OutTri& o : tris_[r])
             created.push_back({o.v[0], o.v[1], o.v[2]});
         checkNewEdgesClosed(created, nV_);
-        const double v = result[r].empty() ? 0.0 : signedVolume(result[r]);
+        const double v = result[r].empty()            ? 0.0
+                         : (r == k_ && restIntegrals) ? restIntegrals->volume
+                                                      : signedVolume(result[r]);
         if (v < 0)
             throw Degenerate{"negative volume"};
         sum += v;
     }
-    const double v0 = signedVolume(mesh_);
+    const double v0 = known ? known->volume : signedVolume(mesh_);
     if (std::abs(sum - v0) > 1e-9 * std::abs(v0))
         throw Degenerate{"volume not conserved"};
     return result;
@@ -803,14 +828,15 @@ Result<CellSplit> clipByConvexCell(const Mesh& mesh, const ConvexPolytope& cell)
     return CellSplit{std::move(split->outside), std::move(split->inside.front())};
 }
 
-Result<MultiCellSplit> clipByConvexCells(const Mesh& mesh, const std::vector<ConvexPolytope>& cells) {
+Result<MultiCellSplit> clipByConvexCells(const Mesh& mesh, const std::vector<ConvexPolytope>& cells,
+                                         const VolumeIntegrals* meshIntegrals) {
     if (cells.empty() ||
         std::any_of(cells.begin(), cells.end(), [](const ConvexPolytope& c) { return c.empty(); }))
         return makeError(ErrorCode::InvalidInput, "no cells, or an empty cell");
     try {
         Clipper clipper(mesh, cells);
-        std::vector<Mesh> regions = clipper.run();
         MultiCellSplit out;
+        std::vector<Mesh> regions = clipper.run(meshIntegrals, out.outsideIntegrals);
         out.outside = std::move(regions.back());
         regions.pop_back();
         out.inside = std::move(regions);

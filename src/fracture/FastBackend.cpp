@@ -12,7 +12,8 @@ namespace {
 
 class FastBackend final : public BooleanBackend {
 public:
-    explicit FastBackend(bool exactFallback) : exactFallback_(exactFallback) {}
+    FastBackend(bool exactFallback, const VolumeIntegrals* inputIntegrals)
+        : exactFallback_(exactFallback), inputIntegrals_(inputIntegrals) {}
 
     std::string name() const override { return "fast"; }
 
@@ -30,8 +31,10 @@ public:
             }
         if (used.empty()) {
             out.remainder = mesh;
+            if (inputIntegrals_)
+                out.remainderIntegrals = *inputIntegrals_;
         } else {
-            auto r = clipByConvexCells(mesh, used);
+            auto r = clipByConvexCells(mesh, used, inputIntegrals_);
             if (!r) {
                 if (!exactFallback_)
                     return r.error();
@@ -45,6 +48,7 @@ public:
             for (std::size_t k = 0; k < index.size(); ++k)
                 out.inside[index[k]] = std::move(r->inside[k]);
             out.remainder = std::move(r->outside);
+            out.remainderIntegrals = r->outsideIntegrals;
         }
         // The clipper always emits uvs and materials; keep the layout identical when nothing is cut.
         if (out.remainder.uvs.empty())
@@ -56,12 +60,13 @@ public:
 
 private:
     bool exactFallback_;
+    const VolumeIntegrals* inputIntegrals_;
 };
 
 } // namespace
 
-std::unique_ptr<BooleanBackend> makeFastBackend(bool exactFallback) {
-    return std::make_unique<FastBackend>(exactFallback);
+std::unique_ptr<BooleanBackend> makeFastBackend(bool exactFallback, const VolumeIntegrals* inputIntegrals) {
+    return std::make_unique<FastBackend>(exactFallback, inputIntegrals);
 }
 
 } // namespace rubble::detail

@@ -6,6 +6,8 @@
 #include <limits>
 #include <span>
 
+#include <time.h>
+
 #include "BooleanBackends.hpp"
 #include "FracturePipeline.hpp"
 #include "geometry/OrientedShells.hpp"
@@ -20,12 +22,34 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double msSince(Clock::time_point t0) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+/// This thread's CPU time in ms.
+double threadCpuMs() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
 }
 
-/// Checks that mesh is a valid closed, oriented solid; its volume out.
-Status validateInput(const Mesh& mesh, double& volume) {
+/// A start on the wall clock and on this thread's CPU clock; a stage's time goes into both timings of a
+/// result (FractureResult::timings and cpuTimings).
+struct Stopwatch {
+    Clock::time_point wall = Clock::now();
+    double cpu = threadCpuMs();
+
+    double wallMs() const { return std::chrono::duration<double, std::milli>(Clock::now() - wall).count(); }
+    /// Sets the stage to the time since the start.
+    void set(FractureResult& r, double FractureTimings::*stage) const {
+        r.timings.*stage = wallMs();
+        r.cpuTimings.*stage = threadCpuMs() - cpu;
+    }
+    /// Adds the time since the start to the stage.
+    void add(FractureResult& r, double FractureTimings::*stage) const {
+        r.timings.*stage += wallMs();
+        r.cpuTimings.*stage += threadCpuMs() - cpu;
+    }
+};
+
+/// Checks that mesh is a valid closed, oriented solid.
+Status checkSolid(const Mesh& mesh) {
     if (mesh.empty())
         return makeError(ErrorCode::InvalidInput, "fracture: the mesh has no triangles");
     if (Status s = mesh.validate(); !s)
@@ -35,10 +59,29 @@ Status validateInput(const Mesh& mesh, double& volume) {
             ErrorCode::InvalidInput,
             "fracture: the mesh is not closed and consistently oriented (every edge must be shared "
             "by exactly two triangles in opposite directions); repair it first");
-    volume = signedVolume(mesh);
+    return {};
+}
+
+Status positiveVolume(double volume) {
     if (!(volume > 0))
         return makeError(ErrorCode::InvalidInput, "fracture: the mesh does not enclose a positive volume");
     return {};
+}
+
+/// The input's volume and, when known facts fit it, its integrals (then nothing is scanned); else the mesh is
+/// validated and integrals is null.
+Status prepareInput(const Mesh& mesh, const MeshFacts& known, double& volume,
+                    const VolumeIntegrals*& integrals) {
+    integrals = nullptr;
+    if (known.fit(mesh) && !mesh.empty()) {
+        integrals = &known.integrals;
+        volume = known.integrals.volume;
+        return positiveVolume(volume);
+    }
+    if (Status s = checkSolid(mesh); !s)
+        return s;
+    volume = signedVolume(mesh);
+    return positiveVolume(volume);
 }
 
 /// An orthonormal basis (u, v) of the plane with normal n, the same for n and -n (so both sides of a cut
@@ -114,26 +157,51 @@ void finishCutFaces(Mesh& m, std::span<const ConvexPolytope> cells, double uvSca
 }
 
 /// The pieces of one split output. simplify: remove the vertices that carry no shape near the cells (focus).
+/// With whole (the output's integrals), the largest island's integrals are whole minus the other islands'
+/// plus what simplification changed, so it is not scanned; the others are measured.
 void addPieces(Mesh&& m, const detail::OutputShells& shells, std::int32_t cell, double minVolume,
-               bool simplify, const Aabb& focus, FractureResult& out) {
+               bool simplify, const Aabb& focus, const VolumeIntegrals* whole, FractureResult& out) {
     if (m.empty())
         return;
-    for (Mesh& island : splitIntoIslands(std::move(m), shells.triangleShell, shells.count)) {
+    std::vector<Mesh> islands = splitIntoIslands(std::move(m), shells.triangleShell, shells.count);
+    std::size_t largest = islands.size();
+    VolumeIntegrals rest;
+    if (whole) {
+        const Stopwatch tm;
+        largest = 0;
+        for (std::size_t i = 1; i < islands.size(); ++i)
+            if (islands[i].triangles.size() > islands[largest].triangles.size())
+                largest = i;
+        rest = *whole;
+        for (std::size_t i = 0; i < islands.size(); ++i)
+            if (i != largest)
+                rest.accumulate(volumeIntegrals(islands[i], whole->reference), -1.0);
+        tm.add(out, &FractureTimings::massMs);
+    }
+    for (std::size_t i = 0; i < islands.size(); ++i) {
+        Mesh& island = islands[i];
+        const bool byDifference = i == largest;
         if (simplify) {
-            const auto ts = Clock::now();
+            const Stopwatch ts;
             PlanarSimplifyParams sp;
             sp.focus = focus;
-            island = simplifyPlanarRegions(island, sp);
-            out.timings.simplifyMs += msSince(ts);
+            sp.integralsReference = rest.reference;
+            PlanarSimplifyReport report;
+            island = simplifyPlanarRegions(std::move(island), sp, &report);
+            if (byDifference && !report.unchanged)
+                rest.accumulate(report.integralsChange, 1.0);
+            ts.add(out, &FractureTimings::simplifyMs);
         }
-        const auto tm = Clock::now();
-        MassProperties mp = computeMassProperties(island);
-        out.timings.massMs += msSince(tm);
+        const Stopwatch tm;
+        MeshFacts facts{true, island.triangles.size(), island.positions.size(),
+                        byDifference ? rest : volumeIntegrals(island)};
+        MassProperties mp = massProperties(facts.integrals);
+        tm.add(out, &FractureTimings::massMs);
         if (!(mp.volume > minVolume)) {
             out.droppedVolume += mp.volume;
             continue;
         }
-        out.pieces.push_back({std::move(island), mp, cell});
+        out.pieces.push_back({std::move(island), mp, cell, std::move(facts)});
     }
 }
 
@@ -144,7 +212,7 @@ std::unique_ptr<BooleanBackend> makeBooleanBackend(BooleanKind kind) {
     case BooleanKind::Nef:
         return detail::makeNefBackend();
     case BooleanKind::Fast:
-        return detail::makeFastBackend();
+        return detail::makeFastBackend(true);
     case BooleanKind::Corefine:
         break;
     }
@@ -169,7 +237,8 @@ bool splitIsSound(const SplitResult& s, double inputVolume, std::vector<OutputSh
             return false;
         if (out)
             out->count = static_cast<std::size_t>(count);
-        const double mv = signedVolume(m);
+        const double mv =
+            &m == &s.remainder && s.remainderIntegrals ? s.remainderIntegrals->volume : signedVolume(m);
         v += mv;
         return mv > 0;
     };
@@ -189,7 +258,7 @@ namespace {
 Result<FractureResult> runPipeline(const Mesh& mesh, std::vector<ConvexPolytope> cells,
                                    const FractureParams& params, const BooleanBackend& backend,
                                    bool exactRedo, double inputVolume) {
-    const auto t0 = Clock::now();
+    const Stopwatch t0;
     FractureResult res;
     res.inputVolume = inputVolume;
     const Aabb meshBox = mesh.bounds();
@@ -203,7 +272,9 @@ Result<FractureResult> runPipeline(const Mesh& mesh, std::vector<ConvexPolytope>
     // The result must close up and conserve volume; a failed fast split is redone exactly. The check labels
     // the shells of every output on the way; the islands below reuse them.
     std::vector<detail::OutputShells> shells;
+    const Stopwatch tv;
     bool sound = split && detail::splitIsSound(*split, inputVolume, &shells);
+    tv.set(res, &FractureTimings::verifyMs);
     if (split && !sound && exactRedo) {
         split = detail::makeCorefineBackend()->split(mesh, cells);
         if (split)
@@ -225,9 +296,9 @@ Result<FractureResult> runPipeline(const Mesh& mesh, std::vector<ConvexPolytope>
             ErrorCode::NoIntersection,
             "fracture: the impact's cells do not intersect the mesh (is the impact outside it?)");
     res.exactFallback = split->exactFallback;
-    res.timings.booleanMs = msSince(t0);
+    t0.set(res, &FractureTimings::booleanMs);
 
-    const auto t1 = Clock::now();
+    const Stopwatch t1;
     Aabb focus; // where the cut made new faces and vertices (the cells, a little larger)
     for (const ConvexPolytope& c : cells)
         focus.extend(c.bounds());
@@ -237,15 +308,17 @@ Result<FractureResult> runPipeline(const Mesh& mesh, std::vector<ConvexPolytope>
     finishCutFaces(split->remainder, cells, params.uvScale, focus, onPlane);
     for (std::size_t i = 0; i < split->inside.size(); ++i) // a cell's piece is cut by that cell only
         finishCutFaces(split->inside[i], std::span(cells).subspan(i, 1), params.uvScale, focus, onPlane);
-    res.timings.massMs = msSince(t1);
+    t1.set(res, &FractureTimings::massMs);
     const double minVolume = std::max(0.0, params.minPieceVolumeFraction) * inputVolume;
-    addPieces(std::move(split->remainder), shells[0], -1, minVolume, params.simplifyPieces, focus, res);
+    const VolumeIntegrals* whole = split->remainderIntegrals ? &*split->remainderIntegrals : nullptr;
+    addPieces(std::move(split->remainder), shells[0], -1, minVolume, params.simplifyPieces, focus, whole,
+              res);
     for (std::size_t i = 0; i < split->inside.size(); ++i)
         addPieces(std::move(split->inside[i]), shells[i + 1], static_cast<std::int32_t>(i), minVolume,
-                  params.simplifyPieces, focus, res);
-    res.timings.islandsMs = msSince(t1);
+                  params.simplifyPieces, focus, nullptr, res);
+    t1.set(res, &FractureTimings::islandsMs);
     res.cells = std::move(cells);
-    res.timings.totalMs = msSince(t0);
+    t0.set(res, &FractureTimings::totalMs);
     return res;
 }
 
@@ -255,50 +328,80 @@ namespace detail {
 
 Result<FractureResult> fractureWithBackend(const Mesh& mesh, std::vector<ConvexPolytope> cells,
                                            const FractureParams& params, const BooleanBackend& backend,
-                                           bool exactRedo) {
-    const auto t0 = Clock::now();
+                                           bool exactRedo, const MeshFacts& known) {
+    const Stopwatch t0;
     double volume = 0;
-    if (Status s = validateInput(mesh, volume); !s)
+    const VolumeIntegrals* integrals = nullptr;
+    if (Status s = prepareInput(mesh, known, volume, integrals); !s)
         return s.error();
-    const double validateMs = msSince(t0);
+    FractureResult pre; // the stages before the pipeline
+    t0.set(pre, &FractureTimings::validateMs);
     auto r = runPipeline(mesh, std::move(cells), params, backend, exactRedo, volume);
     if (r) {
-        r->timings.validateMs = validateMs;
-        r->timings.totalMs = msSince(t0);
+        r->timings.validateMs = pre.timings.validateMs;
+        r->cpuTimings.validateMs = pre.cpuTimings.validateMs;
+        t0.set(*r, &FractureTimings::totalMs);
     }
     return r;
 }
 
 } // namespace detail
 
+Result<MeshFacts> analyzeMesh(const Mesh& mesh) {
+    if (Status s = checkSolid(mesh); !s)
+        return s.error();
+    MeshFacts facts{true, mesh.triangles.size(), mesh.positions.size(), volumeIntegrals(mesh)};
+    if (Status s = positiveVolume(facts.integrals.volume); !s)
+        return s.error();
+    return facts;
+}
+
+namespace {
+
+/// The backend of params, given the input's integrals when they are known (Fast uses them).
+std::unique_ptr<BooleanBackend> backendFor(BooleanKind kind, bool exactFallback,
+                                           const VolumeIntegrals* integrals) {
+    if (kind == BooleanKind::Fast)
+        return detail::makeFastBackend(exactFallback, integrals);
+    return makeBooleanBackend(kind);
+}
+
+} // namespace
+
 Result<FractureResult> fractureWithCells(const Mesh& mesh, std::vector<ConvexPolytope> cells,
-                                         const FractureParams& params) {
-    return detail::fractureWithBackend(mesh, std::move(cells), params, *makeBooleanBackend(params.backend),
-                                       params.backend == BooleanKind::Fast);
+                                         const FractureParams& params, const MeshFacts& known) {
+    const VolumeIntegrals* integrals = known.fit(mesh) ? &known.integrals : nullptr;
+    return detail::fractureWithBackend(mesh, std::move(cells), params,
+                                       *backendFor(params.backend, true, integrals),
+                                       params.backend == BooleanKind::Fast, known);
 }
 
 Result<FractureResult> fracture(const Mesh& mesh, const Impact& impact, const FractureParams& params,
-                                std::uint64_t seed) {
-    const auto t0 = Clock::now();
+                                std::uint64_t seed, const MeshFacts& known) {
+    const Stopwatch t0;
     double volume = 0;
-    if (Status s = validateInput(mesh, volume); !s)
+    const VolumeIntegrals* integrals = nullptr;
+    if (Status s = prepareInput(mesh, known, volume, integrals); !s)
         return s.error();
     if (!isFinite(impact.point) || !std::isfinite(impact.impulse))
         return makeError(ErrorCode::InvalidInput, "fracture: the impact point or impulse is not finite");
-    const double validateMs = msSince(t0);
-    double cellMs = 0;
+    FractureResult pre; // the stages before the pipeline
+    t0.set(pre, &FractureTimings::validateMs);
     auto cellsFor = [&](std::uint64_t s) {
-        const auto tc = Clock::now();
+        const Stopwatch tc;
         std::vector<ConvexPolytope> cells = generateCells(mesh.bounds(), impact, params, s);
-        cellMs += msSince(tc);
+        tc.add(pre, &FractureTimings::cellMs);
         return cells;
     };
     auto finish = [&](Result<FractureResult> r, int redraws) {
         if (r) {
             r->redraws = redraws;
-            r->timings.validateMs = validateMs;
-            r->timings.cellMs = cellMs;
-            r->timings.totalMs = msSince(t0);
+            for (auto [to, from] :
+                 {std::pair{&r->timings, &pre.timings}, {&r->cpuTimings, &pre.cpuTimings}}) {
+                to->validateMs = from->validateMs;
+                to->cellMs = from->cellMs;
+            }
+            t0.set(*r, &FractureTimings::totalMs);
         }
         return r;
     };
@@ -310,15 +413,15 @@ Result<FractureResult> fracture(const Mesh& mesh, const Impact& impact, const Fr
             std::vector<ConvexPolytope> cells = cellsFor(redraw == 0 ? seed : mixSeed(seed, 0xDA7A + redraw));
             if (cells.empty())
                 break;
-            auto r =
-                runPipeline(mesh, std::move(cells), params, *detail::makeFastBackend(false), false, volume);
+            auto r = runPipeline(mesh, std::move(cells), params, *detail::makeFastBackend(false, integrals),
+                                 false, volume);
             if (r || r.error().code != ErrorCode::GeometryFailure)
                 return finish(std::move(r), redraw);
         }
     std::vector<ConvexPolytope> cells = cellsFor(seed);
     if (cells.empty())
         return makeError(ErrorCode::NoIntersection, "fracture: no cell could be built around the impact");
-    return finish(runPipeline(mesh, std::move(cells), params, *makeBooleanBackend(params.backend),
+    return finish(runPipeline(mesh, std::move(cells), params, *backendFor(params.backend, true, integrals),
                               params.backend == BooleanKind::Fast, volume),
                   0);
 }

@@ -24,8 +24,9 @@ bool splitIsSound(const SplitResult& split, double inputVolume, std::vector<Outp
 
 /// fractureWithCells with an explicit backend (tests inject faulty ones). A split that fails splitIsSound
 /// is redone by Corefine when exactRedo is set (then FractureResult::exactFallback), else it is an error.
+/// known: as for fracture (the backend is given the integrals by the caller).
 Result<FractureResult> fractureWithBackend(const Mesh& mesh, std::vector<ConvexPolytope> cells,
                                            const FractureParams& params, const BooleanBackend& backend,
-                                           bool exactRedo);
+                                           bool exactRedo, const MeshFacts& known = {});
 
 } // namespace rubble::detail

@@ -4,30 +4,42 @@
 
 namespace rubble {
 
-namespace {
-// Accumulates the second moments about a reference point r: each triangle (a,b,c) forms a tetrahedron with r.
-// Covariance of the canonical tetrahedron is [[2,1,1],[1,2,1],[1,1,2]]/120 (Blow & Binstock).
-struct Accumulator {
-    double volume = 0;
-    Vec3 first; // ∫ x dV (about r)
-    double cov[3][3] = {};
+// Each triangle (a,b,c) forms a tetrahedron with the reference. Covariance of the canonical tetrahedron is
+// [[2,1,1],[1,2,1],[1,1,2]]/120 (Blow & Binstock).
+void VolumeIntegrals::addRelative(const Vec3& a, const Vec3& b, const Vec3& c, double sign) {
+    const double det = sign * dot(a, cross(b, c));
+    volume += det / 6.0;
+    first += (a + b + c) * (det / 24.0);
+    const Vec3 s = a + b + c;
+    const Vec3 cols[3] = {a, b, c};
+    for (int i = 0; i < 3; ++i)
+        for (int j = i; j < 3; ++j) {
+            double sum = 0;
+            for (const Vec3& v : cols)
+                sum += v[i] * v[j];
+            cov[i][j] += det / 120.0 * (sum + s[i] * s[j]);
+        }
+}
 
-    void add(const Vec3& a, const Vec3& b, const Vec3& c) {
-        const double det = dot(a, cross(b, c));
-        volume += det / 6.0;
-        first += (a + b + c) * (det / 24.0);
-        const Vec3 s = a + b + c;
-        const Vec3 cols[3] = {a, b, c};
-        for (int i = 0; i < 3; ++i)
-            for (int j = i; j < 3; ++j) {
-                double sum = 0;
-                for (const Vec3& v : cols)
-                    sum += v[i] * v[j];
-                cov[i][j] += det / 120.0 * (sum + s[i] * s[j]);
-            }
-    }
-};
-} // namespace
+void VolumeIntegrals::accumulate(const VolumeIntegrals& o, double sign) {
+    volume += sign * o.volume;
+    first += o.first * sign;
+    for (int i = 0; i < 3; ++i)
+        for (int j = i; j < 3; ++j)
+            cov[i][j] += sign * o.cov[i][j];
+}
+
+VolumeIntegrals volumeIntegrals(const Mesh& mesh, const Vec3& reference) {
+    VolumeIntegrals acc;
+    acc.reference = reference;
+    for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
+        acc.add(mesh, t);
+    return acc;
+}
+
+VolumeIntegrals volumeIntegrals(const Mesh& mesh) {
+    return volumeIntegrals(mesh, mesh.positions.empty() ? Vec3{} : mesh.bounds().center());
+}
 
 double signedVolume(const Mesh& mesh) {
     const Vec3 r = mesh.positions.empty() ? Vec3{} : mesh.bounds().center();
@@ -40,15 +52,14 @@ double signedVolume(const Mesh& mesh) {
 }
 
 MassProperties computeMassProperties(const Mesh& mesh) {
-    MassProperties mp;
     if (mesh.triangles.empty())
-        return mp;
-    const Vec3 r = mesh.bounds().center();
-    Accumulator acc;
-    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
-        const auto c = mesh.corners(t);
-        acc.add(c[0] - r, c[1] - r, c[2] - r);
-    }
+        return {};
+    return massProperties(volumeIntegrals(mesh));
+}
+
+MassProperties massProperties(const VolumeIntegrals& acc) {
+    MassProperties mp;
+    const Vec3& r = acc.reference;
     mp.volume = acc.volume;
     if (acc.volume == 0) {
         mp.centerOfMass = r;

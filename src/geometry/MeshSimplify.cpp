@@ -40,8 +40,11 @@ class Simplifier {
 public:
     Simplifier(const Mesh& mesh, const PlanarSimplifyParams& params) : m_(mesh), params_(params) {}
 
-    /// The simplified mesh, or false when the input is to be returned as it is.
-    bool run(Mesh& out, PlanarSimplifyReport& report);
+    /// The simplified mesh, or false when the input is to be returned as it is. With inPlace (the input
+    /// itself), the result is written over the input when it fits (editedInPlace()), else into out.
+    bool run(Mesh& out, PlanarSimplifyReport& report, Mesh* inPlace = nullptr);
+    /// run() wrote the result over the input.
+    bool editedInPlace() const { return editedInPlace_; }
 
 private:
     const Mesh& m_;
@@ -50,6 +53,7 @@ private:
     std::unordered_map<std::uint64_t, std::uint32_t> edgeTri_;           // directed edge → local triangle
     std::unordered_map<std::uint32_t, std::vector<std::uint32_t>> star_; // focus vertex → local triangles
     std::unordered_set<std::uint32_t> removed_;
+    bool editedInPlace_ = false;
 
     std::uint32_t twinTri(std::uint32_t t, int k) const { // triangle across edge k of t, or kNone
         const Tri& tri = m_.triangles[t];
@@ -61,7 +65,26 @@ private:
     bool flat(const std::vector<std::uint32_t>& tris) const;
     bool removable(std::uint32_t v) const;
     bool retriangulate(const std::vector<std::uint32_t>& patch, std::vector<Tri>& out) const;
+    using PatchOf = std::vector<std::pair<std::uint32_t, std::uint32_t>>; // (triangle, patch), by triangle
+    void assemble(Mesh& m, bool inPlace, const PatchOf& patchOf,
+                  const std::vector<std::vector<std::uint32_t>>& patches,
+                  const std::vector<std::vector<Tri>>& fresh, PlanarSimplifyReport& report) const;
 };
+
+/// Whether each patch's new triangles fit, front to back, into the slots of the triangles already passed
+/// when its first triangle is reached (then the output can be written over the input).
+bool fitsInPlace(const std::vector<std::pair<std::uint32_t, std::uint32_t>>& patchOf,
+                 const std::vector<std::vector<std::uint32_t>>& patches,
+                 const std::vector<std::vector<Tri>>& fresh) {
+    std::size_t written = 0, next = 0;
+    for (const auto& [t, p] : patchOf) {
+        written += t - next;
+        next = t + 1;
+        if (patches[p].front() == t && (written += fresh[p].size()) > next)
+            return false;
+    }
+    return true;
+}
 
 /// Can triangles t and s (sharing an edge) be one flat region? The plane is the larger triangle's.
 bool Simplifier::compatible(std::uint32_t t, std::uint32_t s) const {
@@ -320,7 +343,86 @@ bool Simplifier::retriangulate(const std::vector<std::uint32_t>& patch, std::vec
     return std::abs(change) <= 1e-9 * before * diag_;
 }
 
-bool Simplifier::run(Mesh& result, PlanarSimplifyReport& report) {
+/// The output triangles in order into m: the input's other triangles in runs, each patch's new triangles
+/// where its first triangle was (their attributes taken from the patch's corners first). In place (m is m_,
+/// which needs fitsInPlace), runs move towards the front and new triangles overwrite passed slots; else m is
+/// empty and everything is appended.
+void Simplifier::assemble(Mesh& m, bool inPlace, const PatchOf& patchOf,
+                          const std::vector<std::vector<std::uint32_t>>& patches,
+                          const std::vector<std::vector<Tri>>& fresh, PlanarSimplifyReport& report) const {
+    const bool hasMat = m_.hasMaterials(), hasUv = m_.hasUvs(), hasN = m_.hasNormals();
+    std::size_t w = 0, next = 0; // output triangles, first input triangle not yet passed
+    // Writes n entries per triangle of src at triangle w of dst (appending when not in place).
+    auto put = [&](auto& dst, auto first, auto last, std::size_t per) {
+        if (inPlace)
+            std::copy(first, last, dst.begin() + static_cast<std::ptrdiff_t>(per * w));
+        else
+            dst.insert(dst.end(), first, last);
+    };
+    auto run = [&](std::size_t from, std::size_t to) { // input triangles [from, to) as they are
+        auto at = [](const auto& v, std::size_t i) { return v.begin() + static_cast<std::ptrdiff_t>(i); };
+        if (from == to || (inPlace && from == w)) { // nothing to write, or already where it belongs
+            w += to - from;
+            return;
+        }
+        put(m.triangles, at(m_.triangles, from), at(m_.triangles, to), 1);
+        if (hasMat)
+            put(m.materials, at(m_.materials, from), at(m_.materials, to), 1);
+        if (hasUv)
+            put(m.uvs, at(m_.uvs, 3 * from), at(m_.uvs, 3 * to), 3);
+        if (hasN)
+            put(m.normals, at(m_.normals, 3 * from), at(m_.normals, 3 * to), 3);
+        w += to - from;
+    };
+    std::unordered_map<std::uint32_t, std::uint32_t> cornerOf; // a corner of the patch at each vertex
+    std::vector<std::uint32_t> mats;
+    std::vector<Vec2> uvs;
+    std::vector<Vec3> normals;
+    for (const auto& [t, p] : patchOf) {
+        run(next, t);
+        next = t + 1;
+        report.integralsChange.remove(m_, t);
+        if (patches[p].front() != t)
+            continue;
+        cornerOf.clear();
+        for (auto it = patches[p].rbegin(); it != patches[p].rend(); ++it) // the first corner wins
+            for (std::uint32_t k = 0; k < 3; ++k)
+                cornerOf[m_.triangles[*it][k]] = 3 * *it + k;
+        mats.clear();
+        uvs.clear();
+        normals.clear();
+        for (const Tri& tri : fresh[p]) {
+            if (hasMat)
+                mats.push_back(m_.materials[t]);
+            for (std::uint32_t v : tri) {
+                const std::uint32_t c = cornerOf.at(v);
+                if (hasUv)
+                    uvs.push_back(m_.uvs[c]);
+                if (hasN)
+                    normals.push_back(m_.normals[c]);
+            }
+            report.integralsChange.add(m_.positions[tri[0]], m_.positions[tri[1]], m_.positions[tri[2]]);
+        }
+        put(m.triangles, fresh[p].begin(), fresh[p].end(), 1);
+        if (hasMat)
+            put(m.materials, mats.begin(), mats.end(), 1);
+        if (hasUv)
+            put(m.uvs, uvs.begin(), uvs.end(), 3);
+        if (hasN)
+            put(m.normals, normals.begin(), normals.end(), 3);
+        w += fresh[p].size();
+        ++report.regionsRetriangulated;
+    }
+    run(next, m_.triangles.size());
+    if (inPlace) {
+        m.triangles.resize(w);
+        m.materials.resize(hasMat ? w : 0);
+        m.uvs.resize(hasUv ? 3 * w : 0);
+        m.normals.resize(hasN ? 3 * w : 0);
+    }
+}
+
+bool Simplifier::run(Mesh& result, PlanarSimplifyReport& report, Mesh* inPlace) {
     const std::size_t nv = m_.positions.size(), nt = m_.triangles.size();
     if (nt == 0 || (m_.hasUvs() && m_.uvs.size() != 3 * nt) ||
         (m_.hasNormals() && m_.normals.size() != 3 * nt) || (m_.hasMaterials() && m_.materials.size() != nt))
@@ -411,59 +513,73 @@ bool Simplifier::run(Mesh& result, PlanarSimplifyReport& report) {
     }
 
     // Assemble: other triangles in input order; each patch's new triangles where its first triangle was.
-    std::vector<std::uint32_t> patchOf(nt, kNone);
+    // The triangles between patch triangles are copied in runs.
+    PatchOf patchOf;
     for (std::size_t p = 0; p < patches.size(); ++p)
         for (std::uint32_t t : patches[p])
-            patchOf[t] = static_cast<std::uint32_t>(p);
+            patchOf.emplace_back(t, static_cast<std::uint32_t>(p));
+    std::sort(patchOf.begin(), patchOf.end());
+    report.integralsChange = {};
+    report.integralsChange.reference = params_.integralsReference;
+    editedInPlace_ = inPlace && fitsInPlace(patchOf, patches, fresh);
     Mesh out;
-    out.materialNames = m_.materialNames;
-    out.triangles.reserve(nt);
-    out.materials.reserve(m_.materials.size());
-    out.uvs.reserve(m_.uvs.size());
-    out.normals.reserve(m_.normals.size());
-    std::vector<std::uint32_t> cornerOf(nv, kNone); // a corner of the patch at each vertex
-    auto emit = [&](const Tri& tri, std::uint32_t source, const std::uint32_t* corner) {
-        out.triangles.push_back(tri);
-        if (m_.hasMaterials())
-            out.materials.push_back(m_.materials[source]);
-        for (std::size_t k = 0; k < 3; ++k) {
-            const std::size_t c = corner ? corner[k] : 3 * source + k;
-            if (m_.hasUvs())
-                out.uvs.push_back(m_.uvs[c]);
-            if (m_.hasNormals())
-                out.normals.push_back(m_.normals[c]);
-        }
-    };
-    for (std::uint32_t t = 0; t < nt; ++t) {
-        const std::uint32_t p = patchOf[t];
-        if (p == kNone) {
-            emit(m_.triangles[t], t, nullptr);
-            continue;
-        }
-        if (patches[p].front() != t)
-            continue;
-        for (auto it = patches[p].rbegin(); it != patches[p].rend(); ++it) // the first corner wins
-            for (std::uint32_t k = 0; k < 3; ++k)
-                cornerOf[m_.triangles[*it][k]] = 3 * *it + k;
-        for (const Tri& tri : fresh[p]) {
-            const std::uint32_t corner[3] = {cornerOf[tri[0]], cornerOf[tri[1]], cornerOf[tri[2]]};
-            emit(tri, t, corner);
-        }
-        ++report.regionsRetriangulated;
+    Mesh& target = editedInPlace_ ? *inPlace : out;
+    if (!editedInPlace_) {
+        out.materialNames = m_.materialNames;
+        out.triangles.reserve(nt);
+        out.materials.reserve(m_.materials.size());
+        out.uvs.reserve(m_.uvs.size());
+        out.normals.reserve(m_.normals.size());
     }
-    // Drop the removed vertices (only those: the input's own unreferenced vertices stay).
-    std::vector<std::uint32_t> remap(nv, kNone);
-    out.positions.reserve(nv - removed_.size());
-    for (std::uint32_t v = 0; v < nv; ++v)
-        if (!removed_.count(v)) {
-            remap[v] = static_cast<std::uint32_t>(out.positions.size());
-            out.positions.push_back(m_.positions[v]);
+    assemble(target, editedInPlace_, patchOf, patches, fresh, report);
+    // Drop the removed vertices (only those: the input's own unreferenced vertices stay), in place.
+    std::vector<std::uint32_t> gone(removed_.begin(), removed_.end());
+    std::sort(gone.begin(), gone.end());
+    std::vector<std::uint32_t> remap(nv);
+    if (!editedInPlace_)
+        target.positions = m_.positions;
+    std::size_t stay = 0;
+    for (std::uint32_t v = 0, g = 0; v < nv; ++v) {
+        if (g < gone.size() && gone[g] == v) {
+            ++g;
+            remap[v] = kNone;
+            continue;
         }
-    for (Tri& tri : out.triangles)
+        remap[v] = static_cast<std::uint32_t>(stay);
+        target.positions[stay++] = target.positions[v];
+    }
+    target.positions.resize(stay);
+    for (Tri& tri : target.triangles)
         for (std::uint32_t& v : tri)
             v = remap[v];
     report.verticesRemoved = removed_.size();
-    result = std::move(out);
+    if (!editedInPlace_)
+        result = std::move(out);
+    return true;
+}
+
+} // namespace
+
+namespace {
+
+/// Simplifies mesh into out, or over *inPlace (mesh itself) when that fits; false (and a report saying so)
+/// when it stays as it is.
+bool simplifyInto(const Mesh& mesh, const PlanarSimplifyParams& params, PlanarSimplifyReport* report,
+                  Mesh& out, Mesh* inPlace) {
+    PlanarSimplifyReport local;
+    PlanarSimplifyReport& rep = report ? *report : local;
+    rep = {};
+    rep.trianglesBefore = mesh.triangles.size();
+    Simplifier simplifier(mesh, params);
+    if (!simplifier.run(out, rep, inPlace)) {
+        rep = {};
+        rep.trianglesBefore = rep.trianglesAfter = mesh.triangles.size();
+        rep.unchanged = true;
+        return false;
+    }
+    if (simplifier.editedInPlace())
+        out = std::move(*inPlace);
+    rep.trianglesAfter = out.triangles.size();
     return true;
 }
 
@@ -471,18 +587,16 @@ bool Simplifier::run(Mesh& result, PlanarSimplifyReport& report) {
 
 Mesh simplifyPlanarRegions(const Mesh& mesh, const PlanarSimplifyParams& params,
                            PlanarSimplifyReport* report) {
-    PlanarSimplifyReport local;
-    PlanarSimplifyReport& rep = report ? *report : local;
-    rep = {};
-    rep.trianglesBefore = mesh.triangles.size();
     Mesh out;
-    if (!Simplifier(mesh, params).run(out, rep)) {
-        rep = {};
-        rep.trianglesBefore = rep.trianglesAfter = mesh.triangles.size();
-        rep.unchanged = true;
+    if (!simplifyInto(mesh, params, report, out, nullptr))
         return mesh;
-    }
-    rep.trianglesAfter = out.triangles.size();
+    return out;
+}
+
+Mesh simplifyPlanarRegions(Mesh&& mesh, const PlanarSimplifyParams& params, PlanarSimplifyReport* report) {
+    Mesh out;
+    if (!simplifyInto(mesh, params, report, out, &mesh))
+        return std::move(mesh);
     return out;
 }
 

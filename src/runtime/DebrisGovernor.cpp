@@ -10,6 +10,8 @@ namespace {
 constexpr int kSettledFrames = 10;     // a piece falling from rest passes 1 m/s within 6 frames at 60 Hz
 constexpr double kCellSize = 4.0;      // m: frozen pieces are small, so a body's neighbourhood is a few cells
 constexpr double kMovedFraction = 0.1; // a woken body this far (times its radius) from its place has left it
+constexpr double kRestingAcceleration =
+    0.5;                           // a resting body's velocity changes by less than this g·dt a frame
 constexpr double kHoldLow = 0.55;  // the average physics step is held in this band (fractions of the budget)
 constexpr double kHoldHigh = 0.75; // so that single frames stay under the budget
 
@@ -48,7 +50,7 @@ void DebrisGovernor::frozen(BodyId id, const Vec3& center, double radius) {
 }
 
 void DebrisGovernor::thawed(BodyId id) {
-    restFrames_.erase(id);
+    rest_.erase(id);
     settleFrames_.erase(id);
     awakeFrames_.erase(id);
     auto it = frozen_.find(id);
@@ -103,7 +105,7 @@ void DebrisGovernor::wakeNear(const Aabb& box, double margin) {
 
 GovernorActions DebrisGovernor::update(const BodyTable& bodies, const PhysicsBinding& binding,
                                        const std::map<BodyId, double>& frozenHits, double physicsMs,
-                                       bool deterministic, const Vec3& focus) {
+                                       bool deterministic, const Vec3& focus, double dt) {
     GovernorActions out;
     std::set<BodyId> woken;
     for (const auto& [id, impulse] : frozenHits)
@@ -125,6 +127,7 @@ GovernorActions DebrisGovernor::update(const BodyTable& bodies, const PhysicsBin
         if (const BodyRecord* r = bodies.find(id); r && r->motion == BodyMotionState::Frozen)
             out.wake.push_back(id);
 
+    const Vec3 g = binding.gravity();
     std::set<BodyId> leaving;
     struct Awake {
         double volume, speed;
@@ -149,10 +152,15 @@ GovernorActions DebrisGovernor::update(const BodyTable& bodies, const PhysicsBin
             leaving.insert(id);
             continue;
         }
-        const bool resting =
-            length(m.linearVelocity) < budget_.freezeSpeed && length(m.angularVelocity) < budget_.freezeSpeed;
-        int& rest = restFrames_[id];
-        rest = resting ? rest + 1 : 0;
+        // Resting: slow, and not gaining speed (a body in flight, or starting to fall, gains g·dt a frame).
+        Rest& still = rest_[id];
+        const bool steady = still.frames >= 0 &&
+                            length(m.linearVelocity - still.velocity) < kRestingAcceleration * length(g) * dt;
+        const bool resting = steady && length(m.linearVelocity) < budget_.freezeSpeed &&
+                             length(m.angularVelocity) < budget_.freezeSpeed;
+        still.frames = resting ? still.frames + 1 : 0;
+        still.velocity = m.linearVelocity;
+        const int rest = still.frames;
         const double speed = std::max(length(m.linearVelocity), length(m.angularVelocity));
         int& settle = settleFrames_[id];
         settle = speed < budget_.settlingSpeed ? settle + 1 : 0;
@@ -172,7 +180,12 @@ GovernorActions DebrisGovernor::update(const BodyTable& bodies, const PhysicsBin
         smoothedMs_ = smoothedMs_ <= 0 ? physicsMs : 0.9 * smoothedMs_ + 0.1 * physicsMs;
         const double limit = budget_.physicsBudgetMs;
         int b = awakeBudget();
-        if (physicsMs > limit || smoothedMs_ > kHoldHigh * limit)
+        // A lone spike over a cheap average (a stall of the process, one burst of contacts) is no load that
+        // fewer bodies would shed; a spike over an average in the band, or two in a row, is.
+        const bool over = physicsMs > limit;
+        const bool load = over && (lastOver_ || smoothedMs_ > kHoldLow * limit);
+        lastOver_ = over;
+        if (load || smoothedMs_ > kHoldHigh * limit)
             b = std::min(b, static_cast<int>(0.9 * static_cast<double>(bodies.awake())));
         else if (smoothedMs_ < kHoldLow * limit && physicsMs < kHoldHigh * limit)
             b += std::max(1, b / 50);
@@ -240,11 +253,11 @@ GovernorActions DebrisGovernor::update(const BodyTable& bodies, const PhysicsBin
             if (triangles <= budget_.maxTriangles)
                 break;
             triangles -= std::min(triangles, bodies.find(id)->triangles);
-            out.retire.push_back({id, RetireReason::Budget});
+            out.retire.push_back({id, RetireReason::Triangles});
         }
     }
     for (BodyId id : leaving) {
-        restFrames_.erase(id);
+        rest_.erase(id);
         settleFrames_.erase(id);
         awakeFrames_.erase(id);
     }

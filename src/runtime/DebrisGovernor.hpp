@@ -13,7 +13,7 @@
 namespace rubble::detail {
 
 /// Why a debris body leaves the simulation.
-enum class RetireReason { Budget, Fade, FellOut };
+enum class RetireReason { Budget, Triangles, Fade, FellOut };
 
 /// What the governor decided for one frame, in a deterministic order.
 struct GovernorActions {
@@ -29,11 +29,11 @@ public:
     /// Reads the budget at every call.
     explicit DebrisGovernor(const DebrisBudget& budget) : budget_(budget) {}
 
-    /// The frame's decisions. frozenHits: strongest contact impulse on frozen bodies this frame; physicsMs:
-    /// this frame's physics step (ignored when deterministic).
+    /// The decisions of a frame of dt seconds. frozenHits: strongest contact impulse on frozen bodies this
+    /// frame; physicsMs: this frame's physics step (ignored when deterministic).
     GovernorActions update(const BodyTable& bodies, const PhysicsBinding& binding,
                            const std::map<BodyId, double>& frozenHits, double physicsMs, bool deterministic,
-                           const Vec3& focus);
+                           const Vec3& focus, double dt);
     /// A body was frozen at center with the given bounding radius.
     void frozen(BodyId id, const Vec3& center, double radius);
     /// A body stopped being frozen (woken or removed).
@@ -57,7 +57,11 @@ private:
     std::vector<Cell> cellsOf(const Vec3& lo, const Vec3& hi) const;
 
     const DebrisBudget& budget_;
-    std::unordered_map<BodyId, int> restFrames_;   // frames below freezeSpeed in a row
+    struct Rest {
+        int frames = -1; // frames in a row slow and not accelerating (-1: no velocity seen yet)
+        Vec3 velocity;   // linear velocity at the last update
+    };
+    std::unordered_map<BodyId, Rest> rest_;
     std::unordered_map<BodyId, int> settleFrames_; // frames below settlingSpeed in a row
     std::unordered_map<BodyId, int> awakeFrames_;  // frames awake since adopted or woken
     struct WokenEntry {
@@ -70,6 +74,7 @@ private:
     std::vector<BodyId> toWake_;
     int awakeBudget_ = -1;  // < 0: the configured maximum
     double smoothedMs_ = 0; // moving average of the physics step
+    bool lastOver_ = false; // the previous frame's step was over the budget
 };
 
 } // namespace rubble::detail

@@ -144,7 +144,7 @@ struct DestructionRuntime::Impl {
         bodies.erase(id);
     }
 
-    void retire(BodyId id, FrameStats& stats) {
+    void retire(BodyId id, detail::RetireReason reason, FrameStats& stats) {
         const BodyRecord* r = bodies.find(id);
         if (!r)
             return;
@@ -154,6 +154,20 @@ struct DestructionRuntime::Impl {
         ledger.retired += r->volume;
         ++stats.piecesRetired;
         ++counters.piecesRetired;
+        switch (reason) {
+        case detail::RetireReason::Budget:
+            ++counters.retired.awake;
+            break;
+        case detail::RetireReason::Triangles:
+            ++counters.retired.triangles;
+            break;
+        case detail::RetireReason::Fade:
+            ++counters.retired.faded;
+            break;
+        case detail::RetireReason::FellOut:
+            ++counters.retired.fellOut;
+            break;
+        }
         destroy(id, true);
     }
 
@@ -266,6 +280,7 @@ struct DestructionRuntime::Impl {
         }
         stats.piecesRetired += static_cast<int>(plan.particles.size());
         counters.piecesRetired += static_cast<long long>(plan.particles.size());
+        counters.retired.dust += static_cast<long long>(plan.particles.size());
         particles.add(plan.particles);
         settleSupport(stats);          // before the callback, so that it sees the pieces' final motion
         world.finishAdoption(outcome); // the pieces' bodies exist: the impact's timing record ends here
@@ -335,9 +350,9 @@ struct DestructionRuntime::Impl {
         settleSupport(stats);
     }
 
-    void govern(const std::map<BodyId, double>& frozenHits, FrameStats& stats) {
+    void govern(const std::map<BodyId, double>& frozenHits, double dt, FrameStats& stats) {
         const detail::GovernorActions a =
-            governor.update(bodies, binding, frozenHits, stats.physicsMs, deterministic(), focus);
+            governor.update(bodies, binding, frozenHits, stats.physicsMs, deterministic(), focus, dt);
         for (BodyId id : a.wake) {
             makeDynamic(id);
             ++stats.piecesWoken;
@@ -349,7 +364,7 @@ struct DestructionRuntime::Impl {
             ++counters.piecesFrozen;
         }
         for (const auto& [id, reason] : a.retire)
-            retire(id, stats);
+            retire(id, reason, stats);
     }
 
     void advance(double dt) {
@@ -525,6 +540,28 @@ bool DestructionRuntime::submitImpact(BodyId id, const Vec3& worldPoint, const V
     return im.counters.impacts > before;
 }
 
+int DestructionRuntime::blast(const Vec3& center, double radius, double impulse, double edgeShare) {
+    if (!(radius > 0) || !(impulse > 0))
+        return 0;
+    int accepted = 0;
+    for (BodyId id :
+         bodies()) { // a copy: an accepted impact does not change the bodies before the next frame
+        const BodyRecord* b = body(id);
+        if (!b || !b->hasObject)
+            continue;
+        const Vec3 c = motion(id).transform.translation;
+        const Vec3 d = center - c;
+        const double dist = length(d);
+        if (dist > radius + b->radius)
+            continue;
+        const Vec3 n = dist > 1e-9 ? d * (1.0 / dist) : Vec3{0, 1, 0};
+        const Vec3 at = c + n * std::min(dist, 0.7 * b->radius); // a cell centred here cuts the object
+        const double t = std::clamp((dist - b->radius) / radius, 0.0, 1.0);
+        accepted += submitImpact(id, at, n, impulse * (1.0 - (1.0 - edgeShare) * t)) ? 1 : 0;
+    }
+    return accepted;
+}
+
 FrameStats DestructionRuntime::stepFrame(double dt) {
     Impl& im = *impl_;
     FrameStats stats;
@@ -548,7 +585,7 @@ FrameStats DestructionRuntime::stepFrame(double dt) {
             r->anchor = true;
     stats.supportMs += msSince(t2);
     im.adoptResults(stats);
-    im.govern(batch.frozenHits, stats);
+    im.govern(batch.frozenHits, dt, stats);
     im.settleSupport(stats);
     im.feedContactLoads(dt);
     im.settleStructure(stats);

@@ -215,6 +215,7 @@ TEST(DestructionRuntime, AwakeBudgetRetiresTheSmallestPiecesButNeverTheGamesObje
     EXPECT_EQ(rig.runtime.awakeDebris(), 5);
     EXPECT_EQ(rig.runtime.livePieces(), 2) << "the three objects take three of the five";
     EXPECT_EQ(rig.runtime.counters().piecesRetired, static_cast<long long>(pieces.size()) - 2);
+    EXPECT_EQ(rig.runtime.counters().retired.awake, static_cast<long long>(pieces.size()) - 2);
     std::vector<double> kept, all;
     for (const AdoptedPiece& p : pieces) {
         all.push_back(p.state->mass.volume);
@@ -259,6 +260,7 @@ TEST(DestructionRuntime, TriangleBudgetAndFadingRetireDebris) {
     EXPECT_LE(rig.runtime.debrisTriangles(), before / 2);
     EXPECT_GT(rig.runtime.debrisTriangles(), 0u);
     EXPECT_GT(rig.runtime.counters().piecesRetired, 0);
+    EXPECT_EQ(rig.runtime.counters().retired.triangles, rig.runtime.counters().piecesRetired);
 
     DestructionRuntime::Config f = ToyRig::defaults();
     f.debris.fadeVolume = 0.05;
@@ -278,6 +280,8 @@ TEST(DestructionRuntime, TriangleBudgetAndFadingRetireDebris) {
     EXPECT_GT(nearSmall, 0);
     EXPECT_EQ(farSmall, 0) << "tiny pieces far from the focus faded";
     EXPECT_NE(far.runtime.bodyOf(farObject), nullptr) << "the game's own objects never fade";
+    EXPECT_GT(far.runtime.counters().retired.faded, 0);
+    EXPECT_EQ(far.runtime.counters().retired.faded, far.runtime.counters().piecesRetired);
 }
 
 TEST(DestructionRuntime, VolumeAccountingIsExactWithDustParticlesAndRetirement) {
@@ -297,7 +301,40 @@ TEST(DestructionRuntime, VolumeAccountingIsExactWithDustParticlesAndRetirement) 
     EXPECT_GT(rig.runtime.counters().fractures, 1);
     EXPECT_GT(v.dust, 0) << "some pieces were below the minimum volume";
     EXPECT_GT(v.retired, 0) << "the awake budget retired some pieces";
+    const RuntimeCounters& n = rig.runtime.counters();
+    EXPECT_GT(n.retired.dust, 0);
+    EXPECT_GT(n.retired.awake, 0);
+    EXPECT_EQ(n.retired.total(), n.piecesRetired) << "every retirement has one reason";
     EXPECT_LT(std::abs(v.total() - start) / start, 1e-9);
+}
+
+TEST(DestructionRuntime, BlastHitsEveryObjectInRangeWithAnImpulseFallingOffToItsEdge) {
+    ToyRig rig;
+    std::vector<ObjectId> boxes;
+    for (int i = 0; i < 5; ++i) // centres 0, 3, 6, 9, 12 m from the blast; bounding radius sqrt(0.75)
+        boxes.push_back(rig.addBox({0.5, 0.5, 0.5}, {3.0 * i, 0.5, 0}, true));
+    const ObjectId sturdy = rig.addBox({0.5, 0.5, 0.5}, {0, 0.5, 3}, true, {}, false); // not destructible
+    std::vector<JournalEvent> hits;
+    rig.runtime.world().setJournalSink([&](const JournalEvent& e) { hits.push_back(e); });
+    const double radius = 7, impulse = 1000;
+    EXPECT_EQ(rig.runtime.blast({0, 0.5, 0}, radius, impulse), 3) << "the boxes within 7 m plus their radius";
+    ASSERT_EQ(hits.size(), 3u);
+    double last = 2 * impulse;
+    for (std::size_t i = 0; i < hits.size(); ++i) {
+        EXPECT_EQ(hits[i].object, boxes[i]);
+        const double dist = 3.0 * static_cast<double>(i), r = std::sqrt(0.75);
+        const double share = 1 - 0.6 * std::clamp((dist - r) / radius, 0.0, 1.0);
+        EXPECT_NEAR(hits[i].impulse, impulse * share, 1e-6 * impulse); // the journal keeps floats
+        EXPECT_LE(hits[i].impulse, last) << "farther is weaker";
+        EXPECT_GE(hits[i].impulse, 0.4 * impulse);
+        last = hits[i].impulse;
+        if (i > 0) { // the hit is on the side facing the blast, inside the bounding sphere
+            EXPECT_NEAR(hits[i].point[0], -0.7 * r, 1e-6);
+            EXPECT_NEAR(hits[i].normal[0], -1, 1e-6);
+        }
+    }
+    EXPECT_EQ(rig.runtime.blast({0, 0.5, 0}, 0, impulse), 0) << "no radius, no blast";
+    EXPECT_NE(rig.runtime.bodyOf(sturdy), nullptr);
 }
 
 TEST(DestructionRuntime, PhysicsTimeBudgetShrinksTheAwakeBudgetOutsideDeterministicMode) {
