@@ -54,7 +54,7 @@ struct GameSettings {
     bool debugShapes = false;        ///< draw collision shapes
     bool debugAabbs = false;         ///< draw AABBs
     bool debugImpacts = false;       ///< draw impact points
-    bool structure = false;          ///< stress solver: overstressed bonds break (applied on restart)
+    bool structure = true;           ///< stress solver: overstressed bonds break (applied on restart)
     bool debugBonds = false;         ///< draw the structure's bonds, green (idle) to red (breaking)
     bool shadows = true;             ///< shadow mapping
     bool autoLevel = true;           ///< wings level themselves when no roll key is held (L toggles)

@@ -64,11 +64,12 @@ struct Options {
     bool noShadows = false;
     bool bilinear = false;
     bool showcase = false;
-    std::string record; // journal file written at exit
-    std::string replay; // journal file replayed on the loaded scene instead of playing
-    int host = 0;       // port to host loopback multiplayer on
-    std::string join;   // HOST:PORT of a host to follow
-    bool structure = false;
+    std::string record;           // journal file written at exit
+    std::string replay;           // journal file replayed on the loaded scene instead of playing
+    int host = 0;                 // port to host loopback multiplayer on
+    std::string join;             // HOST:PORT of a host to follow
+    bool structure = true;        // the stress solver (with bearings)
+    bool bonds = false;           // draw its bonds by stress
     std::string quality = "auto"; // auto (from GL_RENDERER), software or gpu
     float targetFps = 60;         // dynamic resolution holds this rate (software quality)
     float minScale = -1;          // smallest internal resolution scale (-1: the quality's)
@@ -278,8 +279,10 @@ int main(int argc, char** argv) {
            "smallest internal resolution scale per axis dynamic resolution may use to hold --target-fps "
            "(default 1 = off; 0.667 keeps 1280x720 at 1080p)")
         ->check(CLI::Range(0.25, 1.0));
-    cli.add_flag("--structure", o.structure,
-                 "stress solver: bonds between static parts break under load; draws them by stress");
+    cli.add_flag("--structure,!--no-structure", o.structure,
+                 "stress solver (default on): bonds between static parts carry their load, objects rest on "
+                 "each other as bearings; --structure also draws the bonds by stress");
+    cli.add_flag("--bonds", o.bonds, "draw the structure's bonds by stress");
     CLI11_PARSE(cli, argc, argv);
 
     const bool haveDisplay = std::getenv("DISPLAY") && *std::getenv("DISPLAY");
@@ -350,7 +353,8 @@ int main(int argc, char** argv) {
     app.pending.fracture.sizeLaw = demo::demoSizeLaw(app.pending.fracture.pattern);
     app.pending.fracture.uvScale = 0.25;
     app.pending.debugShapes = app.pending.debugAabbs = app.pending.debugImpacts = o.debug;
-    app.pending.structure = app.pending.debugBonds = o.structure;
+    app.pending.structure = o.structure;
+    app.pending.debugBonds = o.structure && (o.bonds || cli.count("--structure") > 0);
     app.pending.showcase = o.showcase;
 
     std::string error;

@@ -4,7 +4,10 @@
 /// computed from their convex parts.
 
 #include <cstdint>
+#include <unordered_map>
 #include <vector>
+
+#include "rubble/Aabb.hpp"
 
 #include "rubble/ConvexPolytope.hpp"
 #include "rubble/Vec3.hpp"
@@ -47,5 +50,49 @@ BondInterface bondInterface(const std::vector<ConvexPolytope>& a, const std::vec
 /// Bonds between every pair of touching solids, ordered by (a, b).
 std::vector<Bond> buildBonds(const std::vector<std::vector<ConvexPolytope>>& solids,
                              const BondSettings& settings);
+
+/// Bonds kept up to date as solids come and go, equal to buildBonds over the solids present: an added solid
+/// bonds only to the solids whose bounds overlap its own (a uniform grid over the solids' boxes, kept across
+/// calls), a removed one takes only its own bonds. Ids are the solids' indices in buildBonds' terms.
+class BondGraph {
+public:
+    /// An empty graph; cellSize (m) is the grid's cell edge.
+    explicit BondGraph(BondSettings settings = {}, double cellSize = 1);
+
+    /// Adds solid `id` (not present; parts in world coordinates) and returns its new bonds, ordered by the
+    /// other solid; each has a < b and its normal from a to b, as buildBonds.
+    std::vector<Bond> add(std::uint32_t id, std::vector<ConvexPolytope> parts);
+    /// Removes a solid with its bonds; returns the solids it was bonded to, ascending.
+    std::vector<std::uint32_t> remove(std::uint32_t id);
+    /// True when the solid is present.
+    bool contains(std::uint32_t id) const { return solids_.count(id) > 0; }
+    /// Solids present.
+    std::size_t size() const { return solids_.size(); }
+    /// Bonds present.
+    std::size_t bondCount() const { return bonds_.size(); }
+    /// Every bond, ordered by (a, b).
+    std::vector<Bond> bonds() const;
+    /// Solids whose grid cells were searched by the last add (a measure of the broad phase's work).
+    std::size_t lastCandidates() const { return lastCandidates_; }
+
+private:
+    struct Solid {
+        std::vector<ConvexPolytope> parts;
+        Aabb box;
+        bool large = false;            // in large_, not in the grid
+        std::int64_t lo[3]{}, hi[3]{}; // cell range
+        std::vector<std::uint32_t> adjacent;
+    };
+    static std::uint64_t key(std::uint32_t a, std::uint32_t b) { return (std::uint64_t{a} << 32) | b; }
+    std::uint64_t cellKey(std::int64_t x, std::int64_t y, std::int64_t z) const;
+
+    BondSettings settings_;
+    double cellSize_;
+    std::unordered_map<std::uint32_t, Solid> solids_;
+    std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> cells_;
+    std::vector<std::uint32_t> large_; // solids spanning too many cells: checked against every add
+    std::unordered_map<std::uint64_t, BondInterface> bonds_; // key(a, b), a < b
+    std::size_t lastCandidates_ = 0;
+};
 
 } // namespace rubble

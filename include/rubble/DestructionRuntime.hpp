@@ -99,14 +99,17 @@ struct SupportPolicy {
 struct StructurePolicy {
     bool enabled = false;              ///< off: support is connectivity only (SupportPolicy)
     BondSettings bonds{0.02, 1, 1e-4}; ///< what counts as a bond (gap as SupportPolicy::tolerance)
-    StressSettings stress;             ///< solver iterations (gravity is the binding's)
-    double damageRadius = 1.0;         ///< impacts weaken bonds within this distance (m) of the hit
-    double damagePerImpulse = 1e-4;    ///< health a bond at the hit loses per N·s of impulse
+    StressSettings stress{12, 0.05}; ///< solver sweeps a frame, at most 12 (the first solve after objects are
+                                     ///< placed: 120), fewer once every node is at rest within 0.05 m/s^2 (a
+                                     ///< tenth of `unbalanced`); gravity is the binding's
+    double damageRadius = 1.0;       ///< impacts weaken bonds within this distance (m) of the hit
+    double damagePerImpulse = 1e-4;  ///< health a bond at the hit loses per N·s of impulse
     bool bondDebris = false; ///< a static object's debris stays in the structure, bonded across its cut faces
                              ///< until the solver breaks it (a partial crack); false: thrown, no bonds
-    double bearingFriction = 0; ///< > 0: objects (and what is cut from them) rest on each other as bearings
-                                ///< with this friction coefficient (compression and friction only); 0:
-                                ///< welded. Cut faces within one object stay welded
+    double bearingFriction = 0.6; ///< > 0: objects (and what is cut from them) rest on each other as
+                                  ///< bearings with this friction coefficient (compression and friction
+                                  ///< only; 0.6: concrete on hardened concrete, ACI 318); 0: welded. Cut
+                                  ///< faces within one object stay welded
 };
 
 /// A bond of the structure, for debug drawing.

@@ -45,7 +45,10 @@ struct BondStress {
 
 /// Settings of the stress solver.
 struct StressSettings {
-    int iterations = 25;       ///< Gauss-Seidel sweeps over all bonds per solve()
+    int iterations = 25;       ///< Gauss-Seidel sweeps over all bonds per solve(), at most
+    double tolerance = 0.01;   ///< m/s^2 (and rad/s^2): fewer sweeps once every bonded node's remaining
+                               ///< acceleration is below it (a warm-started, unchanged structure needs none);
+                               ///< 0: always `iterations`
     Vec3 gravity{0, -9.81, 0}; ///< m/s^2
     double unbalanced = 0.5;   ///< m/s^2 (and rad/s^2): a node left accelerating this much is not held
     int unbalancedSolves = 30; ///< ... after this many solves in a row (the warm-started solve converges)
@@ -59,6 +62,21 @@ public:
 
     /// Replaces the structure; limits[i] belongs to bonds[i]. Accumulated forces and health are reset.
     void reset(std::vector<StructureNode> nodes, std::vector<Bond> bonds, std::vector<StrengthLimits> limits);
+    /// Adds a node (in a free slot when there is one); returns its index.
+    std::uint32_t addNode(const StructureNode& node);
+    /// Removes a node and its bonds; its index is free for a later addNode.
+    void removeNode(std::uint32_t node);
+    /// Adds a bond between present nodes (in a free slot when there is one); returns its index. The other
+    /// bonds keep their forces and health.
+    std::size_t addBond(Bond bond, StrengthLimits limits);
+    /// Makes a node a root (held) or not; its bonds' effective masses follow.
+    void setRoot(std::uint32_t node, bool root);
+    /// True when the node is present (added and not removed).
+    bool present(std::uint32_t node) const { return node < nodes_.size() && !nodes_[node].removed; }
+    /// True when the node is held (a root).
+    bool root(std::uint32_t node) const { return nodes_[node].node.root; }
+    /// The bonds of a node (broken ones included), ascending.
+    const std::vector<std::size_t>& bondsOf(std::uint32_t node) const { return nodes_[node].bonds; }
     /// Settings (may change between solves).
     StressSettings& settings() { return settings_; }
 
@@ -67,9 +85,11 @@ public:
     /// Runs the bounded iterations, starting from the previous solve's bond forces; consumes the loads.
     void solve();
 
-    /// Bonds.
+    /// Sweeps the last solve() ran.
+    int sweeps() const { return sweeps_; }
+    /// Bond slots (removed bonds leave free slots, which count as broken).
     std::size_t bondCount() const { return bonds_.size(); }
-    /// Nodes.
+    /// Node slots (removed nodes leave free slots, never unsupported).
     std::size_t nodeCount() const { return nodes_.size(); }
     /// The bond (its section and nodes).
     const Bond& bond(std::size_t i) const { return bonds_[i].bond; }
@@ -113,8 +133,10 @@ private:
         Vec3 v, w;          // velocity change this solve
         Vec3 force, torque; // loads this solve
         bool detached = false;
-        int unbalanced = 0;   // solves in a row that left it accelerating
-        bool bearing = false; // rests on (or carries) a bearing
+        bool removed = false;           // a free slot
+        int unbalanced = 0;             // solves in a row that left it accelerating
+        int bearings = 0;               // bearings it rests on (or carries)
+        std::vector<std::size_t> bonds; // ascending
     };
     struct BearingCorner {
         Vec3 offset;                   // from the section centroid (world)
@@ -122,6 +144,8 @@ private:
         double kn = 0, ku = 0, kv = 0; // inverse effective masses along the normal and the in-plane axes
         double press = 0;              // accumulated normal force (>= 0: compression)
         double gu = 0, gv = 0;         // accumulated friction along u and v (|g| <= friction * press)
+        Vec3 ca[3], cb[3];             // ra x d and rb x d for d = normal, u, v
+        Vec3 ia[3], ib[3];             // the inverse inertias times those: the spin an impulse along d gives
     };
     struct BondState {
         Bond bond;
@@ -132,15 +156,23 @@ private:
         Vec3 force, moment; // accumulated (warm start)
         double health = 1;
         bool broken = false;
+        bool removed = false;               // a free slot
         std::vector<BearingCorner> corners; // bearing: contact points at the patch's hull corners
     };
+    void prepare(BondState& b);
+    void removeBond(std::size_t i);
     void apply(BondState& b, const Vec3& force, const Vec3& moment);
     double bearingUtilisation(const BondState& b) const;
     void solveBearing(BondState& b);
+    void gatherBearing(BondState& b);
 
     StressSettings settings_;
     std::vector<NodeState> nodes_;
     std::vector<BondState> bonds_;
+    std::vector<std::uint32_t> freeNodes_; // descending pops give the lowest slot first
+    std::vector<std::uint32_t> checked_;   // solve(): the nodes whose rest ends the sweeps
+    int sweeps_ = 0;
+    std::vector<std::size_t> freeBonds_;
 };
 
 } // namespace rubble

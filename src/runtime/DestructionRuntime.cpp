@@ -205,9 +205,9 @@ struct DestructionRuntime::Impl {
 
     // A node of the structure (when enabled).
     void addStructure(BodyId id, const std::vector<ConvexPolytope>& worldParts, const Material& m, bool root,
-                      std::uint64_t solid) {
+                      std::uint64_t solid, bool classify = false) {
         if (config.structure.enabled)
-            structure.add(id, worldParts, m, root, solid);
+            structure.add(id, worldParts, m, root, solid, classify);
     }
 
     // The solid an object was cut from: its own id for a scene object, its ancestor's for a piece.
@@ -249,6 +249,7 @@ struct DestructionRuntime::Impl {
             config.structure.enabled && config.structure.bondDebris);
         const bool parentResting = !moving(parent);
         const std::uint64_t parentSolid = solidOf(parent.object);
+        const bool parentAnchored = structure.anchored(parent.id); // its pieces may float as it did
         // The world removed the parent object already; what it held wakes near its flying debris (below).
         destroy(parent.id, false, false);
         ++stats.fractures;
@@ -268,7 +269,7 @@ struct DestructionRuntime::Impl {
                 solids[s.object] = parentSolid;
             if (s.structural) {
                 const auto parts = worldParts(st, s.desc.transform * s.objectToBody.inverse());
-                addStructure(made.id, parts, material, s.anchor, parentSolid);
+                addStructure(made.id, parts, material, s.anchor, parentSolid, parentAnchored);
                 support.add(made.id, parts, s.anchor);
                 support.queue(made.id);
             }
@@ -446,7 +447,7 @@ Result<ObjectId> DestructionRuntime::addObject(ObjectDesc desc, const Frame& pla
     const BodyId body = im.insert(rec, s.desc).id;
     if (isStatic) {
         const auto parts = worldParts(st, placement);
-        im.addStructure(body, parts, *material, false, *id);
+        im.addStructure(body, parts, *material, false, *id, true);
         im.support.add(body, parts, false, true);
     }
     return id;

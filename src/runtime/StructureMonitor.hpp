@@ -2,7 +2,6 @@
 // The structure's bonds and stresses over the static structural bodies: which bonds break, what falls.
 
 #include <map>
-#include <set>
 #include <utility>
 #include <vector>
 
@@ -10,23 +9,27 @@
 
 namespace rubble::detail {
 
-/// Static structural bodies as stress-solver nodes. The bond graph is rebuilt from their convex parts when
-/// the set changes (bond health and broken bonds carry over by body pair); every step solves, breaks
-/// overstressed bonds and reports the bodies no chain of bonds holds up any more. Components that no bond
-/// links to a root when the graph is built hold themselves up (as SupportGraph's anchors).
+/// Static structural bodies as stress-solver nodes. The bond graph follows the set incrementally: an added
+/// body bonds to the nodes it touches (BondGraph's grid), a removed one takes only its own bonds, and every
+/// other bond keeps its health, broken state and warm-started forces. Every step solves, breaks overstressed
+/// bonds and reports the bodies no chain of bonds holds up any more. Nodes added with `classify` whose
+/// component reaches no root at the next step hold themselves up (anchors, as SupportGraph's).
 class StructureMonitor {
 public:
-    /// Reads the policy at every call.
-    explicit StructureMonitor(const StructurePolicy& policy) : policy_(policy) {}
+    /// Reads the policy at every call (its bond settings at construction).
+    explicit StructureMonitor(const StructurePolicy& policy);
 
     /// Adds a node (parts in world coordinates); `solid` names the object it was cut from (bonds between
-    /// different solids are bearings when the policy says so).
+    /// different solids are bearings when the policy says so). `classify`: decide at the next step whether
+    /// it floats (an object placed in the air, or a piece of an anchor, becomes an anchor).
     void add(BodyId id, const std::vector<ConvexPolytope>& worldParts, const Material& material, bool root,
-             std::uint64_t solid);
+             std::uint64_t solid, bool classify = false);
     /// Removes a node; its bonds go with it.
     void remove(BodyId id);
     /// True when id is a node.
     bool contains(BodyId id) const { return nodes_.count(id) > 0; }
+    /// True when id is a node that holds itself up by the anchor rule.
+    bool anchored(BodyId id) const;
     /// A load on a node for the next step (a contact force, N, at a world point).
     void addLoad(BodyId id, const Vec3& force, const Vec3& point);
     /// Weakens the bonds near a hit.
@@ -34,35 +37,32 @@ public:
     /// Solves under gravity, breaks overstressed bonds (counted in `broken`); returns the bodies that lost
     /// their support, ascending.
     std::vector<BodyId> step(const Vec3& gravity, int& broken);
-    /// Bonds with their stress, ordered by (a, b).
+    /// Bonds with their stress, a < b, ordered by (a, b).
     std::vector<StructureBond> bonds() const;
     /// Nodes.
     std::size_t size() const { return nodes_.size(); }
 
 private:
     struct Node {
-        std::vector<ConvexPolytope> parts;
         const Material* material = nullptr;
-        StructureNode node;
         std::uint64_t solid = 0;
+        std::uint32_t slot = 0; // solver node and bond-graph solid
+        bool anchor = false;
     };
-    using Pair = std::pair<BodyId, BodyId>;
-    void rebuild();
-    Pair pairOf(std::size_t bond) const;
+    void classify();
 
     const StructurePolicy& policy_;
     std::map<BodyId, Node> nodes_;
-    std::vector<BodyId> order_; // solver node index -> body
-    std::map<Pair, double> health_;
-    std::set<Pair> broken_;
+    std::vector<BodyId> bodyOf_; // solver slot -> body (0: free)
+    std::vector<BodyId> unclassified_;
     std::vector<std::pair<Vec3, double>> pendingDamage_;
     struct Load {
         BodyId id;
         Vec3 force, point;
     };
     std::vector<Load> pendingLoads_;
+    BondGraph graph_;
     StressSolver solver_;
-    bool dirty_ = false;
 };
 
 } // namespace rubble::detail

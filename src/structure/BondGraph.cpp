@@ -206,4 +206,110 @@ std::vector<Bond> buildBonds(const std::vector<std::vector<ConvexPolytope>>& sol
     return bonds;
 }
 
+namespace {
+
+constexpr std::int64_t kMaxCells = 512; // a solid spanning more grid cells is checked against every add
+
+Aabb boundsOf(const std::vector<ConvexPolytope>& parts) {
+    Aabb box;
+    for (const ConvexPolytope& p : parts)
+        box.extend(p.bounds());
+    return box;
+}
+
+} // namespace
+
+BondGraph::BondGraph(BondSettings settings, double cellSize) : settings_(settings), cellSize_(cellSize) {}
+
+std::uint64_t BondGraph::cellKey(std::int64_t x, std::int64_t y, std::int64_t z) const {
+    // 21 bits per axis (wrapping): distinct cells may share a key, which only adds candidates
+    const auto bits = [](std::int64_t v) { return static_cast<std::uint64_t>(v) & 0x1fffff; };
+    return bits(x) | (bits(y) << 21) | (bits(z) << 42);
+}
+
+std::vector<Bond> BondGraph::add(std::uint32_t id, std::vector<ConvexPolytope> parts) {
+    Solid s;
+    s.parts = std::move(parts);
+    s.box = boundsOf(s.parts);
+    std::vector<std::uint32_t> candidates;
+    if (!s.parts.empty()) {
+        std::int64_t cells = 1;
+        for (int k = 0; k < 3; ++k) {
+            s.lo[k] = static_cast<std::int64_t>(std::floor((s.box.lo[k] - settings_.gap) / cellSize_));
+            s.hi[k] = static_cast<std::int64_t>(std::floor((s.box.hi[k] + settings_.gap) / cellSize_));
+            cells *= std::min<std::int64_t>(s.hi[k] - s.lo[k] + 1, kMaxCells + 1);
+        }
+        s.large = cells > kMaxCells;
+        if (s.large) {
+            for (const auto& [other, o] : solids_)
+                candidates.push_back(other);
+        } else {
+            for (std::int64_t x = s.lo[0]; x <= s.hi[0]; ++x)
+                for (std::int64_t y = s.lo[1]; y <= s.hi[1]; ++y)
+                    for (std::int64_t z = s.lo[2]; z <= s.hi[2]; ++z) {
+                        std::vector<std::uint32_t>& cell = cells_[cellKey(x, y, z)];
+                        candidates.insert(candidates.end(), cell.begin(), cell.end());
+                        cell.push_back(id);
+                    }
+            candidates.insert(candidates.end(), large_.begin(), large_.end());
+        }
+    }
+    std::sort(candidates.begin(), candidates.end());
+    candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+    lastCandidates_ = candidates.size();
+    std::vector<Bond> out;
+    for (std::uint32_t other : candidates) {
+        Solid& o = solids_.at(other);
+        if (o.parts.empty() || apart(s.box, o.box, settings_.gap))
+            continue;
+        const std::uint32_t a = std::min(id, other), b = std::max(id, other);
+        BondInterface x = bondInterface(a == id ? s.parts : o.parts, a == id ? o.parts : s.parts, settings_);
+        if (x.area <= 0)
+            continue;
+        s.adjacent.push_back(other);
+        o.adjacent.push_back(id);
+        bonds_.emplace(key(a, b), x);
+        out.push_back({a, b, std::move(x)});
+    }
+    if (s.large)
+        large_.push_back(id);
+    solids_.emplace(id, std::move(s));
+    return out;
+}
+
+std::vector<std::uint32_t> BondGraph::remove(std::uint32_t id) {
+    const auto it = solids_.find(id);
+    if (it == solids_.end())
+        return {};
+    Solid& s = it->second;
+    if (s.large)
+        std::erase(large_, id);
+    else if (!s.parts.empty())
+        for (std::int64_t x = s.lo[0]; x <= s.hi[0]; ++x)
+            for (std::int64_t y = s.lo[1]; y <= s.hi[1]; ++y)
+                for (std::int64_t z = s.lo[2]; z <= s.hi[2]; ++z) {
+                    const auto cell = cells_.find(cellKey(x, y, z));
+                    std::erase(cell->second, id);
+                    if (cell->second.empty())
+                        cells_.erase(cell);
+                }
+    std::vector<std::uint32_t> out = std::move(s.adjacent);
+    for (std::uint32_t other : out) {
+        std::erase(solids_.at(other).adjacent, id);
+        bonds_.erase(key(std::min(id, other), std::max(id, other)));
+    }
+    solids_.erase(it);
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+std::vector<Bond> BondGraph::bonds() const {
+    std::vector<Bond> out;
+    for (const auto& [k, x] : bonds_)
+        out.push_back({static_cast<std::uint32_t>(k >> 32), static_cast<std::uint32_t>(k), x});
+    std::sort(out.begin(), out.end(),
+              [](const Bond& x, const Bond& y) { return x.a < y.a || (x.a == y.a && x.b < y.b); });
+    return out;
+}
+
 } // namespace rubble

@@ -128,62 +128,143 @@ void StressSolver::reset(std::vector<StructureNode> nodes, std::vector<Bond> bon
                          std::vector<StrengthLimits> limits) {
     nodes_.clear();
     bonds_.clear();
-    for (StructureNode& n : nodes) {
-        NodeState s;
-        s.node = n;
-        if (!n.root && n.mass > 0) {
-            s.invMass = 1 / n.mass;
-            s.invInertia = inverse(n.inertia);
-        }
-        nodes_.push_back(s);
+    freeNodes_.clear();
+    freeBonds_.clear();
+    for (const StructureNode& n : nodes)
+        (void)addNode(n);
+    for (std::size_t i = 0; i < bonds.size(); ++i)
+        (void)addBond(std::move(bonds[i]), i < limits.size() ? limits[i] : StrengthLimits{});
+}
+
+std::uint32_t StressSolver::addNode(const StructureNode& node) {
+    NodeState s;
+    s.node = node;
+    if (!node.root && node.mass > 0) {
+        s.invMass = 1 / node.mass;
+        s.invInertia = inverse(node.inertia);
     }
-    for (std::size_t i = 0; i < bonds.size(); ++i) {
-        BondState s;
-        s.bond = std::move(bonds[i]);
-        s.limits = i < limits.size() ? limits[i] : StrengthLimits{};
-        const NodeState& a = nodes_[s.bond.a];
-        const NodeState& b = nodes_[s.bond.b];
-        s.ra = s.bond.section.centroid - a.node.centroid;
-        s.rb = s.bond.section.centroid - b.node.centroid;
-        if (s.limits.friction > 0) {
-            nodes_[s.bond.a].bearing = nodes_[s.bond.b].bearing = true;
-            const BondInterface& x = s.bond.section;
-            auto inverseMass = [&](const Vec3& ra, const Vec3& rb, const Vec3& d) {
-                const Vec3 ca = cross(ra, d), cb = cross(rb, d);
-                return a.invMass + b.invMass + dot(ca, a.invInertia * ca) + dot(cb, b.invInertia * cb);
-            };
-            for (const Vec2& c : bearingCorners(x.corners)) {
-                BearingCorner k;
-                k.offset = x.u * c.x + x.v * c.y;
-                k.ra = s.ra + k.offset;
-                k.rb = s.rb + k.offset;
-                k.kn = inverseMass(k.ra, k.rb, x.normal);
-                k.ku = inverseMass(k.ra, k.rb, x.u);
-                k.kv = inverseMass(k.ra, k.rb, x.v);
-                s.corners.push_back(k);
-            }
-            s.solvable = !s.corners.empty() && s.corners.front().kn > 0;
-            bonds_.push_back(std::move(s));
-            continue;
-        }
-        // Effective mass of the weld at the section centroid: impulse (P, L) on a, (-P, -L) on b.
-        const Eigen::Matrix3d ia = toEigen(a.invInertia), ib = toEigen(b.invInertia);
-        const Eigen::Matrix3d sa = skew(s.ra), sb = skew(s.rb);
-        Mat6 k;
-        k.topLeftCorner<3, 3>() =
-            (a.invMass + b.invMass) * Eigen::Matrix3d::Identity() - sa * ia * sa - sb * ib * sb;
-        k.topRightCorner<3, 3>() = -sa * ia - sb * ib;
-        k.bottomLeftCorner<3, 3>() = ia * sa + ib * sb;
-        k.bottomRightCorner<3, 3>() = ia + ib;
-        const Eigen::FullPivLU<Mat6> lu(k);
-        if (lu.isInvertible()) {
-            const Mat6 inv = lu.inverse();
-            for (int r = 0; r < 6; ++r)
-                for (int c = 0; c < 6; ++c)
-                    s.kinv[r * 6 + c] = inv(r, c);
-            s.solvable = true;
-        }
+    if (freeNodes_.empty()) {
+        nodes_.push_back(std::move(s));
+        return static_cast<std::uint32_t>(nodes_.size() - 1);
+    }
+    const std::uint32_t i = freeNodes_.back();
+    freeNodes_.pop_back();
+    nodes_[i] = std::move(s);
+    return i;
+}
+
+void StressSolver::removeNode(std::uint32_t node) {
+    NodeState& n = nodes_[node];
+    if (n.removed)
+        return;
+    for (std::size_t b : std::vector<std::size_t>(n.bonds))
+        removeBond(b);
+    n = NodeState{};
+    n.removed = n.detached = true;
+    freeNodes_.insert(std::upper_bound(freeNodes_.begin(), freeNodes_.end(), node, std::greater<>()), node);
+}
+
+std::size_t StressSolver::addBond(Bond bond, StrengthLimits limits) {
+    BondState s;
+    s.bond = std::move(bond);
+    s.limits = limits;
+    prepare(s);
+    std::size_t i = bonds_.size();
+    if (freeBonds_.empty()) {
         bonds_.push_back(std::move(s));
+    } else {
+        i = freeBonds_.back();
+        freeBonds_.pop_back();
+        bonds_[i] = std::move(s);
+    }
+    for (std::uint32_t n : {bonds_[i].bond.a, bonds_[i].bond.b}) {
+        std::vector<std::size_t>& list = nodes_[n].bonds;
+        list.insert(std::upper_bound(list.begin(), list.end(), i), i);
+        nodes_[n].bearings += limits.friction > 0;
+    }
+    return i;
+}
+
+void StressSolver::removeBond(std::size_t i) {
+    BondState& b = bonds_[i];
+    for (std::uint32_t n : {b.bond.a, b.bond.b}) {
+        std::erase(nodes_[n].bonds, i);
+        nodes_[n].bearings -= b.limits.friction > 0;
+    }
+    b = BondState{};
+    b.removed = b.broken = true;
+    freeBonds_.insert(std::upper_bound(freeBonds_.begin(), freeBonds_.end(), i, std::greater<>()), i);
+}
+
+void StressSolver::setRoot(std::uint32_t node, bool root) {
+    NodeState& n = nodes_[node];
+    n.node.root = root;
+    n.invMass = 0;
+    n.invInertia = Mat3{};
+    if (!root && n.node.mass > 0) {
+        n.invMass = 1 / n.node.mass;
+        n.invInertia = inverse(n.node.inertia);
+    }
+    for (std::size_t i : n.bonds)
+        prepare(bonds_[i]);
+}
+
+// The lever arms and the inverse effective masses of a bond (or of a bearing's corners).
+void StressSolver::prepare(BondState& s) {
+    const NodeState& a = nodes_[s.bond.a];
+    const NodeState& b = nodes_[s.bond.b];
+    s.ra = s.bond.section.centroid - a.node.centroid;
+    s.rb = s.bond.section.centroid - b.node.centroid;
+    s.solvable = false;
+    if (s.limits.friction > 0) {
+        const BondInterface& x = s.bond.section;
+        auto inverseMass = [&](const Vec3& ra, const Vec3& rb, const Vec3& d) {
+            const Vec3 ca = cross(ra, d), cb = cross(rb, d);
+            return a.invMass + b.invMass + dot(ca, a.invInertia * ca) + dot(cb, b.invInertia * cb);
+        };
+        const std::vector<BearingCorner> old = std::move(s.corners);
+        s.corners.clear();
+        for (const Vec2& c : bearingCorners(x.corners)) {
+            BearingCorner k;
+            k.offset = x.u * c.x + x.v * c.y;
+            k.ra = s.ra + k.offset;
+            k.rb = s.rb + k.offset;
+            k.kn = inverseMass(k.ra, k.rb, x.normal);
+            k.ku = inverseMass(k.ra, k.rb, x.u);
+            k.kv = inverseMass(k.ra, k.rb, x.v);
+            const Vec3 dir[3] = {x.normal, x.u, x.v};
+            for (int j = 0; j < 3; ++j) {
+                k.ca[j] = cross(k.ra, dir[j]);
+                k.cb[j] = cross(k.rb, dir[j]);
+                k.ia[j] = a.invInertia * k.ca[j];
+                k.ib[j] = b.invInertia * k.cb[j];
+            }
+            if (s.corners.size() < old.size()) { // keep the warm start
+                k.press = old[s.corners.size()].press;
+                k.gu = old[s.corners.size()].gu;
+                k.gv = old[s.corners.size()].gv;
+            }
+            s.corners.push_back(k);
+        }
+        s.solvable = !s.corners.empty() && s.corners.front().kn > 0;
+        return;
+    }
+    // Effective mass of the weld at the section centroid: impulse (P, L) on a, (-P, -L) on b.
+    const Eigen::Matrix3d ia = toEigen(a.invInertia), ib = toEigen(b.invInertia);
+    const Eigen::Matrix3d sa = skew(s.ra), sb = skew(s.rb);
+    Mat6 k;
+    k.topLeftCorner<3, 3>() =
+        (a.invMass + b.invMass) * Eigen::Matrix3d::Identity() - sa * ia * sa - sb * ib * sb;
+    k.topRightCorner<3, 3>() = -sa * ia - sb * ib;
+    k.bottomLeftCorner<3, 3>() = ia * sa + ib * sb;
+    k.bottomRightCorner<3, 3>() = ia + ib;
+    const Eigen::FullPivLU<Mat6> lu(k);
+    if (lu.isInvertible()) {
+        const Mat6 inv = lu.inverse();
+        for (int r = 0; r < 6; ++r)
+            for (int c = 0; c < 6; ++c)
+                s.kinv[r * 6 + c] = inv(r, c);
+        s.solvable = true;
     }
 }
 
@@ -216,9 +297,33 @@ void StressSolver::solve() {
     for (BondState& b : bonds_)
         if (!b.broken && b.solvable)
             apply(b, b.force, b.moment);
-    for (int it = 0; it < settings_.iterations; ++it)
+    // Sweeps stop early once every node a bond can still move is at rest within the tolerance.
+    checked_.clear();
+    for (std::uint32_t i = 0; i < nodes_.size(); ++i)
+        if (nodes_[i].invMass > 0 && !nodes_[i].detached)
+            for (std::size_t k : nodes_[i].bonds)
+                if (!bonds_[k].broken && bonds_[k].solvable) {
+                    checked_.push_back(i);
+                    break;
+                }
+    const double tolerance2 = settings_.tolerance * settings_.tolerance;
+    auto converged = [&] {
+        if (settings_.tolerance <= 0)
+            return false;
+        for (std::uint32_t i : checked_)
+            if (lengthSquared(nodes_[i].v) > tolerance2 || lengthSquared(nodes_[i].w) > tolerance2)
+                return false;
+        return true;
+    };
+    // A bond between two nodes at rest within a quarter of the tolerance would change by less: it is skipped
+    // (within the whole tolerance, the nodes just below it would never be corrected, and the sweeps not end).
+    const double quiet2 = tolerance2 / 16;
+    auto resting = [&](const NodeState& n) {
+        return settings_.tolerance > 0 && lengthSquared(n.v) <= quiet2 && lengthSquared(n.w) <= quiet2;
+    };
+    for (sweeps_ = 0; sweeps_ < settings_.iterations && !converged(); ++sweeps_)
         for (BondState& b : bonds_) {
-            if (b.broken || !b.solvable)
+            if (b.broken || !b.solvable || (resting(nodes_[b.bond.a]) && resting(nodes_[b.bond.b])))
                 continue;
             if (!b.corners.empty()) {
                 solveBearing(b);
@@ -241,9 +346,12 @@ void StressSolver::solve() {
             b.moment += dm;
             apply(b, df, dm);
         }
+    for (BondState& b : bonds_)
+        if (!b.broken && b.solvable && !b.corners.empty())
+            gatherBearing(b);
     for (NodeState& n : nodes_) {
         const bool moving = length(n.v) > settings_.unbalanced || length(n.w) > settings_.unbalanced;
-        n.unbalanced = n.bearing && n.invMass > 0 && !n.detached && moving ? n.unbalanced + 1 : 0;
+        n.unbalanced = n.bearings > 0 && n.invMass > 0 && !n.detached && moving ? n.unbalanced + 1 : 0;
     }
 }
 
@@ -282,31 +390,45 @@ BondStress StressSolver::stress(std::size_t i) const {
 
 void StressSolver::solveBearing(BondState& b) {
     const BondInterface& x = b.bond.section;
-    const NodeState& na = nodes_[b.bond.a];
-    const NodeState& nb = nodes_[b.bond.b];
-    auto push = [&](const BearingCorner& k, const Vec3& f) {
-        b.force += f;
-        b.moment += cross(k.offset, f);
-        apply(b, f, cross(k.offset, f));
+    NodeState& na = nodes_[b.bond.a];
+    NodeState& nb = nodes_[b.bond.b];
+    const Vec3 dir[3] = {x.normal, x.u, x.v};
+    // The corner's relative velocity along dir[j], and an impulse l along dir[j] on a (-l on b), through the
+    // corner's precomputed lever arms (no matrix products in the sweep).
+    auto relative = [&](const BearingCorner& k, int j) {
+        return dot(na.v - nb.v, dir[j]) + dot(na.w, k.ca[j]) - dot(nb.w, k.cb[j]);
     };
-    auto relative = [&](const BearingCorner& k) {
-        return (na.v + cross(na.w, k.ra)) - (nb.v + cross(nb.w, k.rb));
+    auto push = [&](const BearingCorner& k, int j, double l) {
+        na.v += dir[j] * (l * na.invMass);
+        na.w += k.ia[j] * l;
+        nb.v -= dir[j] * (l * nb.invMass);
+        nb.w -= k.ib[j] * l;
     };
     for (BearingCorner& k : b.corners) {
         // a corner's force acts on a (its opposite on b): b pushing a away is -normal * press
-        const double press = std::max(0.0, k.press + dot(relative(k), x.normal) / k.kn);
-        push(k, x.normal * -(press - k.press));
+        const double press = std::max(0.0, k.press + relative(k, 0) / k.kn);
+        push(k, 0, -(press - k.press));
         k.press = press;
-        const Vec3 rel = relative(k);
-        double gu = k.gu - dot(rel, x.u) / k.ku, gv = k.gv - dot(rel, x.v) / k.kv;
+        double gu = k.gu - relative(k, 1) / k.ku, gv = k.gv - relative(k, 2) / k.kv;
         const double grip = b.limits.friction * k.press, g = std::sqrt(gu * gu + gv * gv);
         if (g > grip) {
             gu *= grip / g;
             gv *= grip / g;
         }
-        push(k, x.u * (gu - k.gu) + x.v * (gv - k.gv));
+        push(k, 1, gu - k.gu);
+        push(k, 2, gv - k.gv);
         k.gu = gu;
         k.gv = gv;
+    }
+}
+
+void StressSolver::gatherBearing(BondState& b) {
+    const BondInterface& x = b.bond.section;
+    b.force = b.moment = Vec3{};
+    for (const BearingCorner& k : b.corners) {
+        const Vec3 f = x.normal * -k.press + x.u * k.gu + x.v * k.gv;
+        b.force += f;
+        b.moment += cross(k.offset, f);
     }
 }
 
@@ -395,18 +517,11 @@ void StressSolver::breakBond(std::size_t i) {
 
 void StressSolver::detach(std::uint32_t node) {
     nodes_[node].detached = true;
-    for (std::size_t i = 0; i < bonds_.size(); ++i)
-        if (bonds_[i].bond.a == node || bonds_[i].bond.b == node)
-            breakBond(i);
+    for (std::size_t i : nodes_[node].bonds)
+        breakBond(i);
 }
 
 std::vector<std::uint32_t> StressSolver::unsupported() const {
-    std::vector<std::vector<std::uint32_t>> adjacent(nodes_.size());
-    for (const BondState& b : bonds_)
-        if (!b.broken) {
-            adjacent[b.bond.a].push_back(b.bond.b);
-            adjacent[b.bond.b].push_back(b.bond.a);
-        }
     std::vector<char> reached(nodes_.size(), 0);
     std::deque<std::uint32_t> open;
     for (std::uint32_t i = 0; i < nodes_.size(); ++i)
@@ -417,11 +532,14 @@ std::vector<std::uint32_t> StressSolver::unsupported() const {
     while (!open.empty()) {
         const std::uint32_t n = open.front();
         open.pop_front();
-        for (std::uint32_t m : adjacent[n])
-            if (!reached[m]) {
+        for (std::size_t i : nodes_[n].bonds) {
+            const BondState& b = bonds_[i];
+            const std::uint32_t m = b.bond.a == n ? b.bond.b : b.bond.a;
+            if (!b.broken && !reached[m]) {
                 reached[m] = 1;
                 open.push_back(m);
             }
+        }
     }
     std::vector<std::uint32_t> out;
     for (std::uint32_t i = 0; i < nodes_.size(); ++i)

@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
 # `rubble-bench scene` (issue #5): the JSON report's keys and their sense, determinism across worker counts
 # in --deterministic mode, a different seed giving a different world, and a clear error for a bad scene file.
-# Usage: scene_contract.sh RUBBLE_BENCH SCENE.cfg
+# With STRUCTURE.cfg, also the stress solver under fire on that scene: the same world on 1 and 2 workers.
+# Usage: scene_contract.sh RUBBLE_BENCH SCENE.cfg [STRUCTURE.cfg]
 set -eu
 bench="$1"
 scene="$2"
+structure_scene="${3:-}"
 tmp="$(mktemp -d)"
 trap 'rm -rf "$tmp"' EXIT
 fail() { echo "scene_contract.sh: $*"; exit 1; }
@@ -50,4 +52,19 @@ else
 fi
 [ "$code" -eq 2 ] || fail "missing scene: exit $code, expected 2"
 grep -q "missing.cfg" "$tmp/err" || fail "the error does not name the file: $(cat "$tmp/err")"
+if [ -n "$structure_scene" ]; then
+    for w in 1 2; do
+        "$bench" scene "$structure_scene" --seconds 3 --unpaced --deterministic --json --structure \
+            --shots-per-second 10 --pattern shatter --workers "$w" >"$tmp/s$w.json" || fail "structure w$w: exit $?"
+    done
+    python3 - "$tmp" <<'PY' || fail "structure: $(cat "$tmp/s1.json")"
+import json, sys, os
+d = {n: json.load(open(os.path.join(sys.argv[1], n + ".json"))) for n in ("s1", "s2")}
+a, b = d["s1"], d["s2"]
+assert a["fractures"] >= 5, a["fractures"]
+assert a["structure"]["bonds_at_start"] > 100, a["structure"]
+assert a["state_hash"] == b["state_hash"], ("structure, 1 vs 2 workers", a["state_hash"], b["state_hash"])
+assert a["structure"]["bonds_at_end"] == b["structure"]["bonds_at_end"], (a["structure"], b["structure"])
+PY
+fi
 echo "scene_contract.sh: ok"
