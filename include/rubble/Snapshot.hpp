@@ -2,8 +2,9 @@
 /// \file Snapshot.hpp
 /// Snapshots of a destroyed world: a versioned, checksummed binary format holding every object's mesh,
 /// convex parts, mass properties, material and fracture settings, the world's decomposition settings, the
-/// bodies' placements and velocities, the runtime's volume ledger, the unadopted work and the journal
-/// position (layout in docs/journal.md).
+/// bodies' placements and velocities, the runtime's volume ledger and structure (each node's solid, material
+/// and root state; each bond's health and broken state), the unadopted work and the journal position (layout
+/// in docs/journal.md).
 
 #include <cstdint>
 #include <filesystem>
@@ -20,12 +21,13 @@ namespace rubble {
 struct Snapshot {
     WorldState world;                        ///< settings, objects, frame, ids, journal position, work
     std::vector<ObjectPlacement> placements; ///< bodies (empty for a world without an engine)
-    VolumeLedger volumes; ///< where removed volume went (retired, dust, dropped; live unused)
+    VolumeLedger volumes;     ///< where removed volume went (retired, dust, dropped; live unused)
+    StructureState structure; ///< the stress solver's nodes and bonds (saved false: none, rebuilt fresh)
 };
 
 /// The snapshot of a world (and of its bodies, when placements are given).
 Snapshot takeSnapshot(const DestructionWorld& world, std::vector<ObjectPlacement> placements = {});
-/// The snapshot of a runtime: its world, its bodies' placements and its volume ledger.
+/// The snapshot of a runtime: its world, its bodies' placements, its volume ledger and its structure.
 Snapshot takeSnapshot(const DestructionRuntime& runtime);
 /// Loads a snapshot into a world (any worker count; the world adopts the snapshot's settings); fails,
 /// changing nothing, when the state is inconsistent (DestructionWorld::loadState).

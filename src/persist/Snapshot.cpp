@@ -5,7 +5,9 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <bit>
+#include <map>
 
 #include "persist/Bytes.hpp"
 #include "rubble/JournalFile.hpp"
@@ -65,8 +67,9 @@ void checkFinite(ByteReader& r, const std::vector<Vec2>& v, std::size_t start, c
     }
 }
 
-// 2: decomposition settings, each object's mesh hash, the volume ledger.
-constexpr std::uint16_t kVersion = 2;
+// 2: decomposition settings, each object's mesh hash, the volume ledger. 3: the structure (read: 2 and 3).
+constexpr std::uint16_t kVersion = 3;
+constexpr std::uint16_t kOldestVersion = 2;
 
 void vec(ByteWriter& w, const Vec3& v) {
     w.f64(v.x);
@@ -306,6 +309,102 @@ ObjectState readObject(ByteReader& r, const std::uint8_t* data) {
     return o;
 }
 
+void writeStructure(ByteWriter& w, const StructureState& s) {
+    w.u8(s.saved ? 1 : 0);
+    w.u32(static_cast<std::uint32_t>(s.nodes.size()));
+    for (const StructureNodeState& n : s.nodes) {
+        w.u32(n.object);
+        w.u32(n.solid);
+        w.u8(n.material);
+        w.u8(static_cast<std::uint8_t>((n.root ? 1 : 0) | (n.anchor ? 2 : 0) | (n.pending ? 4 : 0)));
+    }
+    w.u32(static_cast<std::uint32_t>(s.bonds.size()));
+    for (const StructureBondState& b : s.bonds) {
+        w.u64(b.a);
+        w.u64(b.b);
+        w.f64(b.health);
+        w.u8(b.broken ? 1 : 0);
+    }
+}
+
+// The structure section: nodes name static placements, ascending; bonds name nodes or ground and scenery
+// keys, a < b, ascending; healths in [0, 1], above 0 unless broken.
+StructureState readStructure(ByteReader& r, const std::vector<ObjectPlacement>& placements) {
+    StructureState s;
+    r.setContext("structure.");
+    std::size_t at = r.offset();
+    s.saved = flag(r, "saved");
+    std::map<ObjectId, BodyMotionState> motion;
+    for (const ObjectPlacement& p : placements)
+        motion.emplace(p.object, p.motion);
+    const std::uint32_t nNodes = r.count("nodes.count", 10);
+    if (r.ok() && !s.saved && nNodes != 0)
+        r.fail(at + 1, "nodes.count", "is " + std::to_string(nNodes) + ", expected 0 (not saved)");
+    s.nodes.reserve(nNodes);
+    for (std::uint32_t i = 0; i < nNodes && r.ok(); ++i) {
+        r.setContext("structure.nodes[" + std::to_string(i) + "].");
+        StructureNodeState n;
+        at = r.offset();
+        n.object = r.u32("object");
+        const auto it = motion.find(n.object);
+        if (r.ok() && (it == motion.end() || it->second != BodyMotionState::Static))
+            r.fail(at, "object", std::to_string(n.object) + " is no static object");
+        else if (r.ok() && i > 0 && n.object <= s.nodes.back().object)
+            r.fail(at, "object", std::to_string(n.object) + " is not above the previous node's");
+        n.solid = r.u32("solid");
+        at = r.offset();
+        n.material = r.u8("material");
+        if (r.ok() && n.material >= materialPresets().size())
+            r.fail(at, "material", "unknown material " + std::to_string(n.material));
+        at = r.offset();
+        const std::uint8_t flags = r.u8("flags");
+        n.root = flags & 1;
+        n.anchor = flags & 2;
+        n.pending = flags & 4;
+        if (r.ok() && (flags > 7 || (n.anchor && !n.root) || (n.pending && n.root)))
+            r.fail(at, "flags",
+                   "is " + std::to_string(flags) +
+                       ", expected root 1, anchor 2 (with root), pending 4 (without)");
+        s.nodes.push_back(n);
+    }
+    r.setContext("structure.");
+    at = r.offset();
+    const std::uint32_t nBonds = r.count("bonds.count", 25);
+    if (r.ok() && !s.saved && nBonds != 0)
+        r.fail(at, "bonds.count", "is " + std::to_string(nBonds) + ", expected 0 (not saved)");
+    s.bonds.reserve(nBonds);
+    auto node = [&](const char* field) {
+        const std::size_t pos = r.offset();
+        const std::uint64_t key = r.u64(field);
+        const bool scenery = key >> 32 == kSceneryNodeKey >> 32;
+        const auto it = std::lower_bound(
+            s.nodes.begin(), s.nodes.end(), key,
+            [](const StructureNodeState& n, std::uint64_t k) { return std::uint64_t{n.object} < k; });
+        if (r.ok() && !scenery && (it == s.nodes.end() || it->object != key))
+            r.fail(pos, field, std::to_string(key) + " is neither a node nor a ground or scenery key");
+        return key;
+    };
+    for (std::uint32_t i = 0; i < nBonds && r.ok(); ++i) {
+        r.setContext("structure.bonds[" + std::to_string(i) + "].");
+        StructureBondState b;
+        b.a = node("a");
+        at = r.offset();
+        b.b = node("b");
+        if (r.ok() && b.a >= b.b)
+            r.fail(at, "b", "is not above a");
+        else if (r.ok() && i > 0 && std::pair{b.a, b.b} <= std::pair{s.bonds.back().a, s.bonds.back().b})
+            r.fail(at, "b", "the pair is not above the previous bond's");
+        at = r.offset();
+        b.health = real(r, "health");
+        b.broken = flag(r, "broken");
+        if (r.ok() && !(b.health >= 0 && b.health <= 1 && (b.health > 0 || b.broken)))
+            r.fail(at, "health", "is " + std::to_string(b.health) + ", expected 0 to 1 (0 only when broken)");
+        s.bonds.push_back(b);
+    }
+    r.setContext("");
+    return s;
+}
+
 } // namespace
 
 Snapshot takeSnapshot(const DestructionWorld& world, std::vector<ObjectPlacement> placements) {
@@ -323,16 +422,18 @@ Snapshot takeSnapshot(const DestructionRuntime& runtime) {
     Snapshot s = takeSnapshot(runtime.world(), runtime.placements());
     s.volumes = runtime.volumes();
     s.volumes.live = 0;
+    s.structure = runtime.structureState();
     return s;
 }
 
 Status restoreSnapshot(DestructionRuntime& runtime, Snapshot snapshot) {
-    return runtime.restore(std::move(snapshot.world), snapshot.placements, snapshot.volumes);
+    return runtime.restore(std::move(snapshot.world), snapshot.placements, snapshot.volumes,
+                           snapshot.structure);
 }
 
 std::vector<std::uint8_t> encodeSnapshot(const Snapshot& s) {
     ByteWriter w;
-    std::size_t estimate = 64;
+    std::size_t estimate = 64 + 10 * s.structure.nodes.size() + 25 * s.structure.bonds.size();
     for (const ObjectState& o : s.world.objects)
         estimate += 512 + 24 * o.mesh.positions.size() + 12 * o.mesh.triangles.size() +
                     24 * o.mesh.normals.size() + 16 * o.mesh.uvs.size() + 4 * o.mesh.materials.size() +
@@ -381,6 +482,7 @@ std::vector<std::uint8_t> encodeSnapshot(const Snapshot& s) {
             w.u64(i < p.ticks.size() ? p.ticks[i] : 0);
         }
     }
+    writeStructure(w, s.structure);
     w.f64(s.volumes.retired);
     w.f64(s.volumes.dust);
     w.f64(s.volumes.dropped);
@@ -397,10 +499,10 @@ Result<Snapshot> decodeSnapshot(const std::uint8_t* data, std::size_t size, cons
     if (r.ok() && !std::equal(magic, magic + 4, kMagic))
         r.fail(0, "magic", "not a Rubble snapshot (expected RBSN)");
     const std::uint16_t version = r.u16("version");
-    if (r.ok() && version != kVersion)
+    if (r.ok() && (version < kOldestVersion || version > kVersion))
         r.fail(4, "version",
-               "version " + std::to_string(version) + " is not supported (this build reads version " +
-                   std::to_string(kVersion) + " only" +
+               "version " + std::to_string(version) + " is not supported (this build reads versions " +
+                   std::to_string(kOldestVersion) + " to " + std::to_string(kVersion) +
                    (version < kVersion ? "; the file was saved by an older build: load it there, or replay "
                                          "its journal on the scene"
                                        : "; the file was saved by a newer build") +
@@ -489,6 +591,8 @@ Result<Snapshot> decodeSnapshot(const std::uint8_t* data, std::size_t size, cons
         s.world.work.push_back(std::move(p));
     }
     body.setContext("");
+    if (version >= 3) // version 2 has no structure: restored with fresh bonds
+        s.structure = readStructure(body, s.placements);
     for (auto [field, v] : {std::pair{"volumes.retired", &s.volumes.retired},
                             {"volumes.dust", &s.volumes.dust},
                             {"volumes.dropped", &s.volumes.dropped}}) {

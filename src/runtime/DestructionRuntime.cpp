@@ -22,7 +22,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-constexpr std::uint64_t kSceneryBit = 1ull << 63; // structure solids of ground and scenery (never objects)
+constexpr std::uint64_t kSceneryBit = kSceneryNodeKey; // structure solids of ground and scenery (not objects)
 
 double msSince(Clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
@@ -342,6 +342,78 @@ struct DestructionRuntime::Impl {
         stats.structureMs += msSince(t0);
         if (!fallen.empty())
             settleSupport(stats);
+    }
+
+    // A saved structure names static objects (nodes once each) and, in bonds, nodes or this runtime's
+    // ground and scenery bodies in the structure; `nodes` gets the records by object.
+    Status checkStructure(const StructureState& saved,
+                          const std::map<ObjectId, const ObjectPlacement*>& where,
+                          std::map<ObjectId, const StructureNodeState*>& nodes) const {
+        if (!saved.saved && !(saved.nodes.empty() && saved.bonds.empty()))
+            return Error{ErrorCode::InvalidInput, "structure: nodes or bonds but not saved"};
+        for (const StructureNodeState& n : saved.nodes) {
+            const std::string which = "structure node of object " + std::to_string(n.object);
+            const auto it = where.find(n.object);
+            if (it == where.end() || it->second->motion != BodyMotionState::Static)
+                return Error{ErrorCode::InvalidInput, which + ": no static object"};
+            if (n.material >= materialPresets().size())
+                return Error{ErrorCode::InvalidInput,
+                             which + ": unknown material " + std::to_string(n.material)};
+            if ((n.anchor && !n.root) || (n.pending && n.root))
+                return Error{ErrorCode::InvalidInput, which + ": an anchor is a root, a pending node is not"};
+            if (!nodes.emplace(n.object, &n).second)
+                return Error{ErrorCode::InvalidInput, which + ": listed twice"};
+        }
+        for (const StructureBondState& b : saved.bonds)
+            for (std::uint64_t key : {b.a, b.b}) {
+                const std::string which = "structure bond " + std::to_string(b.a) + "-" + std::to_string(b.b);
+                if (!(key & kSceneryNodeKey)) {
+                    if (key > 0xFFFFFFFFull || !nodes.count(static_cast<ObjectId>(key)))
+                        return Error{ErrorCode::InvalidInput, which + ": names no structure node"};
+                    continue;
+                }
+                const BodyRecord* r = bodies.find(static_cast<BodyId>(key));
+                if (config.structure.enabled &&
+                    (key >> 32 != kSceneryNodeKey >> 32 || !r || r->hasObject || !structure.contains(r->id)))
+                    return Error{ErrorCode::InvalidInput, which + ": names no ground or scenery body"};
+            }
+        return Status::ok();
+    }
+
+    // A restored static object joins the structure: as saved, or (nothing saved) as a scene object at load.
+    void restoreNode(BodyId body, ObjectId object, const std::vector<ConvexPolytope>& parts, bool saved,
+                     const std::map<ObjectId, const StructureNodeState*>& nodes) {
+        if (!saved) {
+            addStructure(body, parts, defaultMaterial(), false, object, true);
+            return;
+        }
+        const auto it = nodes.find(object);
+        if (it == nodes.end())
+            return;
+        const StructureNodeState& n = *it->second;
+        const Material& m = materialPresets()[n.material];
+        if (&m != &defaultMaterial())
+            materials[object] = &m;
+        if (n.solid != object)
+            solids[object] = n.solid;
+        addStructure(body, parts, m, n.root, n.solid, n.pending);
+        if (n.anchor && config.structure.enabled)
+            structure.markAnchor(body);
+    }
+
+    // The bonds rebuilt from geometry take their saved health and broken state; the next solve settles.
+    void restoreBonds(const StructureState& saved) {
+        if (!config.structure.enabled)
+            return;
+        auto bodyOfKey = [&](std::uint64_t key) -> BodyId {
+            if (key & kSceneryNodeKey)
+                return static_cast<BodyId>(key);
+            const BodyRecord* r = bodies.findObject(static_cast<ObjectId>(key));
+            return r ? r->id : 0;
+        };
+        for (const StructureBondState& b : saved.bonds)
+            (void)structure.restoreBond(bodyOfKey(b.a), bodyOfKey(b.b), b.health, b.broken);
+        structure.settleNext();
     }
 
     void adoptResults(FrameStats& stats) {
@@ -694,7 +766,7 @@ std::vector<ObjectPlacement> DestructionRuntime::placements() const {
 }
 
 Status DestructionRuntime::restore(WorldState state, const std::vector<ObjectPlacement>& placements,
-                                   const VolumeLedger& volumes) {
+                                   const VolumeLedger& volumes, const StructureState& structure) {
     Impl& im = *impl_;
     for (double v : {volumes.retired, volumes.dust, volumes.dropped})
         if (!(v >= 0 && v < 1e300))
@@ -714,6 +786,9 @@ Status DestructionRuntime::restore(WorldState state, const std::vector<ObjectPla
     for (const ObjectState& o : state.objects)
         if (!where.count(o.id))
             return Error{ErrorCode::InvalidInput, "object " + std::to_string(o.id) + " has no placement"};
+    std::map<ObjectId, const StructureNodeState*> nodes;
+    if (Status s = im.checkStructure(structure, where, nodes); !s)
+        return s;
     // The old objects' bodies go (the world's objects are replaced below); nothing is journaled.
     std::vector<BodyId> old;
     for (const auto& [id, r] : im.bodies.all())
@@ -740,12 +815,52 @@ Status DestructionRuntime::restore(WorldState state, const std::vector<ObjectPla
         BodyRecord rec = objectRecord(id, p.role, p.motion, s, st);
         rec.structural = p.motion == BodyMotionState::Static;
         const BodyId body = im.insert(rec, s.desc).id;
-        if (p.motion == BodyMotionState::Static)
-            im.support.add(body, worldParts(st, p.objectToWorld), false, true);
-        else if (p.motion == BodyMotionState::Frozen)
+        if (p.motion == BodyMotionState::Static) {
+            const auto parts = worldParts(st, p.objectToWorld);
+            im.restoreNode(body, id, parts, structure.saved, nodes);
+            im.support.add(body, parts, false, true);
+        } else if (p.motion == BodyMotionState::Frozen) {
             im.governor.frozen(body, s.desc.transform.translation, rec.radius);
+        }
     }
+    im.restoreBonds(structure);
     return Status::ok();
+}
+
+StructureState DestructionRuntime::structureState() const {
+    const Impl& im = *impl_;
+    StructureState out;
+    if (!im.config.structure.enabled)
+        return out;
+    out.saved = true;
+    for (const auto& [id, r] : im.bodies.all()) {
+        if (!r.hasObject || !im.structure.contains(id))
+            continue;
+        const detail::StructureMonitor::SavedNode n = im.structure.saved(id);
+        StructureNodeState v;
+        v.object = r.object;
+        v.solid = static_cast<ObjectId>(n.solid);
+        v.material = static_cast<std::uint8_t>(n.material - materialPresets().data());
+        v.root = n.root;
+        v.anchor = n.anchor;
+        v.pending = n.pending;
+        out.nodes.push_back(v);
+    }
+    std::sort(out.nodes.begin(), out.nodes.end(),
+              [](const StructureNodeState& x, const StructureNodeState& y) { return x.object < y.object; });
+    auto key = [&](BodyId id) -> std::uint64_t {
+        const BodyRecord* r = im.bodies.find(id);
+        return r && r->hasObject ? r->object : kSceneryNodeKey | id;
+    };
+    for (const detail::StructureMonitor::SavedBond& b : im.structure.savedBonds()) {
+        const std::uint64_t ka = key(b.a), kb = key(b.b);
+        out.bonds.push_back({std::min(ka, kb), std::max(ka, kb), b.health, b.broken});
+    }
+    std::sort(out.bonds.begin(), out.bonds.end(),
+              [](const StructureBondState& x, const StructureBondState& y) {
+                  return x.a < y.a || (x.a == y.a && x.b < y.b);
+              });
+    return out;
 }
 
 std::uint64_t DestructionRuntime::stateHash() const {

@@ -88,8 +88,9 @@ void StructureMonitor::classify() {
 
 std::vector<BodyId> StructureMonitor::step(const Vec3& gravity, int& broken) {
     // Objects just placed have no warm start: their first solve may sweep ten times as often.
-    const bool settle = !unclassified_.empty();
-    if (settle)
+    const bool settle = !unclassified_.empty() || settle_;
+    settle_ = false;
+    if (!unclassified_.empty())
         classify();
     const auto before = [&] {
         std::size_t n = 0;
@@ -143,6 +144,50 @@ std::vector<StructureBond> StructureMonitor::bonds() const {
         return x.a < y.a || (x.a == y.a && x.b < y.b);
     });
     return out;
+}
+
+StructureMonitor::SavedNode StructureMonitor::saved(BodyId id) const {
+    const Node& n = nodes_.at(id);
+    SavedNode out;
+    out.solid = n.solid;
+    out.material = n.material;
+    out.root = solver_.root(n.slot);
+    out.anchor = n.anchor;
+    out.pending = std::find(unclassified_.begin(), unclassified_.end(), id) != unclassified_.end();
+    return out;
+}
+
+std::vector<StructureMonitor::SavedBond> StructureMonitor::savedBonds() const {
+    std::vector<SavedBond> out;
+    for (const auto& [id, n] : nodes_)
+        for (std::size_t i : solver_.bondsOf(n.slot)) {
+            const Bond& b = solver_.bond(i);
+            const BodyId other = bodyOf_[b.a == n.slot ? b.b : b.a];
+            if (id < other)
+                out.push_back({id, other, solver_.health(i), solver_.broken(i)});
+        }
+    return out;
+}
+
+void StructureMonitor::markAnchor(BodyId id) {
+    nodes_.at(id).anchor = true;
+}
+
+bool StructureMonitor::restoreBond(BodyId a, BodyId b, double health, bool broken) {
+    const auto ia = nodes_.find(a), ib = nodes_.find(b);
+    if (ia == nodes_.end() || ib == nodes_.end())
+        return false;
+    const std::uint32_t sa = ia->second.slot, sb = ib->second.slot;
+    for (std::size_t i : solver_.bondsOf(sa)) {
+        const Bond& bond = solver_.bond(i);
+        if ((bond.a == sa ? bond.b : bond.a) != sb)
+            continue;
+        solver_.setHealth(i, health);
+        if (broken)
+            solver_.breakBond(i);
+        return true;
+    }
+    return false;
 }
 
 } // namespace rubble::detail

@@ -42,6 +42,29 @@ public:
     /// Nodes.
     std::size_t size() const { return nodes_.size(); }
 
+    /// A node as a snapshot keeps it.
+    struct SavedNode {
+        std::uint64_t solid = 0;
+        const Material* material = nullptr;
+        bool root = false, anchor = false, pending = false;
+    };
+    /// The state of node id (a node).
+    SavedNode saved(BodyId id) const;
+    /// A bond's state: its bodies (a < b), health and broken state.
+    struct SavedBond {
+        BodyId a = 0, b = 0;
+        double health = 1;
+        bool broken = false;
+    };
+    /// Every bond, broken ones included.
+    std::vector<SavedBond> savedBonds() const;
+    /// Marks a root node as held by the anchor rule (a restored anchor).
+    void markAnchor(BodyId id);
+    /// Gives the bond between a and b this health and broken state; false when they share no bond.
+    bool restoreBond(BodyId a, BodyId b, double health, bool broken);
+    /// The next step solves without a warm start (as after objects are placed): ten times the sweeps.
+    void settleNext() { settle_ = true; }
+
 private:
     struct Node {
         const Material* material = nullptr;
@@ -55,6 +78,7 @@ private:
     std::map<BodyId, Node> nodes_;
     std::vector<BodyId> bodyOf_; // solver slot -> body (0: free)
     std::vector<BodyId> unclassified_;
+    bool settle_ = false;
     std::vector<std::pair<Vec3, double>> pendingDamage_;
     struct Load {
         BodyId id;
