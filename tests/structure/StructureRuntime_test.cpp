@@ -2,8 +2,8 @@
 // break and what they held falls through the runtime's collapse path; hits weaken bonds near them.
 #include <gtest/gtest.h>
 
+#include "StructureRig.hpp"
 #include "TestSupport.hpp"
-#include "ToyPhysics.hpp"
 #include "rubble/DestructionRuntime.hpp"
 #include "rubble/SceneConfig.hpp"
 #include "rubble/SceneLoader.hpp"
@@ -11,42 +11,7 @@
 namespace rubble {
 namespace {
 
-struct Rig {
-    explicit Rig(bool structure, int workers = 1, bool bondDebris = false, double bearingFriction = 0)
-        : runtime(engine, config(structure, workers, bondDebris, bearingFriction)) {
-        runtime.addGround({0, -0.5, 0}, {50, 0.5, 50});
-    }
-    static DestructionRuntime::Config config(bool structure, int workers, bool bondDebris,
-                                             double bearingFriction = 0) {
-        DestructionRuntime::Config c;
-        c.world.workers = workers;
-        c.world.deterministic = true;
-        c.world.seed = 5;
-        c.world.minPieceVolume = 0;
-        c.structure.enabled = structure;
-        c.structure.bondDebris = bondDebris;
-        c.structure.bearingFriction = bearingFriction;
-        return c;
-    }
-    // A static box (indestructible unless fracture is given).
-    ObjectId addBox(const Vec3& lo, const Vec3& hi, const char* material = "", bool destructible = false,
-                    const FractureParams& fracture = {}) {
-        ObjectDesc d;
-        d.fracture = fracture;
-        const Vec3 half = (hi - lo) * 0.5;
-        d.mesh = makeBox(-1.0 * half, half);
-        d.density = 500;
-        d.impulseThreshold = 1;
-        d.destructible = destructible;
-        d.material = material;
-        Result<ObjectId> id = runtime.addObject(std::move(d), Frame{Mat3::identity(), (lo + hi) * 0.5}, true);
-        EXPECT_TRUE(id) << (id ? "" : id.error().message);
-        return id ? *id : 0;
-    }
-    BodyMotionState motionOf(ObjectId id) const { return runtime.bodyOf(id)->motion; }
-    test::ToyPhysics engine;
-    DestructionRuntime runtime;
-};
+using Rig = test::StructureRig;
 
 } // namespace
 
