@@ -617,6 +617,8 @@ void Game::updateCounters() {
     counters_.fractures = static_cast<int>(c.fractures);
     counters_.piecesCreated = static_cast<int>(c.piecesCreated);
     counters_.retired = static_cast<int>(c.piecesRetired);
+    counters_.collapsed = static_cast<int>(c.piecesCollapsed);
+    counters_.bondsBroken = static_cast<int>(c.bondsBroken);
     counters_.bodies = static_cast<int>(runtime_->bodyCount());
     counters_.pieces = runtime_->livePieces();
     counters_.jobs = runtime_->world().jobsInFlight();

@@ -70,6 +70,8 @@ struct GameCounters {
     int fractures = 0;                               ///< fracture results adopted
     int piecesCreated = 0;                           ///< piece bodies created
     int retired = 0;                                 ///< pieces turned into particles
+    int collapsed = 0;                               ///< static bodies that lost their support and fell
+    int bondsBroken = 0;                             ///< structure bonds broken (stress solver on)
     int bodies = 0;                                  ///< rigid bodies in the physics world
     int pieces = 0;                                  ///< live piece bodies
     int jobs = 0;                                    ///< fracture jobs queued or running
