@@ -362,6 +362,10 @@ void Game::blast(const V3& point, float radius, float impulse, int by) {
     particles_.impactBurst(point, V3{0, 1, 0}, 2.0f, burstSeed_++);
 }
 
+bool Game::hitAt(const V3& point, float impulse) {
+    return runtime_ && runtime_->blast(rubble::Vec3{point.x, point.y, point.z}, 0.01, impulse, 1.0) > 0;
+}
+
 void Game::checkCrash() {
     if (!vehicle_ || crashTimer_ > 0)
         return;
