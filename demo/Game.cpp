@@ -362,6 +362,10 @@ void Game::blast(const V3& point, float radius, float impulse, int by) {
     particles_.impactBurst(point, V3{0, 1, 0}, 2.0f, burstSeed_++);
 }
 
+bool Game::hitAt(const V3& point, float impulse) {
+    return runtime_ && runtime_->blast(rubble::Vec3{point.x, point.y, point.z}, 0.01, impulse, 1.0) > 0;
+}
+
 void Game::checkCrash() {
     if (!vehicle_ || crashTimer_ > 0)
         return;
@@ -617,6 +621,8 @@ void Game::updateCounters() {
     counters_.fractures = static_cast<int>(c.fractures);
     counters_.piecesCreated = static_cast<int>(c.piecesCreated);
     counters_.retired = static_cast<int>(c.piecesRetired);
+    counters_.collapsed = static_cast<int>(c.piecesCollapsed);
+    counters_.bondsBroken = static_cast<int>(c.bondsBroken);
     counters_.bodies = static_cast<int>(runtime_->bodyCount());
     counters_.pieces = runtime_->livePieces();
     counters_.jobs = runtime_->world().jobsInFlight();

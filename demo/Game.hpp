@@ -70,6 +70,8 @@ struct GameCounters {
     int fractures = 0;                               ///< fracture results adopted
     int piecesCreated = 0;                           ///< piece bodies created
     int retired = 0;                                 ///< pieces turned into particles
+    int collapsed = 0;                               ///< static bodies that lost their support and fell
+    int bondsBroken = 0;                             ///< structure bonds broken (stress solver on)
     int bodies = 0;                                  ///< rigid bodies in the physics world
     int pieces = 0;                                  ///< live piece bodies
     int jobs = 0;                                    ///< fracture jobs queued or running
@@ -132,6 +134,13 @@ public:
     /// Crash or blast: impacts on every destructible body within radius of point, sparks and dust; the
     /// fractures they cause count for `by` (a weapon index, or -1 for a crash).
     void blast(const V3& point, float radius, float impulse, int by = -1);
+    /// One impact at a world point on the objects whose bounds reach it (no sparks); false when none took it.
+    bool hitAt(const V3& point, float impulse);
+    /// Places the showcase camera (GameSettings::showcase) at eye, looking at target.
+    void setShowcaseView(const V3& eye, const V3& target) {
+        showcaseEye_ = eye;
+        showcaseAt_ = target;
+    }
     /// Latencies (impact → adopted, ms) of results adopted since the last call.
     std::vector<double> takeNewLatencies();
     /// All adopted latencies so far (ms).

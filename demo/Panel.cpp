@@ -10,6 +10,9 @@
 
 namespace demo {
 
+// The HUD's key line, top left.
+constexpr const char* kKeyLine = "W/S pitch  A/D roll  Q/E yaw  Z/X speed  Space fire  1-3 weapon  H help";
+
 const std::vector<std::pair<const char*, const char*>>& keyHelp() {
     static const std::vector<std::pair<const char*, const char*>> keys = {
         {"W / S", "pitch down / up"},
@@ -79,7 +82,10 @@ bool Panel::draw(Game& game, GameSettings& pending, bool paused, const std::stri
         ImDrawList* dl = ImGui::GetForegroundDrawList();
         const float size = ImGui::GetFontSize();
         const ImVec2 ts = ImGui::GetFont()->CalcTextSizeA(size, 1e9f, 0.0f, line);
-        const ImVec2 at(io.DisplaySize.x - ts.x - 18 * scale_, 10 * scale_);
+        ImVec2 at(io.DisplaySize.x - ts.x - 18 * scale_, 10 * scale_);
+        const float keyLineEnd = 12 * scale_ + ImGui::GetFont()->CalcTextSizeA(size, 1e9f, 0.0f, kKeyLine).x;
+        if (keyLineEnd + 16 * scale_ > at.x) // a narrow window: below the key line instead of over it
+            at.y += ts.y + 10 * scale_;
         dl->AddRectFilled(ImVec2(at.x - 8 * scale_, at.y - 4 * scale_),
                           ImVec2(at.x + ts.x + 8 * scale_, at.y + ts.y + 4 * scale_), IM_COL32(0, 0, 0, 110),
                           5 * scale_);
@@ -207,8 +213,7 @@ void Panel::drawHud(const Game& game, bool paused, int width, int height) {
     dl->AddRectFilled(ImVec2(12 * k, h - ts.y - 26 * k), ImVec2(32 * k + ts.x, h - 12 * k),
                       IM_COL32(0, 0, 0, 110), 6.0f * k);
     dl->AddText(font, fs, ImVec2(22 * k, h - ts.y - 19 * k), IM_COL32(255, 255, 255, 230), buf);
-    dl->AddText(font, fs, ImVec2(12 * k, 10 * k), IM_COL32(255, 255, 255, 190),
-                "W/S pitch  A/D roll  Q/E yaw  Z/X speed  Space fire  1-3 weapon  H help");
+    dl->AddText(font, fs, ImVec2(12 * k, 10 * k), IM_COL32(255, 255, 255, 190), kKeyLine);
     if (paused) {
         const char* msg = "PAUSED - press Space";
         const ImVec2 ms = font->CalcTextSizeA(fs, 1e9f, 0.0f, msg);

@@ -71,6 +71,8 @@ bool RunReport::write(const std::filesystem::path& dir, const std::string& scene
     j["fractures"] = last.fractures;
     j["pieces_created"] = last.piecesCreated;
     j["pieces_retired_to_particles"] = last.retired;
+    j["bodies_collapsed"] = last.collapsed;
+    j["bonds_broken"] = last.bondsBroken;
     j["latency_ms"] = {{"count", latencies.size()},
                        {"p50", quantile(latencies, 0.5)},
                        {"p99", quantile(latencies, 0.99)},

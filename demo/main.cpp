@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -64,15 +65,18 @@ struct Options {
     bool noShadows = false;
     bool bilinear = false;
     bool showcase = false;
-    std::string record;           // journal file written at exit
-    std::string replay;           // journal file replayed on the loaded scene instead of playing
-    int host = 0;                 // port to host loopback multiplayer on
-    std::string join;             // HOST:PORT of a host to follow
-    bool structure = true;        // the stress solver (with bearings)
-    bool bonds = false;           // draw its bonds by stress
-    std::string quality = "auto"; // auto (from GL_RENDERER), software or gpu
-    float targetFps = 60;         // dynamic resolution holds this rate (software quality)
-    float minScale = -1;          // smallest internal resolution scale (-1: the quality's)
+    std::vector<std::string> hits; // "X,Y,Z,IMPULSE": impacts in the first frame
+    bool holdFire = false;         // the autopilot flies without shooting
+    std::string camera;            // "EX,EY,EZ,TX,TY,TZ": a fixed showcase camera
+    std::string record;            // journal file written at exit
+    std::string replay;            // journal file replayed on the loaded scene instead of playing
+    int host = 0;                  // port to host loopback multiplayer on
+    std::string join;              // HOST:PORT of a host to follow
+    bool structure = true;         // the stress solver (with bearings)
+    bool bonds = false;            // draw its bonds by stress
+    std::string quality = "auto";  // auto (from GL_RENDERER), software or gpu
+    float targetFps = 60;          // dynamic resolution holds this rate (software quality)
+    float minScale = -1;           // smallest internal resolution scale (-1: the quality's)
 };
 
 struct App {
@@ -250,6 +254,12 @@ int main(int argc, char** argv) {
     cli.add_flag("--deterministic", o.deterministic, "adopt fractures a fixed number of frames after impact");
     cli.add_flag("--no-shadows", o.noShadows, "disable shadow mapping");
     cli.add_flag("--showcase", o.showcase, "the camera frames the scene's objects from a fixed point");
+    cli.add_option(
+        "--hit", o.hits,
+        "X,Y,Z,IMPULSE: an impact at that world point (N s) in the first frame, on the objects whose "
+        "bounds reach it (repeatable; e.g. pictures of fracture patterns with --hold-fire)");
+    cli.add_flag("--hold-fire", o.holdFire, "the autopilot flies without shooting");
+    cli.add_option("--camera", o.camera, "EX,EY,EZ,TX,TY,TZ: a fixed camera at EX,EY,EZ looking at TX,TY,TZ");
     cli.add_flag("--bilinear", o.bilinear, "software quality: bilinear textures instead of nearest texels");
     cli.add_option("--record", o.record,
                    "write the destruction journal (every impact and removal, 48 bytes each) to FILE at exit");
@@ -355,7 +365,7 @@ int main(int argc, char** argv) {
     app.pending.debugShapes = app.pending.debugAabbs = app.pending.debugImpacts = o.debug;
     app.pending.structure = o.structure;
     app.pending.debugBonds = o.structure && (o.bonds || cli.count("--structure") > 0);
-    app.pending.showcase = o.showcase;
+    app.pending.showcase = o.showcase || !o.camera.empty();
 
     std::string error;
     app.gl = demo::GlContext::create(o.width, o.height, headless, error);
@@ -443,6 +453,28 @@ int main(int argc, char** argv) {
     demo::DynamicResolution resolution(1000.0f / o.targetFps, app.quality.minScale);
     float lastFrameMs = 0;
 
+    std::vector<std::pair<demo::V3, float>> hits; // --hit, applied before the first step
+    for (const std::string& text : o.hits) {
+        float x = 0, y = 0, z = 0, j = 0;
+        char extra = 0;
+        if (std::sscanf(text.c_str(), "%f,%f,%f,%f%c", &x, &y, &z, &j, &extra) != 4 || !(j > 0)) {
+            std::fprintf(stderr, "error: --hit %s: expected X,Y,Z,IMPULSE with IMPULSE > 0\n", text.c_str());
+            return 2;
+        }
+        hits.push_back({demo::V3{x, y, z}, j});
+    }
+    std::optional<std::pair<demo::V3, demo::V3>> camera;
+    if (!o.camera.empty()) {
+        float v[6];
+        char extra = 0;
+        if (std::sscanf(o.camera.c_str(), "%f,%f,%f,%f,%f,%f%c", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5],
+                        &extra) != 6) {
+            std::fprintf(stderr, "error: --camera %s: expected EX,EY,EZ,TX,TY,TZ\n", o.camera.c_str());
+            return 2;
+        }
+        camera = {demo::V3{v[0], v[1], v[2]}, demo::V3{v[3], v[4], v[5]}};
+    }
+
     demo::Autopilot pilot;
     demo::RunReport report;
     const float fixedDt = 1.0f / 60.0f;
@@ -463,10 +495,18 @@ int main(int argc, char** argv) {
         }
 
         // Simulation.
+        for (const auto& [at, impulse] : hits)
+            if (!app.game.hitAt(at, impulse))
+                std::fprintf(stderr, "warning: --hit %g,%g,%g reached no object\n", static_cast<double>(at.x),
+                             static_cast<double>(at.y), static_cast<double>(at.z));
+        hits.clear();
+        if (camera)
+            app.game.setShowcaseView(camera->first, camera->second);
         const auto stepStart = Clock::now();
         demo::GameSettings& live = app.game.settings();
         if (autopilot) {
-            const demo::ControlInput in = pilot.update(app.game, fixedDt);
+            demo::ControlInput in = pilot.update(app.game, fixedDt);
+            in.fire = in.fire && !app.opt.holdFire;
             app.game.step(in, fixedDt, app.renderer);
         } else if (!app.paused) {
             bool space = false;

@@ -3,7 +3,8 @@
 # is present) run by `rubble-bench scene` for SECONDS (default 60) at 10 shots/s with the default worker count,
 # paced at 60 Hz with idle adoption; one row each in a fresh scene.csv, then scene.png (bench/results/scene.gp).
 # The demolition scenes (assets/scenes/demolition*.cfg) run the same way with --pattern shatter; their frames
-# are summarised per half second in demolition_frames.csv and drawn over time in demolition.png. A last row
+# are summarised per half second in demolition_frames.csv and drawn over time in demolition.png; demolition.cfg
+# runs again with the stress solver on (--structure, bearings), as the demo plays it. A last row
 # is the stretch toward 20,000 pieces at 30 fps: the 500k scene for 2.5 x SECONDS at 25 shots/s of 32 cells,
 # with the debris budgets of a 30 Hz frame (1,500 awake bodies, a 16 ms physics step).
 # Usage: scripts/scene-bench.sh BUILD_DIR [SECONDS]
@@ -64,6 +65,7 @@ done
 for s in demolition.cfg demolition_block.cfg; do
     run "$root/assets/scenes/$s" --pattern shatter
 done
+RUN_TAG=" (structure)" run "$root/assets/scenes/demolition.cfg" --pattern shatter --structure
 RUN_SECONDS=$((5 * seconds / 2)) RUN_RATE=25 RUN_TAG=" (stretch)" run "$root/assets/scenes/demolition_block.cfg" \
     --pattern shatter --cells 32 --max-awake 1500 --physics-budget-ms 16
 echo "CSV: $csv, $frames"
