@@ -188,7 +188,7 @@ TEST(Snapshot, AnOlderVersionIsRefusedWithAClearError) {
               std::string::npos)
         << r.error().message;
     EXPECT_NE(r.error().message.find("older build"), std::string::npos) << r.error().message;
-    // A hostile v2: a zero mesh hash and a negative ledger entry, each named by offset and field.
+    // A hostile file: a zero mesh hash and a negative ledger entry, each named by offset and field.
     MidFire m;
     std::vector<std::uint8_t> b = encodeSnapshot(takeSnapshot(m.rig.runtime));
     const std::size_t firstObject = 4 + 2 + 2 + 8 + 4 + 8 + 4 + 8 + 36 + 8 + 4 + 8 + 4;
@@ -320,8 +320,8 @@ TEST(Snapshot, DamagedFilesAreRefusedNamingOffsetAndFieldAndTheWorldStaysAsItWas
     refused(b, "field crc32: checksum mismatch");
     // Another version, another format.
     b = bytes;
-    b[4] = 3;
-    refused(b, "offset 4, field version");
+    b[4] = 4;
+    refused(b, "offset 4, field version: version 4 is not supported");
     b = bytes;
     b[0] = 'X';
     refused(b, "offset 0, field magic");
