@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <set>
+#include <tuple>
 
 #include "StructureRig.hpp"
 #include "persist/Bytes.hpp"
@@ -63,26 +64,24 @@ std::set<ObjectId> fallen(const DestructionRuntime& runtime) {
     return out;
 }
 
+// Equal records, field by field (fields: a record's fields as a tuple).
+template <class T, class Fields>
+void expectSame(const std::vector<T>& x, const std::vector<T>& y, Fields fields) {
+    ASSERT_EQ(x.size(), y.size());
+    for (std::size_t i = 0; i < x.size(); ++i)
+        EXPECT_TRUE(fields(x[i]) == fields(y[i])) << "record " << i;
+}
+
 void expectSameBonds(const StructureState& x, const StructureState& y) {
-    ASSERT_EQ(x.bonds.size(), y.bonds.size());
-    for (std::size_t i = 0; i < x.bonds.size(); ++i) {
-        EXPECT_EQ(x.bonds[i].a, y.bonds[i].a) << i;
-        EXPECT_EQ(x.bonds[i].b, y.bonds[i].b) << i;
-        EXPECT_EQ(x.bonds[i].health, y.bonds[i].health) << i;
-        EXPECT_EQ(x.bonds[i].broken, y.bonds[i].broken) << i;
-    }
+    expectSame(x.bonds, y.bonds, [](const StructureBondState& b) {
+        return std::tuple{b.a, b.b, b.health, b.broken};
+    });
 }
 
 void expectSameNodes(const StructureState& x, const StructureState& y) {
-    ASSERT_EQ(x.nodes.size(), y.nodes.size());
-    for (std::size_t i = 0; i < x.nodes.size(); ++i) {
-        EXPECT_EQ(x.nodes[i].object, y.nodes[i].object) << i;
-        EXPECT_EQ(x.nodes[i].solid, y.nodes[i].solid) << i;
-        EXPECT_EQ(x.nodes[i].material, y.nodes[i].material) << i;
-        EXPECT_EQ(x.nodes[i].root, y.nodes[i].root) << i;
-        EXPECT_EQ(x.nodes[i].anchor, y.nodes[i].anchor) << i;
-        EXPECT_EQ(x.nodes[i].pending, y.nodes[i].pending) << i;
-    }
+    expectSame(x.nodes, y.nodes, [](const StructureNodeState& n) {
+        return std::tuple{n.object, n.solid, n.material, n.root, n.anchor, n.pending};
+    });
 }
 
 Snapshot decoded(const std::vector<std::uint8_t>& bytes) {
