@@ -139,14 +139,13 @@ struct DebrisBudget {
                                         ///< the smallest frozen pieces become particles
     bool freezeSleeping = true;         ///< a debris body the engine put to sleep is frozen (made static)
     int freezeAfterFrames = 6;          ///< ... or one that rested this many frames in a row
-    double freezeSpeed = 1.0;           ///< m/s (and rad/s) below which a body that is not gaining speed (its
-                              ///< velocity changes by less than g·dt / 2 a frame) rests (Bullet's own
-                              ///< sleeping threshold is 0.8 m/s for 2 s)
-    double wakeImpulse = 100;      ///< a contact impulse (N·s) on a frozen piece that wakes it
-    double fadeVolume = 0.02;      ///< debris below this volume (m³) ...
-    double fadeDistance = 150;     ///< ... farther than this from the focus point fades into particles
-    double killBelowY = -500;      ///< debris falling below this height retires
-    double particleLifetime = 3.0; ///< seconds a particle is drawn
+    double freezeSpeed = 1.0;           ///< m/s (and rad/s) below which a body not gaining speed rests
+                                        ///< (velocity change under g·dt / 2 a frame; docs/architecture.md)
+    double wakeImpulse = 100;           ///< a contact impulse (N·s) on a frozen piece that wakes it
+    double fadeVolume = 0.02;           ///< debris below this volume (m³) ...
+    double fadeDistance = 150;          ///< ... farther than this from the focus point fades into particles
+    double killBelowY = -500;           ///< debris falling below this height retires
+    double particleLifetime = 3.0;      ///< seconds a particle is drawn
 };
 
 /// A particle: a piece too small (or one too many) to simulate, drawn for a while. Its volume stays counted.

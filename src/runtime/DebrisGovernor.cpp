@@ -10,8 +10,7 @@ namespace {
 constexpr int kSettledFrames = 10;     // a piece falling from rest passes 1 m/s within 6 frames at 60 Hz
 constexpr double kCellSize = 4.0;      // m: frozen pieces are small, so a body's neighbourhood is a few cells
 constexpr double kMovedFraction = 0.1; // a woken body this far (times its radius) from its place has left it
-constexpr double kRestingAcceleration =
-    0.5;                           // a resting body's velocity changes by less than this g·dt a frame
+constexpr double kRestingAcceleration = 0.5; // a resting body's velocity changes by under this g·dt a frame
 constexpr double kHoldLow = 0.55;  // the average physics step is held in this band (fractions of the budget)
 constexpr double kHoldHigh = 0.75; // so that single frames stay under the budget
 
@@ -50,9 +49,7 @@ void DebrisGovernor::frozen(BodyId id, const Vec3& center, double radius) {
 }
 
 void DebrisGovernor::thawed(BodyId id) {
-    rest_.erase(id);
-    settleFrames_.erase(id);
-    awakeFrames_.erase(id);
+    awake_.erase(id);
     auto it = frozen_.find(id);
     if (it == frozen_.end())
         return;
@@ -153,18 +150,18 @@ GovernorActions DebrisGovernor::update(const BodyTable& bodies, const PhysicsBin
             continue;
         }
         // Resting: slow, and not gaining speed (a body in flight, or starting to fall, gains g·dt a frame).
-        Rest& still = rest_[id];
-        const bool steady = still.frames >= 0 &&
-                            length(m.linearVelocity - still.velocity) < kRestingAcceleration * length(g) * dt;
+        Watch& w = awake_[id];
+        const bool steady =
+            w.rest >= 0 && length(m.linearVelocity - w.velocity) < kRestingAcceleration * length(g) * dt;
         const bool resting = steady && length(m.linearVelocity) < budget_.freezeSpeed &&
                              length(m.angularVelocity) < budget_.freezeSpeed;
-        still.frames = resting ? still.frames + 1 : 0;
-        still.velocity = m.linearVelocity;
-        const int rest = still.frames;
+        w.rest = resting ? w.rest + 1 : 0;
+        w.velocity = m.linearVelocity;
+        const int rest = w.rest;
         const double speed = std::max(length(m.linearVelocity), length(m.angularVelocity));
-        int& settle = settleFrames_[id];
-        settle = speed < budget_.settlingSpeed ? settle + 1 : 0;
-        const int age = ++awakeFrames_[id];
+        w.settle = speed < budget_.settlingSpeed ? w.settle + 1 : 0;
+        const int settle = w.settle;
+        const int age = ++w.awake;
         if ((budget_.freezeSleeping && m.sleeping) || rest >= std::max(1, budget_.freezeAfterFrames)) {
             out.freeze.push_back(id);
             leaving.insert(id);
@@ -217,7 +214,7 @@ GovernorActions DebrisGovernor::update(const BodyTable& bodies, const PhysicsBin
                 break;
             if (leaving.count(a.id) || a.young || a.speed < budget_.settlingSpeed)
                 continue; // a slow piece is about to settle and freeze
-            out.retire.push_back({a.id, RetireReason::Budget});
+            out.retire.push_back({a.id, RetireReason::Awake});
             leaving.insert(a.id);
             --excess;
         }
@@ -227,7 +224,7 @@ GovernorActions DebrisGovernor::update(const BodyTable& bodies, const PhysicsBin
                 break;
             if (leaving.count(a.id))
                 continue;
-            out.retire.push_back({a.id, RetireReason::Budget});
+            out.retire.push_back({a.id, RetireReason::Awake});
             leaving.insert(a.id);
             --excess;
         }
@@ -257,9 +254,7 @@ GovernorActions DebrisGovernor::update(const BodyTable& bodies, const PhysicsBin
         }
     }
     for (BodyId id : leaving) {
-        rest_.erase(id);
-        settleFrames_.erase(id);
-        awakeFrames_.erase(id);
+        awake_.erase(id);
     }
     return out;
 }

@@ -13,7 +13,7 @@
 namespace rubble::detail {
 
 /// Why a debris body leaves the simulation.
-enum class RetireReason { Budget, Triangles, Fade, FellOut };
+enum class RetireReason { Awake, Triangles, Fade, FellOut };
 
 /// What the governor decided for one frame, in a deterministic order.
 struct GovernorActions {
@@ -57,13 +57,13 @@ private:
     std::vector<Cell> cellsOf(const Vec3& lo, const Vec3& hi) const;
 
     const DebrisBudget& budget_;
-    struct Rest {
-        int frames = -1; // frames in a row slow and not accelerating (-1: no velocity seen yet)
-        Vec3 velocity;   // linear velocity at the last update
+    struct Watch {      // an awake body's history
+        int rest = -1;  // frames in a row slow and not accelerating (-1: no velocity seen yet)
+        Vec3 velocity;  // linear velocity at the last update
+        int settle = 0; // frames below settlingSpeed in a row
+        int awake = 0;  // frames awake since adopted or woken
     };
-    std::unordered_map<BodyId, Rest> rest_;
-    std::unordered_map<BodyId, int> settleFrames_; // frames below settlingSpeed in a row
-    std::unordered_map<BodyId, int> awakeFrames_;  // frames awake since adopted or woken
+    std::unordered_map<BodyId, Watch> awake_;
     struct WokenEntry {
         Vec3 center;
         double radius = 0, margin = 0;
