@@ -22,8 +22,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-constexpr std::uint64_t kSceneryBit = kSceneryNodeKey; // structure solids of ground and scenery (not objects)
-
 double msSince(Clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
@@ -155,7 +153,7 @@ struct DestructionRuntime::Impl {
         ++stats.piecesRetired;
         ++counters.piecesRetired;
         switch (reason) {
-        case detail::RetireReason::Budget:
+        case detail::RetireReason::Awake:
             ++counters.retired.awake;
             break;
         case detail::RetireReason::Triangles:
@@ -494,7 +492,7 @@ BodyId DestructionRuntime::addGround(const Vec3& center, const Vec3& halfExtents
     const BodyId id = impl_->insert(rec, desc).id;
     const std::vector<ConvexPolytope> parts{
         ConvexPolytope::fromAabb(Aabb{center - halfExtents, center + halfExtents})};
-    impl_->addStructure(id, parts, defaultMaterial(), true, kSceneryBit | id);
+    impl_->addStructure(id, parts, defaultMaterial(), true, kSceneryNodeKey | id);
     impl_->support.add(id, parts, true);
     return id;
 }
@@ -559,7 +557,7 @@ Result<BodyId> DestructionRuntime::addConvexBody(const std::vector<Vec3>& points
     const BodyId id = impl_->insert(rec, desc).id;
     if (mass <= 0) {
         const std::vector<ConvexPolytope> parts{ConvexPolytope::fromAabb(box).transformed(placement)};
-        impl_->addStructure(id, parts, defaultMaterial(), true, kSceneryBit | id);
+        impl_->addStructure(id, parts, defaultMaterial(), true, kSceneryNodeKey | id);
         impl_->support.add(id, parts, true);
     }
     return id;
@@ -616,8 +614,8 @@ int DestructionRuntime::blast(const Vec3& center, double radius, double impulse,
     if (!(radius > 0) || !(impulse > 0))
         return 0;
     int accepted = 0;
-    for (BodyId id :
-         bodies()) { // a copy: an accepted impact does not change the bodies before the next frame
+    // bodies() is a copy; an accepted impact changes no body before the next frame anyway
+    for (BodyId id : bodies()) {
         const BodyRecord* b = body(id);
         if (!b || !b->hasObject)
             continue;
