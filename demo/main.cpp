@@ -92,7 +92,9 @@ struct App {
     std::string sceneName;
     std::vector<std::filesystem::path> scenes; // what N cycles through: the demolition, the thesis's scenes
     std::size_t sceneIndex = 0;
-    bool nextScene = false; // N pressed
+    bool nextScene = false;                              // N pressed
+    std::vector<std::pair<demo::V3, float>> hits;        // --hit: (point, impulse), after the first load
+    std::optional<std::pair<demo::V3, demo::V3>> camera; // --camera: (eye, target), after every load
     bool paused = false;
     bool quit = false;
     bool screenshotRequested = false;
@@ -216,6 +218,21 @@ bool loadScene(App& a, std::string& error) {
         return false;
     for (const auto& w : warnings)
         std::fprintf(stderr, "warning: %s\n", w.c_str());
+    if (a.camera)
+        a.game.setShowcaseView(a.camera->first, a.camera->second);
+    return true;
+}
+
+/// Exactly n comma-separated numbers from text into out.
+bool parseNumbers(const std::string& text, std::size_t n, float* out) {
+    const char* p = text.c_str();
+    for (std::size_t i = 0; i < n; ++i) {
+        char* end = nullptr;
+        out[i] = std::strtof(p, &end);
+        if (end == p || *end != (i + 1 < n ? ',' : '\0'))
+            return false;
+        p = end + 1;
+    }
     return true;
 }
 
@@ -294,6 +311,22 @@ int main(int argc, char** argv) {
                  "each other as bearings; --structure also draws the bonds by stress");
     cli.add_flag("--bonds", o.bonds, "draw the structure's bonds by stress");
     CLI11_PARSE(cli, argc, argv);
+    for (const std::string& text : o.hits) {
+        float v[4];
+        if (!parseNumbers(text, 4, v) || !(v[3] > 0)) {
+            std::fprintf(stderr, "error: --hit %s: expected X,Y,Z,IMPULSE with IMPULSE > 0\n", text.c_str());
+            return 2;
+        }
+        app.hits.push_back({demo::V3{v[0], v[1], v[2]}, v[3]});
+    }
+    if (!o.camera.empty()) {
+        float v[6];
+        if (!parseNumbers(o.camera, 6, v)) {
+            std::fprintf(stderr, "error: --camera %s: expected EX,EY,EZ,TX,TY,TZ\n", o.camera.c_str());
+            return 2;
+        }
+        app.camera = {demo::V3{v[0], v[1], v[2]}, demo::V3{v[3], v[4], v[5]}};
+    }
 
     const bool haveDisplay = std::getenv("DISPLAY") && *std::getenv("DISPLAY");
     const bool autopilot = o.autopilot > 0;
@@ -398,6 +431,10 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "error: %s\n", error.c_str());
         return 1;
     }
+    for (const auto& [at, impulse] : app.hits)
+        if (!app.game.hitAt(at, impulse))
+            std::fprintf(stderr, "warning: --hit %g,%g,%g reached no object\n", static_cast<double>(at.x),
+                         static_cast<double>(at.y), static_cast<double>(at.z));
 
     if (o.host > 0) {
         std::string message;
@@ -453,28 +490,6 @@ int main(int argc, char** argv) {
     demo::DynamicResolution resolution(1000.0f / o.targetFps, app.quality.minScale);
     float lastFrameMs = 0;
 
-    std::vector<std::pair<demo::V3, float>> hits; // --hit, applied before the first step
-    for (const std::string& text : o.hits) {
-        float x = 0, y = 0, z = 0, j = 0;
-        char extra = 0;
-        if (std::sscanf(text.c_str(), "%f,%f,%f,%f%c", &x, &y, &z, &j, &extra) != 4 || !(j > 0)) {
-            std::fprintf(stderr, "error: --hit %s: expected X,Y,Z,IMPULSE with IMPULSE > 0\n", text.c_str());
-            return 2;
-        }
-        hits.push_back({demo::V3{x, y, z}, j});
-    }
-    std::optional<std::pair<demo::V3, demo::V3>> camera;
-    if (!o.camera.empty()) {
-        float v[6];
-        char extra = 0;
-        if (std::sscanf(o.camera.c_str(), "%f,%f,%f,%f,%f,%f%c", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5],
-                        &extra) != 6) {
-            std::fprintf(stderr, "error: --camera %s: expected EX,EY,EZ,TX,TY,TZ\n", o.camera.c_str());
-            return 2;
-        }
-        camera = {demo::V3{v[0], v[1], v[2]}, demo::V3{v[3], v[4], v[5]}};
-    }
-
     demo::Autopilot pilot;
     demo::RunReport report;
     const float fixedDt = 1.0f / 60.0f;
@@ -495,13 +510,6 @@ int main(int argc, char** argv) {
         }
 
         // Simulation.
-        for (const auto& [at, impulse] : hits)
-            if (!app.game.hitAt(at, impulse))
-                std::fprintf(stderr, "warning: --hit %g,%g,%g reached no object\n", static_cast<double>(at.x),
-                             static_cast<double>(at.y), static_cast<double>(at.z));
-        hits.clear();
-        if (camera)
-            app.game.setShowcaseView(camera->first, camera->second);
         const auto stepStart = Clock::now();
         demo::GameSettings& live = app.game.settings();
         if (autopilot) {
