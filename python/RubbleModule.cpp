@@ -384,8 +384,7 @@ PYBIND11_MODULE(_rubble, m) {
           py::arg("seed") = 1, py::arg("backend") = "fast", py::arg("convex_parts") = true,
           py::arg("max_parts") = 24, py::arg("pattern") = py::none(),
           "Breaks a closed mesh at an impact into pieces (by default cells > 1 is a shatter pattern of that "
-          "many "
-          "cells; pattern='adaptive' chips on a weak hit and shatters on a strong one).");
+          "many cells; pattern='adaptive' chips on a weak hit and shatters on a strong one).");
     m.def("decompose", &decomposeMesh, py::arg("mesh"), py::kw_only(), py::arg("max_parts") = 24,
           py::arg("concavity") = 0.02, "Convex parts of a closed mesh, each as its corner points.");
 }
