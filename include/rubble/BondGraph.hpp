@@ -33,6 +33,8 @@ struct Bond {
     std::uint32_t a = 0;   ///< first node
     std::uint32_t b = 0;   ///< second node
     BondInterface section; ///< the shared interface, normal from a to b
+    /// The node at the other end from node (one of a and b).
+    std::uint32_t other(std::uint32_t node) const { return node == a ? b : a; }
 };
 
 /// How touching is decided.

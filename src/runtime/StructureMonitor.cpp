@@ -71,7 +71,7 @@ void StructureMonitor::classify() {
                 if (solver_.broken(i))
                     continue;
                 const Bond& b = solver_.bond(i);
-                const std::uint32_t m = b.a == component[k] ? b.b : b.a;
+                const std::uint32_t m = b.other(component[k]);
                 rooted = rooted || solver_.root(m);
                 if (seen.insert(m).second)
                     component.push_back(m);
@@ -162,7 +162,7 @@ std::vector<StructureMonitor::SavedBond> StructureMonitor::savedBonds() const {
     for (const auto& [id, n] : nodes_)
         for (std::size_t i : solver_.bondsOf(n.slot)) {
             const Bond& b = solver_.bond(i);
-            const BodyId other = bodyOf_[b.a == n.slot ? b.b : b.a];
+            const BodyId other = bodyOf_[b.other(n.slot)];
             if (id < other)
                 out.push_back({id, other, solver_.health(i), solver_.broken(i)});
         }
@@ -180,7 +180,7 @@ bool StructureMonitor::restoreBond(BodyId a, BodyId b, double health, bool broke
     const std::uint32_t sa = ia->second.slot, sb = ib->second.slot;
     for (std::size_t i : solver_.bondsOf(sa)) {
         const Bond& bond = solver_.bond(i);
-        if ((bond.a == sa ? bond.b : bond.a) != sb)
+        if (bond.other(sa) != sb)
             continue;
         solver_.setHealth(i, health);
         if (broken)

@@ -99,6 +99,11 @@ bool apart(const Aabb& p, const Aabb& q, double gap) {
            p.hi.z + gap < q.lo.z || q.hi.z + gap < p.lo.z;
 }
 
+// Bonds in (a, b) order.
+bool byNodes(const Bond& x, const Bond& y) {
+    return x.a < y.a || (x.a == y.a && x.b < y.b);
+}
+
 } // namespace
 
 BondInterface bondInterface(const std::vector<ConvexPolytope>& a, const std::vector<ConvexPolytope>& b,
@@ -201,8 +206,7 @@ std::vector<Bond> buildBonds(const std::vector<std::vector<ConvexPolytope>>& sol
             if (s.area > 0)
                 bonds.push_back({a, b, std::move(s)});
         }
-    std::sort(bonds.begin(), bonds.end(),
-              [](const Bond& x, const Bond& y) { return x.a < y.a || (x.a == y.a && x.b < y.b); });
+    std::sort(bonds.begin(), bonds.end(), byNodes);
     return bonds;
 }
 
@@ -307,8 +311,7 @@ std::vector<Bond> BondGraph::bonds() const {
     std::vector<Bond> out;
     for (const auto& [k, x] : bonds_)
         out.push_back({static_cast<std::uint32_t>(k >> 32), static_cast<std::uint32_t>(k), x});
-    std::sort(out.begin(), out.end(),
-              [](const Bond& x, const Bond& y) { return x.a < y.a || (x.a == y.a && x.b < y.b); });
+    std::sort(out.begin(), out.end(), byNodes);
     return out;
 }
 

@@ -534,7 +534,7 @@ std::vector<std::uint32_t> StressSolver::unsupported() const {
         open.pop_front();
         for (std::size_t i : nodes_[n].bonds) {
             const BondState& b = bonds_[i];
-            const std::uint32_t m = b.bond.a == n ? b.bond.b : b.bond.a;
+            const std::uint32_t m = b.bond.other(n);
             if (!b.broken && !reached[m]) {
                 reached[m] = 1;
                 open.push_back(m);
