@@ -177,8 +177,7 @@ GovernorActions DebrisGovernor::update(const BodyTable& bodies, const PhysicsBin
         smoothedMs_ = smoothedMs_ <= 0 ? physicsMs : 0.9 * smoothedMs_ + 0.1 * physicsMs;
         const double limit = budget_.physicsBudgetMs;
         int b = awakeBudget();
-        // A lone spike over a cheap average (a stall of the process, one burst of contacts) is no load that
-        // fewer bodies would shed; a spike over an average in the band, or two in a row, is.
+        // Load: a step over the budget on an average in the band, or two in a row (docs/architecture.md).
         const bool over = physicsMs > limit;
         const bool load = over && (lastOver_ || smoothedMs_ > kHoldLow * limit);
         lastOver_ = over;
