@@ -20,7 +20,9 @@ struct OutputShells {
 /// The verification every split passes before it becomes pieces: each non-empty output valid, closed,
 /// consistently oriented with positive volume, and the volumes summing to inputVolume (relative 1e-7).
 /// With shells, also the shell labels of the remainder and then of each inside mesh (found in the same pass).
-bool splitIsSound(const SplitResult& split, double inputVolume, std::vector<OutputShells>* shells = nullptr);
+/// otherVolume: of an output checked elsewhere (a remainder edited in place), counted in the sum.
+bool splitIsSound(const SplitResult& split, double inputVolume, std::vector<OutputShells>* shells = nullptr,
+                  double otherVolume = 0);
 
 /// fractureWithCells with an explicit backend (tests inject faulty ones). A split that fails splitIsSound
 /// is redone by Corefine when exactRedo is set (then FractureResult::exactFallback), else it is an error.
