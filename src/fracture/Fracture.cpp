@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <span>
+#include <unordered_map>
 #include <utility>
 
 #include <time.h>
@@ -355,6 +356,61 @@ Result<FractureResult> runPipeline(const Mesh& mesh, std::vector<ConvexPolytope>
     return res;
 }
 
+/// simplifyPlanarRegions on the triangles around the cut only (the added ones and those with a corner in
+/// focus that a walk from them reaches), written back in place; rest gets the change of the integrals.
+void simplifyAroundCut(Mesh& mesh, MeshTopology& topology, std::span<const std::uint32_t> added,
+                       const Aabb& focus, double meshDiagonal, VolumeIntegrals& rest) {
+    const std::vector<std::uint32_t> near = detail::trianglesNear(mesh, topology, added, focus);
+    Mesh local; // the triangles near the cut, their vertices numbered in order of first use
+    std::unordered_map<std::uint32_t, std::uint32_t> index;
+    std::vector<std::uint32_t> global;
+    const bool hasN = mesh.hasNormals();
+    for (std::uint32_t t : near) {
+        Triangle tri = mesh.triangles[t];
+        for (std::uint32_t& v : tri) {
+            auto [it, fresh] = index.emplace(v, static_cast<std::uint32_t>(global.size()));
+            if (fresh) {
+                global.push_back(v);
+                local.positions.push_back(mesh.positions[v]);
+            }
+            v = it->second;
+        }
+        local.triangles.push_back(tri);
+        local.materials.push_back(mesh.materials[t]);
+        local.uvs.insert(local.uvs.end(), mesh.uvs.begin() + 3 * t, mesh.uvs.begin() + 3 * t + 3);
+        if (hasN)
+            local.normals.insert(local.normals.end(), mesh.normals.begin() + 3 * t,
+                                 mesh.normals.begin() + 3 * t + 3);
+    }
+    const double localDiagonal = local.bounds().diagonal();
+    if (!(localDiagonal > 0))
+        return;
+    PlanarSimplifyParams sp;
+    sp.focus = focus;
+    sp.integralsReference = rest.reference;
+    sp.planeTolerance *= meshDiagonal / localDiagonal; // relative to the whole mesh, as for a full pass
+    PlanarSimplifyReport report;
+    Mesh simple = simplifyPlanarRegions(std::move(local), sp, &report);
+    if (report.unchanged)
+        return;
+    std::vector<std::uint32_t> toGlobal; // the simplified mesh's vertices: the local ones not removed
+    toGlobal.reserve(simple.positions.size());
+    for (std::uint32_t v = 0, r = 0; v < global.size(); ++v) {
+        if (r < report.removedVertices.size() && report.removedVertices[r] == v) {
+            ++r;
+            continue;
+        }
+        toGlobal.push_back(global[v]);
+    }
+    detail::TriangleBatch batch{std::move(simple.triangles), std::move(simple.normals), std::move(simple.uvs),
+                                std::move(simple.materials)};
+    for (Triangle& tri : batch.triangles)
+        for (std::uint32_t& v : tri)
+            v = toGlobal[v];
+    if (detail::replaceTriangles(mesh, topology, near, {}, std::move(batch)))
+        rest.accumulate(report.integralsChange, 1.0);
+}
+
 /// runPipeline on a mesh with its topology, edited in place (docs/megamesh.md): the split's remainder is an
 /// edit, checked around the cut and then applied; its islands are found by a walk around the cut, with the
 /// full labelling as the fallback. A split that fails leaves mesh and topology as they were (a failed edit
@@ -372,10 +428,6 @@ Result<FractureResult> runInPlace(Mesh& mesh, MeshTopology& topology, std::vecto
     if (!cellsReach(cells, meshBox))
         return cellsMiss();
     const std::size_t nT = mesh.triangles.size();
-    if (mesh.uvs.size() != 3 * nT) // the layout every split output has
-        mesh.uvs.assign(3 * nT, Vec2{});
-    if (mesh.materials.size() != nT)
-        mesh.materials.assign(nT, 0u);
 
     auto split = editing->splitAsEdit(mesh, cells, meshBox);
     const Stopwatch tv;
@@ -394,8 +446,17 @@ Result<FractureResult> runInPlace(Mesh& mesh, MeshTopology& topology, std::vecto
                 hit |= !m.empty();
             if (!hit)
                 return cellsCutNothing();
+            const bool noUvs = mesh.uvs.empty(), noMaterials = mesh.materials.empty();
+            if (noUvs) // the layout every split output has
+                mesh.uvs.assign(3 * nT, Vec2{});
+            if (noMaterials)
+                mesh.materials.assign(nT, 0u);
             slots = detail::replaceTriangles(mesh, topology, edit.removed, edit.newPositions,
                                              std::move(edit.added));
+            if (!slots && noUvs)
+                mesh.uvs.clear();
+            if (!slots && noMaterials)
+                mesh.materials.clear();
         }
         split->inside = std::move(debris.inside);
     }
@@ -443,9 +504,15 @@ Result<FractureResult> runInPlace(Mesh& mesh, MeshTopology& topology, std::vecto
         one = count == 1;
     }
     t1.set(res, &FractureTimings::massMs);
+    VolumeIntegrals& restIntegrals = split->remainderIntegrals;
+    if (one && params.simplifyPieces) {
+        const Stopwatch ts;
+        simplifyAroundCut(mesh, topology, *slots, focus, meshBox.diagonal(), restIntegrals);
+        ts.add(res, &FractureTimings::simplifyMs);
+    }
     const double minVolume = std::max(0.0, params.minPieceVolumeFraction) * inputVolume;
-    addPieces(std::move(mesh), rest, -1, minVolume, params.simplifyPieces, focus, &split->remainderIntegrals,
-              res, one ? &topology : nullptr, true);
+    addPieces(std::move(mesh), rest, -1, minVolume, params.simplifyPieces && !one, focus, &restIntegrals, res,
+              one ? &topology : nullptr, true);
     for (std::size_t i = 0; i < split->inside.size(); ++i)
         addPieces(std::move(split->inside[i]), shells[i + 1], static_cast<std::int32_t>(i), minVolume,
                   params.simplifyPieces, focus, nullptr, res, nullptr, true);
@@ -488,13 +555,20 @@ Result<FractureResult> fractureWithBackend(const Mesh& mesh, std::vector<ConvexP
                                            bool exactRedo, const MeshFacts& known) {
     if (known.fit(mesh) && known.topology.fits(mesh) && dynamic_cast<const EditingBackend*>(&backend)) {
         Mesh copy = mesh;
-        MeshTopology topology = known.topology;
-        return withValidation(copy, known, [&](double volume) {
-            return runInPlace(copy, topology, std::move(cells), params, backend, exactRedo, volume);
-        });
+        MeshFacts facts = known;
+        return fractureInPlaceWithBackend(copy, facts, std::move(cells), params, backend, exactRedo);
     }
     return withValidation(mesh, known, [&](double volume) {
         return runPipeline(mesh, std::move(cells), params, backend, exactRedo, volume);
+    });
+}
+
+Result<FractureResult> fractureInPlaceWithBackend(Mesh& mesh, MeshFacts& known,
+                                                  std::vector<ConvexPolytope> cells,
+                                                  const FractureParams& params, const BooleanBackend& backend,
+                                                  bool exactRedo) {
+    return withValidation(mesh, known, [&](double volume) {
+        return runInPlace(mesh, known.topology, std::move(cells), params, backend, exactRedo, volume);
     });
 }
 
@@ -590,9 +664,7 @@ Result<FractureResult> fractureWithCells(Mesh&& mesh, std::vector<ConvexPolytope
     if (!inPlace(mesh, known, params.backend))
         return fractureWithCells(std::as_const(mesh), std::move(cells), params, known);
     const auto backend = detail::makeFastBackend(true, &known.integrals);
-    return withValidation(mesh, known, [&](double volume) {
-        return runInPlace(mesh, known.topology, std::move(cells), params, *backend, true, volume);
-    });
+    return detail::fractureInPlaceWithBackend(mesh, known, std::move(cells), params, *backend, true);
 }
 
 Result<FractureResult> fracture(const Mesh& mesh, const Impact& impact, const FractureParams& params,

@@ -31,4 +31,12 @@ Result<FractureResult> fractureWithBackend(const Mesh& mesh, std::vector<ConvexP
                                            const FractureParams& params, const BooleanBackend& backend,
                                            bool exactRedo, const MeshFacts& known = {});
 
+/// fractureWithBackend on a mesh whose facts hold its topology, with a backend that edits (EditingBackend;
+/// otherwise as fractureWithBackend): the remainder is mesh edited in place, and known.topology with it. An
+/// error leaves mesh and known as they were; on success, mesh is consumed.
+Result<FractureResult> fractureInPlaceWithBackend(Mesh& mesh, MeshFacts& known,
+                                                  std::vector<ConvexPolytope> cells,
+                                                  const FractureParams& params, const BooleanBackend& backend,
+                                                  bool exactRedo);
+
 } // namespace rubble::detail

@@ -98,21 +98,41 @@ std::optional<std::vector<std::uint32_t>> replaceTriangles(Mesh& mesh, MeshTopol
     const std::size_t allV = nV + newPositions.size();
     // B: the removed triangles' directed edges; N: the added ones'. Conditions 1-4 of docs/megamesh.md.
     std::unordered_map<std::uint64_t, std::uint32_t> inB, inN;
+    std::unordered_map<std::uint32_t, std::uint32_t> outOf; // vertex -> a removed half-edge leaving it
     inB.reserve(3 * removed.size());
     inN.reserve(3 * nA);
     for (std::size_t i = 0; i < removed.size(); ++i) {
         const std::uint32_t t = removed[i];
         if (t >= nT || (i > 0 && removed[i - 1] >= t))
             return std::nullopt;
-        for (std::uint32_t c = 0; c < 3; ++c)
+        for (std::uint32_t c = 0; c < 3; ++c) {
             inB.emplace(edgeKey(mesh.triangles[t][c], mesh.triangles[t][(c + 1) % 3]), 3 * t + c);
+            outOf.emplace(mesh.triangles[t][c], 3 * t + c);
+        }
     }
+    // Whether a kept triangle has the edge a->b: a walk around a from one of its removed half-edges.
+    auto keptEdge = [&](std::uint32_t a, std::uint32_t b) {
+        const auto start = outOf.find(a);
+        if (start == outOf.end())
+            return true; // a vertex no removed triangle has: its triangles are all kept
+        std::uint32_t h = start->second;
+        for (std::size_t steps = 0; steps < 3 * nT; ++steps) {
+            const std::uint32_t t = h / 3;
+            if (mesh.triangles[t][(h % 3 + 1) % 3] == b &&
+                !std::binary_search(removed.begin(), removed.end(), t))
+                return true;
+            h = topology.twin[3 * t + (h % 3 + 2) % 3];
+            if (h == start->second)
+                return false;
+        }
+        return true;
+    };
     for (std::uint32_t i = 0; i < nA; ++i)
         for (std::uint32_t c = 0; c < 3; ++c) {
             const std::uint32_t a = added.triangles[i][c], b = added.triangles[i][(c + 1) % 3];
             if (a >= allV || b >= allV || a == b || !inN.emplace(edgeKey(a, b), 3 * i + c).second)
                 return std::nullopt; // out of range, a loop, or condition 1
-            if (a < nV && b < nV && !inB.count(edgeKey(a, b)))
+            if (a < nV && b < nV && !inB.count(edgeKey(a, b)) && keptEdge(a, b))
                 return std::nullopt; // condition 2
         }
     // Per added half-edge: its twin, 3i+c among the added (marked) or a kept half-edge.
@@ -240,6 +260,33 @@ bool stillOneShell(const Mesh& mesh, const MeshTopology& topology, std::span<con
         }
     }
     return reached == addedSlots.size();
+}
+
+std::vector<std::uint32_t> trianglesNear(const Mesh& mesh, const MeshTopology& topology,
+                                         std::span<const std::uint32_t> seeds, const Aabb& focus) {
+    std::unordered_map<std::uint32_t, bool> seen; // triangle -> taken
+    std::vector<std::uint32_t> out(seeds.begin(), seeds.end()), stack(seeds.begin(), seeds.end());
+    for (std::uint32_t s : seeds)
+        seen.emplace(s, true);
+    while (!stack.empty()) {
+        const std::uint32_t t = stack.back();
+        stack.pop_back();
+        for (std::uint32_t c = 0; c < 3; ++c) {
+            const std::uint32_t u = topology.twin[3 * t + c] / 3;
+            auto [it, fresh] = seen.emplace(u, false);
+            if (!fresh)
+                continue;
+            const Triangle& tri = mesh.triangles[u];
+            if (focus.contains(mesh.positions[tri[0]]) || focus.contains(mesh.positions[tri[1]]) ||
+                focus.contains(mesh.positions[tri[2]])) {
+                it->second = true;
+                out.push_back(u);
+                stack.push_back(u);
+            }
+        }
+    }
+    std::sort(out.begin(), out.end());
+    return out;
 }
 
 void compactVerticesIfSparse(Mesh& mesh) {
