@@ -356,11 +356,12 @@ Result<FractureResult> runPipeline(const Mesh& mesh, std::vector<ConvexPolytope>
     return res;
 }
 
-/// simplifyPlanarRegions on the triangles around the cut only (the added ones and those with a corner in
-/// focus that a walk from them reaches), written back in place; rest gets the change of the integrals.
+/// simplifyPlanarRegions on the triangles around the cut only (the added ones and those sharing a corner
+/// with one: only the added triangles' corners can go), written back in place; rest gets the change of the
+/// integrals.
 void simplifyAroundCut(Mesh& mesh, MeshTopology& topology, std::span<const std::uint32_t> added,
                        const Aabb& focus, double meshDiagonal, VolumeIntegrals& rest) {
-    const std::vector<std::uint32_t> near = detail::trianglesNear(mesh, topology, added, focus);
+    const std::vector<std::uint32_t> near = detail::trianglesAround(mesh, topology, added);
     Mesh local; // the triangles near the cut, their vertices numbered in order of first use
     std::unordered_map<std::uint32_t, std::uint32_t> index;
     std::vector<std::uint32_t> global;

@@ -16,6 +16,14 @@ std::uint64_t edgeKey(std::uint32_t a, std::uint32_t b) {
     return (std::uint64_t(a) << 32) | b;
 }
 
+/// Resizes v to n; when that reallocates, with room for 1/16 more, so that the next edits do not.
+template <class T>
+void growTo(std::vector<T>& v, std::size_t n) {
+    if (n > v.capacity())
+        v.reserve(n + n / 16);
+    v.resize(n);
+}
+
 } // namespace
 
 std::optional<MeshTopology> buildTopology(const Mesh& mesh) {
@@ -159,18 +167,21 @@ std::optional<std::vector<std::uint32_t>> replaceTriangles(Mesh& mesh, MeshTopol
         return std::nullopt;
 
     // Apply: slots for the added triangles, then the surplus slots filled from the end.
-    mesh.positions.insert(mesh.positions.end(), newPositions.begin(), newPositions.end());
+    const std::size_t oldV = mesh.positions.size();
+    growTo(mesh.positions, oldV + newPositions.size());
+    std::copy(newPositions.begin(), newPositions.end(),
+              mesh.positions.begin() + static_cast<std::ptrdiff_t>(oldV));
     std::vector<std::uint32_t> slot(nA);
     for (std::size_t i = 0; i < nA; ++i)
         slot[i] = i < removed.size() ? removed[i] : static_cast<std::uint32_t>(nT + (i - removed.size()));
     const std::size_t total = nT - removed.size() + nA;
     if (total > nT) {
-        mesh.triangles.resize(total);
-        mesh.uvs.resize(3 * total);
-        mesh.materials.resize(total);
+        growTo(mesh.triangles, total);
+        growTo(mesh.uvs, 3 * total);
+        growTo(mesh.materials, total);
         if (hasN)
-            mesh.normals.resize(3 * total);
-        topology.twin.resize(3 * total);
+            growTo(mesh.normals, 3 * total);
+        growTo(topology.twin, 3 * total);
     }
     for (std::size_t i = 0; i < nA; ++i) {
         const std::uint32_t s = slot[i];
@@ -262,30 +273,23 @@ bool stillOneShell(const Mesh& mesh, const MeshTopology& topology, std::span<con
     return reached == addedSlots.size();
 }
 
-std::vector<std::uint32_t> trianglesNear(const Mesh& mesh, const MeshTopology& topology,
-                                         std::span<const std::uint32_t> seeds, const Aabb& focus) {
-    std::unordered_map<std::uint32_t, bool> seen; // triangle -> taken
-    std::vector<std::uint32_t> out(seeds.begin(), seeds.end()), stack(seeds.begin(), seeds.end());
-    for (std::uint32_t s : seeds)
-        seen.emplace(s, true);
-    while (!stack.empty()) {
-        const std::uint32_t t = stack.back();
-        stack.pop_back();
+std::vector<std::uint32_t> trianglesAround(const Mesh& mesh, const MeshTopology& topology,
+                                           std::span<const std::uint32_t> seeds) {
+    std::vector<std::uint32_t> out;
+    const std::size_t limit = mesh.triangles.size();
+    for (std::uint32_t t : seeds)
         for (std::uint32_t c = 0; c < 3; ++c) {
-            const std::uint32_t u = topology.twin[3 * t + c] / 3;
-            auto [it, fresh] = seen.emplace(u, false);
-            if (!fresh)
-                continue;
-            const Triangle& tri = mesh.triangles[u];
-            if (focus.contains(mesh.positions[tri[0]]) || focus.contains(mesh.positions[tri[1]]) ||
-                focus.contains(mesh.positions[tri[2]])) {
-                it->second = true;
-                out.push_back(u);
-                stack.push_back(u);
+            const std::uint32_t start = 3 * t + c; // leaves corner c; the walk turns around it
+            std::uint32_t h = start;
+            for (std::size_t steps = 0; steps < limit; ++steps) {
+                out.push_back(h / 3);
+                h = topology.twin[3 * (h / 3) + (h % 3 + 2) % 3];
+                if (h == start)
+                    break;
             }
         }
-    }
     std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
     return out;
 }
 

@@ -38,10 +38,9 @@ std::optional<std::vector<std::uint32_t>> replaceTriangles(Mesh& mesh, MeshTopol
 bool stillOneShell(const Mesh& mesh, const MeshTopology& topology, std::span<const std::uint32_t> addedSlots,
                    const Aabb& near);
 
-/// The triangles a walk from seeds reaches through triangles with a corner in focus (the seeds included),
-/// ascending: with a vertex in focus, all its triangles when one of them is reached.
-std::vector<std::uint32_t> trianglesNear(const Mesh& mesh, const MeshTopology& topology,
-                                         std::span<const std::uint32_t> seeds, const Aabb& focus);
+/// The seeds and every triangle that shares a corner with one (the stars of their corners), ascending.
+std::vector<std::uint32_t> trianglesAround(const Mesh& mesh, const MeshTopology& topology,
+                                           std::span<const std::uint32_t> seeds);
 
 /// Removes unreferenced vertices when they are more than a quarter of the vertices a closed mesh of this
 /// many triangles references (about half its triangle count); the topology stays valid.
