@@ -204,10 +204,13 @@ void addPieces(Mesh&& m, const detail::OutputShells& shells, std::int32_t cell, 
         }
         const Stopwatch tm;
         MeshTopology topo;
-        if (topology && islands.size() == 1) {
+        const bool large = island.triangles.size() > kTopologyAboveTriangles;
+        if (topology && islands.size() == 1 && large) {
             topo = std::move(*topology);
             detail::compactVerticesIfSparse(island);
-        } else if (wantTopology && island.triangles.size() > kTopologyAboveTriangles) {
+        } else if (topology && islands.size() == 1) {
+            island.removeUnreferencedVertices(); // small: the copying path's layout from now on
+        } else if (wantTopology && large) {
             topo = buildTopology(island).value_or(MeshTopology{});
         }
         MeshFacts facts{true, island.triangles.size(), island.positions.size(),
