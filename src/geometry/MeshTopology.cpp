@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <unordered_map>
+#include <unordered_set>
 
 #include "geometry/TopologyEdit.hpp"
 
@@ -276,20 +277,25 @@ bool stillOneShell(const Mesh& mesh, const MeshTopology& topology, std::span<con
 std::vector<std::uint32_t> trianglesAround(const Mesh& mesh, const MeshTopology& topology,
                                            std::span<const std::uint32_t> seeds) {
     std::vector<std::uint32_t> out;
+    std::unordered_set<std::uint32_t> corners, taken;
+    corners.reserve(2 * seeds.size());
+    taken.reserve(4 * seeds.size());
     const std::size_t limit = mesh.triangles.size();
     for (std::uint32_t t : seeds)
         for (std::uint32_t c = 0; c < 3; ++c) {
+            if (!corners.insert(mesh.triangles[t][c]).second)
+                continue;
             const std::uint32_t start = 3 * t + c; // leaves corner c; the walk turns around it
             std::uint32_t h = start;
             for (std::size_t steps = 0; steps < limit; ++steps) {
-                out.push_back(h / 3);
+                if (taken.insert(h / 3).second)
+                    out.push_back(h / 3);
                 h = topology.twin[3 * (h / 3) + (h % 3 + 2) % 3];
                 if (h == start)
                     break;
             }
         }
     std::sort(out.begin(), out.end());
-    out.erase(std::unique(out.begin(), out.end()), out.end());
     return out;
 }
 
