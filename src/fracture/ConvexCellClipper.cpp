@@ -879,12 +879,28 @@ Result<CellSplit> clipByConvexCell(const Mesh& mesh, const ConvexPolytope& cell)
     return CellSplit{std::move(split->outside), std::move(split->inside.front())};
 }
 
-Result<MultiCellEdit> clipByConvexCellsAsEdit(const Mesh& mesh, const std::vector<ConvexPolytope>& cells,
-                                              const VolumeIntegrals& meshIntegrals) {
+namespace {
+
+/// f() with the clipper's declines and failures as GeometryFailure errors; empty cells are InvalidInput.
+template <class F>
+auto guardedClip(const std::vector<ConvexPolytope>& cells, F f) -> decltype(f()) {
     if (cells.empty() ||
         std::any_of(cells.begin(), cells.end(), [](const ConvexPolytope& c) { return c.empty(); }))
         return makeError(ErrorCode::InvalidInput, "no cells, or an empty cell");
     try {
+        return f();
+    } catch (const Degenerate& d) {
+        return makeError(ErrorCode::GeometryFailure, std::string("fast clip declined: ") + d.why);
+    } catch (const std::exception& e) {
+        return makeError(ErrorCode::GeometryFailure, std::string("fast clip failed: ") + e.what());
+    }
+}
+
+} // namespace
+
+Result<MultiCellEdit> clipByConvexCellsAsEdit(const Mesh& mesh, const std::vector<ConvexPolytope>& cells,
+                                              const VolumeIntegrals& meshIntegrals) {
+    return guardedClip(cells, [&]() -> Result<MultiCellEdit> {
         Clipper clipper(mesh, cells);
         MultiCellEdit out;
         std::optional<VolumeIntegrals> rest;
@@ -893,19 +909,12 @@ Result<MultiCellEdit> clipByConvexCellsAsEdit(const Mesh& mesh, const std::vecto
         out.inside = std::move(regions);
         out.outsideIntegrals = *rest;
         return out;
-    } catch (const Degenerate& d) {
-        return makeError(ErrorCode::GeometryFailure, std::string("fast clip declined: ") + d.why);
-    } catch (const std::exception& e) {
-        return makeError(ErrorCode::GeometryFailure, std::string("fast clip failed: ") + e.what());
-    }
+    });
 }
 
 Result<MultiCellSplit> clipByConvexCells(const Mesh& mesh, const std::vector<ConvexPolytope>& cells,
                                          const VolumeIntegrals* meshIntegrals) {
-    if (cells.empty() ||
-        std::any_of(cells.begin(), cells.end(), [](const ConvexPolytope& c) { return c.empty(); }))
-        return makeError(ErrorCode::InvalidInput, "no cells, or an empty cell");
-    try {
+    return guardedClip(cells, [&]() -> Result<MultiCellSplit> {
         Clipper clipper(mesh, cells);
         MultiCellSplit out;
         std::vector<Mesh> regions = clipper.run(meshIntegrals, out.outsideIntegrals);
@@ -913,11 +922,7 @@ Result<MultiCellSplit> clipByConvexCells(const Mesh& mesh, const std::vector<Con
         regions.pop_back();
         out.inside = std::move(regions);
         return out;
-    } catch (const Degenerate& d) {
-        return makeError(ErrorCode::GeometryFailure, std::string("fast clip declined: ") + d.why);
-    } catch (const std::exception& e) {
-        return makeError(ErrorCode::GeometryFailure, std::string("fast clip failed: ") + e.what());
-    }
+    });
 }
 
 } // namespace rubble::detail

@@ -284,20 +284,44 @@ Aabb cutFocus(const std::vector<ConvexPolytope>& cells, const Aabb& meshBox) {
     return {focus.lo - grow, focus.hi + grow};
 }
 
-bool cellsReach(const std::vector<ConvexPolytope>& cells, const Aabb& meshBox) {
+/// The start of a pipeline: the result knows the input volume, meshBox is the mesh's bounds; an error when
+/// no cell reaches them.
+Status startPipeline(const Mesh& mesh, const std::vector<ConvexPolytope>& cells, double inputVolume,
+                     FractureResult& res, Aabb& meshBox) {
+    res.inputVolume = inputVolume;
+    meshBox = mesh.bounds();
     bool any = false;
     for (const ConvexPolytope& c : cells)
         any |= !c.empty() && c.bounds().overlaps(meshBox);
-    return any;
-}
-
-Error cellsMiss() {
-    return makeError(ErrorCode::NoIntersection, "fracture: the impact's cells do not touch the mesh");
+    if (!any)
+        return makeError(ErrorCode::NoIntersection, "fracture: the impact's cells do not touch the mesh");
+    return {};
 }
 
 Error cellsCutNothing() {
     return makeError(ErrorCode::NoIntersection,
                      "fracture: the impact's cells do not intersect the mesh (is the impact outside it?)");
+}
+
+/// Interior UVs of the cells' pieces: a cell's piece is cut by that cell only.
+void finishInsideCutFaces(std::vector<Mesh>& inside, const std::vector<ConvexPolytope>& cells,
+                          const FractureParams& params, const Aabb& focus, double onPlane) {
+    for (std::size_t i = 0; i < inside.size(); ++i)
+        finishCutFaces(inside[i], std::span(cells).subspan(i, 1), params.uvScale, focus, onPlane);
+}
+
+/// After the remainder's pieces: the cells' pieces (shells[i + 1] for inside[i]), the cells and the times.
+FractureResult finishPieces(std::vector<Mesh>&& inside, const std::vector<detail::OutputShells>& shells,
+                            std::vector<ConvexPolytope>&& cells, const FractureParams& params,
+                            double minVolume, const Aabb& focus, bool wantTopology, const Stopwatch& t0,
+                            const Stopwatch& t1, FractureResult&& res) {
+    for (std::size_t i = 0; i < inside.size(); ++i)
+        addPieces(std::move(inside[i]), shells[i + 1], static_cast<std::int32_t>(i), minVolume,
+                  params.simplifyPieces, focus, nullptr, res, nullptr, wantTopology);
+    t1.set(res, &FractureTimings::islandsMs);
+    res.cells = std::move(cells);
+    t0.set(res, &FractureTimings::totalMs);
+    return std::move(res);
 }
 
 /// The pipeline after input validation. wantTopology: pieces above kTopologyAboveTriangles get theirs.
@@ -306,10 +330,9 @@ Result<FractureResult> runPipeline(const Mesh& mesh, std::vector<ConvexPolytope>
                                    bool exactRedo, double inputVolume, bool wantTopology = false) {
     const Stopwatch t0;
     FractureResult res;
-    res.inputVolume = inputVolume;
-    const Aabb meshBox = mesh.bounds();
-    if (!cellsReach(cells, meshBox))
-        return cellsMiss();
+    Aabb meshBox;
+    if (Status s = startPipeline(mesh, cells, inputVolume, res, meshBox); !s)
+        return s.error();
 
     auto split = backend.split(mesh, cells);
     // The result must close up and conserve volume; a failed fast split is redone exactly. The check labels
@@ -343,20 +366,14 @@ Result<FractureResult> runPipeline(const Mesh& mesh, std::vector<ConvexPolytope>
     const Aabb focus = cutFocus(cells, meshBox);
     const double onPlane = 1e-7 * meshBox.diagonal();
     finishCutFaces(split->remainder, cells, params.uvScale, focus, onPlane);
-    for (std::size_t i = 0; i < split->inside.size(); ++i) // a cell's piece is cut by that cell only
-        finishCutFaces(split->inside[i], std::span(cells).subspan(i, 1), params.uvScale, focus, onPlane);
+    finishInsideCutFaces(split->inside, cells, params, focus, onPlane);
     t1.set(res, &FractureTimings::massMs);
     const double minVolume = std::max(0.0, params.minPieceVolumeFraction) * inputVolume;
     const VolumeIntegrals* whole = split->remainderIntegrals ? &*split->remainderIntegrals : nullptr;
     addPieces(std::move(split->remainder), shells[0], -1, minVolume, params.simplifyPieces, focus, whole, res,
               nullptr, wantTopology);
-    for (std::size_t i = 0; i < split->inside.size(); ++i)
-        addPieces(std::move(split->inside[i]), shells[i + 1], static_cast<std::int32_t>(i), minVolume,
-                  params.simplifyPieces, focus, nullptr, res, nullptr, wantTopology);
-    t1.set(res, &FractureTimings::islandsMs);
-    res.cells = std::move(cells);
-    t0.set(res, &FractureTimings::totalMs);
-    return res;
+    return finishPieces(std::move(split->inside), shells, std::move(cells), params, minVolume, focus,
+                        wantTopology, t0, t1, std::move(res));
 }
 
 /// simplifyPlanarRegions on the triangles around the cut only (the added ones and those sharing a corner
@@ -427,10 +444,9 @@ Result<FractureResult> runInPlace(Mesh& mesh, MeshTopology& topology, std::vecto
         return runPipeline(mesh, std::move(cells), params, backend, exactRedo, inputVolume, true);
     const Stopwatch t0;
     FractureResult res;
-    res.inputVolume = inputVolume;
-    const Aabb meshBox = mesh.bounds();
-    if (!cellsReach(cells, meshBox))
-        return cellsMiss();
+    Aabb meshBox;
+    if (Status s = startPipeline(mesh, cells, inputVolume, res, meshBox); !s)
+        return s.error();
     const std::size_t nT = mesh.triangles.size();
 
     auto split = editing->splitAsEdit(mesh, cells, meshBox);
@@ -488,8 +504,7 @@ Result<FractureResult> runInPlace(Mesh& mesh, MeshTopology& topology, std::vecto
     const Aabb focus = cutFocus(cells, meshBox);
     const double onPlane = 1e-7 * meshBox.diagonal();
     finishCutFaces(mesh, cells, params.uvScale, focus, onPlane, &*slots);
-    for (std::size_t i = 0; i < split->inside.size(); ++i)
-        finishCutFaces(split->inside[i], std::span(cells).subspan(i, 1), params.uvScale, focus, onPlane);
+    finishInsideCutFaces(split->inside, cells, params, focus, onPlane);
     // One shell when a walk around the cut joins all new triangles (the kept ones next to the cut touch
     // them); else the full labelling.
     detail::OutputShells rest;
@@ -517,13 +532,8 @@ Result<FractureResult> runInPlace(Mesh& mesh, MeshTopology& topology, std::vecto
     const double minVolume = std::max(0.0, params.minPieceVolumeFraction) * inputVolume;
     addPieces(std::move(mesh), rest, -1, minVolume, params.simplifyPieces && !one, focus, &restIntegrals, res,
               one ? &topology : nullptr, true);
-    for (std::size_t i = 0; i < split->inside.size(); ++i)
-        addPieces(std::move(split->inside[i]), shells[i + 1], static_cast<std::int32_t>(i), minVolume,
-                  params.simplifyPieces, focus, nullptr, res, nullptr, true);
-    t1.set(res, &FractureTimings::islandsMs);
-    res.cells = std::move(cells);
-    t0.set(res, &FractureTimings::totalMs);
-    return res;
+    return finishPieces(std::move(split->inside), shells, std::move(cells), params, minVolume, focus, true,
+                        t0, t1, std::move(res));
 }
 
 /// Runs a pipeline (runPipeline or runInPlace) after the input's validation, with its timings.

@@ -184,14 +184,20 @@ std::optional<std::vector<std::uint32_t>> replaceTriangles(Mesh& mesh, MeshTopol
             growTo(mesh.normals, 3 * total);
         growTo(topology.twin, 3 * total);
     }
+    // Writes a triangle and its attributes into slot s.
+    auto put = [&](std::uint32_t s, const Triangle& tri, std::uint32_t material, const Vec2* uvs,
+                   const Vec3* normals) {
+        mesh.triangles[s] = tri;
+        mesh.materials[s] = material;
+        std::copy(uvs, uvs + 3, mesh.uvs.begin() + 3 * s);
+        if (hasN)
+            std::copy(normals, normals + 3, mesh.normals.begin() + 3 * s);
+    };
     for (std::size_t i = 0; i < nA; ++i) {
         const std::uint32_t s = slot[i];
-        mesh.triangles[s] = added.triangles[i];
-        mesh.materials[s] = added.materials[i];
+        put(s, added.triangles[i], added.materials[i], &added.uvs[3 * i],
+            hasN ? &added.normals[3 * i] : nullptr);
         for (std::uint32_t c = 0; c < 3; ++c) {
-            mesh.uvs[3 * s + c] = added.uvs[3 * i + c];
-            if (hasN)
-                mesh.normals[3 * s + c] = added.normals[3 * i + c];
             const std::uint32_t t = twinOf[3 * i + c];
             if (t & kAddedBit) {
                 const std::uint32_t j = (t & ~kAddedBit) / 3, d = (t & ~kAddedBit) % 3;
@@ -218,12 +224,9 @@ std::optional<std::vector<std::uint32_t>> replaceTriangles(Mesh& mesh, MeshTopol
         }
         for (std::size_t i = 0; i < holes.size(); ++i) {
             const std::uint32_t from = movers[i], to = holes[i];
-            mesh.triangles[to] = mesh.triangles[from];
-            mesh.materials[to] = mesh.materials[from];
+            put(to, mesh.triangles[from], mesh.materials[from], &mesh.uvs[3 * from],
+                hasN ? &mesh.normals[3 * from] : nullptr);
             for (std::uint32_t c = 0; c < 3; ++c) {
-                mesh.uvs[3 * to + c] = mesh.uvs[3 * from + c];
-                if (hasN)
-                    mesh.normals[3 * to + c] = mesh.normals[3 * from + c];
                 const std::uint32_t t = topology.twin[3 * from + c];
                 topology.twin[3 * to + c] = t;
                 topology.twin[t] = 3 * to + c;
