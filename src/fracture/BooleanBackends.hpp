@@ -18,9 +18,11 @@ std::unique_ptr<BooleanBackend> makeCorefineBackend();
 std::unique_ptr<BooleanBackend> makeNefBackend();
 /// A split whose remainder is an edit of the input (RemainderEdit), for meshes edited in place.
 struct SplitEdit {
-    RemainderEdit remainder;            ///< mesh − ∪ cells as an edit of mesh
-    std::vector<Mesh> inside;           ///< inside[i] = mesh ∩ cells[i] (may be empty)
-    VolumeIntegrals remainderIntegrals; ///< of the remainder, by difference
+    RemainderEdit remainder;             ///< mesh − ∪ cells as an edit of mesh
+    std::vector<Mesh> inside;            ///< inside[i] = mesh ∩ cells[i] (may be empty)
+    std::vector<std::size_t> insideKept; ///< per cell: inside[i]'s first triangles are input triangles kept
+                                         ///< whole, the rest new (all new when unknown: 0)
+    VolumeIntegrals remainderIntegrals;  ///< of the remainder, by difference
 };
 
 /// A backend that can also give the remainder as an edit of the input.

@@ -201,6 +201,8 @@ public:
     /// region of the result is then empty).
     std::vector<Mesh> run(const VolumeIntegrals* known, std::optional<VolumeIntegrals>& restIntegrals,
                           RemainderEdit* edit = nullptr);
+    /// After run: the triangles region r kept whole (assemble puts them first).
+    std::size_t keptWhole(std::uint32_t r) const { return untouched_[r].size(); }
 
 private:
     const Mesh& mesh_;
@@ -907,6 +909,8 @@ Result<MultiCellEdit> clipByConvexCellsAsEdit(const Mesh& mesh, const std::vecto
         std::vector<Mesh> regions = clipper.run(&meshIntegrals, rest, &out.outside);
         regions.pop_back();
         out.inside = std::move(regions);
+        for (std::uint32_t r = 0; r < out.inside.size(); ++r)
+            out.insideKept.push_back(clipper.keptWhole(r));
         out.outsideIntegrals = *rest;
         return out;
     });

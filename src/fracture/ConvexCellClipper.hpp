@@ -59,9 +59,11 @@ struct RemainderEdit {
 
 /// A split whose rest is an edit of the input.
 struct MultiCellEdit {
-    RemainderEdit outside;            ///< mesh − ∪ cells, as an edit of mesh
-    std::vector<Mesh> inside;         ///< mesh ∩ cell k, in the order of the cells
-    VolumeIntegrals outsideIntegrals; ///< of mesh − ∪ cells, by difference
+    RemainderEdit outside;               ///< mesh − ∪ cells, as an edit of mesh
+    std::vector<Mesh> inside;            ///< mesh ∩ cell k, in the order of the cells
+    std::vector<std::size_t> insideKept; ///< per cell: inside's first triangles, input triangles kept whole;
+                                         ///< the rest are new
+    VolumeIntegrals outsideIntegrals;    ///< of mesh − ∪ cells, by difference
 };
 
 /// clipByConvexCells with the rest as an edit of mesh (not assembled: no pass over the untouched triangles

@@ -64,6 +64,7 @@ public:
             return makeError(ErrorCode::InvalidInput, "fast: an edit needs the input's integrals");
         SplitEdit out;
         out.inside.resize(cells.size());
+        out.insideKept.assign(cells.size(), 0);
         std::vector<ConvexPolytope> used;
         std::vector<std::size_t> index;
         for (std::size_t i = 0; i < cells.size(); ++i)
@@ -78,8 +79,10 @@ public:
         auto r = clipByConvexCellsAsEdit(mesh, used, *inputIntegrals_);
         if (!r)
             return r.error();
-        for (std::size_t k = 0; k < index.size(); ++k)
+        for (std::size_t k = 0; k < index.size(); ++k) {
             out.inside[index[k]] = std::move(r->inside[k]);
+            out.insideKept[index[k]] = r->insideKept[k];
+        }
         out.remainder = std::move(r->outside);
         out.remainderIntegrals = r->outsideIntegrals;
         return out;

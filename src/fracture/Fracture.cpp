@@ -310,14 +310,42 @@ void finishInsideCutFaces(std::vector<Mesh>& inside, const std::vector<ConvexPol
         finishCutFaces(inside[i], std::span(cells).subspan(i, 1), params.uvScale, focus, onPlane);
 }
 
+void simplifyAroundCut(Mesh& mesh, MeshTopology& topology, std::span<const std::uint32_t> added,
+                       const Aabb& focus, double meshDiagonal, VolumeIntegrals& rest);
+
+/// The cells' pieces in place: a piece that is one shell and whose first insideKept[i] triangles are the
+/// input's (the rest new) is simplified around its new triangles only, with its topology.
+struct InsideInPlace {
+    const std::vector<std::size_t>& insideKept;
+    double meshDiagonal;
+};
+
 /// After the remainder's pieces: the cells' pieces (shells[i + 1] for inside[i]), the cells and the times.
 FractureResult finishPieces(std::vector<Mesh>&& inside, const std::vector<detail::OutputShells>& shells,
                             std::vector<ConvexPolytope>&& cells, const FractureParams& params,
                             double minVolume, const Aabb& focus, bool wantTopology, const Stopwatch& t0,
-                            const Stopwatch& t1, FractureResult&& res) {
-    for (std::size_t i = 0; i < inside.size(); ++i)
-        addPieces(std::move(inside[i]), shells[i + 1], static_cast<std::int32_t>(i), minVolume,
-                  params.simplifyPieces, focus, nullptr, res, nullptr, wantTopology);
+                            const Stopwatch& t1, FractureResult&& res,
+                            const InsideInPlace* inPlace = nullptr) {
+    for (std::size_t i = 0; i < inside.size(); ++i) {
+        Mesh& m = inside[i];
+        std::optional<MeshTopology> topology;
+        if (inPlace && params.simplifyPieces && shells[i + 1].count == 1 && i < inPlace->insideKept.size() &&
+            inPlace->insideKept[i] < m.triangles.size()) {
+            const Stopwatch ts;
+            topology = buildTopology(m);
+            if (topology) {
+                std::vector<std::uint32_t> added(m.triangles.size() - inPlace->insideKept[i]);
+                for (std::size_t k = 0; k < added.size(); ++k)
+                    added[k] = static_cast<std::uint32_t>(inPlace->insideKept[i] + k);
+                VolumeIntegrals unused; // the piece is measured in full
+                simplifyAroundCut(m, *topology, added, focus, inPlace->meshDiagonal, unused);
+            }
+            ts.add(res, &FractureTimings::simplifyMs);
+        }
+        addPieces(std::move(m), shells[i + 1], static_cast<std::int32_t>(i), minVolume,
+                  params.simplifyPieces && !topology, focus, nullptr, res, topology ? &*topology : nullptr,
+                  wantTopology);
+    }
     t1.set(res, &FractureTimings::islandsMs);
     res.cells = std::move(cells);
     t0.set(res, &FractureTimings::totalMs);
@@ -532,8 +560,9 @@ Result<FractureResult> runInPlace(Mesh& mesh, MeshTopology& topology, std::vecto
     const double minVolume = std::max(0.0, params.minPieceVolumeFraction) * inputVolume;
     addPieces(std::move(mesh), rest, -1, minVolume, params.simplifyPieces && !one, focus, &restIntegrals, res,
               one ? &topology : nullptr, true);
+    const InsideInPlace debris{split->insideKept, meshBox.diagonal()};
     return finishPieces(std::move(split->inside), shells, std::move(cells), params, minVolume, focus, true,
-                        t0, t1, std::move(res));
+                        t0, t1, std::move(res), &debris);
 }
 
 /// Runs a pipeline (runPipeline or runInPlace) after the input's validation, with its timings.
