@@ -15,6 +15,10 @@ namespace rubble {
 
 namespace {
 
+/// A high-poly piece's parts are replaced by their hull when it is at most this much larger than their sum
+/// (they overlap: merges fill the dents), so that a chain of hits restarts from one part.
+constexpr double kHighPolyFillTolerance = 0.01;
+
 struct Fragment {
     ConvexPolytope shape;
     std::int32_t cell = -1; // -1: outside every cell
@@ -332,9 +336,27 @@ std::vector<std::vector<ConvexPolytope>> updateParts(const std::vector<ConvexPol
         result[piece].push_back(std::move(part));
         origins[piece].push_back(origin);
     };
-    std::vector<Aabb> pieceBounds(pieces.size());
+    // A high-poly remainder island alone in its class takes every remainder fragment as it is: its bounds
+    // (a pass over its vertices) are replaced by the parent parts' (which cover it), and nothing is trimmed.
+    std::size_t remainders = 0;
     for (std::size_t i = 0; i < pieces.size(); ++i)
-        pieceBounds[i] = pieces[i]->bounds();
+        remainders += (i < pieceCells.size() ? pieceCells[i] : -1) < 0 ? 1 : 0;
+    std::size_t totalTriangles = 0;
+    for (const Mesh* piece : pieces)
+        totalTriangles += piece->triangles.size();
+    const bool highPolyParent = totalTriangles > params.proxyAboveTriangles;
+    std::vector<bool> trim(pieces.size(), true);
+    std::vector<Aabb> pieceBounds(pieces.size());
+    for (std::size_t i = 0; i < pieces.size(); ++i) {
+        const bool remainder = (i < pieceCells.size() ? pieceCells[i] : -1) < 0;
+        if (remainder && remainders == 1 && pieces[i]->triangles.size() > params.proxyAboveTriangles) {
+            trim[i] = false;
+            for (const ConvexPolytope& part : parentParts)
+                pieceBounds[i].extend(part.bounds());
+        } else {
+            pieceBounds[i] = pieces[i]->bounds();
+        }
+    }
     for (Fragment& frag : fragments) {
         const double fragVolume = frag.shape.volume();
         if (fragVolume <= sliver)
@@ -353,6 +375,10 @@ std::vector<std::vector<ConvexPolytope>> updateParts(const std::vector<ConvexPol
                 candidates.push_back(i);
         }
         if (candidates.size() == 1) {
+            if (!trim[candidates[0]]) {
+                give(candidates[0], std::move(frag.shape), frag.part);
+                continue;
+            }
             // Parent parts may reach into empty space: keep the fragment inside the piece's bounds.
             ConvexPolytope clipped = clippedToBox(std::move(frag.shape), pieceBounds[candidates[0]]);
             if (!clipped.empty())
@@ -360,11 +386,11 @@ std::vector<std::vector<ConvexPolytope>> updateParts(const std::vector<ConvexPol
             continue;
         }
         if (candidates.size() > 1) {
-            // Several islands may share this fragment: give each the hull of its own part inside it (on a
-            // high-poly island, whose inside test costs a pass over its triangles per point, the fragment
-            // clipped to the island's bounds, which also holds that part).
+            // Several islands may share this fragment: give each the hull of its own part inside it (when the
+            // island or the parent is high-poly, whose inside test costs a pass over the island per corner of
+            // a bounded part, the fragment clipped to the island's bounds, which also holds that part).
             for (std::size_t i : candidates) {
-                if (pieces[i]->triangles.size() > params.proxyAboveTriangles) {
+                if (highPolyParent || pieces[i]->triangles.size() > params.proxyAboveTriangles) {
                     ConvexPolytope clipped = clippedToBox(frag.shape, pieceBounds[i]);
                     if (!clipped.empty() && clipped.volume() > sliver)
                         give(i, std::move(clipped), frag.part);
@@ -407,10 +433,11 @@ std::vector<std::vector<ConvexPolytope>> updateParts(const std::vector<ConvexPol
         }
         // A high-poly remainder island whose fragments all come from one parent part is that part minus
         // cells: with two or more fragments it has a dent and does not fill its hull (test skipped).
-        const bool dented = i < pieceCells.size() && pieceCells[i] < 0 &&
-                            pieces[i]->triangles.size() > params.proxyAboveTriangles &&
+        const bool highPoly = pieces[i]->triangles.size() > params.proxyAboveTriangles;
+        const bool dented = i < pieceCells.size() && pieceCells[i] < 0 && highPoly &&
                             std::all_of(origins[i].begin(), origins[i].end(),
                                         [&](std::uint32_t o) { return o == origins[i].front(); });
+        // A high-poly piece's parts that nearly fill their hull become that hull (kHighPolyFillTolerance).
         if (parts.size() > 1 && !dented) {
             double sum = 0;
             std::vector<Vec3> pts;
@@ -421,12 +448,13 @@ std::vector<std::vector<ConvexPolytope>> updateParts(const std::vector<ConvexPol
             }
             // The hull of the extremes in 26 directions lies inside the full hull: when it is already larger
             // than the parts together, they do not fill their hull (and the full hull is not computed).
-            if (auto quick = convexHull(extremePoints(pts)); quick && quick->volume() > sum * (1 + 1e-6)) {
+            const double fillTol = highPoly ? kHighPolyFillTolerance : 1e-6;
+            if (auto quick = convexHull(extremePoints(pts)); quick && quick->volume() > sum * (1 + fillTol)) {
                 mergeToBudget(parts, origins[i], params.maxParts);
                 continue;
             }
             auto h = convexHull(pts);
-            if (h && h->volume() <= sum * (1 + 1e-6)) {
+            if (h && h->volume() <= sum * (1 + fillTol)) {
                 parts.clear();
                 parts.push_back(std::move(h.value()));
                 continue;
