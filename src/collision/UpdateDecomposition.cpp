@@ -15,8 +15,9 @@ namespace rubble {
 
 namespace {
 
-/// A high-poly piece's parts are replaced by their hull when it is at most this much larger than their sum
-/// (they overlap: merges fill the dents), so that a chain of hits restarts from one part.
+/// Of a high-poly parent, a part whose volume inside the cells is at most this fraction of it stays whole,
+/// and a piece's parts become their hull when it is at most this much larger than their sum
+/// (docs/megamesh.md).
 constexpr double kHighPolyFillTolerance = 0.01;
 
 struct Fragment {
@@ -277,6 +278,10 @@ std::vector<std::vector<ConvexPolytope>> updateParts(const std::vector<ConvexPol
     if (pieces.empty())
         return result;
 
+    std::size_t totalTriangles = 0;
+    for (const Mesh* piece : pieces)
+        totalTriangles += piece->triangles.size();
+    const bool highPolyParent = totalTriangles > params.proxyAboveTriangles;
     // 1. Fragments: part ∩ cell_i, and what is left outside every cell.
     double parentVolume = 0;
     std::vector<Fragment> fragments;
@@ -286,8 +291,10 @@ std::vector<std::vector<ConvexPolytope>> updateParts(const std::vector<ConvexPol
         cellBounds.push_back(cell.bounds());
     for (std::uint32_t partIndex = 0; partIndex < parentParts.size(); ++partIndex) {
         const ConvexPolytope& part = parentParts[partIndex];
-        parentVolume += part.volume();
+        const double partVolume = part.volume();
+        parentVolume += partVolume;
         const Aabb pb = part.bounds();
+        double dent = 0; // volume of the part inside the cells
         for (std::size_t c = 0; c < cells.size(); ++c) {
             if (!pb.overlaps(cellBounds[c]))
                 continue;
@@ -297,8 +304,15 @@ std::vector<std::vector<ConvexPolytope>> updateParts(const std::vector<ConvexPol
                 if (inside.empty())
                     break;
             }
-            if (!inside.empty())
+            if (!inside.empty()) {
+                dent += inside.volume();
                 fragments.push_back({std::move(inside), static_cast<std::int32_t>(c), partIndex});
+            }
+        }
+        // A high-poly parent's part barely dented stays whole (the merges would fill the dent back).
+        if (highPolyParent && dent <= kHighPolyFillTolerance * partVolume) {
+            fragments.push_back({part, -1, partIndex});
+            continue;
         }
         // part − every cell; a fragment away from a cell is moved on untouched.
         std::vector<ConvexPolytope> rest{part}, next;
@@ -341,10 +355,6 @@ std::vector<std::vector<ConvexPolytope>> updateParts(const std::vector<ConvexPol
     std::size_t remainders = 0;
     for (std::size_t i = 0; i < pieces.size(); ++i)
         remainders += (i < pieceCells.size() ? pieceCells[i] : -1) < 0 ? 1 : 0;
-    std::size_t totalTriangles = 0;
-    for (const Mesh* piece : pieces)
-        totalTriangles += piece->triangles.size();
-    const bool highPolyParent = totalTriangles > params.proxyAboveTriangles;
     std::vector<bool> trim(pieces.size(), true);
     std::vector<Aabb> pieceBounds(pieces.size());
     for (std::size_t i = 0; i < pieces.size(); ++i) {
@@ -443,6 +453,11 @@ std::vector<std::vector<ConvexPolytope>> updateParts(const std::vector<ConvexPol
             std::vector<Vec3> pts;
             for (const ConvexPolytope& p : parts) {
                 sum += p.volume();
+                if (highPoly) { // corners as they are (repeats do not change a hull; welding is a sort)
+                    for (const PolytopeFace& f : p.faces())
+                        pts.insert(pts.end(), f.corners.begin(), f.corners.end());
+                    continue;
+                }
                 const auto v = p.vertices();
                 pts.insert(pts.end(), v.begin(), v.end());
             }
