@@ -26,12 +26,59 @@ struct Fragment {
     std::uint32_t part = 0; // index of the parent part it was cut from
 };
 
+/// Whether some corner of p lies inside (below) and some outside (above) plane, beyond the tolerance of
+/// ConvexPolytope::clipped: a plane with nothing above it leaves p as it is, without a copy.
+struct Sides {
+    bool in = false, out = false;
+};
+Sides sidesOf(const ConvexPolytope& p, const Plane& plane) {
+    const Aabb b = p.bounds();
+    const double tol =
+        1e-12 * std::max(1.0, std::max({std::abs(b.lo.x), std::abs(b.lo.y), std::abs(b.lo.z),
+                                        std::abs(b.hi.x), std::abs(b.hi.y), std::abs(b.hi.z)}));
+    Sides s;
+    for (const PolytopeFace& f : p.faces())
+        for (const Vec3& c : f.corners) {
+            const double d = plane.signedDistance(c);
+            s.out |= d > tol;
+            s.in |= d < -tol;
+        }
+    return s;
+}
+
+/// part ∩ cell, or empty; clips only by the planes that cut it.
+ConvexPolytope intersectCell(const ConvexPolytope& part, const ConvexPolytope& cell) {
+    ConvexPolytope inside;
+    const ConvexPolytope* current = &part;
+    for (const PolytopeFace& f : cell.faces()) {
+        const Sides s = sidesOf(*current, f.plane);
+        if (!s.out)
+            continue;
+        if (!s.in)
+            return {};
+        inside = current->clipped(f.plane);
+        current = &inside;
+        if (inside.empty())
+            return {};
+    }
+    return current == &part ? part : inside;
+}
+
 /// part − cell as at most one fragment per cell plane: outside plane j and inside planes < j.
 void subtractCell(const ConvexPolytope& part, const ConvexPolytope& cell, std::vector<ConvexPolytope>& out) {
     ConvexPolytope rest = part;
     for (const PolytopeFace& f : cell.faces()) {
-        ConvexPolytope outside = rest.clippedOutside(f.plane);
-        if (!outside.empty())
+        const Sides s = sidesOf(rest, f.plane);
+        if (!s.out) { // nothing outside this plane: rest unchanged (a flat rest on the plane is both)
+            if (!s.in)
+                out.push_back(rest);
+            continue;
+        }
+        if (!s.in) { // all of rest outside
+            out.push_back(std::move(rest));
+            return;
+        }
+        if (ConvexPolytope outside = rest.clippedOutside(f.plane); !outside.empty())
             out.push_back(std::move(outside));
         rest = rest.clipped(f.plane);
         if (rest.empty())
@@ -298,12 +345,7 @@ std::vector<std::vector<ConvexPolytope>> updateParts(const std::vector<ConvexPol
         for (std::size_t c = 0; c < cells.size(); ++c) {
             if (!pb.overlaps(cellBounds[c]))
                 continue;
-            ConvexPolytope inside = part;
-            for (const PolytopeFace& f : cells[c].faces()) {
-                inside = inside.clipped(f.plane);
-                if (inside.empty())
-                    break;
-            }
+            ConvexPolytope inside = intersectCell(part, cells[c]);
             if (!inside.empty()) {
                 dent += inside.volume();
                 fragments.push_back({std::move(inside), static_cast<std::int32_t>(c), partIndex});
