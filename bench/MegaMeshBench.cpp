@@ -186,26 +186,22 @@ void addImpactRows(const std::string& name, const std::string& kind, std::size_t
     for (double e : s.excess)
         excessMax = std::max(excessMax, e);
     const auto med = [](const std::vector<double>& v) { return stats(v).median; };
-    table.rows.push_back({name,
-                          std::to_string(triangles),
-                          std::to_string(s.withParts.size()),
-                          fixed(w.median),
-                          fixed(w.max),
-                          fixed(ratio, 2),
-                          fixed(c.median),
-                          fixed(c.max),
-                          fixed(cpuRatio, 2),
-                          fixed(med(s.cpuValidate)),
-                          fixed(med(s.cpuBoolean)),
-                          fixed(med(s.cpuVerify)),
-                          fixed(med(s.cpuIslands)),
-                          fixed(med(s.cpuMass)),
-                          fixed(med(s.cpuSimplify)),
-                          fixed(med(s.cpuParts)),
-                          fixed(pc.max),
-                          fixed(partsRatio, 2),
-                          fixed(med(s.clip)),
-                          fixed(med(s.touched), 0)});
+    const std::vector<double>* cpuStages[] = {&s.cpuValidate, &s.cpuBoolean,  &s.cpuVerify, &s.cpuIslands,
+                                              &s.cpuMass,     &s.cpuSimplify, &s.cpuParts};
+    std::vector<std::string> row{name,
+                                 std::to_string(triangles),
+                                 std::to_string(s.withParts.size()),
+                                 fixed(w.median),
+                                 fixed(w.max),
+                                 fixed(ratio, 2),
+                                 fixed(c.median),
+                                 fixed(c.max),
+                                 fixed(cpuRatio, 2)};
+    for (const auto* cpuStage : cpuStages)
+        row.push_back(fixed(med(*cpuStage)));
+    row.insert(row.end(),
+               {fixed(pc.max), fixed(partsRatio, 2), fixed(med(s.clip)), fixed(med(s.touched), 0)});
+    table.rows.push_back(std::move(row));
     csv.rows.push_back({name,
                         kind,
                         std::to_string(triangles),
@@ -231,8 +227,7 @@ void addImpactRows(const std::string& name, const std::string& kind, std::size_t
                         str(excessMax),
                         str(med(s.clip)),
                         str(med(s.touched))});
-    for (const auto* cpuStage : {&s.cpuValidate, &s.cpuBoolean, &s.cpuVerify, &s.cpuIslands, &s.cpuMass,
-                                 &s.cpuSimplify, &s.cpuParts})
+    for (const auto* cpuStage : cpuStages)
         csv.rows.back().push_back(str(med(*cpuStage)));
     csv.rows.back().push_back(str(pc.max));
     csv.rows.back().push_back(str(partsRatio));
