@@ -129,14 +129,6 @@ double boxVolume(const Aabb& b) {
     return e.x * e.y * e.z;
 }
 
-/// Merges touching parts until at most maxParts remain, preferring the pairs whose joint hull adds the least
-/// volume. Pairs are ranked by a cheap estimate, the volume their joint bounding box adds to the union of
-/// their two boxes (no hull per pair: the ranking was a Qhull call per touching pair, quadratic in the part
-/// count); the two best-ranked pairs are then compared by their true joint hull, and the winner's hull is the
-/// merged part. Hulls of the losers are kept for the next round (keyed by the pair's versions). Siblings
-/// (fragments of the same parent part, origin[i] == origin[j]) are merged first: they tile their parent part
-/// minus the cells, so their joint hull stays inside that convex part. Only when that does not reach the
-/// budget are all touching pairs considered.
 /// Replaces the fragments of each parent part by their joint hull (inside that convex part): one hull per
 /// parent part instead of pairwise merges, for patterns that cut a part into thousands of fragments.
 void collapseSiblings(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t>& origin) {
@@ -167,6 +159,14 @@ void collapseSiblings(std::vector<ConvexPolytope>& parts, std::vector<std::uint3
     origin = std::move(mergedOrigin);
 }
 
+/// Merges touching parts until at most maxParts remain, preferring the pairs whose joint hull adds the least
+/// volume. Pairs are ranked by a cheap estimate, the volume their joint bounding box adds to the union of
+/// their two boxes (no hull per pair: the ranking was a Qhull call per touching pair, quadratic in the part
+/// count); the two best-ranked pairs are then compared by their true joint hull, and the winner's hull is the
+/// merged part. Hulls of the losers are kept for the next round (keyed by the pair's versions). Siblings
+/// (fragments of the same parent part, origin[i] == origin[j]) are merged first: they tile their parent part
+/// minus the cells, so their joint hull stays inside that convex part. Only when that does not reach the
+/// budget are all touching pairs considered.
 void mergeToBudget(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t> origin, int maxParts) {
     const std::size_t budget = static_cast<std::size_t>(std::max(1, maxParts));
     if (parts.size() <= budget)
@@ -191,11 +191,10 @@ void mergeToBudget(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t
     std::vector<bool> alive(n, true);
     std::vector<Aabb> bounds(n);
     std::vector<double> volumes(n);
-    std::vector<std::vector<Vec3>> corners(n);
+    std::vector<std::vector<Vec3>> corners(n); // welded when a joint hull first needs them
     for (std::size_t i = 0; i < n; ++i) {
         bounds[i] = parts[i].bounds();
         volumes[i] = parts[i].volume();
-        corners[i] = parts[i].vertices();
     }
     // Many fragments (a shatter pattern cuts each part into hundreds): the box ranking alone decides.
     const std::size_t verified = n > 2 * budget ? 1 : 2;
@@ -222,6 +221,9 @@ void mergeToBudget(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t
         auto it = hulls.find(key);
         if (it != hulls.end() && it->second.vi == c.vi && it->second.vj == c.vj)
             return &it->second;
+        for (std::size_t k : {c.i, c.j})
+            if (corners[k].empty())
+                corners[k] = parts[k].vertices();
         std::vector<Vec3> pts = corners[c.i];
         pts.insert(pts.end(), corners[c.j].begin(), corners[c.j].end());
         auto h = convexHull(pts);
@@ -294,7 +296,7 @@ void mergeToBudget(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t
         parts[c.i] = std::move(bestHull->shape);
         bounds[c.i] = parts[c.i].bounds();
         volumes[c.i] = parts[c.i].volume();
-        corners[c.i] = parts[c.i].vertices();
+        corners[c.i].clear();
         ++version[c.i];
         alive[c.j] = false;
         --count;
