@@ -15,9 +15,9 @@ namespace rubble {
 
 namespace {
 
-/// Of a high-poly parent, a part whose volume inside the cells is at most this fraction of it stays whole,
-/// and a piece's parts become their hull when it is at most this much larger than their sum
-/// (docs/megamesh.md).
+/// Of a high-poly remainder over the budget, dented parts are made whole again while this adds at most this
+/// fraction of its parts' volume; a high-poly piece's parts become their hull when it is at most this much
+/// larger than their sum (docs/megamesh.md).
 constexpr double kHighPolyFillTolerance = 0.01;
 
 struct Fragment {
@@ -157,6 +157,58 @@ void collapseSiblings(std::vector<ConvexPolytope>& parts, std::vector<std::uint3
     }
     parts = std::move(merged);
     origin = std::move(mergedOrigin);
+}
+
+/// Of a high-poly remainder over the budget: the fragments of a parent part become that part whole again (no
+/// hull), the least dented part first, while the volume this adds stays within tolerance of the parts' sum.
+void revertToParents(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t>& origin,
+                     const std::vector<ConvexPolytope>& parentParts, std::size_t budget, double tolerance,
+                     const Aabb* box) {
+    struct Group {
+        double volume = 0;
+        std::size_t count = 0;
+    };
+    std::map<std::uint32_t, Group> groups;
+    double sum = 0;
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+        const double v = parts[i].volume();
+        sum += v;
+        groups[origin[i]].volume += v;
+        ++groups[origin[i]].count;
+    }
+    std::vector<std::pair<double, std::uint32_t>> byDent; // (dent, origin), origins cut into several
+    for (const auto& [o, g] : groups)
+        if (g.count > 1)
+            byDent.emplace_back(std::max(0.0, parentParts[o].volume() - g.volume), o);
+    std::sort(byDent.begin(), byDent.end());
+    std::vector<bool> whole(parentParts.size(), false);
+    std::size_t count = parts.size();
+    double added = 0;
+    for (const auto& [dent, o] : byDent) {
+        if (count <= budget || added + dent > tolerance * sum)
+            break;
+        whole[o] = true;
+        added += dent;
+        count -= groups[o].count - 1;
+    }
+    if (count == parts.size())
+        return;
+    std::vector<ConvexPolytope> kept;
+    std::vector<std::uint32_t> keptOrigin;
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+        if (!whole[origin[i]]) {
+            kept.push_back(std::move(parts[i]));
+            keptOrigin.push_back(origin[i]);
+        } else if (std::find(keptOrigin.begin(), keptOrigin.end(), origin[i]) == keptOrigin.end()) {
+            ConvexPolytope part = box ? clippedToBox(parentParts[origin[i]], *box) : parentParts[origin[i]];
+            if (!part.empty()) {
+                kept.push_back(std::move(part));
+                keptOrigin.push_back(origin[i]);
+            }
+        }
+    }
+    parts = std::move(kept);
+    origin = std::move(keptOrigin);
 }
 
 /// Merges touching parts until at most maxParts remain, preferring the pairs whose joint hull adds the least
@@ -340,23 +392,14 @@ std::vector<std::vector<ConvexPolytope>> updateParts(const std::vector<ConvexPol
         cellBounds.push_back(cell.bounds());
     for (std::uint32_t partIndex = 0; partIndex < parentParts.size(); ++partIndex) {
         const ConvexPolytope& part = parentParts[partIndex];
-        const double partVolume = part.volume();
-        parentVolume += partVolume;
+        parentVolume += part.volume();
         const Aabb pb = part.bounds();
-        double dent = 0; // volume of the part inside the cells
         for (std::size_t c = 0; c < cells.size(); ++c) {
             if (!pb.overlaps(cellBounds[c]))
                 continue;
             ConvexPolytope inside = intersectCell(part, cells[c]);
-            if (!inside.empty()) {
-                dent += inside.volume();
+            if (!inside.empty())
                 fragments.push_back({std::move(inside), static_cast<std::int32_t>(c), partIndex});
-            }
-        }
-        // A high-poly parent's part barely dented stays whole (the merges would fill the dent back).
-        if (highPolyParent && dent <= kHighPolyFillTolerance * partVolume) {
-            fragments.push_back({part, -1, partIndex});
-            continue;
         }
         // part − every cell; a fragment away from a cell is moved on untouched.
         std::vector<ConvexPolytope> rest{part}, next;
@@ -485,12 +528,14 @@ std::vector<std::vector<ConvexPolytope>> updateParts(const std::vector<ConvexPol
                 parts = std::move(d->parts);
             continue;
         }
-        // A high-poly remainder island whose fragments all come from one parent part is that part minus
-        // cells: with two or more fragments it has a dent and does not fill its hull (test skipped).
+        // A high-poly remainder island is its parent's parts (which did not fill their hull, or they would be
+        // one) and their fragments, dented by the cells: the test for whether they fill their hull (a hull of
+        // every corner) is skipped. Over the budget, its least dented parts are made whole again.
         const bool highPoly = pieces[i]->triangles.size() > params.proxyAboveTriangles;
-        const bool dented = i < pieceCells.size() && pieceCells[i] < 0 && highPoly &&
-                            std::all_of(origins[i].begin(), origins[i].end(),
-                                        [&](std::uint32_t o) { return o == origins[i].front(); });
+        const bool dented = i < pieceCells.size() && pieceCells[i] < 0 && highPoly;
+        if (dented && parts.size() > static_cast<std::size_t>(params.maxParts))
+            revertToParents(parts, origins[i], parentParts, static_cast<std::size_t>(params.maxParts),
+                            kHighPolyFillTolerance, trim[i] ? &pieceBounds[i] : nullptr);
         // A high-poly piece's parts that nearly fill their hull become that hull (kHighPolyFillTolerance).
         if (parts.size() > 1 && !dented) {
             double sum = 0;
