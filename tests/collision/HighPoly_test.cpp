@@ -178,6 +178,41 @@ TEST(HighPoly, ChainedUpdatesAreTheSameOnOneAndTwoThreads) {
     }
 }
 
+TEST(HighPoly, AHitOnAHighPolySphereLeavesAnExactDentInTheRemaindersParts) {
+    // Within the part budget the remainder's parts are the parent part minus the cell: the debris (inside the
+    // cell) lies in none of them, so the two do not start interpenetrating.
+    const Mesh sphere = makeSphere({0, 0, 0}, 1.0, 400, 126); // ~100k triangles
+    ASSERT_GT(sphere.triangles.size(), 90000u);
+    const DecompositionParams dp;
+    auto d = decompose(sphere, dp);
+    ASSERT_TRUE(d) << d.error().message;
+    FractureParams fp;
+    fp.sizeLaw.base = 0.5;
+    fp.sizeLaw.scale = 0;
+    auto fr = fracture(sphere, {{0.999, 0, 0}, {1, 0, 0}, 10}, fp, 3);
+    ASSERT_TRUE(fr) << fr.error().message;
+    const auto parts = updateDecomposition(d->parts, *fr, dp);
+    int debris = 0, remainders = 0;
+    for (std::size_t i = 0; i < fr->pieces.size(); ++i) {
+        if (fr->pieces[i].cell < 0) {
+            ++remainders;
+            EXPECT_GT(parts[i].size(), 1u) << "the dent was filled";
+            continue;
+        }
+        ++debris;
+        const Vec3 c = fr->pieces[i].mass.centerOfMass;
+        for (std::size_t r = 0; r < fr->pieces.size(); ++r) {
+            if (fr->pieces[r].cell >= 0)
+                continue;
+            for (const ConvexPolytope& p : parts[r]) {
+                EXPECT_FALSE(p.contains(c, -1e-6)) << "the debris lies inside a part of the remainder";
+            }
+        }
+    }
+    EXPECT_EQ(remainders, 1);
+    EXPECT_GE(debris, 1);
+}
+
 TEST(HighPoly, ARingCutTwiceFallsIntoTwoArcs) {
     // The first cut opens the ring at +x; the second, at -x, disconnects the two arcs from each other far
     // from where it hit: each arc must come out as its own closed piece.
