@@ -9,6 +9,7 @@
 #include <btBulletDynamicsCommon.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include "rubble/MassProperties.hpp"
@@ -803,6 +804,16 @@ bool Game::host(std::uint16_t port, std::string& message) {
     runtime_->world().setJournalSink([this](const rubble::JournalEvent& e) { journaled(e); });
     message = "127.0.0.1:" + std::to_string(net_->port());
     return true;
+}
+
+bool Game::waitForClient(double timeoutSeconds) {
+    const auto start = std::chrono::steady_clock::now();
+    while (net_ && net_->stats().joins == 0) {
+        if (std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() > timeoutSeconds)
+            return false;
+        net_->service(10);
+    }
+    return net_ != nullptr;
 }
 
 void Game::finishHosting() {

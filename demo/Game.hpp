@@ -166,6 +166,8 @@ public:
     /// Hosts loopback multiplayer on 127.0.0.1:port (docs/netplay.md): clients get a snapshot, then the
     /// journal and the bodies' placements every step. Needs deterministic settings; false with a message.
     bool host(std::uint16_t port, std::string& message);
+    /// Serves the network without stepping until a client has joined; false after timeoutSeconds.
+    bool waitForClient(double timeoutSeconds);
     /// Waits (at most 5 s) until every client confirmed the last sync; no-op when not hosting.
     void finishHosting();
     /// The host's totals, or null when not hosting.

@@ -71,6 +71,7 @@ struct Options {
     std::string record;            // journal file written at exit
     std::string replay;            // journal file replayed on the loaded scene instead of playing
     int host = 0;                  // port to host loopback multiplayer on
+    double hostWait = 0;           // game seconds at which the host holds until a client joins
     std::string join;              // HOST:PORT of a host to follow
     bool structure = true;         // the stress solver (with bearings)
     bool bonds = false;            // draw its bonds by stress
@@ -289,6 +290,11 @@ int main(int argc, char** argv) {
            "host loopback multiplayer on 127.0.0.1:PORT (needs --deterministic); clients: rubble-bench "
            "netplay-client --port PORT")
         ->check(CLI::Range(1, 65535));
+    cli.add_option("--host-wait", o.hostWait,
+                   "with --host: hold the game at SECONDS of game time until a client has joined (at most "
+                   "120 s), so that it joins late and still sees fractures live")
+        ->needs("--host")
+        ->check(CLI::PositiveNumber);
     cli.add_option(
            "--join", o.join,
            "follow a --host game at HOST:PORT (loopback) in a window: the client cuts the pieces from "
@@ -512,6 +518,12 @@ int main(int argc, char** argv) {
         // Simulation.
         const auto stepStart = Clock::now();
         demo::GameSettings& live = app.game.settings();
+        if (o.hostWait > 0 &&
+            static_cast<long>(app.game.counters().frame) == std::lround(o.hostWait * 60.0) &&
+            !app.game.waitForClient(120.0)) {
+            std::fprintf(stderr, "error: --host-wait: no client joined within 120 s\n");
+            return 1;
+        }
         if (autopilot) {
             demo::ControlInput in = pilot.update(app.game, fixedDt);
             in.fire = in.fire && !app.opt.holdFire;

@@ -54,7 +54,8 @@ Result<Decomposition> decompose(const Mesh& mesh, const DecompositionParams& par
 /// Incremental update at fracture time: clips the parent's parts by the cells and assigns every fragment to
 /// the piece containing it. parentParts are in the same coordinates as cells and pieces. pieceCells[i] is
 /// Piece::cell of piece i (-1 for remainder islands). Returns one part list per piece; a piece that received
-/// no fragment gets a fresh decomposition. Slivers are dropped and parts merged to respect params.maxParts.
+/// no fragment gets a fresh decomposition. Slivers are dropped and parts merged to respect params.maxParts (a
+/// high-poly remainder first makes its least dented parent parts whole again; docs/megamesh.md).
 std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<ConvexPolytope>& parentParts,
                                                              const std::vector<ConvexPolytope>& cells,
                                                              const std::vector<Mesh>& pieces,

@@ -15,18 +15,70 @@ namespace rubble {
 
 namespace {
 
+/// Of a high-poly remainder over the budget, dented parts are made whole again while this adds at most this
+/// fraction of its parts' volume; a high-poly piece's parts become their hull when it is at most this much
+/// larger than their sum (docs/megamesh.md).
+constexpr double kHighPolyFillTolerance = 0.01;
+
 struct Fragment {
     ConvexPolytope shape;
     std::int32_t cell = -1; // -1: outside every cell
     std::uint32_t part = 0; // index of the parent part it was cut from
 };
 
+/// Whether some corner of p lies inside (below) and some outside (above) plane, beyond the tolerance of
+/// ConvexPolytope::clipped: a plane with nothing above it leaves p as it is, without a copy.
+struct Sides {
+    bool in = false, out = false;
+};
+Sides sidesOf(const ConvexPolytope& p, const Plane& plane) {
+    const Aabb b = p.bounds();
+    const double tol =
+        1e-12 * std::max(1.0, std::max({std::abs(b.lo.x), std::abs(b.lo.y), std::abs(b.lo.z),
+                                        std::abs(b.hi.x), std::abs(b.hi.y), std::abs(b.hi.z)}));
+    Sides s;
+    for (const PolytopeFace& f : p.faces())
+        for (const Vec3& c : f.corners) {
+            const double d = plane.signedDistance(c);
+            s.out |= d > tol;
+            s.in |= d < -tol;
+        }
+    return s;
+}
+
+/// part ∩ cell, or empty; clips only by the planes that cut it.
+ConvexPolytope intersectCell(const ConvexPolytope& part, const ConvexPolytope& cell) {
+    ConvexPolytope inside;
+    const ConvexPolytope* current = &part;
+    for (const PolytopeFace& f : cell.faces()) {
+        const Sides s = sidesOf(*current, f.plane);
+        if (!s.out)
+            continue;
+        if (!s.in)
+            return {};
+        inside = current->clipped(f.plane);
+        current = &inside;
+        if (inside.empty())
+            return {};
+    }
+    return current == &part ? part : inside;
+}
+
 /// part − cell as at most one fragment per cell plane: outside plane j and inside planes < j.
 void subtractCell(const ConvexPolytope& part, const ConvexPolytope& cell, std::vector<ConvexPolytope>& out) {
     ConvexPolytope rest = part;
     for (const PolytopeFace& f : cell.faces()) {
-        ConvexPolytope outside = rest.clippedOutside(f.plane);
-        if (!outside.empty())
+        const Sides s = sidesOf(rest, f.plane);
+        if (!s.out) { // nothing outside this plane: rest unchanged (a flat rest on the plane is both)
+            if (!s.in)
+                out.push_back(rest);
+            continue;
+        }
+        if (!s.in) { // all of rest outside
+            out.push_back(std::move(rest));
+            return;
+        }
+        if (ConvexPolytope outside = rest.clippedOutside(f.plane); !outside.empty())
             out.push_back(std::move(outside));
         rest = rest.clipped(f.plane);
         if (rest.empty())
@@ -77,14 +129,6 @@ double boxVolume(const Aabb& b) {
     return e.x * e.y * e.z;
 }
 
-/// Merges touching parts until at most maxParts remain, preferring the pairs whose joint hull adds the least
-/// volume. Pairs are ranked by a cheap estimate, the volume their joint bounding box adds to the union of
-/// their two boxes (no hull per pair: the ranking was a Qhull call per touching pair, quadratic in the part
-/// count); the two best-ranked pairs are then compared by their true joint hull, and the winner's hull is the
-/// merged part. Hulls of the losers are kept for the next round (keyed by the pair's versions). Siblings
-/// (fragments of the same parent part, origin[i] == origin[j]) are merged first: they tile their parent part
-/// minus the cells, so their joint hull stays inside that convex part. Only when that does not reach the
-/// budget are all touching pairs considered.
 /// Replaces the fragments of each parent part by their joint hull (inside that convex part): one hull per
 /// parent part instead of pairwise merges, for patterns that cut a part into thousands of fragments.
 void collapseSiblings(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t>& origin) {
@@ -115,6 +159,66 @@ void collapseSiblings(std::vector<ConvexPolytope>& parts, std::vector<std::uint3
     origin = std::move(mergedOrigin);
 }
 
+/// Of a high-poly remainder over the budget: the fragments of a parent part become that part whole again (no
+/// hull), the least dented part first, while the volume this adds stays within tolerance of the parts' sum.
+void revertToParents(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t>& origin,
+                     const std::vector<ConvexPolytope>& parentParts, std::size_t budget, double tolerance,
+                     const Aabb* box) {
+    struct Group {
+        double volume = 0;
+        std::size_t count = 0;
+    };
+    std::map<std::uint32_t, Group> groups;
+    double sum = 0;
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+        const double v = parts[i].volume();
+        sum += v;
+        groups[origin[i]].volume += v;
+        ++groups[origin[i]].count;
+    }
+    std::vector<std::pair<double, std::uint32_t>> byDent; // (dent, origin), origins cut into several
+    for (const auto& [o, g] : groups)
+        if (g.count > 1)
+            byDent.emplace_back(std::max(0.0, parentParts[o].volume() - g.volume), o);
+    std::sort(byDent.begin(), byDent.end());
+    std::vector<bool> whole(parentParts.size(), false);
+    std::size_t count = parts.size();
+    double added = 0;
+    for (const auto& [dent, o] : byDent) {
+        if (count <= budget || added + dent > tolerance * sum)
+            break;
+        whole[o] = true;
+        added += dent;
+        count -= groups[o].count - 1;
+    }
+    if (count == parts.size())
+        return;
+    std::vector<ConvexPolytope> kept;
+    std::vector<std::uint32_t> keptOrigin;
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+        if (!whole[origin[i]]) {
+            kept.push_back(std::move(parts[i]));
+            keptOrigin.push_back(origin[i]);
+        } else if (std::find(keptOrigin.begin(), keptOrigin.end(), origin[i]) == keptOrigin.end()) {
+            ConvexPolytope part = box ? clippedToBox(parentParts[origin[i]], *box) : parentParts[origin[i]];
+            if (!part.empty()) {
+                kept.push_back(std::move(part));
+                keptOrigin.push_back(origin[i]);
+            }
+        }
+    }
+    parts = std::move(kept);
+    origin = std::move(keptOrigin);
+}
+
+/// Merges touching parts until at most maxParts remain, preferring the pairs whose joint hull adds the least
+/// volume. Pairs are ranked by a cheap estimate, the volume their joint bounding box adds to the union of
+/// their two boxes (no hull per pair: the ranking was a Qhull call per touching pair, quadratic in the part
+/// count); the two best-ranked pairs are then compared by their true joint hull, and the winner's hull is the
+/// merged part. Hulls of the losers are kept for the next round (keyed by the pair's versions). Siblings
+/// (fragments of the same parent part, origin[i] == origin[j]) are merged first: they tile their parent part
+/// minus the cells, so their joint hull stays inside that convex part. Only when that does not reach the
+/// budget are all touching pairs considered.
 void mergeToBudget(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t> origin, int maxParts) {
     const std::size_t budget = static_cast<std::size_t>(std::max(1, maxParts));
     if (parts.size() <= budget)
@@ -139,11 +243,10 @@ void mergeToBudget(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t
     std::vector<bool> alive(n, true);
     std::vector<Aabb> bounds(n);
     std::vector<double> volumes(n);
-    std::vector<std::vector<Vec3>> corners(n);
+    std::vector<std::vector<Vec3>> corners(n); // welded when a joint hull first needs them
     for (std::size_t i = 0; i < n; ++i) {
         bounds[i] = parts[i].bounds();
         volumes[i] = parts[i].volume();
-        corners[i] = parts[i].vertices();
     }
     // Many fragments (a shatter pattern cuts each part into hundreds): the box ranking alone decides.
     const std::size_t verified = n > 2 * budget ? 1 : 2;
@@ -170,6 +273,9 @@ void mergeToBudget(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t
         auto it = hulls.find(key);
         if (it != hulls.end() && it->second.vi == c.vi && it->second.vj == c.vj)
             return &it->second;
+        for (std::size_t k : {c.i, c.j})
+            if (corners[k].empty())
+                corners[k] = parts[k].vertices();
         std::vector<Vec3> pts = corners[c.i];
         pts.insert(pts.end(), corners[c.j].begin(), corners[c.j].end());
         auto h = convexHull(pts);
@@ -242,7 +348,7 @@ void mergeToBudget(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t
         parts[c.i] = std::move(bestHull->shape);
         bounds[c.i] = parts[c.i].bounds();
         volumes[c.i] = parts[c.i].volume();
-        corners[c.i] = parts[c.i].vertices();
+        corners[c.i].clear();
         ++version[c.i];
         alive[c.j] = false;
         --count;
@@ -273,6 +379,10 @@ std::vector<std::vector<ConvexPolytope>> updateParts(const std::vector<ConvexPol
     if (pieces.empty())
         return result;
 
+    std::size_t totalTriangles = 0;
+    for (const Mesh* piece : pieces)
+        totalTriangles += piece->triangles.size();
+    const bool highPolyParent = totalTriangles > params.proxyAboveTriangles;
     // 1. Fragments: part ∩ cell_i, and what is left outside every cell.
     double parentVolume = 0;
     std::vector<Fragment> fragments;
@@ -287,12 +397,7 @@ std::vector<std::vector<ConvexPolytope>> updateParts(const std::vector<ConvexPol
         for (std::size_t c = 0; c < cells.size(); ++c) {
             if (!pb.overlaps(cellBounds[c]))
                 continue;
-            ConvexPolytope inside = part;
-            for (const PolytopeFace& f : cells[c].faces()) {
-                inside = inside.clipped(f.plane);
-                if (inside.empty())
-                    break;
-            }
+            ConvexPolytope inside = intersectCell(part, cells[c]);
             if (!inside.empty())
                 fragments.push_back({std::move(inside), static_cast<std::int32_t>(c), partIndex});
         }
@@ -332,9 +437,23 @@ std::vector<std::vector<ConvexPolytope>> updateParts(const std::vector<ConvexPol
         result[piece].push_back(std::move(part));
         origins[piece].push_back(origin);
     };
-    std::vector<Aabb> pieceBounds(pieces.size());
+    // A high-poly remainder island alone in its class takes every remainder fragment as it is: its bounds
+    // (a pass over its vertices) are replaced by the parent parts' (which cover it), and nothing is trimmed.
+    std::size_t remainders = 0;
     for (std::size_t i = 0; i < pieces.size(); ++i)
-        pieceBounds[i] = pieces[i]->bounds();
+        remainders += (i < pieceCells.size() ? pieceCells[i] : -1) < 0 ? 1 : 0;
+    std::vector<bool> trim(pieces.size(), true);
+    std::vector<Aabb> pieceBounds(pieces.size());
+    for (std::size_t i = 0; i < pieces.size(); ++i) {
+        const bool remainder = (i < pieceCells.size() ? pieceCells[i] : -1) < 0;
+        if (remainder && remainders == 1 && pieces[i]->triangles.size() > params.proxyAboveTriangles) {
+            trim[i] = false;
+            for (const ConvexPolytope& part : parentParts)
+                pieceBounds[i].extend(part.bounds());
+        } else {
+            pieceBounds[i] = pieces[i]->bounds();
+        }
+    }
     for (Fragment& frag : fragments) {
         const double fragVolume = frag.shape.volume();
         if (fragVolume <= sliver)
@@ -353,6 +472,10 @@ std::vector<std::vector<ConvexPolytope>> updateParts(const std::vector<ConvexPol
                 candidates.push_back(i);
         }
         if (candidates.size() == 1) {
+            if (!trim[candidates[0]]) {
+                give(candidates[0], std::move(frag.shape), frag.part);
+                continue;
+            }
             // Parent parts may reach into empty space: keep the fragment inside the piece's bounds.
             ConvexPolytope clipped = clippedToBox(std::move(frag.shape), pieceBounds[candidates[0]]);
             if (!clipped.empty())
@@ -360,11 +483,11 @@ std::vector<std::vector<ConvexPolytope>> updateParts(const std::vector<ConvexPol
             continue;
         }
         if (candidates.size() > 1) {
-            // Several islands may share this fragment: give each the hull of its own part inside it (on a
-            // high-poly island, whose inside test costs a pass over its triangles per point, the fragment
-            // clipped to the island's bounds, which also holds that part).
+            // Several islands may share this fragment: give each the hull of its own part inside it (when the
+            // island or the parent is high-poly, whose inside test costs a pass over the island per corner of
+            // a bounded part, the fragment clipped to the island's bounds, which also holds that part).
             for (std::size_t i : candidates) {
-                if (pieces[i]->triangles.size() > params.proxyAboveTriangles) {
+                if (highPolyParent || pieces[i]->triangles.size() > params.proxyAboveTriangles) {
                     ConvexPolytope clipped = clippedToBox(frag.shape, pieceBounds[i]);
                     if (!clipped.empty() && clipped.volume() > sliver)
                         give(i, std::move(clipped), frag.part);
@@ -405,28 +528,37 @@ std::vector<std::vector<ConvexPolytope>> updateParts(const std::vector<ConvexPol
                 parts = std::move(d->parts);
             continue;
         }
-        // A high-poly remainder island whose fragments all come from one parent part is that part minus
-        // cells: with two or more fragments it has a dent and does not fill its hull (test skipped).
-        const bool dented = i < pieceCells.size() && pieceCells[i] < 0 &&
-                            pieces[i]->triangles.size() > params.proxyAboveTriangles &&
-                            std::all_of(origins[i].begin(), origins[i].end(),
-                                        [&](std::uint32_t o) { return o == origins[i].front(); });
+        // A high-poly remainder island is its parent's parts (which did not fill their hull, or they would be
+        // one) and their fragments, dented by the cells: the test for whether they fill their hull (a hull of
+        // every corner) is skipped. Over the budget, its least dented parts are made whole again.
+        const bool highPoly = pieces[i]->triangles.size() > params.proxyAboveTriangles;
+        const bool dented = i < pieceCells.size() && pieceCells[i] < 0 && highPoly;
+        if (dented && parts.size() > static_cast<std::size_t>(params.maxParts))
+            revertToParents(parts, origins[i], parentParts, static_cast<std::size_t>(params.maxParts),
+                            kHighPolyFillTolerance, trim[i] ? &pieceBounds[i] : nullptr);
+        // A high-poly piece's parts that nearly fill their hull become that hull (kHighPolyFillTolerance).
         if (parts.size() > 1 && !dented) {
             double sum = 0;
             std::vector<Vec3> pts;
             for (const ConvexPolytope& p : parts) {
                 sum += p.volume();
+                if (highPoly) { // corners as they are (repeats do not change a hull; welding is a sort)
+                    for (const PolytopeFace& f : p.faces())
+                        pts.insert(pts.end(), f.corners.begin(), f.corners.end());
+                    continue;
+                }
                 const auto v = p.vertices();
                 pts.insert(pts.end(), v.begin(), v.end());
             }
             // The hull of the extremes in 26 directions lies inside the full hull: when it is already larger
             // than the parts together, they do not fill their hull (and the full hull is not computed).
-            if (auto quick = convexHull(extremePoints(pts)); quick && quick->volume() > sum * (1 + 1e-6)) {
+            const double fillTol = highPoly ? kHighPolyFillTolerance : 1e-6;
+            if (auto quick = convexHull(extremePoints(pts)); quick && quick->volume() > sum * (1 + fillTol)) {
                 mergeToBudget(parts, origins[i], params.maxParts);
                 continue;
             }
             auto h = convexHull(pts);
-            if (h && h->volume() <= sum * (1 + 1e-6)) {
+            if (h && h->volume() <= sum * (1 + fillTol)) {
                 parts.clear();
                 parts.push_back(std::move(h.value()));
                 continue;

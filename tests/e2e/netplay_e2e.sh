@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # End-to-end loopback multiplayer of rubble-demo with real ENet on 127.0.0.1: a headless host (autopilot,
-# --deterministic --host PORT) and a --join window under Xvfb that joins it late (snapshot + journal tail),
-# cuts the pieces itself from the host's journal events and draws them at the host's placements.
+# --deterministic --host PORT --host-wait 3) and a --join window under Xvfb that joins it late (the host holds
+# at 3 s of game time, before the first hit, until it has: snapshot, then live journal events), cuts the
+# pieces itself from the host's journal events and draws them at the host's placements.
 # Asserts: 0 mismatched geometry hashes on both sides, the client's final geometry hash equals the host's, the
 # client drew frames (and its screenshot is not blank), both exit with 0; bad --join addresses are refused.
 # Usage: netplay_e2e.sh PATH/TO/rubble-demo      Exit 77 = skipped (Xvfb missing).
@@ -24,7 +25,7 @@ echo "ok: --join refuses non-loopback hosts and bad ports"
 
 port=$(python3 -c "import socket; s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM); s.bind(('127.0.0.1', 0)); print(s.getsockname()[1])")
 env -u DISPLAY timeout 300 "$demo" --headless --no-panel --scene "$here/e2e.cfg" --autopilot 14 --deterministic \
-    --host "$port" --width 480 --height 270 >"$work/host.log" 2>&1 &
+    --host "$port" --host-wait 3 --width 480 --height 270 >"$work/host.log" 2>&1 &
 host_pid=$!
 listening() { grep -q "^host: listening" "$work/host.log"; }
 for _ in $(seq 1 600); do
