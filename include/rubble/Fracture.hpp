@@ -12,6 +12,7 @@
 #include "rubble/ConvexPolytope.hpp"
 #include "rubble/MassProperties.hpp"
 #include "rubble/Mesh.hpp"
+#include "rubble/MeshTopology.hpp"
 #include "rubble/Result.hpp"
 
 namespace rubble {
@@ -105,6 +106,10 @@ struct MeshFacts {
     std::size_t triangles = 0; ///< the mesh's triangle count
     std::size_t vertices = 0;  ///< the mesh's vertex count
     VolumeIntegrals integrals; ///< of the mesh (its mass properties are massProperties(integrals))
+    /// Of a mesh above kTopologyAboveTriangles that is one shell (analyzeMesh; pieces of a fracture given
+    /// it), else empty: with it, the consuming fracture edits the mesh in place and checks only around the
+    /// cut.
+    MeshTopology topology{};
     /// True when these are facts of a mesh with mesh's counts.
     bool fit(const Mesh& mesh) const {
         return known && triangles == mesh.triangles.size() && vertices == mesh.positions.size();
@@ -144,7 +149,10 @@ struct FractureResult {
     bool exactFallback = false;        ///< Fast declined or failed verification; Corefine made the split
     int redraws = 0; ///< fracture() with Fast: cell patterns redrawn (from derived seeds) because the clipper
                      ///< declined a near-degenerate one; 0 = the seed's own pattern
-    FractureTimings timings;    ///< stage durations, wall clock
+    bool editedInPlace = false;        ///< the remainder is the input edited in place (MeshFacts::topology)
+    bool islandsLabelledFully = false; ///< edited in place, but the walk around the cut did not prove the
+                                       ///< remainder one shell: it was labelled in full (a ring cut twice)
+    FractureTimings timings;           ///< stage durations, wall clock
     FractureTimings cpuTimings; ///< the same stages in the calling thread's CPU time (on a shared machine)
 };
 
@@ -187,11 +195,26 @@ std::unique_ptr<BooleanBackend> makeBooleanBackend(BooleanKind kind);
 /// With known facts of mesh (analyzeMesh, Piece::facts), the mesh is not validated again and, with the Fast
 /// backend, the remainder's mass properties follow from the mesh's by difference (equal to a full
 /// recomputation up to rounding; docs/megamesh.md); the pieces' meshes are the same either way.
+/// With known facts that carry a topology (MeshFacts::topology) and the Fast backend, fracture copies the
+/// mesh and its facts and runs the consuming overload below.
 Result<FractureResult> fracture(const Mesh& mesh, const Impact& impact, const FractureParams& params,
                                 std::uint64_t seed, const MeshFacts& known = {});
+
+/// fracture, consuming the mesh and its facts: with a topology in them and the Fast backend, the remainder
+/// is the input edited in place (the triangles the cut removed replaced by those it made, checked closed
+/// around the cut only; its islands found by a walk around the cut, with a full labelling as the proven
+/// fallback) and keeps an updated topology, so the cost follows the cut (docs/megamesh.md). Its triangles are
+/// then in a different order than the copying path gives, and it may keep unreferenced vertices (compacted
+/// when they are many). Without a topology it is the const& overload.
+Result<FractureResult> fracture(Mesh&& mesh, const Impact& impact, const FractureParams& params,
+                                std::uint64_t seed, MeshFacts known = {});
 
 /// Fractures a closed mesh with explicitly given cells (for merged impacts and tests); known as for fracture.
 Result<FractureResult> fractureWithCells(const Mesh& mesh, std::vector<ConvexPolytope> cells,
                                          const FractureParams& params, const MeshFacts& known = {});
+
+/// fractureWithCells consuming the mesh and its facts, as the consuming fracture.
+Result<FractureResult> fractureWithCells(Mesh&& mesh, std::vector<ConvexPolytope> cells,
+                                         const FractureParams& params, MeshFacts known = {});
 
 } // namespace rubble

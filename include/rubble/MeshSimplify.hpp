@@ -3,6 +3,8 @@
 /// Lossless simplification of the flat parts of a closed mesh: what repeated fracture leaves behind.
 
 #include <cstddef>
+#include <cstdint>
+#include <vector>
 
 #include "rubble/Aabb.hpp"
 #include "rubble/MassProperties.hpp"
@@ -27,12 +29,14 @@ struct PlanarSimplifyParams {
 
 /// What simplifyPlanarRegions did.
 struct PlanarSimplifyReport {
-    std::size_t trianglesBefore = 0;       ///< triangles of the input
-    std::size_t trianglesAfter = 0;        ///< triangles of the output
-    std::size_t verticesRemoved = 0;       ///< vertices that no longer exist
-    std::size_t regionsRetriangulated = 0; ///< flat regions that were triangulated anew
-    std::size_t regionsKept = 0;           ///< flat regions left as they were because re-triangulating failed
-    bool unchanged = false; ///< the input was returned as it was (not closed, or nothing to do)
+    std::size_t trianglesBefore = 0;            ///< triangles of the input
+    std::size_t trianglesAfter = 0;             ///< triangles of the output
+    std::size_t verticesRemoved = 0;            ///< vertices that no longer exist
+    std::vector<std::uint32_t> removedVertices; ///< which: the input's indices, ascending (the others keep
+                                                ///< their order)
+    std::size_t regionsRetriangulated = 0;      ///< flat regions that were triangulated anew
+    std::size_t regionsKept = 0; ///< flat regions left as they were because re-triangulating failed
+    bool unchanged = false;      ///< the input was returned as it was (not closed, or nothing to do)
     /// The volume integrals of the new triangles minus those of the triangles they replaced, about
     /// params.integralsReference: the output's integrals are the input's plus this.
     VolumeIntegrals integralsChange;

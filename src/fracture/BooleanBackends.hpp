@@ -5,6 +5,7 @@
 #include <memory>
 #include <vector>
 
+#include "ConvexCellClipper.hpp"
 #include "rubble/ConvexPolytope.hpp"
 #include "rubble/Fracture.hpp"
 #include "rubble/Mesh.hpp"
@@ -15,9 +16,28 @@ namespace rubble::detail {
 std::unique_ptr<BooleanBackend> makeCorefineBackend();
 /// CGAL Nef_polyhedron_3 backend (the thesis's method).
 std::unique_ptr<BooleanBackend> makeNefBackend();
-/// Convex-cell clipper backend; with exactFallback, Corefine makes the splits the clipper declines, else
-/// they are errors. With inputIntegrals (the split mesh's, which must outlive the backend), its splits carry
-/// the remainder's integrals by difference (SplitResult::remainderIntegrals).
+/// A split whose remainder is an edit of the input (RemainderEdit), for meshes edited in place.
+struct SplitEdit {
+    RemainderEdit remainder;             ///< mesh − ∪ cells as an edit of mesh
+    std::vector<Mesh> inside;            ///< inside[i] = mesh ∩ cells[i] (may be empty)
+    std::vector<std::size_t> insideKept; ///< per cell: inside[i]'s first triangles are input triangles kept
+                                         ///< whole, the rest new (all new when unknown: 0)
+    VolumeIntegrals remainderIntegrals;  ///< of the remainder, by difference
+};
+
+/// A backend that can also give the remainder as an edit of the input.
+class EditingBackend : public BooleanBackend {
+public:
+    /// As split, with the remainder as an edit of mesh (whose integrals the backend was given; bounds are
+    /// mesh's). Errors (declined configurations included) leave the caller to split another way.
+    virtual Result<SplitEdit> splitAsEdit(const Mesh& mesh, const std::vector<ConvexPolytope>& cells,
+                                          const Aabb& bounds) const = 0;
+};
+
+/// Convex-cell clipper backend (an EditingBackend when given inputIntegrals); with exactFallback, Corefine
+/// makes the splits the clipper declines, else they are errors. With inputIntegrals (the split mesh's, which
+/// must outlive the backend), its splits carry the remainder's integrals by difference
+/// (SplitResult::remainderIntegrals).
 std::unique_ptr<BooleanBackend> makeFastBackend(bool exactFallback = true,
                                                 const VolumeIntegrals* inputIntegrals = nullptr);
 

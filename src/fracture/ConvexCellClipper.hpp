@@ -12,6 +12,7 @@
 // reported as an error, and the caller falls back to an exact CGAL backend. Outputs are verified (closedness
 // of all new faces, volume conservation) before they are returned.
 
+#include "geometry/TopologyEdit.hpp"
 #include "rubble/ConvexPolytope.hpp"
 #include "rubble/MassProperties.hpp"
 #include "rubble/Mesh.hpp"
@@ -48,5 +49,26 @@ struct MultiCellSplit {
 /// verification and outsideIntegrals cost what the cut touched instead of two passes over the mesh.
 Result<MultiCellSplit> clipByConvexCells(const Mesh& mesh, const std::vector<ConvexPolytope>& cells,
                                          const VolumeIntegrals* meshIntegrals = nullptr);
+
+/// The rest of a split as an edit of the input mesh (detail::replaceTriangles applies it).
+struct RemainderEdit {
+    std::vector<std::uint32_t> removed; ///< input triangles the rest loses, sorted
+    std::vector<Vec3> newPositions;     ///< points it gains, vertex ids from the input's vertex count on
+    TriangleBatch added;                ///< triangles it gains, with their attributes
+};
+
+/// A split whose rest is an edit of the input.
+struct MultiCellEdit {
+    RemainderEdit outside;               ///< mesh − ∪ cells, as an edit of mesh
+    std::vector<Mesh> inside;            ///< mesh ∩ cell k, in the order of the cells
+    std::vector<std::size_t> insideKept; ///< per cell: inside's first triangles, input triangles kept whole;
+                                         ///< the rest are new
+    VolumeIntegrals outsideIntegrals;    ///< of mesh − ∪ cells, by difference
+};
+
+/// clipByConvexCells with the rest as an edit of mesh (not assembled: no pass over the untouched triangles
+/// but the scan of their bounds). The edit's closedness is checked when it is applied.
+Result<MultiCellEdit> clipByConvexCellsAsEdit(const Mesh& mesh, const std::vector<ConvexPolytope>& cells,
+                                              const VolumeIntegrals& meshIntegrals);
 
 } // namespace rubble::detail

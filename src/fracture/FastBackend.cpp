@@ -10,7 +10,7 @@ namespace rubble::detail {
 
 namespace {
 
-class FastBackend final : public BooleanBackend {
+class FastBackend final : public EditingBackend {
 public:
     FastBackend(bool exactFallback, const VolumeIntegrals* inputIntegrals)
         : exactFallback_(exactFallback), inputIntegrals_(inputIntegrals) {}
@@ -55,6 +55,36 @@ public:
             out.remainder.uvs.assign(3 * out.remainder.triangles.size(), Vec2{});
         if (out.remainder.materials.empty())
             out.remainder.materials.assign(out.remainder.triangles.size(), 0u);
+        return out;
+    }
+
+    Result<SplitEdit> splitAsEdit(const Mesh& mesh, const std::vector<ConvexPolytope>& cells,
+                                  const Aabb& bounds) const override {
+        if (!inputIntegrals_)
+            return makeError(ErrorCode::InvalidInput, "fast: an edit needs the input's integrals");
+        SplitEdit out;
+        out.inside.resize(cells.size());
+        out.insideKept.assign(cells.size(), 0);
+        std::vector<ConvexPolytope> used;
+        std::vector<std::size_t> index;
+        for (std::size_t i = 0; i < cells.size(); ++i)
+            if (!cells[i].empty() && !mesh.empty() && cells[i].bounds().overlaps(bounds)) {
+                used.push_back(cells[i]);
+                index.push_back(i);
+            }
+        if (used.empty()) {
+            out.remainderIntegrals = *inputIntegrals_;
+            return out;
+        }
+        auto r = clipByConvexCellsAsEdit(mesh, used, *inputIntegrals_);
+        if (!r)
+            return r.error();
+        for (std::size_t k = 0; k < index.size(); ++k) {
+            out.inside[index[k]] = std::move(r->inside[k]);
+            out.insideKept[index[k]] = r->insideKept[k];
+        }
+        out.remainder = std::move(r->outside);
+        out.remainderIntegrals = r->outsideIntegrals;
         return out;
     }
 

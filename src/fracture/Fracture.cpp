@@ -5,12 +5,15 @@
 #include <cmath>
 #include <limits>
 #include <span>
+#include <unordered_map>
+#include <utility>
 
 #include <time.h>
 
 #include "BooleanBackends.hpp"
 #include "FracturePipeline.hpp"
 #include "geometry/OrientedShells.hpp"
+#include "geometry/TopologyEdit.hpp"
 #include "rubble/Fracture.hpp"
 #include "rubble/Islands.hpp"
 #include "rubble/MeshSimplify.hpp"
@@ -107,12 +110,14 @@ void cutBasis(Vec3 n, Vec3& u, Vec3& v) {
 /// plane's normal. Interior faces of earlier fractures (not on a face of these cells, or outside focus) keep
 /// theirs. Only cells whose bounds hold a triangle are searched for its plane.
 void finishCutFaces(Mesh& m, std::span<const ConvexPolytope> cells, double uvScale, const Aabb& focus,
-                    double tolerance) {
+                    double tolerance, const std::vector<std::uint32_t>* only = nullptr) {
     if (!m.hasMaterials())
         return;
     if (m.uvs.size() != 3 * m.triangles.size())
         m.uvs.assign(3 * m.triangles.size(), Vec2{});
-    for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+    const std::size_t count = only ? only->size() : m.triangles.size();
+    for (std::size_t i = 0; i < count; ++i) {
+        const std::size_t t = only ? (*only)[i] : i;
         if (m.materials[t] != kInteriorMaterial)
             continue;
         const auto c = m.corners(t);
@@ -158,9 +163,12 @@ void finishCutFaces(Mesh& m, std::span<const ConvexPolytope> cells, double uvSca
 
 /// The pieces of one split output. simplify: remove the vertices that carry no shape near the cells (focus).
 /// With whole (the output's integrals), the largest island's integrals are whole minus the other islands'
-/// plus what simplification changed, so it is not scanned; the others are measured.
+/// plus what simplification changed, so it is not scanned; the others are measured. topology: m's when it is
+/// one island (kept, or found again when simplification changed it); with wantTopology, islands above
+/// kTopologyAboveTriangles get theirs.
 void addPieces(Mesh&& m, const detail::OutputShells& shells, std::int32_t cell, double minVolume,
-               bool simplify, const Aabb& focus, const VolumeIntegrals* whole, FractureResult& out) {
+               bool simplify, const Aabb& focus, const VolumeIntegrals* whole, FractureResult& out,
+               MeshTopology* topology = nullptr, bool wantTopology = false) {
     if (m.empty())
         return;
     std::vector<Mesh> islands = splitIntoIslands(std::move(m), shells.triangleShell, shells.count);
@@ -190,11 +198,23 @@ void addPieces(Mesh&& m, const detail::OutputShells& shells, std::int32_t cell, 
             island = simplifyPlanarRegions(std::move(island), sp, &report);
             if (byDifference && !report.unchanged)
                 rest.accumulate(report.integralsChange, 1.0);
+            if (topology && !report.unchanged)
+                topology = nullptr; // found again below
             ts.add(out, &FractureTimings::simplifyMs);
         }
         const Stopwatch tm;
+        MeshTopology topo;
+        const bool large = island.triangles.size() > kTopologyAboveTriangles;
+        if (topology && islands.size() == 1 && large) {
+            topo = std::move(*topology);
+            detail::compactVerticesIfSparse(island);
+        } else if (topology && islands.size() == 1) {
+            island.removeUnreferencedVertices(); // small: the copying path's layout from now on
+        } else if (wantTopology && large) {
+            topo = buildTopology(island).value_or(MeshTopology{});
+        }
         MeshFacts facts{true, island.triangles.size(), island.positions.size(),
-                        byDifference ? rest : volumeIntegrals(island)};
+                        byDifference ? rest : volumeIntegrals(island), std::move(topo)};
         MassProperties mp = massProperties(facts.integrals);
         tm.add(out, &FractureTimings::massMs);
         if (!(mp.volume > minVolume)) {
@@ -221,8 +241,9 @@ std::unique_ptr<BooleanBackend> makeBooleanBackend(BooleanKind kind) {
 
 namespace detail {
 
-bool splitIsSound(const SplitResult& s, double inputVolume, std::vector<OutputShells>* shells) {
-    double v = 0;
+bool splitIsSound(const SplitResult& s, double inputVolume, std::vector<OutputShells>* shells,
+                  double otherVolume) {
+    double v = otherVolume;
     if (shells)
         shells->assign(1 + s.inside.size(), {});
     std::size_t index = 0;
@@ -254,19 +275,92 @@ bool splitIsSound(const SplitResult& s, double inputVolume, std::vector<OutputSh
 
 namespace {
 
-/// The pipeline after input validation.
-Result<FractureResult> runPipeline(const Mesh& mesh, std::vector<ConvexPolytope> cells,
-                                   const FractureParams& params, const BooleanBackend& backend,
-                                   bool exactRedo, double inputVolume) {
-    const Stopwatch t0;
-    FractureResult res;
+/// Where the cut made new faces and vertices: the cells, a little larger.
+Aabb cutFocus(const std::vector<ConvexPolytope>& cells, const Aabb& meshBox) {
+    Aabb focus;
+    for (const ConvexPolytope& c : cells)
+        focus.extend(c.bounds());
+    const Vec3 grow = Vec3{1, 1, 1} * (1e-6 * (focus.diagonal() + meshBox.diagonal()));
+    return {focus.lo - grow, focus.hi + grow};
+}
+
+/// The start of a pipeline: the result knows the input volume, meshBox is the mesh's bounds; an error when
+/// no cell reaches them.
+Status startPipeline(const Mesh& mesh, const std::vector<ConvexPolytope>& cells, double inputVolume,
+                     FractureResult& res, Aabb& meshBox) {
     res.inputVolume = inputVolume;
-    const Aabb meshBox = mesh.bounds();
+    meshBox = mesh.bounds();
     bool any = false;
     for (const ConvexPolytope& c : cells)
         any |= !c.empty() && c.bounds().overlaps(meshBox);
     if (!any)
         return makeError(ErrorCode::NoIntersection, "fracture: the impact's cells do not touch the mesh");
+    return {};
+}
+
+Error cellsCutNothing() {
+    return makeError(ErrorCode::NoIntersection,
+                     "fracture: the impact's cells do not intersect the mesh (is the impact outside it?)");
+}
+
+/// Interior UVs of the cells' pieces: a cell's piece is cut by that cell only.
+void finishInsideCutFaces(std::vector<Mesh>& inside, const std::vector<ConvexPolytope>& cells,
+                          const FractureParams& params, const Aabb& focus, double onPlane) {
+    for (std::size_t i = 0; i < inside.size(); ++i)
+        finishCutFaces(inside[i], std::span(cells).subspan(i, 1), params.uvScale, focus, onPlane);
+}
+
+void simplifyAroundCut(Mesh& mesh, MeshTopology& topology, std::span<const std::uint32_t> added,
+                       const Aabb& focus, double meshDiagonal, VolumeIntegrals& rest);
+
+/// The cells' pieces in place: a piece that is one shell and whose first insideKept[i] triangles are the
+/// input's (the rest new) is simplified around its new triangles only, with its topology.
+struct InsideInPlace {
+    const std::vector<std::size_t>& insideKept;
+    double meshDiagonal;
+};
+
+/// After the remainder's pieces: the cells' pieces (shells[i + 1] for inside[i]), the cells and the times.
+FractureResult finishPieces(std::vector<Mesh>&& inside, const std::vector<detail::OutputShells>& shells,
+                            std::vector<ConvexPolytope>&& cells, const FractureParams& params,
+                            double minVolume, const Aabb& focus, bool wantTopology, const Stopwatch& t0,
+                            const Stopwatch& t1, FractureResult&& res,
+                            const InsideInPlace* inPlace = nullptr) {
+    for (std::size_t i = 0; i < inside.size(); ++i) {
+        Mesh& m = inside[i];
+        std::optional<MeshTopology> topology;
+        if (inPlace && params.simplifyPieces && shells[i + 1].count == 1 && i < inPlace->insideKept.size() &&
+            inPlace->insideKept[i] < m.triangles.size()) {
+            const Stopwatch ts;
+            topology = buildTopology(m);
+            if (topology) {
+                std::vector<std::uint32_t> added(m.triangles.size() - inPlace->insideKept[i]);
+                for (std::size_t k = 0; k < added.size(); ++k)
+                    added[k] = static_cast<std::uint32_t>(inPlace->insideKept[i] + k);
+                VolumeIntegrals unused; // the piece is measured in full
+                simplifyAroundCut(m, *topology, added, focus, inPlace->meshDiagonal, unused);
+            }
+            ts.add(res, &FractureTimings::simplifyMs);
+        }
+        addPieces(std::move(m), shells[i + 1], static_cast<std::int32_t>(i), minVolume,
+                  params.simplifyPieces && !topology, focus, nullptr, res, topology ? &*topology : nullptr,
+                  wantTopology);
+    }
+    t1.set(res, &FractureTimings::islandsMs);
+    res.cells = std::move(cells);
+    t0.set(res, &FractureTimings::totalMs);
+    return std::move(res);
+}
+
+/// The pipeline after input validation. wantTopology: pieces above kTopologyAboveTriangles get theirs.
+Result<FractureResult> runPipeline(const Mesh& mesh, std::vector<ConvexPolytope> cells,
+                                   const FractureParams& params, const BooleanBackend& backend,
+                                   bool exactRedo, double inputVolume, bool wantTopology = false) {
+    const Stopwatch t0;
+    FractureResult res;
+    Aabb meshBox;
+    if (Status s = startPipeline(mesh, cells, inputVolume, res, meshBox); !s)
+        return s.error();
 
     auto split = backend.split(mesh, cells);
     // The result must close up and conserve volume; a failed fast split is redone exactly. The check labels
@@ -292,34 +386,207 @@ Result<FractureResult> runPipeline(const Mesh& mesh, std::vector<ConvexPolytope>
     for (const Mesh& m : split->inside)
         hit |= !m.empty();
     if (!hit)
-        return makeError(
-            ErrorCode::NoIntersection,
-            "fracture: the impact's cells do not intersect the mesh (is the impact outside it?)");
+        return cellsCutNothing();
     res.exactFallback = split->exactFallback;
     t0.set(res, &FractureTimings::booleanMs);
 
     const Stopwatch t1;
-    Aabb focus; // where the cut made new faces and vertices (the cells, a little larger)
-    for (const ConvexPolytope& c : cells)
-        focus.extend(c.bounds());
-    const Vec3 grow = Vec3{1, 1, 1} * (1e-6 * (focus.diagonal() + meshBox.diagonal()));
-    focus = {focus.lo - grow, focus.hi + grow};
+    const Aabb focus = cutFocus(cells, meshBox);
     const double onPlane = 1e-7 * meshBox.diagonal();
     finishCutFaces(split->remainder, cells, params.uvScale, focus, onPlane);
-    for (std::size_t i = 0; i < split->inside.size(); ++i) // a cell's piece is cut by that cell only
-        finishCutFaces(split->inside[i], std::span(cells).subspan(i, 1), params.uvScale, focus, onPlane);
+    finishInsideCutFaces(split->inside, cells, params, focus, onPlane);
     t1.set(res, &FractureTimings::massMs);
     const double minVolume = std::max(0.0, params.minPieceVolumeFraction) * inputVolume;
     const VolumeIntegrals* whole = split->remainderIntegrals ? &*split->remainderIntegrals : nullptr;
-    addPieces(std::move(split->remainder), shells[0], -1, minVolume, params.simplifyPieces, focus, whole,
-              res);
-    for (std::size_t i = 0; i < split->inside.size(); ++i)
-        addPieces(std::move(split->inside[i]), shells[i + 1], static_cast<std::int32_t>(i), minVolume,
-                  params.simplifyPieces, focus, nullptr, res);
-    t1.set(res, &FractureTimings::islandsMs);
-    res.cells = std::move(cells);
-    t0.set(res, &FractureTimings::totalMs);
-    return res;
+    addPieces(std::move(split->remainder), shells[0], -1, minVolume, params.simplifyPieces, focus, whole, res,
+              nullptr, wantTopology);
+    return finishPieces(std::move(split->inside), shells, std::move(cells), params, minVolume, focus,
+                        wantTopology, t0, t1, std::move(res));
+}
+
+/// simplifyPlanarRegions on the triangles around the cut only (the added ones and those sharing a corner
+/// with one: only the added triangles' corners can go), written back in place; rest gets the change of the
+/// integrals.
+void simplifyAroundCut(Mesh& mesh, MeshTopology& topology, std::span<const std::uint32_t> added,
+                       const Aabb& focus, double meshDiagonal, VolumeIntegrals& rest) {
+    const std::vector<std::uint32_t> near = detail::trianglesAround(mesh, topology, added);
+    Mesh local; // the triangles near the cut, their vertices numbered in order of first use
+    std::unordered_map<std::uint32_t, std::uint32_t> index;
+    std::vector<std::uint32_t> global;
+    const bool hasN = mesh.hasNormals();
+    for (std::uint32_t t : near) {
+        Triangle tri = mesh.triangles[t];
+        for (std::uint32_t& v : tri) {
+            auto [it, fresh] = index.emplace(v, static_cast<std::uint32_t>(global.size()));
+            if (fresh) {
+                global.push_back(v);
+                local.positions.push_back(mesh.positions[v]);
+            }
+            v = it->second;
+        }
+        local.triangles.push_back(tri);
+        local.materials.push_back(mesh.materials[t]);
+        local.uvs.insert(local.uvs.end(), mesh.uvs.begin() + 3 * t, mesh.uvs.begin() + 3 * t + 3);
+        if (hasN)
+            local.normals.insert(local.normals.end(), mesh.normals.begin() + 3 * t,
+                                 mesh.normals.begin() + 3 * t + 3);
+    }
+    const double localDiagonal = local.bounds().diagonal();
+    if (!(localDiagonal > 0))
+        return;
+    PlanarSimplifyParams sp;
+    sp.focus = focus;
+    sp.integralsReference = rest.reference;
+    sp.planeTolerance *= meshDiagonal / localDiagonal; // relative to the whole mesh, as for a full pass
+    PlanarSimplifyReport report;
+    Mesh simple = simplifyPlanarRegions(std::move(local), sp, &report);
+    if (report.unchanged)
+        return;
+    std::vector<std::uint32_t> toGlobal; // the simplified mesh's vertices: the local ones not removed
+    toGlobal.reserve(simple.positions.size());
+    for (std::uint32_t v = 0, r = 0; v < global.size(); ++v) {
+        if (r < report.removedVertices.size() && report.removedVertices[r] == v) {
+            ++r;
+            continue;
+        }
+        toGlobal.push_back(global[v]);
+    }
+    detail::TriangleBatch batch{std::move(simple.triangles), std::move(simple.normals), std::move(simple.uvs),
+                                std::move(simple.materials)};
+    for (Triangle& tri : batch.triangles)
+        for (std::uint32_t& v : tri)
+            v = toGlobal[v];
+    if (detail::replaceTriangles(mesh, topology, near, {}, std::move(batch)))
+        rest.accumulate(report.integralsChange, 1.0);
+}
+
+/// runPipeline on a mesh with its topology, edited in place (docs/megamesh.md): the split's remainder is an
+/// edit, checked around the cut and then applied; its islands are found by a walk around the cut, with the
+/// full labelling as the fallback. A split that fails leaves mesh and topology as they were (a failed edit
+/// is redone by Corefine on the intact mesh when exactRedo is set); on success the mesh is consumed.
+Result<FractureResult> runInPlace(Mesh& mesh, MeshTopology& topology, std::vector<ConvexPolytope> cells,
+                                  const FractureParams& params, const BooleanBackend& backend, bool exactRedo,
+                                  double inputVolume) {
+    const auto* editing = dynamic_cast<const detail::EditingBackend*>(&backend);
+    if (!editing || !topology.fits(mesh))
+        return runPipeline(mesh, std::move(cells), params, backend, exactRedo, inputVolume, true);
+    const Stopwatch t0;
+    FractureResult res;
+    Aabb meshBox;
+    if (Status s = startPipeline(mesh, cells, inputVolume, res, meshBox); !s)
+        return s.error();
+    const std::size_t nT = mesh.triangles.size();
+
+    auto split = editing->splitAsEdit(mesh, cells, meshBox);
+    const Stopwatch tv;
+    std::vector<detail::OutputShells> shells;
+    std::optional<std::vector<std::uint32_t>> slots;
+    bool remainderEmpty = false;
+    if (split) {
+        detail::RemainderEdit& edit = split->remainder;
+        remainderEmpty = edit.removed.size() == nT && edit.added.triangles.empty();
+        const double rest = remainderEmpty ? 0.0 : split->remainderIntegrals.volume;
+        SplitResult debris;
+        debris.inside = std::move(split->inside);
+        if ((remainderEmpty || rest > 0) && detail::splitIsSound(debris, inputVolume, &shells, rest)) {
+            bool hit = false;
+            for (const Mesh& m : debris.inside)
+                hit |= !m.empty();
+            if (!hit)
+                return cellsCutNothing();
+            const bool noUvs = mesh.uvs.empty(), noMaterials = mesh.materials.empty();
+            if (noUvs) // the layout every split output has
+                mesh.uvs.assign(3 * nT, Vec2{});
+            if (noMaterials)
+                mesh.materials.assign(nT, 0u);
+            slots = detail::replaceTriangles(mesh, topology, edit.removed, edit.newPositions,
+                                             std::move(edit.added));
+            if (!slots && noUvs)
+                mesh.uvs.clear();
+            if (!slots && noMaterials)
+                mesh.materials.clear();
+        }
+        split->inside = std::move(debris.inside);
+    }
+    tv.set(res, &FractureTimings::verifyMs);
+    if (!slots) {
+        if (!exactRedo)
+            return split ? makeError(ErrorCode::GeometryFailure,
+                                     "fracture: the " + backend.name() +
+                                         " backend's split is not closed around the cut or does not conserve "
+                                         "volume")
+                         : split.error();
+        auto r = runPipeline(mesh, std::move(cells), params, *detail::makeCorefineBackend(), false,
+                             inputVolume, true);
+        if (r) {
+            r->exactFallback = true;
+            r->timings.verifyMs += res.timings.verifyMs;
+            r->cpuTimings.verifyMs += res.cpuTimings.verifyMs;
+        }
+        return r;
+    }
+    res.editedInPlace = true;
+    t0.set(res, &FractureTimings::booleanMs);
+
+    const Stopwatch t1;
+    const Aabb focus = cutFocus(cells, meshBox);
+    const double onPlane = 1e-7 * meshBox.diagonal();
+    finishCutFaces(mesh, cells, params.uvScale, focus, onPlane, &*slots);
+    finishInsideCutFaces(split->inside, cells, params, focus, onPlane);
+    // One shell when a walk around the cut joins all new triangles (the kept ones next to the cut touch
+    // them); else the full labelling.
+    detail::OutputShells rest;
+    const std::vector<std::uint32_t>& removed = split->remainder.removed;
+    bool one = !mesh.empty() &&
+               (removed.empty() ? slots->empty() : detail::stillOneShell(mesh, topology, *slots, focus));
+    if (one) {
+        rest.count = 1;
+    } else if (!mesh.empty()) {
+        res.islandsLabelledFully = true;
+        const std::int64_t count = detail::closedOrientedShells(mesh, &rest.triangleShell);
+        if (count < 1)
+            return makeError(ErrorCode::GeometryFailure,
+                             "fracture: the remainder edited in place is not closed");
+        rest.count = static_cast<std::size_t>(count);
+        one = count == 1;
+    }
+    t1.set(res, &FractureTimings::massMs);
+    VolumeIntegrals& restIntegrals = split->remainderIntegrals;
+    if (one && params.simplifyPieces) {
+        const Stopwatch ts;
+        simplifyAroundCut(mesh, topology, *slots, focus, meshBox.diagonal(), restIntegrals);
+        ts.add(res, &FractureTimings::simplifyMs);
+    }
+    const double minVolume = std::max(0.0, params.minPieceVolumeFraction) * inputVolume;
+    addPieces(std::move(mesh), rest, -1, minVolume, params.simplifyPieces && !one, focus, &restIntegrals, res,
+              one ? &topology : nullptr, true);
+    const InsideInPlace debris{split->insideKept, meshBox.diagonal()};
+    return finishPieces(std::move(split->inside), shells, std::move(cells), params, minVolume, focus, true,
+                        t0, t1, std::move(res), &debris);
+}
+
+/// Runs a pipeline (runPipeline or runInPlace) after the input's validation, with its timings.
+template <class Run>
+Result<FractureResult> withValidation(const Mesh& mesh, const MeshFacts& known, Run run) {
+    const Stopwatch t0;
+    double volume = 0;
+    const VolumeIntegrals* integrals = nullptr;
+    if (Status s = prepareInput(mesh, known, volume, integrals); !s)
+        return s.error();
+    FractureResult pre; // the stages before the pipeline
+    t0.set(pre, &FractureTimings::validateMs);
+    auto r = run(volume);
+    if (r) {
+        r->timings.validateMs = pre.timings.validateMs;
+        r->cpuTimings.validateMs = pre.cpuTimings.validateMs;
+        t0.set(*r, &FractureTimings::totalMs);
+    }
+    return r;
+}
+
+/// True when mesh is fractured in place: known facts with a topology, the Fast backend.
+bool inPlace(const Mesh& mesh, const MeshFacts& known, BooleanKind kind) {
+    return kind == BooleanKind::Fast && known.fit(mesh) && known.topology.fits(mesh);
 }
 
 } // namespace
@@ -329,20 +596,23 @@ namespace detail {
 Result<FractureResult> fractureWithBackend(const Mesh& mesh, std::vector<ConvexPolytope> cells,
                                            const FractureParams& params, const BooleanBackend& backend,
                                            bool exactRedo, const MeshFacts& known) {
-    const Stopwatch t0;
-    double volume = 0;
-    const VolumeIntegrals* integrals = nullptr;
-    if (Status s = prepareInput(mesh, known, volume, integrals); !s)
-        return s.error();
-    FractureResult pre; // the stages before the pipeline
-    t0.set(pre, &FractureTimings::validateMs);
-    auto r = runPipeline(mesh, std::move(cells), params, backend, exactRedo, volume);
-    if (r) {
-        r->timings.validateMs = pre.timings.validateMs;
-        r->cpuTimings.validateMs = pre.cpuTimings.validateMs;
-        t0.set(*r, &FractureTimings::totalMs);
+    if (known.fit(mesh) && known.topology.fits(mesh) && dynamic_cast<const EditingBackend*>(&backend)) {
+        Mesh copy = mesh;
+        MeshFacts facts = known;
+        return fractureInPlaceWithBackend(copy, facts, std::move(cells), params, backend, exactRedo);
     }
-    return r;
+    return withValidation(mesh, known, [&](double volume) {
+        return runPipeline(mesh, std::move(cells), params, backend, exactRedo, volume);
+    });
+}
+
+Result<FractureResult> fractureInPlaceWithBackend(Mesh& mesh, MeshFacts& known,
+                                                  std::vector<ConvexPolytope> cells,
+                                                  const FractureParams& params, const BooleanBackend& backend,
+                                                  bool exactRedo) {
+    return withValidation(mesh, known, [&](double volume) {
+        return runInPlace(mesh, known.topology, std::move(cells), params, backend, exactRedo, volume);
+    });
 }
 
 } // namespace detail
@@ -353,6 +623,8 @@ Result<MeshFacts> analyzeMesh(const Mesh& mesh) {
     MeshFacts facts{true, mesh.triangles.size(), mesh.positions.size(), volumeIntegrals(mesh)};
     if (Status s = positiveVolume(facts.integrals.volume); !s)
         return s.error();
+    if (mesh.triangles.size() > kTopologyAboveTriangles)
+        facts.topology = buildTopology(mesh).value_or(MeshTopology{});
     return facts;
 }
 
@@ -366,18 +638,11 @@ std::unique_ptr<BooleanBackend> backendFor(BooleanKind kind, bool exactFallback,
     return makeBooleanBackend(kind);
 }
 
-} // namespace
-
-Result<FractureResult> fractureWithCells(const Mesh& mesh, std::vector<ConvexPolytope> cells,
-                                         const FractureParams& params, const MeshFacts& known) {
-    const VolumeIntegrals* integrals = known.fit(mesh) ? &known.integrals : nullptr;
-    return detail::fractureWithBackend(mesh, std::move(cells), params,
-                                       *backendFor(params.backend, true, integrals),
-                                       params.backend == BooleanKind::Fast, known);
-}
-
-Result<FractureResult> fracture(const Mesh& mesh, const Impact& impact, const FractureParams& params,
-                                std::uint64_t seed, const MeshFacts& known) {
+/// fracture: cells from the seed (redrawn when Fast declines them), then run(cells, backend, exactRedo,
+/// volume), which is runPipeline or runInPlace.
+template <class Run>
+Result<FractureResult> fractureBy(const Mesh& mesh, const Impact& impact, const FractureParams& params,
+                                  std::uint64_t seed, const MeshFacts& known, Run run) {
     const Stopwatch t0;
     double volume = 0;
     const VolumeIntegrals* integrals = nullptr;
@@ -413,17 +678,58 @@ Result<FractureResult> fracture(const Mesh& mesh, const Impact& impact, const Fr
             std::vector<ConvexPolytope> cells = cellsFor(redraw == 0 ? seed : mixSeed(seed, 0xDA7A + redraw));
             if (cells.empty())
                 break;
-            auto r = runPipeline(mesh, std::move(cells), params, *detail::makeFastBackend(false, integrals),
-                                 false, volume);
+            auto r = run(std::move(cells), *detail::makeFastBackend(false, integrals), false, volume);
             if (r || r.error().code != ErrorCode::GeometryFailure)
                 return finish(std::move(r), redraw);
         }
     std::vector<ConvexPolytope> cells = cellsFor(seed);
     if (cells.empty())
         return makeError(ErrorCode::NoIntersection, "fracture: no cell could be built around the impact");
-    return finish(runPipeline(mesh, std::move(cells), params, *backendFor(params.backend, true, integrals),
-                              params.backend == BooleanKind::Fast, volume),
+    return finish(run(std::move(cells), *backendFor(params.backend, true, integrals),
+                      params.backend == BooleanKind::Fast, volume),
                   0);
+}
+
+} // namespace
+
+Result<FractureResult> fractureWithCells(const Mesh& mesh, std::vector<ConvexPolytope> cells,
+                                         const FractureParams& params, const MeshFacts& known) {
+    if (inPlace(mesh, known, params.backend))
+        return fractureWithCells(Mesh(mesh), std::move(cells), params, MeshFacts(known));
+    const VolumeIntegrals* integrals = known.fit(mesh) ? &known.integrals : nullptr;
+    return detail::fractureWithBackend(mesh, std::move(cells), params,
+                                       *backendFor(params.backend, true, integrals),
+                                       params.backend == BooleanKind::Fast, known);
+}
+
+Result<FractureResult> fractureWithCells(Mesh&& mesh, std::vector<ConvexPolytope> cells,
+                                         const FractureParams& params, MeshFacts known) {
+    if (!inPlace(mesh, known, params.backend))
+        return fractureWithCells(std::as_const(mesh), std::move(cells), params, known);
+    const auto backend = detail::makeFastBackend(true, &known.integrals);
+    return detail::fractureInPlaceWithBackend(mesh, known, std::move(cells), params, *backend, true);
+}
+
+Result<FractureResult> fracture(const Mesh& mesh, const Impact& impact, const FractureParams& params,
+                                std::uint64_t seed, const MeshFacts& known) {
+    if (inPlace(mesh, known, params.backend))
+        return fracture(Mesh(mesh), impact, params, seed, MeshFacts(known));
+    return fractureBy(
+        mesh, impact, params, seed, known,
+        [&](std::vector<ConvexPolytope> cells, const BooleanBackend& backend, bool exactRedo, double volume) {
+            return runPipeline(mesh, std::move(cells), params, backend, exactRedo, volume);
+        });
+}
+
+Result<FractureResult> fracture(Mesh&& mesh, const Impact& impact, const FractureParams& params,
+                                std::uint64_t seed, MeshFacts known) {
+    if (!inPlace(mesh, known, params.backend))
+        return fracture(std::as_const(mesh), impact, params, seed, known);
+    return fractureBy(
+        mesh, impact, params, seed, known,
+        [&](std::vector<ConvexPolytope> cells, const BooleanBackend& backend, bool exactRedo, double volume) {
+            return runInPlace(mesh, known.topology, std::move(cells), params, backend, exactRedo, volume);
+        });
 }
 
 } // namespace rubble

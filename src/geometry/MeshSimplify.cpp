@@ -553,6 +553,7 @@ bool Simplifier::run(Mesh& result, PlanarSimplifyReport& report, Mesh* inPlace) 
         for (std::uint32_t& v : tri)
             v = remap[v];
     report.verticesRemoved = removed_.size();
+    report.removedVertices = std::move(gone);
     if (!editedInPlace_)
         result = std::move(out);
     return true;

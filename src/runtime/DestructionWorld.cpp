@@ -169,13 +169,18 @@ void runJob(Job& job) {
     // main thread at adoption). The remainder's mass properties found by difference may differ from a full
     // sum in the last bits: its frame comes from the full sum, so that facts change no piece's bytes.
     for (std::size_t i = 0; i < meshes.size(); ++i) {
-        const Piece& piece = job.result.pieces[i];
+        Piece& piece = job.result.pieces[i];
         const MassProperties m = piece.cell < 0 ? computeMassProperties(meshes[i]) : piece.mass;
         Frame f{m.principalAxes, m.centerOfMass};
         const Mat3 rt = f.rotation.transposed();
         meshes[i].transform(rt, Vec3{1, 1, 1}, rt * (-1.0 * f.translation));
         MeshFacts facts{true, meshes[i].triangles.size(), meshes[i].positions.size(),
-                        volumeIntegrals(meshes[i])};
+                        volumeIntegrals(meshes[i]), std::move(piece.facts.topology)};
+        // The topology analyzeMesh finds (so that a loaded world, which finds it again, cuts the same bits).
+        if (meshes[i].triangles.size() <= kTopologyAboveTriangles)
+            facts.topology = {};
+        else if (!facts.topology.fits(meshes[i]))
+            facts.topology = buildTopology(meshes[i]).value_or(MeshTopology{});
         job.localMass.push_back(massProperties(facts.integrals));
         job.localFacts.push_back(std::move(facts));
         job.meshHashes.push_back(meshes[i].hash());

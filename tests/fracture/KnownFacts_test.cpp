@@ -19,26 +19,7 @@ namespace {
 /// The relative tolerance of mass properties by difference against a full recomputation.
 constexpr double kRelative = 1e-12;
 
-double maxAbs(const Mat3& m) {
-    double a = 0;
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j)
-            a = std::max(a, std::abs(m.m[i][j]));
-    return a;
-}
-
-/// Largest relative deviation of mass from a full recomputation of mesh: volume against volume, centre of
-/// mass against the bounds' diagonal, inertia against its largest entry.
-double massError(const Mesh& mesh, const MassProperties& mass) {
-    const MassProperties full = computeMassProperties(mesh);
-    double e = std::abs(mass.volume - full.volume) / full.volume;
-    e = std::max(e, length(mass.centerOfMass - full.centerOfMass) / mesh.bounds().diagonal());
-    double d = 0;
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j)
-            d = std::max(d, std::abs(mass.inertia.m[i][j] - full.inertia.m[i][j]));
-    return std::max(e, d / maxAbs(full.inertia));
-}
+using test::massError;
 
 /// The facts every piece carries describe its mesh: counts, and integrals equal to a recomputation about
 /// the same reference.

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -85,6 +86,19 @@ Mesh unwelded(const Mesh& m, bool withAttributes) {
     if (withAttributes)
         out.materialNames = {"a", "b", "c"};
     return out;
+}
+
+double massError(const Mesh& mesh, const MassProperties& mass) {
+    const MassProperties full = computeMassProperties(mesh);
+    double e = std::abs(mass.volume - full.volume) / full.volume;
+    e = std::max(e, length(mass.centerOfMass - full.centerOfMass) / mesh.bounds().diagonal());
+    double d = 0, big = 0;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) {
+            d = std::max(d, std::abs(mass.inertia.m[i][j] - full.inertia.m[i][j]));
+            big = std::max(big, std::abs(full.inertia.m[i][j]));
+        }
+    return std::max(e, d / big);
 }
 
 ::testing::AssertionResult closedAndOriented(const Mesh& m) {

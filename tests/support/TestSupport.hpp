@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "rubble/MassProperties.hpp"
 #include "rubble/Mesh.hpp"
 #include "rubble/Random.hpp"
 
@@ -36,6 +37,9 @@ Vec3 surfacePoint(const Mesh& m, Rng& rng);
 /// Closed, edge-manifold and consistently oriented: every directed edge once, and its reverse once (for
 /// EXPECT_TRUE; the failure names the first bad edge).
 ::testing::AssertionResult closedAndOriented(const Mesh& m);
+/// Largest relative deviation of mass from a full recomputation of mesh: volume against volume, centre of
+/// mass against the bounds' diagonal, inertia against its largest entry.
+double massError(const Mesh& mesh, const MassProperties& mass);
 
 } // namespace rubble::test
 

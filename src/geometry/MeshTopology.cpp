@@ -1,0 +1,312 @@
+#include "rubble/MeshTopology.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "geometry/TopologyEdit.hpp"
+
+namespace rubble {
+
+namespace {
+
+constexpr std::uint32_t kNoTwin = 0xFFFFFFFFu;
+
+std::uint64_t edgeKey(std::uint32_t a, std::uint32_t b) {
+    return (std::uint64_t(a) << 32) | b;
+}
+
+/// Resizes v to n; when that reallocates, with room for 1/16 more, so that the next edits do not.
+template <class T>
+void growTo(std::vector<T>& v, std::size_t n) {
+    if (n > v.capacity())
+        v.reserve(n + n / 16);
+    v.resize(n);
+}
+
+} // namespace
+
+std::optional<MeshTopology> buildTopology(const Mesh& mesh) {
+    const std::size_t nT = mesh.triangles.size(), nV = mesh.positions.size();
+    if (nT == 0 || 3 * nT >= kNoTwin)
+        return std::nullopt;
+    // Half-edges bucketed by their start vertex (counting sort); a half-edge's twin is in its end's bucket.
+    std::vector<std::uint32_t> offset(nV + 1, 0);
+    for (const Triangle& t : mesh.triangles)
+        for (std::uint32_t v : t) {
+            if (v >= nV)
+                return std::nullopt;
+            ++offset[v + 1];
+        }
+    for (std::size_t v = 0; v < nV; ++v)
+        offset[v + 1] += offset[v];
+    std::vector<std::uint32_t> fill(offset.begin(), offset.end() - 1);
+    std::vector<std::uint32_t> byStart(3 * nT);
+    for (std::uint32_t t = 0; t < nT; ++t)
+        for (std::uint32_t c = 0; c < 3; ++c)
+            byStart[fill[mesh.triangles[t][c]]++] = 3 * t + c;
+    auto end = [&](std::uint32_t h) { return mesh.triangles[h / 3][(h % 3 + 1) % 3]; };
+    MeshTopology topo;
+    topo.twin.assign(3 * nT, kNoTwin);
+    for (std::uint32_t h = 0; h < 3 * nT; ++h) {
+        const std::uint32_t a = mesh.triangles[h / 3][h % 3], b = end(h);
+        if (a == b)
+            return std::nullopt;
+        std::uint32_t found = kNoTwin, same = 0;
+        for (std::uint32_t i = offset[b]; i < offset[b + 1]; ++i)
+            if (end(byStart[i]) == a) {
+                if (found != kNoTwin)
+                    return std::nullopt; // the reverse twice
+                found = byStart[i];
+            }
+        for (std::uint32_t i = offset[a]; i < offset[a + 1]; ++i)
+            same += end(byStart[i]) == b ? 1u : 0u;
+        if (found == kNoTwin || same != 1)
+            return std::nullopt;
+        topo.twin[h] = found;
+    }
+    // One shell: a walk over the twins reaches every triangle.
+    std::vector<bool> seen(nT, false);
+    std::vector<std::uint32_t> stack{0};
+    seen[0] = true;
+    std::size_t reached = 1;
+    while (!stack.empty()) {
+        const std::uint32_t t = stack.back();
+        stack.pop_back();
+        for (std::uint32_t c = 0; c < 3; ++c) {
+            const std::uint32_t u = topo.twin[3 * t + c] / 3;
+            if (!seen[u]) {
+                seen[u] = true;
+                ++reached;
+                stack.push_back(u);
+            }
+        }
+    }
+    if (reached != nT)
+        return std::nullopt;
+    return topo;
+}
+
+namespace detail {
+
+std::optional<std::vector<std::uint32_t>> replaceTriangles(Mesh& mesh, MeshTopology& topology,
+                                                           std::span<const std::uint32_t> removed,
+                                                           std::span<const Vec3> newPositions,
+                                                           TriangleBatch&& added) {
+    const std::size_t nT = mesh.triangles.size(), nA = added.triangles.size();
+    const auto nV = static_cast<std::uint32_t>(mesh.positions.size());
+    const bool hasN = mesh.hasNormals();
+    if (!topology.fits(mesh) || mesh.uvs.size() != 3 * nT || mesh.materials.size() != nT ||
+        added.uvs.size() != 3 * nA || added.materials.size() != nA ||
+        added.normals.size() != (hasN ? 3 * nA : 0) || nT - removed.size() + nA >= kNoTwin / 3)
+        return std::nullopt;
+    for (const Vec3& p : newPositions)
+        if (!isFinite(p))
+            return std::nullopt;
+    const std::size_t allV = nV + newPositions.size();
+    // B: the removed triangles' directed edges; N: the added ones'. Conditions 1-4 of docs/megamesh.md.
+    std::unordered_map<std::uint64_t, std::uint32_t> inB, inN;
+    std::unordered_map<std::uint32_t, std::uint32_t> outOf; // vertex -> a removed half-edge leaving it
+    inB.reserve(3 * removed.size());
+    inN.reserve(3 * nA);
+    for (std::size_t i = 0; i < removed.size(); ++i) {
+        const std::uint32_t t = removed[i];
+        if (t >= nT || (i > 0 && removed[i - 1] >= t))
+            return std::nullopt;
+        for (std::uint32_t c = 0; c < 3; ++c) {
+            inB.emplace(edgeKey(mesh.triangles[t][c], mesh.triangles[t][(c + 1) % 3]), 3 * t + c);
+            outOf.emplace(mesh.triangles[t][c], 3 * t + c);
+        }
+    }
+    // Whether a kept triangle has the edge a->b: a walk around a from one of its removed half-edges.
+    auto keptEdge = [&](std::uint32_t a, std::uint32_t b) {
+        const auto start = outOf.find(a);
+        if (start == outOf.end())
+            return true; // a vertex no removed triangle has: its triangles are all kept
+        std::uint32_t h = start->second;
+        for (std::size_t steps = 0; steps < 3 * nT; ++steps) {
+            const std::uint32_t t = h / 3;
+            if (mesh.triangles[t][(h % 3 + 1) % 3] == b &&
+                !std::binary_search(removed.begin(), removed.end(), t))
+                return true;
+            h = topology.twin[3 * t + (h % 3 + 2) % 3];
+            if (h == start->second)
+                return false;
+        }
+        return true;
+    };
+    for (std::uint32_t i = 0; i < nA; ++i)
+        for (std::uint32_t c = 0; c < 3; ++c) {
+            const std::uint32_t a = added.triangles[i][c], b = added.triangles[i][(c + 1) % 3];
+            if (a >= allV || b >= allV || a == b || !inN.emplace(edgeKey(a, b), 3 * i + c).second)
+                return std::nullopt; // out of range, a loop, or condition 1
+            if (a < nV && b < nV && !inB.count(edgeKey(a, b)) && keptEdge(a, b))
+                return std::nullopt; // condition 2
+        }
+    // Per added half-edge: its twin, 3i+c among the added (marked) or a kept half-edge.
+    constexpr std::uint32_t kAddedBit = 0x80000000u;
+    std::vector<std::uint32_t> twinOf(3 * nA);
+    for (std::uint32_t i = 0; i < nA; ++i)
+        for (std::uint32_t c = 0; c < 3; ++c) {
+            const std::uint32_t a = added.triangles[i][c], b = added.triangles[i][(c + 1) % 3];
+            if (auto r = inN.find(edgeKey(b, a)); r != inN.end()) {
+                twinOf[3 * i + c] = r->second | kAddedBit;
+                continue;
+            }
+            const auto e = inB.find(edgeKey(a, b));
+            if (e == inB.end() || inB.count(edgeKey(b, a)))
+                return std::nullopt; // condition 3
+            twinOf[3 * i + c] = topology.twin[e->second];
+        }
+    for (const auto& [key, h] : inB)
+        if (!inB.count(edgeKey(static_cast<std::uint32_t>(key & 0xFFFFFFFFu),
+                               static_cast<std::uint32_t>(key >> 32))) &&
+            !inN.count(key))
+            return std::nullopt; // condition 4
+    if (3 * nA >= kAddedBit)
+        return std::nullopt;
+
+    // Apply: slots for the added triangles, then the surplus slots filled from the end.
+    const std::size_t oldV = mesh.positions.size();
+    growTo(mesh.positions, oldV + newPositions.size());
+    std::copy(newPositions.begin(), newPositions.end(),
+              mesh.positions.begin() + static_cast<std::ptrdiff_t>(oldV));
+    std::vector<std::uint32_t> slot(nA);
+    for (std::size_t i = 0; i < nA; ++i)
+        slot[i] = i < removed.size() ? removed[i] : static_cast<std::uint32_t>(nT + (i - removed.size()));
+    const std::size_t total = nT - removed.size() + nA;
+    if (total > nT) {
+        growTo(mesh.triangles, total);
+        growTo(mesh.uvs, 3 * total);
+        growTo(mesh.materials, total);
+        if (hasN)
+            growTo(mesh.normals, 3 * total);
+        growTo(topology.twin, 3 * total);
+    }
+    // Writes a triangle and its attributes into slot s.
+    auto put = [&](std::uint32_t s, const Triangle& tri, std::uint32_t material, const Vec2* uvs,
+                   const Vec3* normals) {
+        mesh.triangles[s] = tri;
+        mesh.materials[s] = material;
+        std::copy(uvs, uvs + 3, mesh.uvs.begin() + 3 * s);
+        if (hasN)
+            std::copy(normals, normals + 3, mesh.normals.begin() + 3 * s);
+    };
+    for (std::size_t i = 0; i < nA; ++i) {
+        const std::uint32_t s = slot[i];
+        put(s, added.triangles[i], added.materials[i], &added.uvs[3 * i],
+            hasN ? &added.normals[3 * i] : nullptr);
+        for (std::uint32_t c = 0; c < 3; ++c) {
+            const std::uint32_t t = twinOf[3 * i + c];
+            if (t & kAddedBit) {
+                const std::uint32_t j = (t & ~kAddedBit) / 3, d = (t & ~kAddedBit) % 3;
+                topology.twin[3 * s + c] = 3 * slot[j] + d;
+            } else {
+                topology.twin[3 * s + c] = t;
+                topology.twin[t] = 3 * s + c;
+            }
+        }
+    }
+    if (total < nT) {
+        // Holes: surplus slots below the new end; movers: kept triangles at or above it.
+        const std::span<const std::uint32_t> surplus = removed.subspan(nA);
+        std::vector<std::uint32_t> holes, movers;
+        for (std::uint32_t s : surplus)
+            if (s < total)
+                holes.push_back(s);
+        std::size_t k = 0;
+        for (auto t = static_cast<std::uint32_t>(total); t < nT; ++t) {
+            while (k < surplus.size() && surplus[k] < t)
+                ++k;
+            if (k == surplus.size() || surplus[k] != t)
+                movers.push_back(t);
+        }
+        for (std::size_t i = 0; i < holes.size(); ++i) {
+            const std::uint32_t from = movers[i], to = holes[i];
+            put(to, mesh.triangles[from], mesh.materials[from], &mesh.uvs[3 * from],
+                hasN ? &mesh.normals[3 * from] : nullptr);
+            for (std::uint32_t c = 0; c < 3; ++c) {
+                const std::uint32_t t = topology.twin[3 * from + c];
+                topology.twin[3 * to + c] = t;
+                topology.twin[t] = 3 * to + c;
+            }
+        }
+        mesh.triangles.resize(total);
+        mesh.uvs.resize(3 * total);
+        mesh.materials.resize(total);
+        if (hasN)
+            mesh.normals.resize(3 * total);
+        topology.twin.resize(3 * total);
+    }
+    return slot;
+}
+
+bool stillOneShell(const Mesh& mesh, const MeshTopology& topology, std::span<const std::uint32_t> addedSlots,
+                   const Aabb& near) {
+    if (addedSlots.empty())
+        return false;
+    std::unordered_map<std::uint32_t, bool> seen; // triangle -> is an added one
+    seen.reserve(4 * addedSlots.size());
+    for (std::uint32_t s : addedSlots)
+        seen.emplace(s, false);
+    std::vector<std::uint32_t> stack{addedSlots.front()};
+    seen[addedSlots.front()] = true;
+    std::size_t reached = 1;
+    while (!stack.empty() && reached < addedSlots.size()) {
+        const std::uint32_t t = stack.back();
+        stack.pop_back();
+        for (std::uint32_t c = 0; c < 3; ++c) {
+            const std::uint32_t u = topology.twin[3 * t + c] / 3;
+            auto [it, fresh] = seen.emplace(u, true);
+            if (!fresh) {
+                if (it->second)
+                    continue;
+                it->second = true; // an added triangle, reached for the first time
+                ++reached;
+                stack.push_back(u);
+                continue;
+            }
+            Aabb box;
+            for (std::uint32_t v : mesh.triangles[u])
+                box.extend(mesh.positions[v]);
+            if (box.overlaps(near))
+                stack.push_back(u);
+        }
+    }
+    return reached == addedSlots.size();
+}
+
+std::vector<std::uint32_t> trianglesAround(const Mesh& mesh, const MeshTopology& topology,
+                                           std::span<const std::uint32_t> seeds) {
+    std::vector<std::uint32_t> out;
+    std::unordered_set<std::uint32_t> corners, taken;
+    corners.reserve(2 * seeds.size());
+    taken.reserve(4 * seeds.size());
+    const std::size_t limit = mesh.triangles.size();
+    for (std::uint32_t t : seeds)
+        for (std::uint32_t c = 0; c < 3; ++c) {
+            if (!corners.insert(mesh.triangles[t][c]).second)
+                continue;
+            const std::uint32_t start = 3 * t + c; // leaves corner c; the walk turns around it
+            std::uint32_t h = start;
+            for (std::size_t steps = 0; steps < limit; ++steps) {
+                if (taken.insert(h / 3).second)
+                    out.push_back(h / 3);
+                h = topology.twin[3 * (h / 3) + (h % 3 + 2) % 3];
+                if (h == start)
+                    break;
+            }
+        }
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+void compactVerticesIfSparse(Mesh& mesh) {
+    if (mesh.positions.size() > mesh.triangles.size() / 2 + mesh.triangles.size() / 8 + 1024)
+        mesh.removeUnreferencedVertices();
+}
+
+} // namespace detail
+
+} // namespace rubble

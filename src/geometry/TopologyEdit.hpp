@@ -1,0 +1,49 @@
+#pragma once
+// Private to the core: editing a closed mesh in place while keeping its MeshTopology (docs/megamesh.md,
+// "The remainder edited in place").
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "rubble/Aabb.hpp"
+#include "rubble/Mesh.hpp"
+#include "rubble/MeshTopology.hpp"
+
+namespace rubble::detail {
+
+/// Triangles with their attributes, laid out as in Mesh (normals only when the mesh has them).
+struct TriangleBatch {
+    std::vector<Triangle> triangles;
+    std::vector<Vec3> normals;            ///< 3 per triangle, or empty
+    std::vector<Vec2> uvs;                ///< 3 per triangle
+    std::vector<std::uint32_t> materials; ///< 1 per triangle
+};
+
+/// Replaces the triangles in slots `removed` (sorted, distinct) of a closed mesh with topology by `added`,
+/// whose corners index mesh.positions followed by newPositions, when the result is closed and consistently
+/// oriented by the local conditions of docs/megamesh.md (checked on the removed and added triangles only).
+/// Added triangles take the removed slots in order, then are appended; surplus slots are filled with the
+/// last triangles. Returns the added triangles' slots, or nullopt with mesh and topology untouched. The
+/// mesh must have uvs and materials (and normals exactly when added has them).
+std::optional<std::vector<std::uint32_t>> replaceTriangles(Mesh& mesh, MeshTopology& topology,
+                                                           std::span<const std::uint32_t> removed,
+                                                           std::span<const Vec3> newPositions,
+                                                           TriangleBatch&& added);
+
+/// After replaceTriangles on a mesh that was one shell, with `removed` non-empty: true when a walk from the
+/// added triangles through those whose bounds meet `near` (and the added ones) reaches every added
+/// triangle, which proves that the mesh is still one shell (docs/megamesh.md). False means unknown.
+bool stillOneShell(const Mesh& mesh, const MeshTopology& topology, std::span<const std::uint32_t> addedSlots,
+                   const Aabb& near);
+
+/// The seeds and every triangle that shares a corner with one (the stars of their corners), ascending.
+std::vector<std::uint32_t> trianglesAround(const Mesh& mesh, const MeshTopology& topology,
+                                           std::span<const std::uint32_t> seeds);
+
+/// Removes unreferenced vertices when they are more than a quarter of the vertices a closed mesh of this
+/// many triangles references (about half its triangle count); the topology stays valid.
+void compactVerticesIfSparse(Mesh& mesh);
+
+} // namespace rubble::detail
