@@ -50,9 +50,18 @@ private:
     const Mesh& m_;
     PlanarSimplifyParams params_;
     double planeTol_ = 0, diag_ = 0;
-    std::unordered_map<std::uint64_t, std::uint32_t> edgeTri_;           // directed edge → local triangle
-    std::unordered_map<std::uint32_t, std::vector<std::uint32_t>> star_; // focus vertex → local triangles
-    std::unordered_set<std::uint32_t> removed_;
+    std::unordered_map<std::uint64_t, std::uint32_t> edgeTri_; // directed edge → local triangle
+    // Flat arrays by vertex or triangle rather than hash maps: their lookups were much of the cost.
+    std::vector<std::uint32_t> starOf_;             // per vertex: index into stars_, or kNone
+    std::vector<std::vector<std::uint32_t>> stars_; // focus vertex's local triangles, in triangle order
+    std::vector<std::uint32_t> starVertex_;         // the vertex of each star
+    std::vector<Vec3> normal_;                      // per local triangle: triangleNormal, computed once
+    std::vector<char> isRemoved_;                   // per vertex
+    std::vector<std::uint32_t> removed_;            // the removed vertices, in the order found
+    bool wasRemoved(std::uint32_t v) const { return isRemoved_[v] != 0; }
+    const std::vector<std::uint32_t>* trianglesAt(std::uint32_t v) const {
+        return starOf_[v] == kNone ? nullptr : &stars_[starOf_[v]];
+    }
     bool editedInPlace_ = false;
 
     std::uint32_t twinTri(std::uint32_t t, int k) const { // triangle across edge k of t, or kNone
@@ -88,7 +97,7 @@ bool fitsInPlace(const std::vector<std::pair<std::uint32_t, std::uint32_t>>& pat
 
 /// Can triangles t and s (sharing an edge) be one flat region? The plane is the larger triangle's.
 bool Simplifier::compatible(std::uint32_t t, std::uint32_t s) const {
-    const Vec3 nt = m_.triangleNormal(t), ns = m_.triangleNormal(s);
+    const Vec3 nt = normal_[t], ns = normal_[s];
     if (m_.material(t) != m_.material(s) || dot(nt, ns) <= 0)
         return false;
     const bool tBig = lengthSquared(nt) >= lengthSquared(ns);
@@ -132,9 +141,9 @@ bool Simplifier::compatible(std::uint32_t t, std::uint32_t s) const {
 bool Simplifier::flat(const std::vector<std::uint32_t>& tris) const {
     std::uint32_t best = tris.front();
     for (std::uint32_t t : tris)
-        if (lengthSquared(m_.triangleNormal(t)) > lengthSquared(m_.triangleNormal(best)))
+        if (lengthSquared(normal_[t]) > lengthSquared(normal_[best]))
             best = t;
-    const Vec3 n = normalized(m_.triangleNormal(best)), o = m_.positions[m_.triangles[best][0]];
+    const Vec3 n = normalized(normal_[best]), o = m_.positions[m_.triangles[best][0]];
     Vec3 u, v;
     detail::planeBasis(n, u, v);
     double s[3][3] = {}, su[3] = {}, sv[3] = {};
@@ -193,10 +202,10 @@ bool Simplifier::flat(const std::vector<std::uint32_t>& tris) const {
 }
 
 bool Simplifier::removable(std::uint32_t v) const {
-    const auto it = star_.find(v);
-    if (it == star_.end())
+    const std::vector<std::uint32_t>* found = trianglesAt(v);
+    if (!found)
         return false;
-    const std::vector<std::uint32_t>& star = it->second;
+    const std::vector<std::uint32_t>& star = *found;
     // Walk the fan: from triangle t (corner k at v) to the triangle across its edge (previous corner → v).
     std::vector<std::uint32_t> fan;
     std::vector<bool> crease; // crease[i]: the edge between fan[i] and fan[i + 1] separates two regions
@@ -244,10 +253,12 @@ bool Simplifier::removable(std::uint32_t v) const {
 
 /// Triangulates a patch (compatible triangles around removed vertices) without those vertices.
 bool Simplifier::retriangulate(const std::vector<std::uint32_t>& patch, std::vector<Tri>& tris) const {
-    const std::unordered_set<std::uint32_t> in(patch.begin(), patch.end());
+    auto inPatch = [&](std::uint32_t t) {
+        return std::binary_search(patch.begin(), patch.end(), t);
+    }; // sorted
     auto outside = [&](std::uint32_t t, int k) {
         const std::uint32_t o = twinTri(t, k);
-        return o == kNone || !in.count(o);
+        return o == kNone || !inPatch(o);
     };
     // Boundary chains, from kept vertex to kept vertex.
     std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
@@ -257,14 +268,14 @@ bool Simplifier::retriangulate(const std::vector<std::uint32_t>& patch, std::vec
         for (int k = 0; k < 3; ++k) {
             const Tri& tri = m_.triangles[t];
             const std::uint32_t a = tri[static_cast<std::size_t>(k)];
-            if (!outside(t, k) || removed_.count(a))
+            if (!outside(t, k) || wasRemoved(a))
                 continue;
             std::uint32_t x = tri[static_cast<std::size_t>((k + 1) % 3)];
             std::size_t steps = 0;
-            while (removed_.count(x)) { // the one boundary edge of the patch leaving x
+            while (wasRemoved(x)) { // the one boundary edge of the patch leaving x
                 std::uint32_t next = kNone;
-                for (std::uint32_t s : star_.at(x)) {
-                    if (!in.count(s))
+                for (std::uint32_t s : *trianglesAt(x)) {
+                    if (!inPatch(s))
                         continue;
                     const Tri& st = m_.triangles[s];
                     const int j = st[0] == x ? 0 : st[1] == x ? 1 : 2;
@@ -290,14 +301,14 @@ bool Simplifier::retriangulate(const std::vector<std::uint32_t>& patch, std::vec
     ends.erase(std::unique(ends.begin(), ends.end()), ends.end());
     for (std::uint32_t t : patch) // nothing kept inside
         for (std::uint32_t v : m_.triangles[t])
-            if (!removed_.count(v) && !std::binary_search(ends.begin(), ends.end(), v))
+            if (!wasRemoved(v) && !std::binary_search(ends.begin(), ends.end(), v))
                 return false;
 
     std::uint32_t best = patch.front();
     double before = 0;
     for (std::uint32_t t : patch) {
-        before += length(m_.triangleNormal(t));
-        if (lengthSquared(m_.triangleNormal(t)) > lengthSquared(m_.triangleNormal(best)))
+        before += length(normal_[t]);
+        if (lengthSquared(normal_[t]) > lengthSquared(normal_[best]))
             best = t;
     }
     std::vector<detail::RegionEdge> region;
@@ -306,7 +317,7 @@ bool Simplifier::retriangulate(const std::vector<std::uint32_t>& patch, std::vec
         region.push_back({a, b, 1u});
     const std::size_t first = tris.size();
     if (detail::triangulatePlanarRegion(
-            region, m_.triangleNormal(best), [&](std::uint32_t id) { return m_.positions[id]; }, tris))
+            region, normal_[best], [&](std::uint32_t id) { return m_.positions[id]; }, tris))
         return false;
     // The new triangles: counter-clockwise, the same area, and every directed edge either inside (its reverse
     // is there too) or one of the chains, each exactly once — so the patch closes up with its surroundings.
@@ -438,6 +449,9 @@ bool Simplifier::run(Mesh& result, PlanarSimplifyReport& report, Mesh* inPlace) 
 
     // Local triangles (a corner in the focus), their directed edges and the stars of focus vertices.
     std::vector<std::uint32_t> local;
+    starOf_.assign(nv, kNone);
+    isRemoved_.assign(nv, 0);
+    normal_.resize(nt);
     for (std::uint32_t t = 0; t < nt; ++t) {
         const Tri& tri = m_.triangles[t];
         bool any = everywhere;
@@ -446,33 +460,48 @@ bool Simplifier::run(Mesh& result, PlanarSimplifyReport& report, Mesh* inPlace) 
         if (!any)
             continue;
         local.push_back(t);
+        normal_[t] = m_.triangleNormal(t);
         for (std::size_t k = 0; k < 3; ++k) {
-            if (tri[k] == tri[(k + 1) % 3] || !edgeTri_.emplace(directed(tri[k], tri[(k + 1) % 3]), t).second)
-                return false; // a repeated corner or directed edge: not a clean surface
-            if (everywhere || focus.contains(m_.positions[tri[k]]))
-                star_[tri[k]].push_back(t);
+            if (tri[k] == tri[(k + 1) % 3])
+                return false; // a repeated corner: not a clean surface
+            if (everywhere || focus.contains(m_.positions[tri[k]])) {
+                if (starOf_[tri[k]] == kNone) {
+                    starOf_[tri[k]] = static_cast<std::uint32_t>(stars_.size());
+                    stars_.emplace_back();
+                    starVertex_.push_back(tri[k]);
+                }
+                stars_[starOf_[tri[k]]].push_back(t);
+            }
         }
     }
 
+    edgeTri_.reserve(3 * local.size());
+    for (std::uint32_t t : local)
+        for (std::size_t k = 0; k < 3; ++k)
+            if (!edgeTri_.emplace(directed(m_.triangles[t][k], m_.triangles[t][(k + 1) % 3]), t).second)
+                return false; // a repeated directed edge: not a clean surface
+
     // Removable vertices, then patches; a patch that fails keeps its vertices and everything is redone.
-    std::vector<std::uint32_t> candidates;
-    for (const auto& [v, s] : star_)
-        candidates.push_back(v);
+    std::vector<std::uint32_t> candidates = starVertex_;
     std::sort(candidates.begin(), candidates.end());
     std::unordered_set<std::uint32_t> kept; // vertices a failed patch needs
     std::vector<std::vector<std::uint32_t>> patches;
     std::vector<std::vector<Tri>> fresh;
     for (int round = 0;; ++round) {
+        for (std::uint32_t v : removed_)
+            isRemoved_[v] = 0;
         removed_.clear();
         for (std::uint32_t v : candidates)
             if (!kept.count(v) && removable(v))
-                removed_.insert(v);
+                removed_.push_back(v);
+        for (std::uint32_t v : removed_)
+            isRemoved_[v] = 1;
         if (removed_.empty())
             return false;
         // Patches: the stars of removed vertices, split into edge-connected compatible groups.
         std::vector<std::uint32_t> inPatch;
         for (std::uint32_t v : removed_)
-            inPatch.insert(inPatch.end(), star_.at(v).begin(), star_.at(v).end());
+            inPatch.insert(inPatch.end(), trianglesAt(v)->begin(), trianglesAt(v)->end());
         std::sort(inPatch.begin(), inPatch.end());
         inPatch.erase(std::unique(inPatch.begin(), inPatch.end()), inPatch.end());
         std::unordered_map<std::uint32_t, std::uint32_t> group;
