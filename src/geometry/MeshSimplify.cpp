@@ -57,7 +57,9 @@ private:
     std::vector<std::uint32_t> starVertex_;         // the vertex of each star
     std::vector<Vec3> normal_;                      // per local triangle: triangleNormal, computed once
     std::vector<char> isRemoved_;                   // per vertex
-    std::vector<std::uint32_t> removed_;            // the removed vertices, in the order found
+    mutable std::vector<std::uint32_t> patchStamp_; // per triangle: the stamp of the last patch it was in
+    mutable std::uint32_t stamp_ = 0;
+    std::vector<std::uint32_t> removed_; // the removed vertices, in the order found
     bool wasRemoved(std::uint32_t v) const { return isRemoved_[v] != 0; }
     const std::vector<std::uint32_t>* trianglesAt(std::uint32_t v) const {
         return starOf_[v] == kNone ? nullptr : &stars_[starOf_[v]];
@@ -253,9 +255,10 @@ bool Simplifier::removable(std::uint32_t v) const {
 
 /// Triangulates a patch (compatible triangles around removed vertices) without those vertices.
 bool Simplifier::retriangulate(const std::vector<std::uint32_t>& patch, std::vector<Tri>& tris) const {
-    auto inPatch = [&](std::uint32_t t) {
-        return std::binary_search(patch.begin(), patch.end(), t);
-    }; // sorted
+    const std::uint32_t stamp = ++stamp_;
+    for (std::uint32_t t : patch)
+        patchStamp_[t] = stamp;
+    auto inPatch = [&](std::uint32_t t) { return patchStamp_[t] == stamp; };
     auto outside = [&](std::uint32_t t, int k) {
         const std::uint32_t o = twinTri(t, k);
         return o == kNone || !inPatch(o);
@@ -452,6 +455,7 @@ bool Simplifier::run(Mesh& result, PlanarSimplifyReport& report, Mesh* inPlace) 
     starOf_.assign(nv, kNone);
     isRemoved_.assign(nv, 0);
     normal_.resize(nt);
+    patchStamp_.assign(nt, 0);
     for (std::uint32_t t = 0; t < nt; ++t) {
         const Tri& tri = m_.triangles[t];
         bool any = everywhere;
