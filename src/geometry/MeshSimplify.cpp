@@ -50,7 +50,8 @@ private:
     const Mesh& m_;
     PlanarSimplifyParams params_;
     double planeTol_ = 0, diag_ = 0;
-    std::unordered_map<std::uint64_t, std::uint32_t> edgeTri_; // directed edge → local triangle
+    std::vector<std::uint32_t>
+        twin_; // per local triangle t and edge k (3t + k): the triangle across, or kNone
     // Flat arrays by vertex or triangle rather than hash maps: their lookups were much of the cost.
     std::vector<std::uint32_t> starOf_;             // per vertex: index into stars_, or kNone
     std::vector<std::vector<std::uint32_t>> stars_; // focus vertex's local triangles, in triangle order
@@ -67,10 +68,7 @@ private:
     bool editedInPlace_ = false;
 
     std::uint32_t twinTri(std::uint32_t t, int k) const { // triangle across edge k of t, or kNone
-        const Tri& tri = m_.triangles[t];
-        auto it = edgeTri_.find(
-            directed(tri[static_cast<std::size_t>((k + 1) % 3)], tri[static_cast<std::size_t>(k)]));
-        return it == edgeTri_.end() ? kNone : it->second;
+        return twin_[3 * static_cast<std::size_t>(t) + static_cast<std::size_t>(k)];
     }
     bool compatible(std::uint32_t t, std::uint32_t s) const;
     bool flat(const std::vector<std::uint32_t>& tris) const;
@@ -479,11 +477,34 @@ bool Simplifier::run(Mesh& result, PlanarSimplifyReport& report, Mesh* inPlace) 
         }
     }
 
-    edgeTri_.reserve(3 * local.size());
+    // Twins from the local corners listed by vertex (a counting sort; a hash of directed edges cost more).
+    std::vector<std::uint32_t> first(nv + 1, 0);
     for (std::uint32_t t : local)
-        for (std::size_t k = 0; k < 3; ++k)
-            if (!edgeTri_.emplace(directed(m_.triangles[t][k], m_.triangles[t][(k + 1) % 3]), t).second)
-                return false; // a repeated directed edge: not a clean surface
+        for (std::uint32_t v : m_.triangles[t])
+            ++first[v + 1];
+    for (std::size_t v = 0; v < nv; ++v)
+        first[v + 1] += first[v];
+    std::vector<std::uint32_t> cornerAt(first[nv]);
+    {
+        std::vector<std::uint32_t> cursor(first.begin(), first.end() - 1);
+        for (std::uint32_t t : local)
+            for (std::uint32_t k = 0; k < 3; ++k)
+                cornerAt[cursor[m_.triangles[t][k]]++] = 3 * t + k;
+    }
+    auto next = [&](std::uint32_t c) {
+        return m_.triangles[c / 3][(c % 3 + 1) % 3];
+    }; // corner c's edge's end
+    twin_.assign(3 * nt, kNone);
+    for (std::uint32_t t : local)
+        for (std::uint32_t k = 0; k < 3; ++k) {
+            const std::uint32_t a = m_.triangles[t][k], b = m_.triangles[t][(k + 1) % 3];
+            for (std::uint32_t i = first[a]; i < first[a + 1]; ++i)
+                if (cornerAt[i] != 3 * t + k && next(cornerAt[i]) == b)
+                    return false; // a repeated directed edge: not a clean surface
+            for (std::uint32_t i = first[b]; i < first[b + 1]; ++i)
+                if (next(cornerAt[i]) == a)
+                    twin_[3 * t + k] = cornerAt[i] / 3;
+        }
 
     // Removable vertices, then patches; a patch that fails keeps its vertices and everything is redone.
     std::vector<std::uint32_t> candidates = starVertex_;
