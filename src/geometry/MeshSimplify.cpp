@@ -60,6 +60,9 @@ private:
     std::vector<char> isRemoved_;                   // per vertex
     mutable std::vector<std::uint32_t> patchStamp_; // per triangle: the stamp of the last patch it was in
     mutable std::uint32_t stamp_ = 0;
+    std::vector<std::uint32_t> group_;       // per triangle: its patch (while patches are formed)
+    mutable std::vector<std::uint32_t> fan_; // removable()'s buffers, reused
+    mutable std::vector<bool> crease_;
     std::vector<std::uint32_t> removed_; // the removed vertices, in the order found
     bool wasRemoved(std::uint32_t v) const { return isRemoved_[v] != 0; }
     const std::vector<std::uint32_t>* trianglesAt(std::uint32_t v) const {
@@ -207,8 +210,11 @@ bool Simplifier::removable(std::uint32_t v) const {
         return false;
     const std::vector<std::uint32_t>& star = *found;
     // Walk the fan: from triangle t (corner k at v) to the triangle across its edge (previous corner → v).
-    std::vector<std::uint32_t> fan;
-    std::vector<bool> crease; // crease[i]: the edge between fan[i] and fan[i + 1] separates two regions
+    std::vector<std::uint32_t>& fan = fan_;
+    std::vector<bool>& crease =
+        crease_; // crease[i]: the edge between fan[i] and fan[i + 1] separates two regions
+    fan.clear();
+    crease.clear();
     std::uint32_t t = star.front();
     do {
         const Tri& tri = m_.triangles[t];
@@ -529,9 +535,11 @@ bool Simplifier::run(Mesh& result, PlanarSimplifyReport& report, Mesh* inPlace) 
             inPatch.insert(inPatch.end(), trianglesAt(v)->begin(), trianglesAt(v)->end());
         std::sort(inPatch.begin(), inPatch.end());
         inPatch.erase(std::unique(inPatch.begin(), inPatch.end()), inPatch.end());
-        std::unordered_map<std::uint32_t, std::uint32_t> group;
+        constexpr std::uint32_t kOut = kNone - 1; // not in a removed vertex's star
+        group_.assign(nt, kOut);                  // per triangle: its patch, kNone before it has one
+        std::vector<std::uint32_t>& group = group_;
         for (std::uint32_t t : inPatch)
-            group.emplace(t, kNone);
+            group[t] = kNone;
         patches.clear();
         for (std::uint32_t t : inPatch) {
             if (group[t] != kNone)
@@ -542,9 +550,8 @@ bool Simplifier::run(Mesh& result, PlanarSimplifyReport& report, Mesh* inPlace) 
             for (std::size_t i = 0; i < patches[id].size(); ++i)
                 for (int k = 0; k < 3; ++k) {
                     const std::uint32_t c = patches[id][i], o = twinTri(c, k);
-                    auto g = group.find(o);
-                    if (o != kNone && g != group.end() && g->second == kNone && compatible(c, o)) {
-                        g->second = id;
+                    if (o != kNone && group[o] == kNone && compatible(c, o)) {
+                        group[o] = id;
                         patches[id].push_back(o);
                     }
                 }
