@@ -530,11 +530,12 @@ bool Simplifier::run(Mesh& result, PlanarSimplifyReport& report, Mesh* inPlace) 
         if (removed_.empty())
             return false;
         // Patches: the stars of removed vertices, split into edge-connected compatible groups.
+        // The union of their stars, in order: the local triangles with a removed corner (no sort needed).
         std::vector<std::uint32_t> inPatch;
-        for (std::uint32_t v : removed_)
-            inPatch.insert(inPatch.end(), trianglesAt(v)->begin(), trianglesAt(v)->end());
-        std::sort(inPatch.begin(), inPatch.end());
-        inPatch.erase(std::unique(inPatch.begin(), inPatch.end()), inPatch.end());
+        for (std::uint32_t t : local)
+            if (wasRemoved(m_.triangles[t][0]) || wasRemoved(m_.triangles[t][1]) ||
+                wasRemoved(m_.triangles[t][2]))
+                inPatch.push_back(t);
         constexpr std::uint32_t kOut = kNone - 1; // not in a removed vertex's star
         group_.assign(nt, kOut);                  // per triangle: its patch, kNone before it has one
         std::vector<std::uint32_t>& group = group_;
