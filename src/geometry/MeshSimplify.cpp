@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <span>
 #include <unordered_map>
 #include <unordered_set>
 #include <vector>
@@ -53,9 +54,11 @@ private:
     std::vector<std::uint32_t>
         twin_; // per local triangle t and edge k (3t + k): the triangle across, or kNone
     // Flat arrays by vertex or triangle rather than hash maps: their lookups were much of the cost.
-    std::vector<std::uint32_t> starOf_;             // per vertex: index into stars_, or kNone
-    std::vector<std::vector<std::uint32_t>> stars_; // focus vertex's local triangles, in triangle order
-    std::vector<std::uint32_t> starVertex_;         // the vertex of each star
+    std::vector<char> inFocus_;             // per vertex: a focus vertex of a local triangle (it has a star)
+    std::vector<std::uint32_t> starVertex_; // those vertices, in order of first use
+    // The local triangles' corners (3t + k) by vertex, in triangle order: cornerAt_[first_[v], first_[v +
+    // 1]).
+    std::vector<std::uint32_t> first_, cornerAt_;
     std::vector<Vec3> normal_;                      // per local triangle: triangleNormal, computed once
     std::vector<char> isRemoved_;                   // per vertex
     mutable std::vector<std::uint32_t> patchStamp_; // per triangle: the stamp of the last patch it was in
@@ -65,8 +68,11 @@ private:
     mutable std::vector<bool> crease_;
     std::vector<std::uint32_t> removed_; // the removed vertices, in the order found
     bool wasRemoved(std::uint32_t v) const { return isRemoved_[v] != 0; }
-    const std::vector<std::uint32_t>* trianglesAt(std::uint32_t v) const {
-        return starOf_[v] == kNone ? nullptr : &stars_[starOf_[v]];
+    /// The star of focus vertex v as its corners (triangle c / 3), in triangle order; empty for another.
+    std::span<const std::uint32_t> trianglesAt(std::uint32_t v) const {
+        if (!inFocus_[v])
+            return {};
+        return {cornerAt_.data() + first_[v], cornerAt_.data() + first_[v + 1]};
     }
     bool editedInPlace_ = false;
 
@@ -205,17 +211,17 @@ bool Simplifier::flat(const std::vector<std::uint32_t>& tris) const {
 }
 
 bool Simplifier::removable(std::uint32_t v) const {
-    const std::vector<std::uint32_t>* found = trianglesAt(v);
-    if (!found)
+    const std::span<const std::uint32_t> star = trianglesAt(v);
+    if (star.empty())
         return false;
-    const std::vector<std::uint32_t>& star = *found;
     // Walk the fan: from triangle t (corner k at v) to the triangle across its edge (previous corner → v).
     std::vector<std::uint32_t>& fan = fan_;
     std::vector<bool>& crease =
         crease_; // crease[i]: the edge between fan[i] and fan[i + 1] separates two regions
     fan.clear();
     crease.clear();
-    std::uint32_t t = star.front();
+    const std::uint32_t start = star.front() / 3;
+    std::uint32_t t = start;
     do {
         const Tri& tri = m_.triangles[t];
         const int k = tri[0] == v ? 0 : tri[1] == v ? 1 : 2;
@@ -225,7 +231,7 @@ bool Simplifier::removable(std::uint32_t v) const {
         fan.push_back(t);
         crease.push_back(!compatible(t, next));
         t = next;
-    } while (t != star.front());
+    } while (t != start);
     if (fan.size() != star.size())
         return false; // more than one fan: the surface touches itself here
     const auto creases = std::count(crease.begin(), crease.end(), true);
@@ -281,7 +287,8 @@ bool Simplifier::retriangulate(const std::vector<std::uint32_t>& patch, std::vec
             std::size_t steps = 0;
             while (wasRemoved(x)) { // the one boundary edge of the patch leaving x
                 std::uint32_t next = kNone;
-                for (std::uint32_t s : *trianglesAt(x)) {
+                for (std::uint32_t corner : trianglesAt(x)) {
+                    const std::uint32_t s = corner / 3;
                     if (!inPatch(s))
                         continue;
                     const Tri& st = m_.triangles[s];
@@ -456,7 +463,7 @@ bool Simplifier::run(Mesh& result, PlanarSimplifyReport& report, Mesh* inPlace) 
 
     // Local triangles (a corner in the focus), their directed edges and the stars of focus vertices.
     std::vector<std::uint32_t> local;
-    starOf_.assign(nv, kNone);
+    inFocus_.assign(nv, 0);
     isRemoved_.assign(nv, 0);
     normal_.resize(nt);
     patchStamp_.assign(nt, 0);
@@ -473,24 +480,24 @@ bool Simplifier::run(Mesh& result, PlanarSimplifyReport& report, Mesh* inPlace) 
             if (tri[k] == tri[(k + 1) % 3])
                 return false; // a repeated corner: not a clean surface
             if (everywhere || focus.contains(m_.positions[tri[k]])) {
-                if (starOf_[tri[k]] == kNone) {
-                    starOf_[tri[k]] = static_cast<std::uint32_t>(stars_.size());
-                    stars_.emplace_back();
+                if (!inFocus_[tri[k]]) {
+                    inFocus_[tri[k]] = 1;
                     starVertex_.push_back(tri[k]);
                 }
-                stars_[starOf_[tri[k]]].push_back(t);
             }
         }
     }
 
     // Twins from the local corners listed by vertex (a counting sort; a hash of directed edges cost more).
-    std::vector<std::uint32_t> first(nv + 1, 0);
+    std::vector<std::uint32_t>& first = first_;
+    first.assign(nv + 1, 0);
     for (std::uint32_t t : local)
         for (std::uint32_t v : m_.triangles[t])
             ++first[v + 1];
     for (std::size_t v = 0; v < nv; ++v)
         first[v + 1] += first[v];
-    std::vector<std::uint32_t> cornerAt(first[nv]);
+    std::vector<std::uint32_t>& cornerAt = cornerAt_;
+    cornerAt.assign(first[nv], 0);
     {
         std::vector<std::uint32_t> cursor(first.begin(), first.end() - 1);
         for (std::uint32_t t : local)
