@@ -390,7 +390,8 @@ const rubble::tools::Registrar registrar{
          auto mega = std::make_shared<rubble::bench::MegaArgs>();
          auto megaOn = std::make_shared<bool>(false);
          app.add_flag("--mega", *megaOn,
-                      "only the million-triangle rows (sphere, torus, subdivided arch at 100k, 250k, 1M; "
+                      "only the million-triangle rows (UV sphere, geodesic sphere, torus, subdivided arch at "
+                      "100k, 250k, 1M; "
                       "impact_megamesh.csv/.png)");
          app.add_option("--mega-sizes", mega->sizes, "triangle counts of the --mega rows");
          app.add_option("--mega-kinds", mega->kinds, "meshes of the --mega rows")

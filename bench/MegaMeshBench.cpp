@@ -1,6 +1,7 @@
 // The million-triangle rows (issue #14), run by `rubble-bench impact --mega` and `rubble-bench decomposition
-// --mega`: a sphere, a torus and the arch asset subdivided, at 100k, 250k and 1M triangles. Every hit is a
-// single cell of edge a quarter of the mesh's largest extent at a random surface point (seed = hit index).
+// --mega`: a UV sphere, a geodesic sphere, a torus and the arch asset subdivided, at 100k, 250k and 1M
+// triangles. Every hit is a single cell of edge a quarter of the mesh's largest extent at a random surface
+// point (seed = hit index).
 // The clip-only bound is the time to clip just the triangles whose bounds meet the cell by its planes (found
 // beforehand, untimed): what a fracture must at least do. Each hit fractures a copy of its input made outside
 // the timed region, with the consuming fracture (Mesh&&): with known facts (a topology above 20k triangles),
@@ -247,8 +248,8 @@ void addImpactRows(const std::string& name, const std::string& kind, std::size_t
                                  fixed(cpuRatio, 2)};
     for (const auto* cpuStage : cpuStages)
         row.push_back(fixed(med(*cpuStage)));
-    row.insert(row.end(),
-               {fixed(pc.max), fixed(partsRatio, 2), fixed(med(s.clip)), fixed(med(s.touched), 0)});
+    row.insert(row.end(), {fixed(pc.max), fixed(partsRatio, 2), fixed(med(s.clip)), fixed(med(s.touched), 0),
+                           fixed(stats(s.touched).max, 0)});
     table.rows.push_back(std::move(row));
     csv.rows.push_back({name,
                         kind,
@@ -279,6 +280,8 @@ void addImpactRows(const std::string& name, const std::string& kind, std::size_t
         csv.rows.back().push_back(str(med(*cpuStage)));
     csv.rows.back().push_back(str(pc.max));
     csv.rows.back().push_back(str(partsRatio));
+    csv.rows.back().push_back(str(stats(s.clip).max));
+    csv.rows.back().push_back(str(stats(s.touched).max));
     csv.rows.back().push_back(""); // other_cpu_cores, filled by finishTable
     if (!againstFirst)
         data << kind << " " << triangles << " " << w.median << " " << w.max << " " << med(s.clip) << " "
@@ -291,11 +294,12 @@ void addImpactRows(const std::string& name, const std::string& kind, std::size_t
 
 int runMegaImpact(const MegaArgs& args) {
     const CpuMeter cpu;
-    Table table{{"mesh",      "tris",         "hits",      "with parts med ms",
-                 "max",       "worst/base",   "cpu med",   "cpu max",
-                 "cpu w/b",   "cpu validate", "clip",      "verify",
-                 "islands",   "mass",         "simplify",  "parts",
-                 "parts max", "parts w/b",    "clip-only", "touched"},
+    Table table{{"mesh",       "tris",         "hits",      "with parts med ms",
+                 "max",        "worst/base",   "cpu med",   "cpu max",
+                 "cpu w/b",    "cpu validate", "clip",      "verify",
+                 "islands",    "mass",         "simplify",  "parts",
+                 "parts max",  "parts w/b",    "clip-only", "touched",
+                 "touched max"},
                 {}};
     Table csv{{"mesh",
                "kind",
@@ -331,6 +335,8 @@ int runMegaImpact(const MegaArgs& args) {
                "parts_cpu_median_ms",
                "parts_cpu_max_ms",
                "parts_cpu_worst_over_base",
+               "clip_only_max_ms",
+               "touched_triangles_max",
                "other_cpu_cores"},
               {}};
     std::ostringstream data;
@@ -411,10 +417,13 @@ int runMegaImpact(const MegaArgs& args) {
         args.out, "impact_megamesh", data.str(),
         "set logscale xy\nset xlabel 'triangles'\nset ylabel 'time (ms)'\nset grid\nset key top left\n"
         "set title 'Impact to pieces with convex parts (20 random hits) vs triangles'\n"
-        "plot for [k in 'sphere torus arch'] $DATA u ((strcol(1) eq k) ? $2 : 1/0):3 w lp t k.' median', "
-        "for [k in 'sphere torus arch'] $DATA u ((strcol(1) eq k) ? $2 : 1/0):4 w p t k.' worst', "
-        "for [k in 'sphere torus arch'] $DATA u ((strcol(1) eq k) ? $2 : 1/0):6 w lp dt 3 t k.' CPU median', "
-        "for [k in 'sphere torus arch'] $DATA u ((strcol(1) eq k) ? $2 : 1/0):5 w l dt 2 t k.' clip-only'");
+        "plot for [k in 'sphere geosphere torus arch'] $DATA u ((strcol(1) eq k) ? $2 : 1/0):3 w lp t k.' "
+        "median', "
+        "for [k in 'sphere geosphere torus arch'] $DATA u ((strcol(1) eq k) ? $2 : 1/0):4 w p t k.' worst', "
+        "for [k in 'sphere geosphere torus arch'] $DATA u ((strcol(1) eq k) ? $2 : 1/0):6 w lp dt 3 t k.' "
+        "CPU median', "
+        "for [k in 'sphere geosphere torus arch'] $DATA u ((strcol(1) eq k) ? $2 : 1/0):5 w l dt 2 t k.' "
+        "clip-only'");
     return 0;
 }
 
@@ -469,14 +478,17 @@ int runMegaDecomposition(const MegaArgs& args) {
         }
     if (!finishTable(cpu, table, csv, args.out, "decomposition_megamesh.csv"))
         return 1;
-    plotPng(
-        args.out, "decomposition_megamesh", data.str(),
-        "set logscale xy\nset xlabel 'triangles'\nset ylabel 'time (ms)'\nset grid\nset key top left\n"
-        "set title 'Convex decomposition of high-poly meshes vs triangles'\n"
-        "plot for [k in 'sphere torus arch'] $DATA u ((strcol(1) eq k) ? $2 : 1/0):3 w lp t k.' initial', "
-        "for [k in 'sphere torus arch'] $DATA u ((strcol(1) eq k) ? $2 : 1/0):4 w lp t k.' update', "
-        "for [k in 'sphere torus arch'] $DATA u ((strcol(1) eq k) ? $2 : 1/0):5 w p t k.' initial CPU', "
-        "for [k in 'sphere torus arch'] $DATA u ((strcol(1) eq k) ? $2 : 1/0):6 w p t k.' update CPU'");
+    plotPng(args.out, "decomposition_megamesh", data.str(),
+            "set logscale xy\nset xlabel 'triangles'\nset ylabel 'time (ms)'\nset grid\nset key top left\n"
+            "set title 'Convex decomposition of high-poly meshes vs triangles'\n"
+            "plot for [k in 'sphere geosphere torus arch'] $DATA u ((strcol(1) eq k) ? $2 : 1/0):3 w lp t "
+            "k.' initial', "
+            "for [k in 'sphere geosphere torus arch'] $DATA u ((strcol(1) eq k) ? $2 : 1/0):4 w lp t k.' "
+            "update', "
+            "for [k in 'sphere geosphere torus arch'] $DATA u ((strcol(1) eq k) ? $2 : 1/0):5 w p t k.' "
+            "initial CPU', "
+            "for [k in 'sphere geosphere torus arch'] $DATA u ((strcol(1) eq k) ? $2 : 1/0):6 w p t k.' "
+            "update CPU'");
     return 0;
 }
 

@@ -71,6 +71,19 @@ Mesh megaMesh(const std::string& kind, std::size_t triangles) {
         const int slices = static_cast<int>(std::lround(t / (2.0 * (stacks - 1))));
         return makeSphere({0, 0, 0}, 1.0, slices, stacks);
     }
+    if (kind == "geosphere") { // an icosahedron's 20 faces split n² each, on the sphere: even density
+        const double g = (1 + std::sqrt(5.0)) / 2;
+        Mesh ico;
+        ico.positions = {{-1, g, 0},  {1, g, 0},  {-1, -g, 0}, {1, -g, 0}, {0, -1, g},  {0, 1, g},
+                         {0, -1, -g}, {0, 1, -g}, {g, 0, -1},  {g, 0, 1},  {-g, 0, -1}, {-g, 0, 1}};
+        ico.triangles = {{0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+                         {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
+                         {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+        Mesh m = subdivideTriangles(ico, std::max(1, static_cast<int>(std::lround(std::sqrt(t / 20)))));
+        for (Vec3& p : m.positions)
+            p = p / length(p);
+        return m;
+    }
     if (kind == "torus") { // 2 · major · minor triangles, major = 3 · minor
         const int minor = static_cast<int>(std::lround(std::sqrt(t / 6)));
         const int major = static_cast<int>(std::lround(t / (2.0 * minor)));

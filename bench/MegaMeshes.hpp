@@ -13,12 +13,13 @@ namespace rubble::bench {
 /// stays closed; the shape does not change).
 Mesh subdivideTriangles(const Mesh& mesh, int n);
 
-/// One high-poly mesh: kind "sphere", "torus" or "arch" (the repository's arch subdivided) with about
+/// One high-poly mesh: kind "sphere" (a UV sphere: its triangles crowd at the poles), "geosphere" (a
+/// subdivided icosahedron: even density), "torus" or "arch" (the repository's arch subdivided) with about
 /// `triangles` triangles (exactly for the sphere and torus at 100k, 250k and 1M).
 Mesh megaMesh(const std::string& kind, std::size_t triangles);
 
 /// The kinds of megaMesh.
-inline const std::vector<std::string> kMegaKinds = {"sphere", "torus", "arch"};
+inline const std::vector<std::string> kMegaKinds = {"sphere", "geosphere", "torus", "arch"};
 
 } // namespace rubble::bench
 
