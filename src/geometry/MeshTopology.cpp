@@ -295,11 +295,30 @@ std::vector<std::vector<std::uint32_t>> racingIslands(const MeshTopology& topolo
     std::vector<std::uint32_t> parent(k);
     std::vector<std::vector<std::uint32_t>> queue(k);
     std::vector<std::size_t> head(k, 0), size(k, 1);
-    std::unordered_map<std::uint32_t, std::uint32_t> owner; // triangle -> the walk that reached it first
-    owner.reserve(8 * k);
+    // Triangle -> the walk that reached it first: hashed, dense once the walks reach 1/16 of the mesh.
+    const std::size_t nT = topology.twin.size() / 3;
+    std::unordered_map<std::uint32_t, std::uint32_t> sparse;
+    std::vector<std::uint32_t> dense;
+    sparse.reserve(8 * k);
+    auto claim = [&](std::uint32_t t, std::uint32_t w) { // t's walk, or kNoTwin once w claimed it
+        if (!dense.empty()) {
+            std::uint32_t& o = dense[t];
+            return o == kNoTwin ? (o = w, kNoTwin) : o;
+        }
+        auto [it, fresh] = sparse.emplace(t, w);
+        if (!fresh)
+            return it->second;
+        if (sparse.size() > nT / 16) {
+            dense.assign(nT, kNoTwin);
+            for (const auto& [u, v] : sparse)
+                dense[u] = v;
+            sparse = {};
+        }
+        return kNoTwin;
+    };
     for (std::uint32_t w = 0; w < k; ++w) {
         parent[w] = w;
-        owner.emplace(addedSlots[w], w);
+        claim(addedSlots[w], w);
         queue[w].push_back(addedSlots[w]);
     }
     auto find = [&](std::uint32_t w) {
@@ -318,14 +337,13 @@ std::vector<std::vector<std::uint32_t>> racingIslands(const MeshTopology& topolo
             const std::uint32_t t = queue[w][head[w]++];
             for (std::uint32_t c = 0; c < 3; ++c) {
                 const std::uint32_t u = topology.twin[3 * t + c] / 3;
-                const std::uint32_t r = find(w);
-                auto [it, fresh] = owner.emplace(u, r);
-                if (fresh) {
+                const std::uint32_t r = find(w), o = claim(u, r);
+                if (o == kNoTwin) {
                     queue[r].push_back(u);
                     ++size[r];
                     continue;
                 }
-                const std::uint32_t s = find(it->second);
+                const std::uint32_t s = find(o);
                 if (s == r)
                     continue;
                 // Two running walks meet (an exhausted one has no unwalked neighbour): merge into the
@@ -361,9 +379,15 @@ std::vector<std::vector<std::uint32_t>> racingIslands(const MeshTopology& topolo
             index[r] = static_cast<std::uint32_t>(out.size());
             out.emplace_back();
         }
-    for (const auto& [t, w] : owner)
+    auto collect = [&](std::uint32_t t, std::uint32_t w) {
         if (const std::uint32_t i = index[find(w)]; i != 0xFFFFFFFFu)
             out[i].push_back(t);
+    };
+    for (const auto& [t, w] : sparse)
+        collect(t, w);
+    for (std::uint32_t t = 0; t < dense.size(); ++t)
+        if (dense[t] != kNoTwin)
+            collect(t, dense[t]);
     for (auto& shell : out)
         std::sort(shell.begin(), shell.end());
     return out;
