@@ -360,8 +360,24 @@ int runMegaImpact(const MegaArgs& args) {
             addImpactRows(name, kind, mesh.triangles.size(), s, false, table, csv, data);
         }
     // Chained hits: the largest piece of each hit is hit again, with the parts its update gave it.
-    if (args.chain > 0) {
-        Mesh mesh = withAttributes(megaMesh("sphere", 250000));
+    Table hits; // one row per hit of the chains (thread CPU ms), to find the slow ones and what they did
+    hits.header = {"mesh",
+                   "hit",
+                   "triangles_in",
+                   "touched",
+                   "pieces_ms",
+                   "with_parts_cpu_ms",
+                   "boolean_cpu_ms",
+                   "verify_cpu_ms",
+                   "islands_cpu_ms",
+                   "mass_cpu_ms",
+                   "simplify_cpu_ms",
+                   "parts_cpu_ms",
+                   "islands_path"};
+    for (const char* chainKind : {"sphere", "geosphere"}) {
+        if (args.chain <= 0)
+            break;
+        Mesh mesh = withAttributes(megaMesh(chainKind, 250000));
         const std::size_t startTriangles = mesh.triangles.size();
         auto d = decompose(mesh);
         std::vector<ConvexPolytope> parts = d ? d->parts : std::vector<ConvexPolytope>{};
@@ -385,32 +401,20 @@ int runMegaImpact(const MegaArgs& args) {
                 facts = r->pieces[largest].facts;
             parts = std::move(pieceParts[largest]);
         }
-        addImpactRows("sphere_" + std::to_string(startTriangles) + "_chain" + std::to_string(args.chain),
-                      "sphere_chain", startTriangles, s, true, table, csv, data);
-        // One row per hit of the chain (thread CPU ms), to find the slow ones and what they did.
-        Table hits;
-        hits.header = {"hit",
-                       "triangles_in",
-                       "touched",
-                       "pieces_ms",
-                       "with_parts_cpu_ms",
-                       "boolean_cpu_ms",
-                       "verify_cpu_ms",
-                       "islands_cpu_ms",
-                       "mass_cpu_ms",
-                       "simplify_cpu_ms",
-                       "parts_cpu_ms",
-                       "islands_path"};
+        const std::string name = std::string(chainKind) + "_" + std::to_string(startTriangles) + "_chain" +
+                                 std::to_string(args.chain);
+        addImpactRows(name, std::string(chainKind) + "_chain", startTriangles, s, true, table, csv, data);
         for (std::size_t h = 0; h < s.withPartsCpu.size(); ++h)
-            hits.rows.push_back({std::to_string(h), std::to_string(chainSizes[h]), fixed(s.touched[h], 0),
-                                 fixed(s.pieces[h]), fixed(s.withPartsCpu[h]), fixed(s.cpuBoolean[h]),
-                                 fixed(s.cpuVerify[h]), fixed(s.cpuIslands[h]), fixed(s.cpuMass[h]),
-                                 fixed(s.cpuSimplify[h]), fixed(s.cpuParts[h]), s.path[h]});
-        if (!writeCsv(std::filesystem::path(args.out) / "impact_megamesh_chain.csv", hits))
-            return 1;
+            hits.rows.push_back({name, std::to_string(h), std::to_string(chainSizes[h]),
+                                 fixed(s.touched[h], 0), fixed(s.pieces[h]), fixed(s.withPartsCpu[h]),
+                                 fixed(s.cpuBoolean[h]), fixed(s.cpuVerify[h]), fixed(s.cpuIslands[h]),
+                                 fixed(s.cpuMass[h]), fixed(s.cpuSimplify[h]), fixed(s.cpuParts[h]),
+                                 s.path[h]});
         std::cout << "  (chain: ratios are max / first hit; the last piece has " << mesh.triangles.size()
                   << " triangles)\n";
     }
+    if (args.chain > 0 && !writeCsv(std::filesystem::path(args.out) / "impact_megamesh_chain.csv", hits))
+        return 1;
     if (!finishTable(cpu, table, csv, args.out, "impact_megamesh.csv"))
         return 1;
     plotPng(
