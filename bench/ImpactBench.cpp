@@ -401,7 +401,8 @@ const rubble::tools::Registrar registrar{
              "--no-facts", [mega](std::int64_t) { mega->facts = false; },
              "--mega: fracture without the meshes' known facts (every hit validates and measures the "
              "whole mesh)");
-         app.add_option("--chain", mega->chain, "chained hits on the 250k sphere in --mega (0: none)")
+         app.add_option("--chain", mega->chain,
+                        "chained hits on the 250k UV sphere and geodesic sphere in --mega (0: none)")
              ->check(CLI::Range(0, 100000));
          return [args, mega, megaOn] {
              if (!*megaOn)

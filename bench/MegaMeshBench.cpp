@@ -108,7 +108,8 @@ struct HitSamples {
         parts, clip;
     std::vector<double> cpuValidate, cpuBoolean, cpuVerify, cpuIslands, cpuMass, cpuSimplify, cpuParts;
     std::vector<double> touched, excess;
-    int failures = 0, fallbacks = 0, inPlace = 0, fullLabels = 0;
+    int failures = 0, fallbacks = 0, inPlace = 0, fullLabels = 0, raced = 0;
+    std::vector<std::string> path; ///< per hit: how the remainder's islands were found
 };
 
 /// The mesh with zero texture coordinates and material 0 (untimed), as every piece has them after its first
@@ -185,6 +186,11 @@ std::optional<FractureResult> hitOnce(const Mesh& mesh, Mesh&& work, MeshFacts&&
     s.fallbacks += r->exactFallback ? 1 : 0;
     s.inPlace += r->editedInPlace ? 1 : 0;
     s.fullLabels += r->islandsLabelledFully ? 1 : 0;
+    s.raced += r->islandsByRace ? 1 : 0;
+    s.path.push_back(r->islandsLabelledFully ? "full"
+                     : r->islandsByRace      ? "race"
+                     : r->editedInPlace      ? "walk"
+                                             : "copy");
     std::size_t touched = 0;
     s.clip.push_back(clipOnly(mesh, r->cells, touched));
     s.touched.push_back(static_cast<double>(touched));
@@ -282,7 +288,8 @@ void addImpactRows(const std::string& name, const std::string& kind, std::size_t
              << c.median << "\n";
     std::cout << name << ": with parts median " << fixed(w.median) << " ms, max " << fixed(w.max)
               << " ms; CPU median " << fixed(c.median) << " ms, max " << fixed(c.max) << " ms; " << s.inPlace
-              << " edited in place (" << s.fullLabels << " labelled in full)" << std::endl;
+              << " edited in place (" << s.fullLabels << " labelled in full, " << s.raced
+              << " by racing walks)" << std::endl;
 }
 
 int runMegaImpact(const MegaArgs& args) {
@@ -353,13 +360,30 @@ int runMegaImpact(const MegaArgs& args) {
             addImpactRows(name, kind, mesh.triangles.size(), s, false, table, csv, data);
         }
     // Chained hits: the largest piece of each hit is hit again, with the parts its update gave it.
-    if (args.chain > 0) {
-        Mesh mesh = withAttributes(megaMesh("sphere", 250000));
+    Table hits; // one row per hit of the chains (thread CPU ms), to find the slow ones and what they did
+    hits.header = {"mesh",
+                   "hit",
+                   "triangles_in",
+                   "touched",
+                   "pieces_ms",
+                   "with_parts_cpu_ms",
+                   "boolean_cpu_ms",
+                   "verify_cpu_ms",
+                   "islands_cpu_ms",
+                   "mass_cpu_ms",
+                   "simplify_cpu_ms",
+                   "parts_cpu_ms",
+                   "islands_path"};
+    for (const char* chainKind : {"sphere", "geosphere"}) {
+        if (args.chain <= 0)
+            break;
+        Mesh mesh = withAttributes(megaMesh(chainKind, 250000));
         const std::size_t startTriangles = mesh.triangles.size();
         auto d = decompose(mesh);
         std::vector<ConvexPolytope> parts = d ? d->parts : std::vector<ConvexPolytope>{};
         MeshFacts facts = args.facts ? analyzeMesh(mesh).value() : MeshFacts{};
         HitSamples s;
+        std::vector<std::size_t> chainSizes; // the input's triangles, per successful hit
         for (int h = 0; h < args.chain; ++h) {
             std::vector<std::vector<ConvexPolytope>> pieceParts;
             const Impact impact = randomHit(mesh, static_cast<std::uint64_t>(1000 + h));
@@ -367,6 +391,7 @@ int runMegaImpact(const MegaArgs& args) {
                              static_cast<std::uint64_t>(1000 + h), s, &pieceParts);
             if (!r)
                 continue;
+            chainSizes.push_back(mesh.triangles.size());
             std::size_t largest = 0;
             for (std::size_t i = 1; i < r->pieces.size(); ++i)
                 if (r->pieces[i].mass.volume > r->pieces[largest].mass.volume)
@@ -376,11 +401,20 @@ int runMegaImpact(const MegaArgs& args) {
                 facts = r->pieces[largest].facts;
             parts = std::move(pieceParts[largest]);
         }
-        addImpactRows("sphere_" + std::to_string(startTriangles) + "_chain" + std::to_string(args.chain),
-                      "sphere_chain", startTriangles, s, true, table, csv, data);
+        const std::string name = std::string(chainKind) + "_" + std::to_string(startTriangles) + "_chain" +
+                                 std::to_string(args.chain);
+        addImpactRows(name, std::string(chainKind) + "_chain", startTriangles, s, true, table, csv, data);
+        for (std::size_t h = 0; h < s.withPartsCpu.size(); ++h)
+            hits.rows.push_back({name, std::to_string(h), std::to_string(chainSizes[h]),
+                                 fixed(s.touched[h], 0), fixed(s.pieces[h]), fixed(s.withPartsCpu[h]),
+                                 fixed(s.cpuBoolean[h]), fixed(s.cpuVerify[h]), fixed(s.cpuIslands[h]),
+                                 fixed(s.cpuMass[h]), fixed(s.cpuSimplify[h]), fixed(s.cpuParts[h]),
+                                 s.path[h]});
         std::cout << "  (chain: ratios are max / first hit; the last piece has " << mesh.triangles.size()
                   << " triangles)\n";
     }
+    if (args.chain > 0 && !writeCsv(std::filesystem::path(args.out) / "impact_megamesh_chain.csv", hits))
+        return 1;
     if (!finishTable(cpu, table, csv, args.out, "impact_megamesh.csv"))
         return 1;
     plotPng(

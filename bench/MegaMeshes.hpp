@@ -30,8 +30,8 @@ struct MegaArgs {
     std::vector<std::size_t> sizes{100000, 250000, 1000000}; ///< triangle counts
     std::vector<std::string> kinds = kMegaKinds;             ///< which meshes
     int hits = 20;                                           ///< random hits per mesh
-    int chain = 100;                                         ///< chained hits on the 250k sphere (0: none)
-    std::string out;                                         ///< results folder
+    int chain = 100;   ///< chained hits on the 250k UV and geodesic spheres (0: none)
+    std::string out;   ///< results folder
     bool facts = true; ///< pass each mesh's known facts to fracture (analyzeMesh once, then Piece::facts)
 };
 

@@ -151,8 +151,10 @@ struct FractureResult {
                      ///< declined a near-degenerate one; 0 = the seed's own pattern
     bool editedInPlace = false;        ///< the remainder is the input edited in place (MeshFacts::topology)
     bool islandsLabelledFully = false; ///< edited in place, but the walk around the cut did not prove the
-                                       ///< remainder one shell: it was labelled in full (a ring cut twice)
-    FractureTimings timings;           ///< stage durations, wall clock
+                                       ///< remainder one shell: it was labelled in full (a cavity)
+    bool islandsByRace = false; ///< edited in place, and the remainder's islands were found by walks racing
+                                ///< from the cut (docs/megamesh.md), not by labelling it in full
+    FractureTimings timings;    ///< stage durations, wall clock
     FractureTimings cpuTimings; ///< the same stages in the calling thread's CPU time (on a shared machine)
 };
 

@@ -537,8 +537,32 @@ Result<FractureResult> runInPlace(Mesh& mesh, MeshTopology& topology, std::vecto
     // them); else the full labelling.
     detail::OutputShells rest;
     const std::vector<std::uint32_t>& removed = split->remainder.removed;
+    VolumeIntegrals& restIntegrals = split->remainderIntegrals;
     bool one = !mesh.empty() &&
                (removed.empty() ? slots->empty() : detail::stillOneShell(mesh, topology, *slots, focus));
+    std::vector<Mesh> chips; // shells that broke off the remainder, found by racing walks
+    if (!one && !mesh.empty() && !removed.empty()) {
+        res.islandsByRace = true;
+        const auto broken = detail::racingIslands(topology, *slots);
+        std::vector<std::uint32_t> gone;
+        for (const auto& shell : broken)
+            gone.insert(gone.end(), shell.begin(), shell.end());
+        std::sort(gone.begin(), gone.end());
+        std::vector<std::uint32_t> kept; // the added slots that stay in the remainder
+        for (std::uint32_t s : *slots)
+            if (!std::binary_search(gone.begin(), gone.end(), s))
+                kept.push_back(s);
+        if (!gone.empty()) { // all out at once, then told apart (linear in what broke off)
+            auto taken = detail::takeShells(mesh, topology, gone, &kept);
+            if (!taken)
+                return makeError(ErrorCode::GeometryFailure, "fracture: an island does not close");
+            chips = splitIntoIslands(std::move(*taken));
+        }
+        for (const Mesh& c : chips)
+            restIntegrals.accumulate(volumeIntegrals(c, restIntegrals.reference), -1.0);
+        *slots = std::move(kept);
+        one = true;
+    }
     if (one) {
         rest.count = 1;
     } else if (!mesh.empty()) {
@@ -551,7 +575,6 @@ Result<FractureResult> runInPlace(Mesh& mesh, MeshTopology& topology, std::vecto
         one = count == 1;
     }
     t1.set(res, &FractureTimings::massMs);
-    VolumeIntegrals& restIntegrals = split->remainderIntegrals;
     if (one && params.simplifyPieces) {
         const Stopwatch ts;
         simplifyAroundCut(mesh, topology, *slots, focus, meshBox.diagonal(), restIntegrals);
@@ -560,6 +583,9 @@ Result<FractureResult> runInPlace(Mesh& mesh, MeshTopology& topology, std::vecto
     const double minVolume = std::max(0.0, params.minPieceVolumeFraction) * inputVolume;
     addPieces(std::move(mesh), rest, -1, minVolume, params.simplifyPieces && !one, focus, &restIntegrals, res,
               one ? &topology : nullptr, true);
+    for (Mesh& chip : chips) // measured: they are small
+        addPieces(std::move(chip), detail::OutputShells{{}, 1}, -1, minVolume, params.simplifyPieces, focus,
+                  nullptr, res, nullptr, true);
     const InsideInPlace debris{split->insideKept, meshBox.diagonal()};
     return finishPieces(std::move(split->inside), shells, std::move(cells), params, minVolume, focus, true,
                         t0, t1, std::move(res), &debris);

@@ -93,7 +93,8 @@ namespace detail {
 std::optional<std::vector<std::uint32_t>> replaceTriangles(Mesh& mesh, MeshTopology& topology,
                                                            std::span<const std::uint32_t> removed,
                                                            std::span<const Vec3> newPositions,
-                                                           TriangleBatch&& added) {
+                                                           TriangleBatch&& added,
+                                                           std::vector<std::uint32_t>* follow) {
     const std::size_t nT = mesh.triangles.size(), nA = added.triangles.size();
     const auto nV = static_cast<std::uint32_t>(mesh.positions.size());
     const bool hasN = mesh.hasNormals();
@@ -232,6 +233,14 @@ std::optional<std::vector<std::uint32_t>> replaceTriangles(Mesh& mesh, MeshTopol
                 topology.twin[t] = 3 * to + c;
             }
         }
+        if (follow && !holes.empty()) {
+            std::unordered_map<std::uint32_t, std::uint32_t> moved; // mover -> hole
+            for (std::size_t i = 0; i < holes.size(); ++i)
+                moved.emplace(movers[i], holes[i]);
+            for (std::uint32_t& s : *follow)
+                if (auto it = moved.find(s); it != moved.end())
+                    s = it->second;
+        }
         mesh.triangles.resize(total);
         mesh.uvs.resize(3 * total);
         mesh.materials.resize(total);
@@ -275,6 +284,140 @@ bool stillOneShell(const Mesh& mesh, const MeshTopology& topology, std::span<con
         }
     }
     return reached == addedSlots.size();
+}
+
+std::vector<std::vector<std::uint32_t>> racingIslands(const MeshTopology& topology,
+                                                      std::span<const std::uint32_t> addedSlots) {
+    // Walk w starts at added triangle w; walks that meet merge (union-find, the longer queue kept).
+    const std::size_t k = addedSlots.size();
+    if (k == 0)
+        return {};
+    std::vector<std::uint32_t> parent(k);
+    std::vector<std::vector<std::uint32_t>> queue(k);
+    std::vector<std::size_t> head(k, 0), size(k, 1);
+    // Triangle -> the walk that reached it first: hashed, dense once the walks reach 1/16 of the mesh.
+    const std::size_t nT = topology.twin.size() / 3;
+    std::unordered_map<std::uint32_t, std::uint32_t> sparse;
+    std::vector<std::uint32_t> dense;
+    sparse.reserve(8 * k);
+    auto claim = [&](std::uint32_t t, std::uint32_t w) { // t's walk, or kNoTwin once w claimed it
+        if (!dense.empty()) {
+            std::uint32_t& o = dense[t];
+            return o == kNoTwin ? (o = w, kNoTwin) : o;
+        }
+        auto [it, fresh] = sparse.emplace(t, w);
+        if (!fresh)
+            return it->second;
+        if (sparse.size() > nT / 16) {
+            dense.assign(nT, kNoTwin);
+            for (const auto& [u, v] : sparse)
+                dense[u] = v;
+            sparse = {};
+        }
+        return kNoTwin;
+    };
+    for (std::uint32_t w = 0; w < k; ++w) {
+        parent[w] = w;
+        claim(addedSlots[w], w);
+        queue[w].push_back(addedSlots[w]);
+    }
+    auto find = [&](std::uint32_t w) {
+        while (parent[w] != w)
+            w = parent[w] = parent[parent[w]];
+        return w;
+    };
+    std::vector<std::uint32_t> live(k), exhausted;
+    for (std::uint32_t w = 0; w < k; ++w)
+        live[w] = w;
+    std::size_t running = k;
+    while (running > 1) { // one round: every running walk takes one triangle
+        for (std::uint32_t w : live) {
+            if (find(w) != w || head[w] == queue[w].size())
+                continue; // merged away, or exhausted this round
+            const std::uint32_t t = queue[w][head[w]++];
+            for (std::uint32_t c = 0; c < 3; ++c) {
+                const std::uint32_t u = topology.twin[3 * t + c] / 3;
+                const std::uint32_t r = find(w), o = claim(u, r);
+                if (o == kNoTwin) {
+                    queue[r].push_back(u);
+                    ++size[r];
+                    continue;
+                }
+                const std::uint32_t s = find(o);
+                if (s == r)
+                    continue;
+                // Two running walks meet (an exhausted one has no unwalked neighbour): merge into the
+                // one with more left to walk.
+                const bool keepR = queue[r].size() - head[r] >= queue[s].size() - head[s];
+                const std::uint32_t into = keepR ? r : s, from = keepR ? s : r;
+                queue[into].insert(queue[into].end(),
+                                   queue[from].begin() + static_cast<std::ptrdiff_t>(head[from]),
+                                   queue[from].end());
+                std::vector<std::uint32_t>().swap(queue[from]);
+                head[from] = 0;
+                size[into] += size[from];
+                parent[from] = into;
+                --running;
+            }
+            const std::uint32_t r = find(w);
+            if (head[r] == queue[r].size()) { // a complete shell: every neighbour of its triangles walked
+                exhausted.push_back(r);
+                --running;
+            }
+        }
+        std::erase_if(live, [&](std::uint32_t w) { return find(w) != w || head[w] == queue[w].size(); });
+    }
+    // The shell kept in place: the running walk's, or the largest when all ran out.
+    std::uint32_t keep = live.empty() ? exhausted.front() : live.front();
+    for (std::uint32_t r : exhausted)
+        if (live.empty() && size[r] > size[keep])
+            keep = r;
+    std::vector<std::uint32_t> index(k, 0xFFFFFFFFu);
+    std::vector<std::vector<std::uint32_t>> out;
+    for (std::uint32_t r : exhausted)
+        if (r != keep) {
+            index[r] = static_cast<std::uint32_t>(out.size());
+            out.emplace_back();
+        }
+    auto collect = [&](std::uint32_t t, std::uint32_t w) {
+        if (const std::uint32_t i = index[find(w)]; i != 0xFFFFFFFFu)
+            out[i].push_back(t);
+    };
+    for (const auto& [t, w] : sparse)
+        collect(t, w);
+    for (std::uint32_t t = 0; t < dense.size(); ++t)
+        if (dense[t] != kNoTwin)
+            collect(t, dense[t]);
+    for (auto& shell : out)
+        std::sort(shell.begin(), shell.end());
+    return out;
+}
+
+std::optional<Mesh> takeShells(Mesh& mesh, MeshTopology& topology, std::span<const std::uint32_t> slots,
+                               std::vector<std::uint32_t>* follow) {
+    Mesh out;
+    const bool hasN = mesh.hasNormals();
+    std::unordered_map<std::uint32_t, std::uint32_t> index;
+    index.reserve(slots.size());
+    for (std::uint32_t t : slots) {
+        Triangle tri = mesh.triangles[t];
+        for (std::uint32_t& v : tri) {
+            auto [it, fresh] = index.emplace(v, static_cast<std::uint32_t>(out.positions.size()));
+            if (fresh)
+                out.positions.push_back(mesh.positions[v]);
+            v = it->second;
+        }
+        out.triangles.push_back(tri);
+        out.uvs.insert(out.uvs.end(), mesh.uvs.begin() + 3 * t, mesh.uvs.begin() + 3 * t + 3);
+        out.materials.push_back(mesh.materials[t]);
+        if (hasN)
+            out.normals.insert(out.normals.end(), mesh.normals.begin() + 3 * t,
+                               mesh.normals.begin() + 3 * t + 3);
+    }
+    // A closed shell has no boundary: its slots go with nothing in their place.
+    if (!replaceTriangles(mesh, topology, slots, {}, TriangleBatch{}, follow))
+        return std::nullopt;
+    return out;
 }
 
 std::vector<std::uint32_t> trianglesAround(const Mesh& mesh, const MeshTopology& topology,

@@ -26,17 +26,31 @@ struct TriangleBatch {
 /// oriented by the local conditions of docs/megamesh.md (checked on the removed and added triangles only).
 /// Added triangles take the removed slots in order, then are appended; surplus slots are filled with the
 /// last triangles. Returns the added triangles' slots, or nullopt with mesh and topology untouched. The
-/// mesh must have uvs and materials (and normals exactly when added has them).
+/// mesh must have uvs and materials (and normals exactly when added has them). Slots in *follow (none of
+/// them removed) are renamed when their triangle moves.
 std::optional<std::vector<std::uint32_t>> replaceTriangles(Mesh& mesh, MeshTopology& topology,
                                                            std::span<const std::uint32_t> removed,
                                                            std::span<const Vec3> newPositions,
-                                                           TriangleBatch&& added);
+                                                           TriangleBatch&& added,
+                                                           std::vector<std::uint32_t>* follow = nullptr);
 
 /// After replaceTriangles on a mesh that was one shell, with `removed` non-empty: true when a walk from the
 /// added triangles through those whose bounds meet `near` (and the added ones) reaches every added
 /// triangle, which proves that the mesh is still one shell (docs/megamesh.md). False means unknown.
 bool stillOneShell(const Mesh& mesh, const MeshTopology& topology, std::span<const std::uint32_t> addedSlots,
                    const Aabb& near);
+
+/// After replaceTriangles on a mesh that was one shell, with `removed` non-empty: the remainder's shells
+/// found by walks racing from the added triangles in lockstep (docs/megamesh.md, "Islands by racing walks").
+/// Returns the triangles (ascending) of every shell but one, the one whose walk was still running (or the
+/// largest); empty when the mesh is one shell. Costs about the walks' count times the second-largest shell.
+std::vector<std::vector<std::uint32_t>> racingIslands(const MeshTopology& topology,
+                                                      std::span<const std::uint32_t> addedSlots);
+
+/// Moves the closed shells made of `slots` (ascending) out of mesh into their own mesh (vertices numbered
+/// in order of first use, attributes carried); mesh keeps its topology, and *follow its renamed slots.
+std::optional<Mesh> takeShells(Mesh& mesh, MeshTopology& topology, std::span<const std::uint32_t> slots,
+                               std::vector<std::uint32_t>* follow);
 
 /// The seeds and every triangle that shares a corner with one (the stars of their corners), ascending.
 std::vector<std::uint32_t> trianglesAround(const Mesh& mesh, const MeshTopology& topology,

@@ -208,8 +208,9 @@ TEST(InPlaceFracture, SameSeedSameBytes) {
 }
 
 /// A ring cut across twice falls apart far from the second cut: the walk around the cut cannot prove one
-/// shell, the full labelling finds two remainder islands, as the copying path does.
-TEST(InPlaceFracture, ARingCutTwiceFallsBackToTheFullLabelling) {
+/// shell, the racing walks find two remainder islands (the first cut's walks meet the long way round), as the
+/// copying path does.
+TEST(InPlaceFracture, ARingCutTwiceIsSplitByRacingWalks) {
     const Mesh ring = makeTorus({0, 0, 0}, 1, 0.2, 256, 48);
     ASSERT_GT(ring.triangles.size(), kTopologyAboveTriangles);
     const MeshFacts facts = analyzeMesh(ring).value();
@@ -220,7 +221,8 @@ TEST(InPlaceFracture, ARingCutTwiceFallsBackToTheFullLabelling) {
     auto first = fractureWithCells(Mesh(ring), {box({1.0031, 0.0017, 0.0023}, 0.3011)}, p, MeshFacts(facts));
     ASSERT_TRUE(first);
     EXPECT_TRUE(first->editedInPlace);
-    EXPECT_TRUE(first->islandsLabelledFully); // cut across: the two cut faces meet only far away
+    EXPECT_TRUE(first->islandsByRace); // cut across: the two cut faces meet only far away
+    EXPECT_FALSE(first->islandsLabelledFully);
     ASSERT_EQ(first->pieces.front().cell, -1);
     ASSERT_EQ(
         std::count_if(first->pieces.begin(), first->pieces.end(), [](const Piece& q) { return q.cell < 0; }),
@@ -237,7 +239,8 @@ TEST(InPlaceFracture, ARingCutTwiceFallsBackToTheFullLabelling) {
     ASSERT_TRUE(second);
     ASSERT_TRUE(check);
     EXPECT_TRUE(second->editedInPlace);
-    EXPECT_TRUE(second->islandsLabelledFully);
+    EXPECT_TRUE(second->islandsByRace);
+    EXPECT_FALSE(second->islandsLabelledFully);
     std::vector<double> volumes, expected;
     for (const Piece& piece : second->pieces) {
         expectSoundPiece(piece);
@@ -253,6 +256,74 @@ TEST(InPlaceFracture, ARingCutTwiceFallsBackToTheFullLabelling) {
     std::sort(expected.begin(), expected.end());
     for (std::size_t i = 0; i < 2; ++i)
         EXPECT_NEAR(volumes[i], expected[i], 1e-9 * expected[i]);
+}
+
+/// A 100k ring cut by two slabs close together: the short arc between them breaks off, far from either cut
+/// face's walk. The racing walks find it without labelling the ring: the same islands (triangles and
+/// volumes) as the copying path, every piece sound with the topology of a rebuild, volume conserved, and the
+/// same bytes on a second run.
+TEST(InPlaceFracture, AnArcThatBreaksOffIsFoundByRacingWalks) {
+    const Mesh ring = makeTorus({0, 0, 0}, 1, 0.2, 512, 96);
+    ASSERT_GT(ring.triangles.size(), 90000u);
+    const MeshFacts facts = analyzeMesh(ring).value();
+    FractureParams p;
+    p.simplifyPieces = false; // the copying path simplifies differently; the islands are compared as cut
+    const ConvexPolytope across =
+        ConvexPolytope::fromAabb({{0.5013, -0.5017, -0.3011}, {1.5021, 0.5023, 0.2987}});
+    const ConvexPolytope slab =
+        ConvexPolytope::fromAabb({{0.3007, -0.5013, 0.5019}, {1.3011, 0.5029, 0.6023}});
+    auto first = fractureWithCells(Mesh(ring), {across}, p, MeshFacts(facts));
+    ASSERT_TRUE(first);
+    ASSERT_EQ(first->pieces.front().cell, -1);
+    Piece bent = std::move(first->pieces.front());
+    ASSERT_TRUE(bent.facts.topology.fits(bent.mesh));
+    const Mesh bentMesh = bent.mesh;
+    const MeshFacts bentFacts = bent.facts;
+    auto run = [&](const FractureParams& params) {
+        return fractureWithCells(Mesh(bentMesh), {slab}, params, MeshFacts(bentFacts));
+    };
+    auto second = run(p);
+    auto copied = fractureWithCells(
+        bentMesh, {slab}, p,
+        MeshFacts{true, bentMesh.triangles.size(), bentMesh.positions.size(), bentFacts.integrals, {}});
+    ASSERT_TRUE(second) << second.error().message;
+    ASSERT_TRUE(copied);
+    EXPECT_TRUE(second->editedInPlace);
+    EXPECT_TRUE(second->islandsByRace);
+    EXPECT_FALSE(second->islandsLabelledFully);
+    EXPECT_FALSE(copied->editedInPlace);
+    auto remainderIslands = [](const FractureResult& r) {
+        std::vector<const Piece*> out;
+        for (const Piece& q : r.pieces)
+            if (q.cell == -1)
+                out.push_back(&q);
+        std::sort(out.begin(), out.end(), [](auto* a, auto* b) { return a->mass.volume < b->mass.volume; });
+        return out;
+    };
+    const auto got = remainderIslands(*second), want = remainderIslands(*copied);
+    ASSERT_EQ(got.size(), 2u);
+    ASSERT_EQ(want.size(), 2u);
+    EXPECT_LT(got[0]->mesh.triangles.size(), bentMesh.triangles.size() / 10); // a chip, not a half
+    double total = 0;
+    for (std::size_t i = 0; i < 2; ++i) {
+        EXPECT_TRUE(test::triangleSoup(got[i]->mesh) == test::triangleSoup(want[i]->mesh));
+        EXPECT_NEAR(got[i]->mass.volume, want[i]->mass.volume, 1e-9 * want[i]->mass.volume);
+    }
+    for (const Piece& piece : second->pieces) {
+        expectSoundPiece(piece);
+        total += piece.mass.volume;
+    }
+    EXPECT_NEAR(total + second->droppedVolume, bentFacts.integrals.volume, 1e-9 * bentFacts.integrals.volume);
+    // With simplification too, and twice: the same bytes.
+    auto a = run(FractureParams{}), b = run(FractureParams{});
+    ASSERT_TRUE(a);
+    ASSERT_TRUE(b);
+    EXPECT_TRUE(a->islandsByRace);
+    ASSERT_EQ(a->pieces.size(), b->pieces.size());
+    for (std::size_t i = 0; i < a->pieces.size(); ++i) {
+        expectSoundPiece(a->pieces[i]);
+        EXPECT_EQ(a->pieces[i].mesh.hash(), b->pieces[i].mesh.hash());
+    }
 }
 
 /// A chip off the surface keeps the remainder one shell, proven by the walk (no full labelling).

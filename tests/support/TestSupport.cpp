@@ -124,4 +124,25 @@ void expectSameSolid(const Mesh& before, const Mesh& after) {
     EXPECT_NEAR(signedVolume(after), signedVolume(before), 1e-9 * std::abs(signedVolume(before)));
 }
 
+std::vector<std::array<double, 9>> triangleSoup(const Mesh& m) {
+    std::vector<std::array<double, 9>> out;
+    out.reserve(m.triangles.size());
+    for (const Triangle& t : m.triangles) {
+        std::array<std::array<double, 3>, 3> c;
+        for (int k = 0; k < 3; ++k) {
+            const Vec3& p = m.positions[t[static_cast<std::size_t>(k)]];
+            c[static_cast<std::size_t>(k)] = {p.x, p.y, p.z};
+        }
+        const auto first = std::min_element(c.begin(), c.end()) - c.begin();
+        std::array<double, 9> row;
+        for (int k = 0; k < 3; ++k)
+            for (int d = 0; d < 3; ++d)
+                row[static_cast<std::size_t>(3 * k + d)] =
+                    c[static_cast<std::size_t>((first + k) % 3)][static_cast<std::size_t>(d)];
+        out.push_back(row);
+    }
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
 } // namespace rubble::test

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -37,6 +38,9 @@ Vec3 surfacePoint(const Mesh& m, Rng& rng);
 /// Closed, edge-manifold and consistently oriented: every directed edge once, and its reverse once (for
 /// EXPECT_TRUE; the failure names the first bad edge).
 ::testing::AssertionResult closedAndOriented(const Mesh& m);
+/// The mesh's triangles as corner coordinates, each rotated to start at its smallest corner, sorted: equal
+/// for two meshes with the same triangles whatever their numbering.
+std::vector<std::array<double, 9>> triangleSoup(const Mesh& m);
 /// Largest relative deviation of mass from a full recomputation of mesh: volume against volume, centre of
 /// mass against the bounds' diagonal, inertia against its largest entry.
 double massError(const Mesh& mesh, const MassProperties& mass);
