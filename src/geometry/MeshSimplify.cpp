@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <span>
 #include <unordered_map>
 #include <unordered_set>
 #include <vector>
@@ -50,16 +51,33 @@ private:
     const Mesh& m_;
     PlanarSimplifyParams params_;
     double planeTol_ = 0, diag_ = 0;
-    std::unordered_map<std::uint64_t, std::uint32_t> edgeTri_;           // directed edge → local triangle
-    std::unordered_map<std::uint32_t, std::vector<std::uint32_t>> star_; // focus vertex → local triangles
-    std::unordered_set<std::uint32_t> removed_;
+    std::vector<std::uint32_t>
+        twin_; // per local triangle t and edge k (3t + k): the triangle across, or kNone
+    // Flat arrays by vertex or triangle rather than hash maps: their lookups were much of the cost.
+    std::vector<char> inFocus_;             // per vertex: a focus vertex of a local triangle (it has a star)
+    std::vector<std::uint32_t> starVertex_; // those vertices, in order of first use
+    // The local triangles' corners (3t + k) by vertex, in triangle order: cornerAt_[first_[v], first_[v +
+    // 1]).
+    std::vector<std::uint32_t> first_, cornerAt_;
+    std::vector<Vec3> normal_;                      // per local triangle: triangleNormal, computed once
+    std::vector<char> isRemoved_;                   // per vertex
+    mutable std::vector<std::uint32_t> patchStamp_; // per triangle: the stamp of the last patch it was in
+    mutable std::uint32_t stamp_ = 0;
+    std::vector<std::uint32_t> group_;       // per triangle: its patch (while patches are formed)
+    mutable std::vector<std::uint32_t> fan_; // removable()'s buffers, reused
+    mutable std::vector<bool> crease_;
+    std::vector<std::uint32_t> removed_; // the removed vertices, in the order found
+    bool wasRemoved(std::uint32_t v) const { return isRemoved_[v] != 0; }
+    /// The star of focus vertex v as its corners (triangle c / 3), in triangle order; empty for another.
+    std::span<const std::uint32_t> trianglesAt(std::uint32_t v) const {
+        if (!inFocus_[v])
+            return {};
+        return {cornerAt_.data() + first_[v], cornerAt_.data() + first_[v + 1]};
+    }
     bool editedInPlace_ = false;
 
     std::uint32_t twinTri(std::uint32_t t, int k) const { // triangle across edge k of t, or kNone
-        const Tri& tri = m_.triangles[t];
-        auto it = edgeTri_.find(
-            directed(tri[static_cast<std::size_t>((k + 1) % 3)], tri[static_cast<std::size_t>(k)]));
-        return it == edgeTri_.end() ? kNone : it->second;
+        return twin_[3 * static_cast<std::size_t>(t) + static_cast<std::size_t>(k)];
     }
     bool compatible(std::uint32_t t, std::uint32_t s) const;
     bool flat(const std::vector<std::uint32_t>& tris) const;
@@ -88,7 +106,7 @@ bool fitsInPlace(const std::vector<std::pair<std::uint32_t, std::uint32_t>>& pat
 
 /// Can triangles t and s (sharing an edge) be one flat region? The plane is the larger triangle's.
 bool Simplifier::compatible(std::uint32_t t, std::uint32_t s) const {
-    const Vec3 nt = m_.triangleNormal(t), ns = m_.triangleNormal(s);
+    const Vec3 nt = normal_[t], ns = normal_[s];
     if (m_.material(t) != m_.material(s) || dot(nt, ns) <= 0)
         return false;
     const bool tBig = lengthSquared(nt) >= lengthSquared(ns);
@@ -132,9 +150,9 @@ bool Simplifier::compatible(std::uint32_t t, std::uint32_t s) const {
 bool Simplifier::flat(const std::vector<std::uint32_t>& tris) const {
     std::uint32_t best = tris.front();
     for (std::uint32_t t : tris)
-        if (lengthSquared(m_.triangleNormal(t)) > lengthSquared(m_.triangleNormal(best)))
+        if (lengthSquared(normal_[t]) > lengthSquared(normal_[best]))
             best = t;
-    const Vec3 n = normalized(m_.triangleNormal(best)), o = m_.positions[m_.triangles[best][0]];
+    const Vec3 n = normalized(normal_[best]), o = m_.positions[m_.triangles[best][0]];
     Vec3 u, v;
     detail::planeBasis(n, u, v);
     double s[3][3] = {}, su[3] = {}, sv[3] = {};
@@ -193,14 +211,17 @@ bool Simplifier::flat(const std::vector<std::uint32_t>& tris) const {
 }
 
 bool Simplifier::removable(std::uint32_t v) const {
-    const auto it = star_.find(v);
-    if (it == star_.end())
+    const std::span<const std::uint32_t> star = trianglesAt(v);
+    if (star.empty())
         return false;
-    const std::vector<std::uint32_t>& star = it->second;
     // Walk the fan: from triangle t (corner k at v) to the triangle across its edge (previous corner → v).
-    std::vector<std::uint32_t> fan;
-    std::vector<bool> crease; // crease[i]: the edge between fan[i] and fan[i + 1] separates two regions
-    std::uint32_t t = star.front();
+    std::vector<std::uint32_t>& fan = fan_;
+    std::vector<bool>& crease =
+        crease_; // crease[i]: the edge between fan[i] and fan[i + 1] separates two regions
+    fan.clear();
+    crease.clear();
+    const std::uint32_t start = star.front() / 3;
+    std::uint32_t t = start;
     do {
         const Tri& tri = m_.triangles[t];
         const int k = tri[0] == v ? 0 : tri[1] == v ? 1 : 2;
@@ -210,7 +231,7 @@ bool Simplifier::removable(std::uint32_t v) const {
         fan.push_back(t);
         crease.push_back(!compatible(t, next));
         t = next;
-    } while (t != star.front());
+    } while (t != start);
     if (fan.size() != star.size())
         return false; // more than one fan: the surface touches itself here
     const auto creases = std::count(crease.begin(), crease.end(), true);
@@ -244,10 +265,13 @@ bool Simplifier::removable(std::uint32_t v) const {
 
 /// Triangulates a patch (compatible triangles around removed vertices) without those vertices.
 bool Simplifier::retriangulate(const std::vector<std::uint32_t>& patch, std::vector<Tri>& tris) const {
-    const std::unordered_set<std::uint32_t> in(patch.begin(), patch.end());
+    const std::uint32_t stamp = ++stamp_;
+    for (std::uint32_t t : patch)
+        patchStamp_[t] = stamp;
+    auto inPatch = [&](std::uint32_t t) { return patchStamp_[t] == stamp; };
     auto outside = [&](std::uint32_t t, int k) {
         const std::uint32_t o = twinTri(t, k);
-        return o == kNone || !in.count(o);
+        return o == kNone || !inPatch(o);
     };
     // Boundary chains, from kept vertex to kept vertex.
     std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
@@ -257,14 +281,15 @@ bool Simplifier::retriangulate(const std::vector<std::uint32_t>& patch, std::vec
         for (int k = 0; k < 3; ++k) {
             const Tri& tri = m_.triangles[t];
             const std::uint32_t a = tri[static_cast<std::size_t>(k)];
-            if (!outside(t, k) || removed_.count(a))
+            if (!outside(t, k) || wasRemoved(a))
                 continue;
             std::uint32_t x = tri[static_cast<std::size_t>((k + 1) % 3)];
             std::size_t steps = 0;
-            while (removed_.count(x)) { // the one boundary edge of the patch leaving x
+            while (wasRemoved(x)) { // the one boundary edge of the patch leaving x
                 std::uint32_t next = kNone;
-                for (std::uint32_t s : star_.at(x)) {
-                    if (!in.count(s))
+                for (std::uint32_t corner : trianglesAt(x)) {
+                    const std::uint32_t s = corner / 3;
+                    if (!inPatch(s))
                         continue;
                     const Tri& st = m_.triangles[s];
                     const int j = st[0] == x ? 0 : st[1] == x ? 1 : 2;
@@ -290,14 +315,14 @@ bool Simplifier::retriangulate(const std::vector<std::uint32_t>& patch, std::vec
     ends.erase(std::unique(ends.begin(), ends.end()), ends.end());
     for (std::uint32_t t : patch) // nothing kept inside
         for (std::uint32_t v : m_.triangles[t])
-            if (!removed_.count(v) && !std::binary_search(ends.begin(), ends.end(), v))
+            if (!wasRemoved(v) && !std::binary_search(ends.begin(), ends.end(), v))
                 return false;
 
     std::uint32_t best = patch.front();
     double before = 0;
     for (std::uint32_t t : patch) {
-        before += length(m_.triangleNormal(t));
-        if (lengthSquared(m_.triangleNormal(t)) > lengthSquared(m_.triangleNormal(best)))
+        before += length(normal_[t]);
+        if (lengthSquared(normal_[t]) > lengthSquared(normal_[best]))
             best = t;
     }
     std::vector<detail::RegionEdge> region;
@@ -306,7 +331,7 @@ bool Simplifier::retriangulate(const std::vector<std::uint32_t>& patch, std::vec
         region.push_back({a, b, 1u});
     const std::size_t first = tris.size();
     if (detail::triangulatePlanarRegion(
-            region, m_.triangleNormal(best), [&](std::uint32_t id) { return m_.positions[id]; }, tris))
+            region, normal_[best], [&](std::uint32_t id) { return m_.positions[id]; }, tris))
         return false;
     // The new triangles: counter-clockwise, the same area, and every directed edge either inside (its reverse
     // is there too) or one of the chains, each exactly once — so the patch closes up with its surroundings.
@@ -438,6 +463,10 @@ bool Simplifier::run(Mesh& result, PlanarSimplifyReport& report, Mesh* inPlace) 
 
     // Local triangles (a corner in the focus), their directed edges and the stars of focus vertices.
     std::vector<std::uint32_t> local;
+    inFocus_.assign(nv, 0);
+    isRemoved_.assign(nv, 0);
+    normal_.resize(nt);
+    patchStamp_.assign(nt, 0);
     for (std::uint32_t t = 0; t < nt; ++t) {
         const Tri& tri = m_.triangles[t];
         bool any = everywhere;
@@ -446,38 +475,79 @@ bool Simplifier::run(Mesh& result, PlanarSimplifyReport& report, Mesh* inPlace) 
         if (!any)
             continue;
         local.push_back(t);
+        normal_[t] = m_.triangleNormal(t);
         for (std::size_t k = 0; k < 3; ++k) {
-            if (tri[k] == tri[(k + 1) % 3] || !edgeTri_.emplace(directed(tri[k], tri[(k + 1) % 3]), t).second)
-                return false; // a repeated corner or directed edge: not a clean surface
-            if (everywhere || focus.contains(m_.positions[tri[k]]))
-                star_[tri[k]].push_back(t);
+            if (tri[k] == tri[(k + 1) % 3])
+                return false; // a repeated corner: not a clean surface
+            if (everywhere || focus.contains(m_.positions[tri[k]])) {
+                if (!inFocus_[tri[k]]) {
+                    inFocus_[tri[k]] = 1;
+                    starVertex_.push_back(tri[k]);
+                }
+            }
         }
     }
 
+    // Twins from the local corners listed by vertex (a counting sort; a hash of directed edges cost more).
+    std::vector<std::uint32_t>& first = first_;
+    first.assign(nv + 1, 0);
+    for (std::uint32_t t : local)
+        for (std::uint32_t v : m_.triangles[t])
+            ++first[v + 1];
+    for (std::size_t v = 0; v < nv; ++v)
+        first[v + 1] += first[v];
+    std::vector<std::uint32_t>& cornerAt = cornerAt_;
+    cornerAt.assign(first[nv], 0);
+    {
+        std::vector<std::uint32_t> cursor(first.begin(), first.end() - 1);
+        for (std::uint32_t t : local)
+            for (std::uint32_t k = 0; k < 3; ++k)
+                cornerAt[cursor[m_.triangles[t][k]]++] = 3 * t + k;
+    }
+    auto next = [&](std::uint32_t c) {
+        return m_.triangles[c / 3][(c % 3 + 1) % 3];
+    }; // corner c's edge's end
+    twin_.assign(3 * nt, kNone);
+    for (std::uint32_t t : local)
+        for (std::uint32_t k = 0; k < 3; ++k) {
+            const std::uint32_t a = m_.triangles[t][k], b = m_.triangles[t][(k + 1) % 3];
+            for (std::uint32_t i = first[a]; i < first[a + 1]; ++i)
+                if (cornerAt[i] != 3 * t + k && next(cornerAt[i]) == b)
+                    return false; // a repeated directed edge: not a clean surface
+            for (std::uint32_t i = first[b]; i < first[b + 1]; ++i)
+                if (next(cornerAt[i]) == a)
+                    twin_[3 * t + k] = cornerAt[i] / 3;
+        }
+
     // Removable vertices, then patches; a patch that fails keeps its vertices and everything is redone.
-    std::vector<std::uint32_t> candidates;
-    for (const auto& [v, s] : star_)
-        candidates.push_back(v);
+    std::vector<std::uint32_t> candidates = starVertex_;
     std::sort(candidates.begin(), candidates.end());
     std::unordered_set<std::uint32_t> kept; // vertices a failed patch needs
     std::vector<std::vector<std::uint32_t>> patches;
     std::vector<std::vector<Tri>> fresh;
     for (int round = 0;; ++round) {
+        for (std::uint32_t v : removed_)
+            isRemoved_[v] = 0;
         removed_.clear();
         for (std::uint32_t v : candidates)
             if (!kept.count(v) && removable(v))
-                removed_.insert(v);
+                removed_.push_back(v);
+        for (std::uint32_t v : removed_)
+            isRemoved_[v] = 1;
         if (removed_.empty())
             return false;
         // Patches: the stars of removed vertices, split into edge-connected compatible groups.
+        // The union of their stars, in order: the local triangles with a removed corner (no sort needed).
         std::vector<std::uint32_t> inPatch;
-        for (std::uint32_t v : removed_)
-            inPatch.insert(inPatch.end(), star_.at(v).begin(), star_.at(v).end());
-        std::sort(inPatch.begin(), inPatch.end());
-        inPatch.erase(std::unique(inPatch.begin(), inPatch.end()), inPatch.end());
-        std::unordered_map<std::uint32_t, std::uint32_t> group;
+        for (std::uint32_t t : local)
+            if (wasRemoved(m_.triangles[t][0]) || wasRemoved(m_.triangles[t][1]) ||
+                wasRemoved(m_.triangles[t][2]))
+                inPatch.push_back(t);
+        constexpr std::uint32_t kOut = kNone - 1; // not in a removed vertex's star
+        group_.assign(nt, kOut);                  // per triangle: its patch, kNone before it has one
+        std::vector<std::uint32_t>& group = group_;
         for (std::uint32_t t : inPatch)
-            group.emplace(t, kNone);
+            group[t] = kNone;
         patches.clear();
         for (std::uint32_t t : inPatch) {
             if (group[t] != kNone)
@@ -488,9 +558,8 @@ bool Simplifier::run(Mesh& result, PlanarSimplifyReport& report, Mesh* inPlace) 
             for (std::size_t i = 0; i < patches[id].size(); ++i)
                 for (int k = 0; k < 3; ++k) {
                     const std::uint32_t c = patches[id][i], o = twinTri(c, k);
-                    auto g = group.find(o);
-                    if (o != kNone && g != group.end() && g->second == kNone && compatible(c, o)) {
-                        g->second = id;
+                    if (o != kNone && group[o] == kNone && compatible(c, o)) {
+                        group[o] = id;
                         patches[id].push_back(o);
                     }
                 }
