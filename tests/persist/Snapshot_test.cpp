@@ -238,7 +238,7 @@ TEST(Snapshot, SnapshotPlusJournalTailConvergesWithTheHost) {
 // The world keeps each object's MeshFacts (not saved) and fractures with them; a loaded world finds them
 // again. Hits on pieces of pieces, with a job in flight at the save: the loaded world must continue bit for
 // bit as the original (every mesh and mass property in the saved bytes), on 1 and 2 workers.
-TEST(Snapshot, ALoadedWorldFracturesPiecesOfPiecesBitForBitAsTheOriginal) {
+void expectALoadedWorldContinuesBitForBit(Mesh wallMesh) {
     auto config = [](int workers) {
         DestructionWorld::Config c;
         c.workers = workers;
@@ -260,7 +260,7 @@ TEST(Snapshot, ALoadedWorldFracturesPiecesOfPiecesBitForBitAsTheOriginal) {
     };
     DestructionWorld host(config(1));
     ObjectDesc wall;
-    wall.mesh = makeSubdividedBox({-2, 0, -0.3}, {2, 3, 0.3}, 5);
+    wall.mesh = std::move(wallMesh);
     wall.fracture.pattern = CellPattern::Shatter;
     wall.fracture.cells = 5;
     ASSERT_TRUE(host.addObject(std::move(wall)));
@@ -291,6 +291,19 @@ TEST(Snapshot, ALoadedWorldFracturesPiecesOfPiecesBitForBitAsTheOriginal) {
         EXPECT_EQ(loaded.geometryHash(), host.geometryHash()) << workers << " workers";
         EXPECT_TRUE(encodeSnapshot(takeSnapshot(loaded)) == end) << workers << " workers";
     }
+}
+
+TEST(Snapshot, ALoadedWorldFracturesPiecesOfPiecesBitForBitAsTheOriginal) {
+    expectALoadedWorldContinuesBitForBit(makeSubdividedBox({-2, 0, -0.3}, {2, 3, 0.3}, 5));
+}
+
+// The same with an object above kTopologyAboveTriangles: its pieces are edited in place with the topology
+// that a loaded world builds again.
+TEST(Snapshot, ALoadedWorldFracturesALargeMeshInPlaceBitForBitAsTheOriginal) {
+    Mesh large = makeSphere({0, 1.5, 0}, 1.5, 250, 121); // 60k: its remainders stay above the threshold
+    ASSERT_GT(large.triangles.size(), kTopologyAboveTriangles);
+    ASSERT_FALSE(analyzeMesh(large)->topology.twin.empty());
+    expectALoadedWorldContinuesBitForBit(std::move(large));
 }
 
 TEST(Snapshot, DamagedFilesAreRefusedNamingOffsetAndFieldAndTheWorldStaysAsItWas) {
