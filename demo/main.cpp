@@ -264,7 +264,7 @@ int main(int argc, char** argv) {
     cli.add_option("--workers", o.workers, "fracture worker threads (-1 automatic)");
     cli.add_option("--pattern", o.pattern,
                    "fracture pattern: adaptive (weak hits chip, strong hits shatter), single or shatter")
-        ->check(CLI::IsMember({"single", "shatter"}));
+        ->check(CLI::IsMember({"adaptive", "single", "shatter"}));
     cli.add_option("--cells", o.cells, "cells K of the shatter pattern");
     cli.add_flag(
         "--no-panel", o.noPanel,

@@ -11,7 +11,7 @@ source "$here/../support/e2e.sh" rubble-weapons 20
 scene="$here/../../assets/scenes/demolition.cfg"
 [ -f "$scene" ] || fail "missing $scene"
 
-env -u DISPLAY timeout 600 "$demo" --headless --no-panel --scene "$scene" --autopilot 30 --width 320 --height 180 \
+env -u DISPLAY timeout 600 "$demo" --headless --no-panel --scene "$scene" --pattern adaptive --autopilot 30 --width 320 --height 180 \
     --record "$work/w.rjournal" --out "$work/w" >"$work/log" 2>&1 || fail "rubble-demo exited with $?"
 python3 - "$work/w/report.json" <<'PY' || fail "weapons: $(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['weapons'])" "$work/w/report.json")"
 import json, sys
