@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "geometry/PlanarTriangulation.hpp"
+#include "geometry/TopologyEdit.hpp"
 
 namespace rubble {
 
@@ -51,16 +52,13 @@ private:
     const Mesh& m_;
     PlanarSimplifyParams params_;
     double planeTol_ = 0, diag_ = 0;
-    std::vector<std::uint32_t>
-        twin_; // per local triangle t and edge k (3t + k): the triangle across, or kNone
-    // Flat arrays by vertex or triangle rather than hash maps: their lookups were much of the cost.
+    // Per local triangle t and edge k (3t + k): the triangle across, or kNone.
+    std::vector<std::uint32_t> twin_;
     std::vector<char> inFocus_;             // per vertex: a focus vertex of a local triangle (it has a star)
     std::vector<std::uint32_t> starVertex_; // those vertices, in order of first use
-    // The local triangles' corners (3t + k) by vertex, in triangle order: cornerAt_[first_[v], first_[v +
-    // 1]).
-    std::vector<std::uint32_t> first_, cornerAt_;
-    std::vector<Vec3> normal_;                      // per local triangle: triangleNormal, computed once
-    std::vector<char> isRemoved_;                   // per vertex
+    detail::CornersByVertex corners_;       // the local triangles' corners by vertex, in triangle order
+    std::vector<Vec3> normal_;              // per local triangle: triangleNormal, computed once
+    std::vector<char> isRemoved_;           // per vertex
     mutable std::vector<std::uint32_t> patchStamp_; // per triangle: the stamp of the last patch it was in
     mutable std::uint32_t stamp_ = 0;
     std::vector<std::uint32_t> group_;       // per triangle: its patch (while patches are formed)
@@ -72,7 +70,7 @@ private:
     std::span<const std::uint32_t> trianglesAt(std::uint32_t v) const {
         if (!inFocus_[v])
             return {};
-        return {cornerAt_.data() + first_[v], cornerAt_.data() + first_[v + 1]};
+        return corners_.at(v);
     }
     bool editedInPlace_ = false;
 
@@ -488,35 +486,21 @@ bool Simplifier::run(Mesh& result, PlanarSimplifyReport& report, Mesh* inPlace) 
         }
     }
 
-    // Twins from the local corners listed by vertex (a counting sort; a hash of directed edges cost more).
-    std::vector<std::uint32_t>& first = first_;
-    first.assign(nv + 1, 0);
-    for (std::uint32_t t : local)
-        for (std::uint32_t v : m_.triangles[t])
-            ++first[v + 1];
-    for (std::size_t v = 0; v < nv; ++v)
-        first[v + 1] += first[v];
-    std::vector<std::uint32_t>& cornerAt = cornerAt_;
-    cornerAt.assign(first[nv], 0);
-    {
-        std::vector<std::uint32_t> cursor(first.begin(), first.end() - 1);
-        for (std::uint32_t t : local)
-            for (std::uint32_t k = 0; k < 3; ++k)
-                cornerAt[cursor[m_.triangles[t][k]]++] = 3 * t + k;
-    }
-    auto next = [&](std::uint32_t c) {
-        return m_.triangles[c / 3][(c % 3 + 1) % 3];
-    }; // corner c's edge's end
+    // Twins from the local corners listed by vertex.
+    if (!corners_.build(m_, local))
+        return false;
+    // The end of corner c's edge.
+    auto next = [&](std::uint32_t c) { return m_.triangles[c / 3][(c % 3 + 1) % 3]; };
     twin_.assign(3 * nt, kNone);
     for (std::uint32_t t : local)
         for (std::uint32_t k = 0; k < 3; ++k) {
             const std::uint32_t a = m_.triangles[t][k], b = m_.triangles[t][(k + 1) % 3];
-            for (std::uint32_t i = first[a]; i < first[a + 1]; ++i)
-                if (cornerAt[i] != 3 * t + k && next(cornerAt[i]) == b)
+            for (std::uint32_t c : corners_.at(a))
+                if (c != 3 * t + k && next(c) == b)
                     return false; // a repeated directed edge: not a clean surface
-            for (std::uint32_t i = first[b]; i < first[b + 1]; ++i)
-                if (next(cornerAt[i]) == a)
-                    twin_[3 * t + k] = cornerAt[i] / 3;
+            for (std::uint32_t c : corners_.at(b))
+                if (next(c) == a)
+                    twin_[3 * t + k] = c / 3;
         }
 
     // Removable vertices, then patches; a patch that fails keeps its vertices and everything is redone.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <ranges>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -28,24 +29,13 @@ void growTo(std::vector<T>& v, std::size_t n) {
 } // namespace
 
 std::optional<MeshTopology> buildTopology(const Mesh& mesh) {
-    const std::size_t nT = mesh.triangles.size(), nV = mesh.positions.size();
+    const std::size_t nT = mesh.triangles.size();
     if (nT == 0 || 3 * nT >= kNoTwin)
         return std::nullopt;
-    // Half-edges bucketed by their start vertex (counting sort); a half-edge's twin is in its end's bucket.
-    std::vector<std::uint32_t> offset(nV + 1, 0);
-    for (const Triangle& t : mesh.triangles)
-        for (std::uint32_t v : t) {
-            if (v >= nV)
-                return std::nullopt;
-            ++offset[v + 1];
-        }
-    for (std::size_t v = 0; v < nV; ++v)
-        offset[v + 1] += offset[v];
-    std::vector<std::uint32_t> fill(offset.begin(), offset.end() - 1);
-    std::vector<std::uint32_t> byStart(3 * nT);
-    for (std::uint32_t t = 0; t < nT; ++t)
-        for (std::uint32_t c = 0; c < 3; ++c)
-            byStart[fill[mesh.triangles[t][c]]++] = 3 * t + c;
+    // Half-edges bucketed by their start vertex; a half-edge's twin is in its end's bucket.
+    detail::CornersByVertex byStart;
+    if (!byStart.build(mesh, std::views::iota(std::uint32_t{0}, static_cast<std::uint32_t>(nT))))
+        return std::nullopt;
     auto end = [&](std::uint32_t h) { return mesh.triangles[h / 3][(h % 3 + 1) % 3]; };
     MeshTopology topo;
     topo.twin.assign(3 * nT, kNoTwin);
@@ -54,14 +44,14 @@ std::optional<MeshTopology> buildTopology(const Mesh& mesh) {
         if (a == b)
             return std::nullopt;
         std::uint32_t found = kNoTwin, same = 0;
-        for (std::uint32_t i = offset[b]; i < offset[b + 1]; ++i)
-            if (end(byStart[i]) == a) {
+        for (std::uint32_t g : byStart.at(b))
+            if (end(g) == a) {
                 if (found != kNoTwin)
                     return std::nullopt; // the reverse twice
-                found = byStart[i];
+                found = g;
             }
-        for (std::uint32_t i = offset[a]; i < offset[a + 1]; ++i)
-            same += end(byStart[i]) == b ? 1u : 0u;
+        for (std::uint32_t g : byStart.at(a))
+            same += end(g) == b ? 1u : 0u;
         if (found == kNoTwin || same != 1)
             return std::nullopt;
         topo.twin[h] = found;

@@ -13,6 +13,40 @@
 
 namespace rubble::detail {
 
+/// The corners (3t + k) of some triangles of a mesh bucketed by vertex, in the order the triangles are given.
+struct CornersByVertex {
+    std::vector<std::uint32_t> offset;  ///< per vertex v, its corners are corners[offset[v], offset[v + 1])
+    std::vector<std::uint32_t> corners; ///< corner indices 3t + k
+    /// Buckets the corners of the triangles tris (a range of triangle indices); false when one is out of
+    /// range.
+    template <class Triangles>
+    bool build(const Mesh& mesh, const Triangles& tris);
+    /// The corners at vertex v.
+    std::span<const std::uint32_t> at(std::uint32_t v) const {
+        return {corners.data() + offset[v], corners.data() + offset[v + 1]};
+    }
+};
+
+template <class Triangles>
+bool CornersByVertex::build(const Mesh& mesh, const Triangles& tris) {
+    const std::size_t nV = mesh.positions.size();
+    offset.assign(nV + 1, 0);
+    for (std::uint32_t t : tris)
+        for (std::uint32_t v : mesh.triangles[t]) {
+            if (v >= nV)
+                return false;
+            ++offset[v + 1];
+        }
+    for (std::size_t v = 0; v < nV; ++v)
+        offset[v + 1] += offset[v];
+    corners.assign(offset[nV], 0);
+    std::vector<std::uint32_t> cursor(offset.begin(), offset.end() - 1);
+    for (std::uint32_t t : tris)
+        for (std::uint32_t k = 0; k < 3; ++k)
+            corners[cursor[mesh.triangles[t][k]]++] = 3 * t + k;
+    return true;
+}
+
 /// Triangles with their attributes, laid out as in Mesh (normals only when the mesh has them).
 struct TriangleBatch {
     std::vector<Triangle> triangles;
