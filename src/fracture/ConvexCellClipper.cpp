@@ -228,8 +228,7 @@ private:
     std::vector<Vec3> extra_;   // created points, ids nV_ + i
     std::vector<bool> offEdge_; // per created point: kind 4 (may not end up in an output)
     std::unordered_map<PointKey, std::uint32_t, PointKeyHash> keyed_;
-    // Per mesh vertex: offset into dist_ or -1; a per-thread array reused across clips and reset only at the
-    // vertices it set (a fresh array per clip cost a fill and page faults linear in the mesh).
+    // Per mesh vertex: offset into dist_ or -1; a per-thread array, reset only at the vertices it set.
     struct SlotArray {
         std::vector<std::int32_t> slot;
         std::vector<std::uint32_t> set; // the vertices whose slot is not -1
@@ -790,8 +789,7 @@ std::vector<Mesh> Clipper::run(const VolumeIntegrals* known, std::optional<Volum
                                RemainderEdit* edit) {
     const std::size_t nT = mesh_.triangles.size();
     // Per vertex, the sides of the cells' box (with eps) it lies beyond, 2 bits per axis: a triangle misses
-    // the box exactly when its three corners share a bit (its box's min/max are corners' coordinates), which
-    // reads 3 bytes per triangle instead of 3 positions.
+    // the box exactly when its three corners share a bit.
     thread_local std::vector<std::uint8_t> beyond;
     beyond.resize(nV_);
     const Vec3 hi{box_.hi.x + eps_, box_.hi.y + eps_, box_.hi.z + eps_}, lo = box_.lo;
