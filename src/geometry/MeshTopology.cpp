@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <ranges>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -34,7 +33,7 @@ std::optional<MeshTopology> buildTopology(const Mesh& mesh) {
         return std::nullopt;
     // Half-edges bucketed by their start vertex; a half-edge's twin is in its end's bucket.
     detail::CornersByVertex byStart;
-    if (!byStart.build(mesh, std::views::iota(std::uint32_t{0}, static_cast<std::uint32_t>(nT))))
+    if (!byStart.buildAll(mesh))
         return std::nullopt;
     auto end = [&](std::uint32_t h) { return mesh.triangles[h / 3][(h % 3 + 1) % 3]; };
     MeshTopology topo;

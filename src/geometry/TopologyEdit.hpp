@@ -17,35 +17,52 @@ namespace rubble::detail {
 struct CornersByVertex {
     std::vector<std::uint32_t> offset;  ///< per vertex v, its corners are corners[offset[v], offset[v + 1])
     std::vector<std::uint32_t> corners; ///< corner indices 3t + k
-    /// Buckets the corners of the triangles tris (a range of triangle indices); false when one is out of
-    /// range.
-    template <class Triangles>
-    bool build(const Mesh& mesh, const Triangles& tris);
+    /// Buckets the corners of triangles tris; false when a corner is out of range.
+    bool build(const Mesh& mesh, std::span<const std::uint32_t> tris) {
+        return fill(mesh, [&](auto visit) {
+            for (std::uint32_t t : tris)
+                visit(t);
+        });
+    }
+    /// Buckets the corners of every triangle; false when a corner is out of range.
+    bool buildAll(const Mesh& mesh) {
+        return fill(mesh, [&](auto visit) {
+            for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t)
+                visit(t);
+        });
+    }
     /// The corners at vertex v.
     std::span<const std::uint32_t> at(std::uint32_t v) const {
         return {corners.data() + offset[v], corners.data() + offset[v + 1]};
     }
-};
 
-template <class Triangles>
-bool CornersByVertex::build(const Mesh& mesh, const Triangles& tris) {
-    const std::size_t nV = mesh.positions.size();
-    offset.assign(nV + 1, 0);
-    for (std::uint32_t t : tris)
-        for (std::uint32_t v : mesh.triangles[t]) {
-            if (v >= nV)
-                return false;
-            ++offset[v + 1];
-        }
-    for (std::size_t v = 0; v < nV; ++v)
-        offset[v + 1] += offset[v];
-    corners.assign(offset[nV], 0);
-    std::vector<std::uint32_t> cursor(offset.begin(), offset.end() - 1);
-    for (std::uint32_t t : tris)
-        for (std::uint32_t k = 0; k < 3; ++k)
-            corners[cursor[mesh.triangles[t][k]]++] = 3 * t + k;
-    return true;
-}
+private:
+    /// A counting sort of the corners of the triangles that eachTriangle(visit) visits.
+    template <class EachTriangle>
+    bool fill(const Mesh& mesh, EachTriangle eachTriangle) {
+        const std::size_t nV = mesh.positions.size();
+        offset.assign(nV + 1, 0);
+        bool inRange = true;
+        eachTriangle([&](std::uint32_t t) {
+            for (std::uint32_t v : mesh.triangles[t])
+                if (v < nV)
+                    ++offset[v + 1];
+                else
+                    inRange = false;
+        });
+        if (!inRange)
+            return false;
+        for (std::size_t v = 0; v < nV; ++v)
+            offset[v + 1] += offset[v];
+        corners.assign(offset[nV], 0);
+        std::vector<std::uint32_t> cursor(offset.begin(), offset.end() - 1);
+        eachTriangle([&](std::uint32_t t) {
+            for (std::uint32_t k = 0; k < 3; ++k)
+                corners[cursor[mesh.triangles[t][k]]++] = 3 * t + k;
+        });
+        return true;
+    }
+};
 
 /// Triangles with their attributes, laid out as in Mesh (normals only when the mesh has them).
 struct TriangleBatch {
