@@ -50,7 +50,7 @@ if [ -n "$bench" ]; then
     port=$(python3 -c "import socket; s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM); s.bind(('127.0.0.1', 0)); print(s.getsockname()[1])")
     "$bench" netplay-client --port "$port" --seconds 120 >"$work/client.json" 2>"$work/client.err" &
     client=$!
-    run host --scene "$here/e2e.cfg" --autopilot 4 --deterministic --host "$port"
+    run host --scene "$here/e2e.cfg" --autopilot 4 --deterministic --host "$port" --host-wait 3
     wait "$client" || fail "the client failed: $(cat "$work/client.json" "$work/client.err")"
     python3 - "$work/client.json" "$work/host.log" <<'PY' || fail "the client did not follow the host: $(cat "$work/client.json")"
 import json, re, sys
