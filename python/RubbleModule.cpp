@@ -430,7 +430,8 @@ PYBIND11_MODULE(_rubble, m) {
             rubble::repairMesh(mesh);
             return mesh;
         },
-        py::arg("mesh"), "A repaired copy (duplicate vertices, degenerate triangles, orientation).");
+        py::arg("mesh"),
+        "A repaired copy (duplicate vertices, degenerate triangles, orientation, planar holes).");
     m.def("fracture", &fractureMesh, py::arg("mesh"), py::kw_only(), py::arg("point"),
           py::arg("normal") = py::make_tuple(0.0, 1.0, 0.0), py::arg("impulse") = 1.0, py::arg("cells") = 1,
           py::arg("seed") = 1, py::arg("backend") = "fast", py::arg("convex_parts") = true,

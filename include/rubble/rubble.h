@@ -92,7 +92,8 @@ RUBBLE_C_API rubble_status rubble_mesh_clone(const rubble_mesh* mesh, rubble_mes
 RUBBLE_C_API rubble_status rubble_mesh_destroy(rubble_mesh* mesh);
 /// The mesh's arrays.
 RUBBLE_C_API rubble_status rubble_mesh_get_data(const rubble_mesh* mesh, rubble_mesh_data* out);
-/// Repairs common defects in place (duplicate vertices, degenerate triangles, orientation).
+/// Repairs common defects in place (duplicate vertices, degenerate triangles, orientation, holes whose
+/// boundary is a simple, nearly planar loop); rubble_mesh_check says whether the result is valid.
 RUBBLE_C_API rubble_status rubble_mesh_repair(rubble_mesh* mesh);
 
 /// Mass properties for density 1 (multiply volume and inertia by the density).

@@ -170,7 +170,8 @@ def check(mesh: Mesh) -> MeshReport:
     """Checks whether a mesh is a valid closed solid."""
 
 def repair(mesh: Mesh) -> Mesh:
-    """A repaired copy (duplicate vertices, degenerate and duplicate triangles, orientation)."""
+    """A repaired copy (duplicate vertices, degenerate and duplicate triangles, orientation, holes whose boundary is
+    a simple, nearly planar loop closed). check() the result: other holes stay open."""
 
 def fracture(
     mesh: Mesh,

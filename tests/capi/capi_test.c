@@ -442,10 +442,11 @@ static void test_world(void) {
 }
 
 /* Log messages reach the callback (an open mesh added to a world is repaired or made indestructible, with a
- * warning), and NULL restores the default. */
+ * warning), and NULL restores the default. The mesh is two faces of a tetrahedron: its hole is not planar, so
+ * repair cannot close it. */
 static void test_log_callback(void) {
     const double positions[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
-    const uint32_t open_indices[] = {0, 2, 1, 0, 1, 3, 0, 3, 2};
+    const uint32_t open_indices[] = {0, 2, 1, 0, 1, 3};
     rubble_world* world = NULL;
     rubble_mesh* open = NULL;
     rubble_object_desc desc;
@@ -453,7 +454,7 @@ static void test_log_callback(void) {
     uint32_t id = 0;
     CHECK_OK(rubble_set_log_callback(count_log, &log_calls));
     CHECK_OK(rubble_world_create(NULL, &world));
-    CHECK_OK(rubble_mesh_create(positions, 4, open_indices, 3, &open));
+    CHECK_OK(rubble_mesh_create(positions, 4, open_indices, 2, &open));
     CHECK_OK(rubble_object_desc_init(&desc));
     desc.mesh = open;
     CHECK_OK(rubble_world_add_object(world, &desc, &id));
