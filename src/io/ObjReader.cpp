@@ -197,8 +197,9 @@ private:
         const auto n = static_cast<std::int64_t>(count);
         const std::int64_t idx = k > 0 ? k - 1 : n + k;
         if (idx < 0 || idx >= n)
-            return fail(std::string("face refers to ") + what + " " + std::to_string(k) + " but only " +
-                        std::to_string(count) + (count == 1 ? " is" : " are") + " defined");
+            return fail(std::string("face refers to ") + what + " " + std::to_string(k) +
+                        " (OBJ counts from 1) but only " + std::to_string(count) +
+                        (count == 1 ? " is" : " are") + " defined");
         out = idx;
         return {};
     }
