@@ -6,6 +6,7 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -21,6 +22,8 @@
 #include "rubble/MeshCheck.hpp"
 #include "rubble/MeshIO.hpp"
 #include "rubble/MeshRepair.hpp"
+#include "rubble/ParameterCheck.hpp"
+#include "rubble/Version.hpp"
 
 namespace py = pybind11;
 
@@ -191,15 +194,63 @@ rubble::CellPattern patternOf(const std::optional<std::string>& name, int cells)
     throw py::value_error("pattern: expected 'single', 'shatter' or 'adaptive', got '" + *name + "'");
 }
 
+/// ValueError with the library's message when status is an error.
+void valueCheck(const rubble::Status& status) {
+    if (!status)
+        throw py::value_error(status.message());
+}
+
+/// A Python int or float as a number checkParam can judge (ints beyond 64 bits become +-inf), or ValueError
+/// with checkParam's message naming `name` when it is neither.
+long double numberOf(const py::handle& value, const char* name) {
+    if (PyLong_Check(value.ptr())) {
+        int overflow = 0;
+        const long long v = PyLong_AsLongLongAndOverflow(value.ptr(), &overflow);
+        if (overflow == 0)
+            return static_cast<long double>(v);
+        if (overflow > 0) {
+            const unsigned long long u = PyLong_AsUnsignedLongLong(value.ptr());
+            if (!PyErr_Occurred())
+                return static_cast<long double>(u);
+            PyErr_Clear();
+        }
+        const double d = PyLong_AsDouble(value.ptr()); // rounded, as the CLI reads the digits
+        if (!PyErr_Occurred())
+            return d;
+        PyErr_Clear();
+        return overflow > 0 ? HUGE_VALL : -HUGE_VALL;
+    }
+    if (PyFloat_Check(value.ptr()))
+        return PyFloat_AsDouble(value.ptr());
+    valueCheck(rubble::checkParamText(name, py::str(value).cast<std::string>()));
+    return 0;
+}
+
+/// A checked parameter `name` given from Python (checkParam's range), as T.
+template <class T>
+T checkedParam(const py::handle& value, const char* name) {
+    const long double v = numberOf(value, name);
+    valueCheck(rubble::checkParam(name, v));
+    return static_cast<T>(v);
+}
+
+/// A checked point or direction parameter `name` given from Python.
+rubble::Vec3 checkedVector(const py::object& value, const char* name) {
+    const rubble::Vec3 v = toVec3(value, name);
+    valueCheck(rubble::checkParam(name, v));
+    return v;
+}
+
 std::vector<PyPiece> fractureMesh(const rubble::Mesh& mesh, const py::object& point, const py::object& normal,
-                                  double impulse, int cells, std::uint64_t seed, const std::string& backend,
-                                  bool convexParts, int maxParts, const std::optional<std::string>& pattern) {
+                                  const py::object& impulse, const py::object& cellsArg,
+                                  const py::object& seedArg, const std::string& backend, bool convexParts,
+                                  int maxParts, const std::optional<std::string>& pattern) {
     rubble::Impact impact;
-    impact.point = toVec3(point, "point");
-    impact.normal = toVec3(normal, "normal");
-    impact.impulse = impulse;
-    if (cells < 1)
-        throw py::value_error("cells: expected at least 1");
+    impact.point = checkedVector(point, "point");
+    impact.normal = checkedVector(normal, "normal");
+    impact.impulse = checkedParam<double>(impulse, "impulse");
+    const int cells = checkedParam<int>(cellsArg, "cells");
+    const auto seed = checkedParam<std::uint64_t>(seedArg, "seed");
     if (maxParts < 1)
         throw py::value_error("max_parts: expected at least 1");
     rubble::FractureParams params;
@@ -284,6 +335,7 @@ PYBIND11_MODULE(_rubble, m) {
         }
     });
     m.attr("INTERIOR_MATERIAL") = rubble::kInteriorMaterial;
+    m.attr("__version__") = RUBBLE_VERSION_STRING;
 
     py::class_<rubble::Mesh>(m, "Mesh")
         .def(py::init(&makeMesh), py::arg("vertices"), py::arg("triangles"), py::kw_only(),
@@ -378,7 +430,8 @@ PYBIND11_MODULE(_rubble, m) {
             rubble::repairMesh(mesh);
             return mesh;
         },
-        py::arg("mesh"), "A repaired copy (duplicate vertices, degenerate triangles, orientation).");
+        py::arg("mesh"),
+        "A repaired copy (duplicate vertices, degenerate triangles, orientation, planar holes).");
     m.def("fracture", &fractureMesh, py::arg("mesh"), py::kw_only(), py::arg("point"),
           py::arg("normal") = py::make_tuple(0.0, 1.0, 0.0), py::arg("impulse") = 1.0, py::arg("cells") = 1,
           py::arg("seed") = 1, py::arg("backend") = "fast", py::arg("convex_parts") = true,

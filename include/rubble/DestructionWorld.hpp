@@ -173,7 +173,7 @@ public:
     DestructionWorld& operator=(const DestructionWorld&) = delete;
 
     /// Adds an object. An open or invalid mesh is repaired when possible, else the object becomes
-    /// indestructible and ObjectState::warning says why. Fails only for an empty mesh.
+    /// indestructible and ObjectState::warning says why. Fails for an empty mesh, a bad density or cells.
     Result<ObjectId> addObject(ObjectDesc desc);
     /// Removes an object (pending work for it is discarded).
     void removeObject(ObjectId id);
@@ -183,9 +183,9 @@ public:
     std::vector<ObjectId> objects() const;
 
     /// Submits an impact in the object's local coordinates. Returns false when it is ignored (unknown or
-    /// indestructible object, impulse below threshold). An impact on an object with a job in flight is merged
-    /// into the next job for that object. An accepted impact is rounded to single precision
-    /// (journalPrecision) and journaled.
+    /// indestructible object, impulse below threshold, impact refused by checkFractureParams). An impact on
+    /// an object with a job in flight is merged into the next job for that object. Accepted: rounded to
+    /// single precision (journalPrecision) and journaled.
     bool submitImpact(ObjectId id, const Impact& impact);
 
     /// Called with every journal event as it happens: each accepted impact and each removal of a live object.

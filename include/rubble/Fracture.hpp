@@ -77,14 +77,14 @@ inline constexpr double kShatterGrowth = 3.0;
 /// CellPattern::Adaptive: objects with a bounds diagonal above this lose cuts larger by sqrt(diagonal / it).
 inline constexpr double kAdaptiveReferenceSize = 10.0;
 
-/// The most cells a Shatter pattern has (FractureParams::cells is clamped to it).
+/// The most cells a Shatter pattern has (fracture refuses more: checkFractureParams, ParameterCheck.hpp).
 inline constexpr int kMaxShatterCells = 1000;
 
 /// Parameters of one fracture.
 struct FractureParams {
     CellPattern pattern = CellPattern::SingleCell; ///< single cell (thesis) or shatter pattern
     int seedPoints = 15; ///< random Voronoi sites in the domain besides the impact point
-    int cells = 16;      ///< K, the number of cells of a Shatter pattern (1..kMaxShatterCells)
+    int cells = 16;      ///< K, the cells of a Shatter pattern: 1..kMaxShatterCells (fracture refuses others)
     ShatterLayout layout = ShatterLayout::Clustered; ///< where a Shatter pattern's cells lie
     CellSizeLaw sizeLaw;                             ///< domain size from impulse
     BooleanKind backend = BooleanKind::Fast;         ///< boolean implementation
@@ -164,7 +164,7 @@ struct FractureResult {
 /// sizeLaw.maxSize (demo/README.md, weapons). Pure; a function of the journaled impulse and the geometry.
 ImpactCut impactCut(const FractureParams& params, const Aabb& meshBounds, double impulse);
 
-/// Builds the cutting cells for an impact on a mesh with the given bounds. Deterministic in seed.
+/// Builds the cutting cells of an impact on a mesh with these bounds (clamps cells); deterministic in seed.
 std::vector<ConvexPolytope> generateCells(const Aabb& meshBounds, const Impact& impact,
                                           const FractureParams& params, std::uint64_t seed);
 
@@ -193,9 +193,9 @@ public:
 std::unique_ptr<BooleanBackend> makeBooleanBackend(BooleanKind kind);
 
 /// Fractures a closed mesh at an impact: cells, booleans, islands, mass properties, interior UVs.
-/// Returns ErrorCode::NoIntersection when the cells miss the mesh, InvalidInput for an open or invalid mesh.
-/// With known facts of mesh (analyzeMesh, Piece::facts), the mesh is not validated again and, with the Fast
-/// backend, the remainder's mass properties follow from the mesh's by difference (equal to a full
+/// NoIntersection when the cells miss the mesh; InvalidInput for an open mesh or checkFractureParams'
+/// refusals. With known facts of mesh (analyzeMesh, Piece::facts), the mesh is not validated again and, with
+/// the Fast backend, the remainder's mass properties follow from the mesh's by difference (equal to a full
 /// recomputation up to rounding; docs/megamesh.md); the pieces' meshes are the same either way.
 /// With known facts that carry a topology (MeshFacts::topology) and the Fast backend, fracture copies the
 /// mesh and its facts and runs the consuming overload below.

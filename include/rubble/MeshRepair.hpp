@@ -21,6 +21,8 @@ struct RepairOptions {
     bool orient = true;
     /// Run the self-intersection test in the final check (see CheckOptions::selfIntersections).
     bool checkSelfIntersections = true;
+    /// Close holes whose boundary is one simple loop, planar or nearly so (needs orient).
+    bool fillHoles = true;
 };
 
 /// What repairMesh changed and what it could not fix.
@@ -34,6 +36,8 @@ struct RepairReport {
     std::size_t flippedTriangles = 0;            ///< triangles reversed to agree with their neighbours
     std::size_t invertedShells = 0;      ///< whole shells reversed to face outward (or inward for cavities)
     std::size_t nonOrientableShells = 0; ///< shells that cannot be oriented consistently (e.g. Möbius)
+    std::size_t filledHoles = 0;         ///< holes closed (RepairOptions::fillHoles)
+    std::size_t openHoles = 0;           ///< holes left open: not simple, not planar, or crossing themselves
 
     std::vector<std::string> fixed; ///< one sentence per kind of fix applied
     std::vector<std::string>
@@ -48,8 +52,10 @@ struct RepairReport {
 
 /// Repairs mesh in place and reports what was fixed and what could not be repaired. Attributes (normals, uvs,
 /// materials) stay consistent with the triangles: removed triangles lose theirs, reversed triangles have
-/// their corners swapped and normals that point against the new face negated. Holes, non-manifold edges and
-/// self-intersections are not repaired, only reported. Never fails and never throws.
+/// their corners swapped and normals that point against the new face negated. A hole whose boundary is one
+/// simple loop bending out of its plane by at most 5% of its width is closed by a triangulation in that
+/// plane; other holes, non-manifold edges and self-intersections are not repaired, only reported (unrepaired
+/// says what the user can do). Never fails and never throws.
 RepairReport repairMesh(Mesh& mesh, const RepairOptions& options = {});
 
 } // namespace rubble

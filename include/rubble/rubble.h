@@ -92,7 +92,8 @@ RUBBLE_C_API rubble_status rubble_mesh_clone(const rubble_mesh* mesh, rubble_mes
 RUBBLE_C_API rubble_status rubble_mesh_destroy(rubble_mesh* mesh);
 /// The mesh's arrays.
 RUBBLE_C_API rubble_status rubble_mesh_get_data(const rubble_mesh* mesh, rubble_mesh_data* out);
-/// Repairs common defects in place (duplicate vertices, degenerate triangles, orientation).
+/// Repairs common defects in place (duplicate vertices, degenerate triangles, orientation, holes whose
+/// boundary is a simple, nearly planar loop); rubble_mesh_check says whether the result is valid.
 RUBBLE_C_API rubble_status rubble_mesh_repair(rubble_mesh* mesh);
 
 /// Mass properties for density 1 (multiply volume and inertia by the density).
@@ -143,17 +144,19 @@ typedef RUBBLE_C_ENUM(rubble_backend){
     RUBBLE_BACKEND_NEF = 2,      ///< CGAL Nef polyhedra (the thesis's method; slow)
 } rubble_backend;
 
-/// An impact in the mesh's coordinates.
+/// An impact in the mesh's coordinates. Calls that take one refuse (RUBBLE_ERROR_INVALID_ARGUMENT, with a
+/// message naming the field and its range) a non-finite point, a zero or non-finite normal and an impulse
+/// outside [0, 1e12].
 typedef struct rubble_impact {
-    double point[3];  ///< where it was hit
-    double normal[3]; ///< surface normal there (out of the object)
-    double impulse;   ///< N s; bigger impulses cut bigger cells
+    double point[3];  ///< where it was hit (finite)
+    double normal[3]; ///< surface normal there (out of the object; finite, not all 0)
+    double impulse;   ///< N s, in [0, 1e12]; bigger impulses cut bigger cells
 } rubble_impact;
 
 /// How a mesh breaks; rubble_fracture_params_init sets the defaults.
 typedef struct rubble_fracture_params {
     rubble_pattern pattern; ///< single cell, shatter or adaptive
-    int cells;              ///< cells of a shatter pattern (>= 1)
+    int cells;              ///< cells of a shatter pattern, 1..1000 (others are refused, not clamped)
     rubble_backend backend; ///< boolean implementation
     uint64_t seed;          ///< same seed, same pieces
     int convex_parts;       ///< 1: compute each piece's convex collision parts (decomposes the input first)
@@ -214,7 +217,7 @@ RUBBLE_C_API rubble_status rubble_world_destroy(rubble_world* world);
 /// What an object is made of; rubble_object_desc_init sets the defaults.
 typedef struct rubble_object_desc {
     const rubble_mesh* mesh;         ///< closed mesh in the object's coordinates (copied)
-    double density;                  ///< mass = density x volume
+    double density;                  ///< mass = density x volume; in (0, 1e9]
     double impulse_threshold;        ///< impacts below this impulse are ignored
     int destructible;                ///< 0: never breaks
     rubble_fracture_params fracture; ///< how it breaks (seed and convex_parts are ignored: the world decides)

@@ -28,6 +28,7 @@ Vector3 = Sequence[float] | Float64Array
 Backend = Literal["fast", "corefine", "nef"]
 Pattern = Literal["single", "shatter", "adaptive"]
 
+__version__: str  # "MAJOR.MINOR.PATCH", as RUBBLE_VERSION_STRING in rubble/Version.hpp
 INTERIOR_MATERIAL: int
 """Material id of faces created by a cut (the inside of an object)."""
 
@@ -169,7 +170,8 @@ def check(mesh: Mesh) -> MeshReport:
     """Checks whether a mesh is a valid closed solid."""
 
 def repair(mesh: Mesh) -> Mesh:
-    """A repaired copy (duplicate vertices, degenerate and duplicate triangles, orientation)."""
+    """A repaired copy (duplicate vertices, degenerate and duplicate triangles, orientation, holes whose boundary is
+    a simple, nearly planar loop closed). check() the result: other holes stay open."""
 
 def fracture(
     mesh: Mesh,
@@ -188,7 +190,9 @@ def fracture(
     bigger cells). cells=1 cuts the thesis's single Voronoi cell, cells>1 a shatter pattern of that many cells;
     pattern='adaptive' chips one cell on a weak hit and shatters into cells on one of 400 N s or more.
     The same seed gives the same pieces. With convex_parts, every piece gets convex collision parts (the input
-    is decomposed into at most max_parts first). Raises Error (e.g. "invalid input" for an open mesh,
+    is decomposed into at most max_parts first). Raises ValueError naming the parameter and its range for a
+    non-finite point, a zero or non-finite normal, an impulse outside [0, 1e12], cells outside 1..1000 (refused,
+    not clamped) and a seed outside 0..2**64-1; raises Error (e.g. "invalid input" for an open mesh,
     "no intersection" when the cells miss it)."""
 
 def decompose(mesh: Mesh, *, max_parts: int = 24, concavity: float = 0.02) -> list[Float64Array]:

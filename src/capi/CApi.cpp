@@ -20,6 +20,7 @@
 #include "rubble/MeshCheck.hpp"
 #include "rubble/MeshIO.hpp"
 #include "rubble/MeshRepair.hpp"
+#include "rubble/ParameterCheck.hpp"
 
 static_assert(sizeof(rubble::Vec3) == 3 * sizeof(double), "Vec3 is read as 3 doubles");
 static_assert(sizeof(rubble::Vec2) == 2 * sizeof(double), "Vec2 is read as 2 doubles");
@@ -152,8 +153,8 @@ rubble_status toParams(const char* function, const rubble_fracture_params& in, r
     if (in.backend != RUBBLE_BACKEND_FAST && in.backend != RUBBLE_BACKEND_COREFINE &&
         in.backend != RUBBLE_BACKEND_NEF)
         return invalid(function, "unknown backend");
-    if (in.cells < 1)
-        return invalid(function, "cells must be at least 1");
+    if (rubble::Status s = rubble::checkParam("cells", in.cells); !s)
+        return invalid(function, s.message().c_str());
     if (in.max_convex_parts < 1)
         return invalid(function, "max_convex_parts must be at least 1");
     out.pattern = in.pattern == RUBBLE_PATTERN_SHATTER    ? rubble::CellPattern::Shatter
@@ -163,6 +164,19 @@ rubble_status toParams(const char* function, const rubble_fracture_params& in, r
     out.backend = in.backend == RUBBLE_BACKEND_COREFINE ? rubble::BooleanKind::Corefine
                   : in.backend == RUBBLE_BACKEND_NEF    ? rubble::BooleanKind::Nef
                                                         : rubble::BooleanKind::Fast;
+    return RUBBLE_OK;
+}
+
+/// Checks an impact (point, normal, impulse) and turns it into an Impact; writes the message of what is
+/// wrong.
+rubble_status toImpact(const char* function, const rubble_impact& in, rubble::Impact& out) {
+    out.point = vec(in.point);
+    out.normal = vec(in.normal);
+    out.impulse = in.impulse;
+    for (rubble::Status s : {rubble::checkParam("point", out.point), rubble::checkParam("normal", out.normal),
+                             rubble::checkParam("impulse", out.impulse)})
+        if (!s)
+            return invalid(function, s.message().c_str());
     return RUBBLE_OK;
 }
 
@@ -407,9 +421,8 @@ rubble_status rubble_fracture_mesh(const rubble_mesh* mesh, const rubble_impact*
         if (rubble_status s = toParams(fn, p, fp); s != RUBBLE_OK)
             return s;
         rubble::Impact hit;
-        hit.point = vec(impact->point);
-        hit.normal = vec(impact->normal);
-        hit.impulse = impact->impulse;
+        if (rubble_status s = toImpact(fn, *impact, hit); s != RUBBLE_OK)
+            return s;
         rubble::Result<rubble::FractureResult> broken = rubble::fracture(mesh->mesh, hit, fp, p.seed);
         if (!broken)
             return fail(broken.error());
@@ -542,8 +555,8 @@ rubble_status rubble_world_add_object(rubble_world* world, const rubble_object_d
             return invalid(fn, "world, desc or id is null or invalid");
         if (!valid(desc->mesh))
             return invalid(fn, "desc->mesh is null or invalid");
-        if (!(desc->density > 0))
-            return invalid(fn, "density must be positive");
+        if (rubble::Status s = rubble::checkParam("density", desc->density); !s)
+            return invalid(fn, s.message().c_str());
         rubble::ObjectDesc od;
         od.mesh = desc->mesh->mesh;
         od.density = desc->density;
@@ -576,9 +589,8 @@ rubble_status rubble_world_submit_impact(rubble_world* world, uint32_t id, const
         if (!valid(world) || !impact)
             return invalid(fn, "world or impact is null or invalid");
         rubble::Impact hit;
-        hit.point = vec(impact->point);
-        hit.normal = vec(impact->normal);
-        hit.impulse = impact->impulse;
+        if (rubble_status s = toImpact(fn, *impact, hit); s != RUBBLE_OK)
+            return s;
         const bool taken = world->world->submitImpact(id, hit);
         if (accepted)
             *accepted = taken;

@@ -109,8 +109,8 @@ auto meshParameters(SourceVisitor& visitor) {
 std::string selfIntersectionMessage(const Mesh& mesh) {
     const SelfIntersectionResult s = findSelfIntersections(mesh, 1);
     if (s.pairs > 0)
-        return "corefine: the mesh intersects itself (triangles " + std::to_string(s.examples[0].first + 1) +
-               " and " + std::to_string(s.examples[0].second + 1) + "); repair it first";
+        return "corefine: the mesh intersects itself (triangles " + std::to_string(s.examples[0].first) +
+               " and " + std::to_string(s.examples[0].second) + "); repair it first";
     return "corefine: CGAL found intersecting triangles in an intermediate result of the cut (a degenerate "
            "contact between a cell and the mesh; the mesh itself does not intersect itself)";
 }

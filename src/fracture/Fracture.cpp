@@ -17,6 +17,7 @@
 #include "rubble/Fracture.hpp"
 #include "rubble/Islands.hpp"
 #include "rubble/MeshSimplify.hpp"
+#include "rubble/ParameterCheck.hpp"
 #include "rubble/Random.hpp"
 
 namespace rubble {
@@ -672,10 +673,10 @@ Result<FractureResult> fractureBy(const Mesh& mesh, const Impact& impact, const 
     const Stopwatch t0;
     double volume = 0;
     const VolumeIntegrals* integrals = nullptr;
+    if (Status s = checkFractureParams(impact, params); !s)
+        return makeError(ErrorCode::InvalidInput, "fracture: " + s.message());
     if (Status s = prepareInput(mesh, known, volume, integrals); !s)
         return s.error();
-    if (!isFinite(impact.point) || !std::isfinite(impact.impulse))
-        return makeError(ErrorCode::InvalidInput, "fracture: the impact point or impulse is not finite");
     FractureResult pre; // the stages before the pipeline
     t0.set(pre, &FractureTimings::validateMs);
     auto cellsFor = [&](std::uint64_t s) {

@@ -26,12 +26,12 @@ Status Mesh::validate() const {
     for (std::size_t i = 0; i < positions.size(); ++i)
         if (!isFinite(positions[i]))
             return makeError(ErrorCode::InvalidInput,
-                             "vertex " + std::to_string(i + 1) + " has a non-finite coordinate");
+                             "vertex " + std::to_string(i) + " has a non-finite coordinate");
     for (std::size_t t = 0; t < triangles.size(); ++t)
         for (std::uint32_t v : triangles[t])
             if (v >= positions.size())
-                return makeError(ErrorCode::InvalidInput, "triangle " + std::to_string(t + 1) +
-                                                              " refers to vertex " + std::to_string(v + 1) +
+                return makeError(ErrorCode::InvalidInput, "triangle " + std::to_string(t) +
+                                                              " refers to vertex " + std::to_string(v) +
                                                               " of " + std::to_string(positions.size()));
     if (!normals.empty() && normals.size() != 3 * triangles.size())
         return makeError(ErrorCode::InvalidInput, "normals must have 3 entries per triangle");

@@ -29,7 +29,7 @@ std::string plural(std::size_t n, const char* one, const char* many) {
 }
 
 std::string edgeName(std::uint64_t key) {
-    return std::to_string((key >> 32) + 1) + "-" + std::to_string((key & 0xFFFFFFFFu) + 1);
+    return std::to_string(key >> 32) + "-" + std::to_string(key & 0xFFFFFFFFu);
 }
 
 // " (a, b)" when the items are all there are, " (e.g. a, b, c)" when there are more than listed.
@@ -88,7 +88,7 @@ MeshReport checkMesh(const Mesh& mesh, const CheckOptions& options) {
         if (!finite[i]) {
             ++r.nonFiniteVertices;
             if (nonFiniteEx.size() < maxListed)
-                nonFiniteEx.push_back("vertex " + std::to_string(i + 1));
+                nonFiniteEx.push_back("vertex " + std::to_string(i));
         } else {
             r.bounds.extend(mesh.positions[i]);
         }
@@ -106,9 +106,8 @@ MeshReport checkMesh(const Mesh& mesh, const CheckOptions& options) {
                 inRange = false;
                 ++r.badIndices;
                 if (badIndexEx.size() < maxListed)
-                    badIndexEx.push_back("triangle " + std::to_string(t + 1) + " refers to vertex " +
-                                         std::to_string(std::uint64_t{v} + 1) + " of " +
-                                         std::to_string(mesh.positions.size()));
+                    badIndexEx.push_back("triangle " + std::to_string(t) + " refers to vertex " +
+                                         std::to_string(v) + " of " + std::to_string(mesh.positions.size()));
             }
         if (!inRange) {
             usable[t] = false;
@@ -121,7 +120,7 @@ MeshReport checkMesh(const Mesh& mesh, const CheckOptions& options) {
         if (degenerate) {
             ++r.degenerateTriangles;
             if (degenerateEx.size() < maxListed)
-                degenerateEx.push_back("triangle " + std::to_string(t + 1));
+                degenerateEx.push_back("triangle " + std::to_string(t));
         }
         if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2]) {
             usable[t] = false;
@@ -151,8 +150,8 @@ MeshReport checkMesh(const Mesh& mesh, const CheckOptions& options) {
             if (keyed[i].first == keyed[i - 1].first) {
                 ++r.duplicateTriangles;
                 if (duplicateEx.size() < maxListed)
-                    duplicateEx.push_back("triangle " + std::to_string(keyed[i].second + 1) +
-                                          " repeats triangle " + std::to_string(keyed[i - 1].second + 1));
+                    duplicateEx.push_back("triangle " + std::to_string(keyed[i].second) +
+                                          " repeats triangle " + std::to_string(keyed[i - 1].second));
             }
     }
 
@@ -228,7 +227,7 @@ MeshReport checkMesh(const Mesh& mesh, const CheckOptions& options) {
         std::sort(pinched.begin(), pinched.end());
         r.nonManifoldVertices = pinched.size();
         for (std::size_t i = 0; i < pinched.size() && i < maxListed; ++i)
-            pinchedEx.push_back("vertex " + std::to_string(std::uint64_t{pinched[i]} + 1));
+            pinchedEx.push_back("vertex " + std::to_string(pinched[i]));
     }
     r.vertexManifold = r.badIndices == 0 && r.edgeManifold && r.nonManifoldVertices == 0;
 
@@ -255,7 +254,7 @@ MeshReport checkMesh(const Mesh& mesh, const CheckOptions& options) {
                 std::vector<std::string> ex;
                 for (const auto& [a, b] : si.examples)
                     if (ex.size() < maxListed)
-                        ex.push_back("triangles " + std::to_string(a + 1) + " and " + std::to_string(b + 1));
+                        ex.push_back("triangles " + std::to_string(a) + " and " + std::to_string(b));
                 r.problems.push_back(
                     (si.capped ? "at least " : "") +
                     plural(si.pairs, "pair of triangles intersects", "pairs of triangles intersect") +

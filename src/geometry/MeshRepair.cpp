@@ -7,6 +7,7 @@
 #include <limits>
 #include <unordered_map>
 
+#include "geometry/PlanarTriangulation.hpp"
 #include "geometry/RayParity.hpp"
 
 namespace rubble {
@@ -237,6 +238,122 @@ OrientStats orientShells(Mesh& m) {
     }
     return stats;
 }
+
+/// A hole's boundary may bend out of its best-fit plane by at most this fraction of its width to be filled.
+constexpr double kHolePlanarity = 0.05;
+
+struct HoleStats {
+    std::size_t filled = 0;           // loops closed
+    std::size_t triangles = 0;        // triangles added
+    std::vector<std::string> reasons; // one per loop left open
+};
+
+// Closes the boundary loops that are simple and planar or nearly so: each by a constrained triangulation in
+// its best-fit plane, the new triangles facing like their neighbours (the mesh is oriented consistently
+// first). New triangles take the material of a neighbour, zero UVs and the plane's normal.
+HoleStats fillHoles(Mesh& m) {
+    HoleStats stats;
+    std::unordered_map<std::uint64_t, int> uses; // triangles at each undirected edge
+    for (const Triangle& t : m.triangles)
+        for (int c = 0; c < 3; ++c)
+            ++uses[edgeKey(t[c], t[(c + 1) % 3])];
+    // The fill runs each boundary edge backwards: a -> b in its triangle is b -> a in the hole.
+    std::unordered_map<std::uint32_t, std::vector<std::uint32_t>> next;
+    std::unordered_map<std::uint32_t, std::size_t> triangleAt; // a triangle on the boundary at each vertex
+    for (std::size_t t = 0; t < m.triangles.size(); ++t)
+        for (int c = 0; c < 3; ++c) {
+            const std::uint32_t a = m.triangles[t][c], b = m.triangles[t][(c + 1) % 3];
+            if (uses[edgeKey(a, b)] == 1) {
+                next[b].push_back(a);
+                triangleAt[b] = t;
+            }
+        }
+    std::vector<std::uint32_t> starts;
+    for (const auto& [v, out] : next)
+        starts.push_back(v);
+    std::sort(starts.begin(), starts.end()); // deterministic order of the loops
+    std::unordered_map<std::uint32_t, bool> done;
+    for (std::uint32_t start : starts) {
+        if (done[start])
+            continue;
+        std::vector<std::uint32_t> loop;
+        bool simple = true;
+        for (std::uint32_t v = start;;) {
+            done[v] = true;
+            loop.push_back(v);
+            const auto it = next.find(v);
+            if (it == next.end() || it->second.size() != 1 || loop.size() > next.size()) {
+                simple = false;
+                break;
+            }
+            v = it->second.front();
+            if (v == start)
+                break;
+            if (done[v]) {
+                simple = false;
+                break;
+            }
+        }
+        if (!simple) {
+            stats.reasons.push_back("a hole whose boundary is not one simple loop (at vertex " +
+                                    std::to_string(start) + ")");
+            continue;
+        }
+        // Best-fit (Newell) plane and how far the loop bends out of it.
+        Vec3 normal{}, centre{};
+        Aabb box;
+        for (std::size_t i = 0; i < loop.size(); ++i) {
+            const Vec3& p = m.positions[loop[i]];
+            normal = normal + cross(p, m.positions[loop[(i + 1) % loop.size()]]);
+            centre = centre + p;
+            box.extend(p);
+        }
+        centre = centre / static_cast<double>(loop.size());
+        const double width = box.diagonal();
+        if (!(length(normal) > 0) || !(width > 0)) {
+            stats.reasons.push_back("a hole of " + std::to_string(loop.size()) +
+                                    " edges that encloses no area");
+            continue;
+        }
+        const Vec3 n = normalized(normal);
+        double bend = 0;
+        for (std::uint32_t v : loop)
+            bend = std::max(bend, std::abs(dot(m.positions[v] - centre, n)));
+        if (bend > kHolePlanarity * width) {
+            stats.reasons.push_back("a hole of " + std::to_string(loop.size()) +
+                                    " edges that is not planar (it bends " +
+                                    std::to_string(static_cast<int>(std::lround(100 * bend / width))) +
+                                    "% of its width out of its plane)");
+            continue;
+        }
+        std::vector<detail::RegionEdge> edges;
+        for (std::size_t i = 0; i < loop.size(); ++i)
+            edges.push_back({loop[i], loop[(i + 1) % loop.size()], 1});
+        std::vector<std::array<std::uint32_t, 3>> tris;
+        const char* failure = detail::triangulatePlanarRegion(
+            edges, n, [&](std::uint32_t v) { return m.positions[v]; }, tris);
+        if (failure || tris.size() != loop.size() - 2) {
+            stats.reasons.push_back("a hole of " + std::to_string(loop.size()) +
+                                    " edges whose outline crosses itself seen from its plane");
+            continue;
+        }
+        const std::size_t neighbour = triangleAt[start];
+        for (const auto& t : tris) {
+            m.triangles.push_back({t[0], t[1], t[2]});
+            if (m.hasNormals())
+                for (int c = 0; c < 3; ++c)
+                    m.normals.push_back(n);
+            if (m.hasUvs())
+                for (int c = 0; c < 3; ++c)
+                    m.uvs.push_back(Vec2{0, 0});
+            if (m.hasMaterials())
+                m.materials.push_back(m.materials[neighbour]);
+        }
+        stats.triangles += tris.size();
+        ++stats.filled;
+    }
+    return stats;
+}
 } // namespace
 
 RepairReport repairMesh(Mesh& mesh, const RepairOptions& options) {
@@ -379,6 +496,27 @@ RepairReport repairMesh(Mesh& mesh, const RepairOptions& options) {
         if (s.nonOrientable > 0)
             rep.unrepaired.push_back(plural(s.nonOrientable, "shell cannot", "shells cannot") +
                                      " be oriented consistently (non-orientable surface)");
+    }
+
+    // 6. Holes, then the orientation of the shells they closed.
+    if (options.fillHoles && options.orient && !mesh.triangles.empty()) {
+        const HoleStats h = fillHoles(mesh);
+        rep.filledHoles = h.filled;
+        rep.openHoles = h.reasons.size();
+        if (h.filled > 0) {
+            rep.fixed.push_back("closed " + plural(h.filled, "hole", "holes") + " with " +
+                                plural(h.triangles, "triangle", "triangles"));
+            const OrientStats s = orientShells(mesh);
+            rep.flippedTriangles += s.flipped;
+            rep.invertedShells += s.inverted;
+            if (s.inverted > 0)
+                rep.fixed.push_back("reversed " + plural(s.inverted, "closed shell", "closed shells") +
+                                    " to face outward");
+        }
+        for (const std::string& r : h.reasons)
+            rep.unrepaired.push_back(
+                "could not close " + r +
+                ": close it in a modeller (e.g. Blender's Fill Holes, or a Remesh modifier)");
     }
 
     CheckOptions check;

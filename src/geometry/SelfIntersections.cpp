@@ -45,7 +45,7 @@ std::string preconditionProblem(const Mesh& mesh) {
     }
     const auto most = std::max_element(valence.begin(), valence.end());
     if (most != valence.end() && *most > kMaxValence)
-        return "skipped: vertex " + std::to_string(most - valence.begin() + 1) + " is shared by " +
+        return "skipped: vertex " + std::to_string(most - valence.begin()) + " is shared by " +
                std::to_string(*most) + " triangles, more than " + std::to_string(kMaxValence) +
                " (the test takes quadratic time around such a vertex)";
     return {};

@@ -1,5 +1,6 @@
 #include "io/FileBytes.hpp"
 
+#include <atomic>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
@@ -46,15 +47,31 @@ Result<std::string> readFileBytes(const std::filesystem::path& path, std::uint64
         return makeError(ErrorCode::IoError,
                          displayName(path) + ": the file has " + std::to_string(st.st_size) +
                              " bytes, more than the limit of " + std::to_string(maxBytes) + " bytes");
-    std::ifstream in(path, std::ios::binary);
-    if (!in) {
+    // The size is that of the file opened: a writer may have renamed another file over path since the stat.
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+    if (fd < 0) {
         const int err = errno;
-        return makeError(ErrorCode::IoError, displayName(path) + ": cannot open: " +
-                                                 (err ? std::strerror(err) : "unknown error"));
+        return makeError(ErrorCode::IoError, displayName(path) + ": cannot open: " + std::strerror(err));
     }
-    std::string bytes(static_cast<std::size_t>(st.st_size), '\0');
-    in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    if (in.gcount() != static_cast<std::streamsize>(bytes.size()))
+    struct stat opened {};
+    if (::fstat(fd, &opened) != 0 || !S_ISREG(opened.st_mode) ||
+        static_cast<std::uint64_t>(opened.st_size) > maxBytes) {
+        ::close(fd);
+        return makeError(ErrorCode::IoError,
+                         displayName(path) + ": cannot read: it changed while it was opened");
+    }
+    std::string bytes(static_cast<std::size_t>(opened.st_size), '\0');
+    std::size_t done = 0;
+    while (done < bytes.size()) {
+        const ::ssize_t n = ::read(fd, bytes.data() + done, bytes.size() - done);
+        if (n < 0 && errno == EINTR)
+            continue;
+        if (n <= 0)
+            break;
+        done += static_cast<std::size_t>(n);
+    }
+    ::close(fd);
+    if (done != bytes.size())
         return makeError(ErrorCode::IoError, displayName(path) + ": cannot read the whole file");
     return bytes;
 }
@@ -65,7 +82,10 @@ std::filesystem::path stagingPath(const std::filesystem::path& target) {
 }
 
 Status writeFileAtomically(const std::filesystem::path& path, std::string_view bytes) {
-    const std::filesystem::path tmp = stagingPath(path);
+    // One staging file per call: threads of one process writing the same path must not share it.
+    static std::atomic<std::uint64_t> calls{0};
+    std::filesystem::path tmp = stagingPath(path);
+    tmp += "." + std::to_string(calls.fetch_add(1, std::memory_order_relaxed));
     const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
     if (fd < 0) {
         const int err = errno;

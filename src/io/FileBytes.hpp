@@ -23,8 +23,9 @@ Result<std::string> readFileBytes(const std::filesystem::path& path, std::uint64
 /// it. A staging entry whose process is gone was left by a kill; the CLI removes such entries.
 std::filesystem::path stagingPath(const std::filesystem::path& target);
 
-/// Writes bytes to a staging file next to path and renames it to path: path is either left as it was or holds
-/// all of bytes. Errors (IoError) name path and the reason ("<file>: write failed: No space left on device").
+/// Writes bytes to a staging file next to path (stagingPath plus ".N", one per call, so that threads writing
+/// one path do not share it) and renames it to path: path is either left as it was or holds all of bytes.
+/// Errors (IoError) name path and the reason ("<file>: write failed: No space left on device").
 Status writeFileAtomically(const std::filesystem::path& path, std::string_view bytes);
 
 /// The name used for a path in messages (the path as given).

@@ -21,6 +21,7 @@
 #include "io/PolygonTriangulation.hpp"
 #include "io/ReaderSupport.hpp"
 #include "io/SceneReaders.hpp"
+#include "io/TextTokens.hpp"
 #include "rubble/MeshIO.hpp"
 #include "rubble/SceneIO.hpp"
 
@@ -40,13 +41,14 @@ Status guardOff(const std::string& b, const std::string& name) {
     // Tokens with their line numbers, comments skipped; only the first few are needed.
     std::vector<std::pair<std::string, std::size_t>> tok;
     std::size_t line = 1;
+    const char br = detail::lineBreakOf(b);
     for (std::size_t i = 0; i < b.size() && tok.size() < 6;) {
         const char c = b[i];
-        if (c == '\n') {
+        if (c == br) {
             ++line;
             ++i;
         } else if (c == '#') {
-            while (i < b.size() && b[i] != '\n')
+            while (i < b.size() && b[i] != br)
                 ++i;
         } else if (std::isspace(static_cast<unsigned char>(c))) {
             ++i;

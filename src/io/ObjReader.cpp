@@ -47,7 +47,8 @@ bool parseInt(std::string_view s, std::int64_t& out) {
 
 class ObjParser {
 public:
-    ObjParser(std::string_view text, const std::string& name) : text_(text), name_(name) {}
+    ObjParser(std::string_view text, const std::string& name)
+        : text_(text), br_(detail::lineBreakOf(text)), name_(name) {}
 
     Status parse() {
         std::size_t pos = 0;
@@ -55,7 +56,7 @@ public:
             pos = 3;
         while (pos < text_.size()) {
             ++line_;
-            std::size_t end = text_.find('\n', pos);
+            std::size_t end = text_.find(br_, pos);
             if (end == std::string_view::npos)
                 end = text_.size();
             std::string_view ln = text_.substr(pos, end - pos);
@@ -197,8 +198,9 @@ private:
         const auto n = static_cast<std::int64_t>(count);
         const std::int64_t idx = k > 0 ? k - 1 : n + k;
         if (idx < 0 || idx >= n)
-            return fail(std::string("face refers to ") + what + " " + std::to_string(k) + " but only " +
-                        std::to_string(count) + (count == 1 ? " is" : " are") + " defined");
+            return fail(std::string("face refers to ") + what + " " + std::to_string(k) +
+                        " (OBJ counts from 1) but only " + std::to_string(count) +
+                        (count == 1 ? " is" : " are") + " defined");
         out = idx;
         return {};
     }
@@ -323,6 +325,7 @@ private:
     }
 
     std::string_view text_;
+    char br_; // what ends a line
     std::string name_;
     std::size_t line_ = 0;
     std::vector<Vec3> positions_;

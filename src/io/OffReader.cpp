@@ -27,7 +27,8 @@ bool parseCount(std::string_view s, std::uint64_t& out) {
 
 class OffParser {
 public:
-    OffParser(std::string_view text, const std::string& name) : text_(text), name_(name) {}
+    OffParser(std::string_view text, const std::string& name)
+        : text_(text), br_(detail::lineBreakOf(text)), name_(name) {}
 
     Result<Mesh> parse() {
         if (text_.substr(0, 3) == "\xEF\xBB\xBF") // UTF-8 byte order mark
@@ -82,7 +83,7 @@ private:
         tok.clear();
         while (tok.empty() && pos_ < text_.size()) {
             ++line_;
-            std::size_t end = text_.find('\n', pos_);
+            std::size_t end = text_.find(br_, pos_);
             if (end == std::string_view::npos)
                 end = text_.size();
             std::string_view ln = text_.substr(pos_, end - pos_);
@@ -231,6 +232,7 @@ private:
     }
 
     std::string_view text_;
+    char br_; // what ends a line
     std::string name_;
     std::size_t pos_ = 0, line_ = 0;
     std::uint64_t nv_ = 0, nf_ = 0;

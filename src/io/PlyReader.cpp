@@ -66,9 +66,10 @@ Result<Header> parseHeader(const std::string& b, const std::string& name) {
     Header h;
     bool ended = false, formatSeen = false;
     std::size_t pos = 0, line = 0;
+    const char br = detail::lineBreakOf(std::string_view(b).substr(0, 64));
     while (pos < b.size() && pos < kMaxHeader) {
         ++line;
-        std::size_t end = b.find('\n', pos);
+        std::size_t end = b.find(br, pos);
         if (end == std::string::npos)
             end = b.size();
         const auto w = detail::tokenize(std::string_view(b.data() + pos, end - pos));
@@ -125,6 +126,9 @@ Result<Header> parseHeader(const std::string& b, const std::string& name) {
             return fail("unknown header keyword '" + std::string(w[0]) + "'");
         }
     }
+    if (!ended && pos < b.size())
+        return parseError(name, "PLY header is longer than the limit of " + std::to_string(kMaxHeader) +
+                                    " bytes (no 'end_header' line in them)");
     if (!ended)
         return parseError(name, "PLY header has no 'end_header' line");
     if (!formatSeen)
@@ -153,7 +157,8 @@ Result<Header> parseHeader(const std::string& b, const std::string& name) {
 class AsciiBody {
 public:
     AsciiBody(const std::string& b, const std::string& name, const Header& h)
-        : b_(b), name_(name), pos_(h.bodyPos), line_(h.bodyLine) {}
+        : b_(b), br_(detail::lineBreakOf(std::string_view(b).substr(0, 64))), name_(name), pos_(h.bodyPos),
+          line_(h.bodyLine) {}
 
     Error fail(const std::string& message) const {
         return makeError(ErrorCode::ParseError, name_ + ":" + std::to_string(line_) + ": " + message);
@@ -199,7 +204,7 @@ private:
         tok_.clear();
         while (tok_.empty() && pos_ < b_.size()) {
             ++line_;
-            std::size_t end = b_.find('\n', pos_);
+            std::size_t end = b_.find(br_, pos_);
             if (end == std::string::npos)
                 end = b_.size();
             tok_ = detail::tokenize(std::string_view(b_.data() + pos_, end - pos_));
@@ -208,6 +213,7 @@ private:
     }
 
     const std::string& b_;
+    char br_; // what ends a line
     const std::string& name_;
     std::size_t pos_, line_;
     std::vector<std::string_view> tok_;

@@ -6,6 +6,7 @@
 
 #include "io/FileBytes.hpp"
 #include "io/SceneReaders.hpp"
+#include "io/TextTokens.hpp"
 #include "rubble/MeshIO.hpp"
 #include "rubble/SceneIO.hpp"
 
@@ -88,8 +89,9 @@ Result<AssetScene> readObjScene(const std::filesystem::path& path) {
     const std::string& text = bytes.value();
     // Objects are `o` statements; a file without any is one object (its `g` groups usually split one solid).
     bool hasO = false;
+    const char br = detail::lineBreakOf(text);
     for (std::size_t at = 0; at < text.size() && !hasO;) {
-        std::size_t end = text.find('\n', at);
+        std::size_t end = text.find(br, at);
         if (end == std::string::npos)
             end = text.size();
         const std::string_view line = trim(std::string_view(text).substr(at, end - at));
@@ -139,7 +141,7 @@ Result<AssetScene> readObjScene(const std::filesystem::path& path) {
     // Materials of every mtllib statement.
     std::size_t at = 0;
     while (at < text.size()) {
-        std::size_t end = text.find('\n', at);
+        std::size_t end = text.find(br, at);
         if (end == std::string::npos)
             end = text.size();
         const std::string_view line = trim(std::string_view(text).substr(at, end - at));
@@ -180,8 +182,9 @@ Result<std::vector<AssetMaterial>> parseMtl(std::string_view text, const std::st
     std::vector<AssetMaterial> out;
     std::size_t at = 0;
     std::size_t lineNo = 0;
+    const char br = detail::lineBreakOf(text);
     while (at < text.size()) {
-        std::size_t end = text.find('\n', at);
+        std::size_t end = text.find(br, at);
         if (end == std::string_view::npos)
             end = text.size();
         const std::string_view line = trim(text.substr(at, end - at));

@@ -34,6 +34,7 @@ bool isAsciiStl(const std::string& b) {
 // endsolid, several solids allowed; keywords in any case.
 Result<Mesh> readAsciiStl(const std::string& b, const std::string& name) {
     std::size_t pos = 0, line = 0;
+    const char br = detail::lineBreakOf(b);
     std::vector<std::string> tok;
     auto fail = [&](const std::string& message) {
         return makeError(ErrorCode::ParseError, name + ":" + std::to_string(line) + ": " + message);
@@ -42,7 +43,7 @@ Result<Mesh> readAsciiStl(const std::string& b, const std::string& name) {
         tok.clear();
         while (tok.empty() && pos < b.size()) {
             ++line;
-            std::size_t end = b.find('\n', pos);
+            std::size_t end = b.find(br, pos);
             if (end == std::string::npos)
                 end = b.size();
             for (std::string_view t : detail::tokenize(std::string_view(b.data() + pos, end - pos)))

@@ -1,5 +1,6 @@
 #pragma once
-// Private to rubble_io: tokens and numbers of the text formats Rubble reads itself (OBJ, OFF).
+// Private to rubble_io: lines, tokens and numbers of the text formats Rubble reads itself (OBJ, OFF, PLY,
+// STL).
 
 #include <charconv>
 #include <cmath>
@@ -23,6 +24,15 @@ inline int binaryByte(std::string_view line) {
             return u;
     }
     return -1;
+}
+
+/// The character that ends the lines of text: '\n' (LF or CR LF), or '\r' when its first line ends in a lone
+/// CR (classic Mac OS line endings).
+inline char lineBreakOf(std::string_view text) {
+    const std::size_t cr = text.find('\r');
+    if (cr == std::string_view::npos || cr + 1 >= text.size() || text[cr + 1] == '\n')
+        return '\n';
+    return text.find('\n') < cr ? '\n' : '\r';
 }
 
 /// The blank-separated tokens of a line.

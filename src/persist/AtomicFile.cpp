@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <cstring>
 
@@ -19,8 +20,11 @@ Error ioError(const std::filesystem::path& path, const std::string& what) {
 
 Status writeFileAtomic(const std::filesystem::path& path, const std::vector<std::uint8_t>& bytes) {
     const std::filesystem::path dir = path.has_parent_path() ? path.parent_path() : ".";
+    // One temporary file per call (process id and a counter): threads writing one path must not share it.
+    static std::atomic<std::uint64_t> calls{0};
     const std::filesystem::path tmp =
-        dir / (path.filename().string() + ".tmp." + std::to_string(static_cast<long>(::getpid())));
+        dir / (path.filename().string() + ".tmp." + std::to_string(static_cast<long>(::getpid())) + "." +
+               std::to_string(calls.fetch_add(1, std::memory_order_relaxed)));
     const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
     if (fd < 0)
         return ioError(tmp, "cannot create");

@@ -17,6 +17,7 @@
 #include "rubble/Material.hpp"
 #include "rubble/MeshCheck.hpp"
 #include "rubble/MeshRepair.hpp"
+#include "rubble/ParameterCheck.hpp"
 #include "rubble/Random.hpp"
 #include "rubble/ThreadPool.hpp"
 
@@ -387,6 +388,9 @@ ShatterLayout shatterLayout(FracturePattern p) {
 Result<ObjectId> DestructionWorld::addObject(ObjectDesc desc) {
     if (desc.mesh.triangles.empty() || desc.mesh.positions.empty())
         return Error{ErrorCode::InvalidInput, "addObject: empty mesh"};
+    for (Status st : {checkParam("density", desc.density), checkParam("cells", desc.fracture.cells)})
+        if (!st)
+            return Error{ErrorCode::InvalidInput, "addObject: " + st.message()};
     auto state = std::make_shared<ObjectState>();
     ObjectState& s = *state;
     s.id = impl_->nextId++;
@@ -471,7 +475,8 @@ bool DestructionWorld::submitImpact(ObjectId id, const Impact& impact) {
     if (it == impl_->objects.end() || !it->second->destructible)
         return false;
     const Impact rounded = journalPrecision(impact);
-    if (!(rounded.impulse >= it->second->impulseThreshold)) // also refuses NaN
+    if (!(rounded.impulse >= it->second->impulseThreshold) ||
+        !checkFractureParams(rounded, it->second->fracture))
         return false;
     const ObjectState& o = *it->second;
     JournalEvent e;

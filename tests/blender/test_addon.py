@@ -228,10 +228,41 @@ def screenshot(path):
     bpy.app.timers.register(shoot, first_interval=4.5)
 
 
+def test_without_numpy():
+    """numpy not importable (Debian's Blender started from a pyenv shell): the add-on registers, and the operator
+    reports rubble's import error with the interpreter it needs and the fix, leaving the cube as it was."""
+    rubble_fracture.unregister()
+    names = [n for n in sys.modules if n.split(".")[0] in ("numpy", "rubble")]
+    saved = {n: sys.modules.pop(n) for n in names}
+    sys.modules["numpy"] = None  # import numpy raises ImportError
+    try:
+        rubble_fracture.register()
+        reset_scene()
+        bpy.ops.mesh.primitive_cube_add(size=2.0)
+        cube = bpy.context.active_object
+        message = ""
+        try:
+            result = fracture(cube, cells=4, seed=1)
+        except RuntimeError as e:  # operators that report ERROR raise in background mode
+            result, message = {"CANCELLED"}, str(e)
+        assert result == {"CANCELLED"}, result
+        if bpy.app.background:
+            assert "numpy" in message and "/python3" in message and "pyenv shell system" in message, message
+        assert len(bpy.context.scene.objects) == 1 and len(cube.data.polygons) == 6
+    finally:
+        del sys.modules["numpy"]
+        for n in [n for n in sys.modules if n.split(".")[0] == "rubble"]:
+            del sys.modules[n]
+        sys.modules.update(saved)
+        rubble_fracture.unregister()
+        rubble_fracture.register()
+
+
 def run_all():
     rubble_fracture.register()
     try:
         with tempfile.TemporaryDirectory() as tmp:
+            test_without_numpy()
             test_cube_and_suzanne()
             test_rigid_bodies_and_export(tmp)
             test_import_depth2(tmp)

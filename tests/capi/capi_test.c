@@ -442,10 +442,11 @@ static void test_world(void) {
 }
 
 /* Log messages reach the callback (an open mesh added to a world is repaired or made indestructible, with a
- * warning), and NULL restores the default. */
+ * warning), and NULL restores the default. The mesh is two faces of a tetrahedron: its hole is not planar, so
+ * repair cannot close it. */
 static void test_log_callback(void) {
     const double positions[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
-    const uint32_t open_indices[] = {0, 2, 1, 0, 1, 3, 0, 3, 2};
+    const uint32_t open_indices[] = {0, 2, 1, 0, 1, 3};
     rubble_world* world = NULL;
     rubble_mesh* open = NULL;
     rubble_object_desc desc;
@@ -453,7 +454,7 @@ static void test_log_callback(void) {
     uint32_t id = 0;
     CHECK_OK(rubble_set_log_callback(count_log, &log_calls));
     CHECK_OK(rubble_world_create(NULL, &world));
-    CHECK_OK(rubble_mesh_create(positions, 4, open_indices, 3, &open));
+    CHECK_OK(rubble_mesh_create(positions, 4, open_indices, 2, &open));
     CHECK_OK(rubble_object_desc_init(&desc));
     desc.mesh = open;
     CHECK_OK(rubble_world_add_object(world, &desc, &id));
@@ -465,6 +466,114 @@ static void test_log_callback(void) {
     CHECK_OK(rubble_mesh_destroy(open));
 }
 
+/* Reads "x,y,z" (or one number) into v; returns how many numbers were read. */
+static int read_numbers(const char* text, double* v, int most) {
+    int n = 0;
+    char* end = NULL;
+    while (n < most) {
+        v[n++] = strtod(text, &end);
+        if (*end != ',')
+            break;
+        text = end + 1;
+    }
+    return n;
+}
+
+/* One row of tests/data/parameter_cases.tsv through the C API: RUBBLE_OK, or an invalid argument whose
+ * message contains the row's message. */
+static void check_parameter_case(const char* name, const char* value, const char* message) {
+    const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+    double v[3] = {0, 0, 0};
+    rubble_mesh* cube = NULL;
+    rubble_status status;
+    char error[512];
+    const int expect_ok = strcmp(message, "ok") == 0;
+    read_numbers(value, v, 3);
+    CHECK_OK(rubble_mesh_create_box(lo, hi, 1, &cube));
+    if (strcmp(name, "density") == 0) {
+        rubble_world* world = NULL;
+        rubble_object_desc desc;
+        uint32_t id = 0;
+        CHECK_OK(rubble_world_create(NULL, &world));
+        CHECK_OK(rubble_object_desc_init(&desc));
+        desc.mesh = cube;
+        desc.density = v[0];
+        status = rubble_world_add_object(world, &desc, &id);
+        snprintf(error, sizeof error, "%s", rubble_last_error());
+        CHECK_OK(rubble_world_destroy(world));
+    } else {
+        rubble_impact impact = {{0.5, 0.5, 1}, {0, 0, 1}, 100};
+        rubble_fracture_params params;
+        rubble_fracture* broken = NULL;
+        CHECK_OK(rubble_fracture_params_init(&params));
+        params.convex_parts = 0;
+        if (strcmp(name, "impulse") == 0) {
+            impact.impulse = v[0];
+        } else if (strcmp(name, "normal") == 0) {
+            memcpy(impact.normal, v, sizeof v);
+        } else if (strcmp(name, "point") == 0) {
+            memcpy(impact.point, v, sizeof v);
+        } else if (strcmp(name, "cells") == 0) {
+            params.pattern = RUBBLE_PATTERN_SHATTER;
+            params.cells = (int)v[0];
+        } else {
+            fprintf(stderr, "no C case for %s\n", name);
+            ++failures;
+        }
+        status = rubble_fracture_mesh(cube, &impact, &params, &broken);
+        snprintf(error, sizeof error, "%s", rubble_last_error());
+        CHECK_OK(rubble_fracture_destroy(broken));
+    }
+    if (expect_ok ? status != RUBBLE_OK
+                  : status != RUBBLE_ERROR_INVALID_ARGUMENT || !contains(error, message)) {
+        fprintf(stderr, "parameter case %s %s: status %d, message '%s', expected '%s'\n", name, value,
+                (int)status, error, message);
+        ++failures;
+    }
+    CHECK_OK(rubble_mesh_destroy(cube));
+}
+
+/* True when the comma-separated list faces holds face. */
+static int has_face(const char* faces, const char* face) {
+    const size_t len = strlen(face);
+    for (const char* p = faces; p; p = strchr(p, ',') ? strchr(p, ',') + 1 : NULL)
+        if (strncmp(p, face, len) == 0 && (p[len] == ',' || p[len] == '\0'))
+            return 1;
+    return 0;
+}
+
+/* The C face of the shared parameter table: every row the C API can express. */
+static void test_parameter_table(const char* path) {
+    char line[512];
+    int rows = 0;
+    FILE* f = fopen(path, "r");
+    CHECK(f != NULL);
+    if (!f)
+        return;
+    while (fgets(line, sizeof line, f)) {
+        char* fields[4];
+        int n = 0;
+        char* p = line;
+        line[strcspn(line, "\n")] = '\0';
+        if (line[0] == '#' || line[0] == '\0')
+            continue;
+        while (n < 4) {
+            fields[n++] = p;
+            p = strchr(p, '\t');
+            if (!p)
+                break;
+            *p++ = '\0';
+        }
+        CHECK(n == 4);
+        if (n == 4 && has_face(fields[0], "c")) {
+            check_parameter_case(fields[1], fields[2], fields[3]);
+            ++rows;
+        }
+    }
+    fclose(f);
+    CHECK(rows >= 15);
+}
+
 int main(int argc, char** argv) {
     const char* dir = argc > 1 ? argv[1] : ".";
     test_status_and_version();
@@ -474,6 +583,8 @@ int main(int argc, char** argv) {
     test_fracture();
     test_world();
     test_log_callback();
+    if (argc > 2)
+        test_parameter_table(argv[2]);
     if (failures) {
         fprintf(stderr, "%d checks failed\n", failures);
         return 1;

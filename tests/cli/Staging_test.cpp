@@ -36,15 +36,17 @@ TEST(Staging, StaleEntriesOfDeadProcessesAreRemovedOthersKept) {
     std::filesystem::create_directories(dir / (".out.rubble-tmp-" + dead) / "sub");
     test::writeFile(dir / (".out.rubble-tmp-" + dead) / "sub" / "piece_000.obj", "v 0 0 0\n");
     test::writeFile(dir / (".x.obj.rubble-tmp-" + dead), "partial");
+    test::writeFile(dir / (".y.obj.rubble-tmp-" + dead + ".3"), "partial"); // a file of writeFileAtomically
     const std::vector<std::string> kept = {".out.rubble-tmp-" + std::to_string(::getppid()), // alive
                                            ".out.rubble-tmp-" + std::to_string(::getpid()),  // this process
                                            ".out.rubble-tmp-abc",
                                            "out.rubble-tmp-" + dead,
                                            ".rubble-tmp-" + dead,
+                                           ".z.obj.rubble-tmp-" + dead + ".x",
                                            "model.obj"};
     for (const std::string& k : kept)
         test::writeFile(dir / k, "keep");
-    EXPECT_EQ(tools::removeStaleStaging(dir), 2u);
+    EXPECT_EQ(tools::removeStaleStaging(dir), 3u);
     std::set<std::string> left;
     for (const auto& e : std::filesystem::directory_iterator(dir))
         left.insert(e.path().filename().string());

@@ -55,13 +55,30 @@ grep -q "flipped" "$tmp/repair.txt" || fail "repair report does not say what was
 "$RUBBLE" check "$tmp/fixed.obj" >/dev/null || fail "repaired output is not valid"
 "$RUBBLE" check --json "$tmp/fixed.obj" | grep -qF '"volume":1.0' || fail "repaired volume is not 1"
 
-# --repair cannot close holes: exit 1 and says so, but still writes the output.
+# --repair closes a planar hole: the open cube becomes the unit cube.
+"$RUBBLE" check --repair -o "$tmp/open_fixed.obj" "$data/open_cube.obj" >"$tmp/repair_open.txt" 2>&1 \
+    || fail "repair of the open cube should exit 0: $(cat "$tmp/repair_open.txt")"
+grep -q "closed 1 hole" "$tmp/repair_open.txt" || fail "open repair: no 'closed 1 hole'"
+"$RUBBLE" check --json "$tmp/open_fixed.obj" | grep -qF '"volume":1.0' || fail "closed cube's volume is not 1"
+
+# A hole bent at a right angle (top and front faces missing) cannot be closed: exit 1, says what to do, and
+# writes nothing (also with --json, which reports "written": false).
+grep -v "^f 1 2 6 5" "$data/open_cube.obj" >"$tmp/open2.obj"
 set +e
-"$RUBBLE" check --repair -o "$tmp/open_fixed.obj" "$data/open_cube.obj" >"$tmp/repair_open.txt" 2>&1; code=$?
+"$RUBBLE" check --repair -o "$tmp/open2_fixed.obj" "$tmp/open2.obj" >"$tmp/repair_open2.txt" 2>&1; code=$?
 set -e
-[ "$code" -eq 1 ] || fail "repair of the open cube should exit 1, got $code"
-grep -q "could not repair" "$tmp/repair_open.txt" || fail "open repair: no 'could not repair'"
-[ -s "$tmp/open_fixed.obj" ] || fail "open repair wrote nothing"
+[ "$code" -eq 1 ] || fail "repair of the twice-open cube should exit 1, got $code"
+grep -q "could not repair" "$tmp/repair_open2.txt" || fail "open repair: no 'could not repair'"
+grep -q "Remesh modifier" "$tmp/repair_open2.txt" || fail "open repair: does not say what the user can do"
+[ ! -e "$tmp/open2_fixed.obj" ] || fail "an unrepaired mesh was written"
+set +e
+"$RUBBLE" check --json --repair -o "$tmp/open2_fixed.obj" "$tmp/open2.obj" >"$tmp/repair_open2.json" 2>/dev/null
+code=$?
+set -e
+[ "$code" -eq 1 ] || fail "--json repair of the twice-open cube should exit 1, got $code"
+python3 -c 'import json,sys; m=json.load(open(sys.argv[1]))["meshes"][0]; assert m["written"] is False and m["valid"] is False, m' \
+    "$tmp/repair_open2.json" || fail "--json repair: $(cat "$tmp/repair_open2.json")"
+[ ! -e "$tmp/open2_fixed.obj" ] || fail "an unrepaired mesh was written (--json)"
 
 # Usage errors exit 2.
 set +e

@@ -7,10 +7,8 @@ data="$root/tests/data/meshes"
 tmp="$(mktemp -d)"
 trap 'rm -rf "$tmp"' EXIT
 fail() { echo "robustness.t.sh: $*"; exit 1; }
-# run OUT CMD...: runs CMD with stdout in OUT and stderr in OUT.err; its exit code in $c.
-run() { local out=$1; shift; set +e; "$@" >"$out" 2>"$out.err"; c=$?; set -e; }
-# Parses JSON file $1 and evaluates the Python expression $2 on it as d.
-json_ok() { python3 -c "import json,sys; d=json.load(open(sys.argv[1])); assert $2, d" "$1"; }
+# shellcheck source=../support/cli.sh
+source "$root/tests/support/cli.sh"
 
 # --- JSON output never aborts on bytes that are not UTF-8 ------------------------------------------------------
 printf 'v 0 1 \xe9\nv 1 0 0\nv 0 0 1\nf 1 2 3\n' >"$tmp/latin1.obj"
@@ -79,12 +77,14 @@ mkdir -p "$tmp/stale/.out.rubble-tmp-$dead/sub" "$tmp/stale/.out.rubble-tmp-$$"
 for seed in -1 18446744073709551616 1e3; do
     run "$tmp/seed.txt" "$RUBBLE" fracture "$data/cube.obj" --impact 0.5,0.5,1 --seed "$seed" -o "$tmp/seed"
     [ "$c" -eq 2 ] || fail "--seed $seed: exit $c, expected 2"
-    grep -q "is not a whole number from 0 to 18446744073709551615" "$tmp/seed.txt.err" || fail "--seed $seed message"
+    grep -qF "seed must be a whole number in [0, 18446744073709551615], got " "$tmp/seed.txt.err" \
+        || fail "--seed $seed message"
 done
 "$RUBBLE" fracture "$data/cube.obj" --impact 0.5,0.5,1 --seed 18446744073709551615 -o "$tmp/seedmax" >/dev/null \
     || fail "--seed 2^64-1 should be accepted"
 run "$tmp/nan.txt" "$RUBBLE" fracture "$data/cube.obj" --impact 0.5,0.5,1 --impulse nan -o "$tmp/nan"
-[ "$c" -eq 2 ] && grep -q "'nan' is not a finite number" "$tmp/nan.txt.err" || fail "--impulse nan: exit $c"
+[ "$c" -eq 2 ] && grep -qF "impulse must be a finite number in [0, 1e+12], got nan" "$tmp/nan.txt.err" \
+    || fail "--impulse nan: exit $c"
 run "$tmp/cnan.txt" "$RUBBLE" decompose "$data/cube.obj" --concavity nan
 [ "$c" -eq 2 ] && grep -q "'nan' is not a finite number" "$tmp/cnan.txt.err" || fail "--concavity nan: exit $c"
 # A mesh smaller than the smallest cell: one piece, the input itself, and the output says so.

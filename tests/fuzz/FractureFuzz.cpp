@@ -12,6 +12,7 @@
 #include "FuzzInput.hpp"
 #include "rubble/Fracture.hpp"
 #include "rubble/MassProperties.hpp"
+#include "rubble/ParameterCheck.hpp"
 
 namespace {
 
@@ -180,7 +181,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 
     try {
         const auto r = fracture(mesh, impact, params, seed);
-        if (!acceptableInput(mesh) || !isFinite(impact.point) || !std::isfinite(impact.impulse)) {
+        if (!acceptableInput(mesh) || !checkFractureParams(impact, params)) {
             if (r || r.error().code != ErrorCode::InvalidInput)
                 fail("a broken input (mesh or impact) was not rejected as InvalidInput");
             return 0;

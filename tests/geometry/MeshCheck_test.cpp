@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -114,7 +115,7 @@ TEST(MeshCheck, NonFiniteCoordinatesAreReportedNotComputedWith) {
         EXPECT_EQ(r.volume, 0.0);
         EXPECT_FALSE(r.selfIntersectionsChecked);
         EXPECT_TRUE(
-            test::mentions(r.problems, "1 vertex has a non-finite coordinate (NaN or infinity) (vertex 4)"))
+            test::mentions(r.problems, "1 vertex has a non-finite coordinate (NaN or infinity) (vertex 3)"))
             << test::joinLines(r.problems);
         EXPECT_TRUE(isFinite(r.bounds.lo) && isFinite(r.bounds.hi));
     }
@@ -126,7 +127,7 @@ TEST(MeshCheck, OutOfRangeIndicesAreReportedWithoutCrashing) {
     const MeshReport r = checkMesh(m);
     EXPECT_FALSE(r.valid());
     EXPECT_EQ(r.badIndices, 1u);
-    EXPECT_TRUE(test::mentions(r.problems, "triangle 3 refers to vertex 101 of 8"))
+    EXPECT_TRUE(test::mentions(r.problems, "triangle 2 refers to vertex 100 of 8"))
         << test::joinLines(r.problems);
 }
 
@@ -242,7 +243,7 @@ TEST(MeshCheck, SolidsTouchingAtOneVertexAreNotManifold) {
     EXPECT_FALSE(r.selfIntersectionsChecked);
     EXPECT_EQ(r.selfIntersectionNote, "skipped: the mesh has non-manifold vertices");
     EXPECT_TRUE(
-        test::mentions(r.problems, "1 vertex joins parts that share no edge there (pinched) (vertex 1)"))
+        test::mentions(r.problems, "1 vertex joins parts that share no edge there (pinched) (vertex 0)"))
         << test::joinLines(r.problems);
 
     // Valid meshes have manifold vertices, including open ones with one boundary fan per vertex.
@@ -284,7 +285,7 @@ TEST(MeshCheck, SelfIntersectionTestIsSkippedAroundVeryHighValenceVertices) {
     const MeshReport big = checkMesh(cone(60000));
     EXPECT_FALSE(big.selfIntersectionsChecked);
     EXPECT_EQ(big.selfIntersectionNote,
-              "skipped: vertex 60001 is shared by 60000 triangles, more than 2048 (the test "
+              "skipped: vertex 60000 is shared by 60000 triangles, more than 2048 (the test "
               "takes quadratic time around such a vertex)");
     EXPECT_TRUE(big.valid()); // the other checks still ran
     EXPECT_TRUE(big.closed && big.manifold() && big.oriented);
@@ -310,4 +311,30 @@ TEST(MeshCheck, HugeAndTinyMeshesAreJudgedWithoutOverflow) {
     EXPECT_TRUE(isDegenerateTriangle({0, 0, 0}, {1, 0, 0}, {2, 1e-13, 0}));
     EXPECT_FALSE(isDegenerateTriangle({0, 0, 0}, {1, 0, 0}, {2, 1e-11, 0}));
     EXPECT_TRUE(isDegenerateTriangle({5, 5, 5}, {5, 5, 5}, {1, 2, 3}));
+}
+
+TEST(MeshCheck, ElementNumbersCountFromZero) {
+    // Every message numbers vertices, triangles and edge ends as the indices of Mesh::positions and
+    // triangles.
+    Mesh nan = makeBox({0, 0, 0}, {1, 1, 1});
+    nan.positions[0].x = std::numeric_limits<double>::quiet_NaN();
+    EXPECT_TRUE(test::mentions(checkMesh(nan).problems, "(vertex 0)"))
+        << test::joinLines(checkMesh(nan).problems);
+    EXPECT_EQ(nan.validate().message(), "vertex 0 has a non-finite coordinate");
+
+    Mesh open = makeBox({0, 0, 0}, {1, 1, 1});
+    const Triangle removed = open.triangles.back();
+    open.triangles.pop_back();
+    const std::vector<std::string> problems = checkMesh(open).problems;
+    bool named = false;
+    for (int c = 0; c < 3; ++c) {
+        const std::uint32_t a = std::min(removed[c], removed[(c + 1) % 3]);
+        const std::uint32_t b = std::max(removed[c], removed[(c + 1) % 3]);
+        named = named || test::mentions(problems, "edge " + std::to_string(a) + "-" + std::to_string(b));
+    }
+    EXPECT_TRUE(named) << test::joinLines(problems);
+
+    Mesh bad = makeBox({0, 0, 0}, {1, 1, 1});
+    bad.triangles[0][2] = 8;
+    EXPECT_EQ(bad.validate().message(), "triangle 0 refers to vertex 8 of 8");
 }

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -141,13 +142,27 @@ TEST(MeshRepair, OutOfRangeIndicesAreRemoved) {
     EXPECT_EQ(r.removedBadIndexTriangles, 1u);
 }
 
-TEST(MeshRepair, HolesAndNonManifoldEdgesAreReportedNotHidden) {
+TEST(MeshRepair, HolesThatAreNotPlanarAndNonManifoldEdgesAreReportedNotHidden) {
+    // Two adjacent faces missing: one hole bent at a right angle, left open with what the user can do.
     Mesh open = makeBox({0, 0, 0}, {1, 1, 1});
-    open.triangles.pop_back();
+    std::erase_if(open.triangles, [&](const Triangle& t) {
+        return (open.positions[t[0]].z == 1 && open.positions[t[1]].z == 1 && open.positions[t[2]].z == 1) ||
+               (open.positions[t[0]].y == 0 && open.positions[t[1]].y == 0 && open.positions[t[2]].y == 0);
+    });
+    ASSERT_EQ(open.triangles.size(), 8u);
+    RepairOptions noFill;
+    noFill.fillHoles = false;
+    Mesh kept = open;
+    EXPECT_FALSE(repairMesh(kept, noFill).valid());
     RepairReport r = repairMesh(open);
     EXPECT_FALSE(r.valid());
     EXPECT_FALSE(r.changed());
+    EXPECT_EQ(r.filledHoles, 0u);
+    EXPECT_EQ(r.openHoles, 1u);
     EXPECT_TRUE(test::mentions(r.unrepaired, "not closed")) << test::joinLines(r.unrepaired);
+    EXPECT_TRUE(test::mentions(r.unrepaired, "not planar")) << test::joinLines(r.unrepaired);
+    EXPECT_TRUE(test::mentions(r.unrepaired, "Remesh modifier")) << test::joinLines(r.unrepaired);
+    EXPECT_EQ(open.triangles.size(), 8u);
 
     Mesh fin = makeBox({0, 0, 0}, {1, 1, 1});
     fin.positions.push_back({-1, -1, -1});
@@ -231,4 +246,76 @@ TEST(MeshRepair, AttributeArraysOfTheWrongSizeAreDropped) {
     EXPECT_FALSE(m.hasUvs());
     EXPECT_TRUE(test::mentions(r.fixed, "dropped texture coordinates")) << test::joinLines(r.fixed);
     EXPECT_TRUE(m.validate().isOk());
+}
+
+namespace {
+// Removes the triangles all of whose corners satisfy cut; returns how many.
+template <class Cut>
+std::size_t removeTriangles(Mesh& m, Cut cut) {
+    const std::size_t before = m.triangles.size();
+    std::erase_if(m.triangles, [&](const Triangle& t) {
+        return cut(m.positions[t[0]]) && cut(m.positions[t[1]]) && cut(m.positions[t[2]]);
+    });
+    return before - m.triangles.size();
+}
+
+// Closed, consistently oriented, outward, and the expected volume to 1e-9 relative.
+void expectClosedSolid(const Mesh& m, const RepairReport& r, double volume) {
+    EXPECT_TRUE(r.valid()) << test::joinLines(r.unrepaired);
+    EXPECT_TRUE(r.after.closed && r.after.oriented && r.after.outward);
+    EXPECT_EQ(r.after.boundaryEdges, 0u);
+    EXPECT_NEAR(signedVolume(m), volume, 1e-9 * std::abs(volume));
+}
+} // namespace
+
+TEST(MeshRepair, ACubeWithAMissingFaceIsClosed) {
+    Mesh m = makeBox({0, 0, 0}, {1, 1, 1});
+    ASSERT_EQ(removeTriangles(m, [](const Vec3& p) { return p.z == 1; }), 2u);
+    RepairOptions noFill;
+    noFill.fillHoles = false;
+    Mesh unfilled = m;
+    EXPECT_FALSE(repairMesh(unfilled, noFill).valid()); // the mechanism below is what closes it
+    const RepairReport r = repairMesh(m);
+    EXPECT_EQ(r.filledHoles, 1u);
+    EXPECT_TRUE(test::mentions(r.fixed, "closed 1 hole")) << test::joinLines(r.fixed);
+    expectClosedSolid(m, r, 1.0);
+    EXPECT_EQ(m.triangles.size(), 12u);
+}
+
+TEST(MeshRepair, ASphereWithItsCapCutOffIsClosedByAFlatDisc) {
+    Mesh m = makeSphere({0, 0, 0}, 1.0, 24, 12); // poles on the y axis
+    // The highest ring of vertices below the pole: the cut runs along it.
+    double ring = -2;
+    for (const Vec3& p : m.positions)
+        if (p.y < 0.999 && p.y > ring)
+            ring = p.y;
+    ASSERT_EQ(removeTriangles(m, [&](const Vec3& p) { return p.y >= ring; }), 24u);
+    // Expected: the open mesh's volume plus the flat disc's share, ring * area / 3 (divergence theorem with
+    // the field p / 3; the disc faces +y), its area by the shoelace formula over the ring's vertices.
+    std::vector<Vec3> rim;
+    for (const Vec3& p : m.positions)
+        if (p.y == ring)
+            rim.push_back(p);
+    ASSERT_EQ(rim.size(), 24u);
+    std::sort(rim.begin(), rim.end(),
+              [](const Vec3& a, const Vec3& b) { return std::atan2(a.z, a.x) < std::atan2(b.z, b.x); });
+    double area = 0;
+    for (std::size_t i = 0; i < rim.size(); ++i)
+        area += rim[i].x * rim[(i + 1) % rim.size()].z - rim[(i + 1) % rim.size()].x * rim[i].z;
+    const double expected = signedVolume(m) + ring * std::abs(area / 2) / 3;
+    const RepairReport r = repairMesh(m);
+    EXPECT_EQ(r.filledHoles, 1u);
+    expectClosedSolid(m, r, expected);
+    EXPECT_LT(expected, 4.0 / 3.0 * 3.14159265358979);
+}
+
+TEST(MeshRepair, AMeshWithTwoHolesIsClosed) {
+    Mesh m = makeSubdividedBox({0, 0, 0}, {3, 3, 3}, 3);
+    const auto middle = [](double v) { return v >= 1 && v <= 2; };
+    ASSERT_EQ(removeTriangles(m, [&](const Vec3& p) { return p.z == 3 && middle(p.x) && middle(p.y); }), 2u);
+    ASSERT_EQ(removeTriangles(m, [&](const Vec3& p) { return p.x == 0 && middle(p.y) && middle(p.z); }), 2u);
+    const RepairReport r = repairMesh(m);
+    EXPECT_EQ(r.filledHoles, 2u);
+    EXPECT_EQ(r.openHoles, 0u);
+    expectClosedSolid(m, r, 27.0);
 }

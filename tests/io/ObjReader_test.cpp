@@ -160,13 +160,14 @@ TEST(ObjReader, MaterialsGetIdsInOrderOfFirstUse) {
 TEST(ObjReader, ErrorsNameFileLineAndWhat) {
     const std::string v = kCubeVertices;
     EXPECT_EQ(errorOf(v + "\n\n\n\n\n\n\n\nf 1 2 9\n", "cube.obj"),
-              "cube.obj:17: face refers to vertex 9 but only 8 are defined");
-    EXPECT_EQ(errorOf(v + "f 1 2 -9\n"), "t.obj:9: face refers to vertex -9 but only 8 are defined");
+              "cube.obj:17: face refers to vertex 9 (OBJ counts from 1) but only 8 are defined");
+    EXPECT_EQ(errorOf(v + "f 1 2 -9\n"),
+              "t.obj:9: face refers to vertex -9 (OBJ counts from 1) but only 8 are defined");
     EXPECT_EQ(errorOf(v + "f 0 1 2\n"), "t.obj:9: face refers to vertex 0, but OBJ indices start at 1");
     EXPECT_EQ(errorOf(v + "f 1/1 2/1 3/1\n"),
-              "t.obj:9: face refers to texture coordinate 1 but only 0 are defined");
+              "t.obj:9: face refers to texture coordinate 1 (OBJ counts from 1) but only 0 are defined");
     EXPECT_EQ(errorOf(v + "vn 0 0 1\nf 1//2 2//1 3//1\n"),
-              "t.obj:10: face refers to normal 2 but only 1 is defined");
+              "t.obj:10: face refers to normal 2 (OBJ counts from 1) but only 1 is defined");
     EXPECT_EQ(errorOf(v + "f 1 2\n"), "t.obj:9: face has 2 corners; at least 3 are needed");
     EXPECT_EQ(errorOf(v + "f 1 2 x\n"), "t.obj:9: face corner 'x': expected a vertex index, got 'x'");
     EXPECT_EQ(errorOf(v + "f 1/2/3/4 2 3\n"),

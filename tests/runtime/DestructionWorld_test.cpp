@@ -100,11 +100,28 @@ TEST(DestructionWorld, ImpactBelowThresholdIgnored) {
     EXPECT_EQ(w.jobsInFlight(), 0);
 }
 
+TEST(DestructionWorld, OpenMeshWithAPlanarHoleIsClosedAndDestructible) {
+    HeldJobs jobs;
+    DestructionWorld w(heldConfig(jobs));
+    ObjectDesc d = boxDesc();
+    d.mesh.triangles.pop_back(); // a triangular hole: repair closes it
+    auto id = w.addObject(d);
+    ASSERT_TRUE(id);
+    EXPECT_TRUE(w.object(id.value())->destructible);
+    EXPECT_NEAR(w.object(id.value())->mass.volume, 8.0, 1e-9);
+}
+
 TEST(DestructionWorld, OpenMeshIsIndestructible) {
     HeldJobs jobs;
     DestructionWorld w(heldConfig(jobs));
     ObjectDesc d = boxDesc();
-    d.mesh.triangles.pop_back();
+    // Two adjacent faces missing: one hole bent at a right angle, which repair does not close.
+    std::erase_if(d.mesh.triangles, [&](const Triangle& t) {
+        const auto all = [&](auto on) {
+            return on(d.mesh.positions[t[0]]) && on(d.mesh.positions[t[1]]) && on(d.mesh.positions[t[2]]);
+        };
+        return all([](const Vec3& p) { return p.z == 1; }) || all([](const Vec3& p) { return p.y == -1; });
+    });
     std::vector<std::string> logged;
     setLogFunction([&](LogLevel level, std::string_view message) {
         logged.push_back(std::string(toString(level)) + ": " + std::string(message));

@@ -2,6 +2,7 @@
 
 #include <cerrno>
 #include <charconv>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -49,7 +50,16 @@ std::size_t removeStaleStaging(const std::filesystem::path& folder) {
         const char* first = name.data() + at + kMarker.size();
         const char* last = name.data() + name.size();
         long pid = 0;
-        const auto [ptr, err] = std::from_chars(first, last, pid);
+        auto [ptr, err] = std::from_chars(first, last, pid);
+        if (err == std::errc() && ptr != last && *ptr == '.') { // ".PID.N": a file of writeFileAtomically
+            std::uint64_t call = 0;
+            const char* after = ptr + 1;
+            const std::from_chars_result r = std::from_chars(after, last, call);
+            ptr = r.ptr;
+            err = r.ec;
+            if (ptr == after)
+                continue;
+        }
         if (err != std::errc() || ptr != last || first == last || pid <= 0 || pid == ::getpid())
             continue;
         if (::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH)

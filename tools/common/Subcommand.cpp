@@ -4,6 +4,12 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <iostream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "JsonText.hpp"
 
 namespace rubble::tools {
 
@@ -54,8 +60,11 @@ int runMain(const std::string& description, const std::string& version, int argc
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-        // Help and version exit 0; usage errors exit 2.
+        // Help and version exit 0; usage errors exit 2 (with --json, also as {"error"} on stdout).
         const int code = app.exit(e);
+        if (code != 0 &&
+            std::any_of(argv + 1, argv + argc, [](const char* a) { return a == std::string("--json"); }))
+            std::cout << dumpJson(nlohmann::json{{"error", utf8Escaped(e.what())}}) << "\n";
         return code == 0 ? 0 : 2;
     }
     for (std::size_t i = 0; i < subs.size(); ++i)

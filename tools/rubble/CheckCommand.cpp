@@ -6,10 +6,11 @@
 // "self_intersections","volume","center_of_mass":[x,y,z],"bbox":[[lo],[hi]]}]}, where self_intersections is
 // the number of intersecting triangle pairs or null when the test did not run; an unreadable file appears as
 // {"file","error"}. With --repair the entries describe the repaired meshes, "file" being the path written (or
-// {"file","error"} when it could not be written; exit 2). Two inputs with the same stem are refused with
-// --repair into a folder. Outputs are written through a staging file and renamed.
-// Problems and repair notes go to stderr in --json mode.
-// A file with several objects (a glTF node tree, an OBJ with several `o`) or with collision parts (glTF
+// {"file","error"} when it could not be written; exit 2). A mesh still invalid after repair is not written:
+// its entry keeps the input's "file", describes the repaired mesh and adds "written": false (exit 1). Two
+// inputs with the same stem are refused with --repair into a folder. Outputs are written through a staging
+// file and renamed. Problems and repair notes go to stderr in --json mode. A file with several objects (a
+// glTF node tree, an OBJ with several `o`) or with collision parts (glTF
 // "-convcolonly" children, OBJ UCX_ objects) is checked object by object: each entry then has "object" (its
 // name) and "collision_parts", and a collision part that is not a closed convex solid is a problem of its
 // object. --repair takes single-object files only.
@@ -307,6 +308,16 @@ int runCheck(const CheckArgs& args) {
             for (const std::string& f : rep.fixed)
                 text << "    - " << f << "\n";
         }
+        if (!rep.valid()) {
+            // Nothing is written: a file named like a fix that is still invalid would be taken for one.
+            text << "  not written: the repaired mesh is still INVALID\n";
+            printProblems(text, rep.unrepaired, "could not repair");
+            nlohmann::json j = jsonOf(file, rep.after);
+            j["written"] = false;
+            doc["meshes"].push_back(j);
+            exitCode = std::max(exitCode, 1);
+            continue;
+        }
         rubble::Status written;
         {
             const rubble::tools::DeferSignals
@@ -320,13 +331,10 @@ int runCheck(const CheckArgs& args) {
             exitCode = 2;
             continue;
         }
-        text << "  written to " << out.string() << ": " << (rep.valid() ? "valid" : "still INVALID") << "\n";
+        text << "  written to " << out.string() << ": valid\n";
         if (!args.json)
             printStats(std::cout, rep.after);
-        printProblems(text, rep.unrepaired, "could not repair");
         doc["meshes"].push_back(jsonOf(out.string(), rep.after));
-        if (!rep.valid())
-            exitCode = std::max(exitCode, 1);
     }
     if (args.json)
         std::cout << rubble::tools::dumpJson(doc) << "\n";

@@ -5,7 +5,7 @@
 // {"parts","mesh_volume","hull_volume","excess","ms"}. -o writes the parts (rubble/DecompositionFile.hpp);
 // as MESH's stem.parts.json beside it, a scene loads them instead of decomposing. Exit codes: 0 success,
 // 1 the mesh cannot be decomposed (e.g. open or inside out) or the parts cannot be written, 2 unreadable file
-// or usage error.
+// or usage error. With --json a failure prints {"file","error"}.
 #include <chrono>
 #include <iostream>
 #include <memory>
@@ -31,11 +31,18 @@ struct DecomposeArgs {
 };
 
 int runDecompose(const DecomposeArgs& args) {
+    // A failure prints its message on stderr and, with --json, {"file","error"} on stdout.
+    auto failed = [&](int code, const std::string& message) {
+        std::cerr << "rubble decompose: " << message << "\n";
+        if (args.json)
+            std::cout << rubble::tools::dumpJson({{"file", rubble::tools::utf8Escaped(args.file)},
+                                                  {"error", rubble::tools::utf8Escaped(message)}})
+                      << "\n";
+        return code;
+    };
     auto mesh = rubble::readMesh(args.file);
-    if (!mesh) {
-        std::cerr << "rubble decompose: " << mesh.error().message << "\n";
-        return 2;
-    }
+    if (!mesh)
+        return failed(2, mesh.error().message);
     rubble::DecompositionParams params;
     params.maxParts = args.maxParts;
     params.concavity = args.concavity;
@@ -45,16 +52,12 @@ int runDecompose(const DecomposeArgs& args) {
     auto d = rubble::decompose(mesh.value(), params);
     const double ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    if (!d) {
-        std::cerr << "rubble decompose: " << args.file << ": " << d.error().message << "\n";
-        return 1;
-    }
+    if (!d)
+        return failed(1, args.file + ": " + d.error().message);
     if (!args.output.empty()) {
         const rubble::DecompositionFile file{mesh->hash(), d->meshVolume, d->parts};
-        if (const rubble::Status s = rubble::writeDecompositionFile(args.output, file); !s) {
-            std::cerr << "rubble decompose: " << s.message() << "\n";
-            return 1;
-        }
+        if (const rubble::Status s = rubble::writeDecompositionFile(args.output, file); !s)
+            return failed(1, s.message());
     }
     if (args.json) {
         nlohmann::json j;

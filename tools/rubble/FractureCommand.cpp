@@ -27,7 +27,8 @@
 // cut face (the one piece is the input), "dropped_volume" the volume of pieces below the drop fraction. With
 // several meshes {"results":[...]} with one such object per mesh plus "file". A multi-object input adds
 // "object" (the name of the object fractured) and "kept" (objects written unchanged); --depth D > 1 adds
-// "levels":[{"level","pieces","volume","dropped_volume","bonds","failed"}] for levels 1..D.
+// "levels":[{"level","pieces","volume","dropped_volume","bonds","failed"}] for levels 1..D. Every exit prints
+// an object: a usage error or an invalid input (exit 2) {"error"}; a failed write the results plus "error".
 #include <algorithm>
 #include <charconv>
 #include <chrono>
@@ -43,6 +44,7 @@
 #include <set>
 #include <sstream>
 #include <thread>
+#include <tuple>
 
 #include <unistd.h>
 
@@ -57,6 +59,7 @@
 #include "rubble/MassProperties.hpp"
 #include "rubble/MeshCheck.hpp"
 #include "rubble/MeshIO.hpp"
+#include "rubble/ParameterCheck.hpp"
 #include "rubble/SceneIO.hpp"
 #include "rubble/ThreadPool.hpp"
 
@@ -70,13 +73,16 @@ constexpr int kExitFailed = 1;
 constexpr int kExitUsage = 2;
 constexpr int kExitMissed = 3;
 
+// Numbers are kept as typed and checked by rubble::checkParamText, so that the CLI refuses what every API
+// refuses with the same message (and --json reports it).
 struct FractureArgs {
     std::vector<std::string> files;
     std::string impact;
-    double impulse = rubble::Impact{}.impulse;
-    int cells = 1;
-    int depth = 1;
-    std::uint64_t seed = 1;
+    std::string normal = "0,1,0";
+    std::string impulse = "1";
+    std::string cells = "1";
+    std::string depth = "1";
+    std::string seed = "1";
     std::string interiorTexture;
     std::string backend; // empty: the library's default
     std::string output;
@@ -535,7 +541,7 @@ void drawProgress(std::size_t done, std::size_t total) {
 
 // Writes the fractured meshes into a staging folder next to DIR and renames it to DIR.
 int commitOutput(const std::vector<MeshJob>& jobs, const fs::path& dir, const std::string& format, bool batch,
-                 const std::optional<rubble::AssetMaterial>& interior) {
+                 const std::optional<rubble::AssetMaterial>& interior, std::string& error) {
     std::error_code ec;
     const fs::path parent = dir.has_parent_path() ? dir.parent_path() : fs::path(".");
     fs::create_directories(parent, ec);
@@ -546,6 +552,7 @@ int commitOutput(const std::vector<MeshJob>& jobs, const fs::path& dir, const st
     fs::remove_all(stage, ec);
     auto fail = [&](const std::string& message) {
         std::cerr << "rubble fracture: " << message << "\n";
+        error = message;
         fs::remove_all(stage, ec);
         return kExitFailed;
     };
@@ -575,21 +582,43 @@ int commitOutput(const std::vector<MeshJob>& jobs, const fs::path& dir, const st
     return kExitOk;
 }
 
+// Prints {"error": message} on stdout (--json: every exit prints a result object).
+void printJsonError(const std::string& message) {
+    std::cout << rubble::tools::dumpJson(nlohmann::json{{"error", rubble::tools::utf8Escaped(message)}})
+              << "\n";
+}
+
 int runFracture(const FractureArgs& args) {
-    auto usage = [](const std::string& message) {
+    auto usage = [&](const std::string& message) {
         std::cerr << "rubble fracture: " << message << "\n";
+        if (args.json)
+            printJsonError(message);
         return kExitUsage;
     };
+    for (auto [option, name, text] : {std::tuple{"--impact", "point", &args.impact},
+                                      {"--normal", "normal", &args.normal},
+                                      {"--impulse", "impulse", &args.impulse},
+                                      {"--cells", "cells", &args.cells},
+                                      {"--depth", "depth", &args.depth},
+                                      {"--seed", "seed", &args.seed}})
+        if (rubble::Status s = rubble::checkParamText(name, *text); !s)
+            return usage(std::string(option) + ": " + s.message());
+    const int cells = std::stoi(args.cells);
+    const int depth = std::stoi(args.depth);
+    if (rubble::Status s = rubble::checkPieceBudget(cells, depth); !s)
+        return usage("--cells and --depth: " + s.message());
+    const std::uint64_t seed = std::stoull(args.seed);
     const auto point = parsePoint(args.impact);
-    if (!point)
-        return usage("--impact '" + args.impact + "' is not three finite numbers X,Y,Z");
+    const auto normal = parsePoint(args.normal);
+    if (!point || !normal)
+        return usage("--impact or --normal is not three numbers X,Y,Z in decimal");
     fs::path dir = fs::path(args.output).lexically_normal();
     if (!dir.has_filename() && dir.has_parent_path()) // "out/" names the folder "out"
         dir = dir.parent_path();
     if (dir.empty() || dir.filename() == "." || dir.filename() == "..")
         return usage("-o '" + args.output + "' does not name a folder to create");
-    if (args.depth > 1 && args.format != "gltf")
-        return usage("--depth " + std::to_string(args.depth) +
+    if (depth > 1 && args.format != "gltf")
+        return usage("--depth " + std::to_string(depth) +
                      " writes a node tree: it needs --format gltf (OBJ has no hierarchy)");
     std::optional<rubble::AssetMaterial> interior;
     if (!args.interiorTexture.empty()) {
@@ -607,9 +636,9 @@ int runFracture(const FractureArgs& args) {
                      "' exists and is not an empty folder (choose another one or remove it)");
 
     rubble::FractureParams params;
-    if (args.cells > 1) {
+    if (cells > 1) {
         params.pattern = rubble::CellPattern::Shatter;
-        params.cells = args.cells;
+        params.cells = cells;
     }
     if (args.backend == "corefine")
         params.backend = rubble::BooleanKind::Corefine;
@@ -619,7 +648,8 @@ int runFracture(const FractureArgs& args) {
         params.backend = rubble::BooleanKind::Fast;
     rubble::Impact impact;
     impact.point = *point;
-    impact.impulse = args.impulse;
+    impact.normal = *normal;
+    impact.impulse = std::strtod(args.impulse.c_str(), nullptr);
 
     // Read and validate every input first: a bad one stops everything before anything is computed or written.
     const bool batch = args.files.size() > 1;
@@ -674,7 +704,7 @@ int runFracture(const FractureArgs& args) {
 
     // Fracture: inline for one mesh, on a thread pool for several.
     if (!batch) {
-        runJob(jobs[0], impact, params, args.seed, args.depth, args.cells);
+        runJob(jobs[0], impact, params, seed, depth, cells);
     } else {
         const int workers = static_cast<int>(
             std::min<std::size_t>(jobs.size(), std::max(1u, std::thread::hardware_concurrency())));
@@ -686,7 +716,7 @@ int runFracture(const FractureArgs& args) {
             drawProgress(0, jobs.size());
         for (MeshJob& job : jobs)
             pool.submit([&, j = &job] {
-                runJob(*j, impact, params, args.seed, args.depth, args.cells);
+                runJob(*j, impact, params, seed, depth, cells);
                 std::lock_guard lock(mutex);
                 ++done;
                 if (progress)
@@ -706,9 +736,26 @@ int runFracture(const FractureArgs& args) {
             code = kExitMissed;
         anyFractured |= job.outcome == Outcome::Fractured;
     }
+    auto jsonDoc = [&] {
+        if (!batch)
+            return jsonOf(jobs[0], false);
+        nlohmann::json doc;
+        doc["results"] = nlohmann::json::array();
+        for (const MeshJob& job : jobs)
+            doc["results"].push_back(jsonOf(job, true));
+        return doc;
+    };
+    std::string writeError;
     if (anyFractured)
-        if (const int written = commitOutput(jobs, dir, args.format, batch, interior); written != kExitOk)
+        if (const int written = commitOutput(jobs, dir, args.format, batch, interior, writeError);
+            written != kExitOk) {
+            if (args.json) {
+                nlohmann::json doc = jsonDoc();
+                doc["error"] = rubble::tools::utf8Escaped(writeError);
+                std::cout << rubble::tools::dumpJson(doc) << "\n";
+            }
             return written;
+        }
 
     std::ostream& text = args.json ? std::cerr : std::cout;
     for (const MeshJob& job : jobs)
@@ -716,17 +763,8 @@ int runFracture(const FractureArgs& args) {
             printSummary(text, job, batch ? dir / job.folder : dir);
         else if (!job.cut)
             text << job.file << ": nothing was cut: the piece is the whole input\n";
-    if (args.json) {
-        nlohmann::json doc;
-        if (batch) {
-            doc["results"] = nlohmann::json::array();
-            for (const MeshJob& job : jobs)
-                doc["results"].push_back(jsonOf(job, true));
-        } else {
-            doc = jsonOf(jobs[0], false);
-        }
-        std::cout << rubble::tools::dumpJson(doc) << "\n";
-    }
+    if (args.json)
+        std::cout << rubble::tools::dumpJson(jsonDoc()) << "\n";
     return code;
 }
 
@@ -759,27 +797,31 @@ const rubble::tools::Registrar registrar{
              ->required();
          app.add_option("--impact", args->impact, "impact point X,Y,Z in the mesh's coordinates")->required();
          const rubble::CellSizeLaw law;
-         app.add_option("--impulse", args->impulse,
-                        "impact impulse (N s); the cut region's edge is " + num(law.base) + " + " +
-                            num(law.scale) + " impulse^" + num(law.exponent) + ", clamped to [" +
-                            num(law.minSize) + ", " + num(law.maxSize) + "]")
-             ->check(rubble::tools::finiteNumber())
-             ->check(CLI::Range(0.0, 1e12))
+         app.add_option("--normal", args->normal,
+                        "surface normal at the impact X,Y,Z (out of the mesh; not all 0)")
+             ->capture_default_str();
+         app.add_option(
+                "--impulse", args->impulse,
+                "impact impulse (N s), " + rubble::describeParamRange(*rubble::findParamRange("impulse")) +
+                    "; the cut region's edge is " + num(law.base) + " + " + num(law.scale) + " impulse^" +
+                    num(law.exponent) + ", clamped to [" + num(law.minSize) + ", " + num(law.maxSize) + "]")
              ->capture_default_str();
          app.add_option("--cells", args->cells,
-                        "1: the thesis's single Voronoi cell; K > 1: shatter into K cells")
-             ->check(CLI::Range(1, rubble::kMaxShatterCells))
+                        "1: the thesis's single Voronoi cell; K > 1: shatter into K cells (1.." +
+                            std::to_string(rubble::kMaxShatterCells) + ")")
              ->capture_default_str();
          app.add_option(
                 "--depth", args->depth,
                 "levels of pre-fracture: D > 1 shatters every piece again into --cells cells (at least "
-                "2), D-1 times, into a glTF node tree with bonds between sibling chunks (--format gltf)")
-             ->check(CLI::Range(1, 4))
+                "2), D-1 times, into a glTF node tree with bonds between sibling chunks (--format gltf); "
+                "1.." +
+                    std::to_string(rubble::kMaxFractureDepth) + ", with at most " +
+                    num(static_cast<double>(rubble::kMaxTotalPieces)) + " pieces in all")
              ->capture_default_str();
          app.add_option("--interior-texture", args->interiorTexture,
                         "image for the material 'interior' of the cut faces (copied to DIR/textures/)");
-         app.add_option("--seed", args->seed, "random seed (same seed, same pieces, byte for byte)")
-             ->check(rubble::tools::unsigned64())
+         app.add_option("--seed", args->seed,
+                        "random seed 0..18446744073709551615 (same seed, same pieces, byte for byte)")
              ->capture_default_str();
          app.add_option("--backend", args->backend, "boolean backend (default: the library's default)")
              ->check(CLI::IsMember({"corefine", "nef", "fast"}));

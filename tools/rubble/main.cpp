@@ -1,7 +1,8 @@
 #include "Subcommand.hpp"
+#include "rubble/Version.hpp"
 
 int main(int argc, char** argv) {
     return rubble::tools::runMain(
-        "rubble: real-time destructible meshes (check, repair, fracture, decompose)", "rubble 0.1.0", argc,
-        argv);
+        "rubble: real-time destructible meshes (check, repair, fracture, decompose)",
+        "rubble " RUBBLE_VERSION_STRING, argc, argv);
 }

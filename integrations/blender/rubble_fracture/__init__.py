@@ -46,6 +46,12 @@ def load_rubble():
     try:
         import rubble  # noqa: PLC0415 (imported on first use: the add-on registers without it)
     except ImportError as e:
+        if "rubble needs" in str(e):  # found, but numpy or its extension cannot load in this Python
+            raise ImportError(
+                "Rubble cannot load in Blender's Python: %s Fix: install python3-numpy and start Blender from a "
+                "shell where Debian's /usr/bin/python3 comes first on PATH (e.g. after `pyenv shell system`), "
+                "with PYTHONPATH and PYTHONHOME unset" % e
+            ) from e
         raise ImportError(
             "the rubble Python module is not found (%s); build Rubble and run `make blender-addon`, or set "
             "RUBBLE_PYTHON_DIR to the folder holding the rubble package" % e
@@ -285,8 +291,12 @@ classes = (RubbleSettings, RUBBLE_OT_fracture_at_cursor, RUBBLE_OT_export_gltf, 
 
 def _numpy_bool_alias():
     """Debian's Blender 3.4 glTF importer uses np.bool, which Debian's numpy 1.24 removed: importing any glTF
-    fails with AttributeError. The alias is the builtin bool, as it was until numpy 1.24."""
-    import numpy as np  # noqa: PLC0415
+    fails with AttributeError. The alias is the builtin bool, as it was until numpy 1.24. Without numpy the
+    add-on still registers; its operators then report why Rubble cannot load (load_rubble)."""
+    try:
+        import numpy as np  # noqa: PLC0415
+    except ImportError:
+        return
 
     if "bool" not in np.__dict__:
         np.bool = bool
