@@ -5,6 +5,7 @@
 
 #include <algorithm>
 
+#include "Placements.hpp"
 #include "Protocol.hpp"
 #include "rubble/JournalFile.hpp"
 #include "rubble/JournalPlayer.hpp"
@@ -30,46 +31,47 @@ struct NetClient::Impl {
         double f0 = 0, f1 = 0;
         Frame a, b;
     };
-    std::map<ObjectId, Track> tracks;
+    std::map<ObjectId, Track> tracks; // also of pieces the world does not have yet
+    detail::PlacementDecoder decoder;
+    std::vector<detail::DecodedPlacement> decoded;
     std::function<void(const FractureOutcome&)> onOutcome;
 
     void adopted(const FractureOutcome& o) {
         if (auto t = tracks.find(o.parent); t != tracks.end()) {
             const Track parent = t->second;
             tracks.erase(t);
-            for (const AdoptedPiece& p : o.pieces) // piece → parent local → world
-                tracks[p.id] = {parent.f1, parent.f1, parent.b * p.frame, parent.b * p.frame};
+            for (const AdoptedPiece& p : o.pieces) // piece → parent local → world, unless the host said
+                tracks.try_emplace(p.id, Track{parent.f1, parent.f1, parent.b * p.frame, parent.b * p.frame});
         }
         if (onOutcome)
             onOutcome(o);
     }
 
     void placements(const std::uint8_t* d, std::size_t n) {
-        if (n < 13)
-            return;
-        const double frame = static_cast<double>(detail::readU64(d + 1));
-        const std::uint32_t count = detail::readU32(d + 9);
-        if (n != 13 + static_cast<std::size_t>(count) * detail::kPlacementBytes)
+        if (!stats.joined)
+            return; // the baselines come with the snapshot; unacknowledged, these are sent again
+        std::uint64_t frameNumber = 0;
+        decoded.clear();
+        if (!decoder.decode(d, n, frameNumber, decoded))
             return; // unreliable channel: a malformed packet is dropped
         stats.placementBytes += static_cast<long long>(n);
-        for (std::uint32_t i = 0; i < count; ++i) {
-            const std::uint8_t* r = d + 13 + i * detail::kPlacementBytes;
-            const ObjectId id = detail::readU32(r);
-            if (!world.object(id))
-                continue;
-            Frame f;
-            f.translation = {detail::readF32(r + 4), detail::readF32(r + 8), detail::readF32(r + 12)};
-            f.rotation = detail::fromQuaternion({detail::readF32(r + 16), detail::readF32(r + 20),
-                                                 detail::readF32(r + 24), detail::readF32(r + 28)});
-            Track& t = tracks[id];
+        const double frame = static_cast<double>(frameNumber);
+        for (const detail::DecodedPlacement& r : decoded) {
+            const Frame f = detail::dequantize(r.q);
+            Track& t = tracks[r.id];
             if (frame <= t.f1 && t.f1 > 0)
-                continue; // older than what we have (unsequenced)
+                continue; // older than what we have (reordered)
             t.f0 = t.f1 > 0 ? t.f1 : frame;
             t.a = t.f1 > 0 ? t.b : f;
             t.f1 = frame;
             t.b = f;
             ++stats.placements;
         }
+        std::vector<std::uint8_t> ack{static_cast<std::uint8_t>(Message::PlacementAck)};
+        for (std::uint32_t v : {decoder.latest(), decoder.mask()})
+            for (int i = 0; i < 4; ++i)
+                ack.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
+        detail::sendUnreliable(server, ack);
     }
 
     Status receive(const ENetPacket* packet) {
@@ -84,11 +86,15 @@ struct NetClient::Impl {
                 return s.error();
             const double frame = static_cast<double>(s->world.frame);
             std::map<ObjectId, Track> fresh;
-            for (const ObjectPlacement& p : s->placements)
+            detail::PlacementDecoder baselines;
+            for (const ObjectPlacement& p : s->placements) {
                 fresh[p.object] = {frame, frame, p.objectToWorld, p.objectToWorld};
+                baselines.setBaseline(p.object, detail::quantize(p.objectToWorld));
+            }
             if (Status st = restoreSnapshot(world, std::move(*s)); !st)
                 return st;
             tracks = std::move(fresh);
+            decoder = std::move(baselines);
             stats.joined = true;
             stats.joinMs = std::chrono::duration<double, std::milli>(Clock::now() - connected).count();
             return Status::ok();

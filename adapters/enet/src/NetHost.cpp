@@ -5,6 +5,7 @@
 #include <map>
 #include <vector>
 
+#include "Placements.hpp"
 #include "Protocol.hpp"
 #include "rubble/JournalFile.hpp"
 #include "rubble/Snapshot.hpp"
@@ -26,11 +27,17 @@ struct NetHost::Impl {
     std::map<std::uint64_t, std::uint64_t> hashes; // frame → geometry hash sent in its sync (recent ones)
     HostStats stats;
     std::function<std::vector<ObjectPlacement>()> placementSource;
+    std::map<ENetPeer*, detail::PlacementEncoder> encoders; // per client: its baselines and priorities
+    std::size_t placementBudget = 1200;                     // bytes per client per publishPlacements
 
     void join(ENetPeer* peer) {
         std::vector<std::uint8_t> msg{static_cast<std::uint8_t>(Message::Snapshot)};
-        const std::vector<std::uint8_t> bytes = encodeSnapshot(
-            takeSnapshot(world, placementSource ? placementSource() : std::vector<ObjectPlacement>{}));
+        std::vector<ObjectPlacement> placements =
+            placementSource ? placementSource() : std::vector<ObjectPlacement>{};
+        detail::PlacementEncoder& encoder = encoders[peer] = {};
+        for (const ObjectPlacement& p : placements) // the client has these from its snapshot
+            encoder.setBaseline(p.object, detail::quantize(p.objectToWorld));
+        const std::vector<std::uint8_t> bytes = encodeSnapshot(takeSnapshot(world, std::move(placements)));
         msg.insert(msg.end(), bytes.begin(), bytes.end());
         if (!detail::sendReliable(peer, msg)) {
             enet_peer_disconnect(peer, 0);
@@ -44,6 +51,11 @@ struct NetHost::Impl {
 
     void receive(ENetPeer* peer, const ENetPacket* packet) {
         const std::uint8_t* d = packet->data;
+        if (packet->dataLength == 9 && d[0] == static_cast<std::uint8_t>(Message::PlacementAck)) {
+            if (auto e = encoders.find(peer); e != encoders.end())
+                e->second.acked(detail::readU32(d + 1), detail::readU32(d + 5));
+            return;
+        }
         if (packet->dataLength != 17 || d[0] != static_cast<std::uint8_t>(Message::Ack) || !peers.count(peer))
             return; // clients send nothing else
         ++stats.acks;
@@ -134,32 +146,22 @@ void NetHost::publish() {
 
 void NetHost::publishPlacements(const std::vector<ObjectPlacement>& placements) {
     Impl& im = *impl_;
-    constexpr std::size_t kPerPacket = 37; // 13 + 37 · 32 = 1197 bytes: one UDP datagram
-    std::vector<const ObjectPlacement*> moving;
+    std::vector<std::pair<ObjectId, detail::Quantized>> now;
+    now.reserve(placements.size());
     for (const ObjectPlacement& p : placements)
-        if (p.motion == BodyMotionState::Dynamic)
-            moving.push_back(&p);
-    for (std::size_t start = 0; start < moving.size(); start += kPerPacket) {
-        const std::size_t n = std::min(kPerPacket, moving.size() - start);
-        std::vector<std::uint8_t> msg{static_cast<std::uint8_t>(Message::Placements)};
-        detail::appendU64(msg, im.world.frame());
-        for (int i = 0; i < 4; ++i)
-            msg.push_back(static_cast<std::uint8_t>(n >> (8 * i)));
-        for (std::size_t k = start; k < start + n; ++k) {
-            const ObjectPlacement& p = *moving[k];
-            for (int i = 0; i < 4; ++i)
-                msg.push_back(static_cast<std::uint8_t>(p.object >> (8 * i)));
-            for (int i = 0; i < 3; ++i)
-                detail::appendF32(msg, static_cast<float>(p.objectToWorld.translation[i]));
-            for (double c : detail::toQuaternion(p.objectToWorld.rotation))
-                detail::appendF32(msg, static_cast<float>(c));
-        }
-        for (auto& [peer, position] : im.peers) {
+        now.emplace_back(p.object, detail::quantize(p.objectToWorld));
+    for (auto& [peer, position] : im.peers) {
+        for (const std::vector<std::uint8_t>& msg :
+             im.encoders[peer].encode(im.world.frame(), now, im.placementBudget)) {
             detail::sendUnreliable(peer, msg);
             im.stats.placementBytes += static_cast<long long>(msg.size());
         }
     }
     enet_host_flush(im.host);
+}
+
+void NetHost::setPlacementBudget(std::size_t bytes) {
+    impl_->placementBudget = bytes;
 }
 
 bool NetHost::finish(int timeoutMs) {
@@ -196,6 +198,7 @@ void NetHost::service(int timeoutMs) {
         case ENET_EVENT_TYPE_DISCONNECT:
             im.peers.erase(e.peer);
             im.acked.erase(e.peer);
+            im.encoders.erase(e.peer);
             break;
         default:
             break;

@@ -15,18 +15,15 @@
 
 namespace rubble::net::detail {
 
-/// Message types (first byte of every packet; all on channel 0, reliable and ordered).
+/// Message types (first byte of every packet; on channel 0, reliable and ordered, unless said).
 enum class Message : std::uint8_t {
-    Snapshot = 1,   ///< the snapshot bytes (rubble/Snapshot.hpp)
-    Events = 2,     ///< u32 count, then count × 48-byte journal events
-    Sync = 3,       ///< u64 frame, u64 journal position, u64 geometry hash
-    Ack = 4,        ///< client → host: u64 frame, u64 its geometry hash after that sync
-    Placements = 5, ///< channel 1, unreliable: u64 frame, u32 count, count × (u32 object, 3 f32 position,
-                    ///< 4 f32 rotation quaternion x y z w)
+    Snapshot = 1,     ///< the snapshot bytes (rubble/Snapshot.hpp)
+    Events = 2,       ///< u32 count, then count × 48-byte journal events
+    Sync = 3,         ///< u64 frame, u64 journal position, u64 geometry hash
+    Ack = 4,          ///< client → host: u64 frame, u64 its geometry hash after that sync
+    Placements = 5,   ///< channel 1, unreliable: u32 seq, then varints and records (Placements.hpp)
+    PlacementAck = 6, ///< client → host, channel 1, unreliable: u32 latest seq, u32 mask of the 32 before
 };
-
-/// Bytes of one placement record.
-inline constexpr std::size_t kPlacementBytes = 32;
 
 /// Appends a little-endian float.
 inline void appendF32(std::vector<std::uint8_t>& out, float f) {

@@ -51,9 +51,12 @@ public:
     /// Sends every client the journal events since its last publish and a sync for the world's current
     /// frame; call once per frame after the world (or runtime) stepped.
     void publish();
-    /// Sends every client the placements of the dynamic bodies among placements (unreliable, unsequenced,
-    /// on channel 1, at most 37 per packet): the host is authoritative for motion. Call at a modest rate.
+    /// Sends every client the placements that differ from what it acknowledged (unreliable, on channel 1;
+    /// quantized, delta-coded, the most overdue first within the budget): the host is authoritative for
+    /// motion. Bodies at rest cost nothing. Call at a modest rate (10 Hz).
     void publishPlacements(const std::vector<ObjectPlacement>& placements);
+    /// Bytes of placements per client per publishPlacements (default 1200).
+    void setPlacementBudget(std::size_t bytes);
     /// Handles the network until every connected client confirmed the latest sync (or timeoutMs passed);
     /// true when they all did. Call before closing, so that the clients end in the host's state.
     bool finish(int timeoutMs);
