@@ -26,6 +26,7 @@ struct NetClient::Impl {
     ENetHost* host = nullptr;
     ENetPeer* server = nullptr;
     Clock::time_point connected;
+    Clock::time_point heard; // when the host was last heard
     ClientStats stats;
     struct Track {
         double f0 = 0, f1 = 0;
@@ -188,7 +189,12 @@ Status NetClient::service(int timeoutMs) {
     for (; r > 0; r = enet_host_service(im.host, &e, 0)) {
         if (e.type == ENET_EVENT_TYPE_CONNECT) {
             im.stats.connected = true;
+            detail::configurePeer(im.server);
         } else if (e.type == ENET_EVENT_TYPE_RECEIVE) {
+            const Clock::time_point now = Clock::now();
+            if (now - im.heard > std::chrono::milliseconds(300) && im.server)
+                detail::retransmitSoon(im.server); // the host was silent: an outage ended
+            im.heard = now;
             Status s = im.receive(e.packet);
             enet_packet_destroy(e.packet);
             if (!s)

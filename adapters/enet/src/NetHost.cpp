@@ -30,7 +30,10 @@ struct NetHost::Impl {
     std::map<ENetPeer*, detail::PlacementEncoder> encoders; // per client: its baselines and priorities
     std::size_t placementBudget = 1200;                     // bytes per client per publishPlacements
 
+    std::map<ENetPeer*, std::chrono::steady_clock::time_point> heard; // when each client was last heard
+
     void join(ENetPeer* peer) {
+        detail::configurePeer(peer);
         std::vector<std::uint8_t> msg{static_cast<std::uint8_t>(Message::Snapshot)};
         std::vector<ObjectPlacement> placements =
             placementSource ? placementSource() : std::vector<ObjectPlacement>{};
@@ -50,6 +53,12 @@ struct NetHost::Impl {
     }
 
     void receive(ENetPeer* peer, const ENetPacket* packet) {
+        const auto now = std::chrono::steady_clock::now();
+        if (auto h = heard.find(peer); h != heard.end() && now - h->second > std::chrono::milliseconds(300))
+            detail::retransmitSoon(peer); // it was silent: an outage ended
+        heard[peer] = now;
+        if (packet->dataLength == 0)
+            return;
         const std::uint8_t* d = packet->data;
         if (packet->dataLength == 9 && d[0] == static_cast<std::uint8_t>(Message::PlacementAck)) {
             if (auto e = encoders.find(peer); e != encoders.end())
@@ -199,6 +208,7 @@ void NetHost::service(int timeoutMs) {
             im.peers.erase(e.peer);
             im.acked.erase(e.peer);
             im.encoders.erase(e.peer);
+            im.heard.erase(e.peer);
             break;
         default:
             break;

@@ -3,6 +3,7 @@
 
 #include <enet/enet.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -122,6 +123,23 @@ inline bool sendReliable(ENetPeer* peer, const std::vector<std::uint8_t>& bytes)
         return false;
     }
     return true;
+}
+
+/// A peer for a link that misbehaves: unreliable packets are not throttled (placements keep their own byte
+/// budget), and an outage of up to 15 s (a partition) does not end the connection.
+inline void configurePeer(ENetPeer* peer) {
+    enet_peer_timeout(peer, 0, 15000, 30000);
+    enet_peer_throttle_configure(peer, ENET_PEER_PACKET_THROTTLE_INTERVAL, 0, 0);
+}
+
+/// After an outage, the peer's unacknowledged reliable commands are sent again at the next service instead
+/// of after their timers, which doubled at every retransmission during the outage.
+inline void retransmitSoon(ENetPeer* peer) {
+    for (ENetListIterator it = enet_list_begin(&peer->sentReliableCommands);
+         it != enet_list_end(&peer->sentReliableCommands); it = enet_list_next(it)) {
+        auto* c = reinterpret_cast<ENetOutgoingCommand*>(it);
+        c->roundTripTimeout = std::min<enet_uint32>(c->roundTripTimeout, 1);
+    }
 }
 
 /// Resolves a loopback address (127.0.0.0/8, "localhost"); anything else is refused.
