@@ -122,7 +122,7 @@ TEST(NetLoopback, ClientsConvergeToTheHostsGeometryHash) {
     EXPECT_GT((*first)->stats().syncs, 200);
     EXPECT_EQ(h.stats().joins, 2);
     const double bytesPerEvent = double(h.stats().eventBytes) / double(h.stats().eventsSent);
-    EXPECT_LT(bytesPerEvent, 60) << "48 bytes per event plus a 5-byte header per batch";
+    EXPECT_LT(bytesPerEvent, 36) << "about 32 bytes per impact, 3 per removal, 3 to 4 per batch";
     std::printf(
         "netplay: %lld events, %.1f bytes/event, snapshot %lld bytes, late join %.1f ms, %lld placement "
         "bytes\n",

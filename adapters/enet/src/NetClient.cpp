@@ -1,14 +1,17 @@
 #include "rubble/enet/NetClient.hpp"
 
 #include <chrono>
+#include <deque>
 #include <map>
 
 #include <algorithm>
 
+#include "Events.hpp"
 #include "Placements.hpp"
 #include "Protocol.hpp"
 #include "rubble/JournalFile.hpp"
 #include "rubble/JournalPlayer.hpp"
+#include "rubble/Random.hpp"
 #include "rubble/Snapshot.hpp"
 
 namespace rubble::net {
@@ -34,6 +37,48 @@ struct NetClient::Impl {
     };
     std::map<ObjectId, Track> tracks; // also of pieces the world does not have yet
     detail::PlacementDecoder decoder;
+    std::deque<detail::WireEvent> held; // events received, applied when the world reaches their tick
+    std::vector<detail::WireEvent> arrived;
+    std::uint64_t seed = 0; // the host world's seed (from the snapshot)
+
+    // Applies the held events of the world's current frame, with the fields the host left out.
+    Status applyHeld() {
+        while (!held.empty() && held.front().event.tick == world.frame()) {
+            JournalEvent e = held.front().event;
+            const std::uint8_t check = held.front().check;
+            held.pop_front();
+            if (e.kind == JournalEventKind::Impact) {
+                const ObjectState* o = world.object(e.object);
+                if (!o)
+                    return Error{ErrorCode::InvalidInput, "netplay: impact on object " +
+                                                              std::to_string(e.object) +
+                                                              ", which this world does not have"};
+                e.pattern = patternByte(o->fracture);
+                e.cells = static_cast<std::uint16_t>(std::clamp(o->fracture.cells, 0, 65535));
+                e.seed = mixSeed(mixSeed(seed, o->id), o->version); // the world's next job seed
+                if (detail::eventCheck(e) != check)
+                    return Error{ErrorCode::InvalidInput,
+                                 "netplay: impact on object " + std::to_string(e.object) +
+                                     ": its pattern or job seed differs from the host's"};
+            }
+            if (Status st = player.receive(e); !st)
+                return st;
+        }
+        return Status::ok();
+    }
+
+    // Advances the world to `frame`, applying the events of each frame as it begins.
+    Status advanceTo(std::uint64_t frame) {
+        if (Status st = applyHeld(); !st)
+            return st;
+        while (world.frame() < frame) {
+            if (Status st = player.advanceTo(world.frame() + 1); !st)
+                return st;
+            if (Status st = applyHeld(); !st)
+                return st;
+        }
+        return Status::ok();
+    }
     std::vector<detail::DecodedPlacement> decoded;
     std::function<void(const FractureOutcome&)> onOutcome;
 
@@ -92,10 +137,13 @@ struct NetClient::Impl {
                 fresh[p.object] = {frame, frame, p.objectToWorld, p.objectToWorld};
                 baselines.setBaseline(p.object, detail::quantize(p.objectToWorld));
             }
+            const std::uint64_t hostSeed = s->world.seed;
             if (Status st = restoreSnapshot(world, std::move(*s)); !st)
                 return st;
             tracks = std::move(fresh);
             decoder = std::move(baselines);
+            held.clear();
+            seed = hostSeed;
             stats.joined = true;
             stats.joinMs = std::chrono::duration<double, std::milli>(Clock::now() - connected).count();
             return Status::ok();
@@ -103,22 +151,19 @@ struct NetClient::Impl {
         case Message::Events: {
             if (!stats.joined)
                 return Error{ErrorCode::InvalidInput, "netplay: events before the snapshot"};
-            std::uint32_t count = 0;
-            for (int i = 0; i < 4 && n >= 5; ++i)
-                count |= static_cast<std::uint32_t>(d[1 + i]) << (8 * i);
-            if (n < 5 || n != 5 + static_cast<std::size_t>(count) * kJournalEventBytes)
+            arrived.clear();
+            if (!detail::decodeEvents(d, n, arrived))
                 return Error{ErrorCode::ParseError,
                              "netplay: events message of " + std::to_string(n) + " bytes"};
-            for (std::uint32_t i = 0; i < count; ++i) {
-                Result<JournalEvent> e =
-                    decodeJournalEvent(d + 5 + i * kJournalEventBytes, 5 + i * kJournalEventBytes);
-                if (!e)
-                    return e.error();
-                if (Status st = player.receive(*e); !st)
-                    return st;
+            for (const detail::WireEvent& w : arrived) {
+                const std::uint32_t last = held.empty() ? 0 : held.back().event.tick;
+                if (w.event.tick < world.frame() || w.event.tick < last)
+                    return Error{ErrorCode::InvalidInput, "netplay: journal event of tick " +
+                                                              std::to_string(w.event.tick) + " arrived late"};
+                held.push_back(w);
                 ++stats.events;
             }
-            return Status::ok();
+            return applyHeld();
         }
         case Message::Sync: {
             if (n != 25)
@@ -128,7 +173,7 @@ struct NetClient::Impl {
                 return Status::ok();
             const std::uint64_t frame = detail::readU64(d + 1), position = detail::readU64(d + 9),
                                 hash = detail::readU64(d + 17);
-            if (Status st = player.advanceTo(frame); !st)
+            if (Status st = advanceTo(frame); !st)
                 return st;
             const std::uint64_t mine = world.geometryHash();
             ++stats.syncs;
@@ -231,6 +276,13 @@ std::optional<Frame> NetClient::placement(ObjectId object, double frame) const {
         q[i] = qa[i] * (1 - s) + sign * qb[i] * s;
     f.rotation = detail::fromQuaternion(q);
     return f;
+}
+
+std::optional<double> NetClient::placementFrame(ObjectId object) const {
+    const auto it = impl_->tracks.find(object);
+    if (it == impl_->tracks.end())
+        return std::nullopt;
+    return it->second.f1;
 }
 
 const ClientStats& NetClient::stats() const {

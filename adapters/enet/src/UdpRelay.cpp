@@ -44,6 +44,7 @@ double LinkModel::delay() {
 
 std::vector<double> LinkModel::send(double now, std::size_t bytes) {
     ++stats_.sent;
+    stats_.bytesSent += static_cast<long long>(bytes);
     // Every draw happens for every datagram, so a datagram's fate depends on its index only.
     const double lossDraw = rng_.uniform(), dupDraw = rng_.uniform();
     bad_ = bad_ ? lossDraw >= badToGood_ : lossDraw < goodToBad_;

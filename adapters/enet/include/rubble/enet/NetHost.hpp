@@ -17,14 +17,16 @@ namespace rubble::net {
 
 /// Totals of a host.
 struct HostStats {
-    int clients = 0;                ///< clients connected now
-    long long joins = 0;            ///< clients that joined (each got a snapshot)
-    long long eventsSent = 0;       ///< journal events sent (per client)
-    long long eventBytes = 0;       ///< bytes of journal event messages sent (per client, payload)
-    long long snapshotBytes = 0;    ///< bytes of snapshots sent
-    long long syncs = 0;            ///< frame syncs sent (per client)
-    long long impactEvents = 0;     ///< of eventsSent: impacts (the rest are removals)
-    long long placementBytes = 0;   ///< bytes of placement messages sent (per client, payload)
+    int clients = 0;              ///< clients connected now
+    long long joins = 0;          ///< clients that joined (each got a snapshot)
+    long long eventsSent = 0;     ///< journal events sent (per client)
+    long long eventBytes = 0;     ///< bytes of journal event messages sent (per client, payload)
+    long long snapshotBytes = 0;  ///< bytes of snapshots sent
+    long long syncs = 0;          ///< frame syncs sent (per client)
+    long long impactEvents = 0;   ///< of eventsSent: impacts (the rest are removals)
+    long long placementBytes = 0; ///< bytes of placement messages sent (per client, payload)
+    long long legacyPlacementBytes =
+        0;                          ///< what the 32-byte float records of every dynamic body would have been
     long long acks = 0;             ///< clients' hash reports received
     long long mismatchedHashes = 0; ///< reports whose geometry hash differed from the host's at that frame
 };
@@ -64,6 +66,8 @@ public:
     void setPlacementSource(std::function<std::vector<ObjectPlacement>()> source);
     /// Handles the network (joins, leaves, clients' hash reports) for up to timeoutMs.
     void service(int timeoutMs = 0);
+    /// The latest frame each connected client confirmed (in the order they joined).
+    std::vector<std::uint64_t> confirmedFrames() const;
     /// Totals.
     const HostStats& stats() const;
 

@@ -32,6 +32,7 @@ struct LinkProfile {
 /// Counts of a link.
 struct LinkStats {
     long long sent = 0;           ///< datagrams offered to the link
+    long long bytesSent = 0;      ///< bytes offered to the link
     long long delivered = 0;      ///< datagrams delivered (copies included)
     long long lost = 0;           ///< dropped by the loss model
     long long partitionDrops = 0; ///< dropped because the link was partitioned when sent or due
