@@ -80,11 +80,14 @@ struct Args {
 // Frames between placement samples, and how far behind its latest sync a client shows placements.
 constexpr long kSampleEvery = 30;
 constexpr long kViewLag = 6;
+// A client that keeps two placement periods in hand: a lost placements datagram is bridged by interpolation.
+constexpr long kSafeViewLag = 12;
 
 // A placement sample of a client: (frame, object, position).
 struct Sample {
     std::uint32_t frame, object;
     float x, y, z;
+    std::uint32_t lag; // kViewLag or kSafeViewLag
 };
 
 double percentile(std::vector<double> v, double q) {
@@ -337,7 +340,7 @@ int runHost(const Args& a) {
     long long mismatched = hs.mismatchedHashes;
     double lateJoinMs = -1;
     bool allConverged = true;
-    std::vector<double> allErrors, means, p99s;
+    std::vector<double> allErrors, allSafeErrors, means, p99s;
     for (std::size_t c = 0; c < children.size(); ++c) {
         Child& child = children[c];
         const std::string out = readAll(child.out);
@@ -361,30 +364,34 @@ int runHost(const Args& a) {
             j = report;
         }
         // Placement error against the host, for bodies dynamic at the sampled frame.
-        std::vector<double> errors;
+        std::map<std::uint32_t, std::vector<double>> errorsAt; // lag → errors
         long long missing = 0;
         {
             const std::string path = tmp + std::to_string(c);
             std::ifstream in(path, std::ios::binary);
-            std::map<std::uint64_t, std::map<ObjectId, Vec3>> seen;
+            std::map<std::uint32_t, std::map<std::uint64_t, std::map<ObjectId, Vec3>>> seen;
             for (Sample smp{}; in.read(reinterpret_cast<char*>(&smp), sizeof smp);)
-                seen[smp.frame][smp.object] = Vec3{smp.x, smp.y, smp.z};
+                seen[smp.lag][smp.frame][smp.object] = Vec3{smp.x, smp.y, smp.z};
             std::filesystem::remove(path);
-            for (const auto& [fr, bodies] : seen) {
-                const auto t = truth.find(fr);
-                if (t == truth.end())
-                    continue;
-                for (const auto& [id, at] : t->second) {
-                    const auto v = bodies.find(id);
-                    if (v == bodies.end()) {
-                        ++missing;
+            for (const auto& [lag, sampled] : seen)
+                for (const auto& [fr, bodies] : sampled) {
+                    const auto t = truth.find(fr);
+                    if (t == truth.end())
                         continue;
+                    for (const auto& [id, at] : t->second) {
+                        const auto v = bodies.find(id);
+                        if (v == bodies.end()) {
+                            missing += lag == kViewLag;
+                            continue;
+                        }
+                        errorsAt[lag].push_back(length(v->second - at) * 100);
                     }
-                    errors.push_back(length(v->second - at) * 100);
                 }
-            }
         }
+        const std::vector<double>& errors = errorsAt[kViewLag];
         allErrors.insert(allErrors.end(), errors.begin(), errors.end());
+        allSafeErrors.insert(allSafeErrors.end(), errorsAt[kSafeViewLag].begin(),
+                             errorsAt[kSafeViewLag].end());
         // In play: the seconds after its snapshot arrived (the join's burst is reported apart).
         const double joined = spawned[c] + (report.is_object() ? report.value("join_ms", 0.0) : 0.0) / 1000;
         std::vector<double> play, joining;
@@ -405,6 +412,8 @@ int runHost(const Args& a) {
                                    {"p99", percentile(errors, 0.99)},
                                    {"samples", errors.size()},
                                    {"missing", missing}};
+        j["placement_error_cm_lag12"] = {{"p50", percentile(errorsAt[kSafeViewLag], 0.5)},
+                                         {"p99", percentile(errorsAt[kSafeViewLag], 0.99)}};
         j["link"] = {{"down_lost", relays[c]->down().lost},
                      {"down_partition_drops", relays[c]->down().partitionDrops},
                      {"up_lost", relays[c]->up().lost}};
@@ -438,12 +447,19 @@ int runHost(const Args& a) {
     r["kbps_mean"] = means.empty() ? 0 : *std::max_element(means.begin(), means.end());
     r["kbps_p99"] = p99s.empty() ? 0 : *std::max_element(p99s.begin(), p99s.end());
     r["placement_error_cm"] = {{"p50", percentile(allErrors, 0.5)}, {"p99", percentile(allErrors, 0.99)}};
+    r["placement_error_cm_lag12"] = {{"p50", percentile(allSafeErrors, 0.5)},
+                                     {"p99", percentile(allSafeErrors, 0.99)}};
     r["host_geometry_hash"] = std::to_string(hostHash);
     r["clients"] = clients;
     const auto use = cpu.read();
     r["cpu_cores"] = {{"own", use.own}, {"other", use.other}};
     if (!a.out.empty()) {
         namespace b = rubble::bench;
+        std::streambuf* const stdout = std::cout.rdbuf(std::cerr.rdbuf()); // stdout is for --json
+        struct Restore {
+            std::streambuf* buf;
+            ~Restore() { std::cout.rdbuf(buf); }
+        } restore{stdout};
         writeResults(a.out,
                      {"scene",
                       "clients",
@@ -463,6 +479,7 @@ int runHost(const Args& a) {
                       "placement_ratio_vs_legacy",
                       "error_p50_cm",
                       "error_p99_cm",
+                      "error_p99_cm_lag12",
                       "mismatched_hashes",
                       "final_hashes_equal",
                       "converge_ms",
@@ -487,6 +504,7 @@ int runHost(const Args& a) {
                       b::fixed(r["placement_bytes_ratio_vs_legacy"].get<double>(), 3),
                       b::fixed(percentile(allErrors, 0.5), 2),
                       b::fixed(percentile(allErrors, 0.99), 2),
+                      b::fixed(percentile(allSafeErrors, 0.99), 2),
                       std::to_string(mismatched),
                       allConverged ? "1" : "0",
                       b::fixed(convergeMs, 0),
@@ -529,16 +547,19 @@ int runClient(const Args& a) {
         }
         // What it would show now: one placement period behind its latest sync, every half second.
         const std::uint64_t frame = (*client)->stats().frame;
-        if (frame != lastFrame && samples && frame >= static_cast<std::uint64_t>(kViewLag) &&
-            (frame - kViewLag) % kSampleEvery == 0) {
-            const double view = static_cast<double>(frame - kViewLag);
+        for (const long lag : {kViewLag, kSafeViewLag}) {
+            if (frame == lastFrame || !samples || frame < static_cast<std::uint64_t>(lag) ||
+                (frame - static_cast<std::uint64_t>(lag)) % kSampleEvery != 0)
+                continue;
+            const double view = static_cast<double>(frame - static_cast<std::uint64_t>(lag));
             for (ObjectId id : world.objects()) {
                 const std::optional<double> latest = (*client)->placementFrame(id);
                 if (!latest || *latest < view - 120)
                     continue; // at rest for two seconds or more: not a moving body
                 const Frame at = *(*client)->placement(id, view);
-                const Sample smp{static_cast<std::uint32_t>(view), id, static_cast<float>(at.translation.x),
-                                 static_cast<float>(at.translation.y), static_cast<float>(at.translation.z)};
+                const Sample smp{static_cast<std::uint32_t>(view),     id,
+                                 static_cast<float>(at.translation.x), static_cast<float>(at.translation.y),
+                                 static_cast<float>(at.translation.z), static_cast<std::uint32_t>(lag)};
                 samples.write(reinterpret_cast<const char*>(&smp), sizeof smp);
             }
         }

@@ -19,6 +19,9 @@ namespace rubble::net {
 using detail::Message;
 using Clock = std::chrono::steady_clock;
 
+/// Placements kept per body: enough to show it two placement periods behind with one datagram lost.
+constexpr std::size_t kTrackPoints = 4;
+
 struct NetClient::Impl {
     Impl(DestructionWorld& w, const DestructionWorld::Config& c) : world(w), config(c), player(w) {
         player.setOnOutcome([this](const FractureOutcome& o) { adopted(o); });
@@ -31,9 +34,20 @@ struct NetClient::Impl {
     Clock::time_point connected;
     Clock::time_point heard; // when the host was last heard
     ClientStats stats;
+    /// The latest placements of a body, by host frame (ascending, at most kTrackPoints).
     struct Track {
-        double f0 = 0, f1 = 0;
-        Frame a, b;
+        std::vector<std::pair<double, Frame>> points;
+        void add(double frame, const Frame& f) {
+            auto at = std::lower_bound(points.begin(), points.end(), frame,
+                                       [](const auto& p, double x) { return p.first < x; });
+            if (at != points.end() && at->first == frame)
+                return; // a duplicate
+            if (at == points.begin() && points.size() >= kTrackPoints)
+                return; // older than all it keeps
+            points.insert(at, {frame, f});
+            if (points.size() > kTrackPoints)
+                points.erase(points.begin());
+        }
     };
     std::map<ObjectId, Track> tracks; // also of pieces the world does not have yet
     detail::PlacementDecoder decoder;
@@ -87,7 +101,8 @@ struct NetClient::Impl {
             const Track parent = t->second;
             tracks.erase(t);
             for (const AdoptedPiece& p : o.pieces) // piece → parent local → world, unless the host said
-                tracks.try_emplace(p.id, Track{parent.f1, parent.f1, parent.b * p.frame, parent.b * p.frame});
+                tracks.try_emplace(
+                    p.id, Track{{{parent.points.back().first, parent.points.back().second * p.frame}}});
         }
         if (onOutcome)
             onOutcome(o);
@@ -104,13 +119,7 @@ struct NetClient::Impl {
         const double frame = static_cast<double>(frameNumber);
         for (const detail::DecodedPlacement& r : decoded) {
             const Frame f = detail::dequantize(r.q);
-            Track& t = tracks[r.id];
-            if (frame <= t.f1 && t.f1 > 0)
-                continue; // older than what we have (reordered)
-            t.f0 = t.f1 > 0 ? t.f1 : frame;
-            t.a = t.f1 > 0 ? t.b : f;
-            t.f1 = frame;
-            t.b = f;
+            tracks[r.id].add(frame, f);
             ++stats.placements;
         }
         std::vector<std::uint8_t> ack{static_cast<std::uint8_t>(Message::PlacementAck)};
@@ -134,7 +143,7 @@ struct NetClient::Impl {
             std::map<ObjectId, Track> fresh;
             detail::PlacementDecoder baselines;
             for (const ObjectPlacement& p : s->placements) {
-                fresh[p.object] = {frame, frame, p.objectToWorld, p.objectToWorld};
+                fresh[p.object].add(frame, p.objectToWorld);
                 baselines.setBaseline(p.object, detail::quantize(p.objectToWorld));
             }
             const std::uint64_t hostSeed = s->world.seed;
@@ -263,12 +272,21 @@ std::optional<Frame> NetClient::placement(ObjectId object, double frame) const {
     auto it = impl_->tracks.find(object);
     if (it == impl_->tracks.end())
         return std::nullopt;
-    const Impl::Track& t = it->second;
-    const double span = t.f1 - t.f0;
-    const double s = span > 0 ? std::clamp((frame - t.f0) / span, 0.0, 1.0) : 1.0;
+    const auto& points = it->second.points;
+    if (points.empty())
+        return std::nullopt;
+    if (frame <= points.front().first)
+        return points.front().second;
+    if (frame >= points.back().first)
+        return points.back().second;
+    std::size_t k = 0;
+    while (points[k + 1].first < frame)
+        ++k;
+    const Frame &a = points[k].second, &b = points[k + 1].second;
+    const double s = (frame - points[k].first) / (points[k + 1].first - points[k].first);
     Frame f;
-    f.translation = t.a.translation * (1 - s) + t.b.translation * s;
-    auto qa = detail::toQuaternion(t.a.rotation), qb = detail::toQuaternion(t.b.rotation);
+    f.translation = a.translation * (1 - s) + b.translation * s;
+    auto qa = detail::toQuaternion(a.rotation), qb = detail::toQuaternion(b.rotation);
     const double dot = qa[0] * qb[0] + qa[1] * qb[1] + qa[2] * qb[2] + qa[3] * qb[3];
     const double sign = dot < 0 ? -1 : 1; // the shorter way round
     std::array<double, 4> q{};
@@ -282,7 +300,7 @@ std::optional<double> NetClient::placementFrame(ObjectId object) const {
     const auto it = impl_->tracks.find(object);
     if (it == impl_->tracks.end())
         return std::nullopt;
-    return it->second.f1;
+    return it->second.points.empty() ? std::nullopt : std::optional<double>(it->second.points.back().first);
 }
 
 const ClientStats& NetClient::stats() const {
