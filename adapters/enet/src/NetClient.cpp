@@ -296,6 +296,19 @@ std::optional<Frame> NetClient::placement(ObjectId object, double frame) const {
     return f;
 }
 
+Status NetClient::shoot(const Vec3& origin, const Vec3& velocity) {
+    if (!impl_->server || !impl_->stats.connected)
+        return Error{ErrorCode::IoError, "netplay: not connected"};
+    std::vector<std::uint8_t> msg{static_cast<std::uint8_t>(Message::Shot)};
+    for (const Vec3& v : {origin, velocity})
+        for (int i = 0; i < 3; ++i)
+            detail::appendF32(msg, static_cast<float>(v[i]));
+    if (!detail::sendReliable(impl_->server, msg))
+        return Error{ErrorCode::IoError, "netplay: cannot send a shot"};
+    enet_host_flush(impl_->host);
+    return Status::ok();
+}
+
 std::optional<double> NetClient::placementFrame(ObjectId object) const {
     const auto it = impl_->tracks.find(object);
     if (it == impl_->tracks.end())

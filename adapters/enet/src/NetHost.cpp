@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <map>
 #include <vector>
 
@@ -33,6 +34,30 @@ struct NetHost::Impl {
 
     std::map<ENetPeer*, std::chrono::steady_clock::time_point> heard; // when each client was last heard
     std::map<ENetPeer*, std::uint64_t> joinOrder;                     // 0 for the first to join
+    std::function<void(const ShotRequest&)> shotHandler;
+    ShotRules shotRules;
+    std::map<ENetPeer*, double> shotTokens; // each client's bucket
+
+    // A client's shot: fired through the handler if it passes the rules, else counted as refused.
+    void shot(ENetPeer* peer, const std::uint8_t* d, std::size_t n) {
+        const auto refuse = [this] { ++stats.shotsRefused; };
+        if (n != 25 || !shotHandler || !peers.count(peer))
+            return refuse();
+        ShotRequest r;
+        r.client = joinOrder.at(peer);
+        r.origin = {detail::readF32(d + 1), detail::readF32(d + 5), detail::readF32(d + 9)};
+        r.velocity = {detail::readF32(d + 13), detail::readF32(d + 17), detail::readF32(d + 21)};
+        const double speed = length(r.velocity), distance = length(r.origin);
+        if (!std::isfinite(speed) || !std::isfinite(distance) || speed <= 0 || speed > shotRules.maxSpeed ||
+            distance > shotRules.maxDistance)
+            return refuse();
+        auto tokens = shotTokens.try_emplace(peer, shotRules.burst).first;
+        if (tokens->second < 1)
+            return refuse();
+        tokens->second -= 1;
+        ++stats.shotsAccepted;
+        shotHandler(r);
+    }
 
     void join(ENetPeer* peer) {
         detail::configurePeer(peer);
@@ -68,6 +93,8 @@ struct NetHost::Impl {
                 e->second.acked(detail::readU32(d + 1), detail::readU32(d + 5));
             return;
         }
+        if (d[0] == static_cast<std::uint8_t>(Message::Shot))
+            return shot(peer, d, packet->dataLength);
         if (packet->dataLength != 17 || d[0] != static_cast<std::uint8_t>(Message::Ack) || !peers.count(peer))
             return; // clients send nothing else
         ++stats.acks;
@@ -123,6 +150,8 @@ void NetHost::publish() {
     const std::uint64_t end = im.world.journalPosition();
     const std::uint64_t frame = im.world.frame(), hash = im.world.geometryHash();
     im.hashes[frame] = hash;
+    for (auto& [peer, tokens] : im.shotTokens) // the shot buckets refill per frame (60 Hz)
+        tokens = std::min(im.shotRules.burst, tokens + im.shotRules.perSecond / 60);
     im.lastSync = frame;
     while (im.hashes.size() > 4096)
         im.hashes.erase(im.hashes.begin());
@@ -216,12 +245,18 @@ void NetHost::service(int timeoutMs) {
             im.encoders.erase(e.peer);
             im.heard.erase(e.peer);
             im.joinOrder.erase(e.peer);
+            im.shotTokens.erase(e.peer);
             break;
         default:
             break;
         }
     }
     im.stats.clients = static_cast<int>(im.peers.size());
+}
+
+void NetHost::setShotHandler(std::function<void(const ShotRequest&)> handler, ShotRules rules) {
+    impl_->shotHandler = std::move(handler);
+    impl_->shotRules = rules;
 }
 
 std::vector<std::uint64_t> NetHost::confirmedFrames() const {

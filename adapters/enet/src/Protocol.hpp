@@ -24,6 +24,7 @@ enum class Message : std::uint8_t {
     Ack = 4,          ///< client → host: u64 frame, u64 its geometry hash after that sync
     Placements = 5,   ///< channel 1, unreliable: u32 seq, then varints and records (Placements.hpp)
     PlacementAck = 6, ///< client → host, channel 1, unreliable: u32 latest seq, u32 mask of the 32 before
+    Shot = 7, ///< client → host: 3 f32 origin, 3 f32 velocity (the host checks it, then fires it or not)
 };
 
 /// Appends a little-endian float.

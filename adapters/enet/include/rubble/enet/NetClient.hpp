@@ -47,6 +47,9 @@ public:
     /// the host sent for it (position linearly, rotation by normalised quaternion blend), held at the ends.
     /// A new piece starts where its parent was. Empty for an object the client has no placement of.
     std::optional<Frame> placement(ObjectId object, double frame) const;
+    /// Asks the host to fire a shot (it checks it first: docs/netplay.md, 'Trust model'). Fails when not
+    /// connected.
+    Status shoot(const Vec3& origin, const Vec3& velocity);
     /// Host frame of the latest placement received for an object (empty when none arrived).
     std::optional<double> placementFrame(ObjectId object) const;
     /// Called for every outcome the world adopts (its pieces are in the world already).

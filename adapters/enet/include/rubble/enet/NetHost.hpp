@@ -29,6 +29,23 @@ struct HostStats {
         0;                          ///< what the 32-byte float records of every dynamic body would have been
     long long acks = 0;             ///< clients' hash reports received
     long long mismatchedHashes = 0; ///< reports whose geometry hash differed from the host's at that frame
+    long long shotsAccepted = 0;    ///< clients' shots that passed the checks (handed to the shot handler)
+    long long shotsRefused = 0; ///< clients' shots refused: malformed, implausible, too many, or no handler
+};
+
+/// What a client may ask for: a shot, checked by the host before anything happens.
+struct ShotRules {
+    double perSecond = 10; ///< sustained shots per second per client (a bucket refilled per published frame)
+    double burst = 10;     ///< shots a client may fire at once
+    double maxSpeed = 200; ///< m/s
+    double maxDistance = 1e3; ///< how far from the world's origin a shot may start (m)
+};
+
+/// A client's shot that passed the checks.
+struct ShotRequest {
+    std::uint64_t client = 0; ///< the client, in the order they joined (0 = the first)
+    Vec3 origin;              ///< where it starts (m)
+    Vec3 velocity;            ///< m/s
 };
 
 /// A host on 127.0.0.1 (only loopback addresses are accepted). Replicates the world it is given; the world
@@ -66,6 +83,10 @@ public:
     void setPlacementSource(std::function<std::vector<ObjectPlacement>()> source);
     /// Handles the network (joins, leaves, clients' hash reports) for up to timeoutMs.
     void service(int timeoutMs = 0);
+    /// Takes clients' shots: each one that passes `rules` (finite, speed and origin in range, within the
+    /// client's rate) goes to `handler`, which fires it in the host's world; everything else is refused and
+    /// counted. Without a handler, every shot is refused: clients change nothing.
+    void setShotHandler(std::function<void(const ShotRequest&)> handler, ShotRules rules = {});
     /// The latest frame each connected client confirmed (in the order they joined).
     std::vector<std::uint64_t> confirmedFrames() const;
     /// Totals.
