@@ -22,6 +22,10 @@
 // float records of every dynamic body, every time) in the same run, converge_ms (partition end → every client
 // confirmed a frame at most 12 frames behind the host), late_join_ms, snapshot_bytes. With --out, one row is
 // added to DIR/netplay.csv and DIR/netplay.png is drawn again.
+//
+// With --client-shots R each client asks the host for R shots a second at objects it sees; the host checks
+// them (NetHost::setShotHandler) and fires those it accepts. With --shots-per-second 0 as well, the host is a
+// headless authoritative server whose world changes only through its clients' checked shots.
 #include "Subcommand.hpp"
 
 #if defined(RUBBLE_HAVE_BULLET) && defined(RUBBLE_HAVE_ENET)
@@ -65,6 +69,8 @@ struct Args {
     double seconds = 60;
     int clients = 2;
     double shotsPerSecond = 10;
+    double clientShots = 0; // shots per second each client asks the host for
+    double shootFor = 0;    // client: seconds it shoots for
     int workers = -1;
     std::uint64_t seed = 1;
     double lateJoin = 1.0 / 3;
@@ -142,10 +148,11 @@ Child spawn(const Args& a, std::uint16_t port, const std::string& samples) {
         close(fds[0]);
         close(fds[1]);
         const std::string p = std::to_string(port), w = std::to_string(a.workers), s = std::to_string(a.seed),
-                          t = std::to_string(a.seconds + 60);
+                          t = std::to_string(a.seconds + 60), shoot = std::to_string(a.clientShots),
+                          until = std::to_string(a.seconds);
         execl("/proc/self/exe", "rubble-bench", "netplay-client", "--port", p.c_str(), "--workers", w.c_str(),
-              "--seed", s.c_str(), "--seconds", t.c_str(), "--samples", samples.c_str(),
-              static_cast<char*>(nullptr));
+              "--seed", s.c_str(), "--seconds", t.c_str(), "--samples", samples.c_str(), "--shoot",
+              shoot.c_str(), "--shoot-for", until.c_str(), static_cast<char*>(nullptr));
         _exit(127);
     }
     close(fds[1]);
@@ -277,11 +284,16 @@ int runHost(const Args& a) {
                                           std::chrono::duration<double>(a.partitionAt + a.partitionS));
     double convergeMs = -1;
     long shots = 0, f = 0;
+    std::vector<net::ShotRequest> requested; // clients' shots that passed the host's checks
+    host.setShotHandler([&](const net::ShotRequest& r) { requested.push_back(r); });
     auto frame = [&](bool firing) {
         std::this_thread::sleep_until(start + period * f);
         const long due = static_cast<long>(static_cast<double>(f) * a.shotsPerSecond / 60.0);
         for (; firing && shots < due; ++shots)
             fire(runtime, rng);
+        for (const net::ShotRequest& r : requested)
+            runtime.fireProjectile(r.origin, r.velocity, 2, 0.25);
+        requested.clear();
         runtime.stepFrame();
         host.publish();
         const std::uint64_t now = runtime.world().frame();
@@ -440,6 +452,8 @@ int runHost(const Args& a) {
             ? static_cast<double>(hs.placementBytes) / static_cast<double>(hs.legacyPlacementBytes)
             : 0;
     r["mismatched_hashes"] = mismatched;
+    r["client_shots_accepted"] = hs.shotsAccepted;
+    r["client_shots_refused"] = hs.shotsRefused;
     r["late_join_ms"] = lateJoinMs;
     r["snapshot_bytes"] = hs.snapshotBytes / std::max<long long>(1, hs.joins);
     r["final_hashes_equal"] = allConverged;
@@ -523,7 +537,8 @@ int runHost(const Args& a) {
                   << " mismatched hashes, late join " << lateJoinMs << " ms, converge " << convergeMs
                   << " ms, final hashes equal: " << (allConverged ? "yes" : "NO") << "\n";
     }
-    return mismatched == 0 && allConverged && !children.empty() ? 0 : 1;
+    const bool shotsTaken = a.clientShots <= 0 || hs.shotsAccepted > 0;
+    return mismatched == 0 && allConverged && shotsTaken && !children.empty() ? 0 : 1;
 }
 
 int runClient(const Args& a) {
@@ -535,6 +550,23 @@ int runClient(const Args& a) {
         std::cout << nlohmann::json{{"error", client.error().message}}.dump() << "\n";
         return 1;
     }
+    Rng aim(mixSeed(a.seed, static_cast<std::uint64_t>(getpid())));
+    long long shotsSent = 0;
+    const auto shootAt = [&](double view) { // a shot from 30 m at a random destructible object it can see
+        std::vector<ObjectId> targets;
+        for (ObjectId id : world.objects())
+            if (world.object(id)->destructible && (*client)->placement(id, view))
+                targets.push_back(id);
+        if (targets.empty())
+            return;
+        const ObjectId id = targets[static_cast<std::size_t>(aim.below(targets.size()))];
+        const Vec3 at = (*client)->placement(id, view)->apply(world.object(id)->mesh.bounds().center());
+        const double phi = aim.uniform(0, 2 * 3.14159265358979);
+        const Vec3 dir = normalized(Vec3{std::cos(phi), 0.3, std::sin(phi)});
+        if ((*client)->shoot(at + dir * 30.0, dir * -120.0))
+            ++shotsSent;
+    };
+    const auto started = Clock::now();
     std::ofstream samples;
     if (!a.samples.empty())
         samples.open(a.samples, std::ios::binary);
@@ -564,6 +596,10 @@ int runClient(const Args& a) {
             }
         }
         lastFrame = frame;
+        const double since = std::chrono::duration<double>(Clock::now() - started).count();
+        if (a.clientShots > 0 && (*client)->stats().joined && since < a.shootFor &&
+            static_cast<double>(shotsSent) < since * a.clientShots)
+            shootAt(static_cast<double>(frame));
     }
     const net::ClientStats& st = (*client)->stats();
     nlohmann::json j{{"joined", st.joined},
@@ -575,6 +611,7 @@ int runClient(const Args& a) {
                      {"geometry_hash", std::to_string(world.geometryHash())},
                      {"placements", st.placements},
                      {"placement_bytes", st.placementBytes},
+                     {"shots_sent", shotsSent},
                      {"ending", ending}};
     std::cout << j.dump() << "\n";
     return st.joined ? 0 : 1;
@@ -588,7 +625,11 @@ const rubble::tools::Registrar host{
          app.add_option("--seconds", a->seconds, "seconds of continuous fire")
              ->check(CLI::Range(0.1, 3600.0));
          app.add_option("--clients", a->clients, "client processes")->check(CLI::Range(1, 16));
-         app.add_option("--shots-per-second", a->shotsPerSecond, "projectiles per second");
+         app.add_option("--shots-per-second", a->shotsPerSecond, "projectiles per second the host fires");
+         app.add_option(
+                "--client-shots", a->clientShots,
+                "shots per second each client asks for (the host checks them, fires those it accepts)")
+             ->check(CLI::Range(0.0, 100.0));
          app.add_option("--workers", a->workers, "fracture workers of host and clients (-1 automatic)");
          app.add_option("--seed", a->seed, "world and firing seed");
          app.add_option("--late-join", a->lateJoin, "the last client joins at this fraction of the run")
@@ -623,6 +664,8 @@ const rubble::tools::Registrar client{
          app.add_option("--seed", a->seed, "world seed (the host's)");
          app.add_option("--seconds", a->seconds, "give up after this many seconds");
          app.add_option("--samples", a->samples, "file for its placement samples");
+         app.add_option("--shoot", a->clientShots, "shots per second it asks the host for");
+         app.add_option("--shoot-for", a->shootFor, "seconds it shoots for");
          return [a] { return runClient(*a); };
      }}};
 
