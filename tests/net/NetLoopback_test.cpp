@@ -10,6 +10,7 @@
 #include <cmath>
 
 #include "JournalScene.hpp"
+#include "NetWait.hpp"
 
 namespace rubble {
 namespace {
@@ -39,15 +40,10 @@ TEST(NetLoopback, ClientsConvergeToTheHostsGeometryHash) {
     // Every wait below is for a condition, with a deadline generous enough for a loaded machine under the
     // sanitizers: never for an assumed number of frames or milliseconds.
     const auto until = [&](const auto& done) {
-        const auto end = std::chrono::steady_clock::now() + std::chrono::minutes(2);
-        while (!done()) {
-            if (std::chrono::steady_clock::now() > end)
-                return false;
+        return test::waitFor(done, [&] {
             h.service(1);
-            if (!(*first)->service(1) || (second && !second->service(1)))
-                return false;
-        }
-        return true;
+            return (*first)->service(1) && (!second || second->service(1));
+        });
     };
     ASSERT_TRUE(until([&] { return (*first)->stats().joined; }));
     for (int frame = 0; frame < 240; ++frame) {

@@ -18,6 +18,7 @@
 #include <thread>
 
 #include "JournalScene.hpp"
+#include "NetWait.hpp"
 
 namespace rubble {
 namespace {
@@ -68,17 +69,15 @@ TEST(NetRelay, ClientsThroughMisbehavingLinksConvergeAfterAPartitionAndAReplacem
             ASSERT_TRUE(f->client->service(0));
     };
     const auto until = [&](const auto& done) {
-        for (const auto end = Clock::now() + std::chrono::minutes(2); !done();) {
-            if (Clock::now() > end)
-                return false;
+        return test::waitFor(done, [&] {
             h.service(1);
             for (auto& f : live)
                 if (Status st = f->client->service(1); !st) {
                     ADD_FAILURE() << st.message();
                     return false;
                 }
-        }
-        return true;
+            return true;
+        });
     };
     ASSERT_TRUE(until([&] { return live[0]->client->stats().joined && live[1]->client->stats().joined; }));
     Clock::time_point healAt{};

@@ -10,6 +10,7 @@
 #include <limits>
 
 #include "JournalScene.hpp"
+#include "NetWait.hpp"
 
 namespace rubble {
 namespace {
@@ -25,14 +26,10 @@ TEST(NetShots, TheHostFiresOnlyTheShotsThatPassItsRules) {
     ASSERT_TRUE(client);
     net::NetClient& c = **client;
     const auto until = [&](const auto& done) {
-        for (const auto end = std::chrono::steady_clock::now() + std::chrono::minutes(2); !done();) {
-            if (std::chrono::steady_clock::now() > end)
-                return false;
+        return test::waitFor(done, [&] {
             h.service(1);
-            if (!c.service(1))
-                return false;
-        }
-        return true;
+            return static_cast<bool>(c.service(1));
+        });
     };
     ASSERT_TRUE(until([&] { return c.stats().joined; }));
     const auto counted = [&] { return h.stats().shotsAccepted + h.stats().shotsRefused; };
