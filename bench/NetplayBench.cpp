@@ -1,21 +1,31 @@
 // `rubble-bench netplay SCENE.cfg [--seconds T] [--clients N] [--shots-per-second R] [--workers W] [--seed S]
-//  [--late-join F] [--json]`
+//  [--late-join F] [--delay-ms D] [--jitter-ms J] [--loss L] [--burst B] [--partition-at A --partition-s P]
+//  [--placement-budget BYTES] [--json] [--out DIR]`
 //
-// Loopback multiplayer as separate processes (issue #17): this process hosts the scene on the Bullet binding
-// in deterministic mode (fixed 1/60 s frames paced at 60 Hz, seeded projectiles at destructible bodies), and
-// starts N clients (`rubble-bench netplay-client`, this executable again) that connect over ENet to
-// 127.0.0.1; the last one joins at fraction F of the run (default 1/3: snapshot + journal tail), the others
-// at once. Each frame the host publishes the journal events and a sync with its geometry hash; every 6th
-// frame the dynamic bodies' placements (10 Hz). Each client checks its geometry hash at every sync. After T
-// seconds the host stops firing, lets the fracture jobs finish, waits (at most 10 s) for every client to
-// confirm the last sync, closes the connections; the clients print their figures and exit (a client still
-// running 15 s later is killed). Bounded in time and packets; loopback addresses only.
+// Multiplayer as separate processes over a network that misbehaves: this process hosts the scene on the
+// Bullet binding in deterministic mode (fixed 1/60 s frames paced at 60 Hz, seeded projectiles at
+// destructible bodies) and starts N clients (`rubble-bench netplay-client`, this executable again), each
+// connecting over ENet to 127.0.0.1 through its own seeded UdpRelay (one-way delay D ms with jitter J ms each
+// way, loss L with mean bursts of B datagrams, and a partition of P s at A s into the run); the last one
+// joins at fraction F of the run (default 1/3: snapshot + journal tail), the others at once. Each frame the
+// host publishes the journal events and a sync with its geometry hash; every 6th frame the placements (10 Hz,
+// BYTES per client at most). After T seconds the host stops firing, lets the fracture jobs finish, waits (at
+// most 10 s) for every client to confirm the last sync, closes the connections; the clients print their
+// figures and exit (a client still running 15 s later is killed). Bounded in time and packets; loopback
+// addresses only.
 //
-// Reports impacts (host journal impacts), geometry_bytes_per_impact (journal event messages sent to one
-// client / impacts: 48 bytes per event plus a 5-byte header per frame's batch; removals are events too),
-// transform_bytes_per_s (placement bytes sent to one client per second), mismatched_hashes (Σ over clients of
-// syncs whose hash differed, plus hashes reported back to the host that differed), late_join_ms (connect →
-// snapshot loaded, last client), snapshot_bytes, and the clients' sync counts.
+// Reports per client the kbps the host offered its link (UDP payload: ENet headers included, IP/UDP headers
+// not), mean and 99th-percentile second, its mismatched hashes and placement error (the client's interpolated
+// placement one placement period behind its latest sync against the host's at that frame, every half second,
+// for bodies that were dynamic then: cm, p50 and p99); in all: geometry_bytes_per_impact (journal event
+// messages sent to one client / impacts), the placement bytes against the previous protocol's (32-byte
+// float records of every dynamic body, every time) in the same run, converge_ms (partition end → every client
+// confirmed a frame at most 12 frames behind the host), late_join_ms, snapshot_bytes. With --out, one row is
+// added to DIR/netplay.csv and DIR/netplay.png is drawn again.
+//
+// With --client-shots R each client asks the host for R shots a second at objects it sees; the host checks
+// them (NetHost::setShotHandler) and fires those it accepts. With --shots-per-second 0 as well, the host is a
+// headless authoritative server whose world changes only through its clients' checked shots.
 #include "Subcommand.hpp"
 
 #if defined(RUBBLE_HAVE_BULLET) && defined(RUBBLE_HAVE_ENET)
@@ -24,10 +34,15 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
+#include <map>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -43,6 +58,7 @@
 #include "rubble/bullet/PhysicsWorld.hpp"
 #include "rubble/enet/NetClient.hpp"
 #include "rubble/enet/NetHost.hpp"
+#include "rubble/enet/UdpRelay.hpp"
 
 namespace {
 
@@ -53,12 +69,40 @@ struct Args {
     double seconds = 60;
     int clients = 2;
     double shotsPerSecond = 10;
+    double clientShots = 0; // shots per second each client asks the host for
+    double shootFor = 0;    // client: seconds it shoots for
     int workers = -1;
     std::uint64_t seed = 1;
     double lateJoin = 1.0 / 3;
     bool json = false;
-    int port = 0; // client: the host's port
+    double delayMs = 0, jitterMs = 0, loss = 0, burst = 1;
+    double partitionAt = -1, partitionS = 0;
+    int budget = 1200;
+    std::string out;     // folder for netplay.csv and netplay.png ("" = none)
+    int port = 0;        // client: the host's port
+    std::string samples; // client: where it writes its placement samples
 };
+
+// Frames between placement samples, and how far behind its latest sync a client shows placements.
+constexpr long kSampleEvery = 30;
+constexpr long kViewLag = 6;
+// A client that keeps two placement periods in hand: a lost placements datagram is bridged by interpolation.
+constexpr long kSafeViewLag = 12;
+
+// A placement sample of a client: (frame, object, position).
+struct Sample {
+    std::uint32_t frame, object;
+    float x, y, z;
+    std::uint32_t lag; // kViewLag or kSafeViewLag
+};
+
+double percentile(std::vector<double> v, double q) {
+    if (v.empty())
+        return -1;
+    std::sort(v.begin(), v.end());
+    const auto k = static_cast<std::size_t>(std::ceil(q * static_cast<double>(v.size()))) - (q > 0 ? 1 : 0);
+    return v[std::min(k, v.size() - 1)];
+}
 
 rubble::DestructionRuntime::Config runtimeConfig(const Args& a) {
     rubble::DestructionRuntime::Config rc;
@@ -94,7 +138,7 @@ struct Child {
     int out = -1; // read end of its stdout
 };
 
-Child spawn(const Args& a, std::uint16_t port) {
+Child spawn(const Args& a, std::uint16_t port, const std::string& samples) {
     int fds[2];
     if (pipe(fds) != 0)
         return {};
@@ -104,9 +148,11 @@ Child spawn(const Args& a, std::uint16_t port) {
         close(fds[0]);
         close(fds[1]);
         const std::string p = std::to_string(port), w = std::to_string(a.workers), s = std::to_string(a.seed),
-                          t = std::to_string(a.seconds + 60);
+                          t = std::to_string(a.seconds + 60), shoot = std::to_string(a.clientShots),
+                          until = std::to_string(a.seconds);
         execl("/proc/self/exe", "rubble-bench", "netplay-client", "--port", p.c_str(), "--workers", w.c_str(),
-              "--seed", s.c_str(), "--seconds", t.c_str(), static_cast<char*>(nullptr));
+              "--seed", s.c_str(), "--seconds", t.c_str(), "--samples", samples.c_str(), "--shoot",
+              shoot.c_str(), "--shoot-for", until.c_str(), static_cast<char*>(nullptr));
         _exit(127);
     }
     close(fds[1]);
@@ -120,6 +166,62 @@ std::string readAll(int fd) {
         s.append(buf, static_cast<std::size_t>(n));
     close(fd);
     return s;
+}
+
+// The link of a client spawned `at` seconds into the run: the partition window is in run time.
+rubble::net::LinkProfile linkProfile(const Args& a, double at) {
+    rubble::net::LinkProfile p;
+    p.delayMs = a.delayMs;
+    p.jitterMs = a.jitterMs;
+    p.loss = a.loss;
+    p.burstLength = a.burst;
+    if (a.partitionAt >= 0 && a.partitionS > 0 && a.partitionAt + a.partitionS > at) {
+        p.partitionStartS = std::max(0.0, a.partitionAt - at);
+        p.partitionS = a.partitionAt + a.partitionS - at - p.partitionStartS;
+    }
+    return p;
+}
+
+// Appends a row to DIR/netplay.csv (keeping the rows there) and draws DIR/netplay.png from all of them.
+void writeResults(const std::string& dir, const std::vector<std::string>& header,
+                  const std::vector<std::string>& row) {
+    namespace fs = std::filesystem;
+    rubble::bench::Table t;
+    t.header = header;
+    std::ifstream in(fs::path(dir) / "netplay.csv");
+    std::string line;
+    bool first = true;
+    while (std::getline(in, line)) {
+        if (first) { // an older header: its rows are dropped
+            first = false;
+            if (line != [&] {
+                    std::string h;
+                    for (std::size_t i = 0; i < header.size(); ++i)
+                        h += (i ? "," : "") + header[i];
+                    return h;
+                }())
+                break;
+            continue;
+        }
+        std::vector<std::string> cells;
+        std::string cell;
+        for (std::istringstream ls(line); std::getline(ls, cell, ',');)
+            cells.push_back(cell);
+        if (cells.size() == header.size())
+            t.rows.push_back(cells);
+    }
+    t.rows.push_back(row);
+    if (!rubble::bench::writeCsv(fs::path(dir) / "netplay.csv", t))
+        return;
+    std::string data;
+    for (std::size_t i = 0; i < t.rows.size(); ++i) // index, label, kbps mean, kbps p99, error p99
+        data += std::to_string(i) + " " + t.rows[i][1] + "c/" + t.rows[i][4] + "ms/" + t.rows[i][6] + " " +
+                t.rows[i][11] + " " + t.rows[i][12] + " " + t.rows[i][17] + "\n";
+    rubble::bench::plotPng(dir, "netplay", data,
+                           "set title 'Netplay through the relay: kbps per client (clients/delay/loss)'\n"
+                           "set style data histogram\nset style fill solid 0.6\nset yrange [0:*]\n"
+                           "set ylabel 'kbps'\n"
+                           "plot $DATA u 3:xtic(2) t 'mean', '' u 4 t 'p99 second', 150 w l t '150 kbps'");
 }
 
 int runHost(const Args& a) {
@@ -143,40 +245,105 @@ int runHost(const Args& a) {
     }
     net::NetHost& host = **server;
     host.setPlacementSource([&] { return runtime.placements(); });
+    host.setPlacementBudget(static_cast<std::size_t>(a.budget));
+    const std::string tmp =
+        (std::filesystem::temp_directory_path() / ("rubble-netplay-" + std::to_string(getpid()) + "-"))
+            .string();
     std::vector<Child> children;
+    std::vector<std::unique_ptr<net::UdpRelay>> relays;
+    std::vector<std::vector<double>> kbps, kbpsUp; // per client, per second
+    std::vector<std::vector<double>> secondEnds;   // per client: when each of those seconds ended (run s)
+    std::vector<double> spawned;                   // per client: when it was started (run s)
+    const auto start = Clock::now();
+    const auto launch = [&] {
+        const double at = std::chrono::duration<double>(Clock::now() - start).count();
+        const net::LinkProfile link = linkProfile(a, at);
+        auto relay = net::UdpRelay::start(host.port(), link, link, mixSeed(a.seed, 100 + children.size()));
+        if (!relay) {
+            std::cerr << "rubble-bench netplay: " << relay.error().message << "\n";
+            return;
+        }
+        children.push_back(spawn(a, (*relay)->port(), tmp + std::to_string(children.size())));
+        relays.push_back(std::move(*relay));
+        kbps.emplace_back();
+        kbpsUp.emplace_back();
+        secondEnds.emplace_back();
+        spawned.push_back(at);
+    };
     for (int i = 0; i + 1 < a.clients; ++i)
-        children.push_back(spawn(a, host.port()));
+        launch();
     Rng rng(mixSeed(a.seed, 0x4E7));
     const long frames = std::max(1L, std::lround(a.seconds * 60));
     const long lateFrame = a.clients > 0 ? std::lround(static_cast<double>(frames) * a.lateJoin) : -1;
     const rubble::bench::CpuMeter cpu; // the clients are other processes: "other" includes them
-    const auto start = Clock::now();
     const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / 60));
+    std::map<std::uint64_t, std::map<ObjectId, Vec3>> truth; // frame → dynamic bodies' positions
+    std::vector<long long> lastDown, lastUp;
+    auto lastSecond = Clock::now();
+    const auto partitionEnd = start + std::chrono::duration_cast<Clock::duration>(
+                                          std::chrono::duration<double>(a.partitionAt + a.partitionS));
+    double convergeMs = -1;
     long shots = 0, f = 0;
+    std::vector<net::ShotRequest> requested; // clients' shots that passed the host's checks
+    host.setShotHandler([&](const net::ShotRequest& r) { requested.push_back(r); });
     auto frame = [&](bool firing) {
         std::this_thread::sleep_until(start + period * f);
         const long due = static_cast<long>(static_cast<double>(f) * a.shotsPerSecond / 60.0);
         for (; firing && shots < due; ++shots)
             fire(runtime, rng);
+        for (const net::ShotRequest& r : requested)
+            runtime.fireProjectile(r.origin, r.velocity, 2, 0.25);
+        requested.clear();
         runtime.stepFrame();
         host.publish();
-        if (f % 6 == 0)
-            host.publishPlacements(runtime.placements());
+        const std::uint64_t now = runtime.world().frame();
+        if (f % 6 == 0 || now % kSampleEvery == 0) {
+            const std::vector<ObjectPlacement> placements = runtime.placements();
+            if (f % 6 == 0)
+                host.publishPlacements(placements);
+            if (now % kSampleEvery == 0)
+                for (const ObjectPlacement& p : placements)
+                    if (p.motion == BodyMotionState::Dynamic)
+                        truth[now][p.object] = p.objectToWorld.translation;
+        }
         host.service(0);
+        if (Clock::now() - lastSecond >= std::chrono::seconds(1)) { // each client's link, per second
+            const double dt = std::chrono::duration<double>(Clock::now() - lastSecond).count();
+            lastSecond = Clock::now();
+            lastDown.resize(relays.size(), 0);
+            lastUp.resize(relays.size(), 0);
+            for (std::size_t i = 0; i < relays.size(); ++i) {
+                const long long down = relays[i]->down().bytesSent, up = relays[i]->up().bytesSent;
+                kbps[i].push_back(static_cast<double>(down - lastDown[i]) * 8 / 1000 / dt);
+                kbpsUp[i].push_back(static_cast<double>(up - lastUp[i]) * 8 / 1000 / dt);
+                secondEnds[i].push_back(std::chrono::duration<double>(lastSecond - start).count());
+                lastDown[i] = down;
+                lastUp[i] = up;
+            }
+        }
+        if (a.partitionS > 0 && convergeMs < 0 && Clock::now() >= partitionEnd) {
+            const std::vector<std::uint64_t> confirmed = host.confirmedFrames();
+            if (!confirmed.empty() && *std::min_element(confirmed.begin(), confirmed.end()) + 12 >= now)
+                convergeMs = std::chrono::duration<double, std::milli>(Clock::now() - partitionEnd).count();
+        }
         ++f;
     };
     for (; f < frames;) {
         if (f == lateFrame)
-            children.push_back(spawn(a, host.port()));
+            launch();
         frame(true);
     }
     for (int i = 0; i < 600 && runtime.world().jobsInFlight() > 0; ++i)
         frame(false);
     // Every client confirms the last sync (or 10 s pass).
-    const long long expected = host.stats().syncs;
-    for (const auto t0 = Clock::now();
-         host.stats().acks < expected && Clock::now() - t0 < std::chrono::seconds(10);)
+    const std::uint64_t lastFrame = runtime.world().frame();
+    for (const auto t0 = Clock::now(); Clock::now() - t0 < std::chrono::seconds(10);) {
+        const std::vector<std::uint64_t> confirmed = host.confirmedFrames();
+        if (confirmed.size() == children.size() &&
+            std::all_of(confirmed.begin(), confirmed.end(), [&](std::uint64_t c) { return c >= lastFrame; }))
+            break;
         host.service(5);
+    }
     const net::HostStats hs = host.stats();
     const double runSeconds = std::chrono::duration<double>(Clock::now() - start).count();
     const std::uint64_t hostHash = runtime.world().geometryHash();
@@ -185,59 +352,193 @@ int runHost(const Args& a) {
     long long mismatched = hs.mismatchedHashes;
     double lateJoinMs = -1;
     bool allConverged = true;
-    for (Child& c : children) {
-        const std::string out = readAll(c.out);
+    std::vector<double> allErrors, allSafeErrors, means, p99s;
+    for (std::size_t c = 0; c < children.size(); ++c) {
+        Child& child = children[c];
+        const std::string out = readAll(child.out);
         int status = 0;
-        for (int i = 0; i < 1500 && waitpid(c.pid, &status, WNOHANG) == 0; ++i)
+        for (int i = 0; i < 1500 && waitpid(child.pid, &status, WNOHANG) == 0; ++i)
             std::this_thread::sleep_for(std::chrono::milliseconds(10));
-        if (waitpid(c.pid, &status, WNOHANG) == 0) {
-            kill(c.pid, SIGKILL);
-            waitpid(c.pid, &status, 0);
+        if (waitpid(child.pid, &status, WNOHANG) == 0) {
+            kill(child.pid, SIGKILL);
+            waitpid(child.pid, &status, 0);
         }
-        nlohmann::json j = nlohmann::json::parse(out, nullptr, false);
-        if (j.is_discarded() || !j.is_object()) {
+        nlohmann::json report = nlohmann::json::parse(out, nullptr, false);
+        nlohmann::json j;
+        if (report.is_discarded() || !report.is_object()) {
             j = {{"error", "no report"}, {"output", out}};
             allConverged = false;
         } else {
-            mismatched += j.value("mismatched_hashes", 0LL);
-            lateJoinMs = j.value("join_ms", -1.0);
+            mismatched += report.value("mismatched_hashes", 0LL);
+            lateJoinMs = report.value("join_ms", -1.0);
             allConverged =
-                allConverged && j.value("geometry_hash", std::string()) == std::to_string(hostHash);
+                allConverged && report.value("geometry_hash", std::string()) == std::to_string(hostHash);
+            j = report;
         }
+        // Placement error against the host, for bodies dynamic at the sampled frame.
+        std::map<std::uint32_t, std::vector<double>> errorsAt; // lag → errors
+        long long missing = 0;
+        {
+            const std::string path = tmp + std::to_string(c);
+            std::ifstream in(path, std::ios::binary);
+            std::map<std::uint32_t, std::map<std::uint64_t, std::map<ObjectId, Vec3>>> seen;
+            for (Sample smp{}; in.read(reinterpret_cast<char*>(&smp), sizeof smp);)
+                seen[smp.lag][smp.frame][smp.object] = Vec3{smp.x, smp.y, smp.z};
+            std::filesystem::remove(path);
+            for (const auto& [lag, sampled] : seen)
+                for (const auto& [fr, bodies] : sampled) {
+                    const auto t = truth.find(fr);
+                    if (t == truth.end())
+                        continue;
+                    for (const auto& [id, at] : t->second) {
+                        const auto v = bodies.find(id);
+                        if (v == bodies.end()) {
+                            missing += lag == kViewLag;
+                            continue;
+                        }
+                        errorsAt[lag].push_back(length(v->second - at) * 100);
+                    }
+                }
+        }
+        const std::vector<double>& errors = errorsAt[kViewLag];
+        allErrors.insert(allErrors.end(), errors.begin(), errors.end());
+        allSafeErrors.insert(allSafeErrors.end(), errorsAt[kSafeViewLag].begin(),
+                             errorsAt[kSafeViewLag].end());
+        // In play: the seconds after its snapshot arrived (the join's burst is reported apart).
+        const double joined = spawned[c] + (report.is_object() ? report.value("join_ms", 0.0) : 0.0) / 1000;
+        std::vector<double> play, joining;
+        for (std::size_t k = 0; k < kbps[c].size(); ++k)
+            (secondEnds[c][k] - 1 > joined ? play : joining).push_back(kbps[c][k]);
+        double sum = 0;
+        for (double k : play)
+            sum += k;
+        const double mean = play.empty() ? 0 : sum / static_cast<double>(play.size());
+        means.push_back(mean);
+        p99s.push_back(percentile(play, 0.99));
+        j["kbps_mean"] = mean;
+        j["kbps_p99"] = percentile(play, 0.99);
+        j["kbps_join_max"] = percentile(joining, 1.0);
+        j["kbps_up_p99"] = percentile(kbpsUp[c], 0.99);
+        j["mismatched_hashes"] = report.is_object() ? report.value("mismatched_hashes", 0LL) : -1;
+        j["placement_error_cm"] = {{"p50", percentile(errors, 0.5)},
+                                   {"p99", percentile(errors, 0.99)},
+                                   {"samples", errors.size()},
+                                   {"missing", missing}};
+        j["placement_error_cm_lag12"] = {{"p50", percentile(errorsAt[kSafeViewLag], 0.5)},
+                                         {"p99", percentile(errorsAt[kSafeViewLag], 0.99)}};
+        j["link"] = {{"down_lost", relays[c]->down().lost},
+                     {"down_partition_drops", relays[c]->down().partitionDrops},
+                     {"up_lost", relays[c]->up().lost}};
         clients.push_back(j);
     }
     const double impacts =
         static_cast<double>(hs.impactEvents) / std::max(1, static_cast<int>(children.size()));
     const double perClientEventBytes =
         static_cast<double>(hs.eventBytes) / std::max<std::size_t>(1, children.size());
+    const double perClient = static_cast<double>(std::max<std::size_t>(1, children.size()));
     nlohmann::json r;
     r["scene"] = a.file;
     r["seconds"] = runSeconds;
-    r["clients"] = a.clients;
+    r["link"] = {{"delay_ms", a.delayMs}, {"jitter_ms", a.jitterMs},       {"loss", a.loss},
+                 {"burst", a.burst},      {"partition_at", a.partitionAt}, {"partition_s", a.partitionS}};
+    r["placement_budget"] = a.budget;
     r["impacts"] = runtime.counters().impacts;
     r["fractures"] = runtime.counters().fractures;
     r["geometry_bytes_per_impact"] = impacts > 0 ? perClientEventBytes / impacts : 0;
-    r["transform_bytes_per_s"] =
-        static_cast<double>(hs.placementBytes) / std::max<std::size_t>(1, children.size()) / runSeconds;
+    r["transform_bytes_per_s"] = static_cast<double>(hs.placementBytes) / perClient / runSeconds;
+    r["legacy_transform_bytes_per_s"] = static_cast<double>(hs.legacyPlacementBytes) / perClient / runSeconds;
+    r["placement_bytes_ratio_vs_legacy"] =
+        hs.legacyPlacementBytes > 0
+            ? static_cast<double>(hs.placementBytes) / static_cast<double>(hs.legacyPlacementBytes)
+            : 0;
     r["mismatched_hashes"] = mismatched;
+    r["client_shots_accepted"] = hs.shotsAccepted;
+    r["client_shots_refused"] = hs.shotsRefused;
     r["late_join_ms"] = lateJoinMs;
     r["snapshot_bytes"] = hs.snapshotBytes / std::max<long long>(1, hs.joins);
     r["final_hashes_equal"] = allConverged;
+    r["converge_ms"] = convergeMs;
+    r["kbps_mean"] = means.empty() ? 0 : *std::max_element(means.begin(), means.end());
+    r["kbps_p99"] = p99s.empty() ? 0 : *std::max_element(p99s.begin(), p99s.end());
+    r["placement_error_cm"] = {{"p50", percentile(allErrors, 0.5)}, {"p99", percentile(allErrors, 0.99)}};
+    r["placement_error_cm_lag12"] = {{"p50", percentile(allSafeErrors, 0.5)},
+                                     {"p99", percentile(allSafeErrors, 0.99)}};
     r["host_geometry_hash"] = std::to_string(hostHash);
-    r["client_reports"] = clients;
+    r["clients"] = clients;
     const auto use = cpu.read();
     r["cpu_cores"] = {{"own", use.own}, {"other", use.other}};
+    if (!a.out.empty()) {
+        namespace b = rubble::bench;
+        std::streambuf* const stdout = std::cout.rdbuf(std::cerr.rdbuf()); // stdout is for --json
+        struct Restore {
+            std::streambuf* buf;
+            ~Restore() { std::cout.rdbuf(buf); }
+        } restore{stdout};
+        writeResults(a.out,
+                     {"scene",
+                      "clients",
+                      "seconds",
+                      "shots_per_second",
+                      "delay_ms",
+                      "jitter_ms",
+                      "loss",
+                      "burst",
+                      "partition_s",
+                      "impacts",
+                      "geometry_bytes_per_impact",
+                      "kbps_mean",
+                      "kbps_p99",
+                      "legacy_placement_kbps",
+                      "placement_kbps",
+                      "placement_ratio_vs_legacy",
+                      "error_p50_cm",
+                      "error_p99_cm",
+                      "error_p99_cm_lag12",
+                      "mismatched_hashes",
+                      "final_hashes_equal",
+                      "converge_ms",
+                      "late_join_ms",
+                      "snapshot_bytes",
+                      "other_cpu_cores"},
+                     {std::filesystem::path(a.file).filename().string(),
+                      std::to_string(a.clients),
+                      b::fixed(runSeconds, 1),
+                      b::fixed(a.shotsPerSecond, 1),
+                      b::fixed(a.delayMs, 0),
+                      b::fixed(a.jitterMs, 0),
+                      b::fixed(a.loss, 3),
+                      b::fixed(a.burst, 1),
+                      b::fixed(a.partitionS, 1),
+                      std::to_string(runtime.counters().impacts),
+                      b::fixed(r["geometry_bytes_per_impact"].get<double>(), 1),
+                      b::fixed(r["kbps_mean"].get<double>(), 1),
+                      b::fixed(r["kbps_p99"].get<double>(), 1),
+                      b::fixed(r["legacy_transform_bytes_per_s"].get<double>() * 8 / 1000, 1),
+                      b::fixed(r["transform_bytes_per_s"].get<double>() * 8 / 1000, 1),
+                      b::fixed(r["placement_bytes_ratio_vs_legacy"].get<double>(), 3),
+                      b::fixed(percentile(allErrors, 0.5), 2),
+                      b::fixed(percentile(allErrors, 0.99), 2),
+                      b::fixed(percentile(allSafeErrors, 0.99), 2),
+                      std::to_string(mismatched),
+                      allConverged ? "1" : "0",
+                      b::fixed(convergeMs, 0),
+                      b::fixed(lateJoinMs, 0),
+                      std::to_string(r["snapshot_bytes"].get<long long>()),
+                      b::fixed(use.other, 2)});
+    }
     if (a.json) {
         std::cout << r.dump() << "\n";
     } else {
-        std::cout << "netplay " << a.file << ": " << r["impacts"] << " impacts, " << r["fractures"]
-                  << " fractures, " << r["geometry_bytes_per_impact"] << " geometry bytes/impact, "
-                  << r["transform_bytes_per_s"] << " transform bytes/s, " << mismatched
-                  << " mismatched hashes, "
-                  << "late join " << lateJoinMs
+        std::cout << "netplay " << a.file << ": " << r["impacts"] << " impacts, "
+                  << r["geometry_bytes_per_impact"] << " geometry bytes/impact, " << r["kbps_mean"]
+                  << " kbps mean (worst client), " << r["kbps_p99"] << " kbps p99 second, placements "
+                  << r["placement_bytes_ratio_vs_legacy"] << " of the float records, error p99 "
+                  << r["placement_error_cm"]["p99"] << " cm, " << mismatched
+                  << " mismatched hashes, late join " << lateJoinMs << " ms, converge " << convergeMs
                   << " ms, final hashes equal: " << (allConverged ? "yes" : "NO") << "\n";
     }
-    return mismatched == 0 && allConverged && !children.empty() ? 0 : 1;
+    const bool shotsTaken = a.clientShots <= 0 || hs.shotsAccepted > 0;
+    return mismatched == 0 && allConverged && shotsTaken && !children.empty() ? 0 : 1;
 }
 
 int runClient(const Args& a) {
@@ -249,12 +550,56 @@ int runClient(const Args& a) {
         std::cout << nlohmann::json{{"error", client.error().message}}.dump() << "\n";
         return 1;
     }
+    Rng aim(mixSeed(a.seed, static_cast<std::uint64_t>(getpid())));
+    long long shotsSent = 0;
+    const auto shootAt = [&](double view) { // a shot from 30 m at a random destructible object it can see
+        std::vector<ObjectId> targets;
+        for (ObjectId id : world.objects())
+            if (world.object(id)->destructible && (*client)->placement(id, view))
+                targets.push_back(id);
+        if (targets.empty())
+            return;
+        const ObjectId id = targets[static_cast<std::size_t>(aim.below(targets.size()))];
+        const Vec3 at = (*client)->placement(id, view)->apply(world.object(id)->mesh.bounds().center());
+        const double phi = aim.uniform(0, 2 * 3.14159265358979);
+        const Vec3 dir = normalized(Vec3{std::cos(phi), 0.3, std::sin(phi)});
+        if ((*client)->shoot(at + dir * 30.0, dir * -120.0))
+            ++shotsSent;
+    };
+    const auto started = Clock::now();
+    std::ofstream samples;
+    if (!a.samples.empty())
+        samples.open(a.samples, std::ios::binary);
     std::string ending = "time limit";
+    std::uint64_t lastFrame = 0;
     for (const auto t0 = Clock::now(); Clock::now() - t0 < std::chrono::duration<double>(a.seconds);) {
         if (Status s = (*client)->service(5); !s) {
             ending = s.message();
             break;
         }
+        // What it would show now: one placement period behind its latest sync, every half second.
+        const std::uint64_t frame = (*client)->stats().frame;
+        for (const long lag : {kViewLag, kSafeViewLag}) {
+            if (frame == lastFrame || !samples || frame < static_cast<std::uint64_t>(lag) ||
+                (frame - static_cast<std::uint64_t>(lag)) % kSampleEvery != 0)
+                continue;
+            const double view = static_cast<double>(frame - static_cast<std::uint64_t>(lag));
+            for (ObjectId id : world.objects()) {
+                const std::optional<double> latest = (*client)->placementFrame(id);
+                if (!latest || *latest < view - 120)
+                    continue; // at rest for two seconds or more: not a moving body
+                const Frame at = *(*client)->placement(id, view);
+                const Sample smp{static_cast<std::uint32_t>(view),     id,
+                                 static_cast<float>(at.translation.x), static_cast<float>(at.translation.y),
+                                 static_cast<float>(at.translation.z), static_cast<std::uint32_t>(lag)};
+                samples.write(reinterpret_cast<const char*>(&smp), sizeof smp);
+            }
+        }
+        lastFrame = frame;
+        const double since = std::chrono::duration<double>(Clock::now() - started).count();
+        if (a.clientShots > 0 && (*client)->stats().joined && since < a.shootFor &&
+            static_cast<double>(shotsSent) < since * a.clientShots)
+            shootAt(static_cast<double>(frame));
     }
     const net::ClientStats& st = (*client)->stats();
     nlohmann::json j{{"joined", st.joined},
@@ -266,6 +611,7 @@ int runClient(const Args& a) {
                      {"geometry_hash", std::to_string(world.geometryHash())},
                      {"placements", st.placements},
                      {"placement_bytes", st.placementBytes},
+                     {"shots_sent", shotsSent},
                      {"ending", ending}};
     std::cout << j.dump() << "\n";
     return st.joined ? 0 : 1;
@@ -278,12 +624,30 @@ const rubble::tools::Registrar host{
          app.add_option("scene", a->file, "world.cfg scene")->required()->check(CLI::ExistingFile);
          app.add_option("--seconds", a->seconds, "seconds of continuous fire")
              ->check(CLI::Range(0.1, 3600.0));
-         app.add_option("--clients", a->clients, "client processes")->check(CLI::Range(1, 8));
-         app.add_option("--shots-per-second", a->shotsPerSecond, "projectiles per second");
+         app.add_option("--clients", a->clients, "client processes")->check(CLI::Range(1, 16));
+         app.add_option("--shots-per-second", a->shotsPerSecond, "projectiles per second the host fires");
+         app.add_option(
+                "--client-shots", a->clientShots,
+                "shots per second each client asks for (the host checks them, fires those it accepts)")
+             ->check(CLI::Range(0.0, 100.0));
          app.add_option("--workers", a->workers, "fracture workers of host and clients (-1 automatic)");
          app.add_option("--seed", a->seed, "world and firing seed");
          app.add_option("--late-join", a->lateJoin, "the last client joins at this fraction of the run")
              ->check(CLI::Range(0.0, 1.0));
+         app.add_option("--delay-ms", a->delayMs, "one-way delay of each client's link (each way)")
+             ->check(CLI::Range(0.0, 5000.0));
+         app.add_option("--jitter-ms", a->jitterMs, "standard deviation of that delay")
+             ->check(CLI::Range(0.0, 1000.0));
+         app.add_option("--loss", a->loss, "fraction of datagrams lost (each way)")
+             ->check(CLI::Range(0.0, 0.9));
+         app.add_option("--burst", a->burst, "mean datagrams per loss burst (1: independent losses)")
+             ->check(CLI::Range(1.0, 100.0));
+         app.add_option("--partition-at", a->partitionAt, "seconds into the run when every link goes dead");
+         app.add_option("--partition-s", a->partitionS, "how long the links stay dead")
+             ->check(CLI::Range(0.0, 60.0));
+         app.add_option("--placement-budget", a->budget, "placement bytes per client per 10 Hz publish")
+             ->check(CLI::Range(100, 1000000));
+         app.add_option("--out", a->out, "folder: add a row to netplay.csv, draw netplay.png");
          app.add_flag("--json", a->json, "one JSON object on stdout");
          return [a] { return runHost(*a); };
      }}};
@@ -299,6 +663,9 @@ const rubble::tools::Registrar client{
          app.add_option("--workers", a->workers, "fracture workers");
          app.add_option("--seed", a->seed, "world seed (the host's)");
          app.add_option("--seconds", a->seconds, "give up after this many seconds");
+         app.add_option("--samples", a->samples, "file for its placement samples");
+         app.add_option("--shoot", a->clientShots, "shots per second it asks the host for");
+         app.add_option("--shoot-for", a->shootFor, "seconds it shoots for");
          return [a] { return runClient(*a); };
      }}};
 

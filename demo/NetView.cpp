@@ -53,7 +53,7 @@ void NetView::draw(Renderer& renderer, int texture, float dt) {
     drawn_ = 0;
     if (!client_ || !client_->stats().joined)
         return;
-    const double frame = static_cast<double>(client_->stats().frame) - kPlacementPeriod;
+    const double frame = static_cast<double>(client_->stats().frame) - kViewLag;
     std::map<rubble::ObjectId, Visual> kept;
     V3 lo{std::numeric_limits<float>::max(), std::numeric_limits<float>::max(),
           std::numeric_limits<float>::max()};

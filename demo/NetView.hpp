@@ -29,8 +29,9 @@ public:
     /// Receives what arrived within timeoutMs; an IoError once the connection ended (the host closed it or
     /// never answered), another error when the host sent something the world refused.
     rubble::Status service(int timeoutMs);
-    /// Queues every object at its placement one placement period behind the latest sync (so that it is
-    /// interpolated between two of the host's placements); renderer meshes follow the world's objects.
+    /// Queues every object at its placement two placement periods behind the latest sync (so that it is
+    /// interpolated between the host's placements even when one was lost); renderer meshes follow the world's
+    /// objects.
     void draw(Renderer& renderer, int texture, float dt);
     /// Frees the renderer meshes.
     void clear(Renderer& renderer);
@@ -46,6 +47,8 @@ public:
 
     /// Host frames between two placement messages (the host sends them every 6th frame).
     static constexpr double kPlacementPeriod = 6;
+    /// Host frames it shows behind the latest sync (docs/netplay.md, 'Measured': lag 12).
+    static constexpr double kViewLag = 2 * kPlacementPeriod;
 
 private:
     struct Visual {

@@ -1,19 +1,26 @@
 #include "rubble/enet/NetClient.hpp"
 
 #include <chrono>
+#include <deque>
 #include <map>
 
 #include <algorithm>
 
+#include "Events.hpp"
+#include "Placements.hpp"
 #include "Protocol.hpp"
 #include "rubble/JournalFile.hpp"
 #include "rubble/JournalPlayer.hpp"
+#include "rubble/Random.hpp"
 #include "rubble/Snapshot.hpp"
 
 namespace rubble::net {
 
 using detail::Message;
 using Clock = std::chrono::steady_clock;
+
+/// Placements kept per body: enough to show it two placement periods behind with one datagram lost.
+constexpr std::size_t kTrackPoints = 4;
 
 struct NetClient::Impl {
     Impl(DestructionWorld& w, const DestructionWorld::Config& c) : world(w), config(c), player(w) {
@@ -25,51 +32,101 @@ struct NetClient::Impl {
     ENetHost* host = nullptr;
     ENetPeer* server = nullptr;
     Clock::time_point connected;
+    Clock::time_point heard; // when the host was last heard
     ClientStats stats;
+    /// The latest placements of a body, by host frame (ascending, at most kTrackPoints).
     struct Track {
-        double f0 = 0, f1 = 0;
-        Frame a, b;
+        std::vector<std::pair<double, Frame>> points;
+        void add(double frame, const Frame& f) {
+            auto at = std::lower_bound(points.begin(), points.end(), frame,
+                                       [](const auto& p, double x) { return p.first < x; });
+            if (at != points.end() && at->first == frame)
+                return; // a duplicate
+            if (at == points.begin() && points.size() >= kTrackPoints)
+                return; // older than all it keeps
+            points.insert(at, {frame, f});
+            if (points.size() > kTrackPoints)
+                points.erase(points.begin());
+        }
     };
-    std::map<ObjectId, Track> tracks;
+    std::map<ObjectId, Track> tracks; // also of pieces the world does not have yet
+    detail::PlacementDecoder decoder;
+    std::deque<detail::WireEvent> held; // events received, applied when the world reaches their tick
+    std::vector<detail::WireEvent> arrived;
+    std::uint64_t seed = 0; // the host world's seed (from the snapshot)
+
+    // Applies the held events of the world's current frame, with the fields the host left out.
+    Status applyHeld() {
+        while (!held.empty() && held.front().event.tick == world.frame()) {
+            JournalEvent e = held.front().event;
+            const std::uint8_t check = held.front().check;
+            held.pop_front();
+            if (e.kind == JournalEventKind::Impact) {
+                const ObjectState* o = world.object(e.object);
+                if (!o)
+                    return Error{ErrorCode::InvalidInput, "netplay: impact on object " +
+                                                              std::to_string(e.object) +
+                                                              ", which this world does not have"};
+                e.pattern = patternByte(o->fracture);
+                e.cells = static_cast<std::uint16_t>(std::clamp(o->fracture.cells, 0, 65535));
+                e.seed = mixSeed(mixSeed(seed, o->id), o->version); // the world's next job seed
+                if (detail::eventCheck(e) != check)
+                    return Error{ErrorCode::InvalidInput,
+                                 "netplay: impact on object " + std::to_string(e.object) +
+                                     ": its pattern or job seed differs from the host's"};
+            }
+            if (Status st = player.receive(e); !st)
+                return st;
+        }
+        return Status::ok();
+    }
+
+    // Advances the world to `frame`, applying the events of each frame as it begins.
+    Status advanceTo(std::uint64_t frame) {
+        if (Status st = applyHeld(); !st)
+            return st;
+        while (world.frame() < frame) {
+            if (Status st = player.advanceTo(world.frame() + 1); !st)
+                return st;
+            if (Status st = applyHeld(); !st)
+                return st;
+        }
+        return Status::ok();
+    }
+    std::vector<detail::DecodedPlacement> decoded;
     std::function<void(const FractureOutcome&)> onOutcome;
 
     void adopted(const FractureOutcome& o) {
         if (auto t = tracks.find(o.parent); t != tracks.end()) {
             const Track parent = t->second;
             tracks.erase(t);
-            for (const AdoptedPiece& p : o.pieces) // piece → parent local → world
-                tracks[p.id] = {parent.f1, parent.f1, parent.b * p.frame, parent.b * p.frame};
+            for (const AdoptedPiece& p : o.pieces) // piece → parent local → world, unless the host said
+                tracks.try_emplace(
+                    p.id, Track{{{parent.points.back().first, parent.points.back().second * p.frame}}});
         }
         if (onOutcome)
             onOutcome(o);
     }
 
     void placements(const std::uint8_t* d, std::size_t n) {
-        if (n < 13)
-            return;
-        const double frame = static_cast<double>(detail::readU64(d + 1));
-        const std::uint32_t count = detail::readU32(d + 9);
-        if (n != 13 + static_cast<std::size_t>(count) * detail::kPlacementBytes)
+        if (!stats.joined)
+            return; // the baselines come with the snapshot; unacknowledged, these are sent again
+        std::uint64_t frameNumber = 0;
+        decoded.clear();
+        if (!decoder.decode(d, n, frameNumber, decoded))
             return; // unreliable channel: a malformed packet is dropped
         stats.placementBytes += static_cast<long long>(n);
-        for (std::uint32_t i = 0; i < count; ++i) {
-            const std::uint8_t* r = d + 13 + i * detail::kPlacementBytes;
-            const ObjectId id = detail::readU32(r);
-            if (!world.object(id))
-                continue;
-            Frame f;
-            f.translation = {detail::readF32(r + 4), detail::readF32(r + 8), detail::readF32(r + 12)};
-            f.rotation = detail::fromQuaternion({detail::readF32(r + 16), detail::readF32(r + 20),
-                                                 detail::readF32(r + 24), detail::readF32(r + 28)});
-            Track& t = tracks[id];
-            if (frame <= t.f1 && t.f1 > 0)
-                continue; // older than what we have (unsequenced)
-            t.f0 = t.f1 > 0 ? t.f1 : frame;
-            t.a = t.f1 > 0 ? t.b : f;
-            t.f1 = frame;
-            t.b = f;
+        const double frame = static_cast<double>(frameNumber);
+        for (const detail::DecodedPlacement& r : decoded) {
+            const Frame f = detail::dequantize(r.q);
+            tracks[r.id].add(frame, f);
             ++stats.placements;
         }
+        std::vector<std::uint8_t> ack{static_cast<std::uint8_t>(Message::PlacementAck)};
+        for (std::uint32_t v : {decoder.latest(), decoder.mask()})
+            for (int i = 0; i < 4; ++i)
+                ack.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
+        detail::sendUnreliable(server, ack);
     }
 
     Status receive(const ENetPacket* packet) {
@@ -84,11 +141,18 @@ struct NetClient::Impl {
                 return s.error();
             const double frame = static_cast<double>(s->world.frame);
             std::map<ObjectId, Track> fresh;
-            for (const ObjectPlacement& p : s->placements)
-                fresh[p.object] = {frame, frame, p.objectToWorld, p.objectToWorld};
+            detail::PlacementDecoder baselines;
+            for (const ObjectPlacement& p : s->placements) {
+                fresh[p.object].add(frame, p.objectToWorld);
+                baselines.setBaseline(p.object, detail::quantize(p.objectToWorld));
+            }
+            const std::uint64_t hostSeed = s->world.seed;
             if (Status st = restoreSnapshot(world, std::move(*s)); !st)
                 return st;
             tracks = std::move(fresh);
+            decoder = std::move(baselines);
+            held.clear();
+            seed = hostSeed;
             stats.joined = true;
             stats.joinMs = std::chrono::duration<double, std::milli>(Clock::now() - connected).count();
             return Status::ok();
@@ -96,22 +160,19 @@ struct NetClient::Impl {
         case Message::Events: {
             if (!stats.joined)
                 return Error{ErrorCode::InvalidInput, "netplay: events before the snapshot"};
-            std::uint32_t count = 0;
-            for (int i = 0; i < 4 && n >= 5; ++i)
-                count |= static_cast<std::uint32_t>(d[1 + i]) << (8 * i);
-            if (n < 5 || n != 5 + static_cast<std::size_t>(count) * kJournalEventBytes)
+            arrived.clear();
+            if (!detail::decodeEvents(d, n, arrived))
                 return Error{ErrorCode::ParseError,
                              "netplay: events message of " + std::to_string(n) + " bytes"};
-            for (std::uint32_t i = 0; i < count; ++i) {
-                Result<JournalEvent> e =
-                    decodeJournalEvent(d + 5 + i * kJournalEventBytes, 5 + i * kJournalEventBytes);
-                if (!e)
-                    return e.error();
-                if (Status st = player.receive(*e); !st)
-                    return st;
+            for (const detail::WireEvent& w : arrived) {
+                const std::uint32_t last = held.empty() ? 0 : held.back().event.tick;
+                if (w.event.tick < world.frame() || w.event.tick < last)
+                    return Error{ErrorCode::InvalidInput, "netplay: journal event of tick " +
+                                                              std::to_string(w.event.tick) + " arrived late"};
+                held.push_back(w);
                 ++stats.events;
             }
-            return Status::ok();
+            return applyHeld();
         }
         case Message::Sync: {
             if (n != 25)
@@ -121,7 +182,7 @@ struct NetClient::Impl {
                 return Status::ok();
             const std::uint64_t frame = detail::readU64(d + 1), position = detail::readU64(d + 9),
                                 hash = detail::readU64(d + 17);
-            if (Status st = player.advanceTo(frame); !st)
+            if (Status st = advanceTo(frame); !st)
                 return st;
             const std::uint64_t mine = world.geometryHash();
             ++stats.syncs;
@@ -182,7 +243,12 @@ Status NetClient::service(int timeoutMs) {
     for (; r > 0; r = enet_host_service(im.host, &e, 0)) {
         if (e.type == ENET_EVENT_TYPE_CONNECT) {
             im.stats.connected = true;
+            detail::configurePeer(im.server);
         } else if (e.type == ENET_EVENT_TYPE_RECEIVE) {
+            const Clock::time_point now = Clock::now();
+            if (now - im.heard > std::chrono::milliseconds(300) && im.server)
+                detail::retransmitSoon(im.server); // the host was silent: an outage ended
+            im.heard = now;
             Status s = im.receive(e.packet);
             enet_packet_destroy(e.packet);
             if (!s)
@@ -206,12 +272,21 @@ std::optional<Frame> NetClient::placement(ObjectId object, double frame) const {
     auto it = impl_->tracks.find(object);
     if (it == impl_->tracks.end())
         return std::nullopt;
-    const Impl::Track& t = it->second;
-    const double span = t.f1 - t.f0;
-    const double s = span > 0 ? std::clamp((frame - t.f0) / span, 0.0, 1.0) : 1.0;
+    const auto& points = it->second.points;
+    if (points.empty())
+        return std::nullopt;
+    if (frame <= points.front().first)
+        return points.front().second;
+    if (frame >= points.back().first)
+        return points.back().second;
+    std::size_t k = 0;
+    while (points[k + 1].first < frame)
+        ++k;
+    const Frame &a = points[k].second, &b = points[k + 1].second;
+    const double s = (frame - points[k].first) / (points[k + 1].first - points[k].first);
     Frame f;
-    f.translation = t.a.translation * (1 - s) + t.b.translation * s;
-    auto qa = detail::toQuaternion(t.a.rotation), qb = detail::toQuaternion(t.b.rotation);
+    f.translation = a.translation * (1 - s) + b.translation * s;
+    auto qa = detail::toQuaternion(a.rotation), qb = detail::toQuaternion(b.rotation);
     const double dot = qa[0] * qb[0] + qa[1] * qb[1] + qa[2] * qb[2] + qa[3] * qb[3];
     const double sign = dot < 0 ? -1 : 1; // the shorter way round
     std::array<double, 4> q{};
@@ -219,6 +294,26 @@ std::optional<Frame> NetClient::placement(ObjectId object, double frame) const {
         q[i] = qa[i] * (1 - s) + sign * qb[i] * s;
     f.rotation = detail::fromQuaternion(q);
     return f;
+}
+
+Status NetClient::shoot(const Vec3& origin, const Vec3& velocity) {
+    if (!impl_->server || !impl_->stats.connected)
+        return Error{ErrorCode::IoError, "netplay: not connected"};
+    std::vector<std::uint8_t> msg{static_cast<std::uint8_t>(Message::Shot)};
+    for (const Vec3& v : {origin, velocity})
+        for (int i = 0; i < 3; ++i)
+            detail::appendF32(msg, static_cast<float>(v[i]));
+    if (!detail::sendReliable(impl_->server, msg))
+        return Error{ErrorCode::IoError, "netplay: cannot send a shot"};
+    enet_host_flush(impl_->host);
+    return Status::ok();
+}
+
+std::optional<double> NetClient::placementFrame(ObjectId object) const {
+    const auto it = impl_->tracks.find(object);
+    if (it == impl_->tracks.end())
+        return std::nullopt;
+    return it->second.points.empty() ? std::nullopt : std::optional<double>(it->second.points.back().first);
 }
 
 const ClientStats& NetClient::stats() const {

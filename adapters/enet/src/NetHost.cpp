@@ -2,9 +2,12 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <map>
 #include <vector>
 
+#include "Events.hpp"
+#include "Placements.hpp"
 #include "Protocol.hpp"
 #include "rubble/JournalFile.hpp"
 #include "rubble/Snapshot.hpp"
@@ -26,24 +29,72 @@ struct NetHost::Impl {
     std::map<std::uint64_t, std::uint64_t> hashes; // frame → geometry hash sent in its sync (recent ones)
     HostStats stats;
     std::function<std::vector<ObjectPlacement>()> placementSource;
+    std::map<ENetPeer*, detail::PlacementEncoder> encoders; // per client: its baselines and priorities
+    std::size_t placementBudget = 1200;                     // bytes per client per publishPlacements
+
+    std::map<ENetPeer*, std::chrono::steady_clock::time_point> heard; // when each client was last heard
+    std::map<ENetPeer*, std::uint64_t> joinOrder;                     // 0 for the first to join
+    std::function<void(const ShotRequest&)> shotHandler;
+    ShotRules shotRules;
+    std::map<ENetPeer*, double> shotTokens; // each client's bucket
+
+    // A client's shot: fired through the handler if it passes the rules, else counted as refused.
+    void shot(ENetPeer* peer, const std::uint8_t* d, std::size_t n) {
+        const auto refuse = [this] { ++stats.shotsRefused; };
+        if (n != 25 || !shotHandler || !peers.count(peer))
+            return refuse();
+        ShotRequest r;
+        r.client = joinOrder.at(peer);
+        r.origin = {detail::readF32(d + 1), detail::readF32(d + 5), detail::readF32(d + 9)};
+        r.velocity = {detail::readF32(d + 13), detail::readF32(d + 17), detail::readF32(d + 21)};
+        const double speed = length(r.velocity), distance = length(r.origin);
+        if (!std::isfinite(speed) || !std::isfinite(distance) || speed <= 0 || speed > shotRules.maxSpeed ||
+            distance > shotRules.maxDistance)
+            return refuse();
+        auto tokens = shotTokens.try_emplace(peer, shotRules.burst).first;
+        if (tokens->second < 1)
+            return refuse();
+        tokens->second -= 1;
+        ++stats.shotsAccepted;
+        shotHandler(r);
+    }
 
     void join(ENetPeer* peer) {
+        detail::configurePeer(peer);
         std::vector<std::uint8_t> msg{static_cast<std::uint8_t>(Message::Snapshot)};
-        const std::vector<std::uint8_t> bytes = encodeSnapshot(
-            takeSnapshot(world, placementSource ? placementSource() : std::vector<ObjectPlacement>{}));
+        std::vector<ObjectPlacement> placements =
+            placementSource ? placementSource() : std::vector<ObjectPlacement>{};
+        detail::PlacementEncoder& encoder = encoders[peer] = {};
+        for (const ObjectPlacement& p : placements) // the client has these from its snapshot
+            encoder.setBaseline(p.object, detail::quantize(p.objectToWorld));
+        const std::vector<std::uint8_t> bytes = encodeSnapshot(takeSnapshot(world, std::move(placements)));
         msg.insert(msg.end(), bytes.begin(), bytes.end());
         if (!detail::sendReliable(peer, msg)) {
             enet_peer_disconnect(peer, 0);
             return;
         }
         peers[peer] = world.journalPosition();
+        joinOrder[peer] = static_cast<std::uint64_t>(stats.joins);
         ++stats.joins;
         stats.snapshotBytes += static_cast<long long>(bytes.size());
         enet_host_flush(host);
     }
 
     void receive(ENetPeer* peer, const ENetPacket* packet) {
+        const auto now = std::chrono::steady_clock::now();
+        if (auto h = heard.find(peer); h != heard.end() && now - h->second > std::chrono::milliseconds(300))
+            detail::retransmitSoon(peer); // it was silent: an outage ended
+        heard[peer] = now;
+        if (packet->dataLength == 0)
+            return;
         const std::uint8_t* d = packet->data;
+        if (packet->dataLength == 9 && d[0] == static_cast<std::uint8_t>(Message::PlacementAck)) {
+            if (auto e = encoders.find(peer); e != encoders.end())
+                e->second.acked(detail::readU32(d + 1), detail::readU32(d + 5));
+            return;
+        }
+        if (d[0] == static_cast<std::uint8_t>(Message::Shot))
+            return shot(peer, d, packet->dataLength);
         if (packet->dataLength != 17 || d[0] != static_cast<std::uint8_t>(Message::Ack) || !peers.count(peer))
             return; // clients send nothing else
         ++stats.acks;
@@ -99,23 +150,20 @@ void NetHost::publish() {
     const std::uint64_t end = im.world.journalPosition();
     const std::uint64_t frame = im.world.frame(), hash = im.world.geometryHash();
     im.hashes[frame] = hash;
+    for (auto& [peer, tokens] : im.shotTokens) // the shot buckets refill per frame (60 Hz)
+        tokens = std::min(im.shotRules.burst, tokens + im.shotRules.perSecond / 60);
     im.lastSync = frame;
     while (im.hashes.size() > 4096)
         im.hashes.erase(im.hashes.begin());
     for (auto& [peer, position] : im.peers) {
         if (position < end) {
-            std::vector<std::uint8_t> msg{static_cast<std::uint8_t>(Message::Events)};
-            const auto n = static_cast<std::uint32_t>(end - position);
-            for (int i = 0; i < 4; ++i)
-                msg.push_back(static_cast<std::uint8_t>(n >> (8 * i)));
-            for (std::uint64_t k = position; k < end; ++k) {
-                const JournalEvent& e = im.journal[static_cast<std::size_t>(k - im.base)];
-                im.stats.impactEvents += e.kind == JournalEventKind::Impact;
-                const auto bytes = encodeJournalEvent(e);
-                msg.insert(msg.end(), bytes.begin(), bytes.end());
-            }
+            const auto n = static_cast<std::size_t>(end - position);
+            const JournalEvent* first = im.journal.data() + (position - im.base);
+            for (std::size_t k = 0; k < n; ++k)
+                im.stats.impactEvents += first[k].kind == JournalEventKind::Impact;
+            const std::vector<std::uint8_t> msg = detail::encodeEvents(frame, first, n);
             detail::sendReliable(peer, msg);
-            im.stats.eventsSent += n;
+            im.stats.eventsSent += static_cast<long long>(n);
             im.stats.eventBytes += static_cast<long long>(msg.size());
             position = end;
         }
@@ -134,32 +182,30 @@ void NetHost::publish() {
 
 void NetHost::publishPlacements(const std::vector<ObjectPlacement>& placements) {
     Impl& im = *impl_;
-    constexpr std::size_t kPerPacket = 37; // 13 + 37 · 32 = 1197 bytes: one UDP datagram
-    std::vector<const ObjectPlacement*> moving;
-    for (const ObjectPlacement& p : placements)
-        if (p.motion == BodyMotionState::Dynamic)
-            moving.push_back(&p);
-    for (std::size_t start = 0; start < moving.size(); start += kPerPacket) {
-        const std::size_t n = std::min(kPerPacket, moving.size() - start);
-        std::vector<std::uint8_t> msg{static_cast<std::uint8_t>(Message::Placements)};
-        detail::appendU64(msg, im.world.frame());
-        for (int i = 0; i < 4; ++i)
-            msg.push_back(static_cast<std::uint8_t>(n >> (8 * i)));
-        for (std::size_t k = start; k < start + n; ++k) {
-            const ObjectPlacement& p = *moving[k];
-            for (int i = 0; i < 4; ++i)
-                msg.push_back(static_cast<std::uint8_t>(p.object >> (8 * i)));
-            for (int i = 0; i < 3; ++i)
-                detail::appendF32(msg, static_cast<float>(p.objectToWorld.translation[i]));
-            for (double c : detail::toQuaternion(p.objectToWorld.rotation))
-                detail::appendF32(msg, static_cast<float>(c));
-        }
-        for (auto& [peer, position] : im.peers) {
+    std::vector<std::pair<ObjectId, detail::Quantized>> now;
+    now.reserve(placements.size());
+    std::size_t dynamic = 0;
+    for (const ObjectPlacement& p : placements) {
+        now.emplace_back(p.object, detail::quantize(p.objectToWorld));
+        dynamic += p.motion == BodyMotionState::Dynamic;
+    }
+    // The previous protocol: 13 + 32 n bytes per 37 dynamic bodies, every time.
+    const auto legacy = static_cast<long long>((dynamic + 36) / 37 * 13 + dynamic * 32);
+    for (auto& [peer, position] : im.peers) {
+        if (!im.acked.count(peer))
+            continue; // still loading its snapshot: nothing to compare against yet
+        for (const std::vector<std::uint8_t>& msg :
+             im.encoders[peer].encode(im.world.frame(), now, im.placementBudget)) {
             detail::sendUnreliable(peer, msg);
             im.stats.placementBytes += static_cast<long long>(msg.size());
         }
+        im.stats.legacyPlacementBytes += legacy;
     }
     enet_host_flush(im.host);
+}
+
+void NetHost::setPlacementBudget(std::size_t bytes) {
+    impl_->placementBudget = bytes;
 }
 
 bool NetHost::finish(int timeoutMs) {
@@ -196,12 +242,34 @@ void NetHost::service(int timeoutMs) {
         case ENET_EVENT_TYPE_DISCONNECT:
             im.peers.erase(e.peer);
             im.acked.erase(e.peer);
+            im.encoders.erase(e.peer);
+            im.heard.erase(e.peer);
+            im.joinOrder.erase(e.peer);
+            im.shotTokens.erase(e.peer);
             break;
         default:
             break;
         }
     }
     im.stats.clients = static_cast<int>(im.peers.size());
+}
+
+void NetHost::setShotHandler(std::function<void(const ShotRequest&)> handler, ShotRules rules) {
+    impl_->shotHandler = std::move(handler);
+    impl_->shotRules = rules;
+}
+
+std::vector<std::uint64_t> NetHost::confirmedFrames() const {
+    std::vector<std::pair<std::uint64_t, std::uint64_t>> order; // (join order, frame)
+    for (const auto& [peer, position] : impl_->peers) {
+        const auto a = impl_->acked.find(peer);
+        order.emplace_back(impl_->joinOrder.at(peer), a == impl_->acked.end() ? 0 : a->second);
+    }
+    std::sort(order.begin(), order.end());
+    std::vector<std::uint64_t> frames;
+    for (const auto& [k, frame] : order)
+        frames.push_back(frame);
+    return frames;
 }
 
 const HostStats& NetHost::stats() const {

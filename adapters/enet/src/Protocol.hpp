@@ -3,6 +3,7 @@
 
 #include <enet/enet.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -15,18 +16,16 @@
 
 namespace rubble::net::detail {
 
-/// Message types (first byte of every packet; all on channel 0, reliable and ordered).
+/// Message types (first byte of every packet; on channel 0, reliable and ordered, unless said).
 enum class Message : std::uint8_t {
-    Snapshot = 1,   ///< the snapshot bytes (rubble/Snapshot.hpp)
-    Events = 2,     ///< u32 count, then count × 48-byte journal events
-    Sync = 3,       ///< u64 frame, u64 journal position, u64 geometry hash
-    Ack = 4,        ///< client → host: u64 frame, u64 its geometry hash after that sync
-    Placements = 5, ///< channel 1, unreliable: u64 frame, u32 count, count × (u32 object, 3 f32 position,
-                    ///< 4 f32 rotation quaternion x y z w)
+    Snapshot = 1,     ///< the snapshot bytes (rubble/Snapshot.hpp)
+    Events = 2,       ///< u32 count, then count × 48-byte journal events
+    Sync = 3,         ///< u64 frame, u64 journal position, u64 geometry hash
+    Ack = 4,          ///< client → host: u64 frame, u64 its geometry hash after that sync
+    Placements = 5,   ///< channel 1, unreliable: u32 seq, then varints and records (Placements.hpp)
+    PlacementAck = 6, ///< client → host, channel 1, unreliable: u32 latest seq, u32 mask of the 32 before
+    Shot = 7, ///< client → host: 3 f32 origin, 3 f32 velocity (the host checks it, then fires it or not)
 };
-
-/// Bytes of one placement record.
-inline constexpr std::size_t kPlacementBytes = 32;
 
 /// Appends a little-endian float.
 inline void appendF32(std::vector<std::uint8_t>& out, float f) {
@@ -125,6 +124,23 @@ inline bool sendReliable(ENetPeer* peer, const std::vector<std::uint8_t>& bytes)
         return false;
     }
     return true;
+}
+
+/// A peer for a link that misbehaves: unreliable packets are not throttled (placements keep their own byte
+/// budget), and an outage of up to 15 s (a partition) does not end the connection.
+inline void configurePeer(ENetPeer* peer) {
+    enet_peer_timeout(peer, 0, 15000, 30000);
+    enet_peer_throttle_configure(peer, ENET_PEER_PACKET_THROTTLE_INTERVAL, 0, 0);
+}
+
+/// After an outage, the peer's unacknowledged reliable commands are sent again at the next service instead
+/// of after their timers, which doubled at every retransmission during the outage.
+inline void retransmitSoon(ENetPeer* peer) {
+    for (ENetListIterator it = enet_list_begin(&peer->sentReliableCommands);
+         it != enet_list_end(&peer->sentReliableCommands); it = enet_list_next(it)) {
+        auto* c = reinterpret_cast<ENetOutgoingCommand*>(it);
+        c->roundTripTimeout = std::min<enet_uint32>(c->roundTripTimeout, 1);
+    }
 }
 
 /// Resolves a loopback address (127.0.0.0/8, "localhost"); anything else is refused.

@@ -43,10 +43,15 @@ public:
     /// Receives and applies what arrived within timeoutMs. Fails when the host sent something the world
     /// refuses (a corrupted snapshot or an event out of order) or the connection was lost.
     Status service(int timeoutMs = 0);
-    /// Where an object is at (fractional) host frame `frame`: interpolated between the two latest placements
+    /// Where an object is at (fractional) host frame `frame`: interpolated between the latest four placements
     /// the host sent for it (position linearly, rotation by normalised quaternion blend), held at the ends.
     /// A new piece starts where its parent was. Empty for an object the client has no placement of.
     std::optional<Frame> placement(ObjectId object, double frame) const;
+    /// Asks the host to fire a shot (it checks it first: docs/netplay.md, 'Trust model'). Fails when not
+    /// connected.
+    Status shoot(const Vec3& origin, const Vec3& velocity);
+    /// Host frame of the latest placement received for an object (empty when none arrived).
+    std::optional<double> placementFrame(ObjectId object) const;
     /// Called for every outcome the world adopts (its pieces are in the world already).
     void setOnOutcome(std::function<void(const FractureOutcome&)> callback);
     /// Totals.

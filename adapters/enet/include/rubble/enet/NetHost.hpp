@@ -17,16 +17,35 @@ namespace rubble::net {
 
 /// Totals of a host.
 struct HostStats {
-    int clients = 0;                ///< clients connected now
-    long long joins = 0;            ///< clients that joined (each got a snapshot)
-    long long eventsSent = 0;       ///< journal events sent (per client)
-    long long eventBytes = 0;       ///< bytes of journal event messages sent (per client, payload)
-    long long snapshotBytes = 0;    ///< bytes of snapshots sent
-    long long syncs = 0;            ///< frame syncs sent (per client)
-    long long impactEvents = 0;     ///< of eventsSent: impacts (the rest are removals)
-    long long placementBytes = 0;   ///< bytes of placement messages sent (per client, payload)
+    int clients = 0;              ///< clients connected now
+    long long joins = 0;          ///< clients that joined (each got a snapshot)
+    long long eventsSent = 0;     ///< journal events sent (per client)
+    long long eventBytes = 0;     ///< bytes of journal event messages sent (per client, payload)
+    long long snapshotBytes = 0;  ///< bytes of snapshots sent
+    long long syncs = 0;          ///< frame syncs sent (per client)
+    long long impactEvents = 0;   ///< of eventsSent: impacts (the rest are removals)
+    long long placementBytes = 0; ///< bytes of placement messages sent (per client, payload)
+    long long legacyPlacementBytes =
+        0;                          ///< what the 32-byte float records of every dynamic body would have been
     long long acks = 0;             ///< clients' hash reports received
     long long mismatchedHashes = 0; ///< reports whose geometry hash differed from the host's at that frame
+    long long shotsAccepted = 0;    ///< clients' shots that passed the checks (handed to the shot handler)
+    long long shotsRefused = 0; ///< clients' shots refused: malformed, implausible, too many, or no handler
+};
+
+/// What a client may ask for: a shot, checked by the host before anything happens.
+struct ShotRules {
+    double perSecond = 10; ///< sustained shots per second per client (a bucket refilled per published frame)
+    double burst = 10;     ///< shots a client may fire at once
+    double maxSpeed = 200; ///< m/s
+    double maxDistance = 1e3; ///< how far from the world's origin a shot may start (m)
+};
+
+/// A client's shot that passed the checks.
+struct ShotRequest {
+    std::uint64_t client = 0; ///< the client, in the order they joined (0 = the first)
+    Vec3 origin;              ///< where it starts (m)
+    Vec3 velocity;            ///< m/s
 };
 
 /// A host on 127.0.0.1 (only loopback addresses are accepted). Replicates the world it is given; the world
@@ -51,9 +70,12 @@ public:
     /// Sends every client the journal events since its last publish and a sync for the world's current
     /// frame; call once per frame after the world (or runtime) stepped.
     void publish();
-    /// Sends every client the placements of the dynamic bodies among placements (unreliable, unsequenced,
-    /// on channel 1, at most 37 per packet): the host is authoritative for motion. Call at a modest rate.
+    /// Sends every client the placements that differ from what it acknowledged (unreliable, on channel 1;
+    /// quantized, delta-coded, the most overdue first within the budget): the host is authoritative for
+    /// motion. Bodies at rest cost nothing. Call at a modest rate (10 Hz).
     void publishPlacements(const std::vector<ObjectPlacement>& placements);
+    /// Bytes of placements per client per publishPlacements (default 1200).
+    void setPlacementBudget(std::size_t bytes);
     /// Handles the network until every connected client confirmed the latest sync (or timeoutMs passed);
     /// true when they all did. Call before closing, so that the clients end in the host's state.
     bool finish(int timeoutMs);
@@ -61,6 +83,12 @@ public:
     void setPlacementSource(std::function<std::vector<ObjectPlacement>()> source);
     /// Handles the network (joins, leaves, clients' hash reports) for up to timeoutMs.
     void service(int timeoutMs = 0);
+    /// Takes clients' shots: each one that passes `rules` (finite, speed and origin in range, within the
+    /// client's rate) goes to `handler`, which fires it in the host's world; everything else is refused and
+    /// counted. Without a handler, every shot is refused: clients change nothing.
+    void setShotHandler(std::function<void(const ShotRequest&)> handler, ShotRules rules = {});
+    /// The latest frame each connected client confirmed (in the order they joined).
+    std::vector<std::uint64_t> confirmedFrames() const;
     /// Totals.
     const HostStats& stats() const;
 

@@ -1,0 +1,252 @@
+// Multiplayer on a network that misbehaves: three clients, each through its own seeded relay (delay, jitter,
+// burst loss, reordering, duplication), one of them partitioned and healed, one killed and replaced; and a
+// host that rogue traffic neither crashes nor changes. Every wait is for a condition, with a deadline.
+#include "rubble/enet/NetClient.hpp"
+#include "rubble/enet/NetHost.hpp"
+#include "rubble/enet/UdpRelay.hpp"
+
+#include <arpa/inet.h>
+#include <enet/enet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <thread>
+
+#include "JournalScene.hpp"
+#include "NetWait.hpp"
+
+namespace rubble {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+net::LinkProfile badLink() {
+    net::LinkProfile p;
+    p.delayMs = 15;
+    p.jitterMs = 4;
+    p.loss = 0.03;
+    p.burstLength = 2;
+    p.reorder = 0.02;
+    p.duplicate = 0.01;
+    return p;
+}
+
+// A client with its own world, behind its own relay.
+struct Follower {
+    Follower(std::uint16_t hostPort, std::uint64_t seed) {
+        auto r = net::UdpRelay::start(hostPort, badLink(), badLink(), seed);
+        EXPECT_TRUE(r) << r.error().message;
+        relay = std::move(*r);
+        world = std::make_unique<DestructionWorld>(test::journalConfig(1).world);
+        auto c = net::NetClient::connect(*world, test::journalConfig(1).world, "127.0.0.1", relay->port());
+        EXPECT_TRUE(c) << c.error().message;
+        client = std::move(*c);
+    }
+    std::unique_ptr<net::UdpRelay> relay;
+    std::unique_ptr<DestructionWorld> world;
+    std::unique_ptr<net::NetClient> client;
+};
+
+TEST(NetRelay, ClientsThroughMisbehavingLinksConvergeAfterAPartitionAndAReplacement) {
+    test::JournalRig host(1);
+    const DestructionWorld::Config config = test::journalConfig(1).world;
+    auto server = net::NetHost::listen(host.runtime.world(), config, "127.0.0.1", 0);
+    ASSERT_TRUE(server) << server.error().message;
+    net::NetHost& h = **server;
+    h.setPlacementSource([&] { return host.runtime.placements(); });
+    std::vector<std::unique_ptr<Follower>> live;
+    live.push_back(std::make_unique<Follower>(h.port(), 1));
+    live.push_back(std::make_unique<Follower>(h.port(), 2));
+    std::unique_ptr<Follower> killed;
+    const auto pump = [&] {
+        h.service(0);
+        for (auto& f : live)
+            ASSERT_TRUE(f->client->service(0));
+    };
+    const auto until = [&](const auto& done) {
+        return test::waitFor(done, [&] {
+            h.service(1);
+            for (auto& f : live)
+                if (Status st = f->client->service(1); !st) {
+                    ADD_FAILURE() << st.message();
+                    return false;
+                }
+            return true;
+        });
+    };
+    ASSERT_TRUE(until([&] { return live[0]->client->stats().joined && live[1]->client->stats().joined; }));
+    Clock::time_point healAt{};
+    bool partitioned = false;
+    for (int frame = 0; frame < 300; ++frame) {
+        host.play(1);
+        h.publish();
+        if (frame % 6 == 0)
+            h.publishPlacements(host.runtime.placements());
+        const auto next = Clock::now() + std::chrono::milliseconds(5);
+        while (Clock::now() < next) {
+            pump();
+            std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        }
+        if (frame == 60) { // the first client drops off the network for 1.5 s, while the host fires
+            live[0]->relay->setPartitioned(true);
+            partitioned = true;
+            healAt = Clock::now() + std::chrono::milliseconds(1500);
+        }
+        if (partitioned && Clock::now() >= healAt) {
+            live[0]->relay->setPartitioned(false);
+            partitioned = false;
+        }
+        if (frame == 100) // a third joins late
+            live.push_back(std::make_unique<Follower>(h.port(), 3));
+        if (frame == 150) { // the second is killed: its link goes dead, it says no goodbye
+            live[1]->relay->setPartitioned(true);
+            killed = std::move(live[1]);
+            live.erase(live.begin() + 1);
+        }
+        if (frame == 170) // and someone joins in its place
+            live.push_back(std::make_unique<Follower>(h.port(), 4));
+    }
+    if (partitioned)
+        live[0]->relay->setPartitioned(false);
+    host.settle();
+    h.publish();
+    const std::uint64_t last = host.runtime.world().frame();
+    ASSERT_TRUE(until([&] {
+        for (auto& f : live)
+            if (f->client->stats().frame != last)
+                return false;
+        return true;
+    })) << "frames "
+        << live[0]->client->stats().frame << " " << live[1]->client->stats().frame << " "
+        << live[2]->client->stats().frame << " of " << last;
+    // Placements: what the host last published reaches everyone through the loss (delta-coded, sent again
+    // until acknowledged).
+    const std::vector<ObjectPlacement> placements = host.runtime.placements();
+    int sends = 0;
+    const auto arrived = [&] {
+        for (const ObjectPlacement& p : placements)
+            for (auto& f : live) {
+                const auto at = f->client->placement(p.object, static_cast<double>(last));
+                if (!at ||
+                    length(at->translation - p.objectToWorld.translation) > 0.5e-3 * std::sqrt(3.0) + 1e-9)
+                    return false;
+            }
+        return true;
+    };
+    ASSERT_TRUE(until([&] {
+        if (arrived())
+            return true;
+        if (sends++ % 20 == 0)
+            h.publishPlacements(placements);
+        return false;
+    }));
+    const std::uint64_t hash = host.runtime.world().geometryHash();
+    EXPECT_GT(host.runtime.counters().fractures, 5);
+    for (auto& f : live) {
+        EXPECT_EQ(f->world->geometryHash(), hash);
+        EXPECT_EQ(f->client->stats().mismatchedHashes, 0);
+        EXPECT_GT(f->client->stats().syncs, 50);
+    }
+    EXPECT_EQ(h.stats().mismatchedHashes, 0);
+    EXPECT_EQ(h.stats().joins, 4);
+    EXPECT_GT(live[0]->relay->down().partitionDrops, 0);
+    long long lost = 0, duplicated = 0;
+    for (auto& f : live) {
+        lost += f->relay->down().lost + f->relay->up().lost;
+        duplicated += f->relay->down().duplicated;
+    }
+    EXPECT_GT(lost, 0);
+    EXPECT_GT(duplicated, 0);
+}
+
+TEST(NetRelay, RogueTrafficNeitherCrashesTheHostNorChangesItsWorld) {
+    test::JournalRig host(1), reference(1);
+    const DestructionWorld::Config config = test::journalConfig(1).world;
+    auto server = net::NetHost::listen(host.runtime.world(), config, "127.0.0.1", 0);
+    ASSERT_TRUE(server) << server.error().message;
+    net::NetHost& h = **server;
+    DestructionWorld world(config);
+    auto honest = net::NetClient::connect(world, config, "127.0.0.1", h.port());
+    ASSERT_TRUE(honest);
+
+    // Raw datagrams of any size and content at the host's port.
+    const int raw = socket(AF_INET, SOCK_DGRAM, 0);
+    sockaddr_in to{};
+    to.sin_family = AF_INET;
+    to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    to.sin_port = htons(h.port());
+    // An ENet peer that sends every message type with any payload, on both channels.
+    ENetHost* rogue = enet_host_create(nullptr, 1, 2, 0, 0);
+    ASSERT_NE(rogue, nullptr);
+    ENetAddress a{};
+    enet_address_set_host(&a, "127.0.0.1");
+    a.port = h.port();
+    ENetPeer* peer = enet_host_connect(rogue, &a, 2, 0);
+    ASSERT_NE(peer, nullptr);
+    Rng rng(99);
+    bool rogueConnected = false;
+    long long rogueSent = 0;
+    std::vector<std::uint8_t> big(1 << 20, 0xAB);
+    for (int frame = 0; frame < 200; ++frame) {
+        host.play(1);
+        reference.play(1);
+        h.publish();
+        for (int k = 0; k < 10; ++k) {
+            std::vector<std::uint8_t> junk(static_cast<std::size_t>(rng.below(frame == 7 ? 65000 : 1500)));
+            for (auto& b : junk)
+                b = static_cast<std::uint8_t>(rng.next());
+            if (!junk.empty() && rng.uniform() < 0.5)
+                junk[0] = static_cast<std::uint8_t>(rng.below(8)); // a message type, or none
+            (void)sendto(raw, junk.data(), junk.size(), 0, reinterpret_cast<sockaddr*>(&to), sizeof to);
+            if (rogueConnected) {
+                const bool huge = frame == 50 && k == 0;
+                ENetPacket* p =
+                    enet_packet_create(huge ? big.data() : junk.data(), huge ? big.size() : junk.size(),
+                                       rng.uniform() < 0.5 ? ENET_PACKET_FLAG_RELIABLE : 0);
+                if (enet_peer_send(peer, static_cast<enet_uint8>(rng.below(2)), p) != 0)
+                    enet_packet_destroy(p);
+                else
+                    ++rogueSent;
+            }
+        }
+        ENetEvent e;
+        while (enet_host_service(rogue, &e, 0) > 0) {
+            rogueConnected = rogueConnected || e.type == ENET_EVENT_TYPE_CONNECT;
+            if (e.type == ENET_EVENT_TYPE_RECEIVE)
+                enet_packet_destroy(e.packet);
+        }
+        h.service(1);
+        Status st = (*honest)->service(0);
+        ASSERT_TRUE(st) << st.message();
+    }
+    host.settle();
+    reference.settle();
+    h.publish();
+    const std::uint64_t last = host.runtime.world().frame();
+    for (const auto end = Clock::now() + std::chrono::minutes(2);
+         (*honest)->stats().frame != last && Clock::now() < end;) {
+        h.service(1);
+        ASSERT_TRUE((*honest)->service(1));
+        ENetEvent e;
+        while (enet_host_service(rogue, &e, 0) > 0)
+            if (e.type == ENET_EVENT_TYPE_RECEIVE)
+                enet_packet_destroy(e.packet);
+    }
+    EXPECT_GT(rogueSent, 500);
+    EXPECT_EQ(host.runtime.world().geometryHash(), reference.runtime.world().geometryHash())
+        << "the host's world is what its own shots made it";
+    EXPECT_EQ(host.runtime.world().journalPosition(), reference.runtime.world().journalPosition());
+    EXPECT_EQ((*honest)->stats().frame, last);
+    EXPECT_EQ(world.geometryHash(), host.runtime.world().geometryHash());
+    EXPECT_EQ((*honest)->stats().mismatchedHashes, 0);
+    enet_host_destroy(rogue);
+    close(raw);
+}
+
+} // namespace
+} // namespace rubble
