@@ -55,6 +55,7 @@
 #include "rubble/ConvexDecomposition.hpp"
 #include "rubble/Fracture.hpp"
 #include "rubble/MassProperties.hpp"
+#include "rubble/Material.hpp"
 #include "rubble/MeshCheck.hpp"
 #include "rubble/MeshIO.hpp"
 #include "rubble/SceneIO.hpp"
@@ -82,6 +83,10 @@ struct FractureArgs {
     std::string output;
     bool json = false;
     std::string format = "obj";
+    std::string material;              // a preset's roughness (docs/roughness.md); empty: flat
+    std::optional<double> roughness;   // amplitude, relative to the cell size
+    std::optional<double> hurst;       // Hurst exponent
+    std::optional<double> featureSize; // longest wavelength, relative to the cell size
 };
 
 struct PieceOut {
@@ -611,6 +616,24 @@ int runFracture(const FractureArgs& args) {
         params.pattern = rubble::CellPattern::Shatter;
         params.cells = args.cells;
     }
+    if (!args.material.empty()) {
+        if (!rubble::findMaterial(args.material))
+            return usage("--material '" + args.material + "' is not one of " + rubble::materialNames());
+        params.roughness = rubble::roughnessPreset(args.material);
+    }
+    if (args.roughness || args.hurst || args.featureSize) {
+        if (!params.roughness.relative) { // an absolute preset (brick) set by hand: in cell sizes from now on
+            params.roughness = rubble::Roughness{};
+        }
+        if (args.roughness)
+            params.roughness.amplitude = *args.roughness;
+        if (args.hurst)
+            params.roughness.hurst = *args.hurst;
+        if (args.featureSize)
+            params.roughness.featureSize = *args.featureSize;
+    }
+    if (rubble::Status s = rubble::validateRoughness(params.roughness); !s)
+        return usage(s.message());
     if (args.backend == "corefine")
         params.backend = rubble::BooleanKind::Corefine;
     else if (args.backend == "nef")
@@ -781,6 +804,18 @@ const rubble::tools::Registrar registrar{
          app.add_option("--seed", args->seed, "random seed (same seed, same pieces, byte for byte)")
              ->check(rubble::tools::unsigned64())
              ->capture_default_str();
+         app.add_option("--material", args->material,
+                        "cut with this material's rough cut faces (" + rubble::materialNames() +
+                            "; docs/roughness.md); without it, and with --roughness 0, cuts are flat");
+         app.add_option("--roughness", args->roughness,
+                        "amplitude of rough cut faces, a fraction of the cell size (0: flat)")
+             ->check(rubble::tools::finiteNumber());
+         app.add_option("--hurst", args->hurst, "Hurst exponent of rough cut faces, in (0, 1]")
+             ->check(rubble::tools::finiteNumber());
+         app.add_option(
+                "--feature-size", args->featureSize,
+                "longest wavelength of rough cut faces, a fraction of the cell size (0: 8 amplitudes)")
+             ->check(rubble::tools::finiteNumber());
          app.add_option("--backend", args->backend, "boolean backend (default: the library's default)")
              ->check(CLI::IsMember({"corefine", "nef", "fast"}));
          app.add_option("-o,--output", args->output, "output folder (must not exist, or be empty)")
