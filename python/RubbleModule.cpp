@@ -17,6 +17,7 @@
 #include "rubble/ConvexDecomposition.hpp"
 #include "rubble/Fracture.hpp"
 #include "rubble/MassProperties.hpp"
+#include "rubble/Material.hpp"
 #include "rubble/Mesh.hpp"
 #include "rubble/MeshCheck.hpp"
 #include "rubble/MeshIO.hpp"
@@ -193,7 +194,10 @@ rubble::CellPattern patternOf(const std::optional<std::string>& name, int cells)
 
 std::vector<PyPiece> fractureMesh(const rubble::Mesh& mesh, const py::object& point, const py::object& normal,
                                   double impulse, int cells, std::uint64_t seed, const std::string& backend,
-                                  bool convexParts, int maxParts, const std::optional<std::string>& pattern) {
+                                  bool convexParts, int maxParts, const std::optional<std::string>& pattern,
+                                  const std::optional<std::string>& material,
+                                  const std::optional<double>& roughness, const std::optional<double>& hurst,
+                                  const std::optional<double>& featureSize) {
     rubble::Impact impact;
     impact.point = toVec3(point, "point");
     impact.normal = toVec3(normal, "normal");
@@ -206,6 +210,24 @@ std::vector<PyPiece> fractureMesh(const rubble::Mesh& mesh, const py::object& po
     params.backend = backendOf(backend);
     params.pattern = patternOf(pattern, cells);
     params.cells = cells;
+    if (material) {
+        if (!rubble::findMaterial(*material))
+            throw py::value_error("material: expected one of " + rubble::materialNames() + ", got '" +
+                                  *material + "'");
+        params.roughness = rubble::roughnessPreset(*material);
+    }
+    if (roughness || hurst || featureSize) {
+        if (!params.roughness.relative) // an absolute preset set by hand: in cell sizes
+            params.roughness = rubble::Roughness{};
+        if (roughness)
+            params.roughness.amplitude = *roughness;
+        if (hurst)
+            params.roughness.hurst = *hurst;
+        if (featureSize)
+            params.roughness.featureSize = *featureSize;
+    }
+    if (rubble::Status s = rubble::validateRoughness(params.roughness); !s)
+        throw py::value_error(s.message());
     std::vector<PyPiece> pieces;
     py::gil_scoped_release unlocked;
     rubble::FractureResult result = unwrap(rubble::fracture(mesh, impact, params, seed));
@@ -382,9 +404,12 @@ PYBIND11_MODULE(_rubble, m) {
     m.def("fracture", &fractureMesh, py::arg("mesh"), py::kw_only(), py::arg("point"),
           py::arg("normal") = py::make_tuple(0.0, 1.0, 0.0), py::arg("impulse") = 1.0, py::arg("cells") = 1,
           py::arg("seed") = 1, py::arg("backend") = "fast", py::arg("convex_parts") = true,
-          py::arg("max_parts") = 24, py::arg("pattern") = py::none(),
+          py::arg("max_parts") = 24, py::arg("pattern") = py::none(), py::arg("material") = py::none(),
+          py::arg("roughness") = py::none(), py::arg("hurst") = py::none(),
+          py::arg("feature_size") = py::none(),
           "Breaks a closed mesh at an impact into pieces (by default cells > 1 is a shatter pattern of that "
-          "many cells; pattern='adaptive' chips on a weak hit and shatters on a strong one).");
+          "many cells; pattern='adaptive' chips on a weak hit and shatters on a strong one; material= cuts "
+          "with that material's rough cut faces, roughness= (amplitude) sets them by hand, 0 is flat).");
     m.def("decompose", &decomposeMesh, py::arg("mesh"), py::kw_only(), py::arg("max_parts") = 24,
           py::arg("concavity") = 0.02, "Convex parts of a closed mesh, each as its corner points.");
 }

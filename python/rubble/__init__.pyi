@@ -183,12 +183,19 @@ def fracture(
     convex_parts: bool = True,
     max_parts: int = 24,
     pattern: Pattern | None = None,
+    material: str | None = None,
+    roughness: float | None = None,
+    hurst: float | None = None,
+    feature_size: float | None = None,
 ) -> list[Piece]:
     """Breaks a closed mesh at an impact (point and outward normal in the mesh's coordinates; bigger impulses cut
     bigger cells). cells=1 cuts the thesis's single Voronoi cell, cells>1 a shatter pattern of that many cells;
     pattern='adaptive' chips one cell on a weak hit and shatters into cells on one of 400 N s or more.
     The same seed gives the same pieces. With convex_parts, every piece gets convex collision parts (the input
-    is decomposed into at most max_parts first). Raises Error (e.g. "invalid input" for an open mesh,
+    is decomposed into at most max_parts first). material ('concrete', 'brick', 'stone', 'wood', 'glass',
+    'steel') cuts with that material's rough cut faces; roughness (amplitude), hurst and feature_size
+    (fractions of the cell size) set them by hand, roughness=0 is flat (docs/roughness.md); a bad value raises
+    ValueError naming it. Raises Error (e.g. "invalid input" for an open mesh,
     "no intersection" when the cells miss it)."""
 
 def decompose(mesh: Mesh, *, max_parts: int = 24, concavity: float = 0.02) -> list[Float64Array]:

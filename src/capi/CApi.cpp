@@ -16,6 +16,7 @@
 #include "rubble/Fracture.hpp"
 #include "rubble/Log.hpp"
 #include "rubble/MassProperties.hpp"
+#include "rubble/Material.hpp"
 #include "rubble/Mesh.hpp"
 #include "rubble/MeshCheck.hpp"
 #include "rubble/MeshIO.hpp"
@@ -163,6 +164,25 @@ rubble_status toParams(const char* function, const rubble_fracture_params& in, r
     out.backend = in.backend == RUBBLE_BACKEND_COREFINE ? rubble::BooleanKind::Corefine
                   : in.backend == RUBBLE_BACKEND_NEF    ? rubble::BooleanKind::Nef
                                                         : rubble::BooleanKind::Fast;
+    if (in.material) {
+        if (!rubble::findMaterial(in.material))
+            return invalid(function, (std::string("material '") + in.material + "' is not one of " +
+                                      rubble::materialNames())
+                                         .c_str());
+        out.roughness = rubble::roughnessPreset(in.material);
+    }
+    if (in.roughness >= 0 || in.hurst > 0 || in.feature_size >= 0) {
+        if (!out.roughness.relative) // an absolute preset set by hand: in cell sizes
+            out.roughness = rubble::Roughness{};
+        if (in.roughness >= 0)
+            out.roughness.amplitude = in.roughness;
+        if (in.hurst > 0)
+            out.roughness.hurst = in.hurst;
+        if (in.feature_size >= 0)
+            out.roughness.featureSize = in.feature_size;
+    }
+    if (rubble::Status s = rubble::validateRoughness(out.roughness); !s)
+        return invalid(function, s.message().c_str());
     return RUBBLE_OK;
 }
 
@@ -386,6 +406,8 @@ rubble_status rubble_fracture_params_init(rubble_fracture_params* params) {
         params->seed = 1;
         params->convex_parts = 1;
         params->max_convex_parts = rubble::DecompositionParams{}.maxParts;
+        params->material = nullptr;
+        params->roughness = params->hurst = params->feature_size = -1;
         return ok();
     });
 }
