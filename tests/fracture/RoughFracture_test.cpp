@@ -195,11 +195,15 @@ TEST(RoughFracture, RandomHitsAndPiecesOfPiecesKeepTheInvariants) {
 TEST(RoughFracture, PiecesDoNotSelfIntersect) {
     const Mesh input = cube();
     Rng rng(11);
-    for (int i = 0; i < 6; ++i) {
+    for (int i = 0; i < 12; ++i) {
         Impact impact;
         impact.point = surfacePoint(input, rng);
-        auto r = fracture(input, impact, roughParams(i % 2 ? CellPattern::Shatter : CellPattern::SingleCell),
-                          rng.next());
+        FractureParams params = roughParams(i % 2 ? CellPattern::Shatter : CellPattern::SingleCell);
+        if (i >= 6) { // three times the preset's amplitude: heights limited by the envelope near the creases
+            params.roughness.amplitude = 0.3;
+            params.roughness.featureSize = 0.5;
+        }
+        auto r = fracture(input, impact, params, rng.next());
         ASSERT_TRUE(r);
         EXPECT_TRUE(r->rough);
         for (const Piece& p : r->pieces) {
@@ -251,8 +255,9 @@ TEST(RoughFracture, StructureFunctionFollowsTheHurstExponent) {
         ASSERT_TRUE(r->rough);
         // Heights (x) of the vertices away from the outline (where the fade is 1), pairs binned by distance.
         std::vector<Vec3> v;
+        std::size_t k = 0;
         for (const Vec3& p : cutVertices(*r))
-            if (std::abs(p.y) < 0.75 && std::abs(p.z) < 0.75)
+            if (std::abs(p.y) < 0.75 && std::abs(p.z) < 0.75 && k++ % 3 == 0)
                 v.push_back(p);
         ASSERT_GT(v.size(), 1000u);
         const double r0 = 0.06, r1 = 0.4; // between the finest wavelength and the longest's quarter
