@@ -253,7 +253,8 @@ TEST(RoughFracture, StructureFunctionFollowsTheHurstExponent) {
         auto r = halfCut(rough);
         ASSERT_TRUE(r) << r.error().message;
         ASSERT_TRUE(r->rough);
-        // Heights (x) of the vertices away from the outline (where the fade is 1), pairs binned by distance.
+        // Heights (x) of vertices away from the outline (where the envelope does not bind), binned by
+        // distance.
         std::vector<Vec3> v;
         std::size_t k = 0;
         for (const Vec3& p : cutVertices(*r))
