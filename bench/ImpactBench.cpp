@@ -40,6 +40,7 @@ struct BenchArgs {
     std::string only; // run only the cases whose name contains this
     std::vector<std::string> backends{"corefine", "fast", "nef"}; // which backends run
     std::string out = rubble::bench::kResultsDir;
+    bool rough = false; // only the rough rows beside their flat twins (impact_rough.csv)
 };
 
 using rubble::bench::msSince;
@@ -72,6 +73,8 @@ struct Case {
     rubble::Impact impact;
     double domain = 1; // edge of the cell's domain
     rubble::CellPattern pattern = rubble::CellPattern::SingleCell;
+    int cells = 6;               // of a shatter pattern
+    rubble::Roughness roughness; // flat by default
     double thesisS = -1;
     std::vector<rubble::ConvexPolytope> parentParts; // cached at load time, as the runtime does
     double decomposeMs = 0;
@@ -84,7 +87,8 @@ void runOnce(Case& c, rubble::BooleanKind kind, std::uint64_t seed) {
     params.sizeLaw.base = c.domain;
     params.sizeLaw.scale = 0;
     params.pattern = c.pattern;
-    params.cells = 6;
+    params.cells = c.cells;
+    params.roughness = c.roughness;
     Samples& s = c.samples[kind];
     const auto t0 = Clock::now();
     auto r = rubble::fracture(c.mesh, c.impact, params, seed);
@@ -194,13 +198,48 @@ bool chainCase(Case& c, int chain) {
     return true;
 }
 
+/// The rough rows (issue #28): flat and concrete-rough twins, Fast backend, interleaved in one run; the
+/// 10k cube with one cell and with a 16-cell shatter, and a 250k geodesic sphere.
+std::vector<Case> roughCases(bool quick) {
+    std::vector<Case> cases;
+    Case cube;
+    cube.mesh = rubble::makeSubdividedBox({-1, -1, -1}, {1, 1, 1}, quick ? 7 : 29);
+    cube.name = "cube_" + std::to_string(cube.mesh.triangleCount());
+    cube.impact = {{1, 0.05, 0.1}, {1, 0, 0}, 1};
+    cases.push_back(cube);
+    cube.name += "_shatter16";
+    cube.pattern = rubble::CellPattern::Shatter;
+    cube.cells = 16;
+    cases.push_back(std::move(cube));
+    if (!quick) {
+        Case sphere;
+        sphere.mesh = rubble::bench::megaMesh("geosphere", 250000);
+        sphere.name = "geosphere_" + std::to_string(sphere.mesh.triangleCount());
+        sphere.impact = {surfacePointAtMaxX(sphere.mesh), {1, 0, 0}, 1};
+        sphere.domain = 0.5;
+        cases.push_back(std::move(sphere));
+    }
+    const std::size_t flat = cases.size();
+    for (std::size_t i = 0; i < flat; ++i) {
+        Case c = cases[i];
+        c.name += "_rough";
+        c.roughness = rubble::roughnessPreset("concrete");
+        cases.push_back(std::move(c));
+    }
+    return cases;
+}
+
 int runBench(const BenchArgs& args) {
     const int runs = args.quick ? 2 : std::max(1, args.runs);
     // The thesis's program measured here: impact → final collision shape (seconds, MEASUREMENTS.md).
     const std::map<std::size_t, double> thesis = {
         {12, 0.243}, {108, 0.280}, {588, 0.347}, {2700, 1.199}, {10092, 5.196}};
     std::vector<Case> cases;
-    const std::vector<int> grid = args.quick ? std::vector<int>{1, 3} : std::vector<int>{1, 3, 7, 15, 29};
+    const std::vector<int> grid = args.rough   ? std::vector<int>{}
+                                  : args.quick ? std::vector<int>{1, 3}
+                                               : std::vector<int>{1, 3, 7, 15, 29};
+    if (args.rough)
+        cases = roughCases(args.quick);
     for (int n : grid) {
         Case c;
         c.mesh = rubble::makeSubdividedBox({-1, -1, -1}, {1, 1, 1}, n);
@@ -211,7 +250,7 @@ int runBench(const BenchArgs& args) {
             c.thesisS = it->second;
         cases.push_back(std::move(c));
     }
-    {
+    if (!args.rough) {
         // The largest cube once more, shattered into 6 cells (adjacent cells share faces: see the fallbacks).
         Case c = cases.back();
         c.name += "_shatter6";
@@ -219,7 +258,7 @@ int runBench(const BenchArgs& args) {
         c.thesisS = -1;
         cases.push_back(std::move(c));
     }
-    if (!args.quick) {
+    if (!args.quick && !args.rough) {
         for (const fs::path& p : rubble::bench::repoModels()) {
             auto m = rubble::readMesh(p);
             if (!m) {
@@ -245,7 +284,7 @@ int runBench(const BenchArgs& args) {
     }
     // Chained impacts (pieces of pieces carry many convex parts): the 10th impact on the largest remainder
     // of the largest cube and of two concave models.
-    if (!args.quick) {
+    if (!args.quick && !args.rough) {
         const std::size_t fresh = cases.size();
         for (std::size_t i = 0; i < fresh; ++i)
             if (cases[i].pattern == rubble::CellPattern::SingleCell &&
@@ -345,8 +384,30 @@ int runBench(const BenchArgs& args) {
         "decomposition is cached before the impact (initial_decomposition_ms); other processes used %.2f "
         "cores meanwhile\n",
         failures.c_str(), runs, otherCpu);
-    if (!rubble::bench::writeCsv(fs::path(args.out) / "impact.csv", table))
+    if (!rubble::bench::writeCsv(fs::path(args.out) / (args.rough ? "impact_rough.csv" : "impact.csv"),
+                                 table))
         return 1;
+    if (args.rough) { // rough over flat, per case: with parts, and pieces alone
+        std::string data;
+        for (const Case& c : cases) {
+            const auto flat = std::find_if(cases.begin(), cases.end(),
+                                           [&](const Case& f) { return f.name + "_rough" == c.name; });
+            if (flat == cases.end() || !c.samples.count(rubble::BooleanKind::Fast) ||
+                !flat->samples.count(rubble::BooleanKind::Fast))
+                continue;
+            const Samples &r = c.samples.at(rubble::BooleanKind::Fast),
+                          &f = flat->samples.at(rubble::BooleanKind::Fast);
+            data += "\"" + flat->name + "\" " + fixed(stats(f.withParts).median) + " " +
+                    fixed(stats(r.withParts).median) + "\n";
+        }
+        rubble::bench::plotPng(args.out, "impact_rough", data,
+                               "set termoption noenhanced\nset style data histograms\nset style fill solid "
+                               "0.6\nset ylabel 'impact -> "
+                               "pieces + convex parts (ms)'\nset grid ytics\nset key top left\n"
+                               "set title 'Flat vs rough (concrete) cut faces, fast backend, one run'\n"
+                               "plot $DATA u 2:xtic(1) t 'flat', '' u 3 t 'rough'");
+        return 0;
+    }
 
     // One line per cube: triangles, thesis ms, then pieces+parts medians of corefine, fast, nef ("?" = none).
     std::string data;
@@ -387,6 +448,10 @@ const rubble::tools::Registrar registrar{
                         "triangles)")
              ->check(CLI::IsMember({"corefine", "fast", "nef"}));
          app.add_option("--out", args->out, "folder for impact.csv and impact.png");
+         app.add_flag(
+             "--rough", args->rough,
+             "only flat and rough (concrete) twins: the 10k cube with one cell and a 16-cell shatter, "
+             "a 250k geodesic sphere (impact_rough.csv/.png)");
          auto mega = std::make_shared<rubble::bench::MegaArgs>();
          auto megaOn = std::make_shared<bool>(false);
          app.add_flag("--mega", *megaOn,

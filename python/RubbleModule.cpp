@@ -18,6 +18,7 @@
 #include "rubble/ConvexDecomposition.hpp"
 #include "rubble/Fracture.hpp"
 #include "rubble/MassProperties.hpp"
+#include "rubble/Material.hpp"
 #include "rubble/Mesh.hpp"
 #include "rubble/MeshCheck.hpp"
 #include "rubble/MeshIO.hpp"
@@ -244,7 +245,10 @@ rubble::Vec3 checkedVector(const py::object& value, const char* name) {
 std::vector<PyPiece> fractureMesh(const rubble::Mesh& mesh, const py::object& point, const py::object& normal,
                                   const py::object& impulse, const py::object& cellsArg,
                                   const py::object& seedArg, const std::string& backend, bool convexParts,
-                                  int maxParts, const std::optional<std::string>& pattern) {
+                                  int maxParts, const std::optional<std::string>& pattern,
+                                  const std::optional<std::string>& material,
+                                  const std::optional<double>& roughness, const std::optional<double>& hurst,
+                                  const std::optional<double>& featureSize) {
     rubble::Impact impact;
     impact.point = checkedVector(point, "point");
     impact.normal = checkedVector(normal, "normal");
@@ -257,6 +261,10 @@ std::vector<PyPiece> fractureMesh(const rubble::Mesh& mesh, const py::object& po
     params.backend = backendOf(backend);
     params.pattern = patternOf(pattern, cells);
     params.cells = cells;
+    auto rough = rubble::chooseRoughness({material.value_or(""), roughness, hurst, featureSize});
+    if (!rough)
+        throw py::value_error(rough.error().message);
+    params.roughness = *rough;
     std::vector<PyPiece> pieces;
     py::gil_scoped_release unlocked;
     rubble::FractureResult result = unwrap(rubble::fracture(mesh, impact, params, seed));
@@ -435,9 +443,12 @@ PYBIND11_MODULE(_rubble, m) {
     m.def("fracture", &fractureMesh, py::arg("mesh"), py::kw_only(), py::arg("point"),
           py::arg("normal") = py::make_tuple(0.0, 1.0, 0.0), py::arg("impulse") = 1.0, py::arg("cells") = 1,
           py::arg("seed") = 1, py::arg("backend") = "fast", py::arg("convex_parts") = true,
-          py::arg("max_parts") = 24, py::arg("pattern") = py::none(),
+          py::arg("max_parts") = 24, py::arg("pattern") = py::none(), py::arg("material") = py::none(),
+          py::arg("roughness") = py::none(), py::arg("hurst") = py::none(),
+          py::arg("feature_size") = py::none(),
           "Breaks a closed mesh at an impact into pieces (by default cells > 1 is a shatter pattern of that "
-          "many cells; pattern='adaptive' chips on a weak hit and shatters on a strong one).");
+          "many cells; pattern='adaptive' chips on a weak hit and shatters on a strong one; material= cuts "
+          "with that material's rough cut faces, roughness= (amplitude) sets them by hand, 0 is flat).");
     m.def("decompose", &decomposeMesh, py::arg("mesh"), py::kw_only(), py::arg("max_parts") = 24,
           py::arg("concavity") = 0.02, "Convex parts of a closed mesh, each as its corner points.");
 }

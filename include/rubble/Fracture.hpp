@@ -14,6 +14,7 @@
 #include "rubble/Mesh.hpp"
 #include "rubble/MeshTopology.hpp"
 #include "rubble/Result.hpp"
+#include "rubble/Roughness.hpp"
 
 namespace rubble {
 
@@ -94,6 +95,9 @@ struct FractureParams {
     bool simplifyPieces = true;           ///< remove the vertices that carry no shape from every piece
                                           ///< (simplifyPlanarRegions, lossless): bounds the triangle count of
                                           ///< pieces that are hit again and again
+    /// The cut-surface model: flat (the thesis's cut) by default; rough with the Fast backend, which then
+    /// cuts by copy, not in place (docs/roughness.md). fracture() mixes its seed into roughness.seed.
+    Roughness roughness;
 };
 
 /// What is known of a mesh, so that fracturing it skips the passes over the whole mesh that would find it
@@ -149,7 +153,9 @@ struct FractureResult {
     bool exactFallback = false;        ///< Fast declined or failed verification; Corefine made the split
     int redraws = 0; ///< fracture() with Fast: cell patterns redrawn (from derived seeds) because the clipper
                      ///< declined a near-degenerate one; 0 = the seed's own pattern
-    bool editedInPlace = false;        ///< the remainder is the input edited in place (MeshFacts::topology)
+    bool editedInPlace = false; ///< the remainder is the input edited in place (MeshFacts::topology)
+    bool rough =
+        false; ///< the cut faces were roughened (params.roughness active and the clipper's split kept)
     bool islandsLabelledFully = false; ///< edited in place, but the walk around the cut did not prove the
                                        ///< remainder one shell: it was labelled in full (a cavity)
     bool islandsByRace = false; ///< edited in place, and the remainder's islands were found by walks racing

@@ -48,7 +48,19 @@ inline constexpr ParamRange kParamRanges[] = {
     {"depth", ParamKind::Integer, 1, kMaxFractureDepth},
     {"seed", ParamKind::Integer, 0, 18446744073709551615.0L},
     {"density", ParamKind::Real, 0, kMaxDensity, true},
+    {"roughness", ParamKind::Real, 0, 1},    // Roughness::amplitude, relative to the cell size
+    {"feature_size", ParamKind::Real, 0, 4}, // Roughness::featureSize, relative to the cell size
+    {"hurst", ParamKind::Real, 0, 1, true},
+    {"octaves", ParamKind::Integer, 1, kMaxRoughOctaves},
+    {"grain_stretch", ParamKind::Real, 1, 100},
+    {"grain", ParamKind::Point},
+    {"max_triangles_per_piece", ParamKind::Integer, 64, 10'000'000},
 };
+
+/// The range of an absolute Roughness::amplitude or featureSize (the table's are relative).
+inline constexpr ParamRange kAbsoluteRoughness{"roughness", ParamKind::Real, 0, 1e6};
+/// The range of an absolute Roughness::featureSize.
+inline constexpr ParamRange kAbsoluteFeatureSize{"feature_size", ParamKind::Real, 0, 1e6};
 
 /// The range of the parameter called name, or null.
 const ParamRange* findParamRange(std::string_view name);
@@ -59,6 +71,8 @@ std::string describeParamRange(const ParamRange& range);
 /// InvalidInput "<name> must be <range>, got <value>" when value is outside name's range (or name is
 /// unknown).
 Status checkParam(std::string_view name, long double value);
+/// checkParam against a range of one's own (a Real or Integer range).
+Status checkParam(const ParamRange& range, long double value);
 /// checkParam for a Point or Direction parameter.
 Status checkParam(std::string_view name, const Vec3& value);
 /// checkParam for a value given as text (the CLI's): a value that is no number is refused the same way.

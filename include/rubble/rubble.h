@@ -161,9 +161,14 @@ typedef struct rubble_fracture_params {
     uint64_t seed;          ///< same seed, same pieces
     int convex_parts;       ///< 1: compute each piece's convex collision parts (decomposes the input first)
     int max_convex_parts;   ///< at most this many parts per piece (>= 1)
+    const char* material; ///< NULL (flat cuts) or a material whose rough cut faces apply (docs/roughness.md)
+    double roughness;     ///< amplitude of rough cut faces, a fraction of the cell size; 0 flat; < 0 unset
+    double hurst;         ///< Hurst exponent of rough cut faces, in (0, 1]; <= 0 unset
+    double feature_size;  ///< longest wavelength of rough cut faces, a fraction of the cell size; < 0 unset
 } rubble_fracture_params;
 
-/// The defaults: single cell, 6 shatter cells, Fast backend, seed 1, convex parts on, at most 24 parts.
+/// The defaults: single cell, 6 shatter cells, Fast backend, seed 1, convex parts on, at most 24 parts, flat
+/// cuts (material NULL, roughness, hurst and feature_size unset: -1).
 RUBBLE_C_API rubble_status rubble_fracture_params_init(rubble_fracture_params* params);
 /// Breaks a closed mesh at an impact. NULL params means the defaults.
 RUBBLE_C_API rubble_status rubble_fracture_mesh(const rubble_mesh* mesh, const rubble_impact* impact,

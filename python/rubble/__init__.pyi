@@ -185,14 +185,21 @@ def fracture(
     convex_parts: bool = True,
     max_parts: int = 24,
     pattern: Pattern | None = None,
+    material: str | None = None,
+    roughness: float | None = None,
+    hurst: float | None = None,
+    feature_size: float | None = None,
 ) -> list[Piece]:
     """Breaks a closed mesh at an impact (point and outward normal in the mesh's coordinates; bigger impulses cut
     bigger cells). cells=1 cuts the thesis's single Voronoi cell, cells>1 a shatter pattern of that many cells;
     pattern='adaptive' chips one cell on a weak hit and shatters into cells on one of 400 N s or more.
     The same seed gives the same pieces. With convex_parts, every piece gets convex collision parts (the input
-    is decomposed into at most max_parts first). Raises ValueError naming the parameter and its range for a
-    non-finite point, a zero or non-finite normal, an impulse outside [0, 1e12], cells outside 1..1000 (refused,
-    not clamped) and a seed outside 0..2**64-1; raises Error (e.g. "invalid input" for an open mesh,
+    is decomposed into at most max_parts first). material ('concrete', 'brick', 'stone', 'wood', 'glass',
+    'steel') cuts with that material's rough cut faces; roughness (amplitude), hurst and feature_size
+    (fractions of the cell size) set them by hand, roughness=0 is flat (docs/roughness.md). Raises ValueError
+    naming the parameter and its range for a non-finite point, a zero or non-finite normal, an impulse outside
+    [0, 1e12], cells outside 1..1000 (refused, not clamped), a seed outside 0..2**64-1 and a bad roughness
+    value; raises Error (e.g. "invalid input" for an open mesh,
     "no intersection" when the cells miss it)."""
 
 def decompose(mesh: Mesh, *, max_parts: int = 24, concavity: float = 0.02) -> list[Float64Array]:

@@ -16,6 +16,7 @@
 #include "rubble/Fracture.hpp"
 #include "rubble/Log.hpp"
 #include "rubble/MassProperties.hpp"
+#include "rubble/Material.hpp"
 #include "rubble/Mesh.hpp"
 #include "rubble/MeshCheck.hpp"
 #include "rubble/MeshIO.hpp"
@@ -164,6 +165,18 @@ rubble_status toParams(const char* function, const rubble_fracture_params& in, r
     out.backend = in.backend == RUBBLE_BACKEND_COREFINE ? rubble::BooleanKind::Corefine
                   : in.backend == RUBBLE_BACKEND_NEF    ? rubble::BooleanKind::Nef
                                                         : rubble::BooleanKind::Fast;
+    rubble::RoughnessChoice choice;
+    choice.material = in.material ? in.material : "";
+    if (in.roughness >= 0)
+        choice.amplitude = in.roughness;
+    if (in.hurst > 0)
+        choice.hurst = in.hurst;
+    if (in.feature_size >= 0)
+        choice.featureSize = in.feature_size;
+    auto roughness = rubble::chooseRoughness(choice);
+    if (!roughness)
+        return invalid(function, roughness.error().message.c_str());
+    out.roughness = *roughness;
     return RUBBLE_OK;
 }
 
@@ -400,6 +413,8 @@ rubble_status rubble_fracture_params_init(rubble_fracture_params* params) {
         params->seed = 1;
         params->convex_parts = 1;
         params->max_convex_parts = rubble::DecompositionParams{}.maxParts;
+        params->material = nullptr;
+        params->roughness = params->hurst = params->feature_size = -1;
         return ok();
     });
 }

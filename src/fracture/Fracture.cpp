@@ -12,6 +12,7 @@
 
 #include "BooleanBackends.hpp"
 #include "FracturePipeline.hpp"
+#include "RoughCut.hpp"
 #include "geometry/OrientedShells.hpp"
 #include "geometry/TopologyEdit.hpp"
 #include "rubble/Fracture.hpp"
@@ -88,25 +89,6 @@ Status prepareInput(const Mesh& mesh, const MeshFacts& known, double& volume,
     return positiveVolume(volume);
 }
 
-/// An orthonormal basis (u, v) of the plane with normal n, the same for n and -n (so both sides of a cut
-/// get continuous texture coordinates).
-void cutBasis(Vec3 n, Vec3& u, Vec3& v) {
-    int big = 0;
-    for (int a = 1; a < 3; ++a)
-        if (std::abs(n[a]) > std::abs(n[big]))
-            big = a;
-    if (n[big] < 0)
-        n = -n;
-    int small = 0;
-    for (int a = 1; a < 3; ++a)
-        if (std::abs(n[a]) < std::abs(n[small]))
-            small = a;
-    Vec3 axis;
-    axis[small] = 1;
-    u = normalized(cross(axis, n));
-    v = cross(n, u);
-}
-
 /// Cut faces made by these cells: planar UVs (projection onto the cut plane, scaled by uvScale) and the
 /// plane's normal. Interior faces of earlier fractures (not on a face of these cells, or outside focus) keep
 /// theirs. Only cells whose bounds hold a triangle are searched for its plane.
@@ -152,7 +134,7 @@ void finishCutFaces(Mesh& m, std::span<const ConvexPolytope> cells, double uvSca
         if (dot(n, tn) < 0)
             n = -n;
         Vec3 u, v;
-        cutBasis(n, u, v);
+        detail::cutBasis(n, u, v);
         for (int k = 0; k < 3; ++k) {
             const Vec3& p = c[static_cast<std::size_t>(k)];
             m.uvs[3 * t + static_cast<std::size_t>(k)] = {dot(p, u) * uvScale, dot(p, v) * uvScale};
@@ -364,8 +346,13 @@ Result<FractureResult> runPipeline(const Mesh& mesh, std::vector<ConvexPolytope>
         return s.error();
 
     auto split = backend.split(mesh, cells);
-    // The result must close up and conserve volume; a failed fast split is redone exactly. The check labels
-    // the shells of every output on the way; the islands below reuse them.
+    const double onPlane = 1e-7 * meshBox.diagonal();
+    // Rough cut faces need the clipper's split: each cut triangle in both outputs it separates.
+    res.rough = split && params.roughness.active() && !split->exactFallback && backend.name() == "fast";
+    if (res.rough)
+        detail::roughenSplit(*split, cells, params.roughness, params.uvScale, meshBox, onPlane);
+    // The result must close up and conserve volume; a failed fast split is redone exactly (flat). The check
+    // labels the shells of every output on the way; the islands below reuse them.
     std::vector<detail::OutputShells> shells;
     const Stopwatch tv;
     bool sound = split && detail::splitIsSound(*split, inputVolume, &shells);
@@ -374,6 +361,7 @@ Result<FractureResult> runPipeline(const Mesh& mesh, std::vector<ConvexPolytope>
         split = detail::makeCorefineBackend()->split(mesh, cells);
         if (split)
             split->exactFallback = true;
+        res.rough = false;
         sound = split && detail::splitIsSound(*split, inputVolume, &shells);
     }
     if (!split)
@@ -393,15 +381,19 @@ Result<FractureResult> runPipeline(const Mesh& mesh, std::vector<ConvexPolytope>
 
     const Stopwatch t1;
     const Aabb focus = cutFocus(cells, meshBox);
-    const double onPlane = 1e-7 * meshBox.diagonal();
-    finishCutFaces(split->remainder, cells, params.uvScale, focus, onPlane);
-    finishInsideCutFaces(split->inside, cells, params, focus, onPlane);
+    if (!res.rough) { // roughenSplit gave the rough faces theirs
+        finishCutFaces(split->remainder, cells, params.uvScale, focus, onPlane);
+        finishInsideCutFaces(split->inside, cells, params, focus, onPlane);
+    }
     t1.set(res, &FractureTimings::massMs);
     const double minVolume = std::max(0.0, params.minPieceVolumeFraction) * inputVolume;
     const VolumeIntegrals* whole = split->remainderIntegrals ? &*split->remainderIntegrals : nullptr;
-    addPieces(std::move(split->remainder), shells[0], -1, minVolume, params.simplifyPieces, focus, whole, res,
+    // Rough pieces are not simplified: its plane tolerance would treat the two sides of a cut differently.
+    FractureParams finish = params;
+    finish.simplifyPieces = params.simplifyPieces && !res.rough;
+    addPieces(std::move(split->remainder), shells[0], -1, minVolume, finish.simplifyPieces, focus, whole, res,
               nullptr, wantTopology);
-    return finishPieces(std::move(split->inside), shells, std::move(cells), params, minVolume, focus,
+    return finishPieces(std::move(split->inside), shells, std::move(cells), finish, minVolume, focus,
                         wantTopology, t0, t1, std::move(res));
 }
 
@@ -469,7 +461,7 @@ Result<FractureResult> runInPlace(Mesh& mesh, MeshTopology& topology, std::vecto
                                   const FractureParams& params, const BooleanBackend& backend, bool exactRedo,
                                   double inputVolume) {
     const auto* editing = dynamic_cast<const detail::EditingBackend*>(&backend);
-    if (!editing || !topology.fits(mesh))
+    if (!editing || !topology.fits(mesh) || params.roughness.active())
         return runPipeline(mesh, std::move(cells), params, backend, exactRedo, inputVolume, true);
     const Stopwatch t0;
     FractureResult res;
@@ -594,8 +586,11 @@ Result<FractureResult> runInPlace(Mesh& mesh, MeshTopology& topology, std::vecto
 
 /// Runs a pipeline (runPipeline or runInPlace) after the input's validation, with its timings.
 template <class Run>
-Result<FractureResult> withValidation(const Mesh& mesh, const MeshFacts& known, Run run) {
+Result<FractureResult> withValidation(const Mesh& mesh, const MeshFacts& known, const FractureParams& params,
+                                      Run run) {
     const Stopwatch t0;
+    if (Status s = validateRoughness(params.roughness); !s)
+        return makeError(ErrorCode::InvalidInput, "fracture: " + s.message());
     double volume = 0;
     const VolumeIntegrals* integrals = nullptr;
     if (Status s = prepareInput(mesh, known, volume, integrals); !s)
@@ -612,8 +607,9 @@ Result<FractureResult> withValidation(const Mesh& mesh, const MeshFacts& known, 
 }
 
 /// True when mesh is fractured in place: known facts with a topology, the Fast backend.
-bool inPlace(const Mesh& mesh, const MeshFacts& known, BooleanKind kind) {
-    return kind == BooleanKind::Fast && known.fit(mesh) && known.topology.fits(mesh);
+bool inPlace(const Mesh& mesh, const MeshFacts& known, const FractureParams& params) {
+    return params.backend == BooleanKind::Fast && !params.roughness.active() && known.fit(mesh) &&
+           known.topology.fits(mesh);
 }
 
 } // namespace
@@ -628,7 +624,7 @@ Result<FractureResult> fractureWithBackend(const Mesh& mesh, std::vector<ConvexP
         MeshFacts facts = known;
         return fractureInPlaceWithBackend(copy, facts, std::move(cells), params, backend, exactRedo);
     }
-    return withValidation(mesh, known, [&](double volume) {
+    return withValidation(mesh, known, params, [&](double volume) {
         return runPipeline(mesh, std::move(cells), params, backend, exactRedo, volume);
     });
 }
@@ -637,7 +633,7 @@ Result<FractureResult> fractureInPlaceWithBackend(Mesh& mesh, MeshFacts& known,
                                                   std::vector<ConvexPolytope> cells,
                                                   const FractureParams& params, const BooleanBackend& backend,
                                                   bool exactRedo) {
-    return withValidation(mesh, known, [&](double volume) {
+    return withValidation(mesh, known, params, [&](double volume) {
         return runInPlace(mesh, known.topology, std::move(cells), params, backend, exactRedo, volume);
     });
 }
@@ -671,6 +667,8 @@ template <class Run>
 Result<FractureResult> fractureBy(const Mesh& mesh, const Impact& impact, const FractureParams& params,
                                   std::uint64_t seed, const MeshFacts& known, Run run) {
     const Stopwatch t0;
+    if (Status s = validateRoughness(params.roughness); !s)
+        return makeError(ErrorCode::InvalidInput, "fracture: " + s.message());
     double volume = 0;
     const VolumeIntegrals* integrals = nullptr;
     if (Status s = checkFractureParams(impact, params); !s)
@@ -721,7 +719,7 @@ Result<FractureResult> fractureBy(const Mesh& mesh, const Impact& impact, const 
 
 Result<FractureResult> fractureWithCells(const Mesh& mesh, std::vector<ConvexPolytope> cells,
                                          const FractureParams& params, const MeshFacts& known) {
-    if (inPlace(mesh, known, params.backend))
+    if (inPlace(mesh, known, params))
         return fractureWithCells(Mesh(mesh), std::move(cells), params, MeshFacts(known));
     const VolumeIntegrals* integrals = known.fit(mesh) ? &known.integrals : nullptr;
     return detail::fractureWithBackend(mesh, std::move(cells), params,
@@ -731,26 +729,39 @@ Result<FractureResult> fractureWithCells(const Mesh& mesh, std::vector<ConvexPol
 
 Result<FractureResult> fractureWithCells(Mesh&& mesh, std::vector<ConvexPolytope> cells,
                                          const FractureParams& params, MeshFacts known) {
-    if (!inPlace(mesh, known, params.backend))
+    if (!inPlace(mesh, known, params))
         return fractureWithCells(std::as_const(mesh), std::move(cells), params, known);
     const auto backend = detail::makeFastBackend(true, &known.integrals);
     return detail::fractureInPlaceWithBackend(mesh, known, std::move(cells), params, *backend, true);
 }
 
+namespace {
+
+/// params with the fracture's seed mixed into the roughness seed (a rough surface per fracture).
+FractureParams seeded(const FractureParams& params, std::uint64_t seed) {
+    FractureParams p = params;
+    if (p.roughness.active())
+        p.roughness.seed = mixSeed(seed, p.roughness.seed);
+    return p;
+}
+
+} // namespace
+
 Result<FractureResult> fracture(const Mesh& mesh, const Impact& impact, const FractureParams& params,
                                 std::uint64_t seed, const MeshFacts& known) {
-    if (inPlace(mesh, known, params.backend))
+    if (inPlace(mesh, known, params))
         return fracture(Mesh(mesh), impact, params, seed, MeshFacts(known));
+    const FractureParams p = seeded(params, seed);
     return fractureBy(
-        mesh, impact, params, seed, known,
+        mesh, impact, p, seed, known,
         [&](std::vector<ConvexPolytope> cells, const BooleanBackend& backend, bool exactRedo, double volume) {
-            return runPipeline(mesh, std::move(cells), params, backend, exactRedo, volume);
+            return runPipeline(mesh, std::move(cells), p, backend, exactRedo, volume);
         });
 }
 
 Result<FractureResult> fracture(Mesh&& mesh, const Impact& impact, const FractureParams& params,
                                 std::uint64_t seed, MeshFacts known) {
-    if (!inPlace(mesh, known, params.backend))
+    if (!inPlace(mesh, known, params))
         return fracture(std::as_const(mesh), impact, params, seed, known);
     return fractureBy(
         mesh, impact, params, seed, known,

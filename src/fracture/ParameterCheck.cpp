@@ -73,8 +73,12 @@ Status checkParam(std::string_view name, long double value) {
     const ParamRange* range = findParamRange(name);
     if (!range || range->kind == ParamKind::Point || range->kind == ParamKind::Direction)
         return unknown(name);
-    if (!inRange(*range, value))
-        return refuse(*range, numberText(value));
+    return checkParam(*range, value);
+}
+
+Status checkParam(const ParamRange& range, long double value) {
+    if (!inRange(range, value))
+        return refuse(range, numberText(value));
     return {};
 }
 

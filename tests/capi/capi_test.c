@@ -308,6 +308,50 @@ static void test_fracture(void) {
         params.backend = RUBBLE_BACKEND_COREFINE;
     }
 
+    /* Rough cut faces: a material's preset, or set by hand; still closed, with the volume kept; a bad
+       value or material is refused, naming it. */
+    {
+        rubble_fracture* rough = NULL;
+        rubble_fracture_params rp;
+        rubble_fracture_info rough_info;
+        size_t k, flat_triangles = 0, rough_triangles = 0;
+        CHECK_OK(rubble_fracture_params_init(&rp));
+        CHECK(rp.material == NULL && rp.roughness < 0 && rp.hurst < 0 && rp.feature_size < 0);
+        rp.seed = 7;
+        rp.convex_parts = 0;
+        rp.material = "concrete";
+        CHECK_OK(rubble_fracture_mesh(cube, &impact, &rp, &rough));
+        CHECK_OK(rubble_fracture_get_info(rough, &rough_info));
+        CHECK(fabs(sum_piece_volumes(rough) - 8) < 1e-9 * 8);
+        for (k = 0; k < rough_info.piece_count; ++k) {
+            CHECK_OK(rubble_fracture_get_piece(rough, k, &piece));
+            CHECK_OK(rubble_mesh_check(piece.mesh, &report));
+            CHECK(report.valid);
+            CHECK_OK(rubble_mesh_get_data(piece.mesh, &data));
+            rough_triangles += data.triangle_count;
+        }
+        CHECK_OK(rubble_fracture_destroy(rough));
+        rough = NULL;
+        rp.roughness = 0; /* flat, as without a material */
+        CHECK_OK(rubble_fracture_mesh(cube, &impact, &rp, &rough));
+        CHECK_OK(rubble_fracture_get_info(rough, &rough_info));
+        for (k = 0; k < rough_info.piece_count; ++k) {
+            CHECK_OK(rubble_fracture_get_piece(rough, k, &piece));
+            CHECK_OK(rubble_mesh_get_data(piece.mesh, &data));
+            flat_triangles += data.triangle_count;
+        }
+        CHECK(rough_triangles > flat_triangles);
+        CHECK_OK(rubble_fracture_destroy(rough));
+        rp.roughness = 0.1;
+        rp.hurst = 1.5;
+        CHECK(rubble_fracture_mesh(cube, &impact, &rp, &rough) == RUBBLE_ERROR_INVALID_ARGUMENT);
+        CHECK(contains(rubble_last_error(), "hurst"));
+        rp.hurst = -1;
+        rp.material = "cheese";
+        CHECK(rubble_fracture_mesh(cube, &impact, &rp, &rough) == RUBBLE_ERROR_INVALID_ARGUMENT);
+        CHECK(contains(rubble_last_error(), "cheese"));
+    }
+
     /* Errors: bad parameters, an impact whose cells miss the mesh, an open mesh. */
     params.cells = 0;
     CHECK(rubble_fracture_mesh(cube, &impact, &params, &missed) == RUBBLE_ERROR_INVALID_ARGUMENT);

@@ -62,6 +62,29 @@ n=$(check_json "$tmp/wall.json") || fail "wall JSON: $(cat "$tmp/wall.json")"
     || fail "nef backend should exit 0"
 grep -q "pieces written to" "$tmp/text.txt" || fail "text summary: $(cat "$tmp/text.txt")"
 
+# Rough cut faces: --material concrete cuts with its preset (more triangles, still closed and accepted by
+# `rubble check`, cut faces in "interior"); --roughness 0 is the flat cut, byte for byte; the same seed, the
+# same bytes.
+"$RUBBLE" fracture "$models/cube_588.obj" --impact 0.9,0.2,-0.1 --impulse 400 --seed 7 --material concrete \
+    -o "$tmp/rough" --json >"$tmp/rough.json" || fail "--material concrete should exit 0"
+check_json "$tmp/rough.json" >/dev/null || fail "rough JSON: $(cat "$tmp/rough.json")"
+"$RUBBLE" check "$tmp/rough"/piece_*.obj >"$tmp/check.txt" || fail "rubble check rejects rough pieces: $(cat "$tmp/check.txt")"
+grep -q "^usemtl interior" "$tmp/rough/piece_000.obj" || fail "rough piece_000.obj uses no interior material"
+python3 - "$tmp/a.json" "$tmp/rough.json" <<'PY' || fail "rough pieces should have more triangles than flat ones"
+import json, sys
+flat, rough = (sum(p["triangles"] for p in json.load(open(f))["pieces"]) for f in sys.argv[1:])
+assert rough > 1.5 * flat, (flat, rough)
+PY
+"$RUBBLE" fracture "$models/cube_588.obj" --impact 0.9,0.2,-0.1 --impulse 400 --seed 7 --material concrete \
+    -o "$tmp/rough2" >/dev/null || fail "second rough run should exit 0"
+diff -r "$tmp/rough" "$tmp/rough2" >/dev/null || fail "same seed gave different rough files"
+"$RUBBLE" fracture "$models/cube_588.obj" --impact 0.9,0.2,-0.1 --impulse 400 --seed 7 --material concrete \
+    --roughness 0 -o "$tmp/flat0" >/dev/null || fail "--roughness 0 should exit 0"
+diff -r "$tmp/a" "$tmp/flat0" >/dev/null || fail "--roughness 0 differs from the flat cut"
+"$RUBBLE" fracture "$models/cube_588.obj" --impact 0.9,0.2,-0.1 --impulse 400 --seed 7 --roughness 0.1 \
+    --hurst 0.5 --feature-size 0.3 -o "$tmp/hand" >/dev/null || fail "--roughness by hand should exit 0"
+! diff -r "$tmp/rough" "$tmp/hand" >/dev/null || fail "--roughness by hand gave the preset's files"
+
 # Bad input: exit 2, the file named, nothing written.
 expect_2() { # name, then the command line after `rubble fracture`
     local name="$1"; shift
@@ -80,7 +103,11 @@ grep -q "open_cube.obj" "$tmp/err.txt" || fail "open mesh: message does not name
 expect_2 "batch with one bad file" "$models/cube_12.obj" "$data/garbage.obj" --impact 0,0,0 -o "$tmp/bad4"
 expect_2 "bad impact" "$models/cube_12.obj" --impact 1,2 -o "$tmp/bad5"
 expect_2 "bad backend" "$models/cube_12.obj" --impact 0,0,0 --backend magic -o "$tmp/bad6"
-for d in bad1 bad2 bad3 bad4 bad5 bad6; do [ ! -e "$tmp/$d" ] || fail "$d: output folder was created"; done
+expect_2 "bad hurst" "$models/cube_12.obj" --impact 0.99,0,0 --roughness 0.1 --hurst 2 -o "$tmp/bad7"
+grep -q "hurst" "$tmp/err.txt" || fail "bad hurst: message does not name the parameter: $(cat "$tmp/err.txt")"
+expect_2 "bad material" "$models/cube_12.obj" --impact 0.99,0,0 --material cheese -o "$tmp/bad8"
+grep -q "concrete" "$tmp/err.txt" || fail "bad material: message does not list the materials"
+for d in bad1 bad2 bad3 bad4 bad5 bad6 bad7 bad8; do [ ! -e "$tmp/$d" ] || fail "$d: output folder was created"; done
 mkdir "$tmp/full" && touch "$tmp/full/keep"
 expect_2 "non-empty output folder" "$models/cube_12.obj" --impact 0.99,0,0 -o "$tmp/full"
 [ "$(ls "$tmp/full")" = keep ] || fail "non-empty output folder was changed"

@@ -188,6 +188,21 @@ def test_same_seed_same_pieces_other_seed_other_pieces():
     assert [p.hash() for p in a] != [p.hash() for p in c]
 
 
+def test_rough_cut_faces_by_material_or_by_hand():
+    flat = fracture_cube(seed=11)
+    rough = fracture_cube(seed=11, material="concrete")
+    assert sum(p.volume for p in rough) == pytest.approx(8, rel=1e-9)
+    assert all(rubble.check(p).valid for p in rough)
+    assert sum(len(p.triangles) for p in rough) > sum(len(p.triangles) for p in flat)
+    assert [p.hash() for p in fracture_cube(seed=11, material="concrete", roughness=0)] == [p.hash() for p in flat]
+    by_hand = fracture_cube(seed=11, roughness=0.1, hurst=0.5, feature_size=0.3)
+    assert [p.hash() for p in by_hand] != [p.hash() for p in rough]
+    with pytest.raises(ValueError, match="hurst"):
+        fracture_cube(roughness=0.1, hurst=2.0)
+    with pytest.raises(ValueError, match="material"):
+        fracture_cube(material="cheese")
+
+
 # Errors
 
 

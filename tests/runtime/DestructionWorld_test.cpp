@@ -293,9 +293,11 @@ TEST(DestructionWorld, StaleResultDiscarded) {
     EXPECT_TRUE(w.timings()[0].stale);
 }
 
-std::vector<std::uint64_t> pieceHashes(DestructionWorld::Config cfg) {
+std::vector<std::uint64_t> pieceHashes(DestructionWorld::Config cfg, const Roughness& roughness = {}) {
     DestructionWorld w(cfg);
-    auto id = w.addObject(boxDesc()).value();
+    ObjectDesc desc = boxDesc();
+    desc.fracture.roughness = roughness;
+    auto id = w.addObject(desc).value();
     EXPECT_TRUE(w.submitImpact(id, centreHit()));
     w.waitIdle();
     std::vector<std::uint64_t> h;
@@ -321,6 +323,13 @@ TEST(DestructionWorld, DeterministicAcrossWorkerCounts) {
     EXPECT_FALSE(a.empty());
     EXPECT_EQ(a, pieceHashes(two));
     EXPECT_EQ(a, pieceHashes(det));
+    // Rough cut faces (docs/roughness.md): their own pieces, the same on 1 and 2 workers.
+    const Roughness concrete = roughnessPreset("concrete");
+    const auto rough = pieceHashes(one, concrete);
+    EXPECT_FALSE(rough.empty());
+    EXPECT_NE(a, rough);
+    EXPECT_EQ(rough, pieceHashes(two, concrete));
+    EXPECT_EQ(rough, pieceHashes(det, concrete));
 }
 
 TEST(DestructionWorld, DestroyWithJobsInFlight) {

@@ -57,6 +57,7 @@
 #include "rubble/ConvexDecomposition.hpp"
 #include "rubble/Fracture.hpp"
 #include "rubble/MassProperties.hpp"
+#include "rubble/Material.hpp"
 #include "rubble/MeshCheck.hpp"
 #include "rubble/MeshIO.hpp"
 #include "rubble/ParameterCheck.hpp"
@@ -88,6 +89,10 @@ struct FractureArgs {
     std::string output;
     bool json = false;
     std::string format = "obj";
+    std::string material;              // a preset's roughness (docs/roughness.md); empty: flat
+    std::optional<double> roughness;   // amplitude, relative to the cell size
+    std::optional<double> hurst;       // Hurst exponent
+    std::optional<double> featureSize; // longest wavelength, relative to the cell size
 };
 
 struct PieceOut {
@@ -640,6 +645,10 @@ int runFracture(const FractureArgs& args) {
         params.pattern = rubble::CellPattern::Shatter;
         params.cells = cells;
     }
+    auto roughness = rubble::chooseRoughness({args.material, args.roughness, args.hurst, args.featureSize});
+    if (!roughness)
+        return usage(roughness.error().message);
+    params.roughness = *roughness;
     if (args.backend == "corefine")
         params.backend = rubble::BooleanKind::Corefine;
     else if (args.backend == "nef")
@@ -823,6 +832,18 @@ const rubble::tools::Registrar registrar{
          app.add_option("--seed", args->seed,
                         "random seed 0..18446744073709551615 (same seed, same pieces, byte for byte)")
              ->capture_default_str();
+         app.add_option("--material", args->material,
+                        "cut with this material's rough cut faces (" + rubble::materialNames() +
+                            "; docs/roughness.md); without it, and with --roughness 0, cuts are flat");
+         app.add_option("--roughness", args->roughness,
+                        "amplitude of rough cut faces, a fraction of the cell size (0: flat)")
+             ->check(rubble::tools::finiteNumber());
+         app.add_option("--hurst", args->hurst, "Hurst exponent of rough cut faces, in (0, 1]")
+             ->check(rubble::tools::finiteNumber());
+         app.add_option(
+                "--feature-size", args->featureSize,
+                "longest wavelength of rough cut faces, a fraction of the cell size (0: 8 amplitudes)")
+             ->check(rubble::tools::finiteNumber());
          app.add_option("--backend", args->backend, "boolean backend (default: the library's default)")
              ->check(CLI::IsMember({"corefine", "nef", "fast"}));
          app.add_option("-o,--output", args->output, "output folder (must not exist, or be empty)")

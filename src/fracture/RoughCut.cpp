@@ -1,0 +1,578 @@
+// Rough cut faces: tessellation by edge bisection and a height field along each cut face's normal, both
+// functions of data the two sides of a cut share (docs/roughness.md).
+
+#include "RoughCut.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <tuple>
+#include <unordered_map>
+
+#include "rubble/Random.hpp"
+
+namespace rubble::detail {
+
+void cutBasis(Vec3 n, Vec3& u, Vec3& v) {
+    int big = 0;
+    for (int a = 1; a < 3; ++a)
+        if (std::abs(n[a]) > std::abs(n[big]))
+            big = a;
+    if (n[big] < 0)
+        n = -n;
+    int small = 0;
+    for (int a = 1; a < 3; ++a)
+        if (std::abs(n[a]) < std::abs(n[small]))
+            small = a;
+    Vec3 axis;
+    axis[small] = 1;
+    u = normalized(cross(axis, n));
+    v = cross(n, u);
+}
+
+namespace {
+
+/// A hash of an integer lattice point and a seed, as a value in [-1, 1).
+double latticeValue(std::int64_t x, std::int64_t y, std::int64_t z, std::uint64_t seed) {
+    std::uint64_t h = seed ^ (static_cast<std::uint64_t>(x) * 0x9E3779B97F4A7C15ull);
+    h = (h ^ (h >> 31)) * 0xBF58476D1CE4E5B9ull ^ (static_cast<std::uint64_t>(y) * 0xC2B2AE3D27D4EB4Full);
+    h = (h ^ (h >> 29)) * 0x94D049BB133111EBull ^ (static_cast<std::uint64_t>(z) * 0x165667B19E3779F9ull);
+    h = (h ^ (h >> 32)) * 0xD6E8FEB86659FD93ull;
+    h ^= h >> 32;
+    return static_cast<double>(h >> 11) * 0x1.0p-52 - 1.0;
+}
+
+/// Quintic fade 6t^5 - 15t^4 + 10t^3 (its slope is at most 15/8).
+double fade(double t) {
+    return t * t * t * (t * (t * 6 - 15) + 10);
+}
+
+/// Value noise in [-1, 1]: lattice values blended by the quintic fade.
+double valueNoise(const Vec3& p, std::uint64_t seed) {
+    const double fx = std::floor(p.x), fy = std::floor(p.y), fz = std::floor(p.z);
+    const auto ix = static_cast<std::int64_t>(fx), iy = static_cast<std::int64_t>(fy),
+               iz = static_cast<std::int64_t>(fz);
+    const double tx = fade(p.x - fx), ty = fade(p.y - fy), tz = fade(p.z - fz);
+    double c[2][2];
+    for (int dy = 0; dy < 2; ++dy)
+        for (int dz = 0; dz < 2; ++dz) {
+            const double a = latticeValue(ix, iy + dy, iz + dz, seed);
+            const double b = latticeValue(ix + 1, iy + dy, iz + dz, seed);
+            c[dy][dz] = a + (b - a) * tx;
+        }
+    const double c0 = c[0][0] + (c[1][0] - c[0][0]) * ty, c1 = c[0][1] + (c[1][1] - c[0][1]) * ty;
+    return c0 + (c1 - c0) * tz;
+}
+
+/// The slope of the envelope of a cut face's heights from its outline: tan 10°, so two cut faces meeting at
+/// more than 20°, and a cut face meeting the outer surface at more than 10°, cannot cross
+/// (docs/roughness.md).
+constexpr double kEnvelope = 0.17632698070846498;
+
+/// Squared distance from p to the segment ab.
+double segmentDistance2(const Vec3& p, const Vec3& a, const Vec3& b) {
+    const Vec3 ab = b - a;
+    const double len2 = dot(ab, ab);
+    double t = len2 > 0 ? dot(p - a, ab) / len2 : 0.0;
+    t = std::clamp(t, 0.0, 1.0);
+    const Vec3 d = p - (a + ab * t);
+    return dot(d, d);
+}
+
+bool lexLess(const Vec3& a, const Vec3& b) {
+    return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
+}
+
+std::uint64_t edgeKey(std::uint32_t a, std::uint32_t b) {
+    return a < b ? (std::uint64_t{a} << 32 | b) : (std::uint64_t{b} << 32 | a);
+}
+
+/// A new cut face: a face of a cell, with its plane's normal in the same direction for both sides.
+struct CutFace {
+    const PolytopeFace* face = nullptr;
+    Vec3 normal; // the plane's normal, its largest component positive
+    Vec3 u, v;   // cutBasis
+};
+
+/// The cells' faces and a lookup of the one a triangle lies on.
+class CutFaces {
+public:
+    CutFaces(const std::vector<ConvexPolytope>& cells, double onPlane) : cells_(cells), onPlane_(onPlane) {
+        for (const ConvexPolytope& c : cells) {
+            first_.push_back(faces_.size());
+            for (const PolytopeFace& f : c.faces()) {
+                CutFace cf{&f, f.plane.normal, {}, {}};
+                int big = 0;
+                for (int a = 1; a < 3; ++a)
+                    if (std::abs(cf.normal[a]) > std::abs(cf.normal[big]))
+                        big = a;
+                if (cf.normal[big] < 0)
+                    cf.normal = -cf.normal;
+                cutBasis(cf.normal, cf.u, cf.v);
+                faces_.push_back(cf);
+            }
+        }
+    }
+
+    const CutFace& operator[](std::size_t i) const { return faces_[i]; }
+
+    /// The first face (in the order of the cells) that the triangle lies on, or -1. A function of the
+    /// corners as a set, so both sides of a cut find the same face.
+    std::int32_t find(std::array<Vec3, 3> c) const {
+        std::sort(c.begin(), c.end(), lexLess);
+        Aabb box;
+        for (const Vec3& p : c)
+            box.extend(p);
+        const Vec3 centroid = (c[0] + c[1] + c[2]) * (1.0 / 3.0);
+        const Vec3 tn = cross(c[1] - c[0], c[2] - c[0]);
+        const double tl = length(tn);
+        for (std::size_t k = 0; k < cells_.size(); ++k) {
+            if (cells_[k].empty() || !cells_[k].bounds().overlaps(box, onPlane_))
+                continue;
+            const auto& faces = cells_[k].faces();
+            for (std::size_t j = 0; j < faces.size(); ++j) {
+                const PolytopeFace& f = faces[j];
+                if (std::abs(dot(f.plane.normal, tn)) < 0.5 * tl)
+                    continue;
+                bool on = true;
+                for (const Vec3& p : c)
+                    on &= std::abs(f.plane.signedDistance(p)) <= onPlane_;
+                if (!on || !insidePolygon(f, centroid))
+                    continue;
+                return static_cast<std::int32_t>(first_[k] + j);
+            }
+        }
+        return -1;
+    }
+
+private:
+    bool insidePolygon(const PolytopeFace& f, const Vec3& p) const {
+        const std::size_t n = f.corners.size();
+        for (std::size_t i = 0; i < n; ++i) {
+            const Vec3& a = f.corners[i];
+            const Vec3 e = f.corners[(i + 1) % n] - a;
+            const double el = length(e);
+            if (dot(cross(e, p - a), f.plane.normal) < -onPlane_ * el)
+                return false;
+        }
+        return true;
+    }
+
+    const std::vector<ConvexPolytope>& cells_;
+    double onPlane_;
+    std::vector<std::size_t> first_;
+    std::vector<CutFace> faces_;
+};
+
+/// A triangle being refined, with its corner attributes; face -1: not a cut face (it is only split).
+struct WorkTriangle {
+    std::array<std::uint32_t, 3> v;
+    std::array<Vec3, 3> n;
+    std::array<Vec2, 3> uv;
+    std::uint32_t material = 0;
+    std::int32_t face = -1;
+};
+
+/// A uniform hash grid of segments (ids), cell size = the reach of the distance.
+class SegmentGrid {
+public:
+    explicit SegmentGrid(double cell) : inv_(1.0 / cell) {}
+    void add(std::uint32_t id, const Vec3& a, const Vec3& b) {
+        const auto lo = cellOf(min(a, b)), hi = cellOf(max(a, b));
+        for (std::int64_t x = lo[0]; x <= hi[0]; ++x)
+            for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
+                for (std::int64_t z = lo[2]; z <= hi[2]; ++z)
+                    cells_[key(x, y, z)].push_back(id);
+    }
+    /// Calls visit(id) for every segment with a point within one cell size of p (some more than once).
+    template <class Visit>
+    void near(const Vec3& p, Visit visit) const {
+        const auto c = cellOf(p);
+        for (std::int64_t x = c[0] - 1; x <= c[0] + 1; ++x)
+            for (std::int64_t y = c[1] - 1; y <= c[1] + 1; ++y)
+                for (std::int64_t z = c[2] - 1; z <= c[2] + 1; ++z)
+                    if (auto it = cells_.find(key(x, y, z)); it != cells_.end())
+                        for (std::uint32_t id : it->second)
+                            visit(id);
+    }
+
+private:
+    std::array<std::int64_t, 3> cellOf(const Vec3& p) const {
+        return {static_cast<std::int64_t>(std::floor(p.x * inv_)),
+                static_cast<std::int64_t>(std::floor(p.y * inv_)),
+                static_cast<std::int64_t>(std::floor(p.z * inv_))};
+    }
+    static std::uint64_t key(std::int64_t x, std::int64_t y, std::int64_t z) {
+        const auto u = [](std::int64_t a) { return static_cast<std::uint64_t>(a) & 0x1FFFFFull; };
+        return u(x) << 42 | u(y) << 21 | u(z);
+    }
+    double inv_;
+    std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> cells_;
+};
+
+/// The shared settings of one rough split.
+struct RoughSettings {
+    double amplitude = 0;
+    double reach = 0; // distances to the outline are measured up to here (the envelope is then 2 amplitudes)
+    double edge = 0;  // longest cut-face edge after tessellation
+    const RoughField* field = nullptr;
+    double uvScale = 1;
+};
+
+/// Splits the working triangles' marked edges (edge key -> midpoint vertex) by the templates of red-green
+/// refinement; the two-edge template takes the shorter diagonal (ties by the diagonals' corners).
+void splitTriangles(std::vector<WorkTriangle>& work,
+                    const std::unordered_map<std::uint64_t, std::uint32_t>& mid, const std::vector<Vec3>& pos,
+                    bool normals) {
+    std::vector<WorkTriangle> out;
+    out.reserve(work.size() * 2);
+    for (const WorkTriangle& t : work) {
+        std::array<std::int64_t, 3> m{-1, -1, -1}; // midpoint of edge (k, k+1)
+        int count = 0;
+        for (int k = 0; k < 3; ++k)
+            if (auto it = mid.find(edgeKey(t.v[k], t.v[(k + 1) % 3])); it != mid.end()) {
+                m[k] = it->second;
+                ++count;
+            }
+        if (count == 0) {
+            out.push_back(t);
+            continue;
+        }
+        // Corner attributes of the triangle's corners (0..2) and midpoints (3..5: of edge 0..2).
+        std::array<std::uint32_t, 6> vid{};
+        std::array<Vec3, 6> nn{};
+        std::array<Vec2, 6> uu{};
+        for (int k = 0; k < 3; ++k) {
+            vid[k] = t.v[k];
+            nn[k] = t.n[k];
+            uu[k] = t.uv[k];
+            const int j = (k + 1) % 3;
+            if (m[k] >= 0) {
+                vid[3 + k] = static_cast<std::uint32_t>(m[k]);
+                if (normals)
+                    nn[3 + k] = normalized(t.n[k] + t.n[j]);
+                uu[3 + k] = {(t.uv[k].x + t.uv[j].x) * 0.5, (t.uv[k].y + t.uv[j].y) * 0.5};
+            }
+        }
+        auto emit = [&](int a, int b, int c) {
+            WorkTriangle s = t;
+            s.v = {vid[a], vid[b], vid[c]};
+            s.n = {nn[a], nn[b], nn[c]};
+            s.uv = {uu[a], uu[b], uu[c]};
+            out.push_back(s);
+        };
+        if (count == 3) {
+            emit(0, 3, 5);
+            emit(3, 1, 4);
+            emit(5, 4, 2);
+            emit(3, 4, 5);
+        } else if (count == 1) {
+            const int k = m[0] >= 0 ? 0 : m[1] >= 0 ? 1 : 2; // split edge (k, k+1)
+            const int j = (k + 1) % 3, l = (k + 2) % 3;
+            emit(k, 3 + k, l);
+            emit(3 + k, j, l);
+        } else {
+            const int z = m[0] < 0 ? 0 : m[1] < 0 ? 1 : 2;     // the edge (z, z+1) is whole
+            const int a = (z + 1) % 3, b = (z + 2) % 3, c = z; // split edges (a, b) and (b, c)
+            const int m1 = 3 + a, m2 = 3 + b;
+            emit(m1, b, m2);
+            // Quad (a, m1, m2, c): diagonal a-m2 or m1-c, the shorter; ties by the diagonals' corners.
+            const Vec3 &pa = pos[vid[a]], &pc = pos[vid[c]], &p1 = pos[vid[m1]], &p2 = pos[vid[m2]];
+            const double d1 = dot(pa - p2, pa - p2), d2 = dot(p1 - pc, p1 - pc);
+            bool first = d1 < d2;
+            if (d1 == d2) {
+                const Vec3 k1 = lexLess(pa, p2) ? pa : p2, k2 = lexLess(p1, pc) ? p1 : pc;
+                first = lexLess(k1, k2);
+            }
+            if (first) {
+                emit(a, m1, m2);
+                emit(a, m2, c);
+            } else {
+                emit(a, m1, c);
+                emit(m1, m2, c);
+            }
+        }
+    }
+    work = std::move(out);
+}
+
+/// Roughens one output: its cut triangles (faceOf >= 0) and the triangles along their edges.
+void roughenMesh(Mesh& m, const std::vector<std::int32_t>& faceOf, const CutFaces& faces,
+                 const RoughSettings& s, VolumeIntegrals* integrals) {
+    const std::size_t nT = m.triangles.size();
+    const bool normals = m.hasNormals();
+    std::vector<std::uint8_t> cutVertex(m.positions.size(), 0);
+    for (std::size_t t = 0; t < nT; ++t)
+        if (faceOf[t] >= 0)
+            for (std::uint32_t v : m.triangles[t])
+                cutVertex[v] = 1;
+    std::vector<std::uint8_t> taken(nT, 0);
+    std::vector<WorkTriangle> work;
+    for (std::size_t t = 0; t < nT; ++t) {
+        const Triangle& tri = m.triangles[t];
+        const int onCut = cutVertex[tri[0]] + cutVertex[tri[1]] + cutVertex[tri[2]];
+        if (faceOf[t] < 0 && onCut < 2)
+            continue;
+        taken[t] = 1;
+        WorkTriangle w;
+        w.v = {tri[0], tri[1], tri[2]};
+        for (std::size_t k = 0; k < 3; ++k) {
+            if (normals)
+                w.n[k] = m.normals[3 * t + k];
+            w.uv[k] = m.uvs[3 * t + k];
+        }
+        w.material = m.materials[t];
+        w.face = faceOf[t];
+        work.push_back(w);
+        if (integrals)
+            integrals->remove(m, t);
+    }
+    // Bisect every cut-face edge longer than the target until none is.
+    const double edge2 = s.edge * s.edge;
+    for (int pass = 0; pass < 40; ++pass) {
+        std::unordered_map<std::uint64_t, std::uint32_t> mid;
+        for (const WorkTriangle& t : work) {
+            if (t.face < 0)
+                continue;
+            for (int k = 0; k < 3; ++k) {
+                const std::uint32_t a = t.v[k], b = t.v[(k + 1) % 3];
+                const Vec3 d = m.positions[a] - m.positions[b];
+                if (dot(d, d) <= edge2)
+                    continue;
+                if (auto [it, fresh] = mid.emplace(edgeKey(a, b), 0u); fresh) {
+                    it->second = static_cast<std::uint32_t>(m.positions.size());
+                    const std::uint32_t lo = std::min(a, b), hi = std::max(a, b);
+                    m.positions.push_back((m.positions[lo] + m.positions[hi]) * 0.5);
+                }
+            }
+        }
+        if (mid.empty())
+            break;
+        splitTriangles(work, mid, m.positions, normals);
+    }
+    // Per cut face: its outline (edges of one of its triangles only); outline vertices stay.
+    std::vector<std::tuple<std::int32_t, std::uint64_t, std::uint32_t>> edges; // face, edge, triangle
+    for (std::uint32_t i = 0; i < work.size(); ++i)
+        if (work[i].face >= 0)
+            for (int k = 0; k < 3; ++k)
+                edges.emplace_back(work[i].face, edgeKey(work[i].v[k], work[i].v[(k + 1) % 3]), i);
+    std::sort(edges.begin(), edges.end());
+    std::vector<std::uint8_t> fixed(m.positions.size(), 0);
+    struct FaceRange {
+        std::int32_t face;
+        std::size_t begin, end; // in edges
+    };
+    std::vector<FaceRange> ranges;
+    for (std::size_t i = 0; i < edges.size();) {
+        std::size_t j = i;
+        while (j < edges.size() && std::get<0>(edges[j]) == std::get<0>(edges[i]))
+            ++j;
+        ranges.push_back({std::get<0>(edges[i]), i, j});
+        i = j;
+    }
+    auto isOutline = [&](std::size_t i, std::size_t begin, std::size_t end) {
+        const std::uint64_t e = std::get<1>(edges[i]);
+        return !((i > begin && std::get<1>(edges[i - 1]) == e) ||
+                 (i + 1 < end && std::get<1>(edges[i + 1]) == e));
+    };
+    for (const FaceRange& r : ranges)
+        for (std::size_t i = r.begin; i < r.end; ++i)
+            if (isOutline(i, r.begin, r.end)) {
+                const std::uint64_t e = std::get<1>(edges[i]);
+                fixed[e >> 32] = 1;
+                fixed[e & 0xFFFFFFFFu] = 1;
+            }
+    // UVs of the flat cut (continuous across the displaced surface), then the displacement.
+    for (WorkTriangle& t : work)
+        if (t.face >= 0) {
+            const CutFace& f = faces[static_cast<std::size_t>(t.face)];
+            for (int k = 0; k < 3; ++k) {
+                const Vec3& p = m.positions[t.v[k]];
+                t.uv[k] = {dot(p, f.u) * s.uvScale, dot(p, f.v) * s.uvScale};
+            }
+        }
+    std::vector<std::uint32_t> inner;
+    for (const FaceRange& r : ranges) {
+        SegmentGrid grid(s.reach);
+        std::vector<std::pair<std::uint32_t, std::uint32_t>> outline;
+        inner.clear();
+        for (std::size_t i = r.begin; i < r.end; ++i) {
+            const std::uint64_t e = std::get<1>(edges[i]);
+            const auto a = static_cast<std::uint32_t>(e >> 32),
+                       b = static_cast<std::uint32_t>(e & 0xFFFFFFFFu);
+            if (isOutline(i, r.begin,
+                          r.end)) { // ends in the order of their positions: the same bits both sides
+                const bool swap = lexLess(m.positions[b], m.positions[a]);
+                grid.add(static_cast<std::uint32_t>(outline.size()), m.positions[a], m.positions[b]);
+                outline.emplace_back(swap ? b : a, swap ? a : b);
+            }
+            for (std::uint32_t v : {a, b})
+                if (!fixed[v])
+                    inner.push_back(v);
+        }
+        std::sort(inner.begin(), inner.end());
+        inner.erase(std::unique(inner.begin(), inner.end()), inner.end());
+        // Distance to the outline (up to the reach), then the height within the envelope kEnvelope *
+        // distance.
+        const double reach2 = s.reach * s.reach;
+        const Vec3 n = faces[static_cast<std::size_t>(r.face)].normal;
+        for (const std::uint32_t v : inner) {
+            Vec3& p = m.positions[v];
+            double d2 = reach2;
+            grid.near(p, [&](std::uint32_t id) {
+                d2 = std::min(
+                    d2, segmentDistance2(p, m.positions[outline[id].first], m.positions[outline[id].second]));
+            });
+            const double bound = kEnvelope * std::sqrt(d2);
+            p = p + n * (bound * std::tanh(s.amplitude * (*s.field)(p) / bound));
+        }
+    }
+    // Normals of the displaced surface: smooth across a cut face, its own at the outline.
+    if (normals) {
+        std::unordered_map<std::uint64_t, Vec3> sum; // (face, vertex) -> area-weighted normal
+        auto key = [](std::int32_t face, std::uint32_t v) {
+            return static_cast<std::uint64_t>(static_cast<std::uint32_t>(face)) << 32 | v;
+        };
+        for (const WorkTriangle& t : work)
+            if (t.face >= 0) {
+                const Vec3 tn = cross(m.positions[t.v[1]] - m.positions[t.v[0]],
+                                      m.positions[t.v[2]] - m.positions[t.v[0]]);
+                for (std::uint32_t v : t.v)
+                    sum[key(t.face, v)] += tn;
+            }
+        for (WorkTriangle& t : work)
+            if (t.face >= 0)
+                for (int k = 0; k < 3; ++k)
+                    t.n[k] = normalized(sum[key(t.face, t.v[k])]);
+    }
+    // The untouched triangles in their order, then the worked ones.
+    Mesh out;
+    out.positions = std::move(m.positions);
+    out.materialNames = std::move(m.materialNames);
+    const std::size_t kept = nT - static_cast<std::size_t>(std::count(taken.begin(), taken.end(), 1));
+    out.triangles.reserve(kept + work.size());
+    out.uvs.reserve(3 * (kept + work.size()));
+    out.materials.reserve(kept + work.size());
+    if (normals)
+        out.normals.reserve(3 * (kept + work.size()));
+    for (std::size_t t = 0; t < nT; ++t) {
+        if (taken[t])
+            continue;
+        out.triangles.push_back(m.triangles[t]);
+        out.materials.push_back(m.materials[t]);
+        out.uvs.insert(out.uvs.end(), m.uvs.begin() + 3 * t, m.uvs.begin() + 3 * t + 3);
+        if (normals)
+            out.normals.insert(out.normals.end(), m.normals.begin() + 3 * t, m.normals.begin() + 3 * t + 3);
+    }
+    for (const WorkTriangle& t : work) {
+        out.triangles.push_back({t.v[0], t.v[1], t.v[2]});
+        out.materials.push_back(t.material);
+        out.uvs.insert(out.uvs.end(), t.uv.begin(), t.uv.end());
+        if (normals)
+            out.normals.insert(out.normals.end(), t.n.begin(), t.n.end());
+        if (integrals)
+            integrals->add(out.positions[t.v[0]], out.positions[t.v[1]], out.positions[t.v[2]]);
+    }
+    m = std::move(out);
+}
+
+} // namespace
+
+RoughField::RoughField(const Roughness& r, double featureSize, int octavesUsed, const Vec3& grain)
+    : seed_(r.seed), frequency_(1.0 / featureSize), gain_(std::pow(2.0, -r.hurst)), norm_(0),
+      octaves_(octavesUsed), squash_(1.0 / r.grainStretch - 1.0), grain_(normalized(grain)) {
+    double sum = 0, weight = 1;
+    for (int k = 0; k < octavesUsed; ++k, weight *= gain_)
+        sum += weight;
+    norm_ = 1.0 / sum;
+}
+
+double RoughField::operator()(const Vec3& p) const {
+    Vec3 q = p * frequency_;
+    if (squash_ != 0)
+        q = q + grain_ * (squash_ * dot(q, grain_));
+    double value = 0, weight = 1;
+    for (int k = 0; k < octaves_; ++k, weight *= gain_, q = q * 2.0)
+        value += weight * valueNoise(q, mixSeed(seed_, static_cast<std::uint64_t>(k)));
+    return value * norm_;
+}
+
+RoughCutReport roughenSplit(SplitResult& split, const std::vector<ConvexPolytope>& cells, const Roughness& r,
+                            double uvScale, const Aabb& meshBox, double onPlane) {
+    RoughCutReport report;
+    // The cell size: the cube root of the cells' mean volume.
+    double volume = 0;
+    int count = 0;
+    for (const ConvexPolytope& c : cells)
+        if (!c.empty()) {
+            volume += c.volume();
+            ++count;
+        }
+    if (count == 0 || !(volume > 0))
+        return report;
+    const double cellSize = std::cbrt(volume / count);
+    const double scale = r.relative ? cellSize : 1.0;
+    report.amplitude = r.amplitude * scale;
+    report.featureSize = r.featureSize > 0 ? r.featureSize * scale : 8 * report.amplitude;
+    if (!(report.amplitude > 0))
+        return report;
+
+    const CutFaces faces(cells, onPlane);
+    std::vector<Mesh*> outputs{&split.remainder};
+    for (Mesh& m : split.inside)
+        outputs.push_back(&m);
+    std::vector<std::vector<std::int32_t>> faceOf(outputs.size());
+    Aabb focus;
+    for (const ConvexPolytope& c : cells)
+        focus.extend(c.bounds());
+    focus = {focus.lo - Vec3{1, 1, 1} * onPlane, focus.hi + Vec3{1, 1, 1} * onPlane};
+    double largestCut = 0; // the largest cut area of one output
+    for (std::size_t o = 0; o < outputs.size(); ++o) {
+        const Mesh& m = *outputs[o];
+        faceOf[o].assign(m.triangles.size(), -1);
+        if (!m.hasMaterials() || m.uvs.size() != 3 * m.triangles.size())
+            continue;
+        double area = 0;
+        for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+            if (m.materials[t] != kInteriorMaterial)
+                continue;
+            const auto c = m.corners(t);
+            if (!focus.contains(c[0]) || !focus.contains(c[1]) || !focus.contains(c[2]))
+                continue;
+            faceOf[o][t] = faces.find(c);
+            if (faceOf[o][t] >= 0)
+                area += 0.5 * length(cross(c[1] - c[0], c[2] - c[0]));
+        }
+        largestCut = std::max(largestCut, area);
+    }
+    // Edges resolve the finest octave by three; the budget coarsens them and drops the octaves they miss.
+    const double finest = report.featureSize / std::ldexp(1.0, r.octaves - 1);
+    const double budgetEdge = std::sqrt(largestCut / (0.07 * r.maxTrianglesPerPiece));
+    report.edge = std::max(finest / 3, budgetEdge);
+    report.octaves = 1;
+    while (report.octaves < r.octaves &&
+           report.featureSize / std::ldexp(1.0, report.octaves) >= 3 * report.edge)
+        ++report.octaves;
+    Vec3 grain = r.grain;
+    if (length(grain) == 0) {
+        const Vec3 ext = meshBox.hi - meshBox.lo;
+        grain = ext.x >= ext.y && ext.x >= ext.z ? Vec3{1, 0, 0}
+                : ext.y >= ext.z                 ? Vec3{0, 1, 0}
+                                                 : Vec3{0, 0, 1};
+    }
+    const RoughField field(r, report.featureSize, report.octaves, grain);
+    RoughSettings s{report.amplitude, 2 * report.amplitude / kEnvelope, report.edge, &field, uvScale};
+    for (std::size_t o = 0; o < outputs.size(); ++o) {
+        if (std::none_of(faceOf[o].begin(), faceOf[o].end(), [](std::int32_t f) { return f >= 0; }))
+            continue;
+        VolumeIntegrals* integrals =
+            o == 0 && split.remainderIntegrals ? &*split.remainderIntegrals : nullptr;
+        roughenMesh(*outputs[o], faceOf[o], faces, s, integrals);
+        for (std::uint32_t mat : outputs[o]->materials)
+            report.faces += mat == kInteriorMaterial ? 1 : 0;
+    }
+    return report;
+}
+
+} // namespace rubble::detail

@@ -1,0 +1,371 @@
+// Rough cut faces (docs/roughness.md): the invariants of a flat cut kept (closed pieces, exact volume,
+// neighbours that fit, the outer surface unmoved, no self-intersection) and the cut really rough, with the
+// requested Hurst exponent.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+
+#include "TestSupport.hpp"
+#include "fracture/RoughCut.hpp"
+#include "rubble/Fracture.hpp"
+#include "rubble/MassProperties.hpp"
+#include "rubble/MeshCheck.hpp"
+#include "rubble/Random.hpp"
+
+using namespace rubble;
+using rubble::test::closedAndOriented;
+using rubble::test::surfacePoint;
+
+namespace {
+
+Mesh cube() {
+    return makeSubdividedBox({-1, -1, -1}, {1, 1, 1}, 6);
+}
+
+FractureParams roughParams(CellPattern pattern = CellPattern::SingleCell) {
+    FractureParams p;
+    p.pattern = pattern;
+    p.cells = 8;
+    p.sizeLaw.base = 1.6;
+    p.sizeLaw.scale = 0;
+    p.roughness = roughnessPreset("concrete");
+    p.minPieceVolumeFraction = 0;
+    return p;
+}
+
+/// Sum of the pieces' volumes (of their meshes) and dropped volume.
+double volumeSum(const FractureResult& r) {
+    double v = r.droppedVolume;
+    for (const Piece& p : r.pieces)
+        v += signedVolume(p.mesh);
+    return v;
+}
+
+void expectSoundPieces(const Mesh& input, const FractureResult& r, const std::string& what) {
+    const double v0 = signedVolume(input);
+    for (const Piece& p : r.pieces) {
+        EXPECT_TRUE(closedAndOriented(p.mesh)) << what;
+        EXPECT_TRUE(p.mesh.validate().isOk()) << what;
+        EXPECT_GT(p.mass.volume, 0) << what;
+        EXPECT_LT(test::massError(p.mesh, p.mass), 1e-9) << what; // mass of the rough mesh
+        EXPECT_EQ(p.mesh.uvs.size(), 3 * p.mesh.triangles.size()) << what;
+    }
+    EXPECT_NEAR(volumeSum(r), v0, 1e-9 * v0) << what;
+}
+
+/// A triangle's corners from its smallest, in its orientation (reversed: the other orientation).
+std::array<double, 9> orientedKey(const Mesh& m, std::size_t t, bool reversed) {
+    auto c = m.corners(t);
+    if (reversed)
+        std::swap(c[1], c[2]);
+    std::size_t first = 0;
+    for (std::size_t k = 1; k < 3; ++k)
+        if (std::tie(c[k].x, c[k].y, c[k].z) < std::tie(c[first].x, c[first].y, c[first].z))
+            first = k;
+    std::array<double, 9> key{};
+    for (std::size_t k = 0; k < 3; ++k)
+        for (int a = 0; a < 3; ++a)
+            key[3 * k + static_cast<std::size_t>(a)] = c[(first + k) % 3][a];
+    return key;
+}
+
+/// Every cut triangle (interior material) of every piece is in exactly one other piece, reversed, with the
+/// same bits: neighbouring cut surfaces coincide.
+void expectCutsCoincide(const FractureResult& r, const std::string& what) {
+    std::map<std::array<double, 9>, std::vector<std::size_t>> owners;
+    for (std::size_t i = 0; i < r.pieces.size(); ++i) {
+        const Mesh& m = r.pieces[i].mesh;
+        for (std::size_t t = 0; t < m.triangles.size(); ++t)
+            if (m.materials[t] == kInteriorMaterial)
+                owners[orientedKey(m, t, false)].push_back(i);
+    }
+    std::size_t unmatched = 0;
+    for (const auto& [key, pieces] : owners) {
+        std::array<double, 9> rev{};
+        // The reversed triangle: corners 0, 2, 1 from the same first corner.
+        for (int a = 0; a < 3; ++a) {
+            rev[static_cast<std::size_t>(a)] = key[static_cast<std::size_t>(a)];
+            rev[3 + static_cast<std::size_t>(a)] = key[6 + static_cast<std::size_t>(a)];
+            rev[6 + static_cast<std::size_t>(a)] = key[3 + static_cast<std::size_t>(a)];
+        }
+        auto it = owners.find(rev);
+        if (pieces.size() != 1 || it == owners.end() || it->second.size() != 1 || it->second[0] == pieces[0])
+            ++unmatched;
+    }
+    EXPECT_EQ(unmatched, 0u) << what << ": of " << owners.size() << " cut triangles";
+}
+
+/// The largest distance of an outer (non-cut) triangle's corner from the cube's surface.
+double offCube(const FractureResult& r) {
+    double worst = 0;
+    for (const Piece& p : r.pieces)
+        for (std::size_t t = 0; t < p.mesh.triangles.size(); ++t) {
+            if (p.mesh.materials[t] == kInteriorMaterial)
+                continue;
+            for (const Vec3& c : p.mesh.corners(t)) {
+                const double d = std::min(
+                    {std::abs(std::abs(c.x) - 1), std::abs(std::abs(c.y) - 1), std::abs(std::abs(c.z) - 1)});
+                worst = std::max(worst, d);
+            }
+        }
+    return worst;
+}
+
+std::uint64_t hashAll(const FractureResult& r) {
+    std::uint64_t h = 1469598103934665603ull;
+    for (const Piece& p : r.pieces)
+        h = mixSeed(h, p.mesh.hash());
+    return h;
+}
+
+/// A cube cut by one big cell: its part x > 0.01 (the cut is a square of area 4; x = 0 holds vertices).
+Result<FractureResult> halfCut(const Roughness& rough) {
+    FractureParams p;
+    p.roughness = rough;
+    p.simplifyPieces = false;
+    std::vector<ConvexPolytope> cells{ConvexPolytope::fromAabb({{0.01, -3, -3}, {3, 3, 3}})};
+    return fractureWithCells(cube(), cells, p);
+}
+
+/// The vertices of the half cut's cut face (interior material) of the piece x < 0.
+std::vector<Vec3> cutVertices(const FractureResult& r) {
+    std::set<std::tuple<double, double, double>> seen;
+    std::vector<Vec3> out;
+    for (const Piece& p : r.pieces) {
+        if (p.cell != -1)
+            continue;
+        for (std::size_t t = 0; t < p.mesh.triangles.size(); ++t)
+            if (p.mesh.materials[t] == kInteriorMaterial)
+                for (const Vec3& c : p.mesh.corners(t))
+                    if (seen.emplace(c.x, c.y, c.z).second)
+                        out.push_back(c);
+    }
+    return out;
+}
+
+double cutArea(const FractureResult& r, std::int32_t cell) {
+    double a = 0;
+    for (const Piece& p : r.pieces)
+        if (p.cell == cell)
+            for (std::size_t t = 0; t < p.mesh.triangles.size(); ++t)
+                if (p.mesh.materials[t] == kInteriorMaterial)
+                    a += 0.5 * length(p.mesh.triangleNormal(t));
+    return a;
+}
+
+} // namespace
+
+TEST(RoughFracture, RandomHitsAndPiecesOfPiecesKeepTheInvariants) {
+    const Mesh input = cube();
+    Rng rng(7);
+    int rough = 0, total = 0;
+    for (int i = 0; i < 6; ++i) {
+        Impact impact;
+        impact.point = surfacePoint(input, rng);
+        impact.impulse = 1;
+        const FractureParams params = roughParams(i % 2 ? CellPattern::Shatter : CellPattern::SingleCell);
+        const std::string what = "impact " + std::to_string(i);
+        auto r = fracture(input, impact, params, rng.next());
+        ASSERT_TRUE(r) << what << ": " << r.error().message;
+        ++total;
+        rough += r->rough ? 1 : 0;
+        expectSoundPieces(input, *r, what);
+        if (r->rough) // a flat cut (exact fallback) is simplified: its sides may differ in flat regions
+            expectCutsCoincide(*r, what);
+        EXPECT_LT(offCube(*r), 1e-12) << what;
+        // Pieces of pieces: the largest piece hit again is roughened again where it is cut.
+        const auto largest =
+            std::max_element(r->pieces.begin(), r->pieces.end(),
+                             [](const Piece& a, const Piece& b) { return a.mass.volume < b.mass.volume; });
+        Impact again;
+        again.point = surfacePoint(largest->mesh, rng);
+        auto r2 = fracture(largest->mesh, again, params, rng.next(), largest->facts);
+        ASSERT_TRUE(r2) << what << " again: " << r2.error().message;
+        ++total;
+        rough += r2->rough ? 1 : 0;
+        expectSoundPieces(largest->mesh, *r2, what + " again");
+    }
+    EXPECT_GE(rough, total - 2); // the exact fallback (flat) is rare
+}
+
+TEST(RoughFracture, PiecesDoNotSelfIntersect) {
+    const Mesh input = cube();
+    Rng rng(11);
+    for (int i = 0; i < 12; ++i) {
+        Impact impact;
+        impact.point = surfacePoint(input, rng);
+        FractureParams params = roughParams(i % 2 ? CellPattern::Shatter : CellPattern::SingleCell);
+        if (i >= 6) { // three times the preset's amplitude: heights limited by the envelope near the creases
+            params.roughness.amplitude = 0.3;
+            params.roughness.featureSize = 0.5;
+        }
+        auto r = fracture(input, impact, params, rng.next());
+        ASSERT_TRUE(r);
+        EXPECT_TRUE(r->rough);
+        for (const Piece& p : r->pieces) {
+            const MeshReport report = checkMesh(p.mesh);
+            EXPECT_TRUE(report.selfIntersectionsChecked) << report.selfIntersectionNote;
+            EXPECT_EQ(report.selfIntersections, 0u) << "impact " << i;
+
+            EXPECT_TRUE(report.valid()) << test::joinLines(report.problems);
+        }
+    }
+}
+
+TEST(RoughFracture, TheCutIsRough) {
+    // Fine roughness (amplitude 0.8 of the feature size) with a budget that resolves it.
+    Roughness rough;
+    rough.relative = false;
+    rough.amplitude = 0.12;
+    rough.featureSize = 0.15;
+    rough.octaves = 2;
+    rough.maxTrianglesPerPiece = 100000;
+    auto r = halfCut(rough);
+    ASSERT_TRUE(r) << r.error().message;
+    ASSERT_TRUE(r->rough);
+    ASSERT_EQ(r->pieces.size(), 2u);
+    expectCutsCoincide(*r, "half cut");
+    // The flat cut is the square x = 0 of area 4.
+    EXPECT_GE(cutArea(*r, -1), 1.15 * 4.0);
+    EXPECT_NEAR(cutArea(*r, -1), cutArea(*r, 0), 1e-9);
+    double largest = 0;
+    for (const Vec3& v : cutVertices(*r))
+        largest = std::max(largest, std::abs(v.x - 0.01));
+    EXPECT_GE(largest, rough.amplitude / 3);
+    EXPECT_LE(largest, rough.amplitude);
+    EXPECT_LT(offCube(*r), 1e-12);
+}
+
+TEST(RoughFracture, StructureFunctionFollowsTheHurstExponent) {
+    for (const double hurst : {0.5, 0.8}) {
+        Roughness rough;
+        rough.relative = false;
+        rough.amplitude = 0.05;
+        rough.featureSize = 3.2;
+        rough.hurst = hurst;
+        rough.octaves = 7;
+        rough.maxTrianglesPerPiece = 200000;
+        rough.seed = 3;
+        auto r = halfCut(rough);
+        ASSERT_TRUE(r) << r.error().message;
+        ASSERT_TRUE(r->rough);
+        // Heights (x) of vertices away from the outline (where the envelope does not bind), binned by
+        // distance.
+        std::vector<Vec3> v;
+        std::size_t k = 0;
+        for (const Vec3& p : cutVertices(*r))
+            if (std::abs(p.y) < 0.75 && std::abs(p.z) < 0.75 && k++ % 3 == 0)
+                v.push_back(p);
+        ASSERT_GT(v.size(), 1000u);
+        const double r0 = 0.06, r1 = 0.4; // between the finest wavelength and the longest's quarter
+        constexpr int kBins = 8;
+        std::array<double, kBins> sum{}, count{};
+        for (std::size_t i = 0; i < v.size(); ++i)
+            for (std::size_t j = i + 1; j < v.size(); ++j) {
+                const double d = std::hypot(v[i].y - v[j].y, v[i].z - v[j].z);
+                if (d < r0 || d >= r1)
+                    continue;
+                const int b = static_cast<int>(kBins * std::log(d / r0) / std::log(r1 / r0));
+                const double dh = v[i].x - v[j].x; // the plane is x = 0.01
+                sum[static_cast<std::size_t>(b)] += dh * dh;
+                count[static_cast<std::size_t>(b)] += 1;
+            }
+        // Least-squares slope of log S against log r.
+        double sx = 0, sy = 0, sxx = 0, sxy = 0;
+        for (std::size_t b = 0; b < kBins; ++b) {
+            ASSERT_GT(count[b], 0);
+            const double x = std::log(r0) + (static_cast<double>(b) + 0.5) * std::log(r1 / r0) / kBins;
+            const double y = std::log(sum[b] / count[b]);
+            sx += x;
+            sy += y;
+            sxx += x * x;
+            sxy += x * y;
+        }
+        const double slope = (kBins * sxy - sx * sy) / (kBins * sxx - sx * sx);
+        EXPECT_NEAR(slope, 2 * hurst, 0.2) << "hurst " << hurst;
+    }
+}
+
+TEST(RoughFracture, SameSeedSameBytesOtherSeedOtherSurface) {
+    const Mesh input = cube();
+    Impact impact;
+    impact.point = {1, 0.2, 0.1};
+    impact.normal = {1, 0, 0};
+    const FractureParams params = roughParams(CellPattern::Shatter);
+    auto a = fracture(input, impact, params, 42);
+    auto b = fracture(input, impact, params, 42);
+    ASSERT_TRUE(a && b);
+    EXPECT_TRUE(a->rough);
+    EXPECT_EQ(hashAll(*a), hashAll(*b));
+    // Pinned, as the flat scenes' golden hash (tests/persist/GoldenHash_test.cpp): a change of the rough
+    // surface's bytes must be deliberate.
+    EXPECT_EQ(hashAll(*a), 0xcb37e76bfb39785full);
+    FractureParams other = params;
+    other.roughness.seed = 1;
+    auto c = fracture(input, impact, other, 42);
+    ASSERT_TRUE(c);
+    EXPECT_NE(hashAll(*a), hashAll(*c));
+    // Flat is the default, and roughness 0 is flat, bit for bit.
+    FractureParams flat = params;
+    flat.roughness = {};
+    auto f = fracture(input, impact, flat, 42);
+    flat.roughness.hurst = 0.5;
+    auto g = fracture(input, impact, flat, 42);
+    ASSERT_TRUE(f && g);
+    EXPECT_FALSE(f->rough);
+    EXPECT_EQ(hashAll(*f), hashAll(*g));
+    EXPECT_NE(hashAll(*f), hashAll(*a));
+}
+
+TEST(RoughFracture, SmallPiecesFollowTheBudget) {
+    Roughness rough;
+    rough.relative = false;
+    rough.amplitude = 0.1;
+    rough.featureSize = 1.0;
+    rough.octaves = 8; // finer than any budget allows
+    rough.maxTrianglesPerPiece = 500;
+    auto r = halfCut(rough);
+    ASSERT_TRUE(r && r->rough);
+    for (const Piece& p : r->pieces) {
+        std::size_t cut = 0;
+        for (std::uint32_t m : p.mesh.materials)
+            cut += m == kInteriorMaterial ? 1 : 0;
+        EXPECT_LE(cut, 500u);
+        EXPECT_GT(cut, 100u);
+    }
+}
+
+TEST(RoughFracture, ParametersAreValidated) {
+    EXPECT_TRUE(validateRoughness({}));
+    for (const char* m : {"concrete", "brick", "stone", "wood", "glass", "steel"})
+        EXPECT_TRUE(validateRoughness(roughnessPreset(m))) << m;
+    EXPECT_FALSE(roughnessPreset("steel").active());
+    EXPECT_TRUE(roughnessPreset("concrete").active());
+    auto expectRefused = [](Roughness r, const std::string& name) {
+        const Status s = validateRoughness(r);
+        ASSERT_FALSE(s);
+        EXPECT_NE(s.message().find(name), std::string::npos) << s.message();
+    };
+    Roughness r;
+    r.amplitude = std::nan("");
+    expectRefused(r, "roughness must be");
+    r = {};
+    r.amplitude = 2; // relative: at most 1
+    expectRefused(r, "roughness must be");
+    r = {};
+    r.hurst = 0;
+    expectRefused(r, "hurst must be");
+    r = {};
+    r.octaves = 11;
+    expectRefused(r, "octaves must be");
+    r = {};
+    r.featureSize = -1;
+    expectRefused(r, "feature_size must be");
+    r = {};
+    r.grainStretch = 0.5;
+    expectRefused(r, "grain_stretch must be");
+}
