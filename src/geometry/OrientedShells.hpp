@@ -3,7 +3,9 @@
 // and labels its shells. The fracture pipeline runs it on every split output and reuses the labels for the
 // islands, instead of verifying and labelling separately.
 
+#include <cstddef>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "rubble/Mesh.hpp"
@@ -15,5 +17,11 @@ namespace rubble::detail {
 /// null) and returns their number. Otherwise returns -1. No hashing: per vertex, the sorted outgoing and
 /// incoming neighbour lists must be equal and free of repeats, which pairs every half-edge with its twin.
 std::int64_t closedOrientedShells(const Mesh& mesh, std::vector<std::uint32_t>* triangleShell);
+
+/// The shells facing the wrong way for their nesting (one inside an odd number of others must face inward,
+/// any other outward), with up to maxListed of them described in listed. The mesh is closed, oriented and
+/// finite, and shellOf labels its shells.
+std::size_t misnestedShells(const Mesh& mesh, const std::vector<std::uint32_t>& shellOf, std::size_t shells,
+                            std::size_t maxListed, std::vector<std::string>& listed);
 
 } // namespace rubble::detail
