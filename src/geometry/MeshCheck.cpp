@@ -92,42 +92,57 @@ Status checkCoordinateRange(const Mesh& mesh, const std::string& what) {
 }
 
 namespace detail {
+ShellNesting shellNesting(const Mesh& mesh, const std::vector<std::vector<std::size_t>>& trisOf,
+                          const std::vector<bool>* closed) {
+    const std::size_t k = trisOf.size();
+    ShellNesting out{std::vector<double>(k, 0.0), std::vector<std::size_t>(k, 0)};
+    std::vector<Aabb> box(k);
+    const Vec3 r = mesh.bounds().center();
+    for (std::size_t s = 0; s < k; ++s)
+        for (std::size_t t : trisOf[s]) {
+            const auto c = mesh.corners(t);
+            out.volume[s] += dot(c[0] - r, cross(c[1] - r, c[2] - r)) / 6.0;
+            for (const Vec3& p : c)
+                box[s].extend(p);
+        }
+    auto takesPart = [&](std::size_t s) { return !trisOf[s].empty() && (!closed || (*closed)[s]); };
+    // A shell can only be inside one whose box holds its box and differs from it (which keeps overlapping,
+    // self-intersecting shells from being taken for cavities).
+    auto contains = [](const Aabb& outer, const Aabb& inner) {
+        return outer.contains(inner.lo) && outer.contains(inner.hi) &&
+               !(outer.lo == inner.lo && outer.hi == inner.hi);
+    };
+    for (std::size_t s = 0; s < k; ++s) {
+        if (!takesPart(s))
+            continue;
+        // Shells do not cross (else they intersect): one point of s tells whether s is inside another shell,
+        // a triangle's centroid, since a vertex may be shared with a shell touching s there.
+        const auto c = mesh.corners(trisOf[s][0]);
+        const Vec3 probe = (c[0] + c[1] + c[2]) / 3.0;
+        for (std::size_t o = 0; o < k; ++o)
+            if (o != s && takesPart(o) && contains(box[o], box[s]) &&
+                detail::insideByRayParity(mesh, trisOf[o], probe))
+                ++out.depth[s];
+    }
+    return out;
+}
+
 std::size_t misnestedShells(const Mesh& mesh, const std::vector<std::uint32_t>& shellOf, std::size_t shells,
                             std::size_t maxListed, std::vector<std::string>& listed) {
     std::vector<std::vector<std::size_t>> trisOf(shells);
     for (std::size_t t = 0; t < shellOf.size(); ++t)
         trisOf[shellOf[t]].push_back(t);
-    std::vector<double> volume(shells, 0.0);
-    std::vector<Aabb> box(shells);
-    const Vec3 r = mesh.bounds().center();
-    for (std::size_t s = 0; s < shells; ++s)
-        for (std::size_t t : trisOf[s]) {
-            const auto c = mesh.corners(t);
-            volume[s] += dot(c[0] - r, cross(c[1] - r, c[2] - r)) / 6.0;
-            for (const Vec3& p : c)
-                box[s].extend(p);
-        }
-    auto contains = [](const Aabb& outer, const Aabb& inner) {
-        return outer.lo.x <= inner.lo.x && outer.lo.y <= inner.lo.y && outer.lo.z <= inner.lo.z &&
-               inner.hi.x <= outer.hi.x && inner.hi.y <= outer.hi.y && inner.hi.z <= outer.hi.z;
-    };
+    const ShellNesting nesting = shellNesting(mesh, trisOf);
     std::size_t wrong = 0;
     for (std::size_t s = 0; s < shells; ++s) {
-        // Shells do not cross (else they intersect): one point of s tells whether s is inside another shell,
-        // a triangle's centroid, since a vertex may be shared with a shell touching s there.
-        const auto c = mesh.corners(trisOf[s][0]);
-        const Vec3 probe = (c[0] + c[1] + c[2]) / 3.0;
-        std::size_t depth = 0;
-        for (std::size_t o = 0; o < shells; ++o)
-            if (o != s && contains(box[o], box[s]) && detail::insideByRayParity(mesh, trisOf[o], probe))
-                ++depth;
-        if ((depth % 2 == 1) == (volume[s] < 0))
+        const std::size_t depth = nesting.depth[s];
+        if ((depth % 2 == 1) == (nesting.volume[s] < 0))
             continue;
         ++wrong;
         if (listed.size() < maxListed)
             listed.push_back("the shell of triangle " + std::to_string(trisOf[s][0] + 1) + " lies inside " +
                              plural(depth, "other shell", "other shells") + " and faces " +
-                             (volume[s] < 0 ? "inward" : "outward"));
+                             (nesting.volume[s] < 0 ? "inward" : "outward"));
     }
     return wrong;
 }
