@@ -150,6 +150,20 @@ bool writeCsv(const fs::path& path, const Table& table) {
     return true;
 }
 
+bool makeResultsDir(const fs::path& dir) {
+    std::error_code ec;
+    if (fs::exists(dir, ec) && !fs::is_directory(dir, ec)) {
+        std::cerr << "--out " << dir.string() << ": exists and is not a folder\n";
+        return false;
+    }
+    fs::create_directories(dir, ec);
+    if (ec) {
+        std::cerr << "--out " << dir.string() << ": cannot create the folder: " << ec.message() << "\n";
+        return false;
+    }
+    return true;
+}
+
 void plotPng(const fs::path& dir, const std::string& stem, const std::string& data, const std::string& plot) {
     if (std::system("command -v gnuplot >/dev/null 2>&1") != 0) {
         std::cout << "gnuplot not found: plot skipped\n";

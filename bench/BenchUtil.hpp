@@ -75,6 +75,10 @@ void printTable(const Table& table);
 /// Returns false (after printing why) when the file cannot be written.
 bool writeCsv(const std::filesystem::path& path, const Table& table);
 
+/// Creates the results folder dir; false (after printing why on stderr) when it cannot be, e.g. when dir
+/// names a file.
+bool makeResultsDir(const std::filesystem::path& dir);
+
 /// Draws DIR/<stem>.png with gnuplot (pngcairo, 900x600): `data` is written to a temporary data file and
 /// `plot` is a gnuplot script in which $DATA names that file (e.g. "set logscale y\nplot $DATA u 1:2 w lp").
 /// Prints where the plot is, or why it was skipped (no gnuplot, gnuplot failed); temporary files are removed.

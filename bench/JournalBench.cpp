@@ -8,8 +8,10 @@
 // snapshot: bytes, encode, atomic save, load (read + decode + restore) in ms, and the journal's bytes against
 // the snapshot's (what sending meshes instead of impacts would take); the load's thread CPU time too, since
 // on a shared machine the wall time mostly measures waiting for a core. Deterministic mode, so both runs
-// adopt each job at the same frame. Table on stdout, CSV in DIR/journal.csv, plot in DIR/journal.png.
+// adopt each job at the same frame. Table on stdout, CSV in DIR/journal.csv, plot in DIR/journal.png; the
+// timed snapshot file is written in the temporary folder. Exit code 2 when DIR cannot be a folder.
 #include <time.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <filesystem>
@@ -72,16 +74,15 @@ double threadCpuMs() {
     return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) / 1e6;
 }
 
-// Encodes, saves atomically, reads, decodes and restores into a fresh world.
+// Encodes, saves atomically to the file scratch, reads, decodes and restores into a fresh world.
 SnapshotTiming timeSnapshot(const rubble::DestructionWorld& world,
-                            const rubble::DestructionWorld::Config& config, const std::string& dir) {
+                            const rubble::DestructionWorld::Config& config, const fs::path& scratch) {
     SnapshotTiming t;
     const auto s0 = Clock::now();
     const std::vector<std::uint8_t> bytes = rubble::encodeSnapshot(rubble::takeSnapshot(world));
     t.encodeMs = msSince(s0);
     t.bytes = bytes.size();
-    fs::create_directories(dir);
-    const fs::path file = fs::path(dir) / "journal-bench.rsnap";
+    const fs::path file = scratch;
     const auto w0 = Clock::now();
     if (!rubble::writeFileAtomic(file, bytes))
         return t;
@@ -100,6 +101,12 @@ SnapshotTiming timeSnapshot(const rubble::DestructionWorld& world,
 }
 
 int runBench(const BenchArgs& args) {
+    if (!rubble::bench::makeResultsDir(args.out))
+        return 2;
+    // The timed snapshot file goes to the temporary folder, never into the results (or source) folder.
+    std::error_code ec;
+    const fs::path scratch =
+        fs::temp_directory_path(ec) / ("rubble-journal-bench-" + std::to_string(::getpid()) + ".rsnap");
     const int impacts = args.quick ? 30 : args.impacts;
     const int grid = args.quick ? 7 : 29; // 588 or 10,092 triangles
     const rubble::bench::CpuMeter cpu;
@@ -163,7 +170,7 @@ int runBench(const BenchArgs& args) {
     }
     const double replayMs = msSince(p0);
     const bool same = replayer.geometryHash() == recorder.geometryHash();
-    const SnapshotTiming cubeSnap = timeSnapshot(replayer, worldConfig(args.workers), args.out);
+    const SnapshotTiming cubeSnap = timeSnapshot(replayer, worldConfig(args.workers), scratch);
     // A world of many pieces: a grid of small boxes, each shattered once, until it holds targetPieces
     // objects.
     const int targetPieces = args.quick ? 200 : 5000;
@@ -189,7 +196,7 @@ int runBench(const BenchArgs& args) {
         pieces.beginFrame();
         (void)pieces.collect();
     }
-    const SnapshotTiming pieceSnap = timeSnapshot(pieces, worldConfig(args.workers), args.out);
+    const SnapshotTiming pieceSnap = timeSnapshot(pieces, worldConfig(args.workers), scratch);
     const double otherCpu = cpu.read().other;
 
     const double journalPerImpact = double(journalBytes.size()) / double(impacts);

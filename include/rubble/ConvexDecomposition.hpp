@@ -17,9 +17,12 @@ namespace rubble {
 
 struct FractureResult;
 
+/// Largest DecompositionParams::maxParts: every part costs a search over candidate planes.
+inline constexpr int kMaxConvexParts = 1024;
+
 /// Parameters of a decomposition.
 struct DecompositionParams {
-    int maxParts = 24;       ///< at most this many convex parts
+    int maxParts = 24;       ///< at most this many convex parts, in [1, kMaxConvexParts]
     double concavity = 0.02; ///< stop splitting a part whose concavity is below this fraction of the
                              ///< mesh's bounding-box diagonal
     double minPartVolumeFraction = 1e-6; ///< parts below this fraction of the mesh volume are dropped
@@ -48,7 +51,10 @@ Result<ConvexPolytope> convexHull(const std::vector<Vec3>& points);
 /// exact hull has at most maxFaces faces it is returned instead. Fails for flat or too few points.
 Result<ConvexPolytope> boundedHull(const std::vector<Vec3>& points, std::size_t maxFaces);
 
-/// Decomposes a closed mesh into at most params.maxParts convex parts; a convex mesh gives exactly one part.
+/// Decomposes a closed mesh into at most params.maxParts convex parts; a convex mesh gives exactly one part
+/// (whatever params.concavity: a part convex to within 1e-9 of the diagonal is not split). InvalidInput for a
+/// mesh that is not closed and consistently oriented, has coordinates beyond ±kMaxCoordinate or no positive
+/// volume, and for maxParts outside [1, kMaxConvexParts].
 Result<Decomposition> decompose(const Mesh& mesh, const DecompositionParams& params = {});
 
 /// Incremental update at fracture time: clips the parent's parts by the cells and assigns every fragment to

@@ -61,7 +61,8 @@ Result<JournalFile> readJournal(const std::filesystem::path& path);
 /// Writes bytes to path atomically: a temporary file in the same folder, flushed to disk, then renamed over
 /// path. A process killed at any point leaves either the old file or the new one, never a mix.
 Status writeFileAtomic(const std::filesystem::path& path, const std::vector<std::uint8_t>& bytes);
-/// The whole content of a file, or an IoError naming it.
+/// The whole content of a regular file of at most 2 GiB, or an IoError naming it. Devices, FIFOs and sockets
+/// are refused without blocking ("<file>: cannot read: it is a FIFO, not a regular file").
 Result<std::vector<std::uint8_t>> readFileBinary(const std::filesystem::path& path);
 
 } // namespace rubble

@@ -11,6 +11,11 @@
 
 namespace rubble {
 
+/// Most frames between a journal event and the one before it (or the frame a replay starts from): 2^22, about
+/// 19 hours at 60 frames per second. A larger gap is a damaged journal: stepping through 2^32 frames takes
+/// hours.
+inline constexpr std::uint64_t kMaxJournalTickGap = std::uint64_t{1} << 22;
+
 /// Applies journal events to a world at the frames they were recorded in. The world must be built from the
 /// same scene with the same Config (deterministic, same seed and delayFrames) as the one that recorded them.
 /// An event of tick t was recorded while the recording world's frame() was t, after that frame's collect();
@@ -21,7 +26,8 @@ public:
     explicit JournalPlayer(DestructionWorld& world);
 
     /// Takes the next event in journal order: applied now when its tick is the world's frame, kept until
-    /// advanceTo() reaches it when later. An event of an earlier tick, or one the world refuses
+    /// advanceTo() reaches it when later. An event of an earlier tick, one more than kMaxJournalTickGap
+    /// frames after the previous event (or the world's frame), or one the world refuses
     /// (DestructionWorld::applyJournalEvent), is an error and changes nothing.
     Status receive(const JournalEvent& event);
     /// Steps the world (beginFrame, collect, then the kept events of the new frame) until frame() == tick.

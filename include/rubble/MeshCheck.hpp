@@ -14,6 +14,10 @@
 
 namespace rubble {
 
+/// Largest coordinate magnitude of a valid mesh (1e50): the volume integrals (up to fifth powers of
+/// coordinates, for the inertia) then stay finite; beyond about 1e61 they overflow.
+inline constexpr double kMaxCoordinate = 1e50;
+
 /// What checkMesh examines.
 struct CheckOptions {
     /// Run the (CGAL) self-intersection test. It only runs on meshes that are valid polygon meshes
@@ -45,9 +49,13 @@ struct MeshReport {
     std::size_t degenerateTriangles = 0; ///< triangles with a repeated index or zero area
     std::size_t duplicateTriangles = 0;  ///< triangles with the same three vertices as an earlier one
     std::size_t nonFiniteVertices = 0;   ///< vertices with a NaN or infinite coordinate
+    std::size_t hugeVertices = 0;        ///< vertices with a coordinate beyond ±kMaxCoordinate
     std::size_t badIndices = 0;          ///< triangle corners referring to a vertex that does not exist
     std::size_t shells = 0;              ///< edge-connected components of triangles
-    std::size_t badAttributeArrays = 0;  ///< normals/uvs/materials present with the wrong number of entries
+    /// Shells facing the wrong way for their nesting: one inside an odd number of others must face inward
+    /// (a cavity), any other outward. Examined on closed, oriented, manifold meshes.
+    std::size_t misnestedShells = 0;
+    std::size_t badAttributeArrays = 0; ///< normals/uvs/materials present with the wrong number of entries
 
     /// True when the self-intersection test ran (see CheckOptions::selfIntersections).
     bool selfIntersectionsChecked = false;
@@ -69,15 +77,19 @@ struct MeshReport {
     /// True when both edges and vertices are manifold.
     bool manifold() const { return edgeManifold && vertexManifold; }
 
-    /// True when the mesh is a valid solid: non-empty, closed, manifold, oriented outward, finite, with
-    /// attribute arrays of the right sizes, without degenerate triangles and (when checked) without
-    /// self-intersections.
+    /// True when the mesh is a valid solid: non-empty, closed, manifold, oriented outward (every shell as its
+    /// nesting requires), finite and within ±kMaxCoordinate, with attribute arrays of the right sizes,
+    /// without degenerate triangles and (when checked) without self-intersections.
     bool valid() const;
 };
 
 /// Examines a mesh and reports what is wrong with it. Never fails and never throws: any exception from the
 /// geometric kernel is caught and recorded in selfIntersectionNote.
 MeshReport checkMesh(const Mesh& mesh, const CheckOptions& options = {});
+
+/// Ok when every coordinate is within ±kMaxCoordinate; otherwise an InvalidInput error naming the first
+/// vertex beyond it and the bound ("what: vertex 3 has a coordinate of 1e+100, beyond ±1e+50 ...").
+Status checkCoordinateRange(const Mesh& mesh, const std::string& what);
 
 /// True when the triangle abc has (numerically) zero area: its doubled area is below 1e-12 times the square
 /// of its longest edge.

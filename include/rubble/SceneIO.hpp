@@ -57,8 +57,10 @@ bool isCollisionName(const std::string& name);
 /// embedded images as bytes). OBJ: one object per `o` (see parseObjObjects; without any `o`, the whole file
 /// is one object, since `g` groups usually split one solid), "UCX_<name>_<n>" objects attached to object
 /// <name>, materials from the `mtllib` files with map paths resolved against the .obj's folder. Other
-/// formats: one object named after the file stem (readMesh). Errors as readMesh; a missing .mtl or image is a
-/// warning, not an error.
+/// formats: one object named after the file stem (readMesh). Errors as readMesh; a missing or malformed .mtl
+/// and a missing image are warnings, not errors. An image named by an absolute path is dropped with a
+/// warning, so that writers never copy files from anywhere on the machine (relative paths, "../textures/",
+/// are the model's layout).
 Result<AssetScene> readScene(const std::filesystem::path& path);
 
 /// Parses MTL text into materials; map file names are resolved against folder. Unknown statements are kept

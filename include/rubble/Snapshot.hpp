@@ -43,7 +43,8 @@ std::vector<std::uint8_t> encodeSnapshot(const Snapshot& snapshot);
 Result<Snapshot> decodeSnapshot(const std::uint8_t* data, std::size_t size, const std::string& source);
 /// Writes a snapshot atomically (temporary file, fsync, rename).
 Status saveSnapshot(const std::filesystem::path& path, const Snapshot& snapshot);
-/// Reads a snapshot file.
+/// Reads a snapshot file: a regular file of at most 2 GiB (devices, FIFOs and sockets are refused without
+/// blocking).
 Result<Snapshot> loadSnapshot(const std::filesystem::path& path);
 
 } // namespace rubble

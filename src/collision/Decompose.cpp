@@ -17,8 +17,10 @@
 #include <optional>
 
 #include "collision/MeshRegion.hpp"
+#include "geometry/OrientedShells.hpp"
 #include "rubble/ConvexDecomposition.hpp"
 #include "rubble/MassProperties.hpp"
+#include "rubble/MeshCheck.hpp"
 
 namespace rubble {
 
@@ -41,6 +43,8 @@ constexpr int kProxyCells = 16;
 constexpr double kProxyVolumeError = 0.25;
 /// Hull faces whose depth is sampled per part when searching a proxy.
 constexpr std::size_t kProxyDepthFaces = 64;
+/// Concavity below this fraction of the diagonal is rounding: such a part is convex.
+constexpr double kConvexTolerance = 1e-9;
 
 class Decomposer {
 public:
@@ -357,7 +361,8 @@ public:
         for (const PolytopeFace& f : hull->faces())
             for (std::size_t i = 1; i + 1 < f.corners.size(); ++i)
                 area += 0.5 * length(cross(f.corners[i] - f.corners[0], f.corners[i + 1] - f.corners[0]));
-        const double threshold = params_.concavity * diag_;
+        // A part convex to within kConvexTolerance of the diagonal is not split (rounding is not concavity).
+        const double threshold = std::max(params_.concavity, kConvexTolerance) * diag_;
         minPartVolume_ = params_.minPartVolumeFraction * out.meshVolume;
         if (params_.maxParts <= 1 || hull->volume() - searchVolume <= 0.01 * threshold * area) {
             Part whole;
@@ -443,8 +448,18 @@ private:
 } // namespace
 
 Result<Decomposition> decompose(const Mesh& mesh, const DecompositionParams& params) {
+    if (params.maxParts < 1 || params.maxParts > kMaxConvexParts)
+        return makeError(ErrorCode::InvalidInput, "decompose: maxParts " + std::to_string(params.maxParts) +
+                                                      " is outside [1, " + std::to_string(kMaxConvexParts) +
+                                                      "]");
     if (const Status s = mesh.validate(); !s)
         return s.error();
+    if (const Status s = checkCoordinateRange(mesh, "decompose"); !s)
+        return s.error();
+    if (detail::closedOrientedShells(mesh, nullptr) < 0)
+        return makeError(ErrorCode::InvalidInput,
+                         "decompose: the mesh is not closed and consistently oriented (every edge must be "
+                         "shared by exactly two triangles in opposite directions); see rubble check");
     if (mesh.triangles.size() < 4)
         return makeError(ErrorCode::InvalidInput, "decompose: a closed mesh needs at least 4 triangles");
     if (mesh.triangles.size() > params.proxyAboveTriangles) {

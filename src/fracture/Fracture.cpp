@@ -17,6 +17,7 @@
 #include "geometry/TopologyEdit.hpp"
 #include "rubble/Fracture.hpp"
 #include "rubble/Islands.hpp"
+#include "rubble/MeshCheck.hpp"
 #include "rubble/MeshSimplify.hpp"
 #include "rubble/ParameterCheck.hpp"
 #include "rubble/Random.hpp"
@@ -59,11 +60,20 @@ Status checkSolid(const Mesh& mesh) {
         return makeError(ErrorCode::InvalidInput, "fracture: the mesh has no triangles");
     if (Status s = mesh.validate(); !s)
         return makeError(ErrorCode::InvalidInput, "fracture: invalid mesh: " + s.message());
-    if (!detail::isClosedOriented(mesh))
+    if (Status s = checkCoordinateRange(mesh, "fracture"); !s)
+        return s;
+    std::vector<std::uint32_t> shellOf;
+    const std::int64_t shells = detail::closedOrientedShells(mesh, &shellOf);
+    if (shells < 0)
         return makeError(
             ErrorCode::InvalidInput,
             "fracture: the mesh is not closed and consistently oriented (every edge must be shared "
             "by exactly two triangles in opposite directions); repair it first");
+    std::vector<std::string> listed;
+    if (shells > 1 && detail::misnestedShells(mesh, shellOf, static_cast<std::size_t>(shells), 1, listed) > 0)
+        return makeError(ErrorCode::InvalidInput,
+                         "fracture: a shell faces the wrong way for its nesting (" + listed.front() +
+                             "); a shell inside another must face inward (a cavity)");
     return {};
 }
 

@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <unordered_map>
 
+#include "geometry/OrientedShells.hpp"
+#include "geometry/RayParity.hpp"
 #include "rubble/Islands.hpp"
 #include "rubble/MassProperties.hpp"
 
@@ -50,8 +52,9 @@ struct EdgeUse {
 
 bool MeshReport::valid() const {
     return triangles > 0 && closed && edgeManifold && vertexManifold && oriented && outward &&
-           degenerateTriangles == 0 && duplicateTriangles == 0 && nonFiniteVertices == 0 && badIndices == 0 &&
-           badAttributeArrays == 0 && !(selfIntersectionsChecked && selfIntersections > 0);
+           degenerateTriangles == 0 && duplicateTriangles == 0 && nonFiniteVertices == 0 &&
+           hugeVertices == 0 && badIndices == 0 && misnestedShells == 0 && badAttributeArrays == 0 &&
+           !(selfIntersectionsChecked && selfIntersections > 0);
 }
 
 bool isDegenerateTriangle(const Vec3& a0, const Vec3& b0, const Vec3& c0) {
@@ -75,13 +78,83 @@ bool isDegenerateTriangle(const Vec3& a0, const Vec3& b0, const Vec3& c0) {
     return lengthSquared(cross(e0, e1)) <= 1e-24 * longest * longest;
 }
 
+Status checkCoordinateRange(const Mesh& mesh, const std::string& what) {
+    for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
+        const Vec3& p = mesh.positions[i];
+        const double most = std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+        if (most > kMaxCoordinate)
+            return makeError(ErrorCode::InvalidInput,
+                             what + ": vertex " + std::to_string(i) + " has a coordinate of " +
+                                 num(most) + ", beyond ±" + num(kMaxCoordinate) +
+                                 " (the bound that keeps the volume integrals finite); scale the mesh down");
+    }
+    return {};
+}
+
+namespace detail {
+ShellNesting shellNesting(const Mesh& mesh, const std::vector<std::vector<std::size_t>>& trisOf,
+                          const std::vector<bool>* closed) {
+    const std::size_t k = trisOf.size();
+    ShellNesting out{std::vector<double>(k, 0.0), std::vector<std::size_t>(k, 0)};
+    std::vector<Aabb> box(k);
+    const Vec3 r = mesh.bounds().center();
+    for (std::size_t s = 0; s < k; ++s)
+        for (std::size_t t : trisOf[s]) {
+            const auto c = mesh.corners(t);
+            out.volume[s] += dot(c[0] - r, cross(c[1] - r, c[2] - r)) / 6.0;
+            for (const Vec3& p : c)
+                box[s].extend(p);
+        }
+    auto takesPart = [&](std::size_t s) { return !trisOf[s].empty() && (!closed || (*closed)[s]); };
+    // A shell can only be inside one whose box holds its box and differs from it (which keeps overlapping,
+    // self-intersecting shells from being taken for cavities).
+    auto contains = [](const Aabb& outer, const Aabb& inner) {
+        return outer.contains(inner.lo) && outer.contains(inner.hi) &&
+               !(outer.lo == inner.lo && outer.hi == inner.hi);
+    };
+    for (std::size_t s = 0; s < k; ++s) {
+        if (!takesPart(s))
+            continue;
+        // Shells do not cross (else they intersect): one point of s tells whether s is inside another shell,
+        // a triangle's centroid, since a vertex may be shared with a shell touching s there.
+        const auto c = mesh.corners(trisOf[s][0]);
+        const Vec3 probe = (c[0] + c[1] + c[2]) / 3.0;
+        for (std::size_t o = 0; o < k; ++o)
+            if (o != s && takesPart(o) && contains(box[o], box[s]) &&
+                detail::insideByRayParity(mesh, trisOf[o], probe))
+                ++out.depth[s];
+    }
+    return out;
+}
+
+std::size_t misnestedShells(const Mesh& mesh, const std::vector<std::uint32_t>& shellOf, std::size_t shells,
+                            std::size_t maxListed, std::vector<std::string>& listed) {
+    std::vector<std::vector<std::size_t>> trisOf(shells);
+    for (std::size_t t = 0; t < shellOf.size(); ++t)
+        trisOf[shellOf[t]].push_back(t);
+    const ShellNesting nesting = shellNesting(mesh, trisOf);
+    std::size_t wrong = 0;
+    for (std::size_t s = 0; s < shells; ++s) {
+        const std::size_t depth = nesting.depth[s];
+        if ((depth % 2 == 1) == (nesting.volume[s] < 0))
+            continue;
+        ++wrong;
+        if (listed.size() < maxListed)
+            listed.push_back("the shell of triangle " + std::to_string(trisOf[s][0]) + " lies inside " +
+                             plural(depth, "other shell", "other shells") + " and faces " +
+                             (nesting.volume[s] < 0 ? "inward" : "outward"));
+    }
+    return wrong;
+}
+} // namespace detail
+
 MeshReport checkMesh(const Mesh& mesh, const CheckOptions& options) {
     MeshReport r;
     r.vertices = mesh.positions.size();
     r.triangles = mesh.triangles.size();
     const std::size_t maxListed = options.maxListedPerKind;
 
-    std::vector<std::string> nonFiniteEx, badIndexEx, degenerateEx, duplicateEx;
+    std::vector<std::string> nonFiniteEx, hugeEx, badIndexEx, degenerateEx, duplicateEx, misnestedEx;
     std::vector<bool> finite(mesh.positions.size());
     for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
         finite[i] = isFinite(mesh.positions[i]);
@@ -90,6 +163,13 @@ MeshReport checkMesh(const Mesh& mesh, const CheckOptions& options) {
             if (nonFiniteEx.size() < maxListed)
                 nonFiniteEx.push_back("vertex " + std::to_string(i));
         } else {
+            const Vec3& p = mesh.positions[i];
+            const double most = std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+            if (most > kMaxCoordinate) {
+                ++r.hugeVertices;
+                if (hugeEx.size() < maxListed)
+                    hugeEx.push_back("vertex " + std::to_string(i) + " at " + num(most));
+            }
             r.bounds.extend(mesh.positions[i]);
         }
     }
@@ -234,6 +314,9 @@ MeshReport checkMesh(const Mesh& mesh, const CheckOptions& options) {
     if (r.badIndices == 0) {
         std::vector<std::uint32_t> shellOf;
         r.shells = labelShells(mesh, shellOf);
+        if (r.shells > 1 && r.closed && r.oriented && r.nonManifoldVertices == 0 &&
+            r.nonFiniteVertices == 0 && r.hugeVertices == 0)
+            r.misnestedShells = detail::misnestedShells(mesh, shellOf, r.shells, maxListed, misnestedEx);
     }
     if (r.badIndices == 0 && r.nonFiniteVertices == 0 && !mesh.triangles.empty()) {
         const MassProperties mp = computeMassProperties(mesh);
@@ -323,19 +406,19 @@ MeshReport checkMesh(const Mesh& mesh, const CheckOptions& options) {
                            plural(r.misorientedEdges, "edge is", "edges are") +
                            " used twice in the same direction" + examples(ex, r.misorientedEdges));
     }
-    if (!mesh.triangles.empty() && r.badIndices == 0 && r.nonFiniteVertices == 0 && r.closed && r.oriented &&
-        !r.outward) {
-        if (!std::isfinite(r.volume)) {
-            double most = 0;
-            for (const Vec3& p : mesh.positions)
-                most = std::max({most, std::abs(p.x), std::abs(p.y), std::abs(p.z)});
-            problems.push_back("the mesh's volume overflows the range of doubles (coordinates up to " +
-                               num(most) + "); scale the mesh down");
-        } else {
-            problems.push_back(r.volume < 0 ? "the mesh is inside out (signed volume " + num(r.volume) + ")"
-                                            : "the mesh encloses no volume");
-        }
-    }
+    if (r.hugeVertices > 0)
+        problems.push_back(plural(r.hugeVertices, "vertex has", "vertices have") + " a coordinate beyond ±" +
+                           num(kMaxCoordinate) + ", the bound that keeps the volume integrals finite" +
+                           examples(hugeEx, r.hugeVertices) + "; scale the mesh down");
+    if (!mesh.triangles.empty() && r.badIndices == 0 && r.nonFiniteVertices == 0 && r.hugeVertices == 0 &&
+        r.closed && r.oriented && !r.outward)
+        problems.push_back(r.volume < 0 ? "the mesh is inside out (signed volume " + num(r.volume) + ")"
+                                        : "the mesh encloses no volume");
+    if (r.misnestedShells > 0)
+        problems.push_back(plural(r.misnestedShells, "shell faces", "shells face") +
+                           " the wrong way for its nesting: a shell inside another must face inward (a "
+                           "cavity), one inside none outward" +
+                           examples(misnestedEx, r.misnestedShells));
     if (r.degenerateTriangles > 0)
         problems.push_back(plural(r.degenerateTriangles, "triangle is", "triangles are") +
                            " degenerate (repeated vertex or zero area)" +

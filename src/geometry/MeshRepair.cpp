@@ -7,6 +7,7 @@
 #include <limits>
 #include <unordered_map>
 
+#include "geometry/OrientedShells.hpp"
 #include "geometry/PlanarTriangulation.hpp"
 #include "geometry/RayParity.hpp"
 
@@ -134,13 +135,6 @@ std::vector<std::uint32_t> weldVertices(const Mesh& m, double tol) {
     return rep;
 }
 
-// True when box inner lies inside box outer (a shell can only be a cavity of a shell whose box holds it;
-// this keeps overlapping, self-intersecting shells from being mistaken for cavities).
-bool encloses(const Aabb& outer, const Aabb& inner) {
-    return outer.contains(inner.lo) && outer.contains(inner.hi) &&
-           !(outer.lo == inner.lo && outer.hi == inner.hi);
-}
-
 struct OrientStats {
     std::size_t flipped = 0, inverted = 0, nonOrientable = 0;
 };
@@ -207,30 +201,12 @@ OrientStats orientShells(Mesh& m) {
     }
 
     // Outward: compare the sign of each component's volume with its nesting depth among closed components.
-    const std::size_t k = comps.size();
-    std::vector<double> vol(k, 0.0);
-    std::vector<Aabb> box(k);
-    const Vec3 r = m.bounds().center();
-    for (std::size_t i = 0; i < k; ++i)
-        for (std::size_t t : comps[i]) {
-            const auto c = m.corners(t);
-            vol[i] += dot(c[0] - r, cross(c[1] - r, c[2] - r)) / 6.0;
-            for (const Vec3& p : c)
-                box[i].extend(p);
-        }
-    for (std::size_t i = 0; i < k; ++i) {
-        if (vol[i] == 0)
+    const detail::ShellNesting nesting = detail::shellNesting(m, comps, &compClosed);
+    for (std::size_t i = 0; i < comps.size(); ++i) {
+        if (nesting.volume[i] == 0)
             continue;
-        int depth = 0;
-        if (compClosed[i]) {
-            const Vec3 probe = m.positions[m.triangles[comps[i][0]][0]];
-            for (std::size_t j = 0; j < k; ++j)
-                if (j != i && compClosed[j] && encloses(box[j], box[i]) &&
-                    detail::insideByRayParity(m, comps[j], probe))
-                    ++depth;
-        }
-        const bool wantPositive = depth % 2 == 0;
-        if ((vol[i] > 0) != wantPositive) {
+        const bool wantPositive = nesting.depth[i] % 2 == 0;
+        if ((nesting.volume[i] > 0) != wantPositive) {
             for (std::size_t t : comps[i])
                 flipTriangle(m, t);
             ++stats.inverted;

@@ -3,7 +3,8 @@
 #include <atomic>
 #include <cerrno>
 #include <cstring>
-#include <fstream>
+#include <optional>
+#include <utility>
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -31,48 +32,78 @@ const char* fileKind(mode_t mode) {
 }
 } // namespace
 
-Result<std::string> readFileBytes(const std::filesystem::path& path, std::uint64_t maxBytes) {
+RegularFile& RegularFile::operator=(RegularFile&& o) noexcept {
+    if (this != &o) {
+        if (fd_ >= 0)
+            ::close(fd_);
+        fd_ = std::exchange(o.fd_, -1);
+        size_ = o.size_;
+    }
+    return *this;
+}
+
+RegularFile::~RegularFile() {
+    if (fd_ >= 0)
+        ::close(fd_);
+}
+
+Result<RegularFile> openRegularFile(const std::filesystem::path& path, std::uint64_t maxBytes) {
     // Only regular files (after symbolic links): /dev/zero never ends and a FIFO blocks the open.
-    struct stat st {};
-    if (::stat(path.c_str(), &st) != 0) {
-        const int err = errno;
-        return makeError(ErrorCode::IoError, displayName(path) + ": cannot open: " + std::strerror(err));
-    }
-    if (S_ISDIR(st.st_mode))
-        return makeError(ErrorCode::IoError, displayName(path) + ": cannot read: is a directory");
-    if (!S_ISREG(st.st_mode))
-        return makeError(ErrorCode::IoError, displayName(path) + ": cannot read: it is " +
-                                                 fileKind(st.st_mode) + ", not a regular file");
-    if (static_cast<std::uint64_t>(st.st_size) > maxBytes)
-        return makeError(ErrorCode::IoError,
+    auto refuse = [&](const struct stat& st) -> std::optional<Error> {
+        if (S_ISDIR(st.st_mode))
+            return Error{ErrorCode::IoError, displayName(path) + ": cannot read: is a directory"};
+        if (!S_ISREG(st.st_mode))
+            return Error{ErrorCode::IoError, displayName(path) + ": cannot read: it is " +
+                                                 fileKind(st.st_mode) + ", not a regular file"};
+        if (static_cast<std::uint64_t>(st.st_size) > maxBytes)
+            return Error{ErrorCode::IoError,
                          displayName(path) + ": the file has " + std::to_string(st.st_size) +
-                             " bytes, more than the limit of " + std::to_string(maxBytes) + " bytes");
-    // The size is that of the file opened: a writer may have renamed another file over path since the stat.
+                             " bytes, more than the limit of " + std::to_string(maxBytes) + " bytes"};
+        return std::nullopt;
+    };
+    auto cannotOpen = [&](int err) {
+        return makeError(ErrorCode::IoError, displayName(path) + ": cannot open: " +
+                                                 (err ? std::strerror(err) : "unknown error"));
+    };
+    struct stat st {};
+    if (::stat(path.c_str(), &st) != 0)
+        return cannotOpen(errno);
+    if (auto e = refuse(st))
+        return *e;
+    // Non-blocking, then checked again: the path may have been swapped for a FIFO since the stat.
     const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
-    if (fd < 0) {
-        const int err = errno;
-        return makeError(ErrorCode::IoError, displayName(path) + ": cannot open: " + std::strerror(err));
-    }
-    struct stat opened {};
-    if (::fstat(fd, &opened) != 0 || !S_ISREG(opened.st_mode) ||
-        static_cast<std::uint64_t>(opened.st_size) > maxBytes) {
-        ::close(fd);
-        return makeError(ErrorCode::IoError,
-                         displayName(path) + ": cannot read: it changed while it was opened");
-    }
-    std::string bytes(static_cast<std::size_t>(opened.st_size), '\0');
+    if (fd < 0)
+        return cannotOpen(errno);
+    RegularFile file(fd, 0);
+    if (::fstat(fd, &st) != 0)
+        return cannotOpen(errno);
+    if (auto e = refuse(st))
+        return *e;
+    const int flags = ::fcntl(fd, F_GETFL);
+    if (flags < 0 || ::fcntl(fd, F_SETFL, flags & ~O_NONBLOCK) != 0)
+        return cannotOpen(errno);
+    file.setSize(static_cast<std::uint64_t>(st.st_size));
+    return file;
+}
+
+Result<std::string> readFileBytes(const std::filesystem::path& path, std::uint64_t maxBytes) {
+    auto file = openRegularFile(path, maxBytes);
+    if (!file)
+        return file.error();
+    std::string bytes(static_cast<std::size_t>(file->size()), '\0');
     std::size_t done = 0;
     while (done < bytes.size()) {
-        const ::ssize_t n = ::read(fd, bytes.data() + done, bytes.size() - done);
+        const ::ssize_t n = ::read(file->fd(), bytes.data() + done, bytes.size() - done);
         if (n < 0 && errno == EINTR)
             continue;
-        if (n <= 0)
-            break;
+        if (n < 0) {
+            const int err = errno;
+            return makeError(ErrorCode::IoError, displayName(path) + ": cannot read: " + std::strerror(err));
+        }
+        if (n == 0)
+            return makeError(ErrorCode::IoError, displayName(path) + ": cannot read the whole file");
         done += static_cast<std::size_t>(n);
     }
-    ::close(fd);
-    if (done != bytes.size())
-        return makeError(ErrorCode::IoError, displayName(path) + ": cannot read the whole file");
     return bytes;
 }
 

@@ -22,6 +22,7 @@
 #include "io/ReaderSupport.hpp"
 #include "io/SceneReaders.hpp"
 #include "io/TextTokens.hpp"
+#include "io/TextureFiles.hpp"
 #include "rubble/MeshIO.hpp"
 #include "rubble/SceneIO.hpp"
 
@@ -156,6 +157,50 @@ long double base64Bytes(const std::string& uri) {
 // them.
 constexpr std::size_t kMaxGltfJsonDepth = 256;
 constexpr std::size_t kMaxGltfNodeDepth = 1024;
+// Triangles of a glTF file once every node's mesh is copied into place (nodes instancing one mesh multiply
+// it).
+constexpr long double kMaxGltfInstancedTriangles = 1 << 24;
+
+// The triangles a glTF file expands to: the triangles of each node's mesh, summed over the nodes (accessor
+// counts already checked against their buffers).
+long double gltfInstancedTriangles(const nlohmann::json& j) {
+    using nlohmann::json;
+    if (!j.contains("nodes") || !j["nodes"].is_array() || !j.contains("meshes") || !j["meshes"].is_array())
+        return 0;
+    const json* accessors = j.contains("accessors") && j["accessors"].is_array() ? &j["accessors"] : nullptr;
+    auto accessorCount = [&](const json& index) -> long double {
+        if (!accessors || !index.is_number_unsigned() || index.get<std::uint64_t>() >= accessors->size())
+            return 0;
+        const json& a = (*accessors)[index.get<std::size_t>()];
+        return a.is_object() && a.contains("count") && a["count"].is_number() ? a["count"].get<long double>()
+                                                                              : 0;
+    };
+    std::vector<long double> meshTriangles;
+    for (const json& m : j["meshes"]) {
+        long double t = 0;
+        if (m.is_object() && m.contains("primitives") && m["primitives"].is_array())
+            for (const json& p : m["primitives"]) {
+                if (!p.is_object())
+                    continue;
+                long double n = 0;
+                if (p.contains("indices"))
+                    n = accessorCount(p["indices"]);
+                else if (p.contains("attributes") && p["attributes"].is_object() &&
+                         p["attributes"].contains("POSITION"))
+                    n = accessorCount(p["attributes"]["POSITION"]);
+                const long double mode =
+                    p.contains("mode") && p["mode"].is_number() ? p["mode"].get<long double>() : 4;
+                t += mode == 4 ? n / 3 : mode == 5 || mode == 6 ? std::max(n - 2, 0.0L) : 0;
+            }
+        meshTriangles.push_back(t);
+    }
+    long double total = 0;
+    for (const json& node : j["nodes"])
+        if (node.is_object() && node.contains("mesh") && node["mesh"].is_number_unsigned() &&
+            node["mesh"].get<std::uint64_t>() < meshTriangles.size())
+            total += meshTriangles[node["mesh"].get<std::size_t>()];
+    return total;
+}
 
 // The JSON's nesting depth stays within kMaxGltfJsonDepth (scanned before any parser sees the text).
 Status guardJsonDepth(std::string_view text, const std::string& name) {
@@ -317,6 +362,10 @@ Status guardGltfJson(const nlohmann::json& j, const std::filesystem::path& path,
                                             " bytes) but its buffer view has " +
                                             bytesText(viewLen[static_cast<std::size_t>(vi)]) + " bytes");
         }
+    if (const long double triangles = gltfInstancedTriangles(j); triangles > kMaxGltfInstancedTriangles)
+        return parseError(name, "its nodes place " + bytesText(triangles) +
+                                    " triangles (every node a copy of its mesh), more than the limit of " +
+                                    bytesText(kMaxGltfInstancedTriangles));
     return {};
 }
 
@@ -561,7 +610,7 @@ void readAssimpMaterials(const aiScene* scene, const std::filesystem::path& fold
                     out.warnings.push_back("material '" + mat.name +
                                            "': uncompressed embedded texture skipped");
                 }
-            } else if (!uri.empty()) {
+            } else if (!uri.empty() && !io::refuseAbsoluteImage(mat.name, uri, out.warnings)) {
                 map.file = (folder / uri).lexically_normal();
                 std::error_code ec;
                 if (!std::filesystem::exists(map.file, ec))

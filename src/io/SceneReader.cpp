@@ -7,6 +7,7 @@
 #include "io/FileBytes.hpp"
 #include "io/SceneReaders.hpp"
 #include "io/TextTokens.hpp"
+#include "io/TextureFiles.hpp"
 #include "rubble/MeshIO.hpp"
 #include "rubble/SceneIO.hpp"
 
@@ -154,11 +155,19 @@ Result<AssetScene> readObjScene(const std::filesystem::path& path) {
             scene.warnings.push_back(mtlBytes.error().message);
             continue;
         }
-        auto mats = parseMtl(mtlBytes.value(), io::displayName(mtl), mtl.parent_path());
-        if (!mats)
-            return mats.error();
-        for (AssetMaterial& m : mats.value())
+        auto mats = parseMtl(mtlBytes.value(), io::displayName(mtl), {}); // image paths as written
+        if (!mats) { // as a missing one: the geometry does not depend on it
+            scene.warnings.push_back(mats.error().message + " (its materials are not used)");
+            continue;
+        }
+        for (AssetMaterial& m : mats.value()) {
+            std::erase_if(m.maps, [&](const TextureMap& map) {
+                return io::refuseAbsoluteImage(m.name, map.file, scene.warnings);
+            });
+            for (TextureMap& map : m.maps)
+                map.file = (mtl.parent_path() / map.file).lexically_normal();
             scene.materials.push_back(std::move(m));
+        }
     }
     for (const AssetMaterial& m : scene.materials)
         for (const TextureMap& map : m.maps) {

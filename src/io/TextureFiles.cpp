@@ -17,6 +17,17 @@ std::uint64_t fnv1a(const std::string& bytes) {
 }
 } // namespace
 
+bool refuseAbsoluteImage(const std::string& material, const std::filesystem::path& image,
+                         std::vector<std::string>& warnings) {
+    if (!image.is_absolute())
+        return false;
+    warnings.push_back(
+        "material '" + material + "': image " + image.string() +
+        " is named by an absolute path: not used (images are copied only from paths relative to "
+        "the model's folder)");
+    return true;
+}
+
 Result<std::string> TextureFiles::place(const TextureMap& map) {
     namespace fs = std::filesystem;
     const bool embedded = map.file.empty();

@@ -5,11 +5,18 @@
 #include <map>
 #include <set>
 #include <string>
+#include <vector>
 
 #include "rubble/Result.hpp"
 #include "rubble/SceneIO.hpp"
 
 namespace rubble::io {
+
+/// True, with a warning, when a material's image is named by an absolute path: such an image is not used, so
+/// that writers never copy files from anywhere on the machine into an output (relative paths, resolved
+/// against the model's folder, are the model's own layout).
+bool refuseAbsoluteImage(const std::string& material, const std::filesystem::path& image,
+                         std::vector<std::string>& warnings);
 
 /// Copies the images of texture maps into "textures/" next to a written file and gives their relative URIs.
 class TextureFiles {

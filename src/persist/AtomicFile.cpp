@@ -7,6 +7,7 @@
 #include <cerrno>
 #include <cstring>
 
+#include "io/FileBytes.hpp"
 #include "rubble/JournalFile.hpp"
 
 namespace rubble {
@@ -62,33 +63,11 @@ Status writeFileAtomic(const std::filesystem::path& path, const std::vector<std:
 }
 
 Result<std::vector<std::uint8_t>> readFileBinary(const std::filesystem::path& path) {
-    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-    if (fd < 0)
-        return ioError(path, "cannot open");
-    // Read straight into a buffer of the file's size (one allocation, no copies); a file that grows meanwhile
-    // is read to its end all the same.
-    struct stat st {};
-    std::vector<std::uint8_t> out(
-        ::fstat(fd, &st) == 0 && st.st_size > 0 ? static_cast<std::size_t>(st.st_size) : 0);
-    std::size_t done = 0;
-    for (;;) {
-        if (done == out.size())
-            out.resize(std::max<std::size_t>(out.size() * 2, 1 << 16));
-        const ssize_t n = ::read(fd, out.data() + done, out.size() - done);
-        if (n < 0 && errno == EINTR)
-            continue;
-        if (n < 0) {
-            Error e = ioError(path, "read failed");
-            ::close(fd);
-            return e;
-        }
-        if (n == 0)
-            break;
-        done += static_cast<std::size_t>(n);
-    }
-    ::close(fd);
-    out.resize(done);
-    return out;
+    // Regular files only, as the mesh readers: a device never ends and a FIFO blocks.
+    Result<std::string> bytes = io::readFileBytes(path);
+    if (!bytes)
+        return bytes.error();
+    return std::vector<std::uint8_t>(bytes->begin(), bytes->end());
 }
 
 } // namespace rubble

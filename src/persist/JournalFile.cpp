@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "persist/Bytes.hpp"
+#include "rubble/JournalPlayer.hpp"
 
 namespace rubble {
 namespace {
@@ -161,8 +162,24 @@ Result<JournalFile> decodeJournal(const std::uint8_t* data, std::size_t size, co
         (void)r.u8("scene");
     const std::uint32_t n = r.count("events.count", kJournalEventBytes);
     j.events.reserve(n);
-    for (std::uint32_t i = 0; i < n && r.ok(); ++i)
-        j.events.push_back(readEvent(r));
+    for (std::uint32_t i = 0; i < n && r.ok(); ++i) {
+        const std::size_t at = r.offset();
+        const JournalEvent e = readEvent(r);
+        if (r.ok() && !j.events.empty()) {
+            // In tick order, without a gap the replay would step through for hours.
+            const std::uint64_t previous = j.events.back().tick;
+            if (e.tick < previous)
+                r.fail(at + 8, "tick",
+                       "is " + std::to_string(e.tick) + ", before the previous event's tick " +
+                           std::to_string(previous) + " (events are in tick order)");
+            else if (e.tick - previous > kMaxJournalTickGap)
+                r.fail(at + 8, "tick",
+                       "is " + std::to_string(e.tick) + ", " + std::to_string(e.tick - previous) +
+                           " frames after the previous event's tick " + std::to_string(previous) +
+                           ", more than the limit of " + std::to_string(kMaxJournalTickGap) + " frames");
+        }
+        j.events.push_back(e);
+    }
     if (r.ok() && r.remaining() != 4)
         r.fail(r.offset(), "crc32",
                std::to_string(r.remaining() - 4) + " unexpected bytes before the checksum");

@@ -9,6 +9,7 @@
 #include <bit>
 #include <map>
 
+#include "io/FileBytes.hpp"
 #include "persist/Bytes.hpp"
 #include "rubble/JournalFile.hpp"
 
@@ -613,22 +614,18 @@ Status saveSnapshot(const std::filesystem::path& path, const Snapshot& snapshot)
 }
 
 Result<Snapshot> loadSnapshot(const std::filesystem::path& path) {
-    // A regular file is mapped (no copy, pages populated in one go); snapshots are replaced by rename, never
-    // rewritten in place, so the mapped file does not change under the reader. Anything else is read.
-    if (const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC); fd >= 0) {
-        struct stat st {};
-        if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0) {
-            const auto size = static_cast<std::size_t>(st.st_size);
-            void* map = ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
-            ::close(fd);
-            if (map != MAP_FAILED) {
-                Result<Snapshot> s =
-                    decodeSnapshot(static_cast<const std::uint8_t*>(map), size, path.string());
-                ::munmap(map, size);
-                return s;
-            }
-        } else {
-            ::close(fd);
+    // Regular files only (a device never ends, a FIFO blocks), mapped: no copy, pages populated in one go.
+    // Snapshots are replaced by rename, never rewritten in place, so the mapped file does not change.
+    auto file = io::openRegularFile(path);
+    if (!file)
+        return file.error();
+    const auto size = static_cast<std::size_t>(file->size());
+    if (size > 0) {
+        void* map = ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE | MAP_POPULATE, file->fd(), 0);
+        if (map != MAP_FAILED) {
+            Result<Snapshot> s = decodeSnapshot(static_cast<const std::uint8_t*>(map), size, path.string());
+            ::munmap(map, size);
+            return s;
         }
     }
     Result<std::vector<std::uint8_t>> bytes = readFileBinary(path);

@@ -573,7 +573,7 @@ Status DestructionWorld::loadState(WorldState w) {
                    std::to_string(w.crumbleCells) + ", minPieceVolume " + std::to_string(w.minPieceVolume) +
                    ")");
     const DecompositionParams& d = w.decomposition;
-    if (d.maxParts < 1 || !(d.concavity >= 0 && d.concavity < 1e300) ||
+    if (d.maxParts < 1 || d.maxParts > kMaxConvexParts || !(d.concavity >= 0 && d.concavity < 1e300) ||
         !(d.minPartVolumeFraction >= 0 && d.minPartVolumeFraction <= 1) || d.maxPartFaces < 4)
         return bad("decomposition settings out of range (maxParts " + std::to_string(d.maxParts) +
                    ", concavity " + std::to_string(d.concavity) + ", minPartVolumeFraction " +

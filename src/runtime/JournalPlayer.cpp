@@ -19,6 +19,14 @@ Status JournalPlayer::receive(const JournalEvent& event) {
         return Error{ErrorCode::InvalidInput, "journal event of tick " + std::to_string(event.tick) +
                                                   " arrived after frame " + std::to_string(frame) +
                                                   " had begun (events must come in journal order)"};
+    const std::uint64_t previous = pending_.empty() ? frame : pending_.back().tick;
+    if (event.tick - previous > kMaxJournalTickGap)
+        return Error{ErrorCode::InvalidInput,
+                     "journal event of tick " + std::to_string(event.tick) + " comes " +
+                         std::to_string(event.tick - previous) + " frames after " +
+                         (pending_.empty() ? "frame " : "the event of tick ") + std::to_string(previous) +
+                         ", more than the limit of " + std::to_string(kMaxJournalTickGap) +
+                         " frames (the journal is damaged)"};
     if (event.tick == frame && pending_.empty())
         return apply(event);
     pending_.push_back(event);

@@ -617,5 +617,44 @@ TEST(DecompositionCache, MemoryAndDiskHitsAndCorruptFiles) {
     EXPECT_EQ(single->parts.size(), 1u);
 }
 
+// Round 3, defect 8: with concavity 0 a convex box was split until maxParts (400 parts at --max-parts 400, no
+// end at 100000); a part convex to within rounding is not split, and maxParts is bounded.
+TEST(ConvexDecomposition, ConvexBoxIsOnePartAtZeroConcavity) {
+    DecompositionParams params;
+    params.concavity = 0;
+    params.maxParts = kMaxConvexParts;
+    for (const Mesh& box : {makeBox({0, 0, 0}, {1, 2, 3}), makeSubdividedBox({-1, -1, -1}, {1, 1, 1}, 29)}) {
+        auto d = decompose(box, params);
+        ASSERT_TRUE(d.isOk()) << d.error().message;
+        EXPECT_EQ(d->parts.size(), 1u) << box.triangleCount();
+    }
+    for (int maxParts : {0, kMaxConvexParts + 1, 100000}) {
+        params.maxParts = maxParts;
+        auto d = decompose(makeBox({0, 0, 0}, {1, 1, 1}), params);
+        ASSERT_FALSE(d.isOk()) << maxParts;
+        EXPECT_EQ(d.error().code, ErrorCode::InvalidInput);
+        EXPECT_EQ(d.error().message, "decompose: maxParts " + std::to_string(maxParts) + " is outside [1, " +
+                                         std::to_string(kMaxConvexParts) + "]");
+    }
+}
+
+// Round 3, defect 9 and the 1e100 cube: an open mesh gave 24 parts whose hulls held less than the mesh, and
+// a 1e100 cube reached Qhull (which printed its diagnostics); both are invalid input.
+TEST(ConvexDecomposition, RefusesOpenMeshesAndHugeCoordinates) {
+    Mesh open = makeBox({0, 0, 0}, {1, 1, 1});
+    open.triangles.pop_back();
+    open.triangles.pop_back();
+    auto d = decompose(open);
+    ASSERT_FALSE(d.isOk());
+    EXPECT_EQ(d.error().code, ErrorCode::InvalidInput);
+    EXPECT_NE(d.error().message.find("not closed and consistently oriented"), std::string::npos)
+        << d.error().message;
+    const double h = 1e100;
+    auto huge = decompose(makeBox({-h, -h, -h}, {h, h, h}));
+    ASSERT_FALSE(huge.isOk());
+    EXPECT_EQ(huge.error().code, ErrorCode::InvalidInput);
+    EXPECT_NE(huge.error().message.find("beyond ±1e+50"), std::string::npos) << huge.error().message;
+}
+
 } // namespace
 } // namespace rubble

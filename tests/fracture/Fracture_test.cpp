@@ -565,3 +565,39 @@ TEST(Fracture, AttributesAreKeptAndCutFacesGetInteriorUvs) {
 
 INSTANTIATE_TEST_SUITE_P(Backends, FractureBackend,
                          ::testing::Values(BooleanKind::Corefine, BooleanKind::Fast), backendName);
+
+// Round 3, defects 6 and 10: fracture refuses what check calls invalid: nested shells both facing outward
+// (pieces overlapped, summing to 9 for a solid of 8), coordinates whose volume integrals overflow.
+TEST(Fracture, RefusesMisnestedShellsAndHugeCoordinates) {
+    Mesh nested = makeBox({-1, -1, -1}, {1, 1, 1});
+    nested.append(makeBox({-0.5, -0.5, -0.5}, {0.5, 0.5, 0.5}));
+    FractureParams shatter;
+    shatter.pattern = CellPattern::Shatter;
+    shatter.cells = 8;
+    const Impact impact{{0.9, 0.9, 1}, {0, 0, -1}, 200};
+    auto r = fracture(nested, impact, shatter, 1);
+    ASSERT_FALSE(r.isOk());
+    EXPECT_EQ(r.error().code, ErrorCode::InvalidInput);
+    EXPECT_NE(r.error().message.find("faces the wrong way for its nesting"), std::string::npos)
+        << r.error().message;
+    EXPECT_FALSE(analyzeMesh(nested).isOk());
+
+    // With the inner shell facing inward (a cavity) the pieces keep the volume 8 - 1.
+    Mesh hollow = makeBox({-1, -1, -1}, {1, 1, 1});
+    Mesh inner = makeBox({-0.5, -0.5, -0.5}, {0.5, 0.5, 0.5});
+    for (Triangle& t : inner.triangles)
+        std::swap(t[1], t[2]);
+    hollow.append(inner);
+    auto ok = fracture(hollow, impact, shatter, 1);
+    ASSERT_TRUE(ok.isOk()) << ok.error().message;
+    double volume = ok->droppedVolume;
+    for (const Piece& p : ok->pieces)
+        volume += p.mass.volume;
+    EXPECT_NEAR(volume, 7.0, 1e-6);
+
+    const double h = 1e150;
+    auto huge = fracture(makeBox({-h, -h, -h}, {h, h, h}), Impact{{0, 0, h}, {0, 0, -1}, 200}, shatter, 1);
+    ASSERT_FALSE(huge.isOk());
+    EXPECT_EQ(huge.error().code, ErrorCode::InvalidInput);
+    EXPECT_NE(huge.error().message.find("beyond ±1e+50"), std::string::npos) << huge.error().message;
+}

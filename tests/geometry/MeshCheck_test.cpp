@@ -299,10 +299,13 @@ TEST(MeshCheck, HugeAndTinyMeshesAreJudgedWithoutOverflow) {
     const MeshReport huge = checkMesh(makeBox({0, 0, 0}, {1e300, 1e300, 1e300}));
     EXPECT_FALSE(huge.valid());
     EXPECT_EQ(huge.degenerateTriangles, 0u);
+    EXPECT_EQ(huge.hugeVertices, 7u);
     ASSERT_EQ(huge.problems.size(), 1u) << test::joinLines(huge.problems);
-    EXPECT_EQ(
-        huge.problems[0],
-        "the mesh's volume overflows the range of doubles (coordinates up to 1e+300); scale the mesh down");
+    EXPECT_EQ(huge.problems[0].rfind("7 vertices have a coordinate beyond ±1e+50, the bound that keeps the "
+                                     "volume integrals finite (e.g. vertex 2 at 1e+300",
+                                     0),
+              0u)
+        << huge.problems[0];
     // 1e-100: the squared areas (1e-400) underflowed and every triangle was called degenerate.
     const MeshReport tiny = checkMesh(makeBox({0, 0, 0}, {1e-100, 1e-100, 1e-100}));
     EXPECT_TRUE(tiny.valid()) << test::joinLines(tiny.problems);
@@ -337,4 +340,76 @@ TEST(MeshCheck, ElementNumbersCountFromZero) {
     Mesh bad = makeBox({0, 0, 0}, {1, 1, 1});
     bad.triangles[0][2] = 8;
     EXPECT_EQ(bad.validate().message(), "triangle 0 refers to vertex 8 of 8");
+}
+
+// Round 3, defect 10: a cube of half-size 1e150 was valid with an infinite volume, and from 1e78 to 1e102 its
+// centre of mass was NaN; coordinates beyond ±kMaxCoordinate are invalid input, within it the integrals are
+// finite.
+TEST(MeshCheck, CoordinatesBeyondTheBoundAreInvalid) {
+    for (double h : {1e150, 1e90, 1e60}) {
+        const Mesh m = makeBox({-h, -h, -h}, {h, h, h});
+        const MeshReport r = checkMesh(m);
+        EXPECT_FALSE(r.valid()) << h;
+        EXPECT_EQ(r.hugeVertices, 8u) << h;
+        ASSERT_FALSE(r.problems.empty());
+        EXPECT_NE(r.problems[0].find("beyond ±1e+50"), std::string::npos) << r.problems[0];
+        const Status s = checkCoordinateRange(m, "m");
+        ASSERT_FALSE(s.isOk());
+        EXPECT_EQ(s.error().code, ErrorCode::InvalidInput);
+        EXPECT_NE(s.message().find("m: vertex 0 has a coordinate of"), std::string::npos) << s.message();
+    }
+    const Mesh edge = makeBox({-kMaxCoordinate, -kMaxCoordinate, -kMaxCoordinate},
+                              {kMaxCoordinate, kMaxCoordinate, kMaxCoordinate});
+    const MeshReport r = checkMesh(edge);
+    EXPECT_TRUE(r.valid()) << test::joinLines(r.problems);
+    EXPECT_TRUE(std::isfinite(r.volume));
+    EXPECT_TRUE(isFinite(r.centerOfMass));
+    const MassProperties mp = computeMassProperties(edge);
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            EXPECT_TRUE(std::isfinite(mp.inertia.m[i][j])) << i << j;
+    EXPECT_TRUE(checkCoordinateRange(edge, "m").isOk());
+}
+
+namespace {
+Mesh inverted(Mesh m) {
+    for (Triangle& t : m.triangles)
+        std::swap(t[1], t[2]);
+    return m;
+}
+} // namespace
+
+// Round 3, defect 6: two nested cubes both facing outward were a valid solid of volume 9 (8 enclosed).
+TEST(MeshCheck, AnInnerShellMustFaceInward) {
+    Mesh nested = makeBox({-1, -1, -1}, {1, 1, 1});
+    nested.append(makeBox({-0.5, -0.5, -0.5}, {0.5, 0.5, 0.5}));
+    const MeshReport bad = checkMesh(nested);
+    EXPECT_FALSE(bad.valid());
+    EXPECT_EQ(bad.shells, 2u);
+    EXPECT_EQ(bad.misnestedShells, 1u);
+    EXPECT_TRUE(test::mentions(bad.problems, "1 shell faces the wrong way for its nesting"))
+        << test::joinLines(bad.problems);
+    EXPECT_TRUE(
+        test::mentions(bad.problems, "the shell of triangle 12 lies inside 1 other shell and faces outward"))
+        << test::joinLines(bad.problems);
+
+    // The inner shell facing inward is a cavity: valid, volume 8 - 1.
+    Mesh hollow = makeBox({-1, -1, -1}, {1, 1, 1});
+    hollow.append(inverted(makeBox({-0.5, -0.5, -0.5}, {0.5, 0.5, 0.5})));
+    const MeshReport cavity = checkMesh(hollow);
+    EXPECT_TRUE(cavity.valid()) << test::joinLines(cavity.problems);
+    EXPECT_NEAR(cavity.volume, 7.0, 1e-12);
+
+    // A solid inside the cavity faces outward again (depth 2); a lone shell facing inward next to another is
+    // wrong although the total volume is positive.
+    Mesh island = hollow;
+    island.append(makeBox({-0.1, -0.1, -0.1}, {0.1, 0.1, 0.1}));
+    EXPECT_TRUE(checkMesh(island).valid()) << test::joinLines(checkMesh(island).problems);
+    Mesh apart = makeBox({0, 0, 0}, {2, 2, 2});
+    apart.append(inverted(makeBox({5, 0, 0}, {6, 1, 1})));
+    const MeshReport lone = checkMesh(apart);
+    EXPECT_FALSE(lone.valid());
+    EXPECT_EQ(lone.misnestedShells, 1u);
+    EXPECT_TRUE(test::mentions(lone.problems, "lies inside 0 other shells and faces inward"))
+        << test::joinLines(lone.problems);
 }

@@ -632,3 +632,47 @@ TEST(MeshReader, AsciiStlIsReadExactlyWithLineNumbers) {
     EXPECT_EQ(read("empty_solid.stl", "solid x\nendsolid x\n").error().message,
               d + "empty_solid.stl: no triangles");
 }
+
+// Round 3, defect 2: 5,000 nodes instancing one 20k-triangle mesh (a 238 KB glTF) grew to 2 GB and aborted
+// with bad_alloc; the triangles the nodes place are bounded before Assimp reads the file.
+TEST(MeshReader, GltfInstancesAreBoundedBeforeAnyAllocation) {
+    const auto dir = test::tempDir("MeshReader_instances");
+    std::string buf;
+    for (float c : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f})
+        put(buf, c);
+    const std::size_t indices = 3 * 20000;
+    for (std::size_t i = 0; i < indices; ++i)
+        put(buf, static_cast<std::uint16_t>(i % 4));
+    auto file = [&](std::size_t nodes) {
+        std::string list, refs;
+        for (std::size_t n = 0; n < nodes; ++n) {
+            list += std::string(n ? "," : "") + R"({"mesh":0})";
+            refs += std::string(n ? "," : "") + std::to_string(n);
+        }
+        return R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[)" + refs + R"(]}],"nodes":[)" +
+               list + R"(],"meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1}]}],)" +
+               R"("buffers":[{"byteLength":)" + std::to_string(buf.size()) +
+               R"(,"uri":"data:application/octet-stream;base64,)" + base64(buf) + R"("}],)" +
+               R"("bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":48},{"buffer":0,"byteOffset":48,)" +
+               R"("byteLength":)" + std::to_string(2 * indices) + R"(}],"accessors":[{"bufferView":0,)" +
+               R"("componentType":5126,"count":4,"type":"VEC3","min":[0,0,0],"max":[1,1,1]},)" +
+               R"({"bufferView":1,"componentType":5123,"count":)" + std::to_string(indices) +
+               R"(,"type":"SCALAR"}]})";
+    };
+    test::writeFile(dir / "instances.gltf", file(5000));
+    const Error e = errorOf(dir / "instances.gltf");
+    EXPECT_EQ(e.code, ErrorCode::ParseError);
+    EXPECT_EQ(e.message,
+              (dir / "instances.gltf").string() +
+                  ": its nodes place 100000000 triangles (every node a copy of its mesh), more than "
+                  "the limit of 16777216");
+    const auto scene = readScene(dir / "instances.gltf");
+    ASSERT_FALSE(scene.isOk());
+    EXPECT_EQ(scene.error().message, e.message);
+    // Two instances are read: twice the triangles.
+    test::writeFile(dir / "two.gltf", file(2));
+    const auto two = readScene(dir / "two.gltf");
+    ASSERT_TRUE(two.isOk()) << two.error().message;
+    ASSERT_EQ(two->objects.size(), 2u);
+    EXPECT_EQ(two->objects[0].mesh.triangleCount() + two->objects[1].mesh.triangleCount(), 2 * 20000u);
+}

@@ -227,3 +227,55 @@ TEST(SceneReader, ObjGroupsWithoutObjectsAreOneObject) {
     EXPECT_EQ(scene->objects[0].name, "g");
     EXPECT_EQ(scene->objects[0].mesh.triangleCount(), 4u);
 }
+
+// Round 3: `map_Kd /etc/passwd` ended up in OUT/textures/. An image named by an absolute path is not used (a
+// warning), so writing the scene copies nothing from elsewhere; relative paths ("../textures/") still work.
+TEST(SceneReader, ImagesNamedByAbsolutePathsAreNotUsed) {
+    const auto dir = std::filesystem::absolute(tempDir("scene_absolute"));
+    const auto secret = writeFile(dir / "outside" / "secret.txt", "secret");
+    writeFile(dir / "textures" / "ok.png", "image bytes");
+    std::string cube = slurp(test::sourceDir() / "tests" / "data" / "meshes" / "cube.obj");
+    cube.insert(cube.rfind("\nf ") + 1, "usemtl b\n"); // the last face in material b
+    const auto obj = writeFile(dir / "model" / "m.obj", "mtllib m.mtl\nusemtl a\n" + cube);
+    writeFile(dir / "model" / "m.mtl",
+              "newmtl a\nKd 1 0 0\nmap_Kd " + secret.string() + "\nnewmtl b\nmap_Kd ../textures/ok.png\n");
+    auto scene = readScene(obj);
+    ASSERT_TRUE(scene.isOk()) << scene.error().message;
+    ASSERT_EQ(scene->warnings.size(), 1u) << test::joinLines(scene->warnings);
+    EXPECT_EQ(scene->warnings[0], "material 'a': image " + secret.string() +
+                                      " is named by an absolute path: not used (images are copied only from "
+                                      "paths relative to the model's folder)");
+    const AssetMaterial* a = find(*scene, "a");
+    const AssetMaterial* b = find(*scene, "b");
+    ASSERT_TRUE(a && b);
+    EXPECT_TRUE(a->maps.empty());
+    ASSERT_EQ(b->maps.size(), 1u);
+    EXPECT_EQ(b->maps[0].file, (dir / "textures" / "ok.png").lexically_normal());
+
+    ObjWriteOptions options;
+    options.objectName = "m";
+    options.materials = scene->materials;
+    std::filesystem::create_directories(dir / "out");
+    ASSERT_TRUE(writeObj(dir / "out" / "m.obj", scene->objects[0].mesh, options).isOk());
+    std::vector<std::string> copied;
+    for (const auto& e : std::filesystem::directory_iterator(dir / "out" / "textures"))
+        copied.push_back(e.path().filename().string());
+    EXPECT_EQ(copied, std::vector<std::string>{"ok.png"});
+}
+
+// Round 3: a malformed .mtl made check and fracture exit 2 while decompose (which reads no materials) exited
+// 0; like a missing .mtl it is now a warning naming its line, and the geometry is read.
+TEST(SceneReader, AMalformedMtlIsAWarningLikeAMissingOne) {
+    const auto dir = tempDir("scene_bad_mtl");
+    const std::string cube = slurp(test::sourceDir() / "tests" / "data" / "meshes" / "cube.obj");
+    const auto obj = writeFile(dir / "m.obj", "mtllib bad.mtl\n" + cube);
+    writeFile(dir / "bad.mtl", "Kd 1 1 1\n");
+    auto scene = readScene(obj);
+    ASSERT_TRUE(scene.isOk()) << scene.error().message;
+    ASSERT_EQ(scene->warnings.size(), 1u);
+    EXPECT_NE(scene->warnings[0].find("bad.mtl:1: 'Kd' before the first newmtl (its materials are not used)"),
+              std::string::npos)
+        << scene->warnings[0];
+    EXPECT_TRUE(scene->materials.empty());
+    EXPECT_EQ(scene->objects.at(0).mesh.triangleCount(), 12u);
+}

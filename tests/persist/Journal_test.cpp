@@ -280,5 +280,43 @@ TEST(Journal, FileRoundTripsAndNamesTheOffsetOfDamage) {
     EXPECT_NE(bad.error().message.find("offset 4, field version"), std::string::npos) << bad.error().message;
 }
 
+// Round 3, defect 5: a journal with valid CRCs whose last event's tick is 0xFFFFFFF0 made the replay step
+// toward it for about 4 hours. The decoder refuses such a gap naming offset and field, and so does the
+// player.
+TEST(Journal, AGapOfBillionsOfFramesIsRefused) {
+    const Recording rec = record(1, 60);
+    ASSERT_FALSE(rec.events.empty());
+    JournalFile j{journalHeaderOf(test::journalConfig(1).world), rec.events};
+    JournalEvent far = rec.events.back();
+    far.tick = 0xFFFFFFF0u;
+    j.events.push_back(far);
+    std::vector<std::uint8_t> bytes = encodeJournal(j); // a valid checksum
+    Result<JournalFile> bad = decodeJournal(bytes.data(), bytes.size(), "x.rjournal");
+    ASSERT_FALSE(bad);
+    const std::size_t tickAt = 48 + 48 * rec.events.size() + 8;
+    EXPECT_NE(bad.error().message.find("offset " + std::to_string(tickAt) + ", field tick"),
+              std::string::npos)
+        << bad.error().message;
+    EXPECT_NE(bad.error().message.find("more than the limit of 4194304 frames"), std::string::npos)
+        << bad.error().message;
+    // A gap of exactly the limit is a journal.
+    j.events.back().tick = static_cast<std::uint32_t>(rec.events.back().tick + kMaxJournalTickGap);
+    bytes = encodeJournal(j);
+    EXPECT_TRUE(decodeJournal(bytes.data(), bytes.size(), "x.rjournal"));
+
+    // The player refuses the far event from any source and keeps the others.
+    auto world = test::journalWorld(1);
+    JournalPlayer player(*world);
+    for (const JournalEvent& e : rec.events)
+        ASSERT_TRUE(player.receive(e));
+    const std::size_t pending = player.pending();
+    Status s = player.receive(far);
+    ASSERT_FALSE(s);
+    EXPECT_NE(s.message().find("more than the limit of 4194304 frames"), std::string::npos) << s.message();
+    EXPECT_EQ(player.pending(), pending);
+    ASSERT_TRUE(player.advanceTo(rec.frame));
+    EXPECT_EQ(world->geometryHash(), rec.geometry);
+}
+
 } // namespace
 } // namespace rubble

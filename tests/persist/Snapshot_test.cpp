@@ -3,14 +3,17 @@
 // process killed mid-save leaves the previous snapshot intact.
 #include "rubble/Snapshot.hpp"
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <future>
 #include <random>
 
 #include "JournalScene.hpp"
@@ -416,6 +419,53 @@ TEST(Snapshot, AProcessKilledMidSaveLeavesThePreviousSnapshot) {
         leftovers += entry.path().filename().string().find(".tmp.") != std::string::npos;
     std::printf("kill test: %d times the first, %d times the second snapshot, %zu temporary files left\n",
                 sawA, sawB, leftovers);
+}
+
+// Round 3, defect 4: /dev/zero as a snapshot or journal (the demo's F9 and --replay) read until memory ran
+// out, and a FIFO blocked forever; both are refused without reading or blocking, as the mesh readers do.
+TEST(Snapshot, DevicesAndFifosAreRefusedWithoutBlocking) {
+    const std::filesystem::path dir = test::tempDir("snapshot_special");
+    const std::filesystem::path fifo = dir / "quicksave.rsnap";
+    const std::filesystem::path zero = dir / "zero.rsnap";
+    std::filesystem::remove(fifo);
+    std::filesystem::remove(zero);
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    std::filesystem::create_symlink("/dev/zero", zero);
+    // Each reader runs on its own thread; one blocked on the FIFO past the deadline is released by a writer.
+    auto refused = [&](const std::filesystem::path& path, auto read) {
+        auto result = std::async(std::launch::async, read);
+        if (result.wait_for(std::chrono::seconds(60)) == std::future_status::timeout) {
+            const int fd = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
+            if (fd >= 0)
+                ::close(fd);
+            ADD_FAILURE() << path << ": the reader blocked";
+            return std::string();
+        }
+        return result.get();
+    };
+    for (const auto& [path, kind] :
+         {std::pair{fifo, std::string("it is a FIFO, not a regular file")},
+          std::pair{zero, std::string("it is a character device, not a regular file")}}) {
+        const std::string expected = path.string() + ": cannot read: " + kind;
+        EXPECT_EQ(refused(path,
+                          [p = path] {
+                              auto r = loadSnapshot(p);
+                              return r ? std::string("loaded") : r.error().message;
+                          }),
+                  expected);
+        EXPECT_EQ(refused(path,
+                          [p = path] {
+                              auto r = readJournal(p);
+                              return r ? std::string("read") : r.error().message;
+                          }),
+                  expected);
+        EXPECT_EQ(refused(path,
+                          [p = path] {
+                              auto r = readFileBinary(p);
+                              return r ? std::string("read") : r.error().message;
+                          }),
+                  expected);
+    }
 }
 
 } // namespace

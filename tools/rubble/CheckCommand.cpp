@@ -227,6 +227,8 @@ int runCheck(const CheckArgs& args) {
             exitCode = 2;
             continue;
         }
+        for (const std::string& w : scene.value().warnings) // e.g. a missing or malformed .mtl
+            std::cerr << "rubble check: warning: " << w << "\n";
         const auto& objects = scene.value().objects;
         if (objects.size() > 1 || !objects.front().collision.empty()) {
             if (args.repair) {

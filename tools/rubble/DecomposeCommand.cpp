@@ -85,7 +85,8 @@ const rubble::tools::Registrar registrar{
          app.add_option("mesh", args->file, "mesh file (.obj, .off, .stl, .ply, .3ds, .gltf, .glb)")
              ->required();
          app.add_option("--max-parts", args->maxParts, "at most this many convex parts")
-             ->check(CLI::Range(1, 100000));
+             ->check(CLI::Range(1, rubble::kMaxConvexParts))
+             ->capture_default_str();
          app.add_option("--concavity", args->concavity,
                         "stop splitting below this depth, as a fraction of the bounding-box diagonal")
              ->check(rubble::tools::finiteNumber())

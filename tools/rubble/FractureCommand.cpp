@@ -17,9 +17,11 @@
 // Everything is computed before anything is written, and the output is staged in a sibling folder renamed to
 // DIR at the end, so that an error leaves no partial output. SIGINT and SIGTERM are held back while the
 // staging folder exists; staging folders of killed runs (".DIR.rubble-tmp-PID" of a dead PID) are removed.
+// Objects are written under unique names: objects sharing a name (which glTF allows) become "wall",
+// "wall_2", ..., and a piece never takes a kept object's name.
 // Exit codes: 0 every mesh fractured and written; 1 a fracture or a write failed (the other meshes are
-// written); 2 unreadable or invalid mesh, or a usage error (nothing written); 3 the impact misses a mesh (no
-// pieces for it; the other meshes are written).
+// written); 2 unreadable or invalid mesh (the checks of `rubble check`, self-intersections included), or a
+// usage error (nothing written); 3 the impact misses a mesh (no pieces for it; the other meshes are written).
 // --json prints
 // {"input":{"volume","triangles","closed"},"cut","dropped_volume","pieces":[{"volume","triangles",
 // "closed","oriented","center_of_mass":[x,y,z],"convex_parts"}],"timings_ms":{"cell","boolean","islands",
@@ -30,6 +32,7 @@
 // "levels":[{"level","pieces","volume","dropped_volume","bonds","failed"}] for levels 1..D. Every exit prints
 // an object: a usage error or an invalid input (exit 2) {"error"}; a failed write the results plus "error".
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <chrono>
 #include <cmath>
@@ -142,8 +145,9 @@ struct MeshJob {
     rubble::FractureTimings timings;
     double decompositionMs = 0; // the incremental update
     double parentDecompositionMs = 0;
-    double droppedVolume = 0; // pieces below the drop fraction
-    bool cut = false;         // some piece has a cut face (else the one piece is the input itself)
+    double droppedVolume = 0;    // pieces below the drop fraction
+    bool cut = false;            // some piece has a cut face (else the one piece is the input itself)
+    std::set<std::string> names; // the names given so far, lower case
 };
 
 double msSince(Clock::time_point t0) {
@@ -184,6 +188,26 @@ std::string pieceName(const std::string& prefix, std::size_t i) {
     char buf[32];
     std::snprintf(buf, sizeof buf, "_%03zu", i);
     return prefix + buf;
+}
+
+// A name for an output object that no earlier one of the job has, without regard to case ("wall", "wall_2",
+// ...; objects and glTF nodes may share names, files may not), usable as a file name (no '/', '\\' or
+// control characters, not "." or "..").
+std::string claimName(MeshJob& job, std::string wanted) {
+    for (char& c : wanted)
+        if (c == '/' || c == '\\' || static_cast<unsigned char>(c) < 0x20)
+            c = '_';
+    if (wanted.empty() || wanted == "." || wanted == "..")
+        wanted = "object";
+    auto lower = [](std::string t) {
+        for (char& c : t)
+            c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+        return t;
+    };
+    std::string name = wanted;
+    for (int n = 2; !job.names.insert(lower(name)).second; ++n)
+        name = wanted + "_" + std::to_string(n);
+    return name;
 }
 
 // The pieces of one fracture with their parts; false when the fracture failed (message set).
@@ -277,7 +301,7 @@ void runJob(MeshJob& job, const rubble::Impact& impact, const rubble::FracturePa
             if (i == job.target || !isLeaf(job.scene, i))
                 continue;
             PieceOut p;
-            p.name = o.name;
+            p.name = claimName(job, o.name);
             p.mesh = o.mesh;
             p.mass = rubble::computeMassProperties(o.mesh);
             rubble::CheckOptions quick;
@@ -311,6 +335,7 @@ void runJob(MeshJob& job, const rubble::Impact& impact, const rubble::FracturePa
     job.cut = first.cut;
     std::vector<std::size_t> level;
     for (PieceOut& p : first.pieces) {
+        p.name = claimName(job, p.name);
         level.push_back(job.pieces.size());
         roots.push_back(job.pieces.size());
         job.pieces.push_back(std::move(p));
@@ -354,6 +379,7 @@ void runJob(MeshJob& job, const rubble::Impact& impact, const rubble::FracturePa
             ls.droppedVolume += f.droppedVolume;
             std::vector<std::size_t> siblings;
             for (PieceOut& p : f.pieces) {
+                p.name = claimName(job, p.name);
                 ls.volume += p.mass.volume;
                 siblings.push_back(job.pieces.size());
                 next.push_back(job.pieces.size());
@@ -664,8 +690,6 @@ int runFracture(const FractureArgs& args) {
     const bool batch = args.files.size() > 1;
     std::vector<MeshJob> jobs(args.files.size());
     std::set<std::string> folders;
-    rubble::CheckOptions noSelfIntersections;
-    noSelfIntersections.selfIntersections = false;
     for (std::size_t i = 0; i < args.files.size(); ++i) {
         MeshJob& job = jobs[i];
         job.file = args.files[i];
@@ -701,7 +725,9 @@ int runFracture(const FractureArgs& args) {
         const rubble::Mesh& mesh = job.scene.objects[job.target].mesh;
         const std::string what =
             job.multiObject ? job.file + " (object '" + job.scene.objects[job.target].name + "')" : job.file;
-        const rubble::MeshReport r = rubble::checkMesh(mesh, noSelfIntersections);
+        // The checks of `rubble check`, self-intersections included (a load-time cost, as in a game's
+        // loader).
+        const rubble::MeshReport r = rubble::checkMesh(mesh);
         if (!r.valid())
             return usage(what + ": not a valid solid, cannot fracture it: " +
                          (r.problems.empty() ? std::string("invalid mesh") : r.problems.front()) +
