@@ -24,6 +24,7 @@
 #include "GlContext.hpp"
 #include "JoinSession.hpp"
 #include "Panel.hpp"
+#include "RenderBench.hpp"
 #include "Renderer.hpp"
 #include "RunReport.hpp"
 #include "ScaledTarget.hpp"
@@ -78,6 +79,9 @@ struct Options {
     std::string quality = "auto";  // auto (from GL_RENDERER), software or gpu
     float targetFps = 60;          // dynamic resolution holds this rate (software quality)
     float minScale = -1;           // smallest internal resolution scale (-1: the quality's)
+    std::string renderBench;       // "N,N,...": the render bench's resting piece counts
+    int benchFrames = 60;          // measured frames per render bench row
+    bool json = false;             // the render bench prints JSON
 };
 
 struct App {
@@ -316,7 +320,30 @@ int main(int argc, char** argv) {
                  "stress solver (default on): bonds between static parts carry their load, objects rest on "
                  "each other as bearings; --structure also draws the bonds by stress");
     cli.add_flag("--bonds", o.bonds, "draw the structure's bonds by stress");
+    cli.add_option(
+        "--render-bench", o.renderBench,
+        "N,N,...: render fields of N resting fractured pieces (and 64 moving ones) offscreen at "
+        "--width x --height and print the CPU per frame and draw calls of each (rubble-bench render "
+        "runs this), then exit");
+    cli.add_option("--bench-frames", o.benchFrames, "measured frames per --render-bench row (default 60)")
+        ->check(CLI::Range(1, 100000));
+    cli.add_flag("--json", o.json, "--render-bench prints a JSON list of rows");
     CLI11_PARSE(cli, argc, argv);
+    if (!o.renderBench.empty()) {
+        demo::RenderBenchOptions b;
+        std::string message;
+        if (!demo::parsePieceCounts(o.renderBench, b.pieces, message)) {
+            std::fprintf(stderr, "error: %s\n", message.c_str());
+            return 2;
+        }
+        b.width = o.width;
+        b.height = o.height;
+        b.frames = o.benchFrames;
+        b.json = o.json;
+        b.quality = o.quality;
+        b.out = o.out;
+        return demo::runRenderBench(b);
+    }
     for (const std::string& text : o.hits) {
         float v[4];
         if (!parseNumbers(text, 4, v) || !(v[3] > 0)) {
