@@ -872,7 +872,7 @@ void Renderer::mergeRanges(std::vector<GLint>& firsts, std::vector<GLsizei>& cou
     }
 }
 
-void Renderer::cullAndBatch(const M4& vp, float pixelsPerRadian) {
+void Renderer::cullAndBatch(const M4& vp, float pixelsPerRadian, bool lod) {
     // Frustum planes of the view-projection (Gribb-Hartmann), tested against each mesh's bounding sphere.
     float planes[6][4];
     for (int i = 0; i < 6; ++i) {
@@ -925,7 +925,8 @@ void Renderer::cullAndBatch(const M4& vp, float pixelsPerRadian) {
     }
     // the largest on screen keep their triangles (at most the budget); the rest are chips
     size_t meshes = visible_.size();
-    if (meshes > static_cast<size_t>(quality_.meshBudget)) {
+    const float chipPixels = lod ? quality_.chipPixels : 0.0f;
+    if (lod && meshes > static_cast<size_t>(quality_.meshBudget)) {
         meshes = static_cast<size_t>(quality_.meshBudget);
         std::nth_element(visible_.begin(), visible_.begin() + static_cast<long>(meshes), visible_.end(),
                          [](const Visible& a, const Visible& b) { return a.pixels > b.pixels; });
@@ -933,7 +934,7 @@ void Renderer::cullAndBatch(const M4& vp, float pixelsPerRadian) {
     for (size_t i = 0; i < visible_.size(); ++i) {
         const Visible& v = visible_[i];
         const MeshRec& rec = meshes_[v.id];
-        if (i < meshes && v.pixels >= quality_.chipPixels) {
+        if (i < meshes && v.pixels >= chipPixels) {
             ++meshesDrawn_;
             for (int range = 0; range < 2; ++range)
                 if (rec.count[range] > 0) {
@@ -998,7 +999,8 @@ void Renderer::render(const FrameView& fv) {
     for (auto& b : batches_)
         if (b.dirty)
             uploadBatch(b);
-    cullAndBatch(fv.proj * fv.view, fv.proj.m[5] * 0.5f * static_cast<float>(fv.height));
+    cullAndBatch(fv.proj * fv.view, fv.proj.m[5] * 0.5f * static_cast<float>(fv.height),
+                 skip.find("lod") == std::string::npos);
 
     // Per-object transforms → buffer texture.
     const size_t floats = static_cast<size_t>(std::max(maxSlotUsed_, 1)) * kTexelsPerSlot * 4;

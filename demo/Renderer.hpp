@@ -153,7 +153,7 @@ private:
     void uploadBatch(Batch& b);
     void compact(Batch& b, int batchIndex);
     void drawBatches(bool depthOnly, GLuint program);
-    void cullAndBatch(const M4& viewProj, float pixelsPerRadian);
+    void cullAndBatch(const M4& viewProj, float pixelsPerRadian, bool lod);
     static void mergeRanges(std::vector<GLint>& firsts, std::vector<GLsizei>& counts);
     void applyFilter(GLenum target);
 
