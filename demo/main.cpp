@@ -85,7 +85,7 @@ struct Options {
     std::string renderBench;       // "N,N,...": the render bench's resting piece counts
     int benchFrames = 60;          // measured frames per render bench row
     bool json = false;             // the render bench prints JSON
-    int rasterNice = 10;           // niceness of llvmpipe's rasteriser threads (0: unchanged)
+    int rasterNice = 0;            // niceness of llvmpipe's rasteriser threads (0: unchanged)
     double demolish = 0;           // seconds between demolition charges on standing targets (0: none)
 };
 
@@ -357,8 +357,8 @@ int main(int argc, char** argv) {
     cli.add_flag("--json", o.json, "--render-bench prints a JSON list of rows");
     cli.add_option(
            "--raster-nice", o.rasterNice,
-           "niceness of llvmpipe's rasteriser threads (default 10): fracture workers run before them, so "
-           "that pieces appear within the frames after an impact; 0 leaves them alone")
+           "niceness of llvmpipe's rasteriser threads (default 0: unchanged): above 0, fracture workers run "
+           "before them (on a machine shared with other work they also lose to it; docs/rendering.md)")
         ->check(CLI::Range(0, 19));
     CLI11_PARSE(cli, argc, argv);
     if (!o.renderBench.empty()) {
