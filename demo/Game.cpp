@@ -363,6 +363,16 @@ void Game::blast(const V3& point, float radius, float impulse, int by) {
     particles_.impactBurst(point, V3{0, 1, 0}, 2.0f, burstSeed_++);
 }
 
+bool Game::blastNextTarget() {
+    const std::vector<V3> standing = targets();
+    if (standing.empty())
+        return false;
+    const WeaponSpec& charge = weaponSpec(Weapon::Charge);
+    blast(standing[nextTarget_++ % standing.size()], charge.blastRadius, charge.blastImpulse,
+          static_cast<int>(Weapon::Charge));
+    return true;
+}
+
 bool Game::hitAt(const V3& point, float impulse) {
     return runtime_ && runtime_->blast(rubble::Vec3{point.x, point.y, point.z}, 0.01, impulse, 1.0) > 0;
 }
@@ -626,6 +636,8 @@ void Game::updateCounters() {
     counters_.bondsBroken = static_cast<int>(c.bondsBroken);
     counters_.bodies = static_cast<int>(runtime_->bodyCount());
     counters_.pieces = runtime_->livePieces();
+    counters_.awake = runtime_->awakeDebris();
+    counters_.frozen = runtime_->frozenDebris();
     counters_.jobs = runtime_->world().jobsInFlight();
 }
 

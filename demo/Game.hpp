@@ -74,6 +74,8 @@ struct GameCounters {
     int bondsBroken = 0;                             ///< structure bonds broken (stress solver on)
     int bodies = 0;                                  ///< rigid bodies in the physics world
     int pieces = 0;                                  ///< live piece bodies
+    int awake = 0;                                   ///< dynamic debris bodies (pieces and objects)
+    int frozen = 0;                                  ///< debris bodies frozen at rest
     int jobs = 0;                                    ///< fracture jobs queued or running
     int warnings = 0;                                ///< scene warnings
     int crashes = 0;                                 ///< the jet hit the ground or an object
@@ -134,6 +136,9 @@ public:
     /// Crash or blast: impacts on every destructible body within radius of point, sparks and dust; the
     /// fractures they cause count for `by` (a weapon index, or -1 for a crash).
     void blast(const V3& point, float radius, float impulse, int by = -1);
+    /// A demolition charge's blast on the next standing target (round robin over targets()), for --demolish;
+    /// false when nothing stands.
+    bool blastNextTarget();
     /// One impact at a world point on the objects whose bounds reach it (no sparks); false when none took it.
     bool hitAt(const V3& point, float impulse);
     /// Places the showcase camera (GameSettings::showcase) at eye, looking at target.
@@ -245,6 +250,7 @@ private:
     std::vector<Shell> landed_;                        // shells that hit something this step
     std::vector<rubble::JournalEvent> stepImpacts_;    // impacts journaled this step, credited after it
     int blastBy_ = -1;                                 // weapon whose blast is submitting impacts
+    std::size_t nextTarget_ = 0;                       // --demolish: the target blasted next
     std::map<rubble::ObjectId, int> hitBy_;            // object -> weapon whose impact will fracture it
 };
 

@@ -202,13 +202,16 @@ void Panel::drawHud(const Game& game, bool paused, int width, int height) {
     dl->AddLine(ImVec2(cx + 11 * k, cy), ImVec2(cx + 18 * k, cy), col, 1.5f * k);
     dl->AddLine(ImVec2(cx, cy - 18 * k), ImVec2(cx, cy - 11 * k), col, 1.5f * k);
     dl->AddLine(ImVec2(cx, cy + 11 * k), ImVec2(cx, cy + 18 * k), col, 1.5f * k);
-    char buf[160];
+    char buf[224];
     V3 pos, fwd, up;
     game.vehicleFrame(pos, fwd, up);
-    std::snprintf(buf, sizeof buf, "[%d] %s   SPEED %3.0f m/s   ALT %4.0f m   HITS %d   FRACTURES %d",
+    const GameCounters& c = game.counters();
+    std::snprintf(buf, sizeof buf,
+                  "[%d] %s   SPEED %3.0f m/s   ALT %4.0f m   HITS %d   FRACTURES %d   PIECES %d (AWAKE %d, "
+                  "FROZEN %d)",
                   static_cast<int>(game.weapon()) + 1, weaponSpec(game.weapon()).name,
-                  static_cast<double>(game.speed()), static_cast<double>(pos.y - game.groundY()),
-                  game.counters().impacts, game.counters().fractures);
+                  static_cast<double>(game.speed()), static_cast<double>(pos.y - game.groundY()), c.impacts,
+                  c.fractures, c.pieces, c.awake, c.frozen);
     const ImVec2 ts = font->CalcTextSizeA(fs, 1e9f, 0.0f, buf);
     dl->AddRectFilled(ImVec2(12 * k, h - ts.y - 26 * k), ImVec2(32 * k + ts.x, h - 12 * k),
                       IM_COL32(0, 0, 0, 110), 6.0f * k);

@@ -190,6 +190,26 @@ void main() {
     oColor = vec4(vColor.rgb, vColor.a * f);
 })";
 
+// Chips: distant small pieces as opaque squares (points), lit and fogged per piece.
+const char* kChipVs = R"(#version 330 core
+layout(location=0) in vec4 aPosSize;
+layout(location=1) in vec3 aColor;
+uniform mat4 uViewProj;
+uniform vec3 uCamPos;
+uniform vec3 uFogColor;
+out vec3 vColor;
+void main() {
+    vec3 dv = uCamPos - aPosSize.xyz;
+    float x = dot(dv, dv) * 2.5e-6;
+    vColor = mix(aColor, uFogColor, x / (1.0 + x));
+    gl_PointSize = aPosSize.w;
+    gl_Position = uViewProj * vec4(aPosSize.xyz, 1.0);
+})";
+
+const char* kChipFs = R"(#version 330 core
+in vec3 vColor; out vec4 oColor;
+void main() { oColor = vec4(vColor, 1.0); })";
+
 const char* kLineVs = R"(#version 330 core
 layout(location=0) in vec3 aPos;
 layout(location=1) in vec3 aColor;
@@ -286,6 +306,9 @@ RenderQuality RenderQuality::forRenderer(const std::string& glRenderer) {
         // Dynamic resolution stays off: with per-vertex lighting a pixel costs about what the upscale pass
         // costs per output pixel, so on llvmpipe 2/3 scale saved nothing (docs/rendering.md).
         q.minScale = 1.0f;
+        // a vertex costs llvmpipe's main thread about 45 ns: small pieces become chips early
+        q.chipPixels = 4.0f;
+        q.meshBudget = 600;
     }
     return q;
 }
@@ -300,7 +323,8 @@ bool Renderer::init(const RenderQuality& quality, std::string& error) {
     skyProg_ = linkProgram(kSkyVs, kSkyFs, error);
     particleProg_ = linkProgram(kParticleVs, kParticleFs, error);
     lineProg_ = linkProgram(kLineVs, kLineFs, error);
-    if (!meshProg_ || !depthProg_ || !skyProg_ || !particleProg_ || !lineProg_)
+    chipProg_ = linkProgram(kChipVs, kChipFs, error);
+    if (!meshProg_ || !depthProg_ || !skyProg_ || !particleProg_ || !lineProg_ || !chipProg_)
         return false;
 
     glGenBuffers(1, &slotBuf_);
@@ -326,6 +350,16 @@ bool Renderer::init(const RenderQuality& quality, std::string& error) {
     glVertexAttribDivisor(2, 1);
 
     makeTripleArray(lineVao_, lineVbo_, {});
+    glGenVertexArrays(1, &chipVao_);
+    glBindVertexArray(chipVao_);
+    glGenBuffers(1, &chipVbo_);
+    glBindBuffer(GL_ARRAY_BUFFER, chipVbo_);
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 4, GL_FLOAT, GL_FALSE, 7 * sizeof(float), nullptr);
+    glEnableVertexAttribArray(1);
+    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 7 * sizeof(float),
+                          reinterpret_cast<void*>(4 * sizeof(float)));
+    glBindVertexArray(0);
 
     glGenFramebuffers(1, &shadowFbo_);
     glGenTextures(1, &shadowTex_);
@@ -362,7 +396,7 @@ void Renderer::shutdown() {
     for (GLuint& t : skyFaces_)
         if (t)
             glDeleteTextures(1, &t), t = 0;
-    GLuint progs[] = {meshProg_, depthProg_, skyProg_, particleProg_, lineProg_};
+    GLuint progs[] = {meshProg_, depthProg_, skyProg_, particleProg_, lineProg_, chipProg_};
     for (GLuint p : progs)
         if (p)
             glDeleteProgram(p);
@@ -627,6 +661,30 @@ int Renderer::batchFor(int texture, bool interior) {
     Batch b;
     b.texture = texture;
     b.interior = interior;
+    const int shown = interior && texture < 0 ? interiorTex_ : texture;
+    if (shown >= 0 && static_cast<size_t>(shown) < textures_.size()) {
+        // the texture's mean colour: its smallest mip level, averaged
+        glBindTexture(GL_TEXTURE_2D, textures_[static_cast<size_t>(shown)]);
+        int level = 0, w = 0, h = 0;
+        for (int l = 0; l < 16; ++l) {
+            GLint lw = 0, lh = 0;
+            glGetTexLevelParameteriv(GL_TEXTURE_2D, l, GL_TEXTURE_WIDTH, &lw);
+            glGetTexLevelParameteriv(GL_TEXTURE_2D, l, GL_TEXTURE_HEIGHT, &lh);
+            if (lw <= 0 || lh <= 0)
+                break;
+            level = l, w = lw, h = lh;
+        }
+        if (w > 0 && h > 0 && w * h <= 4096) {
+            std::vector<unsigned char> px(static_cast<size_t>(w) * static_cast<size_t>(h) * 4);
+            glGetTexImage(GL_TEXTURE_2D, level, GL_RGBA, GL_UNSIGNED_BYTE, px.data());
+            float sum[3] = {0, 0, 0};
+            for (size_t i = 0; i < px.size(); i += 4)
+                for (int c = 0; c < 3; ++c)
+                    sum[c] += static_cast<float>(px[i + static_cast<size_t>(c)]) / 255.0f;
+            const float n = static_cast<float>(w * h);
+            b.average = {sum[0] / n, sum[1] / n, sum[2] / n};
+        }
+    }
     glGenVertexArrays(1, &b.vao);
     glGenBuffers(1, &b.vbo);
     glBindVertexArray(b.vao);
@@ -687,6 +745,22 @@ int Renderer::addMesh(const rubble::Mesh& mesh, int texture, float r, float g, f
         rec.centre = {static_cast<float>(c.x), static_cast<float>(c.y), static_cast<float>(c.z)};
         rec.radius = static_cast<float>(std::sqrt(h.x * h.x + h.y * h.y + h.z * h.z));
     }
+    { // mean of the outside and the cut faces by triangle count, in the per-vertex path's light on a
+      // surface facing the sun half-way, with its tone map and gamma
+        const float lit[3] = {0.155f + 0.72f, 0.172f + 0.67f, 0.209f + 0.59f};
+        const float tints[2][3] = {{r, g, b}, {0.85f, 0.78f, 0.70f}};
+        const float total = static_cast<float>(std::max(1, rec.count[0] + rec.count[1]));
+        float out[3] = {0, 0, 0};
+        for (int range = 0; range < 2; ++range) {
+            const V3 a = batches_[rec.batch[range]].average;
+            const float avg[3] = {a.x, a.y, a.z}, share = static_cast<float>(rec.count[range]) / total;
+            for (int c = 0; c < 3; ++c) {
+                const float l = tints[range][c] * lit[c];
+                out[c] += share * avg[c] * std::sqrt(l / (1.0f + 0.15f * l));
+            }
+        }
+        rec.chip = {out[0], out[1], out[2]};
+    }
     ++liveMeshes_;
     const size_t need = static_cast<size_t>(id + 1) * kTexelsPerSlot * 4;
     if (slotData_.size() < need)
@@ -745,12 +819,14 @@ void Renderer::uploadBatch(Batch& b) {
 
 void Renderer::beginFrame() {
     for (auto& b : batches_) {
+        b.drawn = 0;
         b.firsts.clear();
         b.counts.clear();
         b.shadowFirsts.clear();
         b.shadowCounts.clear();
     }
     queued_.clear();
+    chips_.clear();
     dust_.clear();
     sparks_.clear();
     lines_.clear();
@@ -779,7 +855,24 @@ void Renderer::addLine(const V3& a, const V3& b, float r, float g, float bl) {
     lines_.insert(lines_.end(), d, d + 12);
 }
 
-void Renderer::cullAndBatch(const M4& vp) {
+void Renderer::mergeRanges(std::vector<GLint>& firsts, std::vector<GLsizei>& counts) {
+    // one range per run of adjacent meshes: fewer draws inside the multi-draw
+    thread_local std::vector<std::pair<GLint, GLsizei>> ranges;
+    ranges.clear();
+    for (size_t i = 0; i < firsts.size(); ++i)
+        ranges.emplace_back(firsts[i], counts[i]);
+    std::sort(ranges.begin(), ranges.end());
+    firsts.clear();
+    counts.clear();
+    for (const auto& [first, count] : ranges) {
+        if (!firsts.empty() && firsts.back() + counts.back() == first)
+            counts.back() += count;
+        else
+            firsts.push_back(first), counts.push_back(count);
+    }
+}
+
+void Renderer::cullAndBatch(const M4& vp, float pixelsPerRadian, bool lod) {
     // Frustum planes of the view-projection (Gribb-Hartmann), tested against each mesh's bounding sphere.
     float planes[6][4];
     for (int i = 0; i < 6; ++i) {
@@ -796,39 +889,88 @@ void Renderer::cullAndBatch(const M4& vp) {
             v *= inv;
     }
     culled_ = 0;
+    meshesDrawn_ = 0;
+    chipsDrawn_ = 0;
+    visible_.clear();
     for (int id : queued_) {
         const MeshRec& rec = meshes_[id];
         const float* s = &slotData_[static_cast<size_t>(id) * kTexelsPerSlot * 4];
-        M4 model;
-        std::copy(s, s + 16, model.m);
-        const V3 c = model.point(rec.centre);
-        const float scale =
-            std::max({len(V3{s[0], s[1], s[2]}), len(V3{s[4], s[5], s[6]}), len(V3{s[8], s[9], s[10]})});
+        const V3 c{s[0] * rec.centre.x + s[4] * rec.centre.y + s[8] * rec.centre.z + s[12],
+                   s[1] * rec.centre.x + s[5] * rec.centre.y + s[9] * rec.centre.z + s[13],
+                   s[2] * rec.centre.x + s[6] * rec.centre.y + s[10] * rec.centre.z + s[14]};
+        const float scale = std::sqrt(
+            std::max({s[0] * s[0] + s[1] * s[1] + s[2] * s[2], s[4] * s[4] + s[5] * s[5] + s[6] * s[6],
+                      s[8] * s[8] + s[9] * s[9] + s[10] * s[10]}));
+        const float radius = rec.radius * scale;
         bool inside = true;
         for (const auto& p : planes)
-            if (p[0] * c.x + p[1] * c.y + p[2] * c.z + p[3] < -rec.radius * scale) {
+            if (p[0] * c.x + p[1] * c.y + p[2] * c.z + p[3] < -radius) {
                 inside = false;
                 break;
             }
-        culled_ += inside ? 0 : 1;
-        for (int range = 0; range < 2; ++range) {
-            if (rec.count[range] == 0)
-                continue;
-            Batch& b = batches_[rec.batch[range]];
-            b.shadowFirsts.push_back(rec.first[range]);
-            b.shadowCounts.push_back(rec.count[range]);
-            if (inside) {
-                b.firsts.push_back(rec.first[range]);
-                b.counts.push_back(rec.count[range]);
-            }
+        if (shadows)
+            for (int range = 0; range < 2; ++range)
+                if (rec.count[range] > 0) {
+                    Batch& b = batches_[rec.batch[range]];
+                    b.shadowFirsts.push_back(rec.first[range]);
+                    b.shadowCounts.push_back(rec.count[range]);
+                }
+        if (!inside) {
+            ++culled_;
+            continue;
         }
+        const float w = vp.m[3] * c.x + vp.m[7] * c.y + vp.m[11] * c.z + vp.m[15];
+        const float pixels = w > radius ? radius * pixelsPerRadian / w : 1e30f;
+        visible_.push_back({id, pixels});
     }
+    // the largest on screen keep their triangles (at most the budget); the rest are chips
+    size_t meshes = visible_.size();
+    const float chipPixels = lod ? quality_.chipPixels : 0.0f;
+    if (lod && meshes > static_cast<size_t>(quality_.meshBudget)) {
+        meshes = static_cast<size_t>(quality_.meshBudget);
+        std::nth_element(visible_.begin(), visible_.begin() + static_cast<long>(meshes), visible_.end(),
+                         [](const Visible& a, const Visible& b) { return a.pixels > b.pixels; });
+    }
+    for (size_t i = 0; i < visible_.size(); ++i) {
+        const Visible& v = visible_[i];
+        const MeshRec& rec = meshes_[v.id];
+        if (i < meshes && v.pixels >= chipPixels) {
+            ++meshesDrawn_;
+            for (int range = 0; range < 2; ++range)
+                if (rec.count[range] > 0) {
+                    Batch& b = batches_[rec.batch[range]];
+                    b.firsts.push_back(rec.first[range]);
+                    b.counts.push_back(rec.count[range]);
+                    ++b.drawn;
+                }
+            continue;
+        }
+        ++chipsDrawn_;
+        const float* s = &slotData_[static_cast<size_t>(v.id) * kTexelsPerSlot * 4];
+        const V3 c{s[0] * rec.centre.x + s[4] * rec.centre.y + s[8] * rec.centre.z + s[12],
+                   s[1] * rec.centre.x + s[5] * rec.centre.y + s[9] * rec.centre.z + s[13],
+                   s[2] * rec.centre.x + s[6] * rec.centre.y + s[10] * rec.centre.z + s[14]};
+        // a shard covers about the square of 0.9 bounding radii
+        const float d[7] = {c.x,        c.y,        c.z,       std::max(1.0f, 0.9f * v.pixels),
+                            rec.chip.x, rec.chip.y, rec.chip.z};
+        chips_.insert(chips_.end(), d, d + 7);
+    }
+    for (auto& b : batches_) {
+        mergeRanges(b.firsts, b.counts);
+        mergeRanges(b.shadowFirsts, b.shadowCounts);
+    }
+    batchOrder_.resize(batches_.size());
+    for (size_t i = 0; i < batches_.size(); ++i)
+        batchOrder_[i] = static_cast<int>(i);
+    std::stable_sort(batchOrder_.begin(), batchOrder_.end(),
+                     [this](int a, int b) { return batches_[a].drawn > batches_[b].drawn; });
     queued_.clear();
 }
 
 void Renderer::drawBatches(bool depthOnly, GLuint program) {
     const GLint interiorLoc = depthOnly ? -1 : loc(program, "uInterior");
-    for (auto& b : batches_) {
+    for (const int index : batchOrder_) {
+        Batch& b = batches_[static_cast<size_t>(index)];
         const auto& firsts = depthOnly ? b.shadowFirsts : b.firsts;
         const auto& counts = depthOnly ? b.shadowCounts : b.counts;
         if (firsts.empty())
@@ -857,7 +999,8 @@ void Renderer::render(const FrameView& fv) {
     for (auto& b : batches_)
         if (b.dirty)
             uploadBatch(b);
-    cullAndBatch(fv.proj * fv.view);
+    cullAndBatch(fv.proj * fv.view, fv.proj.m[5] * 0.5f * static_cast<float>(fv.height),
+                 skip.find("lod") == std::string::npos);
 
     // Per-object transforms → buffer texture.
     const size_t floats = static_cast<size_t>(std::max(maxSlotUsed_, 1)) * kTexelsPerSlot * 4;
@@ -920,6 +1063,20 @@ void Renderer::render(const FrameView& fv) {
     if (skip.find("mesh") == std::string::npos)
         drawBatches(false, meshProg_);
     glDisable(GL_CULL_FACE);
+    if (!chips_.empty() && skip.find("chips") == std::string::npos) {
+        glUseProgram(chipProg_);
+        glUniformMatrix4fv(loc(chipProg_, "uViewProj"), 1, GL_FALSE, viewProj.m);
+        glUniform3f(loc(chipProg_, "uCamPos"), fv.eye.x, fv.eye.y, fv.eye.z);
+        glUniform3f(loc(chipProg_, "uFogColor"), fog.x, fog.y, fog.z);
+        glEnable(GL_PROGRAM_POINT_SIZE);
+        glBindVertexArray(chipVao_);
+        glBindBuffer(GL_ARRAY_BUFFER, chipVbo_);
+        glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(chips_.size() * sizeof(float)), chips_.data(),
+                     GL_STREAM_DRAW);
+        glDrawArrays(GL_POINTS, 0, static_cast<GLsizei>(chips_.size() / 7));
+        glDisable(GL_PROGRAM_POINT_SIZE);
+        ++drawCalls_;
+    }
 
     // Sky behind everything (drawn last among opaque passes so early depth rejects covered pixels).
     M4 viewNoT = fv.view;

@@ -34,8 +34,11 @@ struct RenderQuality {
     bool trilinear = true;      ///< mipmaps blended (else nearest mip level, bilinear)
     bool nearestTexels = false; ///< nearest texel of the nearest mip level, sky included (no filtering)
     float minScale = 1.0f;      ///< smallest internal resolution scale dynamic resolution may use (1 = off)
+    float chipPixels = 1.5f;    ///< meshes whose bounding sphere projects below this radius (px) are chips
+    int meshBudget = 8000;      ///< meshes drawn with their triangles a frame; the smallest on screen beyond
+                                ///< it are chips
     /// GPUs: everything on; software GL: shadows off, per-vertex lighting, nearest texels, fewer dust
-    /// particles.
+    /// particles, more and larger chips.
     static RenderQuality forRenderer(const std::string& glRenderer);
     /// "software" or "gpu".
     const char* name() const { return software ? "software" : "gpu"; }
@@ -103,6 +106,10 @@ public:
     long long triangles() const { return triangles_; }
     /// Meshes left out of the last render() by frustum culling.
     int culled() const { return culled_; }
+    /// Meshes drawn with their triangles in the last render().
+    int meshesDrawn() const { return meshesDrawn_; }
+    /// Meshes drawn as chips (one opaque square each, the level of detail of distant small pieces).
+    int chipsDrawn() const { return chipsDrawn_; }
     /// Shadows on/off.
     bool shadows = true;
     /// Sun direction (pointing from the sun).
@@ -121,6 +128,8 @@ private:
         std::vector<GLsizei> counts;       ///< their vertex counts
         std::vector<GLint> shadowFirsts;   ///< ranges casting shadows (every queued mesh)
         std::vector<GLsizei> shadowCounts; ///< their vertex counts
+        V3 average{0.5f, 0.5f, 0.5f};      ///< mean colour of the texture (chips)
+        int drawn = 0;                     ///< meshes drawn from it this frame (fullest batches first)
     };
     /// A mesh: its exterior triangles (range 0) and its cut faces (range 1), each in its own batch.
     struct MeshRec {
@@ -130,14 +139,22 @@ private:
         bool alive = false;
         V3 centre;        ///< bounding sphere in mesh coordinates
         float radius = 0; ///< bounding sphere radius
+        V3 chip;          ///< colour as a chip: texture mean, tint and average light
+    };
+    /// A visible mesh this frame: id and projected bounding radius in pixels.
+    struct Visible {
+        int id;
+        float pixels;
     };
     int batchFor(int texture, bool interior);
+    std::vector<int> batchOrder_; ///< batches by meshes drawn, most first: debris before the ground it hides
     void bakeSkyCube();
     void bakeProceduralSky();
     void uploadBatch(Batch& b);
     void compact(Batch& b, int batchIndex);
     void drawBatches(bool depthOnly, GLuint program);
-    void cullAndBatch(const M4& viewProj);
+    void cullAndBatch(const M4& viewProj, float pixelsPerRadian, bool lod);
+    static void mergeRanges(std::vector<GLint>& firsts, std::vector<GLsizei>& counts);
     void applyFilter(GLenum target);
 
     RenderQuality quality_;
@@ -152,6 +169,8 @@ private:
     int liveMeshes_ = 0;
     std::vector<int> queued_; ///< meshes drawn this frame (drawMesh), culled in render()
     int culled_ = 0;
+    int meshesDrawn_ = 0;
+    int chipsDrawn_ = 0;
     std::vector<GLuint> textures_;
     std::vector<std::string> texturePaths_;
     GLuint skyFaces_[6] = {}; ///< the scene's six sky images (0: procedural sky)
@@ -162,6 +181,10 @@ private:
     GLuint particleVao_ = 0, particleQuad_ = 0, particleInst_ = 0;
     std::vector<float> dust_, sparks_;
     GLuint lineVao_ = 0, lineVbo_ = 0;
+    GLuint chipProg_ = 0, chipVao_ = 0, chipVbo_ = 0;
+    std::vector<float> chips_;     ///< per chip: position, diameter in pixels, colour
+    std::vector<Visible> visible_; ///< meshes inside the frustum this frame
+
     std::vector<float> lines_;
     GLuint shadowFbo_ = 0, shadowTex_ = 0;
     int shadowSize_ = 1024;

@@ -31,13 +31,14 @@ bool RunReport::write(const std::filesystem::path& dir, const std::string& scene
     if (!csv)
         return false;
     csv << "frame,sim_time_s,frame_ms,step_ms,draw_calls,bodies,pieces,jobs,shots,impacts,fractures,render_w,"
-           "render_h\n";
+           "render_h,awake,frozen\n";
     std::vector<double> ms, widths, heights;
     for (const auto& f : frames_) {
         csv << f.frame << ',' << f.simTime << ',' << f.frameMs << ',' << f.stepMs << ',' << f.drawCalls << ','
             << f.counters.bodies << ',' << f.counters.pieces << ',' << f.counters.jobs << ','
             << f.counters.shots << ',' << f.counters.impacts << ',' << f.counters.fractures << ','
-            << f.renderWidth << ',' << f.renderHeight << '\n';
+            << f.renderWidth << ',' << f.renderHeight << ',' << f.counters.awake << ',' << f.counters.frozen
+            << '\n';
         ms.push_back(f.frameMs);
         widths.push_back(f.renderWidth);
         heights.push_back(f.renderHeight);
@@ -70,6 +71,9 @@ bool RunReport::write(const std::filesystem::path& dir, const std::string& scene
     j["impacts_submitted"] = last.submitted;
     j["fractures"] = last.fractures;
     j["pieces_created"] = last.piecesCreated;
+    j["pieces_live"] = last.pieces;
+    j["pieces_awake"] = last.awake;
+    j["pieces_frozen"] = last.frozen;
     j["pieces_retired_to_particles"] = last.retired;
     j["bodies_collapsed"] = last.collapsed;
     j["bonds_broken"] = last.bondsBroken;

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <optional>
 #include <string>
@@ -18,12 +19,15 @@
 
 #include <CLI/CLI.hpp>
 
+#include <sys/resource.h>
+
 #include "Autopilot.hpp"
 #include "DynamicResolution.hpp"
 #include "Game.hpp"
 #include "GlContext.hpp"
 #include "JoinSession.hpp"
 #include "Panel.hpp"
+#include "RenderBench.hpp"
 #include "Renderer.hpp"
 #include "RunReport.hpp"
 #include "ScaledTarget.hpp"
@@ -78,6 +82,11 @@ struct Options {
     std::string quality = "auto";  // auto (from GL_RENDERER), software or gpu
     float targetFps = 60;          // dynamic resolution holds this rate (software quality)
     float minScale = -1;           // smallest internal resolution scale (-1: the quality's)
+    std::string renderBench;       // "N,N,...": the render bench's resting piece counts
+    int benchFrames = 60;          // measured frames per render bench row
+    bool json = false;             // the render bench prints JSON
+    int rasterNice = 0;            // niceness of llvmpipe's rasteriser threads (0: unchanged)
+    double demolish = 0;           // seconds between demolition charges on standing targets (0: none)
 };
 
 struct App {
@@ -224,6 +233,23 @@ bool loadScene(App& a, std::string& error) {
     return true;
 }
 
+/// Lowers the scheduling priority of llvmpipe's rasteriser threads (named llvmpipe-N) to `niceness`, so that
+/// on a small machine the fracture workers run first; returns how many threads it changed.
+int lowerRasterizerPriority(int niceness) {
+    int changed = 0;
+    std::error_code ec;
+    for (const auto& task : std::filesystem::directory_iterator("/proc/self/task", ec)) {
+        std::ifstream comm(task.path() / "comm");
+        std::string name;
+        if (!std::getline(comm, name) || name.rfind("llvmpipe", 0) != 0)
+            continue;
+        const int tid = std::atoi(task.path().filename().c_str());
+        if (tid > 0 && setpriority(PRIO_PROCESS, static_cast<id_t>(tid), niceness) == 0)
+            ++changed;
+    }
+    return changed;
+}
+
 /// Exactly n comma-separated numbers from text into out.
 bool parseNumbers(const std::string& text, std::size_t n, float* out) {
     const char* p = text.c_str();
@@ -277,6 +303,11 @@ int main(int argc, char** argv) {
         "X,Y,Z,IMPULSE: an impact at that world point (N s) in the first frame, on the objects whose "
         "bounds reach it (repeatable; e.g. pictures of fracture patterns with --hold-fire)");
     cli.add_flag("--hold-fire", o.holdFire, "the autopilot flies without shooting");
+    cli.add_option(
+           "--demolish", o.demolish,
+           "every SECONDS of game time a demolition charge blasts the next standing object or large "
+           "piece until nothing stands (with --showcase and demolition_block.cfg: the block comes down)")
+        ->check(CLI::Range(0.05, 60.0));
     cli.add_option("--camera", o.camera, "EX,EY,EZ,TX,TY,TZ: a fixed camera at EX,EY,EZ looking at TX,TY,TZ");
     cli.add_flag("--bilinear", o.bilinear, "software quality: bilinear textures instead of nearest texels");
     cli.add_option("--record", o.record,
@@ -316,7 +347,35 @@ int main(int argc, char** argv) {
                  "stress solver (default on): bonds between static parts carry their load, objects rest on "
                  "each other as bearings; --structure also draws the bonds by stress");
     cli.add_flag("--bonds", o.bonds, "draw the structure's bonds by stress");
+    cli.add_option(
+        "--render-bench", o.renderBench,
+        "N,N,...: render fields of N resting fractured pieces (and 64 moving ones) offscreen at "
+        "--width x --height and print the CPU per frame and draw calls of each (rubble-bench render "
+        "runs this), then exit");
+    cli.add_option("--bench-frames", o.benchFrames, "measured frames per --render-bench row (default 60)")
+        ->check(CLI::Range(1, 100000));
+    cli.add_flag("--json", o.json, "--render-bench prints a JSON list of rows");
+    cli.add_option(
+           "--raster-nice", o.rasterNice,
+           "niceness of llvmpipe's rasteriser threads (default 0: unchanged): above 0, fracture workers run "
+           "before them (on a machine shared with other work they also lose to it; docs/rendering.md)")
+        ->check(CLI::Range(0, 19));
     CLI11_PARSE(cli, argc, argv);
+    if (!o.renderBench.empty()) {
+        demo::RenderBenchOptions b;
+        std::string message;
+        if (!demo::parsePieceCounts(o.renderBench, b.pieces, message)) {
+            std::fprintf(stderr, "error: %s\n", message.c_str());
+            return 2;
+        }
+        b.width = o.width;
+        b.height = o.height;
+        b.frames = o.benchFrames;
+        b.json = o.json;
+        b.quality = o.quality;
+        b.out = o.out;
+        return demo::runRenderBench(b);
+    }
     for (const std::string& text : o.hits) {
         float v[4];
         if (!parseNumbers(text, 4, v) || !(v[3] > 0)) {
@@ -421,6 +480,7 @@ int main(int argc, char** argv) {
     if (o.bilinear)
         app.quality.nearestTexels = false;
     app.pending.shadows = !o.noShadows && app.quality.shadows;
+    const int reniced = o.rasterNice > 0 ? lowerRasterizerPriority(o.rasterNice) : 0;
     if (!o.join.empty()) { // a follower: no game of its own, the host's world drawn
         demo::JoinOptions j{{}, 0, o.workers, o.out, o.screenshotEvery, o.stats, o.statsEvery};
         if (!demo::parseHostPort(o.join, j.address, j.port, error) || !prepareRenderer(app, error)) {
@@ -489,10 +549,11 @@ int main(int argc, char** argv) {
     }
     std::fprintf(stderr,
                  "rubble-demo: %s, %dx%d, %s, %s quality (shadows %s, %s lighting, internal scale >= %.2f), "
-                 "fracture DestructionWorld + rubble_bullet\n",
+                 "fracture DestructionWorld + rubble_bullet, %d rasteriser threads at niceness %d\n",
                  headless ? "EGL offscreen" : "window", app.gl->width(), app.gl->height(),
                  rendererName.c_str(), app.quality.name(), app.pending.shadows ? "on" : "off",
-                 app.quality.pixelLighting ? "per-pixel" : "per-vertex", app.quality.minScale);
+                 app.quality.pixelLighting ? "per-pixel" : "per-vertex", app.quality.minScale, reniced,
+                 o.rasterNice);
     demo::DynamicResolution resolution(1000.0f / o.targetFps, app.quality.minScale);
     float lastFrameMs = 0;
 
@@ -502,6 +563,7 @@ int main(int argc, char** argv) {
     const long totalFrames = autopilot ? std::lround(o.autopilot * 60.0) : -1;
     const long shotEvery = o.screenshotEvery > 0 ? std::max(1L, std::lround(o.screenshotEvery * 60.0)) : 0;
     long renderFrame = 0;
+    long nextDemolish = 60; // --demolish: game frame of the next charge (the first after a second)
     double accumulator = 0;
     auto last = Clock::now();
 
@@ -523,6 +585,10 @@ int main(int argc, char** argv) {
             !app.game.waitForClient(120.0)) {
             std::fprintf(stderr, "error: --host-wait: no client joined within 120 s\n");
             return 1;
+        }
+        if (o.demolish > 0 && !o.holdFire && static_cast<long>(app.game.counters().frame) >= nextDemolish) {
+            app.game.blastNextTarget(); // --demolish: the next charge, on the next standing target
+            nextDemolish = static_cast<long>(app.game.counters().frame) + std::lround(o.demolish * 60.0);
         }
         if (autopilot) {
             demo::ControlInput in = pilot.update(app.game, fixedDt);
@@ -660,10 +726,11 @@ int main(int argc, char** argv) {
         if (o.stats && renderFrame % std::max(1, o.statsEvery) == 0) {
             std::printf(
                 "stats render=%ld frame=%llu paused=%d shots=%d impacts=%d fractures=%d bodies=%d pieces=%d "
-                "jobs=%d crashes=%d respawns=%d turnbacks=%d weapon=%d x=%.0f z=%.0f frame_ms=%.2f\n",
+                "awake=%d frozen=%d jobs=%d crashes=%d respawns=%d turnbacks=%d weapon=%d x=%.0f z=%.0f "
+                "frame_ms=%.2f\n",
                 renderFrame, static_cast<unsigned long long>(c.frame), app.paused ? 1 : 0, c.shots, c.impacts,
-                c.fractures, c.bodies, c.pieces, c.jobs, c.crashes, c.respawns, c.turnBacks,
-                static_cast<int>(app.game.weapon()) + 1, static_cast<double>(vpos.x),
+                c.fractures, c.bodies, c.pieces, c.awake, c.frozen, c.jobs, c.crashes, c.respawns,
+                c.turnBacks, static_cast<int>(app.game.weapon()) + 1, static_cast<double>(vpos.x),
                 static_cast<double>(vpos.z), frameMs);
             std::fflush(stdout);
         }
