@@ -255,8 +255,7 @@ std::vector<PyPiece> fractureMesh(const rubble::Mesh& mesh, const py::object& po
     impact.impulse = checkedParam<double>(impulse, "impulse");
     const int cells = checkedParam<int>(cellsArg, "cells");
     const auto seed = checkedParam<std::uint64_t>(seedArg, "seed");
-    if (maxParts < 1)
-        throw py::value_error("max_parts: expected at least 1");
+    valueCheck(rubble::checkParam("max_parts", maxParts));
     rubble::FractureParams params;
     params.backend = backendOf(backend);
     params.pattern = patternOf(pattern, cells);
@@ -312,8 +311,7 @@ void writeGltfPieces(const std::filesystem::path& path, const py::list& nodes) {
 }
 
 py::list decomposeMesh(const rubble::Mesh& mesh, int maxParts, double concavity) {
-    if (maxParts < 1)
-        throw py::value_error("max_parts: expected at least 1");
+    valueCheck(rubble::checkParam("max_parts", maxParts));
     rubble::DecompositionParams params;
     params.maxParts = maxParts;
     params.concavity = concavity;

@@ -7,6 +7,7 @@
 #include <string>
 #include <string_view>
 
+#include "rubble/ConvexDecomposition.hpp"
 #include "rubble/Fracture.hpp"
 #include "rubble/Result.hpp"
 #include "rubble/Vec3.hpp"
@@ -48,6 +49,7 @@ inline constexpr ParamRange kParamRanges[] = {
     {"depth", ParamKind::Integer, 1, kMaxFractureDepth},
     {"seed", ParamKind::Integer, 0, 18446744073709551615.0L},
     {"density", ParamKind::Real, 0, kMaxDensity, true},
+    {"max_parts", ParamKind::Integer, 1, kMaxConvexParts}, // DecompositionParams::maxParts
     {"roughness", ParamKind::Real, 0, 1},    // Roughness::amplitude, relative to the cell size
     {"feature_size", ParamKind::Real, 0, 4}, // Roughness::featureSize, relative to the cell size
     {"hurst", ParamKind::Real, 0, 1, true},

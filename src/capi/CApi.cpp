@@ -156,8 +156,8 @@ rubble_status toParams(const char* function, const rubble_fracture_params& in, r
         return invalid(function, "unknown backend");
     if (rubble::Status s = rubble::checkParam("cells", in.cells); !s)
         return invalid(function, s.message().c_str());
-    if (in.max_convex_parts < 1)
-        return invalid(function, "max_convex_parts must be at least 1");
+    if (rubble::Status s = rubble::checkParam("max_parts", in.max_convex_parts); !s)
+        return invalid(function, ("max_convex_parts: " + s.message()).c_str());
     out.pattern = in.pattern == RUBBLE_PATTERN_SHATTER    ? rubble::CellPattern::Shatter
                   : in.pattern == RUBBLE_PATTERN_ADAPTIVE ? rubble::CellPattern::Adaptive
                                                           : rubble::CellPattern::SingleCell;

@@ -560,6 +560,16 @@ static void check_parameter_case(const char* name, const char* value, const char
         } else if (strcmp(name, "cells") == 0) {
             params.pattern = RUBBLE_PATTERN_SHATTER;
             params.cells = (int)v[0];
+        } else if (strcmp(name, "roughness") == 0) {
+            params.roughness = v[0];
+        } else if (strcmp(name, "hurst") == 0) {
+            params.roughness = 0.1;
+            params.hurst = v[0];
+        } else if (strcmp(name, "feature_size") == 0) {
+            params.roughness = 0.1;
+            params.feature_size = v[0];
+        } else if (strcmp(name, "max_parts") == 0) {
+            params.max_convex_parts = (int)v[0];
         } else {
             fprintf(stderr, "no C case for %s\n", name);
             ++failures;

@@ -24,6 +24,9 @@ while IFS=$'\t' read -r faces name value message; do
         seed) args+=(--seed "$value") ;;
         depth) args+=(--depth "$value" --format gltf) ;;
         "cells x depth") args+=(--cells "${value%,*}" --depth "${value#*,}" --format gltf) ;;
+        roughness) args+=(--roughness "$value") ;;
+        hurst) args+=(--roughness 0.1 --hurst "$value") ;;
+        feature_size) args+=(--roughness 0.1 --feature-size "$value") ;;
         *) fail "no CLI case for $name" ;;
     esac
     args+=(--impact "$impact" --normal "$normal" --impulse "$impulse")

@@ -31,6 +31,8 @@ def test_parameter_table(name, value, message):
     args = dict(point=(0.5, 0.5, 1.0), normal=(0, 0, 1), impulse=100, convex_parts=False)
     if name == "cells":
         args["pattern"] = "shatter"
+    if name in ("hurst", "feature_size"):
+        args["roughness"] = 0.1
     args[name] = _value(value)
     cube = rubble.box((0, 0, 0), (1, 1, 1))
     if message == "ok":
@@ -43,7 +45,7 @@ def test_parameter_table(name, value, message):
 
 def test_table_covers_every_python_parameter():
     names = {row.values[0] for row in _rows()}
-    assert names == {"impulse", "normal", "point", "cells", "seed"}
+    assert names == {"impulse", "normal", "point", "cells", "seed", "roughness", "hurst", "feature_size", "max_parts"}
 
 
 def test_a_non_number_is_refused_with_the_range():

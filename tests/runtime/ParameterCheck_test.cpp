@@ -83,6 +83,14 @@ std::string run(const Case& c) {
     else if (c.name == "cells") {
         params.pattern = CellPattern::Shatter;
         params.cells = static_cast<int>(std::strtol(c.value.c_str(), nullptr, 10));
+    } else if (c.name == "roughness")
+        params.roughness.amplitude = std::strtod(c.value.c_str(), nullptr);
+    else if (c.name == "hurst") {
+        params.roughness.amplitude = 0.1;
+        params.roughness.hurst = std::strtod(c.value.c_str(), nullptr);
+    } else if (c.name == "feature_size") {
+        params.roughness.amplitude = 0.1;
+        params.roughness.featureSize = std::strtod(c.value.c_str(), nullptr);
     } else {
         ADD_FAILURE() << "no C++ case for " << c.name;
     }
