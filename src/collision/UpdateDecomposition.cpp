@@ -446,6 +446,7 @@ void mergeToBudget(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t
     std::vector<double> volumes(n);
     std::vector<std::vector<Vec3>> corners(n); // welded when a joint hull first needs them
     std::vector<Overlaps> owned(n); // each merged part's overlap with the guard's cells (fragments have none)
+    std::vector<std::vector<std::size_t>> blocked(n); // partners whose joint hull covers a crater
     for (std::size_t i = 0; i < n; ++i) {
         bounds[i] = parts[i].bounds();
         volumes[i] = parts[i].volume();
@@ -467,7 +468,9 @@ void mergeToBudget(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t
         common.hi = min(bounds[i].hi, bounds[j].hi);
         const double added =
             boxVolume(joint) - boxVolume(bounds[i]) - boxVolume(bounds[j]) + boxVolume(common);
-        heap.push_back({added, i, j, version[i], version[j]});
+        // A pair that covered a crater still does once either part has grown (hulls only grow).
+        const bool covers = guard && std::find(blocked[i].begin(), blocked[i].end(), j) != blocked[i].end();
+        heap.push_back({added, i, j, version[i], version[j], covers});
         std::push_heap(heap.begin(), heap.end(), std::greater<>());
     };
     auto jointHull = [&](const Candidate& c) -> Hull* {
@@ -546,6 +549,8 @@ void mergeToBudget(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t
                 if (const double e = guard->excess(h->added); e > 0) { // ranked again behind the others
                     picked[k].covers = true;
                     picked[k].cost = e;
+                    blocked[picked[k].i].push_back(picked[k].j);
+                    blocked[picked[k].j].push_back(picked[k].i);
                     heap.push_back(picked[k]);
                     std::push_heap(heap.begin(), heap.end(), std::greater<>());
                     failed[k] = true;
@@ -570,6 +575,10 @@ void mergeToBudget(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t
         if (c.covers) // the craters cannot all stay open: the rest merges as without a guard
             guard = nullptr;
         owned[c.i] = std::move(bestHull->overlaps);
+        for (std::size_t k : blocked[c.j]) {
+            blocked[c.i].push_back(k);
+            blocked[k].push_back(c.i);
+        }
         parts[c.i] = std::move(bestHull->shape);
         bounds[c.i] = parts[c.i].bounds();
         volumes[c.i] = parts[c.i].volume();
