@@ -46,9 +46,11 @@ struct Decomposition {
 /// The convex hull of a point set (Qhull). Fails for fewer than 4 non-coplanar points.
 Result<ConvexPolytope> convexHull(const std::vector<Vec3>& points);
 
-/// A convex polytope containing every point with at most about maxFaces / 2 faces: the planes of the hull of
-/// the points' extremes in maxFaces / 4 fixed directions, each pushed out to the farthest point. When the
-/// exact hull has at most maxFaces faces it is returned instead. Fails for flat or too few points.
+/// A convex polytope containing every point with at most maxFaces faces: facet planes of the exact hull,
+/// added where it reaches farthest out, until it reaches at most half of kPartHullTolerance out of the hull
+/// (rubble/CollisionTolerance.hpp); above 16 points per face, the planes of the hull of the points' extremes
+/// in maxFaces / 4 directions pushed out to the farthest point. When the exact hull has at most maxFaces
+/// faces it is returned instead. Fails for flat or too few points.
 Result<ConvexPolytope> boundedHull(const std::vector<Vec3>& points, std::size_t maxFaces);
 
 /// Decomposes a closed mesh into at most params.maxParts convex parts; a convex mesh gives exactly one part
@@ -61,7 +63,9 @@ Result<Decomposition> decompose(const Mesh& mesh, const DecompositionParams& par
 /// the piece containing it. parentParts are in the same coordinates as cells and pieces. pieceCells[i] is
 /// Piece::cell of piece i (-1 for remainder islands). Returns one part list per piece; a piece that received
 /// no fragment gets a fresh decomposition. Slivers are dropped and parts merged to respect params.maxParts (a
-/// high-poly remainder first makes its least dented parent parts whole again; docs/megamesh.md).
+/// high-poly remainder first makes its least dented parent parts whole again; docs/megamesh.md). A
+/// remainder's parts stay out of the cells' debris and may number up to kCraterBudgetFactor × maxParts to do
+/// so; every piece's parts stay within kPartHullTolerance of its convex hull (docs/collision.md).
 std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<ConvexPolytope>& parentParts,
                                                              const std::vector<ConvexPolytope>& cells,
                                                              const std::vector<Mesh>& pieces,

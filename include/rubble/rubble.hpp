@@ -6,6 +6,7 @@
 /// Tools-only headers (TimingReport.hpp, SceneConfig.hpp, SceneLoader.hpp, MeshSimplify.hpp, Islands.hpp,
 /// ThreadPool.hpp) are included on their own. The C API is rubble/rubble.h.
 
+#include "rubble/CollisionTolerance.hpp"
 #include "rubble/ConvexDecomposition.hpp"
 #include "rubble/DecompositionFile.hpp"
 #include "rubble/DestructionRuntime.hpp"
@@ -22,6 +23,7 @@
 #include "rubble/MeshIO.hpp"
 #include "rubble/MeshRepair.hpp"
 #include "rubble/ParameterCheck.hpp"
+#include "rubble/PartConcavity.hpp"
 #include "rubble/PhysicsBinding.hpp"
 #include "rubble/Random.hpp"
 #include "rubble/Result.hpp"

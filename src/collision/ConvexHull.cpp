@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
+#include <map>
 #include <numbers>
 #include <string>
 #include <tuple>
@@ -14,6 +15,7 @@ extern "C" {
 #include <libqhull_r/qhull_ra.h>
 }
 
+#include "rubble/CollisionTolerance.hpp"
 #include "rubble/ConvexDecomposition.hpp"
 
 namespace rubble {
@@ -122,13 +124,12 @@ Result<ConvexPolytope> convexHull(const std::vector<Vec3>& points) {
     return result;
 }
 
-Result<ConvexPolytope> boundedHull(const std::vector<Vec3>& points, std::size_t maxFaces) {
+namespace {
+
+/// The planes of the hull of the points' extremes in maxFaces / 4 directions, each pushed out to the farthest
+/// point: about maxFaces / 2 faces, in a few passes over the points.
+Result<ConvexPolytope> pushedOutHull(const std::vector<Vec3>& points, std::size_t maxFaces) {
     const std::size_t directions = std::max<std::size_t>(8, maxFaces / 4);
-    if (points.size() <= 4 * maxFaces) { // few points: the exact hull, when it is small enough
-        auto exact = convexHull(points);
-        if (!exact || exact->faces().size() <= maxFaces)
-            return exact;
-    }
     Aabb box;
     for (const Vec3& p : points)
         box.extend(p);
@@ -168,6 +169,67 @@ Result<ConvexPolytope> boundedHull(const std::vector<Vec3>& points, std::size_t 
         out = out.clipped(Plane{f.plane.normal, offset});
         if (out.empty())
             return convexHull(points);
+    }
+    return out;
+}
+
+} // namespace
+
+/// Above this many points per allowed face, boundedHull pushes planes out instead of choosing hull facets.
+constexpr std::size_t kExactPointsPerFace = 16;
+
+Result<ConvexPolytope> boundedHull(const std::vector<Vec3>& points, std::size_t maxFaces) {
+    if (points.size() > kExactPointsPerFace * maxFaces)
+        return pushedOutHull(points, maxFaces);
+    auto exact = convexHull(points);
+    if (!exact || exact->faces().size() <= maxFaces)
+        return exact;
+    // Supporting planes of the exact hull only (so the result contains every point), added where the polytope
+    // reaches farthest out of the hull, a batch per round, from the points' box: until it reaches at most
+    // half of kPartHullTolerance out, or (past maxFaces / 2 faces) at most maxFaces faces.
+    const std::vector<PolytopeFace>& facets = exact->faces();
+    Aabb box;
+    for (const Vec3& p : points)
+        box.extend(p);
+    const double stop = 0.5 * partHullTolerance(box.diagonal());
+    ConvexPolytope out = ConvexPolytope::fromAabb(box);
+    struct Reach {
+        double distance = 0;
+        std::size_t facet = 0;
+    };
+    std::map<std::tuple<double, double, double>, Reach> reach; // per corner, the facet it is farthest out of
+    for (std::size_t round = 0; round < maxFaces; ++round) {
+        std::vector<std::pair<double, std::size_t>> violated; // (distance, facet), one per facet
+        std::vector<bool> taken(facets.size(), false);
+        for (const PolytopeFace& f : out.faces())
+            for (const Vec3& c : f.corners) {
+                auto [it, fresh] = reach.try_emplace(std::make_tuple(c.x, c.y, c.z));
+                if (fresh) {
+                    it->second.distance = -std::numeric_limits<double>::infinity();
+                    for (std::size_t k = 0; k < facets.size(); ++k)
+                        if (const double d = facets[k].plane.signedDistance(c); d > it->second.distance)
+                            it->second = {d, k};
+                }
+                if (it->second.distance > stop && !taken[it->second.facet]) {
+                    taken[it->second.facet] = true;
+                    violated.emplace_back(it->second.distance, it->second.facet);
+                }
+            }
+        if (violated.empty())
+            break;
+        const std::size_t faces = out.faces().size();
+        const std::size_t room = faces < maxFaces / 2 ? maxFaces / 2 - faces : (faces < maxFaces ? 1 : 0);
+        if (room == 0)
+            break;
+        std::sort(violated.begin(), violated.end(), std::greater<>());
+        if (violated.size() > room)
+            violated.resize(room);
+        for (const auto& [d, k] : violated) {
+            ConvexPolytope next = out.clipped(facets[k].plane);
+            if (next.empty())
+                return exact;
+            out = std::move(next);
+        }
     }
     return out;
 }

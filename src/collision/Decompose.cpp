@@ -41,6 +41,9 @@ struct Part {
 /// volume is off by more than kProxyVolumeError).
 constexpr int kProxyCells = 16;
 constexpr double kProxyVolumeError = 0.25;
+/// A pocket shallower than this fraction of the diagonal is rounding, not concavity (a convex mesh is one
+/// part even at concavity 0).
+constexpr double kFlatDepth = 1e-9;
 /// Hull faces whose depth is sampled per part when searching a proxy.
 constexpr std::size_t kProxyDepthFaces = 64;
 /// Concavity below this fraction of the diagonal is rounding: such a part is convex.
@@ -364,7 +367,8 @@ public:
         // A part convex to within kConvexTolerance of the diagonal is not split (rounding is not concavity).
         const double threshold = std::max(params_.concavity, kConvexTolerance) * diag_;
         minPartVolume_ = params_.minPartVolumeFraction * out.meshVolume;
-        if (params_.maxParts <= 1 || hull->volume() - searchVolume <= 0.01 * threshold * area) {
+        if (params_.maxParts <= 1 ||
+            hull->volume() - searchVolume <= std::max(0.01 * threshold, kFlatDepth * diag_) * area) {
             Part whole;
             whole.region = ConvexPolytope::fromAabb(box);
             whole.hull = std::move(hull.value());
@@ -394,7 +398,7 @@ public:
         while (static_cast<int>(parts.size()) < params_.maxParts) {
             int best = -1;
             for (std::size_t i = 0; i < parts.size(); ++i)
-                if (!done[i] && parts[i].depth > threshold &&
+                if (!done[i] && parts[i].depth > std::max(threshold, kFlatDepth * diag_) &&
                     (best < 0 || parts[i].depth > parts[best].depth))
                     best = static_cast<int>(i);
             if (best < 0)

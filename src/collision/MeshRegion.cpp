@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <numbers>
 #include <unordered_map>
@@ -9,6 +10,31 @@
 #include "rubble/ConvexDecomposition.hpp"
 
 namespace rubble::detail {
+
+void keepInsideHull(std::vector<ConvexPolytope>& parts, const ConvexPolytope& hull, double margin) {
+    std::vector<ConvexPolytope> kept;
+    kept.reserve(parts.size());
+    for (ConvexPolytope& part : parts) {
+        // The hull plane that the part's farthest corner is farthest out of, one at a time: a part that
+        // reaches out at one place is clipped there only.
+        for (std::size_t round = 0; round < kMaxHullClips && !part.empty(); ++round) {
+            double reach = margin;
+            const Plane* worst = nullptr;
+            for (const Vec3& c : part.vertices())
+                for (const PolytopeFace& h : hull.faces())
+                    if (const double d = h.plane.signedDistance(c); d > reach) {
+                        reach = d;
+                        worst = &h.plane;
+                    }
+            if (!worst)
+                break;
+            part = part.clipped(*worst);
+        }
+        if (!part.empty())
+            kept.push_back(std::move(part));
+    }
+    parts = std::move(kept);
+}
 
 void splitPolygon(const Polygon& poly, const Plane& plane, Polygon& inside, Polygon& outside) {
     inside.clear();

@@ -35,6 +35,13 @@ Result<ConvexPolytope> hullOfMeshInRegion(const Mesh& mesh, const ConvexPolytope
 /// necessarily manifold; its winding number follows the mesh's away from the surface.
 Mesh clusteredProxy(const Mesh& mesh, int cellsPerAxis);
 
+/// Most hull planes that keepInsideHull clips one part by.
+constexpr std::size_t kMaxHullClips = 256;
+
+/// Clips every part by the planes of hull that it reaches farthest out of, until it reaches at most margin
+/// outside hull (or after kMaxHullClips planes); parts left empty are removed.
+void keepInsideHull(std::vector<ConvexPolytope>& parts, const ConvexPolytope& hull, double margin);
+
 /// Hull of polygons' corners plus extra points.
 Result<ConvexPolytope> hullOfPolygons(const std::vector<Polygon>& polys, const std::vector<Vec3>& extra);
 

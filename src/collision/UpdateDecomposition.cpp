@@ -4,9 +4,11 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <optional>
 #include <unordered_map>
 
 #include "collision/MeshRegion.hpp"
+#include "rubble/CollisionTolerance.hpp"
 #include "rubble/ConvexDecomposition.hpp"
 #include "rubble/Fracture.hpp"
 #include "rubble/MassProperties.hpp"
@@ -19,6 +21,10 @@ namespace {
 /// fraction of its parts' volume; a high-poly piece's parts become their hull when it is at most this much
 /// larger than their sum (docs/megamesh.md).
 constexpr double kHighPolyFillTolerance = 0.01;
+
+/// The share of kPartOverlapTolerance that the merges of a remainder may spend (the rest is margin for the
+/// pieces' real surfaces against the cells).
+constexpr double kOverlapShare = 0.5;
 
 struct Fragment {
     ConvexPolytope shape;
@@ -86,6 +92,174 @@ void subtractCell(const ConvexPolytope& part, const ConvexPolytope& cell, std::v
     }
 }
 
+/// A face of a cell that no other cell shares: a piece of the boundary of the cells' union.
+struct OuterFace {
+    Plane plane; // outward from its cell
+    std::size_t cell = 0;
+    double area = 0;
+    Aabb bounds;
+};
+
+/// The outer faces of the cells, largest first (a face whose plane another touching cell has, reversed, is
+/// shared and lies inside the union).
+std::vector<OuterFace> outerFaces(const std::vector<ConvexPolytope>& cells,
+                                  const std::vector<Aabb>& cellBounds) {
+    std::vector<OuterFace> out;
+    for (std::size_t c = 0; c < cells.size(); ++c) {
+        const double tol = 1e-9 * (cellBounds[c].diagonal() + 1);
+        for (const PolytopeFace& f : cells[c].faces()) {
+            bool shared = false;
+            for (std::size_t d = 0; d < cells.size() && !shared; ++d) {
+                if (d == c || !cellBounds[d].overlaps(cellBounds[c], tol))
+                    continue;
+                for (const PolytopeFace& g : cells[d].faces())
+                    if (dot(f.plane.normal, g.plane.normal) < -1 + 1e-9 &&
+                        std::abs(f.plane.offset + g.plane.offset) < tol) {
+                        shared = true;
+                        break;
+                    }
+            }
+            if (shared)
+                continue;
+            OuterFace o{f.plane, c, 0, {}};
+            for (std::size_t k = 1; k + 1 < f.corners.size(); ++k)
+                o.area += 0.5 * length(cross(f.corners[k] - f.corners[0], f.corners[k + 1] - f.corners[0]));
+            for (const Vec3& p : f.corners)
+                o.bounds.extend(p);
+            out.push_back(std::move(o));
+        }
+    }
+    std::stable_sort(out.begin(), out.end(),
+                     [](const OuterFace& a, const OuterFace& b) { return a.area > b.area; });
+    return out;
+}
+
+/// region − every cell by sequential subtraction (fragments along every cell plane, shared ones included).
+void subtractSequentially(const ConvexPolytope& region, const std::vector<ConvexPolytope>& cells,
+                          const std::vector<Aabb>& cellBounds, std::vector<ConvexPolytope>& out) {
+    const Aabb pb = region.bounds();
+    std::vector<ConvexPolytope> rest{region}, next;
+    std::vector<Aabb> restBounds{pb}, nextBounds;
+    for (std::size_t c = 0; c < cells.size(); ++c) {
+        if (!pb.overlaps(cellBounds[c]))
+            continue;
+        next.clear();
+        nextBounds.clear();
+        for (std::size_t r = 0; r < rest.size(); ++r) {
+            if (!restBounds[r].overlaps(
+                    cellBounds[c])) { // a fragment away from the cell is moved on untouched
+                next.push_back(std::move(rest[r]));
+                nextBounds.push_back(restBounds[r]);
+                continue;
+            }
+            const std::size_t first = next.size();
+            subtractCell(rest[r], cells[c], next);
+            for (std::size_t k = first; k < next.size(); ++k)
+                nextBounds.push_back(next[k].bounds());
+        }
+        rest.swap(next);
+        restBounds.swap(nextBounds);
+    }
+    for (ConvexPolytope& r : rest)
+        out.push_back(std::move(r));
+}
+
+/// Deepest split of subtractUnion before it subtracts cell by cell.
+constexpr int kMaxUnionSplits = 32;
+
+/// region − ∪cells as convex fragments, split only along the outer faces of the union (largest first): a
+/// region clear of the cells is kept whole, one inside them dropped. Far fewer fragments than subtracting
+/// cell by cell, whose shared faces cut the remainder into slabs (docs/collision.md).
+void subtractUnion(const ConvexPolytope& region, const std::vector<ConvexPolytope>& cells,
+                   const std::vector<Aabb>& cellBounds, const std::vector<OuterFace>& faces, int depth,
+                   std::vector<ConvexPolytope>& out) {
+    const Aabb rb = region.bounds();
+    const double volume = region.volume();
+    double covered = 0;
+    std::vector<bool> touching(cells.size(), false);
+    for (std::size_t c = 0; c < cells.size(); ++c)
+        if (rb.overlaps(cellBounds[c]))
+            if (const double v = intersectCell(region, cells[c]).volume(); v > 0) {
+                covered += v;
+                touching[c] = true;
+            }
+    if (covered <= 1e-9 * volume) {
+        out.push_back(region);
+        return;
+    }
+    if (covered >= (1 - 1e-9) * volume)
+        return;
+    if (depth < kMaxUnionSplits)
+        for (const OuterFace& f : faces) {
+            if (!touching[f.cell] || !rb.overlaps(f.bounds))
+                continue;
+            const Sides s = sidesOf(region, f.plane);
+            if (!s.in || !s.out)
+                continue;
+            if (ConvexPolytope outside = region.clippedOutside(f.plane); !outside.empty())
+                subtractUnion(outside, cells, cellBounds, faces, depth + 1, out);
+            if (ConvexPolytope inside = region.clipped(f.plane); !inside.empty())
+                subtractUnion(inside, cells, cellBounds, faces, depth + 1, out);
+            return;
+        }
+    subtractSequentially(region, cells, cellBounds, out);
+}
+
+/// Volume of a shape inside each cell it reaches: (cell index, volume).
+using Overlaps = std::vector<std::pair<std::uint32_t, double>>;
+
+/// The cells whose pieces a remainder's parts must stay out of, and the overlap each cell still allows (a
+/// share of kPartOverlapTolerance; docs/collision.md). Merges and hulls that would cover a crater are
+/// refused.
+class CellGuard {
+public:
+    CellGuard(const std::vector<ConvexPolytope>& cells, const std::vector<Aabb>& bounds,
+              std::vector<double> allowance)
+        : cells_(cells), bounds_(bounds), left_(std::move(allowance)) {}
+
+    Overlaps overlaps(const ConvexPolytope& shape) const {
+        Overlaps out;
+        const Aabb b = shape.bounds();
+        for (std::size_t c = 0; c < cells_.size(); ++c) {
+            if (!(left_[c] < std::numeric_limits<double>::infinity()) || !b.overlaps(bounds_[c]))
+                continue;
+            const double v = intersectCell(shape, cells_[c]).volume();
+            if (v > 0)
+                out.emplace_back(static_cast<std::uint32_t>(c), v);
+        }
+        return out;
+    }
+    /// How far the overlaps exceed what the cells still allow (0: they fit).
+    double excess(const Overlaps& o) const {
+        double e = 0;
+        for (const auto& [c, v] : o)
+            e += std::max(0.0, v - left_[c]);
+        return e;
+    }
+    /// What a merged hull overlaps beyond what the two parts it replaces overlapped already.
+    static Overlaps added(const Overlaps& merged, const Overlaps& a, const Overlaps& b) {
+        Overlaps out;
+        for (const auto& [c, v] : merged) {
+            double before = 0;
+            for (const Overlaps* o : {&a, &b})
+                for (const auto& [d, w] : *o)
+                    before += d == c ? w : 0;
+            if (v > before)
+                out.emplace_back(c, v - before);
+        }
+        return out;
+    }
+    void take(const Overlaps& o) {
+        for (const auto& [c, v] : o)
+            left_[c] -= v;
+    }
+
+private:
+    const std::vector<ConvexPolytope>& cells_;
+    const std::vector<Aabb>& bounds_;
+    std::vector<double> left_;
+};
+
 /// The points extreme in the 26 directions of a cube's faces, edges and corners (repeats removed).
 std::vector<Vec3> extremePoints(const std::vector<Vec3>& pts) {
     std::vector<Vec3> out;
@@ -130,8 +304,10 @@ double boxVolume(const Aabb& b) {
 }
 
 /// Replaces the fragments of each parent part by their joint hull (inside that convex part): one hull per
-/// parent part instead of pairwise merges, for patterns that cut a part into thousands of fragments.
-void collapseSiblings(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t>& origin) {
+/// parent part instead of pairwise merges, for patterns that cut a part into thousands of fragments. A hull
+/// that the guard refuses (it would cover a crater) leaves its fragments as they are.
+void collapseSiblings(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t>& origin,
+                      CellGuard* guard) {
     std::map<std::uint32_t, std::vector<std::size_t>> byOrigin;
     for (std::size_t i = 0; i < parts.size(); ++i)
         byOrigin[origin[i]].push_back(i);
@@ -144,7 +320,11 @@ void collapseSiblings(std::vector<ConvexPolytope>& parts, std::vector<std::uint3
                 const auto v = parts[i].vertices();
                 pts.insert(pts.end(), v.begin(), v.end());
             }
-            if (auto h = convexHull(pts)) {
+            auto h = convexHull(pts);
+            const Overlaps covered = h && guard ? guard->overlaps(*h) : Overlaps{};
+            if (h && (!guard || guard->excess(covered) <= 0)) {
+                if (guard)
+                    guard->take(covered);
                 merged.push_back(std::move(h.value()));
                 mergedOrigin.push_back(o);
                 continue;
@@ -163,7 +343,7 @@ void collapseSiblings(std::vector<ConvexPolytope>& parts, std::vector<std::uint3
 /// hull), the least dented part first, while the volume this adds stays within tolerance of the parts' sum.
 void revertToParents(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t>& origin,
                      const std::vector<ConvexPolytope>& parentParts, std::size_t budget, double tolerance,
-                     const Aabb* box) {
+                     const Aabb* box, CellGuard* guard) {
     struct Group {
         double volume = 0;
         std::size_t count = 0;
@@ -187,6 +367,12 @@ void revertToParents(std::vector<ConvexPolytope>& parts, std::vector<std::uint32
     for (const auto& [dent, o] : byDent) {
         if (count <= budget || added + dent > tolerance * sum)
             break;
+        if (guard) { // a whole part would cover the crater its fragments leave open
+            const Overlaps ov = guard->overlaps(parentParts[o]);
+            if (guard->excess(ov) > 0)
+                continue;
+            guard->take(ov);
+        }
         whole[o] = true;
         added += dent;
         count -= groups[o].count - 1;
@@ -218,25 +404,40 @@ void revertToParents(std::vector<ConvexPolytope>& parts, std::vector<std::uint32
 /// merged part. Hulls of the losers are kept for the next round (keyed by the pair's versions). Siblings
 /// (fragments of the same parent part, origin[i] == origin[j]) are merged first: they tile their parent part
 /// minus the cells, so their joint hull stays inside that convex part. Only when that does not reach the
-/// budget are all touching pairs considered.
-void mergeToBudget(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t> origin, int maxParts) {
+/// budget are all touching pairs considered. With a guard, a merge whose hull would cover a crater beyond
+/// what the guard allows is ranked behind every other (by that excess) and taken only when nothing else is
+/// left.
+void mergeToBudget(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t> origin, int maxParts,
+                   CellGuard* guard) {
     const std::size_t budget = static_cast<std::size_t>(std::max(1, maxParts));
+    // A guarded piece stops merging at up to kCraterBudgetFactor times the budget rather than cover a crater.
+    std::size_t stretch = guard ? budget * kCraterBudgetFactor : budget;
     if (parts.size() <= budget)
         return;
     if (parts.size() > 4 * budget) // pairwise merging is quadratic in the fragment count
-        collapseSiblings(parts, origin);
+        collapseSiblings(parts, origin, guard);
+    // Too many fragments to keep the craters open within the budget: collapsed as they were
+    // (docs/collision.md).
+    if (guard && parts.size() > 4 * stretch) {
+        guard = nullptr;
+        stretch = budget;
+        collapseSiblings(parts, origin, nullptr);
+    }
     if (parts.size() <= budget)
         return;
     struct Candidate {
         double cost;
         std::size_t i, j;
         std::uint32_t vi, vj; // versions of i and j when ranked
-        bool operator>(const Candidate& o) const { return cost > o.cost; }
+        bool covers = false;  // its hull covers a crater beyond the guard's allowance; cost is that excess
+        bool operator>(const Candidate& o) const { return covers != o.covers ? covers : cost > o.cost; }
     };
     struct Hull {
         std::uint32_t vi, vj;
         double cost;
         ConvexPolytope shape;
+        Overlaps overlaps; // with the guard's cells
+        Overlaps added;    // of which the two parts did not overlap already
     };
     const std::size_t n = parts.size();
     std::vector<std::uint32_t> version(n, 0);
@@ -244,6 +445,8 @@ void mergeToBudget(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t
     std::vector<Aabb> bounds(n);
     std::vector<double> volumes(n);
     std::vector<std::vector<Vec3>> corners(n); // welded when a joint hull first needs them
+    std::vector<Overlaps> owned(n); // each merged part's overlap with the guard's cells (fragments have none)
+    std::vector<std::vector<std::size_t>> blocked(n); // partners whose joint hull covers a crater
     for (std::size_t i = 0; i < n; ++i) {
         bounds[i] = parts[i].bounds();
         volumes[i] = parts[i].volume();
@@ -265,7 +468,9 @@ void mergeToBudget(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t
         common.hi = min(bounds[i].hi, bounds[j].hi);
         const double added =
             boxVolume(joint) - boxVolume(bounds[i]) - boxVolume(bounds[j]) + boxVolume(common);
-        heap.push_back({added, i, j, version[i], version[j]});
+        // A pair that covered a crater still does once either part has grown (hulls only grow).
+        const bool covers = guard && std::find(blocked[i].begin(), blocked[i].end(), j) != blocked[i].end();
+        heap.push_back({added, i, j, version[i], version[j], covers});
         std::push_heap(heap.begin(), heap.end(), std::greater<>());
     };
     auto jointHull = [&](const Candidate& c) -> Hull* {
@@ -282,8 +487,10 @@ void mergeToBudget(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t
         if (!h)
             return nullptr;
         const double cost = h->volume() - volumes[c.i] - volumes[c.j];
+        Overlaps overlaps = guard ? guard->overlaps(*h) : Overlaps{};
+        Overlaps added = CellGuard::added(overlaps, owned[c.i], owned[c.j]);
         Hull& slot = hulls[key];
-        slot = {c.vi, c.vj, cost, std::move(h.value())};
+        slot = {c.vi, c.vj, cost, std::move(h.value()), std::move(overlaps), std::move(added)};
         return &slot;
     };
     // Pairs whose boxes can touch, by a sweep along x over the current boxes (consider checks the exact
@@ -305,11 +512,17 @@ void mergeToBudget(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t
                 fn(std::min(byX[a], byX[b]), std::max(byX[a], byX[b]));
     };
     forEachNearPair(consider);
-    std::size_t count = n;
+    std::size_t count = n, limit = budget;
     std::vector<Candidate> picked;
-    while (count > budget) {
+    while (count > limit) {
         picked.clear();
         while (picked.size() < verified && !heap.empty()) {
+            if (heap.front().covers && (siblingsOnly || !picked.empty()))
+                break; // pairs that cover a crater wait for every other pair
+            if (heap.front().covers && count <= stretch) {
+                limit = count; // a crater kept open is worth a few more parts
+                break;
+            }
             std::pop_heap(heap.begin(), heap.end(), std::greater<>());
             const Candidate c = heap.back();
             heap.pop_back();
@@ -332,6 +545,18 @@ void mergeToBudget(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t
         for (std::size_t k = 0; k < picked.size(); ++k) {
             Hull* h = jointHull(picked[k]);
             failed[k] = h == nullptr;
+            if (h && guard && !picked[k].covers) {
+                if (const double e = guard->excess(h->added); e > 0) { // ranked again behind the others
+                    picked[k].covers = true;
+                    picked[k].cost = e;
+                    blocked[picked[k].i].push_back(picked[k].j);
+                    blocked[picked[k].j].push_back(picked[k].i);
+                    heap.push_back(picked[k]);
+                    std::push_heap(heap.begin(), heap.end(), std::greater<>());
+                    failed[k] = true;
+                    continue;
+                }
+            }
             if (h && (!bestHull || h->cost < bestHull->cost)) {
                 best = k;
                 bestHull = h;
@@ -345,6 +570,15 @@ void mergeToBudget(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t
         if (!bestHull)
             continue;
         const Candidate c = picked[best];
+        if (guard)
+            guard->take(bestHull->added);
+        if (c.covers) // the craters cannot all stay open: the rest merges as without a guard
+            guard = nullptr;
+        owned[c.i] = std::move(bestHull->overlaps);
+        for (std::size_t k : blocked[c.j]) {
+            blocked[c.i].push_back(k);
+            blocked[k].push_back(c.i);
+        }
         parts[c.i] = std::move(bestHull->shape);
         bounds[c.i] = parts[c.i].bounds();
         volumes[c.i] = parts[c.i].volume();
@@ -361,10 +595,10 @@ void mergeToBudget(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t
         if (alive[i])
             kept.push_back(std::move(parts[i]));
     // Parts that touch nothing are kept whole; if still over budget, the smallest go.
-    if (kept.size() > budget) {
+    if (kept.size() > limit) {
         std::sort(kept.begin(), kept.end(),
                   [](const ConvexPolytope& a, const ConvexPolytope& b) { return a.volume() > b.volume(); });
-        kept.resize(budget);
+        kept.resize(limit);
     }
     parts = std::move(kept);
 }
@@ -390,6 +624,7 @@ std::vector<std::vector<ConvexPolytope>> updateParts(const std::vector<ConvexPol
     cellBounds.reserve(cells.size());
     for (const ConvexPolytope& cell : cells)
         cellBounds.push_back(cell.bounds());
+    const std::vector<OuterFace> outer = outerFaces(cells, cellBounds);
     for (std::uint32_t partIndex = 0; partIndex < parentParts.size(); ++partIndex) {
         const ConvexPolytope& part = parentParts[partIndex];
         parentVolume += part.volume();
@@ -401,28 +636,9 @@ std::vector<std::vector<ConvexPolytope>> updateParts(const std::vector<ConvexPol
             if (!inside.empty())
                 fragments.push_back({std::move(inside), static_cast<std::int32_t>(c), partIndex});
         }
-        // part − every cell; a fragment away from a cell is moved on untouched.
-        std::vector<ConvexPolytope> rest{part}, next;
-        std::vector<Aabb> restBounds{pb}, nextBounds;
-        for (std::size_t c = 0; c < cells.size(); ++c) {
-            if (!pb.overlaps(cellBounds[c]))
-                continue;
-            next.clear();
-            nextBounds.clear();
-            for (std::size_t r = 0; r < rest.size(); ++r) {
-                if (!restBounds[r].overlaps(cellBounds[c])) {
-                    next.push_back(std::move(rest[r]));
-                    nextBounds.push_back(restBounds[r]);
-                    continue;
-                }
-                const std::size_t first = next.size();
-                subtractCell(rest[r], cells[c], next);
-                for (std::size_t k = first; k < next.size(); ++k)
-                    nextBounds.push_back(next[k].bounds());
-            }
-            rest.swap(next);
-            restBounds.swap(nextBounds);
-        }
+        // part − every cell.
+        std::vector<ConvexPolytope> rest;
+        subtractUnion(part, cells, cellBounds, outer, 0, rest);
         for (ConvexPolytope& r : rest)
             fragments.push_back({std::move(r), -1, partIndex});
     }
@@ -518,10 +734,29 @@ std::vector<std::vector<ConvexPolytope>> updateParts(const std::vector<ConvexPol
         }
     }
 
+    // Volume of the debris of each cell: what a remainder's parts must not cover (kPartOverlapTolerance).
+    std::vector<double> debrisVolume(cells.size(), 0);
+    for (std::size_t i = 0; i < pieces.size(); ++i)
+        if (const std::int32_t cell = i < pieceCells.size() ? pieceCells[i] : -1;
+            cell >= 0 && static_cast<std::size_t>(cell) < cells.size())
+            debrisVolume[static_cast<std::size_t>(cell)] += std::abs(signedVolume(*pieces[i]));
     // 4. Per piece: one hull when the fragments fill it, else merge to the budget; fresh decomposition when
     //    nothing arrived.
     for (std::size_t i = 0; i < pieces.size(); ++i) {
         std::vector<ConvexPolytope>& parts = result[i];
+        // A remainder's parts stay out of the cells (a debris piece's stay in its own cell by construction).
+        std::optional<CellGuard> guard;
+        if ((i < pieceCells.size() ? pieceCells[i] : -1) < 0 && !parts.empty()) {
+            double own = 0;
+            for (const ConvexPolytope& p : parts)
+                own += p.volume();
+            std::vector<double> allowance(cells.size(), std::numeric_limits<double>::infinity());
+            for (std::size_t c = 0; c < cells.size(); ++c)
+                if (debrisVolume[c] > 0)
+                    allowance[c] = kOverlapShare * kPartOverlapTolerance * std::min(own, debrisVolume[c]);
+            guard.emplace(cells, cellBounds, std::move(allowance));
+        }
+        CellGuard* g = guard ? &*guard : nullptr;
         if (parts.empty()) {
             auto d = decompose(*pieces[i], params);
             if (d)
@@ -535,7 +770,7 @@ std::vector<std::vector<ConvexPolytope>> updateParts(const std::vector<ConvexPol
         const bool dented = i < pieceCells.size() && pieceCells[i] < 0 && highPoly;
         if (dented && parts.size() > static_cast<std::size_t>(params.maxParts))
             revertToParents(parts, origins[i], parentParts, static_cast<std::size_t>(params.maxParts),
-                            kHighPolyFillTolerance, trim[i] ? &pieceBounds[i] : nullptr);
+                            kHighPolyFillTolerance, trim[i] ? &pieceBounds[i] : nullptr, g);
         // A high-poly piece's parts that nearly fill their hull become that hull (kHighPolyFillTolerance).
         if (parts.size() > 1 && !dented) {
             double sum = 0;
@@ -554,24 +789,30 @@ std::vector<std::vector<ConvexPolytope>> updateParts(const std::vector<ConvexPol
             // than the parts together, they do not fill their hull (and the full hull is not computed).
             const double fillTol = highPoly ? kHighPolyFillTolerance : 1e-6;
             if (auto quick = convexHull(extremePoints(pts)); quick && quick->volume() > sum * (1 + fillTol)) {
-                mergeToBudget(parts, origins[i], params.maxParts);
+                mergeToBudget(parts, origins[i], params.maxParts, g);
                 continue;
             }
             auto h = convexHull(pts);
-            if (h && h->volume() <= sum * (1 + fillTol)) {
+            if (h && h->volume() <= sum * (1 + fillTol) && (!g || g->excess(g->overlaps(*h)) <= 0)) {
                 parts.clear();
                 parts.push_back(std::move(h.value()));
                 continue;
             }
         }
-        mergeToBudget(parts, origins[i], params.maxParts);
+        mergeToBudget(parts, origins[i], params.maxParts, g);
     }
-    // 5. Parts kept to a bounded size, so that the next hit clips the same few faces.
-    for (std::vector<ConvexPolytope>& parts : result)
-        for (ConvexPolytope& p : parts)
+    // 5. Parts kept inside their piece's convex hull (kPartHullTolerance), and to a bounded size, so that the
+    //    next hit clips the same few faces (a bounded part reaches at most half the tolerance out of its
+    //    hull).
+    for (std::size_t i = 0; i < pieces.size(); ++i) {
+        if (!result[i].empty() && pieces[i]->triangles.size() <= params.proxyAboveTriangles)
+            if (auto hull = convexHull(pieces[i]->positions))
+                detail::keepInsideHull(result[i], *hull, 1e-9 * pieces[i]->bounds().diagonal());
+        for (ConvexPolytope& p : result[i])
             if (p.faces().size() > params.maxPartFaces)
                 if (auto b = boundedHull(p.vertices(), params.maxPartFaces))
                     p = std::move(b.value());
+    }
     return result;
 }
 

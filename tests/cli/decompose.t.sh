@@ -10,10 +10,25 @@ fail() { echo "decompose.t.sh: $*"; exit 1; }
 python3 - "$tmp/cube.json" <<'PY' || fail "cube JSON: $(cat "$tmp/cube.json")"
 import json, sys
 d = json.load(open(sys.argv[1]))
-assert set(d) == {"parts", "mesh_volume", "hull_volume", "excess", "ms"}, d
+assert set(d) == {"parts", "mesh_volume", "hull_volume", "excess", "concavity", "ms"}, d
 assert d["parts"] == 1 and abs(d["mesh_volume"] - 1) < 1e-12 and abs(d["excess"]) < 1e-9 and d["ms"] >= 0, d
+assert d["concavity"] < 1e-9, d  # a convex mesh and its hull: no surface point inside a part
 PY
 "$RUBBLE" decompose "$data/cube.obj" | grep -q "1 convex part" || fail "text output"
+# A convex box is one part even at concavity 0; the fighter's hull alone covers pockets 5 % of its diagonal deep.
+models="$data/../../../assets/models"
+"$RUBBLE" decompose "$models/cube_588.obj" --concavity 0 --max-parts 400 --json >"$tmp/box.json" ||
+    fail "convex box at concavity 0"
+python3 -c 'import json, sys; d = json.load(open(sys.argv[1])); assert d["parts"] == 1, d' "$tmp/box.json" ||
+    fail "a convex box at concavity 0 should be one part: $(cat "$tmp/box.json")"
+"$RUBBLE" decompose "$models/fighter.obj" --max-parts 1 --json >"$tmp/one.json" || fail "fighter in one part"
+"$RUBBLE" decompose "$models/fighter.obj" --json >"$tmp/many.json" || fail "fighter"
+python3 - "$tmp/one.json" "$tmp/many.json" <<'PY' || fail "fighter concavity: $(cat "$tmp/one.json" "$tmp/many.json")"
+import json, sys
+one, many = (json.load(open(f)) for f in sys.argv[1:])
+assert one["parts"] == 1 and one["concavity"] > 0.05, one
+assert many["parts"] > 1 and 0 < many["concavity"] < 1, many
+PY
 
 # A non-convex mesh (two cubes joined in an L) gives several parts, at most --max-parts.
 cat >"$tmp/l.obj" <<'OBJ'

@@ -8,6 +8,7 @@
 #include <numeric>
 
 #include "TestSupport.hpp"
+#include "rubble/CollisionTolerance.hpp"
 #include "rubble/ConvexDecomposition.hpp"
 #include "rubble/Fracture.hpp"
 #include "rubble/MassProperties.hpp"
@@ -438,8 +439,10 @@ TEST(UpdateDecomposition, ChainedMergesAreDeterministicAndKeepTheBudget) {
         for (std::size_t i = 0; i < pieces.size(); ++i) {
             SCOPED_TRACE("round " + std::to_string(round) + " piece " + std::to_string(i));
             expectCovers(pieces[i], once[i], 1e-6 * diag(makeLPrism(2)));
-            EXPECT_LE(once[i].size(), 5u);
-            atBudget += once[i].size() == 5u ? 1 : 0;
+            // A remainder may keep up to kCraterBudgetFactor times the budget rather than cover its crater.
+            const std::size_t budget = pieceCells[i] < 0 ? 5 * kCraterBudgetFactor : 5;
+            EXPECT_LE(once[i].size(), budget);
+            atBudget += once[i].size() >= 5u ? 1 : 0;
             ASSERT_EQ(once[i].size(), twice[i].size());
             for (std::size_t k = 0; k < once[i].size(); ++k) {
                 EXPECT_EQ(once[i][k].volume(), twice[i][k].volume());

@@ -29,6 +29,7 @@
 #include "JsonText.hpp"
 #include "Staging.hpp"
 #include "Subcommand.hpp"
+#include "rubble/CollisionTolerance.hpp"
 #include "rubble/ConvexDecomposition.hpp"
 #include "rubble/MeshCheck.hpp"
 #include "rubble/MeshIO.hpp"
@@ -243,11 +244,11 @@ int runCheck(const CheckArgs& args) {
                 for (std::size_t k = 0; k < object.collision.size(); ++k)
                     for (std::string& p : partProblems(object.collision[k], k))
                         r.problems.push_back(std::move(p));
-                // Parts may stand out of the hull as far as the decomposition's concavity allows.
+                // Parts may stand out of the hull by the tolerance the decomposition keeps.
                 const double outside =
                     object.collision.empty() ? 0 : outsideHull(object.mesh, object.collision);
                 const double diagonal = length(r.bounds.hi - r.bounds.lo);
-                const double allowed = rubble::DecompositionParams{}.concavity * diagonal;
+                const double allowed = rubble::partHullTolerance(diagonal);
                 if (!(outside <= allowed))
                     r.problems.push_back("collision parts reach " + num(outside) +
                                          " outside the object's convex hull (allowed: " + num(allowed) + ")");

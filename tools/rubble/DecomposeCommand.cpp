@@ -1,11 +1,11 @@
 // `rubble decompose MESH [--max-parts N] [--concavity C] [--json] [-o PARTS.json]`
 //
 // Approximate convex decomposition of a closed mesh. Prints the number of convex parts, the mesh and hull
-// volumes, the excess (hull − mesh) / mesh and the time taken; --json prints
-// {"parts","mesh_volume","hull_volume","excess","ms"}. -o writes the parts (rubble/DecompositionFile.hpp);
-// as MESH's stem.parts.json beside it, a scene loads them instead of decomposing. Exit codes: 0 success,
-// 1 the mesh cannot be decomposed (e.g. open or inside out) or the parts cannot be written, 2 unreadable file
-// or usage error. With --json a failure prints {"file","error"}.
+// volumes, the excess (hull − mesh) / mesh, the concavity (rubble/PartConcavity.hpp) and the time taken;
+// --json prints {"parts","mesh_volume","hull_volume","excess","concavity","ms"}. -o writes the parts
+// (rubble/DecompositionFile.hpp); as MESH's stem.parts.json beside it, a scene loads them instead of
+// decomposing. Exit codes: 0 success, 1 the mesh cannot be decomposed (e.g. open or inside out) or the parts
+// cannot be written, 2 unreadable file or usage error. With --json a failure prints {"file","error"}.
 #include <chrono>
 #include <iostream>
 #include <memory>
@@ -17,6 +17,7 @@
 #include "rubble/ConvexDecomposition.hpp"
 #include "rubble/DecompositionFile.hpp"
 #include "rubble/MeshIO.hpp"
+#include "rubble/PartConcavity.hpp"
 
 namespace {
 
@@ -59,19 +60,22 @@ int runDecompose(const DecomposeArgs& args) {
         if (const rubble::Status s = rubble::writeDecompositionFile(args.output, file); !s)
             return failed(1, s.message());
     }
+    const double concavity = rubble::partConcavity(mesh.value(), d->parts);
     if (args.json) {
         nlohmann::json j;
         j["parts"] = d->parts.size();
         j["mesh_volume"] = d->meshVolume;
         j["hull_volume"] = d->hullVolume;
         j["excess"] = d->excess();
+        j["concavity"] = concavity;
         j["ms"] = ms;
         std::cout << rubble::tools::dumpJson(j) << "\n";
     } else {
         std::cout << args.file << ": " << d->parts.size()
                   << (d->parts.size() == 1 ? " convex part" : " convex parts") << "\n  mesh volume  "
                   << d->meshVolume << "\n  hull volume  " << d->hullVolume << "\n  excess       "
-                  << d->excess() << "\n  time         " << ms << " ms\n";
+                  << d->excess() << "\n  concavity    " << concavity << " of the diagonal\n  time         "
+                  << ms << " ms\n";
     }
     return 0;
 }
@@ -98,7 +102,8 @@ const rubble::tools::Registrar registrar{
          app.add_option("-o,--output", args->output,
                         "write the parts as JSON (MESH-stem.parts.json beside the mesh is loaded by scenes)");
          app.add_flag("--json", args->json,
-                      "print {\"parts\",\"mesh_volume\",\"hull_volume\",\"excess\",\"ms\"} as JSON");
+                      "print {\"parts\",\"mesh_volume\",\"hull_volume\",\"excess\",\"concavity\",\"ms\"} as "
+                      "JSON");
          return [args] { return runDecompose(*args); };
      }}};
 
