@@ -223,6 +223,7 @@ private:
         Vec3 centroid, normal;         // the section's
     };
     void inherit();
+    void coldStart();
     std::vector<Orphan> orphans_;          // since the last solve
     std::vector<std::size_t> fresh_;       // bonds added since the last solve
     std::vector<std::uint32_t> bondStamp_; // GaussSeidel: the sweep that listed the bond

@@ -351,10 +351,66 @@ void StressSolver::inherit() {
     fresh_.clear();
 }
 
+// A structure whose bonds carry nothing yet (just built) starts from its dead load passed down: from the
+// highest node to the lowest, each node's weight and what rests on it goes to the bonds under it, by
+// horizontal section area (a warm start: the solve corrects it).
+void StressSolver::coldStart() {
+    for (const BondState& b : bonds_)
+        if (!b.broken && (lengthSquared(b.force) > 0 || lengthSquared(b.moment) > 0))
+            return;
+    const double g = length(settings_.gravity);
+    if (g <= 0)
+        return;
+    const Vec3 down = settings_.gravity / g;
+    std::vector<std::uint32_t> order;
+    for (std::uint32_t i = 0; i < nodes_.size(); ++i)
+        if (movable(i))
+            order.push_back(i);
+    auto height = [&](std::uint32_t i) { return -dot(nodes_[i].node.centroid, down); };
+    std::stable_sort(order.begin(), order.end(),
+                     [&](std::uint32_t x, std::uint32_t y) { return height(x) > height(y); });
+    std::vector<double> load(nodes_.size(), 0);
+    for (std::uint32_t i : order) {
+        const NodeState& n = nodes_[i];
+        const double total = load[i] + n.node.mass * g + std::max(0.0, dot(n.force, down));
+        double area = 0;
+        auto under = [&](const BondState& b) {
+            const BondInterface& x = b.bond.section;
+            return !b.broken && b.solvable && std::abs(dot(x.normal, down)) > 0.5 &&
+                   dot(x.centroid - n.node.centroid, down) > 0;
+        };
+        for (std::size_t k : n.bonds)
+            if (under(bonds_[k]))
+                area +=
+                    bonds_[k].bond.section.sectionArea * std::abs(dot(bonds_[k].bond.section.normal, down));
+        if (area <= 0)
+            continue;
+        for (std::size_t k : n.bonds) {
+            BondState& b = bonds_[k];
+            if (!under(b))
+                continue;
+            const double share =
+                total * b.bond.section.sectionArea * std::abs(dot(b.bond.section.normal, down)) / area;
+            const std::uint32_t j = b.bond.other(i);
+            if (movable(j))
+                load[j] += share;
+            b.force = down * (b.bond.a == i ? -share : share); // up on the node above
+            for (BearingCorner& c : b.corners)
+                c.press = share / static_cast<double>(b.corners.size());
+        }
+    }
+    allDirty_ = true;
+}
+
 void StressSolver::solve() {
     if (!orphans_.empty())
         inherit();
     fresh_.clear();
+    if (settings_.method != StressMethod::SweepBudget && allDirty_) {
+        if (!reachValid_)
+            reach();
+        coldStart();
+    }
     const double scale = startSolve();
     scale_ = scale;
     history_.clear();
