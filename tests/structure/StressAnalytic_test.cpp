@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "BondLookup.hpp"
 #include "rubble/StressSolver.hpp"
 
 using namespace rubble;
@@ -51,13 +52,7 @@ struct Lattice {
     double mass(std::uint32_t i) const { return structureNode(solids[i], density[i], false).mass; }
 };
 
-std::size_t bondBetween(const StressSolver& s, std::uint32_t a, std::uint32_t b) {
-    for (std::size_t i = 0; i < s.bondCount(); ++i)
-        if (s.bond(i).a == std::min(a, b) && s.bond(i).b == std::max(a, b))
-            return i;
-    ADD_FAILURE() << "no bond " << a << "-" << b;
-    return 0;
-}
+using test::bondBetween;
 
 // The converged solvers (one solve from zero forces reaches the residual).
 std::vector<StressSettings> converged() {
