@@ -64,8 +64,11 @@ struct StressSettings {
     double residual = 1e-3; ///< GaussSeidel, ConjugateGradient: the relative residual solve() reaches
     int maxSweeps = 5000;   ///< GaussSeidel, ConjugateGradient: sweeps (iterations) at most, for structures
                             ///< bearings cannot hold (they never converge)
-    bool trace = false;     ///< record the relative residual after every sweep (history(); costs a pass over
-                            ///< the nodes per sweep)
+    bool deadLoadGuess = false; ///< GaussSeidel, ConjugateGradient: a structure whose bonds carry nothing yet
+                                ///< starts from its dead load passed down (off: it biases which equilibrium
+                                ///< indeterminate contacts reach; docs/structure.md)
+    bool trace = false; ///< record the relative residual after every sweep (history(); costs a pass over
+                        ///< the nodes per sweep)
 };
 
 /// The stress solver over one structure (nodes joined by bonds).

@@ -406,7 +406,7 @@ void StressSolver::solve() {
     if (!orphans_.empty())
         inherit();
     fresh_.clear();
-    if (settings_.method != StressMethod::SweepBudget && allDirty_) {
+    if (settings_.method != StressMethod::SweepBudget && settings_.deadLoadGuess && allDirty_) {
         if (!reachValid_)
             reach();
         coldStart();
