@@ -1,13 +1,15 @@
-// `rubble-bench structure [--quick] [--frames N] [--iterations N] [--json] [--out DIR]`
+// `rubble-bench structure [--quick] [--frames N] [--iterations N] [--json] [--convergence] [--out DIR]`
 //
-// Stress-solver cost per frame against bond count: a block of stacked bricks (k x h x k, 1 x 0.5 x 1 m each)
-// on a ground root, each brick bonded to its face neighbours, solved frame after frame (warm-started) with 1
-// and with --iterations (default 25, as Blast) Gauss-Seidel sweeps. Also the bond-graph build time, and what
-// one fracture costs the structure: a brick replaced by its Voronoi pieces, updated incrementally (BondGraph
-// and the solver's add/remove, as StructureMonitor does) against a from-scratch rebuild (buildBonds and
-// reset), both in thread CPU time. Table on stdout (or with --json one row per graph size for --iterations:
-// {"bonds": N, "solve_ms": {"p50", "p99"}, "update_ms": {"p50", "p99"}, "rebuild_ms": ...}), CSV in
-// DIR/structure.csv, plot in DIR/structure.png (gnuplot).
+// Stress-solver cost per frame under fire against bond count, one row per solver: a block of stacked bricks
+// (k x h x k, 1 x 0.5 x 1 m each) on a ground root, each brick welded to its face neighbours; every frame one
+// brick is replaced by its Voronoi pieces and debris loads land on random bricks, then one solve (thread CPU
+// time) with its relative residual. Solvers: the converged Gauss-Seidel and conjugate gradient, and the old
+// sweep budget at 12 sweeps (and at --iterations, default 25, as Blast). Also the first solve's cost, and
+// what one fracture costs the structure: a brick replaced by its pieces, updated incrementally (BondGraph and
+// the solver's add/remove, as StructureMonitor does) against a from-scratch rebuild (buildBonds and reset).
+// Table on stdout (or with --json one row per graph size and solver: {"bonds", "solver", "solve_ms": {"p50",
+// "p99"}, "residual": {"p50", "max"}, ...}), CSV in DIR/structure.csv, plots in DIR/structure.png and
+// DIR/structure_convergence.png (residual against time of a first solve from zero forces, per solver).
 #include <algorithm>
 #include <chrono>
 #include <ctime>
@@ -30,14 +32,19 @@ using rubble::bench::fixed;
 struct BenchArgs {
     bool quick = false;
     bool json = false;
+    bool convergenceOnly = false;
     int frames = 60;
     int iterations = 25;
     std::string out = rubble::bench::kResultsDir;
 };
 
 struct Row {
-    std::size_t nodes = 0, bonds = 0;
+    std::string solver;
+    std::size_t nodes = 0, bonds = 0, bondsAtEnd = 0;
     int iterations = 0;
+    double residualP50 = 0, residualMax = 0, sweepsP50 = 0; // under fire
+    double coldMs = 0, coldResidual = 0;                    // the first solve, from zero
+    int coldSweeps = 0;
     double buildMs = 0, p50 = 0, p99 = 0, max = 0;
     double updateP50 = 0, updateP99 = 0, rebuildMs = 0; // one fracture's structure update, thread CPU
     double pieces = 0;                                  // pieces per fracture (mean)
@@ -89,96 +96,184 @@ std::vector<std::vector<rubble::ConvexPolytope>> shatter(const rubble::Aabb& bri
     return out;
 }
 
-// One fracture after another (bricks spread through the block), each replacing a brick by its pieces: the
-// incremental update's thread CPU time per fracture, and a full rebuild's after the last one.
-void measureUpdates(std::vector<std::vector<rubble::ConvexPolytope>> solids,
-                    const std::vector<rubble::StructureNode>& nodes, int fractures, Row& row) {
+// A solver configuration: a row of the table.
+struct Solver {
+    std::string name;
+    rubble::StressMethod method;
+    int sweeps = 0; // SweepBudget: sweeps a frame
+};
+
+std::vector<Solver> solvers(int iterations) {
+    std::vector<Solver> out{{"gauss-seidel", rubble::StressMethod::GaussSeidel, 0},
+                            {"conjugate-gradient", rubble::StressMethod::ConjugateGradient, 0},
+                            {"sweeps-12", rubble::StressMethod::SweepBudget, 12}};
+    if (iterations != 12)
+        out.push_back(
+            {"sweeps-" + std::to_string(iterations), rubble::StressMethod::SweepBudget, iterations});
+    return out;
+}
+
+rubble::StressSettings settingsOf(const Solver& s) {
+    rubble::StressSettings settings;
+    settings.method = s.method;
+    settings.iterations = std::max(1, s.sweeps);
+    settings.tolerance = 0.01; // the sweep budget's early stop (its own criterion, about 1e-3 g)
+    settings.deadLoadGuess = true;
+    return settings;
+}
+
+// A structure under fire: the brick block with its bond graph, changed one fracture at a time.
+struct Structure {
+    std::vector<std::vector<rubble::ConvexPolytope>> solids;
     rubble::BondGraph graph;
     rubble::StressSolver solver;
-    std::vector<std::uint32_t> slot(solids.size());
-    auto addSolid = [&](std::size_t i) {
-        slot[i] = solver.addNode(rubble::structureNode(solids[i], 1900, i == 0));
-        for (rubble::Bond& b : graph.add(slot[i], solids[i]))
-            (void)solver.addBond(std::move(b), {});
-    };
-    for (std::size_t i = 0; i < solids.size(); ++i) {
-        slot[i] = solver.addNode(nodes[i]);
+    std::vector<std::uint32_t> slot;
+
+    void addSolid(std::size_t i, const rubble::StructureNode& node) {
+        slot[i] = solver.addNode(node);
         for (rubble::Bond& b : graph.add(slot[i], solids[i]))
             (void)solver.addBond(std::move(b), {});
     }
-    solver.solve();
-    std::vector<double> ms;
-    std::size_t pieces = 0;
-    for (int f = 0; f < fractures; ++f) {
-        const std::size_t victim = 1 + (static_cast<std::size_t>(f) * 7919) % (solids.size() - 1);
-        rubble::Aabb box;
-        for (const rubble::ConvexPolytope& p : solids[victim])
-            box.extend(p.bounds());
-        const auto parts = shatter(box, static_cast<std::uint64_t>(f) + 1);
-        pieces += parts.size();
-        const double t0 = threadCpuMs();
+    Structure(std::vector<std::vector<rubble::ConvexPolytope>> s,
+              const std::vector<rubble::StructureNode>& nodes)
+        : solids(std::move(s)), slot(solids.size()) {
+        for (std::size_t i = 0; i < solids.size(); ++i)
+            addSolid(i, nodes[i]);
+    }
+    // Replaces the victim brick by pieces (the first takes its place).
+    void fracture(std::size_t victim, const std::vector<std::vector<rubble::ConvexPolytope>>& parts) {
         (void)graph.remove(slot[victim]);
         solver.removeNode(slot[victim]);
         solids[victim] = parts.front();
-        addSolid(victim);
+        addSolid(victim, rubble::structureNode(solids[victim], 1900, false));
         for (std::size_t p = 1; p < parts.size(); ++p) {
             solids.push_back(parts[p]);
             slot.push_back(0);
-            addSolid(solids.size() - 1);
+            addSolid(solids.size() - 1, rubble::structureNode(parts[p], 1900, false));
         }
+    }
+};
+
+// One fracture a frame: which brick, and its pieces (computed once, shared by every solver).
+struct Shot {
+    std::size_t victim = 0;
+    std::vector<std::vector<rubble::ConvexPolytope>> parts;
+};
+
+std::vector<Shot> shots(const std::vector<std::vector<rubble::ConvexPolytope>>& solids, int count) {
+    std::vector<Shot> out;
+    for (int f = 0; f < count; ++f) {
+        Shot s;
+        s.victim = 1 + (static_cast<std::size_t>(f) * 7919) % (solids.size() - 1);
+        rubble::Aabb box;
+        for (const rubble::ConvexPolytope& p : solids[s.victim])
+            box.extend(p.bounds());
+        s.parts = shatter(box, static_cast<std::uint64_t>(f) + 1);
+        out.push_back(std::move(s));
+    }
+    return out;
+}
+
+// One fracture after another (bricks spread through the block), each replacing a brick by its pieces: the
+// incremental update's thread CPU time per fracture, and a full rebuild's after the last one.
+void measureUpdates(const std::vector<std::vector<rubble::ConvexPolytope>>& solids,
+                    const std::vector<rubble::StructureNode>& nodes, const std::vector<Shot>& fire,
+                    Row& row) {
+    Structure s(solids, nodes);
+    s.solver.solve();
+    std::vector<double> ms;
+    std::size_t pieces = 0;
+    for (const Shot& shot : fire) {
+        pieces += shot.parts.size();
+        const double t0 = threadCpuMs();
+        s.fracture(shot.victim, shot.parts);
         ms.push_back(threadCpuMs() - t0);
-        solver.solve();
+        s.solver.solve();
     }
     std::vector<rubble::StructureNode> all; // the old monitor kept its nodes: only bonds were rebuilt
-    for (std::size_t i = 0; i < solids.size(); ++i)
-        all.push_back(rubble::structureNode(solids[i], 1900, i == 0));
+    for (std::size_t i = 0; i < s.solids.size(); ++i)
+        all.push_back(rubble::structureNode(s.solids[i], 1900, i == 0));
     const double t1 = threadCpuMs();
-    std::vector<rubble::Bond> bonds = rubble::buildBonds(solids, {});
+    std::vector<rubble::Bond> bonds = rubble::buildBonds(s.solids, {});
     const std::size_t count = bonds.size();
     rubble::StressSolver fresh;
     fresh.reset(std::move(all), std::move(bonds), std::vector<rubble::StrengthLimits>(count));
     row.rebuildMs = threadCpuMs() - t1;
     row.updateP50 = percentile(ms, 0.5);
     row.updateP99 = percentile(ms, 0.99);
-    row.pieces = static_cast<double>(pieces) / fractures;
+    row.pieces = static_cast<double>(pieces) / static_cast<double>(fire.size());
 }
 
-std::vector<Row> measure(int k, int h, const std::vector<int>& iterations, int frames, int fractures) {
+// Debris landing on the block this frame: a few contact forces on bricks, fixed by the frame number.
+void debris(Structure& s, int frame) {
+    std::uint64_t x = 0x9e3779b97f4a7c15ull * static_cast<std::uint64_t>(frame + 1);
+    for (int i = 0; i < 8; ++i) {
+        x ^= x >> 12;
+        x ^= x << 25;
+        x ^= x >> 27;
+        const std::size_t solid = 1 + (x * 0x2545f4914f6cdd1dull >> 33) % (s.solids.size() - 1);
+        rubble::Aabb box;
+        for (const rubble::ConvexPolytope& p : s.solids[solid])
+            box.extend(p.bounds());
+        const double push = 500.0 + static_cast<double>(x % 2000); // N: a 50-250 kg piece settling
+        s.solver.addLoad(s.slot[solid], {0.1 * push, -push, 0}, {box.lo.x, box.hi.y, box.center().z});
+    }
+}
+
+std::vector<Row> measure(int k, int h, const std::vector<Solver>& list, int frames, int fractures) {
     const auto solids = bricks(k, h);
     const auto t0 = std::chrono::steady_clock::now();
-    std::vector<rubble::Bond> bonds = rubble::buildBonds(solids, {});
+    const std::size_t bondCount = rubble::buildBonds(solids, {}).size();
     const double buildMs = rubble::bench::msSince(t0);
     std::vector<rubble::StructureNode> nodes;
     for (std::size_t i = 0; i < solids.size(); ++i)
         nodes.push_back(rubble::structureNode(solids[i], 1900, i == 0));
+    const std::vector<Shot> fire = shots(solids, std::max(frames, fractures));
     std::vector<Row> rows;
-    for (int it : iterations) {
-        rubble::StressSettings settings;
-        settings.iterations = it;
-        settings.tolerance = 0; // every sweep: the cost of a structure that keeps changing
-        rubble::StressSolver solver(settings);
-        solver.reset(nodes, bonds,
-                     std::vector<rubble::StrengthLimits>(bonds.size())); // unlimited: nothing breaks
-        for (int i = 0; i < 3; ++i)
-            solver.solve();
-        std::vector<double> ms;
-        for (int f = 0; f < frames; ++f) {
-            const auto s0 = std::chrono::steady_clock::now();
-            solver.solve();
-            ms.push_back(rubble::bench::msSince(s0));
-        }
+    for (const Solver& solver : list) {
+        Structure s(solids, nodes);
         Row r;
+        r.solver = solver.name;
         r.nodes = nodes.size();
-        r.bonds = bonds.size();
-        r.iterations = it;
+        r.bonds = bondCount;
+        r.iterations = solver.sweeps;
         r.buildMs = buildMs;
+        // The first solve, from zero forces.
+        s.solver.settings() = settingsOf(solver);
+        const double c0 = threadCpuMs();
+        s.solver.solve();
+        r.coldMs = threadCpuMs() - c0;
+        r.coldResidual = s.solver.residual();
+        r.coldSweeps = s.solver.sweeps();
+        // Every solver starts under fire from the same converged state.
+        s.solver.settings().method = rubble::StressMethod::ConjugateGradient;
+        s.solver.settings().residual = 1e-9;
+        s.solver.settings().maxSweeps = 5000;
+        s.solver.solve();
+        s.solver.settings() = settingsOf(solver);
+        std::vector<double> ms, residual, sweeps;
+        for (int f = 0; f < frames; ++f) {
+            s.fracture(fire[static_cast<std::size_t>(f)].victim, fire[static_cast<std::size_t>(f)].parts);
+            debris(s, f);
+            const double s0 = threadCpuMs();
+            s.solver.solve();
+            ms.push_back(threadCpuMs() - s0);
+            residual.push_back(s.solver.residual());
+            sweeps.push_back(s.solver.sweeps());
+        }
+        r.bondsAtEnd = 0;
+        for (std::size_t i = 0; i < s.solver.bondCount(); ++i)
+            r.bondsAtEnd += !s.solver.broken(i);
         r.p50 = percentile(ms, 0.5);
         r.p99 = percentile(ms, 0.99);
         r.max = *std::max_element(ms.begin(), ms.end());
+        r.residualP50 = percentile(residual, 0.5);
+        r.residualMax = *std::max_element(residual.begin(), residual.end());
+        r.sweepsP50 = percentile(sweeps, 0.5);
         rows.push_back(r);
     }
     Row update;
-    measureUpdates(solids, nodes, fractures, update);
+    measureUpdates(solids, nodes, std::vector<Shot>(fire.begin(), fire.begin() + fractures), update);
     for (Row& r : rows) {
         r.updateP50 = update.updateP50;
         r.updateP99 = update.updateP99;
@@ -188,72 +283,134 @@ std::vector<Row> measure(int k, int h, const std::vector<int>& iterations, int f
     return rows;
 }
 
+// Residual after each sweep of a first solve (from zero forces), per solver: the convergence plot.
+std::string convergence(int k, int h, const std::vector<Solver>& list, std::vector<std::string>& titles) {
+    const auto solids = bricks(k, h);
+    std::vector<rubble::StructureNode> nodes;
+    for (std::size_t i = 0; i < solids.size(); ++i)
+        nodes.push_back(rubble::structureNode(solids[i], 1900, i == 0));
+    std::ostringstream data;
+    for (const Solver& solver : list) {
+        if (solver.method == rubble::StressMethod::SweepBudget && solver.sweeps != 12)
+            continue;
+        Structure s(solids, nodes);
+        rubble::StressSettings settings = settingsOf(solver);
+        settings.iterations = 2000; // the sweep budget's sweeps, unbounded here
+        settings.tolerance = 0;
+        settings.maxSweeps = 2000;
+        settings.deadLoadGuess = false; // from zero forces: the iteration alone
+        s.solver.settings() = settings;
+        const double t0 = threadCpuMs();
+        s.solver.solve();
+        const double msTotal = threadCpuMs() - t0; // untraced: the time per sweep
+        const int count = s.solver.sweeps();
+        s.solver.settings().trace = true;
+        Structure traced(solids, nodes);
+        traced.solver.settings() = s.solver.settings();
+        traced.solver.solve();
+        const std::vector<double>& history = traced.solver.history();
+        for (std::size_t i = 0; i < history.size(); ++i)
+            data << (i + 1) << " " << (msTotal * static_cast<double>(i + 1) / std::max(1, count)) << " "
+                 << history[i] << "\n";
+        data << "\n\n";
+        titles.push_back(solver.method == rubble::StressMethod::SweepBudget
+                             ? "gauss-seidel, every bond a sweep"
+                             : solver.name);
+    }
+    return data.str();
+}
+
 int runBench(const BenchArgs& args) {
     const int frames = args.quick ? 5 : std::max(1, args.frames);
     // (k, h): bonds ~ 3 k^2 h.
     const std::vector<std::pair<int, int>> sizes =
         args.quick ? std::vector<std::pair<int, int>>{{4, 4}, {8, 8}}
                    : std::vector<std::pair<int, int>>{{4, 4}, {8, 8}, {12, 12}, {16, 26}, {20, 34}};
-    std::vector<int> iterations{1};
-    if (args.iterations != 1)
-        iterations.push_back(args.iterations);
+    const std::vector<Solver> list = solvers(args.iterations);
     const rubble::bench::CpuMeter cpu;
     std::vector<Row> rows;
     for (const auto& [k, h] : sizes)
-        for (const Row& r : measure(k, h, iterations, frames, args.quick ? 3 : 20))
+        for (const Row& r :
+             args.convergenceOnly ? std::vector<Row>{} : measure(k, h, list, frames, args.quick ? 3 : 20))
             rows.push_back(r);
+    std::vector<std::string> titles;
+    const std::string history = convergence(args.quick ? 8 : 16, args.quick ? 8 : 26, list, titles);
     const double otherCpu = cpu.read().other;
 
     if (args.json) {
-        for (const Row& r : rows)
-            if (r.iterations == args.iterations) {
-                nlohmann::json j;
-                j["bonds"] = r.bonds;
-                j["solve_ms"] = {{"p50", r.p50}, {"p99", r.p99}};
-                j["update_ms"] = {{"p50", r.updateP50}, {"p99", r.updateP99}};
-                j["rebuild_ms"] = r.rebuildMs;
-                std::cout << j.dump() << "\n";
-            }
+        for (const Row& r : rows) {
+            nlohmann::json j;
+            j["bonds"] = r.bonds;
+            j["solver"] = r.solver;
+            j["solve_ms"] = {{"p50", r.p50}, {"p99", r.p99}};
+            j["residual"] = {{"p50", r.residualP50}, {"max", r.residualMax}};
+            j["sweeps_p50"] = r.sweepsP50;
+            j["cold"] = {{"ms", r.coldMs}, {"residual", r.coldResidual}, {"sweeps", r.coldSweeps}};
+            j["update_ms"] = {{"p50", r.updateP50}, {"p99", r.updateP99}};
+            j["rebuild_ms"] = r.rebuildMs;
+            std::cout << j.dump() << "\n";
+        }
     }
-    rubble::bench::Table table{{"bonds", "nodes", "iterations", "build ms", "solve p50 ms", "p99", "max",
-                                "ns / bond / iteration", "update p50 ms", "update p99", "rebuild ms"},
+    rubble::bench::Table table{{"bonds", "solver", "solve p50 ms", "p99", "max", "residual p50", "max",
+                                "sweeps p50", "cold ms", "cold residual", "update p50 ms", "rebuild ms"},
                                {}};
-    rubble::bench::Table csv{{"bonds", "nodes", "iterations", "frames", "build_ms", "solve_p50_ms",
-                              "solve_p99_ms", "solve_max_ms", "ns_per_bond_iteration", "update_p50_ms",
-                              "update_p99_ms", "rebuild_ms", "pieces_per_fracture", "other_cpu_cores"},
+    rubble::bench::Table csv{{"bonds", "nodes", "solver", "frames", "build_ms", "solve_p50_ms",
+                              "solve_p99_ms", "solve_max_ms", "residual_p50", "residual_max", "sweeps_p50",
+                              "cold_ms", "cold_residual", "cold_sweeps", "update_p50_ms", "update_p99_ms",
+                              "rebuild_ms", "pieces_per_fracture", "other_cpu_cores"},
                              {}};
-    std::ostringstream data;
+    auto sci = [](double v) {
+        std::ostringstream o;
+        o.precision(2);
+        o << std::scientific << v;
+        return o.str();
+    };
     for (const Row& r : rows) {
-        const double perBond = r.p50 * 1e6 / (static_cast<double>(r.bonds) * r.iterations);
-        table.rows.push_back({std::to_string(r.bonds), std::to_string(r.nodes), std::to_string(r.iterations),
-                              fixed(r.buildMs), fixed(r.p50), fixed(r.p99), fixed(r.max), fixed(perBond, 1),
-                              fixed(r.updateP50), fixed(r.updateP99), fixed(r.rebuildMs)});
-        csv.rows.push_back({std::to_string(r.bonds), std::to_string(r.nodes), std::to_string(r.iterations),
+        table.rows.push_back({std::to_string(r.bonds), r.solver, fixed(r.p50), fixed(r.p99), fixed(r.max),
+                              sci(r.residualP50), sci(r.residualMax), fixed(r.sweepsP50, 0), fixed(r.coldMs),
+                              sci(r.coldResidual), fixed(r.updateP50), fixed(r.rebuildMs)});
+        csv.rows.push_back({std::to_string(r.bonds), std::to_string(r.nodes), r.solver,
                             std::to_string(frames), fixed(r.buildMs), fixed(r.p50, 4), fixed(r.p99, 4),
-                            fixed(r.max, 4), fixed(perBond, 2), fixed(r.updateP50, 4), fixed(r.updateP99, 4),
-                            fixed(r.rebuildMs, 2), fixed(r.pieces, 1), fixed(otherCpu, 2)});
-    }
-    for (int it : iterations) {
-        for (const Row& r : rows)
-            if (r.iterations == it)
-                data << r.bonds << " " << r.p50 << " " << r.p99 << "\n";
-        data << "\n\n";
+                            fixed(r.max, 4), sci(r.residualP50), sci(r.residualMax), fixed(r.sweepsP50, 0),
+                            fixed(r.coldMs, 3), sci(r.coldResidual), std::to_string(r.coldSweeps),
+                            fixed(r.updateP50, 4), fixed(r.updateP99, 4), fixed(r.rebuildMs, 2),
+                            fixed(r.pieces, 1), fixed(otherCpu, 2)});
     }
     if (!args.json)
         rubble::bench::printTable(table);
     else
         std::cerr << "(table omitted with --json)\n";
-    if (!rubble::bench::writeCsv(fs::path(args.out) / "structure.csv", csv))
+    if (!args.convergenceOnly && !rubble::bench::writeCsv(fs::path(args.out) / "structure.csv", csv))
         return 1;
-    std::ostringstream plot;
-    plot << "set logscale xy\nset xlabel 'bonds'\nset ylabel 'solve time per frame (ms)'\nset grid\n"
-            "set key top left\nset title 'Stress solver: one frame (one core)'\n"
-            "plot $DATA index 0 u 1:2 w lp t 'p50, 1 iteration', '' index 0 u 1:3 w lp t 'p99, 1 iteration'";
-    if (iterations.size() > 1)
-        plot << ", '' index 1 u 1:2 w lp t 'p50, " << args.iterations
-             << " iterations', '' index 1 u 1:3 w lp t 'p99, " << args.iterations << " iterations'";
-    plot << ", 1 w l dt 2 t '1 ms budget'";
-    rubble::bench::plotPng(args.out, "structure", data.str(), plot.str());
+    std::ostringstream data, plot;
+    plot << "set multiplot layout 1,2\nset logscale xy\nset xlabel 'bonds'\nset ylabel 'solve ms a frame "
+            "under fire'\n"
+            "set grid\nset key top left\nset title 'Solve per frame (p50, one core)'\nplot ";
+    for (std::size_t s = 0; s < list.size(); ++s) {
+        for (const Row& r : rows)
+            if (r.solver == list[s].name)
+                data << r.bonds << " " << r.p50 << " " << r.residualMax << "\n";
+        data << "\n\n";
+        plot << (s ? ", " : "") << "$DATA index " << s << " u 1:2 w lp t '" << list[s].name << "'";
+    }
+    plot << ", 1 w l dt 2 t '1 ms'\nset ylabel 'largest relative residual'\nset title 'Residual a frame acts "
+            "on'"
+            "\nplot ";
+    for (std::size_t s = 0; s < list.size(); ++s)
+        plot << (s ? ", " : "") << "$DATA index " << s << " u 1:3 w lp t '" << list[s].name << "'";
+    plot << ", 1e-3 w l dt 2 t 'target'\nunset multiplot\n";
+    if (!args.convergenceOnly)
+        rubble::bench::plotPng(args.out, "structure", data.str(), plot.str());
+    std::ostringstream conv;
+    conv << "set logscale xy\nset yrange [1e-15:2]\nset key bottom left\nset xlabel 'ms (first solve, from "
+            "zero forces)'\nset ylabel 'relative "
+            "residual'\n"
+            "set grid\nset title 'Convergence on a brick block, "
+         << (args.quick ? "8 x 8 x 8" : "16 x 26 x 16") << "'\nplot ";
+    for (std::size_t s = 0; s < titles.size(); ++s)
+        conv << (s ? ", " : "") << "$DATA index " << s << " u 2:3 w l t '" << titles[s] << "'";
+    conv << ", 1e-3 w l dt 2 t 'target'\n";
+    rubble::bench::plotPng(args.out, "structure_convergence", history, conv.str());
     return 0;
 }
 
@@ -261,9 +418,11 @@ const rubble::tools::Registrar registrar{
     {"structure", "Stress solver: solve time per frame against bond count", [](CLI::App& app) {
          auto args = std::make_shared<BenchArgs>();
          app.add_flag("--quick", args->quick, "two small graphs, 5 frames (CI smoke run)");
-         app.add_flag("--json", args->json, "one JSON row per graph size on stdout");
+         app.add_flag("--json", args->json, "one JSON row per graph size and solver on stdout");
+         app.add_flag("--convergence", args->convergenceOnly,
+                      "only the convergence plot (structure_convergence.png)");
          app.add_option("--frames", args->frames, "timed frames per case")->check(CLI::Range(1, 100000));
-         app.add_option("--iterations", args->iterations, "Gauss-Seidel sweeps per frame")
+         app.add_option("--iterations", args->iterations, "sweeps a frame of a second sweep-budget row")
              ->check(CLI::Range(1, 1000));
          app.add_option("--out", args->out, "folder for structure.csv and structure.png");
          return [args] { return runBench(*args); };

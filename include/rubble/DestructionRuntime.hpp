@@ -99,11 +99,12 @@ struct SupportPolicy {
 struct StructurePolicy {
     bool enabled = false;              ///< off: support is connectivity only (SupportPolicy)
     BondSettings bonds{0.02, 1, 1e-4}; ///< what counts as a bond (gap as SupportPolicy::tolerance)
-    StressSettings stress{12, 0.05}; ///< solver sweeps a frame, at most 12 (the first solve after objects are
-                                     ///< placed: 120), fewer once every node is at rest within 0.05 m/s^2 (a
-                                     ///< tenth of `unbalanced`); gravity is the binding's
-    double damageRadius = 1.0;       ///< impacts weaken bonds within this distance (m) of the hit
-    double damagePerImpulse = 1e-4;  ///< health a bond at the hit loses per N·s of impulse
+    StressSettings stress{}; ///< the solver (converged Gauss-Seidel to a relative residual of 1e-3); gravity
+                             ///< is the binding's. With StressMethod::SweepBudget: at most `iterations`
+                             ///< sweeps a frame (ten times that in the first solve after objects are placed)
+    int breakRounds = 8; ///< solves after bonds break in a frame, for the new load path (converged methods)
+    double damageRadius = 1.0;      ///< impacts weaken bonds within this distance (m) of the hit
+    double damagePerImpulse = 1e-4; ///< health a bond at the hit loses per N·s of impulse
     bool bondDebris = false; ///< a static object's debris stays in the structure, bonded across its cut faces
                              ///< until the solver breaks it (a partial crack); false: thrown, no bonds
     double bearingFriction = 0.6; ///< > 0: objects (and what is cut from them) rest on each other as
@@ -166,21 +167,22 @@ struct ImpactMark {
 
 /// What one frame did.
 struct FrameStats {
-    int substeps = 0;         ///< internal physics steps
-    int impactsSubmitted = 0; ///< impacts accepted by the DestructionWorld
-    int projectileHits = 0;   ///< projectiles that hit something this frame
-    int fractures = 0;        ///< outcomes adopted
-    int piecesCreated = 0;    ///< piece bodies created
-    int piecesRetired = 0;    ///< bodies and dust turned into particles
-    int piecesCollapsed = 0;  ///< static objects or pieces that lost their support and became dynamic
-    int piecesFrozen = 0;     ///< debris bodies frozen
-    int piecesWoken = 0;      ///< frozen bodies woken by a hit
-    int supportSearches = 0;  ///< support searches run
-    double supportMs = 0;     ///< of adoptMs: support (neighbour tests, searches, collapses)
-    int bondsBroken = 0;      ///< structure bonds broken by stress or damage
-    double structureMs = 0;   ///< of adoptMs: bond graph and stress solve
-    double physicsMs = 0;     ///< physics step incl. contact gathering
-    double adoptMs = 0;       ///< submit + collect + adoption + governor
+    int substeps = 0;             ///< internal physics steps
+    int impactsSubmitted = 0;     ///< impacts accepted by the DestructionWorld
+    int projectileHits = 0;       ///< projectiles that hit something this frame
+    int fractures = 0;            ///< outcomes adopted
+    int piecesCreated = 0;        ///< piece bodies created
+    int piecesRetired = 0;        ///< bodies and dust turned into particles
+    int piecesCollapsed = 0;      ///< static objects or pieces that lost their support and became dynamic
+    int piecesFrozen = 0;         ///< debris bodies frozen
+    int piecesWoken = 0;          ///< frozen bodies woken by a hit
+    int supportSearches = 0;      ///< support searches run
+    double supportMs = 0;         ///< of adoptMs: support (neighbour tests, searches, collapses)
+    int bondsBroken = 0;          ///< structure bonds broken by stress or damage
+    double structureMs = 0;       ///< of adoptMs: bond graph and stress solve
+    double structureResidual = 0; ///< relative residual of the stress solve the frame acted on (0: none)
+    double physicsMs = 0;         ///< physics step incl. contact gathering
+    double adoptMs = 0;           ///< submit + collect + adoption + governor
 };
 
 /// Pieces turned into particles, by reason.

@@ -43,6 +43,14 @@ struct BondStress {
     double shear = 0;       ///< mean transverse shear plus the largest torsional shear
 };
 
+/// How StressSolver::solve() iterates (docs/structure.md, "Convergence").
+enum class StressMethod {
+    SweepBudget, ///< Gauss-Seidel over every bond, at most `iterations` sweeps (the solver before issue #32)
+    GaussSeidel, ///< Gauss-Seidel over the bonds of the nodes not at rest, until `residual` is met
+    ConjugateGradient ///< block-Jacobi preconditioned conjugate gradient on the welds, until `residual` is
+                      ///< met
+};
+
 /// Settings of the stress solver.
 struct StressSettings {
     int iterations = 25;       ///< Gauss-Seidel sweeps over all bonds per solve(), at most
@@ -52,6 +60,15 @@ struct StressSettings {
     Vec3 gravity{0, -9.81, 0}; ///< m/s^2
     double unbalanced = 0.5;   ///< m/s^2 (and rad/s^2): a node left accelerating this much is not held
     int unbalancedSolves = 30; ///< ... after this many solves in a row (the warm-started solve converges)
+    StressMethod method = StressMethod::GaussSeidel; ///< how solve() iterates
+    double residual = 1e-3; ///< GaussSeidel, ConjugateGradient: the relative residual solve() reaches
+    int maxSweeps = 5000;   ///< GaussSeidel, ConjugateGradient: sweeps (iterations) at most, for structures
+                            ///< bearings cannot hold (they never converge)
+    bool deadLoadGuess = false; ///< GaussSeidel, ConjugateGradient: a structure whose bonds carry nothing yet
+                                ///< starts from its dead load passed down (off: it biases which equilibrium
+                                ///< indeterminate contacts reach; docs/structure.md)
+    bool trace = false; ///< record the relative residual after every sweep (history(); costs a pass over
+                        ///< the nodes per sweep)
 };
 
 /// The stress solver over one structure (nodes joined by bonds).
@@ -64,7 +81,9 @@ public:
     void reset(std::vector<StructureNode> nodes, std::vector<Bond> bonds, std::vector<StrengthLimits> limits);
     /// Adds a node (in a free slot when there is one); returns its index.
     std::uint32_t addNode(const StructureNode& node);
-    /// Removes a node and its bonds; its index is free for a later addNode.
+    /// Removes a node and its bonds; its index is free for a later addNode. Until the next solve, bonds added
+    /// to its former neighbours across the same faces inherit the forces its bonds carried (by area): the
+    /// pieces that replace a fractured body start from its load path.
     void removeNode(std::uint32_t node);
     /// Adds a bond between present nodes (in a free slot when there is one); returns its index. The other
     /// bonds keep their forces and health.
@@ -85,8 +104,14 @@ public:
     /// Runs the bounded iterations, starting from the previous solve's bond forces; consumes the loads.
     void solve();
 
-    /// Sweeps the last solve() ran.
+    /// Sweeps (or conjugate-gradient iterations) the last solve() ran.
     int sweeps() const { return sweeps_; }
+    /// The last solve()'s relative residual: the largest remaining acceleration of a supported node (its
+    /// linear and angular parts in the mass metric, m/s^2) over the largest acceleration the loads alone
+    /// give.
+    double residual() const { return residual_; }
+    /// With StressSettings::trace: the relative residual after each sweep of the last solve().
+    const std::vector<double>& history() const { return history_; }
     /// Bond slots (removed bonds leave free slots, which count as broken).
     std::size_t bondCount() const { return bonds_.size(); }
     /// Node slots (removed nodes leave free slots, never unsupported).
@@ -132,6 +157,8 @@ private:
         Mat3 invInertia;
         Vec3 v, w;          // velocity change this solve
         Vec3 force, torque; // loads this solve
+        Vec3 fv, fw;        // the loads' (and gravity's) part of v and w
+        bool dirty = false; // v and w to be recomputed from the bonds at the next solve
         bool detached = false;
         bool removed = false;           // a free slot
         int unbalanced = 0;             // solves in a row that left it accelerating
@@ -165,6 +192,18 @@ private:
     double bearingUtilisation(const BondState& b) const;
     void solveBearing(BondState& b);
     void gatherBearing(BondState& b);
+    void solveWeld(BondState& b);
+    void markDirty(std::uint32_t node);
+    double startSolve();
+    void reach();
+    std::vector<char> reachable() const;
+    double nodeResidual(const NodeState& n) const;
+    bool movable(std::uint32_t i) const;
+    void solveSweepBudget();
+    void solveGaussSeidel(double tolerance);
+    void solveConjugateGradient(double tolerance);
+    void finishSolve(double scale);
+    void traceSweep();
 
     StressSettings settings_;
     std::vector<NodeState> nodes_;
@@ -172,7 +211,27 @@ private:
     std::vector<std::uint32_t> freeNodes_; // descending pops give the lowest slot first
     std::vector<std::uint32_t> checked_;   // solve(): the nodes whose rest ends the sweeps
     int sweeps_ = 0;
+    double residual_ = 0;
+    double scale_ = 0; // the last solve's residual scale (m/s^2)
+    std::vector<double> history_;
     std::vector<std::size_t> freeBonds_;
+    std::vector<std::uint32_t> dirty_; // nodes whose v and w the next solve recomputes
+    bool allDirty_ = true;             // every node's (gravity changed, or never solved)
+    Vec3 gravity_;                     // the gravity v and w hold
+    std::vector<char> reached_;        // a chain of intact bonds links the node to a root
+    bool reachValid_ = false;          // reached_ matches the bonds
+    struct Orphan {                    // the load a removed node's bond put on a neighbour
+        std::uint32_t node;            // the neighbour
+        Vec3 force, moment;            // on it, the moment about the section centroid
+        Vec3 centroid, normal;         // the section's
+    };
+    void inherit();
+    void coldStart();
+    std::vector<Orphan> orphans_;          // since the last solve
+    std::vector<std::size_t> fresh_;       // bonds added since the last solve
+    std::vector<std::uint32_t> bondStamp_; // GaussSeidel: the sweep that listed the bond
+    std::vector<std::uint32_t> nodeStamp_; // ... that moved the node
+    std::uint32_t stampNow_ = 0;
 };
 
 } // namespace rubble

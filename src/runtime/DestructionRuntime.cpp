@@ -330,6 +330,7 @@ struct DestructionRuntime::Impl {
         const auto t0 = Clock::now();
         int broken = 0;
         const std::vector<BodyId> fallen = structure.step(binding.gravity(), broken);
+        stats.structureResidual = structure.residual();
         stats.bondsBroken += broken;
         counters.bondsBroken += broken;
         for (BodyId id : fallen) {

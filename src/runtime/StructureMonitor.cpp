@@ -108,10 +108,17 @@ std::vector<BodyId> StructureMonitor::step(const Vec3& gravity, int& broken) {
     pendingLoads_.clear();
     solver_.settings() = policy_.stress;
     solver_.settings().gravity = gravity;
-    if (settle)
+    const bool budget = policy_.stress.method == StressMethod::SweepBudget;
+    if (settle && budget)
         solver_.settings().iterations *= 10;
     solver_.solve();
-    (void)solver_.breakOverstressed();
+    // A converged solve finds the new load path of what broke in the same frame (a few rounds at most).
+    for (int round = 0; round < policy_.breakRounds; ++round) {
+        if (solver_.breakOverstressed().empty() || budget)
+            break;
+        solver_.solve();
+    }
+    residual_ = solver_.residual();
     broken += static_cast<int>(before() - brokenBefore);
     std::vector<BodyId> out;
     for (std::uint32_t n : solver_.unsupported())

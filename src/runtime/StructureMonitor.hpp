@@ -41,6 +41,8 @@ public:
     std::vector<StructureBond> bonds() const;
     /// Nodes.
     std::size_t size() const { return nodes_.size(); }
+    /// The relative residual of the last step's final solve.
+    double residual() const { return residual_; }
 
     /// A node as a snapshot keeps it.
     struct SavedNode {
@@ -78,6 +80,7 @@ private:
     std::map<BodyId, Node> nodes_;
     std::vector<BodyId> bodyOf_; // solver slot -> body (0: free)
     std::vector<BodyId> unclassified_;
+    double residual_ = 0;
     bool settle_ = false;
     std::vector<std::pair<Vec3, double>> pendingDamage_;
     struct Load {

@@ -2,8 +2,8 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <cmath>
-#include <deque>
 #include <limits>
 
 #include "rubble/MassProperties.hpp"
@@ -130,6 +130,11 @@ void StressSolver::reset(std::vector<StructureNode> nodes, std::vector<Bond> bon
     bonds_.clear();
     freeNodes_.clear();
     freeBonds_.clear();
+    dirty_.clear();
+    orphans_.clear();
+    fresh_.clear();
+    allDirty_ = true;
+    reachValid_ = false;
     for (const StructureNode& n : nodes)
         (void)addNode(n);
     for (std::size_t i = 0; i < bonds.size(); ++i)
@@ -143,6 +148,7 @@ std::uint32_t StressSolver::addNode(const StructureNode& node) {
         s.invMass = 1 / node.mass;
         s.invInertia = inverse(node.inertia);
     }
+    reachValid_ = false;
     if (freeNodes_.empty()) {
         nodes_.push_back(std::move(s));
         return static_cast<std::uint32_t>(nodes_.size() - 1);
@@ -157,10 +163,21 @@ void StressSolver::removeNode(std::uint32_t node) {
     NodeState& n = nodes_[node];
     if (n.removed)
         return;
+    for (std::size_t k : n.bonds) {
+        const BondState& b = bonds_[k];
+        if (b.broken || !b.solvable)
+            continue;
+        const std::uint32_t m = b.bond.other(node);
+        const double sign = b.bond.a == m ? 1.0 : -1.0;
+        orphans_.push_back(
+            {m, b.force * sign, b.moment * sign, b.bond.section.centroid, b.bond.section.normal});
+    }
+    std::erase_if(orphans_, [&](const Orphan& o) { return o.node == node; });
     for (std::size_t b : std::vector<std::size_t>(n.bonds))
         removeBond(b);
     n = NodeState{};
     n.removed = n.detached = true;
+    reachValid_ = false;
     freeNodes_.insert(std::upper_bound(freeNodes_.begin(), freeNodes_.end(), node, std::greater<>()), node);
 }
 
@@ -182,6 +199,9 @@ std::size_t StressSolver::addBond(Bond bond, StrengthLimits limits) {
         list.insert(std::upper_bound(list.begin(), list.end(), i), i);
         nodes_[n].bearings += limits.friction > 0;
     }
+    reachValid_ = false;
+    if (!orphans_.empty())
+        fresh_.push_back(i);
     return i;
 }
 
@@ -190,7 +210,9 @@ void StressSolver::removeBond(std::size_t i) {
     for (std::uint32_t n : {b.bond.a, b.bond.b}) {
         std::erase(nodes_[n].bonds, i);
         nodes_[n].bearings -= b.limits.friction > 0;
+        markDirty(n);
     }
+    reachValid_ = false;
     b = BondState{};
     b.removed = b.broken = true;
     freeBonds_.insert(std::upper_bound(freeBonds_.begin(), freeBonds_.end(), i, std::greater<>()), i);
@@ -205,8 +227,19 @@ void StressSolver::setRoot(std::uint32_t node, bool root) {
         n.invMass = 1 / n.node.mass;
         n.invInertia = inverse(n.node.inertia);
     }
-    for (std::size_t i : n.bonds)
+    markDirty(node);
+    for (std::size_t i : n.bonds) {
         prepare(bonds_[i]);
+        markDirty(bonds_[i].bond.other(node));
+    }
+    reachValid_ = false;
+}
+
+void StressSolver::markDirty(std::uint32_t node) {
+    if (!nodes_[node].dirty) {
+        nodes_[node].dirty = true;
+        dirty_.push_back(node);
+    }
 }
 
 // The lever arms and the inverse effective masses of a bond (or of a bearing's corners).
@@ -283,20 +316,222 @@ void StressSolver::apply(BondState& b, const Vec3& force, const Vec3& moment) {
     nb.w -= nb.invInertia * (cross(b.rb, force) + moment);
 }
 
+// Bonds added across the faces of removed bonds take their loads, split by area (a warm start: the solve
+// corrects it).
+void StressSolver::inherit() {
+    for (const Orphan& o : orphans_) {
+        std::vector<std::size_t> heirs;
+        double area = 0;
+        for (std::size_t k : fresh_) {
+            const BondState& b = bonds_[k];
+            if (!b.removed && !b.broken && b.solvable && (b.bond.a == o.node || b.bond.b == o.node) &&
+                std::abs(dot(b.bond.section.normal, o.normal)) > 0.99) {
+                heirs.push_back(k);
+                area += b.bond.section.sectionArea;
+            }
+        }
+        for (std::size_t k : heirs) {
+            BondState& b = bonds_[k];
+            const double share = area > 0 ? b.bond.section.sectionArea / area : 0.0;
+            const Vec3 force = o.force * share;
+            const Vec3 moment = (o.moment + cross(o.centroid - b.bond.section.centroid, o.force)) * share;
+            const double sign = b.bond.a == o.node ? 1.0 : -1.0;
+            b.force += force * sign;
+            b.moment += moment * sign;
+            for (BearingCorner& c : b.corners) // a bearing: its push, shared by the corners
+                c.press = std::max(0.0, -dot(b.force, b.bond.section.normal)) /
+                          static_cast<double>(b.corners.size());
+            if (!b.corners.empty())
+                gatherBearing(b);
+            markDirty(b.bond.a);
+            markDirty(b.bond.b);
+        }
+    }
+    orphans_.clear();
+    fresh_.clear();
+}
+
+// A structure whose bonds carry nothing yet (just built) starts from its dead load passed down: from the
+// highest node to the lowest, each node's weight and what rests on it goes to the bonds under it, by
+// horizontal section area (a warm start: the solve corrects it).
+void StressSolver::coldStart() {
+    for (const BondState& b : bonds_)
+        if (!b.broken && (lengthSquared(b.force) > 0 || lengthSquared(b.moment) > 0))
+            return;
+    const double g = length(settings_.gravity);
+    if (g <= 0)
+        return;
+    const Vec3 down = settings_.gravity / g;
+    std::vector<std::uint32_t> order;
+    for (std::uint32_t i = 0; i < nodes_.size(); ++i)
+        if (movable(i))
+            order.push_back(i);
+    auto height = [&](std::uint32_t i) { return -dot(nodes_[i].node.centroid, down); };
+    std::stable_sort(order.begin(), order.end(),
+                     [&](std::uint32_t x, std::uint32_t y) { return height(x) > height(y); });
+    std::vector<double> load(nodes_.size(), 0);
+    for (std::uint32_t i : order) {
+        const NodeState& n = nodes_[i];
+        const double total = load[i] + n.node.mass * g + std::max(0.0, dot(n.force, down));
+        double area = 0;
+        auto under = [&](const BondState& b) {
+            const BondInterface& x = b.bond.section;
+            return !b.broken && b.solvable && std::abs(dot(x.normal, down)) > 0.5 &&
+                   dot(x.centroid - n.node.centroid, down) > 0;
+        };
+        for (std::size_t k : n.bonds)
+            if (under(bonds_[k]))
+                area +=
+                    bonds_[k].bond.section.sectionArea * std::abs(dot(bonds_[k].bond.section.normal, down));
+        if (area <= 0)
+            continue;
+        for (std::size_t k : n.bonds) {
+            BondState& b = bonds_[k];
+            if (!under(b))
+                continue;
+            const double share =
+                total * b.bond.section.sectionArea * std::abs(dot(b.bond.section.normal, down)) / area;
+            const std::uint32_t j = b.bond.other(i);
+            if (movable(j))
+                load[j] += share;
+            b.force = down * (b.bond.a == i ? -share : share); // up on the node above
+            for (BearingCorner& c : b.corners)
+                c.press = share / static_cast<double>(b.corners.size());
+        }
+    }
+    allDirty_ = true;
+}
+
 void StressSolver::solve() {
-    // Unit time step: velocity changes are accelerations and accumulated impulses are forces.
-    for (NodeState& n : nodes_) {
+    if (!orphans_.empty())
+        inherit();
+    fresh_.clear();
+    if (settings_.method != StressMethod::SweepBudget && settings_.deadLoadGuess && allDirty_) {
+        if (!reachValid_)
+            reach();
+        coldStart();
+    }
+    const double scale = startSolve();
+    scale_ = scale;
+    history_.clear();
+    switch (settings_.method) {
+    case StressMethod::SweepBudget:
+        solveSweepBudget();
+        break;
+    case StressMethod::GaussSeidel:
+        solveGaussSeidel(settings_.residual * scale);
+        break;
+    case StressMethod::ConjugateGradient:
+        solveConjugateGradient(settings_.residual * scale);
+        break;
+    }
+    finishSolve(scale);
+}
+
+bool StressSolver::movable(std::uint32_t i) const {
+    const NodeState& n = nodes_[i];
+    return reached_[i] && n.invMass > 0 && !n.detached;
+}
+
+// The squared size of a node's acceleration (v, w) in the mass metric: |v|^2 + w.I w / m, in (m/s^2)^2.
+double StressSolver::nodeResidual(const NodeState& n) const {
+    return lengthSquared(n.v) + dot(n.w, n.node.inertia * n.w) * n.invMass;
+}
+
+// Unit time step: velocity changes are accelerations and accumulated impulses are forces. Each node's v and w
+// hold its acceleration under its loads and the bonds' forces between solves; this frame's loads replace the
+// last's, and nodes whose bonds changed are summed again. Returns the largest acceleration the loads alone
+// give a supported node (the residual's scale).
+double StressSolver::startSolve() {
+    if (!(settings_.gravity == gravity_))
+        allDirty_ = true;
+    gravity_ = settings_.gravity;
+    if (!reachValid_)
+        reach();
+    double scale2 = 0;
+    for (std::uint32_t i = 0; i < nodes_.size(); ++i) {
+        NodeState& n = nodes_[i];
+        Vec3 fv, fw;
         if (n.invMass > 0 && !n.detached) {
-            n.v = settings_.gravity + n.force * n.invMass;
-            n.w = n.invInertia * n.torque;
-        } else {
-            n.v = n.w = Vec3{};
+            fv = settings_.gravity + n.force * n.invMass;
+            fw = n.invInertia * n.torque;
         }
         n.force = n.torque = Vec3{};
+        if (allDirty_ || n.dirty) {
+            n.v = fv;
+            n.w = fw;
+            n.dirty = false;
+            for (std::size_t k : n.bonds) {
+                const BondState& b = bonds_[k];
+                if (b.broken || !b.solvable || n.invMass <= 0 || n.detached)
+                    continue;
+                const double sign = b.bond.a == i ? 1.0 : -1.0;
+                n.v += b.force * (sign * n.invMass);
+                n.w += n.invInertia * ((cross(b.bond.a == i ? b.ra : b.rb, b.force) + b.moment) * sign);
+            }
+        } else {
+            n.v += fv - n.fv;
+            n.w += fw - n.fw;
+        }
+        n.fv = fv;
+        n.fw = fw;
+        if (movable(i))
+            scale2 = std::max(scale2, lengthSquared(fv) + dot(fw, n.node.inertia * fw) * n.invMass);
     }
-    for (BondState& b : bonds_)
-        if (!b.broken && b.solvable)
-            apply(b, b.force, b.moment);
+    dirty_.clear();
+    allDirty_ = false;
+    return std::sqrt(scale2);
+}
+
+// The nodes a chain of intact bonds links to a root (kept until a bond or root changes).
+void StressSolver::reach() {
+    reached_ = reachable();
+    reachValid_ = true;
+}
+
+std::vector<char> StressSolver::reachable() const {
+    std::vector<char> reached(nodes_.size(), 0);
+    std::vector<std::uint32_t> open;
+    for (std::uint32_t i = 0; i < nodes_.size(); ++i)
+        if (nodes_[i].node.root && !nodes_[i].detached) {
+            reached[i] = 1;
+            open.push_back(i);
+        }
+    while (!open.empty()) {
+        const std::uint32_t n = open.back();
+        open.pop_back();
+        for (std::size_t i : nodes_[n].bonds) {
+            const BondState& b = bonds_[i];
+            const std::uint32_t m = b.bond.other(n);
+            if (!b.broken && !reached[m]) {
+                reached[m] = 1;
+                open.push_back(m);
+            }
+        }
+    }
+    return reached;
+}
+
+void StressSolver::solveWeld(BondState& b) {
+    const NodeState& na = nodes_[b.bond.a];
+    const NodeState& nb = nodes_[b.bond.b];
+    const Vec3 lin = (na.v + cross(na.w, b.ra)) - (nb.v + cross(nb.w, b.rb));
+    const Vec3 ang = na.w - nb.w;
+    const double rel[6] = {lin.x, lin.y, lin.z, ang.x, ang.y, ang.z};
+    double d[6];
+    for (int r = 0; r < 6; ++r) {
+        double sum = 0;
+        for (int c = 0; c < 6; ++c)
+            sum += b.kinv[r * 6 + c] * rel[c];
+        d[r] = -sum;
+    }
+    const Vec3 df{d[0], d[1], d[2]}, dm{d[3], d[4], d[5]};
+    b.force += df;
+    b.moment += dm;
+    apply(b, df, dm);
+}
+
+void StressSolver::solveSweepBudget() {
     // Sweeps stop early once every node a bond can still move is at rest within the tolerance.
     checked_.clear();
     for (std::uint32_t i = 0; i < nodes_.size(); ++i)
@@ -321,38 +556,213 @@ void StressSolver::solve() {
     auto resting = [&](const NodeState& n) {
         return settings_.tolerance > 0 && lengthSquared(n.v) <= quiet2 && lengthSquared(n.w) <= quiet2;
     };
-    for (sweeps_ = 0; sweeps_ < settings_.iterations && !converged(); ++sweeps_)
+    for (sweeps_ = 0; sweeps_ < settings_.iterations && !converged(); ++sweeps_) {
         for (BondState& b : bonds_) {
             if (b.broken || !b.solvable || (resting(nodes_[b.bond.a]) && resting(nodes_[b.bond.b])))
                 continue;
-            if (!b.corners.empty()) {
+            if (!b.corners.empty())
                 solveBearing(b);
-                continue;
-            }
-            const NodeState& na = nodes_[b.bond.a];
-            const NodeState& nb = nodes_[b.bond.b];
-            const Vec3 lin = (na.v + cross(na.w, b.ra)) - (nb.v + cross(nb.w, b.rb));
-            const Vec3 ang = na.w - nb.w;
-            const double rel[6] = {lin.x, lin.y, lin.z, ang.x, ang.y, ang.z};
-            double d[6];
-            for (int r = 0; r < 6; ++r) {
-                double sum = 0;
-                for (int c = 0; c < 6; ++c)
-                    sum += b.kinv[r * 6 + c] * rel[c];
-                d[r] = -sum;
-            }
-            const Vec3 df{d[0], d[1], d[2]}, dm{d[3], d[4], d[5]};
-            b.force += df;
-            b.moment += dm;
-            apply(b, df, dm);
+            else
+                solveWeld(b);
         }
+        traceSweep();
+    }
+}
+
+// Gauss-Seidel over a work list: each sweep visits, in ascending order, the bonds of the nodes whose
+// acceleration exceeds a quarter of the tolerance, until none exceeds the tolerance. A structure that did not
+// change costs one pass over its nodes; a local change, sweeps over its neighbourhood.
+void StressSolver::solveGaussSeidel(double tolerance) {
+    const double tolerance2 = tolerance * tolerance, quiet2 = tolerance2 * 1e-4;
+    std::vector<std::uint32_t> active, touched;
+    std::vector<std::size_t> list;
+    double max2 = 0;
+    for (std::uint32_t i = 0; i < nodes_.size(); ++i)
+        if (movable(i)) {
+            const double e2 = nodeResidual(nodes_[i]);
+            max2 = std::max(max2, e2);
+            if (e2 > quiet2)
+                active.push_back(i);
+        }
+    bondStamp_.resize(bonds_.size(), 0);
+    nodeStamp_.resize(nodes_.size(), 0);
+    auto resting = [&](std::uint32_t i) { return !movable(i) || nodeResidual(nodes_[i]) <= quiet2; };
+    for (sweeps_ = 0; sweeps_ < settings_.maxSweeps && max2 > tolerance2; ++sweeps_) {
+        if (++stampNow_ == 0) {
+            std::fill(bondStamp_.begin(), bondStamp_.end(), 0);
+            std::fill(nodeStamp_.begin(), nodeStamp_.end(), 0);
+            stampNow_ = 1;
+        }
+        list.clear();
+        for (std::uint32_t n : active)
+            for (std::size_t k : nodes_[n].bonds)
+                if (!bonds_[k].broken && bonds_[k].solvable && bondStamp_[k] != stampNow_) {
+                    bondStamp_[k] = stampNow_;
+                    list.push_back(k);
+                }
+        std::sort(list.begin(), list.end());
+        touched.clear();
+        for (std::size_t k : list) {
+            BondState& b = bonds_[k];
+            if (resting(b.bond.a) && resting(b.bond.b))
+                continue;
+            if (!b.corners.empty())
+                solveBearing(b);
+            else
+                solveWeld(b);
+            for (std::uint32_t n : {b.bond.a, b.bond.b})
+                if (nodeStamp_[n] != stampNow_) {
+                    nodeStamp_[n] = stampNow_;
+                    touched.push_back(n);
+                }
+        }
+        std::sort(touched.begin(), touched.end());
+        active.clear();
+        max2 = 0;
+        for (std::uint32_t n : touched)
+            if (movable(n)) {
+                const double e2 = nodeResidual(nodes_[n]);
+                max2 = std::max(max2, e2);
+                if (e2 > quiet2)
+                    active.push_back(n);
+            }
+        traceSweep();
+    }
+}
+
+// With StressSettings::trace, the relative residual after this sweep.
+void StressSolver::traceSweep() {
+    if (!settings_.trace)
+        return;
+    double max2 = 0;
+    for (std::uint32_t i = 0; i < nodes_.size(); ++i)
+        if (movable(i))
+            max2 = std::max(max2, nodeResidual(nodes_[i]));
+    history_.push_back(scale_ > 0 ? std::sqrt(max2) / scale_ : 0.0);
+}
+
+// Block-Jacobi preconditioned conjugate gradient on the welds' impulses (the system J M^-1 J^T l = -J v, the
+// preconditioner each weld's own 6x6 block, as Gauss-Seidel uses), restarted after a projected sweep over the
+// bearings every 16 iterations when there are any.
+void StressSolver::solveConjugateGradient(double tolerance) {
+    const double tolerance2 = tolerance * tolerance;
+    using Block = std::array<double, 6>;
+    std::vector<std::size_t> welds, bearings;
+    for (std::size_t k = 0; k < bonds_.size(); ++k) {
+        const BondState& b = bonds_[k];
+        if (b.broken || !b.solvable || (!movable(b.bond.a) && !movable(b.bond.b)))
+            continue;
+        (b.corners.empty() ? welds : bearings).push_back(k);
+    }
+    std::vector<Block> r(welds.size()), z(welds.size()), p(welds.size()), q(welds.size());
+    std::vector<Vec3> tv(nodes_.size()), tw(nodes_.size());
+    auto relative = [&](const BondState& b, const Vec3& va, const Vec3& wa, const Vec3& vb, const Vec3& wb) {
+        const Vec3 lin = (va + cross(wa, b.ra)) - (vb + cross(wb, b.rb)), ang = wa - wb;
+        return Block{lin.x, lin.y, lin.z, ang.x, ang.y, ang.z};
+    };
+    auto precondition = [&](const BondState& b, const Block& in, Block& out) {
+        for (int i = 0; i < 6; ++i) {
+            double sum = 0;
+            for (int c = 0; c < 6; ++c)
+                sum += b.kinv[i * 6 + c] * in[c];
+            out[i] = sum;
+        }
+    };
+    auto dot6 = [](const Block& a, const Block& b) {
+        double s = 0;
+        for (int i = 0; i < 6; ++i)
+            s += a[i] * b[i];
+        return s;
+    };
+    auto maxResidual2 = [&] {
+        double m = 0;
+        for (std::uint32_t i = 0; i < nodes_.size(); ++i)
+            if (movable(i))
+                m = std::max(m, nodeResidual(nodes_[i]));
+        return m;
+    };
+    double rz = 0;
+    auto restart = [&] {
+        rz = 0;
+        for (std::size_t j = 0; j < welds.size(); ++j) {
+            const BondState& b = bonds_[welds[j]];
+            const NodeState &na = nodes_[b.bond.a], &nb = nodes_[b.bond.b];
+            r[j] = relative(b, na.v, na.w, nb.v, nb.w);
+            for (double& x : r[j])
+                x = -x;
+            precondition(b, r[j], z[j]);
+            p[j] = z[j];
+            rz += dot6(r[j], z[j]);
+        }
+    };
+    restart();
+    for (sweeps_ = 0; sweeps_ < settings_.maxSweeps && maxResidual2() > tolerance2; ++sweeps_) {
+        if (!bearings.empty() && (sweeps_ % 16 == 15 || rz <= 0)) {
+            for (std::size_t k : bearings)
+                solveBearing(bonds_[k]);
+            restart();
+            traceSweep();
+            continue;
+        }
+        if (rz <= 0)
+            break;
+        std::fill(tv.begin(), tv.end(), Vec3{});
+        std::fill(tw.begin(), tw.end(), Vec3{});
+        for (std::size_t j = 0; j < welds.size(); ++j) {
+            const BondState& b = bonds_[welds[j]];
+            const Vec3 f{p[j][0], p[j][1], p[j][2]}, m{p[j][3], p[j][4], p[j][5]};
+            const NodeState &na = nodes_[b.bond.a], &nb = nodes_[b.bond.b];
+            tv[b.bond.a] += f * na.invMass;
+            tw[b.bond.a] += na.invInertia * (cross(b.ra, f) + m);
+            tv[b.bond.b] -= f * nb.invMass;
+            tw[b.bond.b] -= nb.invInertia * (cross(b.rb, f) + m);
+        }
+        double pq = 0;
+        for (std::size_t j = 0; j < welds.size(); ++j) {
+            const BondState& b = bonds_[welds[j]];
+            q[j] = relative(b, tv[b.bond.a], tw[b.bond.a], tv[b.bond.b], tw[b.bond.b]);
+            pq += dot6(p[j], q[j]);
+        }
+        if (pq <= 0)
+            break;
+        const double alpha = rz / pq;
+        double rzNext = 0;
+        for (std::size_t j = 0; j < welds.size(); ++j) {
+            BondState& b = bonds_[welds[j]];
+            b.force += Vec3{p[j][0], p[j][1], p[j][2]} * alpha;
+            b.moment += Vec3{p[j][3], p[j][4], p[j][5]} * alpha;
+            for (int i = 0; i < 6; ++i)
+                r[j][i] -= alpha * q[j][i];
+            precondition(b, r[j], z[j]);
+            rzNext += dot6(r[j], z[j]);
+        }
+        for (std::uint32_t i = 0; i < nodes_.size(); ++i) {
+            nodes_[i].v += tv[i] * alpha;
+            nodes_[i].w += tw[i] * alpha;
+        }
+        const double beta = rzNext / rz;
+        rz = rzNext;
+        for (std::size_t j = 0; j < welds.size(); ++j)
+            for (int i = 0; i < 6; ++i)
+                p[j][i] = z[j][i] + beta * p[j][i];
+        traceSweep();
+    }
+}
+
+// Bearings' resultants, the residual, and the count of solves each node has been left unbalanced.
+void StressSolver::finishSolve(double scale) {
     for (BondState& b : bonds_)
         if (!b.broken && b.solvable && !b.corners.empty())
             gatherBearing(b);
-    for (NodeState& n : nodes_) {
+    double max2 = 0;
+    for (std::uint32_t i = 0; i < nodes_.size(); ++i) {
+        NodeState& n = nodes_[i];
+        if (movable(i))
+            max2 = std::max(max2, nodeResidual(n));
         const bool moving = length(n.v) > settings_.unbalanced || length(n.w) > settings_.unbalanced;
         n.unbalanced = n.bearings > 0 && n.invMass > 0 && !n.detached && moving ? n.unbalanced + 1 : 0;
     }
+    residual_ = scale > 0 ? std::sqrt(max2) / scale : 0.0;
 }
 
 BondStress StressSolver::stress(std::size_t i) const {
@@ -511,39 +921,29 @@ void StressSolver::setHealth(std::size_t i, double health) {
 }
 
 void StressSolver::breakBond(std::size_t i) {
+    if (!bonds_[i].broken) {
+        markDirty(bonds_[i].bond.a);
+        markDirty(bonds_[i].bond.b);
+        reachValid_ = false;
+    }
     bonds_[i].broken = true;
     bonds_[i].force = bonds_[i].moment = Vec3{};
 }
 
 void StressSolver::detach(std::uint32_t node) {
     nodes_[node].detached = true;
+    markDirty(node);
+    reachValid_ = false;
     for (std::size_t i : nodes_[node].bonds)
         breakBond(i);
 }
 
 std::vector<std::uint32_t> StressSolver::unsupported() const {
-    std::vector<char> reached(nodes_.size(), 0);
-    std::deque<std::uint32_t> open;
-    for (std::uint32_t i = 0; i < nodes_.size(); ++i)
-        if (nodes_[i].node.root && !nodes_[i].detached) {
-            reached[i] = 1;
-            open.push_back(i);
-        }
-    while (!open.empty()) {
-        const std::uint32_t n = open.front();
-        open.pop_front();
-        for (std::size_t i : nodes_[n].bonds) {
-            const BondState& b = bonds_[i];
-            const std::uint32_t m = b.bond.other(n);
-            if (!b.broken && !reached[m]) {
-                reached[m] = 1;
-                open.push_back(m);
-            }
-        }
-    }
+    const std::vector<char> fresh = reachValid_ ? std::vector<char>{} : reachable();
+    const std::vector<char>& r = reachValid_ ? reached_ : fresh;
     std::vector<std::uint32_t> out;
     for (std::uint32_t i = 0; i < nodes_.size(); ++i)
-        if ((!reached[i] || nodes_[i].unbalanced >= settings_.unbalancedSolves) && !nodes_[i].detached)
+        if ((!r[i] || nodes_[i].unbalanced >= settings_.unbalancedSolves) && !nodes_[i].detached)
             out.push_back(i);
     return out;
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "BondLookup.hpp"
 #include "rubble/StressSolver.hpp"
 
 using namespace rubble;
@@ -47,13 +48,7 @@ struct Scene {
     }
 };
 
-std::size_t bondBetween(const StressSolver& s, std::uint32_t a, std::uint32_t b) {
-    for (std::size_t i = 0; i < s.bondCount(); ++i)
-        if (s.bond(i).a == std::min(a, b) && s.bond(i).b == std::max(a, b))
-            return i;
-    ADD_FAILURE() << "no bond " << a << "-" << b;
-    return 0;
-}
+using test::bondBetween;
 } // namespace
 
 TEST(StressSolver, NodeMassAndInertiaFromTheParts) {
