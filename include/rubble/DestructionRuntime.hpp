@@ -99,9 +99,10 @@ struct SupportPolicy {
 struct StructurePolicy {
     bool enabled = false;              ///< off: support is connectivity only (SupportPolicy)
     BondSettings bonds{0.02, 1, 1e-4}; ///< what counts as a bond (gap as SupportPolicy::tolerance)
-    StressSettings stress{}; ///< the solver (converged Gauss-Seidel to a relative residual of 1e-3); gravity
-                             ///< is the binding's. With StressMethod::SweepBudget: at most `iterations`
-                             ///< sweeps a frame (ten times that in the first solve after objects are placed)
+    StressSettings stress{}; ///< the solver (a sweep budget by default; StressMethod::GaussSeidel converges
+                             ///< to a relative residual of 1e-3); gravity is the binding's. With
+                             ///< StressMethod::SweepBudget: at most `iterations` sweeps a frame (ten times
+                             ///< that in the first solve after objects are placed)
     int breakRounds = 8; ///< solves after bonds break in a frame, for the new load path (converged methods)
     double damageRadius = 1.0;      ///< impacts weaken bonds within this distance (m) of the hit
     double damagePerImpulse = 1e-4; ///< health a bond at the hit loses per N·s of impulse

@@ -60,10 +60,11 @@ struct StressSettings {
     Vec3 gravity{0, -9.81, 0}; ///< m/s^2
     double unbalanced = 0.5;   ///< m/s^2 (and rad/s^2): a node left accelerating this much is not held
     int unbalancedSolves = 30; ///< ... after this many solves in a row (the warm-started solve converges)
-    StressMethod method = StressMethod::GaussSeidel; ///< how solve() iterates
-    double residual = 1e-3; ///< GaussSeidel, ConjugateGradient: the relative residual solve() reaches
-    int maxSweeps = 5000;   ///< GaussSeidel, ConjugateGradient: sweeps (iterations) at most, for structures
-                            ///< bearings cannot hold (they never converge)
+    StressMethod method =
+        StressMethod::SweepBudget; ///< how solve() iterates (docs/structure.md, "Convergence")
+    double residual = 1e-3;        ///< GaussSeidel, ConjugateGradient: the relative residual solve() reaches
+    int maxSweeps = 5000; ///< GaussSeidel, ConjugateGradient: sweeps (iterations) at most, for structures
+                          ///< bearings cannot hold (they never converge)
     bool deadLoadGuess = false; ///< GaussSeidel, ConjugateGradient: a structure whose bonds carry nothing yet
                                 ///< starts from its dead load passed down (off: it biases which equilibrium
                                 ///< indeterminate contacts reach; docs/structure.md)

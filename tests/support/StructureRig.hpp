@@ -13,13 +13,14 @@ namespace rubble::test {
 /// The runtime over the toy engine with a 100 x 1 x 100 m ground box under y = 0.
 struct StructureRig {
     explicit StructureRig(bool structure, int workers = 1, bool bondDebris = false,
-                          double bearingFriction = 0)
-        : runtime(engine, config(structure, workers, bondDebris, bearingFriction)) {
+                          double bearingFriction = 0, StressMethod method = StressSettings{}.method)
+        : runtime(engine, config(structure, workers, bondDebris, bearingFriction, method)) {
         runtime.addGround({0, -0.5, 0}, {50, 0.5, 50});
     }
     /// Deterministic settings, seed 5, no dust limit.
     static DestructionRuntime::Config config(bool structure, int workers, bool bondDebris,
-                                             double bearingFriction = 0) {
+                                             double bearingFriction = 0,
+                                             StressMethod method = StressSettings{}.method) {
         DestructionRuntime::Config c;
         c.world.workers = workers;
         c.world.deterministic = true;
@@ -28,6 +29,7 @@ struct StructureRig {
         c.structure.enabled = structure;
         c.structure.bondDebris = bondDebris;
         c.structure.bearingFriction = bearingFriction;
+        c.structure.stress.method = method;
         return c;
     }
     /// A static box of density 500 (indestructible unless fracture is given).
