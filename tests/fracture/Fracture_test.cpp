@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <map>
 
+#include "PieceHash.hpp"
 #include "TestSupport.hpp"
 #include "fracture/ConvexCellClipper.hpp"
 #include "rubble/Fracture.hpp"
@@ -94,13 +95,6 @@ void checkResult(const Mesh& input, const FractureResult& r, const std::string& 
     EXPECT_GE(r.timings.totalMs, r.timings.booleanMs) << what;
 }
 
-std::uint64_t hashAll(const FractureResult& r) {
-    std::uint64_t h = 1469598103934665603ull;
-    for (const Piece& p : r.pieces)
-        h = mixSeed(h, p.mesh.hash());
-    return h;
-}
-
 /// Fallbacks to the exact backend, by cell pattern.
 struct Fallbacks {
     int single = 0, singleImpacts = 0;   ///< CellPattern::SingleCell
@@ -139,7 +133,7 @@ int runImpacts(const Mesh& mesh, const std::string& name, int count, BooleanKind
             auto again = fracture(mesh, impact, params, s);
             EXPECT_TRUE(again.isOk());
             if (again) {
-                EXPECT_EQ(hashAll(*r), hashAll(*again)) << what << ": not deterministic";
+                EXPECT_EQ(test::hashPieces(*r), test::hashPieces(*again)) << what << ": not deterministic";
             }
         }
     }
@@ -304,7 +298,7 @@ TEST(Fracture, NefBackendFractures) {
     for (int i = 0; i < 3; ++i) {
         auto again = fracture(box, {{0.99, 0.1, 0}, {1, 0, 0}, 1}, params, 4);
         ASSERT_TRUE(again.isOk());
-        EXPECT_EQ(hashAll(*again), hashAll(*r));
+        EXPECT_EQ(test::hashPieces(*again), test::hashPieces(*r));
     }
 }
 
@@ -458,7 +452,7 @@ TEST(Fracture, FastRedrawsADeclinedPattern) {
     checkResult(*arch, *r, "redrawn pattern");
     auto again = fracture(*arch, impact, params, 3);
     ASSERT_TRUE(again.isOk());
-    EXPECT_EQ(hashAll(*r), hashAll(*again));
+    EXPECT_EQ(test::hashPieces(*r), test::hashPieces(*again));
 }
 
 TEST(Fracture, OpenOrInvalidInputIsRejected) {

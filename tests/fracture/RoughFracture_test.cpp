@@ -9,6 +9,7 @@
 #include <map>
 #include <set>
 
+#include "PieceHash.hpp"
 #include "TestSupport.hpp"
 #include "fracture/RoughCut.hpp"
 #include "rubble/Fracture.hpp"
@@ -113,13 +114,6 @@ double offCube(const FractureResult& r) {
             }
         }
     return worst;
-}
-
-std::uint64_t hashAll(const FractureResult& r) {
-    std::uint64_t h = 1469598103934665603ull;
-    for (const Piece& p : r.pieces)
-        h = mixSeed(h, p.mesh.hash());
-    return h;
 }
 
 /// A cube cut by one big cell: its part x > 0.01 (the cut is a square of area 4; x = 0 holds vertices).
@@ -300,15 +294,15 @@ TEST(RoughFracture, SameSeedSameBytesOtherSeedOtherSurface) {
     auto b = fracture(input, impact, params, 42);
     ASSERT_TRUE(a && b);
     EXPECT_TRUE(a->rough);
-    EXPECT_EQ(hashAll(*a), hashAll(*b));
+    EXPECT_EQ(test::hashPieces(*a), test::hashPieces(*b));
     // Pinned, as the flat scenes' golden hash (tests/persist/GoldenHash_test.cpp): a change of the rough
     // surface's bytes must be deliberate.
-    EXPECT_EQ(hashAll(*a), 0xcb37e76bfb39785full);
+    EXPECT_EQ(test::hashPieces(*a), 0xcb37e76bfb39785full);
     FractureParams other = params;
     other.roughness.seed = 1;
     auto c = fracture(input, impact, other, 42);
     ASSERT_TRUE(c);
-    EXPECT_NE(hashAll(*a), hashAll(*c));
+    EXPECT_NE(test::hashPieces(*a), test::hashPieces(*c));
     // Flat is the default, and roughness 0 is flat, bit for bit.
     FractureParams flat = params;
     flat.roughness = {};
@@ -317,8 +311,8 @@ TEST(RoughFracture, SameSeedSameBytesOtherSeedOtherSurface) {
     auto g = fracture(input, impact, flat, 42);
     ASSERT_TRUE(f && g);
     EXPECT_FALSE(f->rough);
-    EXPECT_EQ(hashAll(*f), hashAll(*g));
-    EXPECT_NE(hashAll(*f), hashAll(*a));
+    EXPECT_EQ(test::hashPieces(*f), test::hashPieces(*g));
+    EXPECT_NE(test::hashPieces(*f), test::hashPieces(*a));
 }
 
 TEST(RoughFracture, SmallPiecesFollowTheBudget) {

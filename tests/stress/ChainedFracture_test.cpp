@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "../fuzz/FuzzChecks.hpp"
+#include "PieceHash.hpp"
 #include "RepositoryModels.hpp"
 #include "TestSupport.hpp"
 #include "rubble/Fracture.hpp"
@@ -44,13 +45,6 @@ std::vector<Shape> stressShapes() {
     test::appendRepositoryModels(shapes, {"arch", "building", "column", "cube_588", "fighter", "missile",
                                           "projectile", "pyramid", "ship", "wall"});
     return shapes;
-}
-
-std::uint64_t hashPieces(const FractureResult& r) {
-    std::uint64_t h = 1469598103934665603ull;
-    for (const Piece& p : r.pieces)
-        h = mixSeed(h, p.mesh.hash());
-    return h;
 }
 
 void dumpInput(const char* dir, const Mesh& parent, const Impact& impact, const FractureParams& params,
@@ -163,7 +157,7 @@ TEST(ChainedFractureStress, RandomImpactsOnRandomPiecesStayValid) {
             }
             if (impacts % 97 == 0) {
                 auto again = fracture(parent, impact, params, seed);
-                if (!again || hashPieces(*again) != hashPieces(*r)) {
+                if (!again || test::hashPieces(*again) != test::hashPieces(*r)) {
                     ++nondeterministic;
                     ADD_FAILURE() << what << ": the same seed gave different pieces";
                 }

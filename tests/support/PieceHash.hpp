@@ -1,0 +1,19 @@
+#pragma once
+// A hash of a fracture's pieces, shared by the determinism tests.
+
+#include <cstdint>
+
+#include "rubble/Fracture.hpp"
+#include "rubble/Random.hpp"
+
+namespace rubble::test {
+
+/// A hash of a fracture's pieces' meshes, in order (same seed → same bytes).
+inline std::uint64_t hashPieces(const FractureResult& r) {
+    std::uint64_t h = 1469598103934665603ull;
+    for (const Piece& p : r.pieces)
+        h = mixSeed(h, p.mesh.hash());
+    return h;
+}
+
+} // namespace rubble::test
