@@ -50,7 +50,7 @@ inline constexpr ParamRange kParamRanges[] = {
     {"seed", ParamKind::Integer, 0, 18446744073709551615.0L},
     {"density", ParamKind::Real, 0, kMaxDensity, true},
     {"max_parts", ParamKind::Integer, 1, kMaxConvexParts}, // DecompositionParams::maxParts
-    {"roughness", ParamKind::Real, 0, 1},    // Roughness::amplitude, relative to the cell size
+    {"roughness", ParamKind::Real, 0, 1},                  // Roughness::amplitude, relative to the cell size
     {"feature_size", ParamKind::Real, 0, 4}, // Roughness::featureSize, relative to the cell size
     {"hurst", ParamKind::Real, 0, 1, true},
     {"octaves", ParamKind::Integer, 1, kMaxRoughOctaves},

@@ -84,8 +84,8 @@ Status checkCoordinateRange(const Mesh& mesh, const std::string& what) {
         const double most = std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
         if (most > kMaxCoordinate)
             return makeError(ErrorCode::InvalidInput,
-                             what + ": vertex " + std::to_string(i) + " has a coordinate of " +
-                                 num(most) + ", beyond ±" + num(kMaxCoordinate) +
+                             what + ": vertex " + std::to_string(i) + " has a coordinate of " + num(most) +
+                                 ", beyond ±" + num(kMaxCoordinate) +
                                  " (the bound that keeps the volume integrals finite); scale the mesh down");
     }
     return {};

@@ -865,8 +865,8 @@ const rubble::tools::Registrar registrar{
                         "amplitude of rough cut faces, a fraction of the cell size (0: flat)");
          app.add_option("--hurst", args->hurst, "Hurst exponent of rough cut faces, in (0, 1]");
          app.add_option(
-                "--feature-size", args->featureSize,
-                "longest wavelength of rough cut faces, a fraction of the cell size (0: 8 amplitudes)");
+             "--feature-size", args->featureSize,
+             "longest wavelength of rough cut faces, a fraction of the cell size (0: 8 amplitudes)");
          app.add_option("--backend", args->backend, "boolean backend (default: the library's default)")
              ->check(CLI::IsMember({"corefine", "nef", "fast"}));
          app.add_option("-o,--output", args->output, "output folder (must not exist, or be empty)")
