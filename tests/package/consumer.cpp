@@ -46,7 +46,7 @@ int main() {
     desc.mesh = cube;
     desc.impulseThreshold = 1;
     const rubble::Result<rubble::ObjectId> object =
-        runtime.addObject(desc, rubble::Frame{{}, {0, 1, 0}}, true);
+        runtime.addObject(desc, rubble::Frame{rubble::Mat3::identity(), {0, 1, 0}}, true);
     if (!object) {
         std::fprintf(stderr, "addObject failed: %s\n", object.error().message.c_str());
         return 1;

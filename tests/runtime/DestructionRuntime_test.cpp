@@ -84,6 +84,27 @@ struct ToyRig {
 
 } // namespace
 
+// A placement that is no rigid motion (Mat3{} is the zero matrix) is refused: its impacts had no normal.
+TEST(DestructionRuntime, APlacementThatIsNoRigidMotionIsRefused) {
+    ToyRig rig;
+    const std::size_t bodies = rig.runtime.bodyCount();
+    Mat3 stretched = Mat3::identity();
+    stretched.m[0][0] = 2;
+    Mat3 mirrored = Mat3::identity();
+    mirrored.m[2][2] = -1;
+    for (const Frame& f : {Frame{Mat3{}, {0, 1, 0}}, Frame{stretched, {0, 1, 0}}, Frame{mirrored, {0, 1, 0}},
+                           Frame{Mat3::identity(), {0, std::nan(""), 0}}}) {
+        ObjectDesc d;
+        d.mesh = makeBox({-1, -1, -1}, {1, 1, 1});
+        const Result<ObjectId> id = rig.runtime.addObject(std::move(d), f, true);
+        ASSERT_FALSE(id);
+        EXPECT_EQ(id.error().code, ErrorCode::InvalidInput);
+        EXPECT_NE(id.error().message.find("not a rigid motion"), std::string::npos) << id.error().message;
+    }
+    EXPECT_EQ(rig.runtime.bodyCount(), bodies);
+    EXPECT_TRUE(rig.runtime.world().objects().empty());
+}
+
 TEST(DestructionRuntime, ColumnCutOnTheToyEngineKeepsItsFootAndDropsWhatItHeld) {
     ToyRig rig;
     const ObjectId column = rig.addBox({0.5, 4, 0.5}, {0, 4, 0}, true, cubeCell(2.4));
