@@ -167,11 +167,11 @@ rubble_status toParams(const char* function, const rubble_fracture_params& in, r
                                                         : rubble::BooleanKind::Fast;
     rubble::RoughnessChoice choice;
     choice.material = in.material ? in.material : "";
-    if (in.roughness >= 0)
+    if (!(in.roughness < 0)) // NaN is set (and refused), not unset
         choice.amplitude = in.roughness;
-    if (in.hurst > 0)
+    if (!(in.hurst <= 0))
         choice.hurst = in.hurst;
-    if (in.feature_size >= 0)
+    if (!(in.feature_size < 0))
         choice.featureSize = in.feature_size;
     auto roughness = rubble::chooseRoughness(choice);
     if (!roughness)

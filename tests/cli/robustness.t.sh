@@ -99,8 +99,8 @@ awk '/^v /{printf "v %s %s %s\n", $2*1e300, $3*1e300, $4*1e300; next} {print}' "
 run "$tmp/huge.json" "$RUBBLE" check --json "$tmp/huge.obj"
 [ "$c" -eq 1 ] || fail "1e300 cube: exit $c"
 json_ok "$tmp/huge.json" "d['meshes'][0]['valid'] is False and d['meshes'][0]['problems'] == \
-    [\"7 vertices have a coordinate beyond ±1e+50, the bound that keeps the volume integrals finite (e.g. vertex 2 \
-at 1e+300, vertex 3 at 1e+300, vertex 4 at 1e+300); scale the mesh down\"]" \
+    [\"7 vertices have a coordinate beyond ±1e+50, the bound that keeps the volume integrals finite (e.g. vertex 1 \
+at 1e+300, vertex 2 at 1e+300, vertex 3 at 1e+300); scale the mesh down\"]" \
     || fail "1e300 cube JSON: $(cat "$tmp/huge.json")"
 "$RUBBLE" check --json "$data/cube.obj" >"$tmp/valid.json"
 json_ok "$tmp/valid.json" "d['meshes'][0]['valid'] is True and d['meshes'][0]['problems'] == []" \

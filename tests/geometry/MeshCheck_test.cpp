@@ -302,7 +302,7 @@ TEST(MeshCheck, HugeAndTinyMeshesAreJudgedWithoutOverflow) {
     EXPECT_EQ(huge.hugeVertices, 7u);
     ASSERT_EQ(huge.problems.size(), 1u) << test::joinLines(huge.problems);
     EXPECT_EQ(huge.problems[0].rfind("7 vertices have a coordinate beyond ±1e+50, the bound that keeps the "
-                                     "volume integrals finite (e.g. vertex 2 at 1e+300",
+                                     "volume integrals finite (e.g. vertex 1 at 1e+300",
                                      0),
               0u)
         << huge.problems[0];
