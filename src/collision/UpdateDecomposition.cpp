@@ -575,7 +575,10 @@ void mergeToBudget(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t
         if (c.covers) // the craters cannot all stay open: the rest merges as without a guard
             guard = nullptr;
         owned[c.i] = std::move(bestHull->overlaps);
-        for (std::size_t k : blocked[c.j]) {
+        const std::vector<std::size_t> partners = blocked[c.j]; // a copy: the loop grows these lists
+        for (std::size_t k : partners) {
+            if (k == c.i || k == c.j)
+                continue;
             blocked[c.i].push_back(k);
             blocked[k].push_back(c.i);
         }
