@@ -37,16 +37,23 @@ if [ ! -f "$dir/build.ninja" ]; then
 else
     cmake "$dir" >/dev/null # pick up new targets
 fi
+# Builds every target first, then runs them JOBS at a time (each fuzzer is one process on one core); each run's
+# summary is printed when it ends.
+built=()
 status=0
 for t in "${targets[@]}"; do
-    if ! grep -q "fuzz/fuzz_$t:" "$dir/build.ninja"; then
+    if grep -q "fuzz/fuzz_$t:" "$dir/build.ninja"; then
+        built+=("$t")
+    else
         echo "fuzz: no target fuzz_$t in $dir (configured without -DRUBBLE_BUILD_FUZZERS=ON?)"
         status=1
-        continue
     fi
-    cmake --build "$dir" --target "fuzz_$t" -j "${JOBS:-$(nproc)}" >/dev/null
-    repro=()
-    norand=()
+done
+[ ${#built[@]} -eq 0 ] || cmake --build "$dir" -j "${JOBS:-$(nproc)}" --target "${built[@]/#/fuzz_}" >/dev/null
+
+run_one() { # target; prints its summary, returns non-zero on a finding
+    local t=$1 work t0 runs cov
+    local repro=() norand=()
     if [ $ci = 1 ]; then
         work=$dir/corpus-ci/$t
         rm -rf "$work"
@@ -70,11 +77,23 @@ for t in "${targets[@]}"; do
         find "$dir/crashes/$t" -type f -newermt "@$t0" | while read -r f; do
             echo "fuzz: $f (base64): $(base64 -w0 "$f")"
         done
-        status=1
-    else
-        runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$dir/fuzz_$t.log")
-        cov=$(grep -o 'cov: [0-9]*' "$dir/fuzz_$t.log" | tail -1)
-        echo "fuzz: $t ok, $runs inputs in $(($(date +%s) - t0)) s, $cov"
+        return 1
     fi
+    runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$dir/fuzz_$t.log")
+    cov=$(grep -o 'cov: [0-9]*' "$dir/fuzz_$t.log" | tail -1)
+    echo "fuzz: $t ok, $runs inputs in $(($(date +%s) - t0)) s, $cov"
+}
+
+slots=${JOBS:-$(nproc)}
+mkdir -p "$dir/fuzz-out"
+pids=()
+for t in "${built[@]}"; do
+    while [ "$(jobs -rp | wc -l)" -ge "$slots" ]; do wait -n || true; done
+    run_one "$t" >"$dir/fuzz-out/$t.txt" 2>&1 &
+    pids+=("$!:$t")
+done
+for p in "${pids[@]}"; do
+    if ! wait "${p%%:*}"; then status=1; fi
+    cat "$dir/fuzz-out/${p#*:}.txt"
 done
 exit $status
