@@ -24,10 +24,10 @@
 #include "BenchUtil.hpp"
 #include "MegaMeshes.hpp"
 #include "Subcommand.hpp"
-#include "rubble/ConvexDecomposition.hpp"
-#include "rubble/Fracture.hpp"
-#include "rubble/MeshIO.hpp"
-#include "rubble/Random.hpp"
+#include "rubble/collision/ConvexDecomposition.hpp"
+#include "rubble/core/Random.hpp"
+#include "rubble/fracture/Fracture.hpp"
+#include "rubble/io/MeshIO.hpp"
 
 namespace {
 

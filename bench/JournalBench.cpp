@@ -21,10 +21,10 @@
 
 #include "BenchUtil.hpp"
 #include "Subcommand.hpp"
-#include "rubble/JournalFile.hpp"
-#include "rubble/JournalPlayer.hpp"
-#include "rubble/Random.hpp"
-#include "rubble/Snapshot.hpp"
+#include "rubble/core/Random.hpp"
+#include "rubble/persist/JournalFile.hpp"
+#include "rubble/persist/Snapshot.hpp"
+#include "rubble/runtime/JournalPlayer.hpp"
 
 namespace {
 

@@ -18,9 +18,9 @@
 
 #include "BenchUtil.hpp"
 #include "MegaMeshes.hpp"
-#include "rubble/ConvexDecomposition.hpp"
-#include "rubble/Fracture.hpp"
-#include "rubble/Random.hpp"
+#include "rubble/collision/ConvexDecomposition.hpp"
+#include "rubble/core/Random.hpp"
+#include "rubble/fracture/Fracture.hpp"
 
 namespace rubble::bench {
 

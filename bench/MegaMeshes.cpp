@@ -6,7 +6,7 @@
 #include <map>
 #include <stdexcept>
 
-#include "rubble/MeshIO.hpp"
+#include "rubble/io/MeshIO.hpp"
 
 namespace rubble::bench {
 

@@ -50,15 +50,15 @@
 #include <nlohmann/json.hpp>
 
 #include "BenchUtil.hpp"
-#include "rubble/DestructionRuntime.hpp"
-#include "rubble/Random.hpp"
-#include "rubble/SceneConfig.hpp"
-#include "rubble/SceneLoader.hpp"
 #include "rubble/bullet/BulletBinding.hpp"
 #include "rubble/bullet/PhysicsWorld.hpp"
+#include "rubble/core/Random.hpp"
 #include "rubble/enet/NetClient.hpp"
 #include "rubble/enet/NetHost.hpp"
 #include "rubble/enet/UdpRelay.hpp"
+#include "rubble/io/SceneConfig.hpp"
+#include "rubble/runtime/DestructionRuntime.hpp"
+#include "rubble/runtime/SceneLoader.hpp"
 
 namespace {
 

@@ -50,14 +50,14 @@
 
 #include <nlohmann/json.hpp>
 
-#include "rubble/DestructionRuntime.hpp"
-#include "rubble/Random.hpp"
-#include "rubble/SceneConfig.hpp"
-#include "rubble/SceneLoader.hpp"
-#include "rubble/ThreadPool.hpp"
-#include "rubble/TimingReport.hpp"
 #include "rubble/bullet/BulletBinding.hpp"
 #include "rubble/bullet/PhysicsWorld.hpp"
+#include "rubble/core/Random.hpp"
+#include "rubble/core/ThreadPool.hpp"
+#include "rubble/io/SceneConfig.hpp"
+#include "rubble/runtime/DestructionRuntime.hpp"
+#include "rubble/runtime/SceneLoader.hpp"
+#include "rubble/runtime/TimingReport.hpp"
 
 namespace {
 

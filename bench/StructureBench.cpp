@@ -21,8 +21,8 @@
 
 #include "BenchUtil.hpp"
 #include "Subcommand.hpp"
-#include "rubble/Fracture.hpp"
-#include "rubble/StressSolver.hpp"
+#include "rubble/fracture/Fracture.hpp"
+#include "rubble/structure/StressSolver.hpp"
 
 namespace {
 

@@ -2,9 +2,7 @@
 
 #include "GroundMesh.hpp"
 
-#include "rubble/JournalFile.hpp"
-#include "rubble/JournalPlayer.hpp"
-#include "rubble/Snapshot.hpp"
+#include "rubble/rubble.hpp"
 
 #include <btBulletDynamicsCommon.h>
 
@@ -12,9 +10,6 @@
 #include <chrono>
 #include <cmath>
 
-#include "rubble/MassProperties.hpp"
-#include "rubble/MeshIO.hpp"
-#include "rubble/SceneLoader.hpp"
 #include "rubble/bullet/Convert.hpp"
 
 namespace demo {

@@ -18,12 +18,10 @@
 #include "ParticleSystem.hpp"
 #include "Renderer.hpp"
 #include "Weapons.hpp"
-#include "rubble/DestructionRuntime.hpp"
-#include "rubble/Fracture.hpp"
-#include "rubble/SceneConfig.hpp"
 #include "rubble/bullet/BulletBinding.hpp"
 #include "rubble/bullet/PhysicsWorld.hpp"
 #include "rubble/enet/NetHost.hpp"
+#include "rubble/rubble.hpp"
 
 namespace demo {
 

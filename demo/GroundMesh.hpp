@@ -5,8 +5,7 @@
 
 #include <cmath>
 
-#include "rubble/Mesh.hpp"
-#include "rubble/SceneConfig.hpp"
+#include "rubble/rubble.hpp"
 
 namespace demo {
 

@@ -8,7 +8,7 @@
 
 #include "GlContext.hpp"
 #include "Renderer.hpp"
-#include "rubble/SceneConfig.hpp"
+#include "rubble/rubble.hpp"
 
 namespace demo {
 

@@ -10,8 +10,8 @@
 
 #include "Math.hpp"
 #include "Renderer.hpp"
-#include "rubble/DestructionWorld.hpp"
 #include "rubble/enet/NetClient.hpp"
+#include "rubble/rubble.hpp"
 
 namespace demo {
 

@@ -3,8 +3,8 @@
 #include "GlContext.hpp"
 #include "Renderer.hpp"
 #include "RunReport.hpp"
-#include "rubble/Fracture.hpp"
-#include "rubble/Random.hpp"
+#include "rubble/core/Random.hpp"
+#include "rubble/rubble.hpp"
 
 #include <sys/resource.h>
 

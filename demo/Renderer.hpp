@@ -13,7 +13,7 @@
 #include <epoxy/gl.h>
 
 #include "Math.hpp"
-#include "rubble/Mesh.hpp"
+#include "rubble/rubble.hpp"
 
 namespace demo {
 

@@ -4,7 +4,7 @@
 
 #include <array>
 
-#include "rubble/Fracture.hpp"
+#include "rubble/rubble.hpp"
 
 namespace demo {
 

@@ -32,7 +32,7 @@
 #include "RunReport.hpp"
 #include "ScaledTarget.hpp"
 #include "Weapons.hpp"
-#include "rubble/SceneConfig.hpp"
+#include "rubble/rubble.hpp"
 
 namespace {
 

@@ -3,9 +3,7 @@
 // thread).
 #include <cstdio>
 
-#include "rubble/DestructionWorld.hpp"
-#include "rubble/Fracture.hpp"
-#include "rubble/Mesh.hpp"
+#include "rubble/rubble.hpp"
 
 int main() {
     // 1. A mesh is a value type: a closed 2 m cube of 588 triangles.

@@ -15,16 +15,16 @@
 #include <utility>
 #include <vector>
 
-#include "rubble/ConvexDecomposition.hpp"
-#include "rubble/Fracture.hpp"
-#include "rubble/MassProperties.hpp"
-#include "rubble/Material.hpp"
-#include "rubble/Mesh.hpp"
-#include "rubble/MeshCheck.hpp"
-#include "rubble/MeshIO.hpp"
-#include "rubble/MeshRepair.hpp"
-#include "rubble/ParameterCheck.hpp"
-#include "rubble/Version.hpp"
+#include "rubble/collision/ConvexDecomposition.hpp"
+#include "rubble/core/ParameterCheck.hpp"
+#include "rubble/core/Version.hpp"
+#include "rubble/fracture/Fracture.hpp"
+#include "rubble/geometry/MassProperties.hpp"
+#include "rubble/geometry/Mesh.hpp"
+#include "rubble/geometry/MeshCheck.hpp"
+#include "rubble/geometry/MeshRepair.hpp"
+#include "rubble/io/MeshIO.hpp"
+#include "rubble/structure/Material.hpp"
 
 namespace py = pybind11;
 

@@ -1238,7 +1238,7 @@ def scenes():
     return out
 
 
-# The material presets a world.cfg line may name in its optional 10th field (include/rubble/Material.hpp).
+# The material presets a world.cfg line may name in its optional 10th field (include/rubble/structure/Material.hpp).
 MATERIALS = ("concrete", "brick", "stone", "wood", "glass", "steel")
 
 

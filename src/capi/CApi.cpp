@@ -11,17 +11,17 @@
 #include <utility>
 #include <vector>
 
-#include "rubble/ConvexDecomposition.hpp"
-#include "rubble/DestructionWorld.hpp"
-#include "rubble/Fracture.hpp"
-#include "rubble/Log.hpp"
-#include "rubble/MassProperties.hpp"
-#include "rubble/Material.hpp"
-#include "rubble/Mesh.hpp"
-#include "rubble/MeshCheck.hpp"
-#include "rubble/MeshIO.hpp"
-#include "rubble/MeshRepair.hpp"
-#include "rubble/ParameterCheck.hpp"
+#include "rubble/collision/ConvexDecomposition.hpp"
+#include "rubble/core/Log.hpp"
+#include "rubble/core/ParameterCheck.hpp"
+#include "rubble/fracture/Fracture.hpp"
+#include "rubble/geometry/MassProperties.hpp"
+#include "rubble/geometry/Mesh.hpp"
+#include "rubble/geometry/MeshCheck.hpp"
+#include "rubble/geometry/MeshRepair.hpp"
+#include "rubble/io/MeshIO.hpp"
+#include "rubble/runtime/DestructionWorld.hpp"
+#include "rubble/structure/Material.hpp"
 
 static_assert(sizeof(rubble::Vec3) == 3 * sizeof(double), "Vec3 is read as 3 doubles");
 static_assert(sizeof(rubble::Vec2) == 2 * sizeof(double), "Vec2 is read as 2 doubles");

@@ -15,8 +15,8 @@ extern "C" {
 #include <libqhull_r/qhull_ra.h>
 }
 
-#include "rubble/CollisionTolerance.hpp"
-#include "rubble/ConvexDecomposition.hpp"
+#include "rubble/collision/CollisionTolerance.hpp"
+#include "rubble/collision/ConvexDecomposition.hpp"
 
 namespace rubble {
 

@@ -18,9 +18,9 @@
 
 #include "collision/MeshRegion.hpp"
 #include "geometry/OrientedShells.hpp"
-#include "rubble/ConvexDecomposition.hpp"
-#include "rubble/MassProperties.hpp"
-#include "rubble/MeshCheck.hpp"
+#include "rubble/collision/ConvexDecomposition.hpp"
+#include "rubble/geometry/MassProperties.hpp"
+#include "rubble/geometry/MeshCheck.hpp"
 
 namespace rubble {
 

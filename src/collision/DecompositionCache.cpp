@@ -5,7 +5,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "rubble/ConvexDecomposition.hpp"
+#include "rubble/collision/ConvexDecomposition.hpp"
 
 namespace rubble {
 

@@ -7,7 +7,7 @@
 #include <numbers>
 #include <unordered_map>
 
-#include "rubble/ConvexDecomposition.hpp"
+#include "rubble/collision/ConvexDecomposition.hpp"
 
 namespace rubble::detail {
 

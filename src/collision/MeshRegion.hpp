@@ -4,9 +4,9 @@
 
 #include <vector>
 
-#include "rubble/ConvexPolytope.hpp"
-#include "rubble/Mesh.hpp"
-#include "rubble/Result.hpp"
+#include "rubble/core/Result.hpp"
+#include "rubble/geometry/ConvexPolytope.hpp"
+#include "rubble/geometry/Mesh.hpp"
 
 namespace rubble::detail {
 

@@ -1,11 +1,11 @@
 // One-sided Hausdorff distance from a mesh's surface to its convex parts (docs/collision.md).
-#include "rubble/PartConcavity.hpp"
+#include "rubble/collision/PartConcavity.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include "rubble/Random.hpp"
+#include "rubble/core/Random.hpp"
 
 namespace rubble {
 

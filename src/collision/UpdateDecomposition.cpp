@@ -8,10 +8,10 @@
 #include <unordered_map>
 
 #include "collision/MeshRegion.hpp"
-#include "rubble/CollisionTolerance.hpp"
-#include "rubble/ConvexDecomposition.hpp"
-#include "rubble/Fracture.hpp"
-#include "rubble/MassProperties.hpp"
+#include "rubble/collision/CollisionTolerance.hpp"
+#include "rubble/collision/ConvexDecomposition.hpp"
+#include "rubble/fracture/Fracture.hpp"
+#include "rubble/geometry/MassProperties.hpp"
 
 namespace rubble {
 

@@ -6,9 +6,9 @@
 #include <vector>
 
 #include "ConvexCellClipper.hpp"
-#include "rubble/ConvexPolytope.hpp"
-#include "rubble/Fracture.hpp"
-#include "rubble/Mesh.hpp"
+#include "rubble/fracture/Fracture.hpp"
+#include "rubble/geometry/ConvexPolytope.hpp"
+#include "rubble/geometry/Mesh.hpp"
 
 namespace rubble::detail {
 

@@ -16,8 +16,8 @@
 #include <CGAL/Triangulation_vertex_base_with_info_3.h>
 #include <voro++/voro++.hh>
 
-#include "rubble/Fracture.hpp"
-#include "rubble/Random.hpp"
+#include "rubble/core/Random.hpp"
+#include "rubble/fracture/Fracture.hpp"
 
 namespace rubble {
 

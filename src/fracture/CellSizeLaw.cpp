@@ -1,7 +1,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "rubble/Fracture.hpp"
+#include "rubble/fracture/Fracture.hpp"
 
 namespace rubble {
 

@@ -9,7 +9,7 @@
 
 #include "geometry/PlanarTriangulation.hpp"
 #include "geometry/RayParity.hpp"
-#include "rubble/MassProperties.hpp"
+#include "rubble/geometry/MassProperties.hpp"
 
 namespace rubble::detail {
 

@@ -13,10 +13,10 @@
 // of all new faces, volume conservation) before they are returned.
 
 #include "geometry/TopologyEdit.hpp"
-#include "rubble/ConvexPolytope.hpp"
-#include "rubble/MassProperties.hpp"
-#include "rubble/Mesh.hpp"
-#include "rubble/Result.hpp"
+#include "rubble/core/Result.hpp"
+#include "rubble/geometry/ConvexPolytope.hpp"
+#include "rubble/geometry/MassProperties.hpp"
+#include "rubble/geometry/Mesh.hpp"
 
 #include <optional>
 #include <vector>

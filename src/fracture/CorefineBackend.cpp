@@ -23,7 +23,7 @@
 
 #include "BooleanBackends.hpp"
 #include "ExactMesh.hpp"
-#include "rubble/MeshCheck.hpp"
+#include "rubble/geometry/MeshCheck.hpp"
 
 namespace rubble::detail {
 

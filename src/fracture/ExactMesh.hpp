@@ -11,8 +11,8 @@
 #include <CGAL/Exact_predicates_exact_constructions_kernel.h>
 #include <CGAL/Surface_mesh.h>
 
-#include "rubble/ConvexPolytope.hpp"
-#include "rubble/Mesh.hpp"
+#include "rubble/geometry/ConvexPolytope.hpp"
+#include "rubble/geometry/Mesh.hpp"
 
 namespace rubble::detail::exact {
 

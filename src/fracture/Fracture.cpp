@@ -13,14 +13,14 @@
 #include "BooleanBackends.hpp"
 #include "FracturePipeline.hpp"
 #include "RoughCut.hpp"
+#include "geometry/Islands.hpp"
 #include "geometry/OrientedShells.hpp"
 #include "geometry/TopologyEdit.hpp"
-#include "rubble/Fracture.hpp"
-#include "rubble/Islands.hpp"
-#include "rubble/MeshCheck.hpp"
-#include "rubble/MeshSimplify.hpp"
-#include "rubble/ParameterCheck.hpp"
-#include "rubble/Random.hpp"
+#include "rubble/core/ParameterCheck.hpp"
+#include "rubble/core/Random.hpp"
+#include "rubble/fracture/Fracture.hpp"
+#include "rubble/geometry/MeshCheck.hpp"
+#include "rubble/geometry/MeshSimplify.hpp"
 
 namespace rubble {
 

@@ -5,9 +5,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "rubble/ConvexPolytope.hpp"
-#include "rubble/Fracture.hpp"
-#include "rubble/Mesh.hpp"
+#include "rubble/fracture/Fracture.hpp"
+#include "rubble/geometry/ConvexPolytope.hpp"
+#include "rubble/geometry/Mesh.hpp"
 
 namespace rubble::detail {
 

@@ -10,7 +10,7 @@
 #include <tuple>
 #include <unordered_map>
 
-#include "rubble/Random.hpp"
+#include "rubble/core/Random.hpp"
 
 namespace rubble::detail {
 

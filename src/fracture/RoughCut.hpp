@@ -4,9 +4,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "rubble/ConvexPolytope.hpp"
-#include "rubble/Fracture.hpp"
-#include "rubble/Roughness.hpp"
+#include "rubble/fracture/Fracture.hpp"
+#include "rubble/fracture/Roughness.hpp"
+#include "rubble/geometry/ConvexPolytope.hpp"
 
 namespace rubble::detail {
 

@@ -5,9 +5,9 @@
 #include <iterator>
 #include <string>
 
-#include "rubble/Roughness.hpp"
+#include "rubble/fracture/Roughness.hpp"
 
-#include "rubble/ParameterCheck.hpp"
+#include "rubble/core/ParameterCheck.hpp"
 
 namespace rubble {
 

@@ -2,7 +2,7 @@
 // Private to the core: closest point on a triangle (used by the fracture's split verification and by the
 // runtime, which moves impacts reported off the surface onto it).
 
-#include "rubble/Vec3.hpp"
+#include "rubble/core/Vec3.hpp"
 
 namespace rubble::detail {
 

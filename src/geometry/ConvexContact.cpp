@@ -4,7 +4,7 @@
 #include <limits>
 #include <tuple>
 
-#include "rubble/ConvexPolytope.hpp"
+#include "rubble/geometry/ConvexPolytope.hpp"
 
 namespace rubble {
 namespace {

@@ -1,4 +1,4 @@
-#include "rubble/ConvexPolytope.hpp"
+#include "rubble/geometry/ConvexPolytope.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "rubble/Islands.hpp"
+#include "geometry/Islands.hpp"
 
 #include <algorithm>
 #include <cstdint>
@@ -6,7 +6,7 @@
 
 #include "geometry/OrientedShells.hpp"
 #include "geometry/RayParity.hpp"
-#include "rubble/MassProperties.hpp"
+#include "rubble/geometry/MassProperties.hpp"
 
 namespace rubble {
 

@@ -1,4 +1,4 @@
-#include "rubble/MassProperties.hpp"
+#include "rubble/geometry/MassProperties.hpp"
 
 #include <Eigen/Eigenvalues>
 

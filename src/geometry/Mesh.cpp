@@ -1,4 +1,4 @@
-#include "rubble/Mesh.hpp"
+#include "rubble/geometry/Mesh.hpp"
 
 #include "geometry/ClosestPoint.hpp"
 

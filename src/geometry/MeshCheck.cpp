@@ -1,4 +1,4 @@
-#include "rubble/MeshCheck.hpp"
+#include "rubble/geometry/MeshCheck.hpp"
 
 #include <algorithm>
 #include <array>
@@ -6,10 +6,10 @@
 #include <cstdio>
 #include <unordered_map>
 
+#include "geometry/Islands.hpp"
 #include "geometry/OrientedShells.hpp"
 #include "geometry/RayParity.hpp"
-#include "rubble/Islands.hpp"
-#include "rubble/MassProperties.hpp"
+#include "rubble/geometry/MassProperties.hpp"
 
 namespace rubble {
 

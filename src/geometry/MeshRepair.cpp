@@ -1,4 +1,4 @@
-#include "rubble/MeshRepair.hpp"
+#include "rubble/geometry/MeshRepair.hpp"
 
 #include <algorithm>
 #include <array>

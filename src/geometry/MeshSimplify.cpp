@@ -13,7 +13,7 @@
 //    its vertices (and so do its neighbours: everything is redone until no patch fails).
 //    Each patch and its replacement must also enclose no volume together (they share their boundary).
 
-#include "rubble/MeshSimplify.hpp"
+#include "rubble/geometry/MeshSimplify.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "rubble/MeshTopology.hpp"
+#include "rubble/geometry/MeshTopology.hpp"
 
 #include <algorithm>
 #include <cmath>

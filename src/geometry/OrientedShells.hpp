@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "rubble/Mesh.hpp"
+#include "rubble/geometry/Mesh.hpp"
 
 namespace rubble::detail {
 

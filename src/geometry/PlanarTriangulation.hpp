@@ -8,7 +8,7 @@
 #include <functional>
 #include <vector>
 
-#include "rubble/Vec3.hpp"
+#include "rubble/core/Vec3.hpp"
 
 namespace rubble::detail {
 

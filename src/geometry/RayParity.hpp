@@ -4,7 +4,7 @@
 
 #include <cstddef>
 
-#include "rubble/Mesh.hpp"
+#include "rubble/geometry/Mesh.hpp"
 
 namespace rubble::detail {
 

@@ -11,7 +11,7 @@
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Surface_mesh.h>
 
-#include "rubble/MeshCheck.hpp"
+#include "rubble/geometry/MeshCheck.hpp"
 
 namespace rubble {
 

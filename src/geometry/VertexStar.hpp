@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "rubble/Mesh.hpp"
+#include "rubble/geometry/Mesh.hpp"
 
 namespace rubble::detail {
 

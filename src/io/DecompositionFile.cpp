@@ -1,4 +1,4 @@
-#include "rubble/DecompositionFile.hpp"
+#include "rubble/io/DecompositionFile.hpp"
 
 #include <cinttypes>
 #include <cmath>

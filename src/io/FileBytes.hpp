@@ -6,7 +6,7 @@
 #include <string>
 #include <string_view>
 
-#include "rubble/Result.hpp"
+#include "rubble/core/Result.hpp"
 
 namespace rubble::io {
 

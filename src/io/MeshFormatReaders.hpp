@@ -4,8 +4,8 @@
 
 #include <string>
 
-#include "rubble/Mesh.hpp"
-#include "rubble/Result.hpp"
+#include "rubble/core/Result.hpp"
+#include "rubble/geometry/Mesh.hpp"
 
 namespace rubble::io {
 

@@ -11,7 +11,7 @@
 #include "io/FileBytes.hpp"
 #include "io/PolygonTriangulation.hpp"
 #include "io/TextTokens.hpp"
-#include "rubble/MeshIO.hpp"
+#include "rubble/io/MeshIO.hpp"
 
 namespace rubble {
 

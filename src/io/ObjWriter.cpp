@@ -10,7 +10,7 @@
 
 #include "io/FileBytes.hpp"
 #include "io/TextureFiles.hpp"
-#include "rubble/MeshIO.hpp"
+#include "rubble/io/MeshIO.hpp"
 
 namespace rubble {
 

@@ -5,7 +5,7 @@
 #include <cstddef>
 #include <vector>
 
-#include "rubble/Vec3.hpp"
+#include "rubble/core/Vec3.hpp"
 
 namespace rubble::io {
 

@@ -11,8 +11,8 @@
 #include <string_view>
 #include <unordered_map>
 
-#include "rubble/Mesh.hpp"
-#include "rubble/Result.hpp"
+#include "rubble/core/Result.hpp"
+#include "rubble/geometry/Mesh.hpp"
 
 namespace rubble::detail {
 

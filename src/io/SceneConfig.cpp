@@ -1,4 +1,4 @@
-#include "rubble/SceneConfig.hpp"
+#include "rubble/io/SceneConfig.hpp"
 
 #include <charconv>
 #include <cmath>
@@ -6,7 +6,7 @@
 #include <string_view>
 
 #include "io/FileBytes.hpp"
-#include "rubble/Material.hpp"
+#include "rubble/structure/Material.hpp"
 
 namespace rubble {
 

@@ -8,8 +8,8 @@
 #include "io/SceneReaders.hpp"
 #include "io/TextTokens.hpp"
 #include "io/TextureFiles.hpp"
-#include "rubble/MeshIO.hpp"
-#include "rubble/SceneIO.hpp"
+#include "rubble/io/MeshIO.hpp"
+#include "rubble/io/SceneIO.hpp"
 
 namespace rubble {
 

@@ -3,8 +3,8 @@
 
 #include <filesystem>
 
-#include "rubble/Result.hpp"
-#include "rubble/SceneIO.hpp"
+#include "rubble/core/Result.hpp"
+#include "rubble/io/SceneIO.hpp"
 
 namespace rubble::io {
 

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "rubble/Result.hpp"
-#include "rubble/SceneIO.hpp"
+#include "rubble/core/Result.hpp"
+#include "rubble/io/SceneIO.hpp"
 
 namespace rubble::io {
 

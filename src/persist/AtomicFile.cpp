@@ -8,7 +8,7 @@
 #include <cstring>
 
 #include "io/FileBytes.hpp"
-#include "rubble/JournalFile.hpp"
+#include "rubble/persist/JournalFile.hpp"
 
 namespace rubble {
 namespace {

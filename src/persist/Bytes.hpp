@@ -10,7 +10,7 @@
 #include <string_view>
 #include <vector>
 
-#include "rubble/Result.hpp"
+#include "rubble/core/Result.hpp"
 
 namespace rubble::persist {
 

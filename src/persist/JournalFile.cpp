@@ -1,9 +1,9 @@
-#include "rubble/JournalFile.hpp"
+#include "rubble/persist/JournalFile.hpp"
 
 #include <cmath>
 
 #include "persist/Bytes.hpp"
-#include "rubble/JournalPlayer.hpp"
+#include "rubble/runtime/JournalPlayer.hpp"
 
 namespace rubble {
 namespace {

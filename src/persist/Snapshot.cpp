@@ -1,4 +1,4 @@
-#include "rubble/Snapshot.hpp"
+#include "rubble/persist/Snapshot.hpp"
 
 #include <fcntl.h>
 #include <sys/mman.h>
@@ -11,7 +11,7 @@
 
 #include "io/FileBytes.hpp"
 #include "persist/Bytes.hpp"
-#include "rubble/JournalFile.hpp"
+#include "rubble/persist/JournalFile.hpp"
 
 namespace rubble {
 namespace {

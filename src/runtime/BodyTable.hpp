@@ -5,7 +5,7 @@
 #include <set>
 #include <unordered_map>
 
-#include "rubble/DestructionRuntime.hpp"
+#include "rubble/runtime/DestructionRuntime.hpp"
 
 namespace rubble::detail {
 

@@ -7,7 +7,7 @@
 #include <unordered_map>
 #include <vector>
 
-#include "rubble/DestructionRuntime.hpp"
+#include "rubble/runtime/DestructionRuntime.hpp"
 #include "runtime/BodyTable.hpp"
 
 namespace rubble::detail {

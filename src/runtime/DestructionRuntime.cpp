@@ -1,4 +1,4 @@
-#include "rubble/DestructionRuntime.hpp"
+#include "rubble/runtime/DestructionRuntime.hpp"
 
 #include <algorithm>
 #include <bit>

@@ -1,4 +1,4 @@
-#include "rubble/DestructionWorld.hpp"
+#include "rubble/runtime/DestructionWorld.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -12,14 +12,14 @@
 #include <string>
 
 #include "geometry/ClosestPoint.hpp"
-#include "rubble/Log.hpp"
-#include "rubble/MassProperties.hpp"
-#include "rubble/Material.hpp"
-#include "rubble/MeshCheck.hpp"
-#include "rubble/MeshRepair.hpp"
-#include "rubble/ParameterCheck.hpp"
-#include "rubble/Random.hpp"
-#include "rubble/ThreadPool.hpp"
+#include "rubble/core/Log.hpp"
+#include "rubble/core/ParameterCheck.hpp"
+#include "rubble/core/Random.hpp"
+#include "rubble/core/ThreadPool.hpp"
+#include "rubble/geometry/MassProperties.hpp"
+#include "rubble/geometry/MeshCheck.hpp"
+#include "rubble/geometry/MeshRepair.hpp"
+#include "rubble/structure/Material.hpp"
 
 namespace rubble {
 namespace {

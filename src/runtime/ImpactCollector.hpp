@@ -4,7 +4,7 @@
 #include <map>
 #include <vector>
 
-#include "rubble/DestructionRuntime.hpp"
+#include "rubble/runtime/DestructionRuntime.hpp"
 #include "runtime/BodyTable.hpp"
 
 namespace rubble::detail {

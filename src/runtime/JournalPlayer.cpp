@@ -1,4 +1,4 @@
-#include "rubble/JournalPlayer.hpp"
+#include "rubble/runtime/JournalPlayer.hpp"
 
 #include <string>
 

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "rubble/ConvexDecomposition.hpp"
+#include "rubble/collision/ConvexDecomposition.hpp"
 
 namespace rubble::detail {
 

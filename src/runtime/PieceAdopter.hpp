@@ -4,7 +4,7 @@
 
 #include <vector>
 
-#include "rubble/DestructionRuntime.hpp"
+#include "rubble/runtime/DestructionRuntime.hpp"
 
 namespace rubble::detail {
 

@@ -1,11 +1,11 @@
-#include "rubble/SceneLoader.hpp"
+#include "rubble/runtime/SceneLoader.hpp"
 
 #include <algorithm>
 #include <cmath>
 
-#include "rubble/DecompositionFile.hpp"
-#include "rubble/MassProperties.hpp"
-#include "rubble/MeshIO.hpp"
+#include "rubble/geometry/MassProperties.hpp"
+#include "rubble/io/DecompositionFile.hpp"
+#include "rubble/io/MeshIO.hpp"
 
 namespace rubble {
 namespace {

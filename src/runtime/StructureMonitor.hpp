@@ -5,7 +5,7 @@
 #include <utility>
 #include <vector>
 
-#include "rubble/DestructionRuntime.hpp"
+#include "rubble/runtime/DestructionRuntime.hpp"
 
 namespace rubble::detail {
 

@@ -6,8 +6,8 @@
 #include <set>
 #include <vector>
 
-#include "rubble/ConvexPolytope.hpp"
-#include "rubble/DestructionRuntime.hpp"
+#include "rubble/geometry/ConvexPolytope.hpp"
+#include "rubble/runtime/DestructionRuntime.hpp"
 
 namespace rubble::detail {
 

@@ -1,4 +1,4 @@
-#include "rubble/TimingReport.hpp"
+#include "rubble/runtime/TimingReport.hpp"
 
 #include <algorithm>
 #include <cmath>

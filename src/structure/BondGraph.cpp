@@ -1,4 +1,4 @@
-#include "rubble/BondGraph.hpp"
+#include "rubble/structure/BondGraph.hpp"
 
 #include <algorithm>
 #include <cmath>

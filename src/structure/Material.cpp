@@ -1,4 +1,4 @@
-#include "rubble/Material.hpp"
+#include "rubble/structure/Material.hpp"
 
 namespace rubble {
 

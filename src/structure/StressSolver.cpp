@@ -1,4 +1,4 @@
-#include "rubble/StressSolver.hpp"
+#include "rubble/structure/StressSolver.hpp"
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -6,7 +6,7 @@
 #include <cmath>
 #include <limits>
 
-#include "rubble/MassProperties.hpp"
+#include "rubble/geometry/MassProperties.hpp"
 
 namespace rubble {
 

@@ -13,13 +13,13 @@
 
 #include "TestSupport.hpp"
 
-#include "rubble/DestructionRuntime.hpp"
-#include "rubble/MassProperties.hpp"
-#include "rubble/Random.hpp"
-#include "rubble/SceneConfig.hpp"
-#include "rubble/SceneLoader.hpp"
 #include "rubble/bullet/BulletBinding.hpp"
 #include "rubble/bullet/Convert.hpp"
+#include "rubble/core/Random.hpp"
+#include "rubble/geometry/MassProperties.hpp"
+#include "rubble/io/SceneConfig.hpp"
+#include "rubble/runtime/DestructionRuntime.hpp"
+#include "rubble/runtime/SceneLoader.hpp"
 
 using namespace rubble;
 using namespace rubble::bullet;

@@ -2,11 +2,11 @@
 // of mass.
 #include <gtest/gtest.h>
 
-#include "rubble/ConvexPolytope.hpp"
-#include "rubble/MassProperties.hpp"
 #include "rubble/bullet/CollisionShape.hpp"
 #include "rubble/bullet/Convert.hpp"
 #include "rubble/bullet/PhysicsWorld.hpp"
+#include "rubble/geometry/ConvexPolytope.hpp"
+#include "rubble/geometry/MassProperties.hpp"
 
 using namespace rubble;
 using namespace rubble::bullet;

@@ -10,11 +10,11 @@
 
 #include "TestSupport.hpp"
 
-#include "rubble/CollisionTolerance.hpp"
-#include "rubble/ConvexDecomposition.hpp"
-#include "rubble/DestructionRuntime.hpp"
 #include "rubble/bullet/BulletBinding.hpp"
 #include "rubble/bullet/Convert.hpp"
+#include "rubble/collision/CollisionTolerance.hpp"
+#include "rubble/collision/ConvexDecomposition.hpp"
+#include "rubble/runtime/DestructionRuntime.hpp"
 
 using namespace rubble;
 using namespace rubble::bullet;

@@ -5,9 +5,9 @@
 #include <algorithm>
 
 #include "TestSupport.hpp"
-#include "rubble/SceneConfig.hpp"
-#include "rubble/SceneLoader.hpp"
 #include "rubble/bullet/BulletBinding.hpp"
+#include "rubble/io/SceneConfig.hpp"
+#include "rubble/runtime/SceneLoader.hpp"
 
 using namespace rubble;
 using namespace rubble::bullet;

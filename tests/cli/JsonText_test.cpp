@@ -2,7 +2,7 @@
 
 #include <gtest/gtest.h>
 
-#include "rubble/MeshIO.hpp"
+#include "rubble/io/MeshIO.hpp"
 
 using rubble::tools::dumpJson;
 using rubble::tools::utf8Escaped;

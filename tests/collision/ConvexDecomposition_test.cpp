@@ -8,12 +8,12 @@
 #include <numeric>
 
 #include "TestSupport.hpp"
-#include "rubble/CollisionTolerance.hpp"
-#include "rubble/ConvexDecomposition.hpp"
-#include "rubble/Fracture.hpp"
-#include "rubble/MassProperties.hpp"
-#include "rubble/MeshIO.hpp"
-#include "rubble/Random.hpp"
+#include "rubble/collision/CollisionTolerance.hpp"
+#include "rubble/collision/ConvexDecomposition.hpp"
+#include "rubble/core/Random.hpp"
+#include "rubble/fracture/Fracture.hpp"
+#include "rubble/geometry/MassProperties.hpp"
+#include "rubble/io/MeshIO.hpp"
 
 namespace rubble {
 namespace {

@@ -5,10 +5,10 @@
 
 #include <gtest/gtest.h>
 
-#include "rubble/ConvexDecomposition.hpp"
-#include "rubble/Fracture.hpp"
-#include "rubble/MassProperties.hpp"
-#include "rubble/Random.hpp"
+#include "rubble/collision/ConvexDecomposition.hpp"
+#include "rubble/core/Random.hpp"
+#include "rubble/fracture/Fracture.hpp"
+#include "rubble/geometry/MassProperties.hpp"
 
 namespace rubble {
 namespace {

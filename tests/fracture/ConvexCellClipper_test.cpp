@@ -4,9 +4,9 @@
 
 #include "TestSupport.hpp"
 #include "fracture/ConvexCellClipper.hpp"
-#include "rubble/Fracture.hpp"
-#include "rubble/MassProperties.hpp"
-#include "rubble/Random.hpp"
+#include "rubble/core/Random.hpp"
+#include "rubble/fracture/Fracture.hpp"
+#include "rubble/geometry/MassProperties.hpp"
 
 using namespace rubble;
 using rubble::test::closedAndOriented;

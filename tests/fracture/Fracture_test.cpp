@@ -10,11 +10,11 @@
 #include "PieceHash.hpp"
 #include "TestSupport.hpp"
 #include "fracture/ConvexCellClipper.hpp"
-#include "rubble/Fracture.hpp"
-#include "rubble/MassProperties.hpp"
-#include "rubble/MeshCheck.hpp"
-#include "rubble/MeshIO.hpp"
-#include "rubble/Random.hpp"
+#include "rubble/core/Random.hpp"
+#include "rubble/fracture/Fracture.hpp"
+#include "rubble/geometry/MassProperties.hpp"
+#include "rubble/geometry/MeshCheck.hpp"
+#include "rubble/io/MeshIO.hpp"
 
 using namespace rubble;
 using rubble::test::closedAndOriented;

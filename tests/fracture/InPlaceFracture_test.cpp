@@ -12,9 +12,9 @@
 #include "fracture/BooleanBackends.hpp"
 #include "fracture/FracturePipeline.hpp"
 #include "geometry/TopologyEdit.hpp"
-#include "rubble/Fracture.hpp"
-#include "rubble/MeshTopology.hpp"
-#include "rubble/Random.hpp"
+#include "rubble/core/Random.hpp"
+#include "rubble/fracture/Fracture.hpp"
+#include "rubble/geometry/MeshTopology.hpp"
 
 namespace rubble {
 namespace {

@@ -5,11 +5,11 @@
 #include <map>
 
 #include "TestSupport.hpp"
-#include "rubble/Fracture.hpp"
-#include "rubble/MassProperties.hpp"
-#include "rubble/MeshCheck.hpp"
-#include "rubble/MeshSimplify.hpp"
-#include "rubble/Random.hpp"
+#include "rubble/core/Random.hpp"
+#include "rubble/fracture/Fracture.hpp"
+#include "rubble/geometry/MassProperties.hpp"
+#include "rubble/geometry/MeshCheck.hpp"
+#include "rubble/geometry/MeshSimplify.hpp"
 
 namespace rubble {
 namespace {

@@ -12,10 +12,10 @@
 #include "PieceHash.hpp"
 #include "TestSupport.hpp"
 #include "fracture/RoughCut.hpp"
-#include "rubble/Fracture.hpp"
-#include "rubble/MassProperties.hpp"
-#include "rubble/MeshCheck.hpp"
-#include "rubble/Random.hpp"
+#include "rubble/core/Random.hpp"
+#include "rubble/fracture/Fracture.hpp"
+#include "rubble/geometry/MassProperties.hpp"
+#include "rubble/geometry/MeshCheck.hpp"
 
 using namespace rubble;
 using rubble::test::closedAndOriented;

@@ -10,10 +10,10 @@
 
 #include "fracture/BooleanBackends.hpp"
 #include "fracture/FracturePipeline.hpp"
-#include "rubble/Fracture.hpp"
-#include "rubble/Islands.hpp"
-#include "rubble/MassProperties.hpp"
-#include "rubble/Random.hpp"
+#include "geometry/Islands.hpp"
+#include "rubble/core/Random.hpp"
+#include "rubble/fracture/Fracture.hpp"
+#include "rubble/geometry/MassProperties.hpp"
 
 using namespace rubble;
 

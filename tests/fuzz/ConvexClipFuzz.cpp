@@ -6,7 +6,7 @@
 #include "FuzzChecks.hpp"
 #include "FuzzInput.hpp"
 #include "fracture/ConvexCellClipper.hpp"
-#include "rubble/MassProperties.hpp"
+#include "rubble/geometry/MassProperties.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     using namespace rubble;

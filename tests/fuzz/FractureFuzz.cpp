@@ -10,9 +10,9 @@
 
 #include "FuzzChecks.hpp"
 #include "FuzzInput.hpp"
-#include "rubble/Fracture.hpp"
-#include "rubble/MassProperties.hpp"
-#include "rubble/ParameterCheck.hpp"
+#include "rubble/core/ParameterCheck.hpp"
+#include "rubble/fracture/Fracture.hpp"
+#include "rubble/geometry/MassProperties.hpp"
 
 namespace {
 

@@ -6,7 +6,7 @@
 #include <map>
 #include <utility>
 
-#include "rubble/Mesh.hpp"
+#include "rubble/geometry/Mesh.hpp"
 
 namespace rubble::fuzz {
 

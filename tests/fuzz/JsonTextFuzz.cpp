@@ -6,7 +6,7 @@
 #include <string_view>
 
 #include "JsonText.hpp"
-#include "rubble/MeshIO.hpp"
+#include "rubble/io/MeshIO.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     if (size == 0)

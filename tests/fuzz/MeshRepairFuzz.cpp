@@ -2,8 +2,8 @@
 #include <cstdint>
 
 #include "FuzzInput.hpp"
-#include "rubble/MeshCheck.hpp"
-#include "rubble/MeshRepair.hpp"
+#include "rubble/geometry/MeshCheck.hpp"
+#include "rubble/geometry/MeshRepair.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     rubble::fuzz::FuzzInput in(data, size);

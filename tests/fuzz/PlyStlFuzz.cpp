@@ -5,8 +5,8 @@
 
 #include "FuzzChecks.hpp"
 #include "io/MeshFormatReaders.hpp"
-#include "rubble/MeshCheck.hpp"
-#include "rubble/MeshRepair.hpp"
+#include "rubble/geometry/MeshCheck.hpp"
+#include "rubble/geometry/MeshRepair.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     if (size == 0)

@@ -9,9 +9,9 @@
 
 #include "FuzzInput.hpp"
 #include "persist/Bytes.hpp"
-#include "rubble/JobSystem.hpp"
-#include "rubble/JournalFile.hpp"
-#include "rubble/Snapshot.hpp"
+#include "rubble/core/JobSystem.hpp"
+#include "rubble/persist/JournalFile.hpp"
+#include "rubble/persist/Snapshot.hpp"
 
 namespace {
 

@@ -3,8 +3,8 @@
 
 #include <cmath>
 
-#include "rubble/ConvexPolytope.hpp"
-#include "rubble/Random.hpp"
+#include "rubble/core/Random.hpp"
+#include "rubble/geometry/ConvexPolytope.hpp"
 
 namespace rubble {
 namespace {

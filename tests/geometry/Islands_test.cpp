@@ -4,10 +4,10 @@
 #include <cmath>
 #include <map>
 
-#include "rubble/Islands.hpp"
-#include "rubble/MassProperties.hpp"
-#include "rubble/MeshCheck.hpp"
-#include "rubble/Random.hpp"
+#include "geometry/Islands.hpp"
+#include "rubble/core/Random.hpp"
+#include "rubble/geometry/MassProperties.hpp"
+#include "rubble/geometry/MeshCheck.hpp"
 
 using namespace rubble;
 

@@ -3,8 +3,8 @@
 #include <cmath>
 #include <numbers>
 
-#include "rubble/MassProperties.hpp"
-#include "rubble/Random.hpp"
+#include "rubble/core/Random.hpp"
+#include "rubble/geometry/MassProperties.hpp"
 
 using namespace rubble;
 

@@ -1,4 +1,4 @@
-#include "rubble/MeshSimplify.hpp"
+#include "rubble/geometry/MeshSimplify.hpp"
 
 #include <gtest/gtest.h>
 
@@ -6,8 +6,8 @@
 #include <map>
 
 #include "TestSupport.hpp"
-#include "rubble/MassProperties.hpp"
-#include "rubble/MeshCheck.hpp"
+#include "rubble/geometry/MassProperties.hpp"
+#include "rubble/geometry/MeshCheck.hpp"
 
 namespace rubble {
 namespace {

@@ -8,8 +8,8 @@
 #include <thread>
 #include <vector>
 
-#include "rubble/Log.hpp"
-#include "rubble/Result.hpp"
+#include "rubble/core/Log.hpp"
+#include "rubble/core/Result.hpp"
 
 using namespace rubble;
 

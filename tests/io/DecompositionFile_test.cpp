@@ -4,7 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "TestSupport.hpp"
-#include "rubble/DecompositionFile.hpp"
+#include "rubble/io/DecompositionFile.hpp"
 
 namespace rubble {
 namespace {

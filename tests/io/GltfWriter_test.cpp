@@ -7,8 +7,8 @@
 
 #include "TestSupport.hpp"
 #include "io/FileBytes.hpp"
-#include "rubble/MassProperties.hpp"
-#include "rubble/MeshIO.hpp"
+#include "rubble/geometry/MassProperties.hpp"
+#include "rubble/io/MeshIO.hpp"
 
 using namespace rubble;
 

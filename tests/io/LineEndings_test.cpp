@@ -6,8 +6,8 @@
 #include <string>
 
 #include "TestSupport.hpp"
-#include "rubble/MassProperties.hpp"
-#include "rubble/MeshIO.hpp"
+#include "rubble/geometry/MassProperties.hpp"
+#include "rubble/io/MeshIO.hpp"
 
 using namespace rubble;
 

@@ -8,10 +8,10 @@
 #include <sys/stat.h>
 
 #include "TestSupport.hpp"
-#include "rubble/MassProperties.hpp"
-#include "rubble/MeshCheck.hpp"
-#include "rubble/MeshIO.hpp"
-#include "rubble/Random.hpp"
+#include "rubble/core/Random.hpp"
+#include "rubble/geometry/MassProperties.hpp"
+#include "rubble/geometry/MeshCheck.hpp"
+#include "rubble/io/MeshIO.hpp"
 
 using namespace rubble;
 

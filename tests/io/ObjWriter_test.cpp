@@ -9,10 +9,10 @@
 #include <unistd.h>
 
 #include "TestSupport.hpp"
-#include "rubble/MassProperties.hpp"
-#include "rubble/MeshCheck.hpp"
-#include "rubble/MeshIO.hpp"
-#include "rubble/Random.hpp"
+#include "rubble/core/Random.hpp"
+#include "rubble/geometry/MassProperties.hpp"
+#include "rubble/geometry/MeshCheck.hpp"
+#include "rubble/io/MeshIO.hpp"
 
 using namespace rubble;
 

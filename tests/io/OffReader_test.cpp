@@ -4,8 +4,8 @@
 #include <numbers>
 
 #include "TestSupport.hpp"
-#include "rubble/MeshCheck.hpp"
-#include "rubble/MeshIO.hpp"
+#include "rubble/geometry/MeshCheck.hpp"
+#include "rubble/io/MeshIO.hpp"
 
 using namespace rubble;
 

@@ -1,7 +1,7 @@
 #include <gtest/gtest.h>
 
 #include "TestSupport.hpp"
-#include "rubble/SceneConfig.hpp"
+#include "rubble/io/SceneConfig.hpp"
 
 using namespace rubble;
 

@@ -4,9 +4,9 @@
 
 #include "TestSupport.hpp"
 #include "io/FileBytes.hpp"
-#include "rubble/MassProperties.hpp"
-#include "rubble/MeshIO.hpp"
-#include "rubble/SceneIO.hpp"
+#include "rubble/geometry/MassProperties.hpp"
+#include "rubble/io/MeshIO.hpp"
+#include "rubble/io/SceneIO.hpp"
 
 using namespace rubble;
 using rubble::test::tempDir;

@@ -3,8 +3,8 @@
 #include <gtest/gtest.h>
 
 #include "TestSupport.hpp"
-#include "rubble/MeshCheck.hpp"
-#include "rubble/MeshIO.hpp"
+#include "rubble/geometry/MeshCheck.hpp"
+#include "rubble/io/MeshIO.hpp"
 
 using namespace rubble;
 

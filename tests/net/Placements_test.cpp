@@ -7,7 +7,7 @@
 #include <cmath>
 #include <set>
 
-#include "rubble/Random.hpp"
+#include "rubble/core/Random.hpp"
 
 namespace rubble {
 namespace {

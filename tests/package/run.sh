@@ -29,7 +29,7 @@ install)
     for f in "$libdir"/cmake/Rubble/RubbleConfig.cmake "$libdir"/cmake/Rubble/RubbleConfigVersion.cmake \
         "$libdir"/cmake/Rubble/RubbleTargets.cmake "$libdir"/cmake/Rubble/RubbleBulletTargets.cmake \
         "$libdir"/pkgconfig/rubble.pc "$libdir"/pkgconfig/rubble-bullet.pc "$libdir"/librubble.so \
-        "$libdir"/librubble_bullet.so include/rubble/rubble.hpp include/rubble/rubble.h include/rubble/Mesh.hpp \
+        "$libdir"/librubble_bullet.so include/rubble/rubble.hpp include/rubble/rubble.h include/rubble/geometry/Mesh.hpp \
         include/rubble/bullet/BulletBinding.hpp bin/rubble; do
         [ -e "$prefix/$f" ] || fail "missing $f in the installed tree"
     done

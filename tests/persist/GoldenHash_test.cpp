@@ -5,8 +5,8 @@
 
 #include "JournalScene.hpp"
 #include "persist/Bytes.hpp"
-#include "rubble/JournalFile.hpp"
-#include "rubble/JournalPlayer.hpp"
+#include "rubble/persist/JournalFile.hpp"
+#include "rubble/runtime/JournalPlayer.hpp"
 
 namespace rubble {
 namespace {

@@ -1,6 +1,6 @@
 // The destruction journal: 48-byte events, recorded for every accepted impact and removal, replayed on a
 // fresh world from the same scene to the same geometry on 1 or 2 workers; the journal file and its errors.
-#include "rubble/JournalFile.hpp"
+#include "rubble/persist/JournalFile.hpp"
 
 #include <gtest/gtest.h>
 
@@ -9,7 +9,7 @@
 #include "JournalScene.hpp"
 #include "TestSupport.hpp"
 #include "persist/Bytes.hpp"
-#include "rubble/JournalPlayer.hpp"
+#include "rubble/runtime/JournalPlayer.hpp"
 
 namespace rubble {
 namespace {

@@ -9,7 +9,7 @@
 
 #include "StructureRig.hpp"
 #include "persist/Bytes.hpp"
-#include "rubble/Snapshot.hpp"
+#include "rubble/persist/Snapshot.hpp"
 
 namespace rubble {
 namespace {

@@ -1,7 +1,7 @@
 // Snapshots: load then save gives the same bytes and geometry, a late joiner converges with snapshot +
 // journal tail, damaged or hostile files are refused naming offset and field with the world untouched, and a
 // process killed mid-save leaves the previous snapshot intact.
-#include "rubble/Snapshot.hpp"
+#include "rubble/persist/Snapshot.hpp"
 
 #include <fcntl.h>
 #include <gtest/gtest.h>
@@ -19,8 +19,8 @@
 #include "JournalScene.hpp"
 #include "TestSupport.hpp"
 #include "persist/Bytes.hpp"
-#include "rubble/JournalFile.hpp"
-#include "rubble/JournalPlayer.hpp"
+#include "rubble/persist/JournalFile.hpp"
+#include "rubble/runtime/JournalPlayer.hpp"
 
 namespace rubble {
 namespace {

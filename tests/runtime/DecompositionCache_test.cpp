@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "TestSupport.hpp"
-#include "rubble/ConvexDecomposition.hpp"
+#include "rubble/collision/ConvexDecomposition.hpp"
 
 namespace rubble {
 namespace {

@@ -1,6 +1,6 @@
 // The engine-neutral runtime on a second binding, the toy engine of tests/support (no Bullet): support and
 // collapse, freezing and waking, the debris governor's budgets and exact volume accounting with particles.
-#include "rubble/DestructionRuntime.hpp"
+#include "rubble/runtime/DestructionRuntime.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "rubble/DestructionWorld.hpp"
+#include "rubble/runtime/DestructionWorld.hpp"
 
 #include <gtest/gtest.h>
 
@@ -11,11 +11,11 @@
 #include <vector>
 
 #include "TestSupport.hpp"
-#include "rubble/Journal.hpp"
-#include "rubble/Log.hpp"
-#include "rubble/MassProperties.hpp"
-#include "rubble/Random.hpp"
-#include "rubble/ThreadPool.hpp"
+#include "rubble/core/Log.hpp"
+#include "rubble/core/Random.hpp"
+#include "rubble/core/ThreadPool.hpp"
+#include "rubble/geometry/MassProperties.hpp"
+#include "rubble/runtime/Journal.hpp"
 
 namespace rubble {
 namespace {

@@ -11,9 +11,9 @@
 #include <vector>
 
 #include "TestSupport.hpp"
-#include "rubble/DestructionWorld.hpp"
-#include "rubble/Fracture.hpp"
-#include "rubble/ParameterCheck.hpp"
+#include "rubble/core/ParameterCheck.hpp"
+#include "rubble/fracture/Fracture.hpp"
+#include "rubble/runtime/DestructionWorld.hpp"
 
 namespace rubble {
 namespace {

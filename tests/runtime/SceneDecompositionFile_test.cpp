@@ -4,11 +4,11 @@
 
 #include "TestSupport.hpp"
 #include "ToyPhysics.hpp"
-#include "rubble/DecompositionFile.hpp"
-#include "rubble/DestructionRuntime.hpp"
-#include "rubble/MeshIO.hpp"
-#include "rubble/SceneConfig.hpp"
-#include "rubble/SceneLoader.hpp"
+#include "rubble/io/DecompositionFile.hpp"
+#include "rubble/io/MeshIO.hpp"
+#include "rubble/io/SceneConfig.hpp"
+#include "rubble/runtime/DestructionRuntime.hpp"
+#include "rubble/runtime/SceneLoader.hpp"
 
 namespace rubble {
 namespace {

@@ -1,4 +1,4 @@
-#include "rubble/ThreadPool.hpp"
+#include "rubble/core/ThreadPool.hpp"
 
 #include <gtest/gtest.h>
 

@@ -14,10 +14,10 @@
 
 #include "RepositoryModels.hpp"
 #include "TestSupport.hpp"
-#include "rubble/Fracture.hpp"
-#include "rubble/MassProperties.hpp"
-#include "rubble/MeshIO.hpp"
-#include "rubble/Random.hpp"
+#include "rubble/core/Random.hpp"
+#include "rubble/fracture/Fracture.hpp"
+#include "rubble/geometry/MassProperties.hpp"
+#include "rubble/io/MeshIO.hpp"
 
 using namespace rubble;
 using rubble::test::closedAndOriented;

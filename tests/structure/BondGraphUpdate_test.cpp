@@ -7,8 +7,8 @@
 #include <set>
 
 #include "ShatteredSolids.hpp"
-#include "rubble/BondGraph.hpp"
-#include "rubble/Random.hpp"
+#include "rubble/core/Random.hpp"
+#include "rubble/structure/BondGraph.hpp"
 #include "runtime/StructureMonitor.hpp"
 
 namespace rubble {

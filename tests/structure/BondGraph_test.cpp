@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "rubble/BondGraph.hpp"
+#include "rubble/structure/BondGraph.hpp"
 
 using namespace rubble;
 

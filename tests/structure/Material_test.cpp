@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "rubble/Material.hpp"
+#include "rubble/structure/Material.hpp"
 
 using namespace rubble;
 

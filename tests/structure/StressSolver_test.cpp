@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "BondLookup.hpp"
-#include "rubble/StressSolver.hpp"
+#include "rubble/structure/StressSolver.hpp"
 
 using namespace rubble;
 

@@ -4,9 +4,9 @@
 
 #include "StructureRig.hpp"
 #include "TestSupport.hpp"
-#include "rubble/DestructionRuntime.hpp"
-#include "rubble/SceneConfig.hpp"
-#include "rubble/SceneLoader.hpp"
+#include "rubble/io/SceneConfig.hpp"
+#include "rubble/runtime/DestructionRuntime.hpp"
+#include "rubble/runtime/SceneLoader.hpp"
 
 namespace rubble {
 namespace {

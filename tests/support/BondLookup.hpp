@@ -5,7 +5,7 @@
 
 #include <algorithm>
 
-#include "rubble/StressSolver.hpp"
+#include "rubble/structure/StressSolver.hpp"
 
 namespace rubble::test {
 

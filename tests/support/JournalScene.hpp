@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "ToyPhysics.hpp"
-#include "rubble/DestructionRuntime.hpp"
-#include "rubble/Mesh.hpp"
+#include "rubble/geometry/Mesh.hpp"
+#include "rubble/runtime/DestructionRuntime.hpp"
 
 namespace rubble::test {
 

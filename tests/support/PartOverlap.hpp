@@ -6,10 +6,10 @@
 #include <cstddef>
 #include <vector>
 
-#include "rubble/ConvexDecomposition.hpp"
-#include "rubble/ConvexPolytope.hpp"
-#include "rubble/MassProperties.hpp"
-#include "rubble/Mesh.hpp"
+#include "rubble/collision/ConvexDecomposition.hpp"
+#include "rubble/geometry/ConvexPolytope.hpp"
+#include "rubble/geometry/MassProperties.hpp"
+#include "rubble/geometry/Mesh.hpp"
 
 namespace rubble::test {
 

@@ -3,8 +3,8 @@
 
 #include <cstdint>
 
-#include "rubble/Fracture.hpp"
-#include "rubble/Random.hpp"
+#include "rubble/core/Random.hpp"
+#include "rubble/fracture/Fracture.hpp"
 
 namespace rubble::test {
 

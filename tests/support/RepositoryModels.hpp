@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "TestSupport.hpp"
-#include "rubble/MeshIO.hpp"
+#include "rubble/io/MeshIO.hpp"
 
 namespace rubble::test {
 

@@ -7,9 +7,9 @@
 #include <chrono>
 #include <vector>
 
-#include "rubble/ConvexPolytope.hpp"
-#include "rubble/DestructionWorld.hpp"
-#include "rubble/Mesh.hpp"
+#include "rubble/geometry/ConvexPolytope.hpp"
+#include "rubble/geometry/Mesh.hpp"
+#include "rubble/runtime/DestructionWorld.hpp"
 
 namespace rubble::test {
 

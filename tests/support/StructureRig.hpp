@@ -5,8 +5,8 @@
 #include <gtest/gtest.h>
 
 #include "ToyPhysics.hpp"
-#include "rubble/DestructionRuntime.hpp"
-#include "rubble/Mesh.hpp"
+#include "rubble/geometry/Mesh.hpp"
+#include "rubble/runtime/DestructionRuntime.hpp"
 
 namespace rubble::test {
 

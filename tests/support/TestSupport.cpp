@@ -8,8 +8,8 @@
 #include <fstream>
 #include <map>
 
-#include "rubble/MassProperties.hpp"
-#include "rubble/MeshCheck.hpp"
+#include "rubble/geometry/MassProperties.hpp"
+#include "rubble/geometry/MeshCheck.hpp"
 
 namespace rubble::test {
 

@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "rubble/MassProperties.hpp"
-#include "rubble/Mesh.hpp"
-#include "rubble/Random.hpp"
+#include "rubble/core/Random.hpp"
+#include "rubble/geometry/MassProperties.hpp"
+#include "rubble/geometry/Mesh.hpp"
 
 namespace rubble::test {
 

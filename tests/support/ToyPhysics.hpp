@@ -6,7 +6,7 @@
 #include <map>
 #include <vector>
 
-#include "rubble/PhysicsBinding.hpp"
+#include "rubble/runtime/PhysicsBinding.hpp"
 
 namespace rubble::test {
 

@@ -29,12 +29,12 @@
 #include "JsonText.hpp"
 #include "Staging.hpp"
 #include "Subcommand.hpp"
-#include "rubble/CollisionTolerance.hpp"
-#include "rubble/ConvexDecomposition.hpp"
-#include "rubble/MeshCheck.hpp"
-#include "rubble/MeshIO.hpp"
-#include "rubble/MeshRepair.hpp"
-#include "rubble/SceneIO.hpp"
+#include "rubble/collision/CollisionTolerance.hpp"
+#include "rubble/collision/ConvexDecomposition.hpp"
+#include "rubble/geometry/MeshCheck.hpp"
+#include "rubble/geometry/MeshRepair.hpp"
+#include "rubble/io/MeshIO.hpp"
+#include "rubble/io/SceneIO.hpp"
 
 namespace {
 

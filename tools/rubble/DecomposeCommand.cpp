@@ -1,9 +1,10 @@
 // `rubble decompose MESH [--max-parts N] [--concavity C] [--json] [-o PARTS.json]`
 //
 // Approximate convex decomposition of a closed mesh. Prints the number of convex parts, the mesh and hull
-// volumes, the excess (hull − mesh) / mesh, the concavity (rubble/PartConcavity.hpp) and the time taken;
+// volumes, the excess (hull − mesh) / mesh, the concavity (rubble/collision/PartConcavity.hpp) and the time
+// taken;
 // --json prints {"parts","mesh_volume","hull_volume","excess","concavity","ms"}. -o writes the parts
-// (rubble/DecompositionFile.hpp); as MESH's stem.parts.json beside it, a scene loads them instead of
+// (rubble/io/DecompositionFile.hpp); as MESH's stem.parts.json beside it, a scene loads them instead of
 // decomposing. Exit codes: 0 success, 1 the mesh cannot be decomposed (e.g. open or inside out) or the parts
 // cannot be written, 2 unreadable file or usage error. With --json a failure prints {"file","error"}.
 #include <chrono>
@@ -14,10 +15,10 @@
 
 #include "JsonText.hpp"
 #include "Subcommand.hpp"
-#include "rubble/ConvexDecomposition.hpp"
-#include "rubble/DecompositionFile.hpp"
-#include "rubble/MeshIO.hpp"
-#include "rubble/PartConcavity.hpp"
+#include "rubble/collision/ConvexDecomposition.hpp"
+#include "rubble/collision/PartConcavity.hpp"
+#include "rubble/io/DecompositionFile.hpp"
+#include "rubble/io/MeshIO.hpp"
 
 namespace {
 

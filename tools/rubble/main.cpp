@@ -1,5 +1,5 @@
 #include "Subcommand.hpp"
-#include "rubble/Version.hpp"
+#include "rubble/core/Version.hpp"
 
 int main(int argc, char** argv) {
     return rubble::tools::runMain(

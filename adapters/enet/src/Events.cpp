@@ -4,7 +4,7 @@
 
 #include "Placements.hpp"
 #include "Protocol.hpp"
-#include "rubble/Random.hpp"
+#include "rubble/core/Random.hpp"
 
 namespace rubble::net::detail {
 

@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "rubble/Journal.hpp"
+#include "rubble/runtime/Journal.hpp"
 
 namespace rubble::net::detail {
 

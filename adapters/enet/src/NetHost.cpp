@@ -9,8 +9,8 @@
 #include "Events.hpp"
 #include "Placements.hpp"
 #include "Protocol.hpp"
-#include "rubble/JournalFile.hpp"
-#include "rubble/Snapshot.hpp"
+#include "rubble/persist/JournalFile.hpp"
+#include "rubble/persist/Snapshot.hpp"
 
 namespace rubble::net {
 

@@ -8,8 +8,8 @@
 #include <map>
 #include <vector>
 
-#include "rubble/DestructionWorld.hpp"
-#include "rubble/Frame.hpp"
+#include "rubble/core/Frame.hpp"
+#include "rubble/runtime/DestructionWorld.hpp"
 
 namespace rubble::net::detail {
 

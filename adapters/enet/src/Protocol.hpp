@@ -11,14 +11,14 @@
 #include <string>
 #include <vector>
 
-#include "rubble/Frame.hpp"
-#include "rubble/Result.hpp"
+#include "rubble/core/Frame.hpp"
+#include "rubble/core/Result.hpp"
 
 namespace rubble::net::detail {
 
 /// Message types (first byte of every packet; on channel 0, reliable and ordered, unless said).
 enum class Message : std::uint8_t {
-    Snapshot = 1,     ///< the snapshot bytes (rubble/Snapshot.hpp)
+    Snapshot = 1,     ///< the snapshot bytes (rubble/persist/Snapshot.hpp)
     Events = 2,       ///< u32 count, then count × 48-byte journal events
     Sync = 3,         ///< u64 frame, u64 journal position, u64 geometry hash
     Ack = 4,          ///< client → host: u64 frame, u64 its geometry hash after that sync

@@ -9,11 +9,10 @@
 
 #include <btBulletDynamicsCommon.h>
 
-#include "rubble/DestructionRuntime.hpp"
-#include "rubble/PhysicsBinding.hpp"
 #include "rubble/bullet/CollisionShape.hpp"
 #include "rubble/bullet/DebugDraw.hpp"
 #include "rubble/bullet/PhysicsWorld.hpp"
+#include "rubble/rubble.hpp"
 
 namespace rubble::bullet {
 

@@ -9,8 +9,8 @@
 
 #include <btBulletCollisionCommon.h>
 
-#include "rubble/ConvexPolytope.hpp"
-#include "rubble/DestructionWorld.hpp"
+#include "rubble/geometry/ConvexPolytope.hpp"
+#include "rubble/runtime/DestructionWorld.hpp"
 
 namespace rubble::bullet {
 

@@ -5,8 +5,8 @@
 #include <LinearMath/btTransform.h>
 #include <LinearMath/btVector3.h>
 
-#include "rubble/DestructionWorld.hpp"
-#include "rubble/Vec3.hpp"
+#include "rubble/core/Vec3.hpp"
+#include "rubble/runtime/DestructionWorld.hpp"
 
 namespace rubble::bullet {
 

@@ -8,7 +8,7 @@
 
 #include <btBulletDynamicsCommon.h>
 
-#include "rubble/Vec3.hpp"
+#include "rubble/core/Vec3.hpp"
 
 namespace rubble::bullet {
 

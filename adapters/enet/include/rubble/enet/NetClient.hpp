@@ -9,8 +9,8 @@
 #include <optional>
 #include <string>
 
-#include "rubble/DestructionWorld.hpp"
-#include "rubble/Result.hpp"
+#include "rubble/core/Result.hpp"
+#include "rubble/runtime/DestructionWorld.hpp"
 
 namespace rubble::net {
 

@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "rubble/DestructionRuntime.hpp"
-#include "rubble/DestructionWorld.hpp"
-#include "rubble/Result.hpp"
+#include "rubble/core/Result.hpp"
+#include "rubble/runtime/DestructionRuntime.hpp"
+#include "rubble/runtime/DestructionWorld.hpp"
 
 namespace rubble::net {
 

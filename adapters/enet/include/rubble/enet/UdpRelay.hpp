@@ -9,8 +9,8 @@
 #include <memory>
 #include <vector>
 
-#include "rubble/Random.hpp"
-#include "rubble/Result.hpp"
+#include "rubble/core/Random.hpp"
+#include "rubble/core/Result.hpp"
 
 namespace rubble::net {
 

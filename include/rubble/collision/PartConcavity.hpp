@@ -1,0 +1,19 @@
+#pragma once
+/// \file PartConcavity.hpp
+/// How far a set of convex parts is from the surface it stands for (docs/collision.md).
+
+#include <cstddef>
+#include <vector>
+
+#include "rubble/geometry/ConvexPolytope.hpp"
+#include "rubble/geometry/Mesh.hpp"
+
+namespace rubble {
+
+/// The one-sided Hausdorff distance from a closed mesh's surface to the boundary of its convex parts, as a
+/// fraction of the mesh's bounding-box diagonal: over samples of the surface (deterministic, area-weighted),
+/// the largest depth of a sample inside a part (a pocket the part covers) or distance outside every part (a
+/// hole in the cover). 0 for a convex mesh and its hull; a crater covered by a part counts its depth.
+double partConcavity(const Mesh& mesh, const std::vector<ConvexPolytope>& parts, std::size_t samples = 4096);
+
+} // namespace rubble

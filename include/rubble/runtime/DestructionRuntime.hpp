@@ -1,0 +1,390 @@
+#pragma once
+/// \file DestructionRuntime.hpp
+/// The engine-neutral runtime of a destructible world: bodies in a physics engine (through a PhysicsBinding),
+/// impacts from their contacts, fracture outcomes adopted as piece bodies, structural support and collapse,
+/// and a debris governor that keeps thousands of pieces affordable (freezing, particles, budgets).
+
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "rubble/runtime/DestructionWorld.hpp"
+#include "rubble/runtime/PhysicsBinding.hpp"
+#include "rubble/structure/BondGraph.hpp"
+#include "rubble/structure/StressSolver.hpp"
+
+namespace rubble {
+
+/// What a body is in the game.
+enum class BodyRole : std::uint8_t {
+    Ground,     ///< a static ground box (a root of support)
+    Scenery,    ///< an indestructible body that is no DestructionWorld object (e.g. a vehicle)
+    Object,     ///< a destructible object added by the game or a scene
+    Piece,      ///< a piece made by a fracture
+    Projectile, ///< a fast small sphere whose first hit on an object always counts as an impact
+};
+
+/// How a body moves.
+enum class BodyMotionState : std::uint8_t {
+    Static,  ///< does not move: ground, scenery or a structural part held up by what it touches
+    Dynamic, ///< simulated
+    Frozen,  ///< a piece that came to rest and was made static by the debris governor; wakes when hit
+};
+
+/// The runtime's record of one body.
+struct BodyRecord {
+    BodyId id = 0;                                    ///< its id in the PhysicsBinding
+    BodyRole role = BodyRole::Scenery;                ///< role
+    BodyMotionState motion = BodyMotionState::Static; ///< static, dynamic or frozen
+    bool hasObject = false;                           ///< `object` names a DestructionWorld object
+    ObjectId object = 0;                              ///< the object (when hasObject)
+    Frame objectToBody;          ///< body → object coordinates: p_object = rotation · p_body + translation
+    double volume = 0;           ///< solid volume (m³)
+    double mass = 0;             ///< mass when dynamic (kg)
+    Vec3 inertia;                ///< principal moments when dynamic (kg·m²)
+    std::size_t triangles = 0;   ///< triangles of its mesh
+    double radius = 0;           ///< bounding sphere radius about the body origin (projectile: its radius)
+    std::uint64_t bornFrame = 0; ///< frame it was created in
+    bool anchor = false;     ///< static and holds itself up (a floating platform, or the kept piece of one)
+    bool structural = false; ///< static and part of the support graph
+    bool spent = false;      ///< projectile: its one hit has been counted
+    double age = 0;          ///< seconds since creation
+    double spentAge = 0;     ///< projectile: seconds since its hit
+
+    /// Dynamic or frozen piece or object: debris the governor manages.
+    bool isDebris() const {
+        return (role == BodyRole::Piece || role == BodyRole::Object) && motion != BodyMotionState::Static;
+    }
+};
+
+/// When contacts become impacts (ImpactCollector).
+struct ImpactPolicy {
+    double collisionImpulseThreshold = 2500; ///< non-projectile contacts fracture only above this total
+                                             ///< impulse per contact pair and step (and the object's own
+                                             ///< threshold)
+    double minApproachSpeed = 2.0;           ///< non-projectile contacts also need this approach speed (m/s)
+    int graceFrames = 30;             ///< new pieces ignore non-projectile contacts for this many frames
+    double minFractureVolume = 0;     ///< impacts on bodies below this volume (m³) are ignored
+    double maxContactDistance = 0.05; ///< contacts farther apart than this (m) are not hits
+    int maxImpactMarks = 64;          ///< recent impacts kept for debug drawing
+};
+
+/// How fracture outcomes become bodies (PieceAdopter).
+struct AdoptionPolicy {
+    double debrisKick = 0.5; ///< share of a hit's impulse that throws the debris of a *static* object outward
+                             ///< (along the surface normal, spread away from the impact); dynamic objects
+                             ///< already took the impulse from the physics engine
+    double maxDebrisKickSpeed = 12;  ///< upper bound of that outward speed (m/s)
+    double singleHullVolume = 0.25;  ///< pieces below this volume (m³) collide as one hull of their parts
+    bool keepStaticRemainder = true; ///< false: every piece of a static object becomes dynamic
+    double friction = 0.7;           ///< friction of piece bodies
+    double restitution = 0.1;        ///< restitution of piece bodies
+};
+
+/// Structural support (SupportGraph): static parts stay up only while a chain of touching static bodies links
+/// them to the ground, static scenery or an anchor.
+struct SupportPolicy {
+    bool collapseUnsupported =
+        true;                     ///< off: the largest piece of a static object stays static, the rest falls
+    double tolerance = 0.02;      ///< gap (m) between static bodies that still counts as touching
+    int maxVisits = 4096;         ///< bodies one support search visits; a larger structure is supported
+    int maxSearchesPerFrame = 64; ///< support searches per frame; the rest wait for the next frame
+};
+
+/// Structural stress (StructureMonitor, docs/structure.md): bonds between touching static bodies carry their
+/// weight and the contact forces of moving bodies on them; a bond over its material's limit breaks and what
+/// no chain of bonds holds up falls. Set at construction.
+struct StructurePolicy {
+    bool enabled = false;              ///< off: support is connectivity only (SupportPolicy)
+    BondSettings bonds{0.02, 1, 1e-4}; ///< what counts as a bond (gap as SupportPolicy::tolerance)
+    StressSettings stress{}; ///< the solver (a sweep budget by default; StressMethod::GaussSeidel converges
+                             ///< to a relative residual of 1e-3); gravity is the binding's. With
+                             ///< StressMethod::SweepBudget: at most `iterations` sweeps a frame (ten times
+                             ///< that in the first solve after objects are placed)
+    int breakRounds = 8; ///< solves after bonds break in a frame, for the new load path (converged methods)
+    double damageRadius = 1.0;      ///< impacts weaken bonds within this distance (m) of the hit
+    double damagePerImpulse = 1e-4; ///< health a bond at the hit loses per N·s of impulse
+    bool bondDebris = false; ///< a static object's debris stays in the structure, bonded across its cut faces
+                             ///< until the solver breaks it (a partial crack); false: thrown, no bonds
+    double bearingFriction = 0.6; ///< > 0: objects (and what is cut from them) rest on each other as
+                                  ///< bearings with this friction coefficient (compression and friction
+                                  ///< only; 0.6: concrete on hardened concrete, ACI 318); 0: welded. Cut
+                                  ///< faces within one object stay welded
+};
+
+/// A bond of the structure, for debug drawing.
+struct StructureBond {
+    BodyId a = 0, b = 0;    ///< the bodies it joins
+    Vec3 centroid;          ///< interface centroid (world)
+    Vec3 normal;            ///< interface normal, from a to b
+    double area = 0;        ///< interface area (m²)
+    double utilisation = 0; ///< largest stress / limit ratio (1 = breaking)
+    double health = 1;      ///< remaining fraction of the section
+};
+
+/// Budgets of the debris governor (DebrisGovernor): what keeps thousands of pieces affordable. Every resting
+/// moving body that carries an object may be frozen, but only pieces are ever retired (the game's own objects
+/// leave only by falling out of the world).
+struct DebrisBudget {
+    int maxAwakeBodies = 400;   ///< dynamic debris bodies; beyond it the slowest settling pieces
+                                ///< (below settlingSpeed) freeze, then the smallest become particles
+    double settlingSpeed = 1.0; ///< m/s (and rad/s): a piece this slow for 10 frames in a row may be frozen
+                                ///< to hold the awake budget
+    int awakeOvershoot = 16;    ///< pieces beyond maxAwakeBodies that may stay awake while they settle (new
+                                ///< pieces get 10 frames, slow ones until they freeze); beyond it, hard
+    double physicsBudgetMs = 8; ///< physics step time no frame should exceed: the awake budget shrinks on a
+                                ///< frame over it and holds the average at 55-75 % of it (ignored in
+                                ///< deterministic mode, where time must not matter)
+    std::size_t maxTriangles = 4000000; ///< triangles of all debris bodies (dynamic and frozen); beyond it
+                                        ///< the smallest frozen pieces become particles
+    bool freezeSleeping = true;         ///< a debris body the engine put to sleep is frozen (made static)
+    int freezeAfterFrames = 6;          ///< ... or one that rested this many frames in a row
+    double freezeSpeed = 1.0;           ///< m/s (and rad/s) below which a body not gaining speed rests
+                                        ///< (velocity change under g·dt / 2 a frame; docs/architecture.md)
+    double wakeImpulse = 100;           ///< a contact impulse (N·s) on a frozen piece that wakes it
+    double fadeVolume = 0.02;           ///< debris below this volume (m³) ...
+    double fadeDistance = 150;          ///< ... farther than this from the focus point fades into particles
+    double killBelowY = -500;           ///< debris falling below this height retires
+    double particleLifetime = 3.0;      ///< seconds a particle is drawn
+};
+
+/// A particle: a piece too small (or one too many) to simulate, drawn for a while. Its volume stays counted.
+struct DebrisParticle {
+    Vec3 position;       ///< world position (m)
+    Vec3 velocity;       ///< world velocity (m/s)
+    double size = 0;     ///< edge length of a cube of the same volume (m)
+    double volume = 0;   ///< volume (m³)
+    double lifetime = 0; ///< seconds left to draw it
+};
+
+/// A recent impact, for debug drawing.
+struct ImpactMark {
+    Vec3 point;         ///< world position
+    Vec3 normal;        ///< world normal (out of the object hit)
+    double impulse = 0; ///< impulse submitted
+};
+
+/// What one frame did.
+struct FrameStats {
+    int substeps = 0;             ///< internal physics steps
+    int impactsSubmitted = 0;     ///< impacts accepted by the DestructionWorld
+    int projectileHits = 0;       ///< projectiles that hit something this frame
+    int fractures = 0;            ///< outcomes adopted
+    int piecesCreated = 0;        ///< piece bodies created
+    int piecesRetired = 0;        ///< bodies and dust turned into particles
+    int piecesCollapsed = 0;      ///< static objects or pieces that lost their support and became dynamic
+    int piecesFrozen = 0;         ///< debris bodies frozen
+    int piecesWoken = 0;          ///< frozen bodies woken by a hit
+    int supportSearches = 0;      ///< support searches run
+    double supportMs = 0;         ///< of adoptMs: support (neighbour tests, searches, collapses)
+    int bondsBroken = 0;          ///< structure bonds broken by stress or damage
+    double structureMs = 0;       ///< of adoptMs: bond graph and stress solve
+    double structureResidual = 0; ///< relative residual of the stress solve the frame acted on (0: none)
+    double physicsMs = 0;         ///< physics step incl. contact gathering
+    double adoptMs = 0;           ///< submit + collect + adoption + governor
+};
+
+/// Pieces turned into particles, by reason.
+struct RetiredPieces {
+    long long dust = 0;      ///< below DestructionWorld::Config::minPieceVolume when adopted
+    long long awake = 0;     ///< over the awake-body budget (or the physics time budget)
+    long long triangles = 0; ///< over the triangle budget
+    long long faded = 0;     ///< tiny and far from the focus
+    long long fellOut = 0;   ///< below DebrisBudget::killBelowY
+    /// The sum.
+    long long total() const { return dust + awake + triangles + faded + fellOut; }
+};
+
+/// Totals since construction.
+struct RuntimeCounters {
+    std::uint64_t frames = 0;      ///< frames stepped
+    long long impacts = 0;         ///< impacts accepted by the DestructionWorld
+    long long projectileHits = 0;  ///< projectile hits on anything
+    long long fractures = 0;       ///< outcomes adopted
+    long long piecesCreated = 0;   ///< piece bodies created
+    long long piecesRetired = 0;   ///< bodies and dust turned into particles (retired.total())
+    RetiredPieces retired;         ///< the same, by reason
+    long long piecesCollapsed = 0; ///< static bodies that lost their support
+    long long bondsBroken = 0;     ///< structure bonds broken
+    long long piecesFrozen = 0;    ///< debris bodies frozen
+    long long piecesWoken = 0;     ///< frozen bodies woken
+    long long staleOutcomes = 0;   ///< outcomes whose parent had no body
+};
+
+/// Where the volume of the world went (m³); live + retired + dust + dropped stays constant.
+struct VolumeLedger {
+    double live = 0;    ///< bodies that carry an object (static, dynamic and frozen)
+    double retired = 0; ///< bodies turned into particles (budget, fading, falling out of the world)
+    double dust = 0;    ///< pieces below DestructionWorld::Config::minPieceVolume
+    double dropped = 0; ///< slivers the fracture kernel dropped
+    /// The sum.
+    double total() const { return live + retired + dust + dropped; }
+};
+
+/// Where an object's body is and how it moves (what a snapshot or a network host sends).
+struct ObjectPlacement {
+    ObjectId object = 0;                              ///< the object
+    BodyRole role = BodyRole::Object;                 ///< an object of the scene or a piece of a fracture
+    BodyMotionState motion = BodyMotionState::Static; ///< static, dynamic or frozen
+    Frame objectToWorld;                              ///< world ← object coordinates
+    Vec3 linearVelocity;                              ///< m/s (world)
+    Vec3 angularVelocity;                             ///< rad/s (world)
+};
+
+/// Structure keys of bodies without objects (ground, scenery) in StructureBondState: this bit | the body id.
+constexpr std::uint64_t kSceneryNodeKey = 1ull << 63;
+
+/// What a snapshot keeps of a structure node (a static object or piece in the stress solver).
+struct StructureNodeState {
+    ObjectId object = 0;       ///< the object
+    ObjectId solid = 0;        ///< the scene object it was cut from (its own id for a scene object)
+    std::uint8_t material = 0; ///< its material: an index into materialPresets()
+    bool root = false;         ///< held in place (an anchor, or the piece an anchor kept)
+    bool anchor = false;       ///< made a root by the anchor rule (its pieces are classified again)
+    bool pending = false;      ///< placed since the last step: the anchor rule decides at the next one
+};
+
+/// What a snapshot keeps of a bond: what geometry cannot give back. Its nodes are object ids, or
+/// kSceneryNodeKey | body id for ground and scenery (the same bodies in the same order as in the saver).
+struct StructureBondState {
+    std::uint64_t a = 0, b = 0; ///< its nodes, a < b
+    double health = 1;          ///< remaining fraction of the section
+    bool broken = false;        ///< broken (it stays broken while both nodes stay)
+};
+
+/// The structure's saved state (docs/journal.md, Snapshots).
+struct StructureState {
+    bool saved = false; ///< false: not saved (no structure, a world-only or a version 2 snapshot)
+    std::vector<StructureNodeState> nodes; ///< ascending object
+    std::vector<StructureBondState> bonds; ///< every bond, broken ones included, ascending (a, b)
+};
+
+/// The runtime. Call everything from one (main) thread; fracture jobs run on the DestructionWorld's workers.
+class DestructionRuntime {
+public:
+    /// Configuration: each component's own settings.
+    struct Config {
+        DestructionWorld::Config world; ///< fracture jobs (its minPieceVolume: smaller pieces become dust)
+        ImpactPolicy impacts;           ///< contacts → impacts
+        AdoptionPolicy adoption;        ///< outcomes → piece bodies
+        SupportPolicy support;          ///< structural support and collapse
+        StructurePolicy structure;      ///< structural stress
+        DebrisBudget debris;            ///< the debris governor
+        double projectileLifetime = 6;  ///< seconds before a projectile is removed
+        double spentProjectileLifetime = 0.5; ///< seconds a projectile lives after its hit
+        Config() { world.minPieceVolume = 1e-3; }
+    };
+
+    /// A runtime over the given engine.
+    DestructionRuntime(PhysicsBinding& binding, Config config);
+    /// Removes every body it created from the engine.
+    ~DestructionRuntime();
+    DestructionRuntime(const DestructionRuntime&) = delete;
+    DestructionRuntime& operator=(const DestructionRuntime&) = delete;
+
+    /// The fracture jobs and object states.
+    DestructionWorld& world();
+    /// The fracture jobs and object states.
+    const DestructionWorld& world() const;
+    /// The engine.
+    PhysicsBinding& binding();
+    /// The settings (may be changed between frames; Config::world only at construction).
+    Config& config();
+
+    /// A static ground box centred at center (a root of support).
+    BodyId addGround(const Vec3& center, const Vec3& halfExtents);
+    /// A destructible (or indestructible) object placed at `placement` (world ← object coordinates). Static
+    /// objects do not move but still break. Fails when the DestructionWorld refuses the mesh.
+    Result<ObjectId> addObject(ObjectDesc desc, const Frame& placement, bool isStatic);
+    /// An indestructible convex body (the hull of points in object coordinates placed at placement), mass 0 =
+    /// static. Fails for fewer than 4 points or points that span no volume.
+    Result<BodyId> addConvexBody(const std::vector<Vec3>& points, const Frame& placement, double mass,
+                                 bool neverSleeps = false);
+    /// A projectile: a sphere from `from` with `velocity`, with continuous collision detection.
+    BodyId fireProjectile(const Vec3& from, const Vec3& velocity, double mass, double radius);
+    /// Removes a body (a destructible object's DestructionWorld object too); what it held up is re-checked.
+    void removeBody(BodyId id);
+    /// Submits an impact on a body's object at a world point with a world normal (out of the object) and an
+    /// impulse, e.g. for a blast. False when ignored (no destructible object, below its threshold).
+    bool submitImpact(BodyId id, const Vec3& worldPoint, const Vec3& worldNormal, double impulse);
+    /// A blast: an impact on every destructible object whose bounding sphere meets the sphere of `radius`
+    /// around `center`, at the point of its bounding sphere nearest the centre (pushed in), its normal toward
+    /// the centre, the impulse falling off linearly from `impulse` to `edgeShare` of it across the radius.
+    /// Returns the impacts accepted.
+    int blast(const Vec3& center, double radius, double impulse, double edgeShare = 0.4);
+
+    /// One frame: physics step, contacts → impacts, outcomes adopted, support settled, debris governed,
+    /// particles and projectiles advanced.
+    FrameStats stepFrame(double dt = 1.0 / 60);
+    /// Adopts the results ready now, between frames (nothing in deterministic mode).
+    FrameStats adoptReady();
+
+    /// The record of a body, or null.
+    const BodyRecord* body(BodyId id) const;
+    /// The body carrying an object, or null.
+    const BodyRecord* bodyOf(ObjectId id) const;
+    /// Ids of every body, ascending (creation order).
+    std::vector<BodyId> bodies() const;
+    /// Where a body is (through the binding).
+    BodyMotion motion(BodyId id) const;
+    /// Number of bodies.
+    std::size_t bodyCount() const;
+    /// Piece bodies (static, dynamic and frozen).
+    int livePieces() const;
+    /// Dynamic debris bodies (pieces and objects).
+    int awakeDebris() const;
+    /// Frozen debris bodies.
+    int frozenDebris() const;
+    /// Triangles of all debris bodies (what DebrisBudget::maxTriangles bounds).
+    std::size_t debrisTriangles() const;
+    /// The awake budget in force (DebrisBudget::maxAwakeBodies, shrunk while physics is over its budget).
+    int awakeBudget() const;
+    /// Particles still drawn.
+    const std::vector<DebrisParticle>& particles() const;
+    /// Recent impacts (oldest first).
+    const std::deque<ImpactMark>& recentImpacts() const;
+    /// Totals.
+    const RuntimeCounters& counters() const;
+    /// Where the volume went.
+    VolumeLedger volumes() const;
+    /// Static bodies that touch this one in the support graph (ascending), for debug drawing and tests.
+    std::vector<BodyId> supportNeighbours(BodyId id) const;
+    /// The structure's bonds with their stress (empty unless StructurePolicy::enabled), ordered by (a, b).
+    std::vector<StructureBond> structureBonds() const;
+    /// The point distant debris fades from (e.g. the camera).
+    void setFocus(const Vec3& point);
+
+    /// The placement of every body that carries an object, ascending body id.
+    std::vector<ObjectPlacement> placements() const;
+    /// The structure's nodes and bonds for a snapshot (saved false unless StructurePolicy::enabled).
+    StructureState structureState() const;
+    /// Replaces the world's state and every body that carries an object by a saved world (a snapshot): each
+    /// object gets a body at its placement with its velocities and motion state (static ones join the support
+    /// graph and the structure, frozen ones the governor's grid). Bodies without objects (ground, scenery,
+    /// projectiles) stay. With a saved structure, its nodes join with their solid, material and root state,
+    /// and the bonds rebuilt from geometry take the saved health and broken state; without, every static
+    /// object joins as a scene object does at load (fresh bonds). The volume ledger continues from volumes'
+    /// retired, dust and dropped (live is the objects'). Fails, changing nothing, when the state is
+    /// inconsistent (DestructionWorld::loadState), an object has no placement or a placement no object, a
+    /// placement's role is neither Object nor Piece, a volume is negative or not finite, or a structure node
+    /// or bond names no static object (or a bond no ground or scenery body of this runtime).
+    Status restore(WorldState state, const std::vector<ObjectPlacement>& placements,
+                   const VolumeLedger& volumes = {}, const StructureState& structure = {});
+
+    /// Hash of the live body set (id, role, motion, object version and mesh hash, transform bits) and of the
+    /// volume ledger: equal runs give equal hashes.
+    std::uint64_t stateHash() const;
+
+    /// Called for every adopted outcome after its piece bodies exist (e.g. for the renderer).
+    void setOnAdopted(std::function<void(const FractureOutcome&)> callback);
+    /// Called before a body is removed (e.g. for the renderer).
+    void setOnRemoved(std::function<void(const BodyRecord&)> callback);
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+} // namespace rubble

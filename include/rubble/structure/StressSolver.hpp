@@ -1,0 +1,238 @@
+#pragma once
+/// \file StressSolver.hpp
+/// Bond forces of a structure under gravity and contact loads (an iterative, warm-started solve of rigid
+/// bond constraints, as in NVIDIA Blast's stress solver), the stresses they cause over each bond's section,
+/// breaking and damage. Theory and validation in docs/structure.md.
+
+#include <cstdint>
+#include <vector>
+
+#include "rubble/core/Vec3.hpp"
+#include "rubble/geometry/ConvexPolytope.hpp"
+#include "rubble/structure/BondGraph.hpp"
+#include "rubble/structure/Material.hpp"
+
+namespace rubble {
+
+/// One rigid part of a structure.
+struct StructureNode {
+    double mass = 0;   ///< kg
+    Vec3 centroid;     ///< centre of mass
+    Mat3 inertia;      ///< inertia tensor about the centre of mass, kg m^2
+    bool root = false; ///< held in place (ground, scenery)
+};
+
+/// The node of a solid of convex parts with the given density (kg/m^3).
+StructureNode structureNode(const std::vector<ConvexPolytope>& parts, double density, bool root);
+
+/// What a bond withstands, in Pa (0: unlimited).
+struct StrengthLimits {
+    double compressive = 0; ///< Pa
+    double tensile = 0;     ///< Pa
+    double shear = 0;       ///< Pa
+    double friction = 0;    ///< > 0: a bearing (dry contact) with this friction coefficient, not a weld
+};
+
+/// The limits of a bond between two materials: the weaker of each.
+StrengthLimits bondLimits(const Material& a, const Material& b);
+
+/// The stresses over a bond's section (Pa), at the current health.
+struct BondStress {
+    double compression = 0; ///< largest compressive normal stress (axial plus bending)
+    double tension = 0;     ///< largest tensile normal stress (axial plus bending)
+    double shear = 0;       ///< mean transverse shear plus the largest torsional shear
+};
+
+/// How StressSolver::solve() iterates (docs/structure.md, "Convergence").
+enum class StressMethod {
+    SweepBudget, ///< Gauss-Seidel over every bond, at most `iterations` sweeps (the solver before issue #32)
+    GaussSeidel, ///< Gauss-Seidel over the bonds of the nodes not at rest, until `residual` is met
+    ConjugateGradient ///< block-Jacobi preconditioned conjugate gradient on the welds, until `residual` is
+                      ///< met
+};
+
+/// Settings of the stress solver.
+struct StressSettings {
+    int iterations = 25;       ///< Gauss-Seidel sweeps over all bonds per solve(), at most
+    double tolerance = 0.01;   ///< m/s^2 (and rad/s^2): fewer sweeps once every bonded node's remaining
+                               ///< acceleration is below it (a warm-started, unchanged structure needs none);
+                               ///< 0: always `iterations`
+    Vec3 gravity{0, -9.81, 0}; ///< m/s^2
+    double unbalanced = 0.5;   ///< m/s^2 (and rad/s^2): a node left accelerating this much is not held
+    int unbalancedSolves = 30; ///< ... after this many solves in a row (the warm-started solve converges)
+    StressMethod method =
+        StressMethod::SweepBudget; ///< how solve() iterates (docs/structure.md, "Convergence")
+    double residual = 1e-3;        ///< GaussSeidel, ConjugateGradient: the relative residual solve() reaches
+    int maxSweeps = 5000; ///< GaussSeidel, ConjugateGradient: sweeps (iterations) at most, for structures
+                          ///< bearings cannot hold (they never converge)
+    bool deadLoadGuess = false; ///< GaussSeidel, ConjugateGradient: a structure whose bonds carry nothing yet
+                                ///< starts from its dead load passed down (off: it biases which equilibrium
+                                ///< indeterminate contacts reach; docs/structure.md)
+    bool trace = false; ///< record the relative residual after every sweep (history(); costs a pass over
+                        ///< the nodes per sweep)
+};
+
+/// The stress solver over one structure (nodes joined by bonds).
+class StressSolver {
+public:
+    /// An empty structure.
+    explicit StressSolver(StressSettings settings = {}) : settings_(settings) {}
+
+    /// Replaces the structure; limits[i] belongs to bonds[i]. Accumulated forces and health are reset.
+    void reset(std::vector<StructureNode> nodes, std::vector<Bond> bonds, std::vector<StrengthLimits> limits);
+    /// Adds a node (in a free slot when there is one); returns its index.
+    std::uint32_t addNode(const StructureNode& node);
+    /// Removes a node and its bonds; its index is free for a later addNode. Until the next solve, bonds added
+    /// to its former neighbours across the same faces inherit the forces its bonds carried (by area): the
+    /// pieces that replace a fractured body start from its load path.
+    void removeNode(std::uint32_t node);
+    /// Adds a bond between present nodes (in a free slot when there is one); returns its index. The other
+    /// bonds keep their forces and health.
+    std::size_t addBond(Bond bond, StrengthLimits limits);
+    /// Makes a node a root (held) or not; its bonds' effective masses follow.
+    void setRoot(std::uint32_t node, bool root);
+    /// True when the node is present (added and not removed).
+    bool present(std::uint32_t node) const { return node < nodes_.size() && !nodes_[node].removed; }
+    /// True when the node is held (a root).
+    bool root(std::uint32_t node) const { return nodes_[node].node.root; }
+    /// The bonds of a node (broken ones included), ascending.
+    const std::vector<std::size_t>& bondsOf(std::uint32_t node) const { return nodes_[node].bonds; }
+    /// Settings (may change between solves).
+    StressSettings& settings() { return settings_; }
+
+    /// Adds a load on a node for the next solve (e.g. a contact force), applied at a point.
+    void addLoad(std::uint32_t node, const Vec3& force, const Vec3& point);
+    /// Runs the bounded iterations, starting from the previous solve's bond forces; consumes the loads.
+    void solve();
+
+    /// Sweeps (or conjugate-gradient iterations) the last solve() ran.
+    int sweeps() const { return sweeps_; }
+    /// The last solve()'s relative residual: the largest remaining acceleration of a supported node (its
+    /// linear and angular parts in the mass metric, m/s^2) over the largest acceleration the loads alone
+    /// give.
+    double residual() const { return residual_; }
+    /// With StressSettings::trace: the relative residual after each sweep of the last solve().
+    const std::vector<double>& history() const { return history_; }
+    /// Bond slots (removed bonds leave free slots, which count as broken).
+    std::size_t bondCount() const { return bonds_.size(); }
+    /// Node slots (removed nodes leave free slots, never unsupported).
+    std::size_t nodeCount() const { return nodes_.size(); }
+    /// The bond (its section and nodes).
+    const Bond& bond(std::size_t i) const { return bonds_[i].bond; }
+    /// The force that node b exerts on node a through the bond (N).
+    Vec3 bondForce(std::size_t i) const { return bonds_[i].force; }
+    /// The couple that node b exerts on node a through the bond, about the section centroid (N m).
+    Vec3 bondMoment(std::size_t i) const { return bonds_[i].moment; }
+    /// The stresses over the bond's section at its current health.
+    BondStress stress(std::size_t i) const;
+    /// The largest ratio of a stress to its limit (1 = breaking; 0 for a broken bond). A bearing carries
+    /// compression only, its resultant inside the contact patch and its transverse force within friction: the
+    /// solve keeps it there (a body it cannot hold is unbalanced, see unsupported()), and it breaks only by
+    /// crushing.
+    double utilisation(std::size_t i) const;
+    /// The bond's remaining fraction of section, 1 when whole.
+    double health(std::size_t i) const { return bonds_[i].health; }
+    /// True when the bond has broken.
+    bool broken(std::size_t i) const { return bonds_[i].broken; }
+
+    /// Weakens bonds whose centroid lies within radius of point: health drops by amount * (1 - d / radius).
+    /// Bonds reaching 0 break.
+    void damage(const Vec3& point, double radius, double amount);
+    /// Breaks every bond whose stress exceeds its limits; returns them, ascending.
+    std::vector<std::size_t> breakOverstressed();
+    /// Sets a bond's health (e.g. carried over from an earlier graph); 0 breaks it.
+    void setHealth(std::size_t i, double health);
+    /// Breaks one bond.
+    void breakBond(std::size_t i);
+    /// Takes a node out of the structure (it fell or was removed); its bonds break.
+    void detach(std::uint32_t node);
+    /// Nodes still in the structure that no chain of intact bonds links to a root, or that bearings have not
+    /// held in equilibrium for `StressSettings::unbalancedSolves` solves in a row (tipping or sliding),
+    /// ascending.
+    std::vector<std::uint32_t> unsupported() const;
+
+private:
+    struct NodeState {
+        StructureNode node;
+        double invMass = 0;
+        Mat3 invInertia;
+        Vec3 v, w;          // velocity change this solve
+        Vec3 force, torque; // loads this solve
+        Vec3 fv, fw;        // the loads' (and gravity's) part of v and w
+        bool dirty = false; // v and w to be recomputed from the bonds at the next solve
+        bool detached = false;
+        bool removed = false;           // a free slot
+        int unbalanced = 0;             // solves in a row that left it accelerating
+        int bearings = 0;               // bearings it rests on (or carries)
+        std::vector<std::size_t> bonds; // ascending
+    };
+    struct BearingCorner {
+        Vec3 offset;                   // from the section centroid (world)
+        Vec3 ra, rb;                   // from each node's centre of mass
+        double kn = 0, ku = 0, kv = 0; // inverse effective masses along the normal and the in-plane axes
+        double press = 0;              // accumulated normal force (>= 0: compression)
+        double gu = 0, gv = 0;         // accumulated friction along u and v (|g| <= friction * press)
+        Vec3 ca[3], cb[3];             // ra x d and rb x d for d = normal, u, v
+        Vec3 ia[3], ib[3];             // the inverse inertias times those: the spin an impulse along d gives
+    };
+    struct BondState {
+        Bond bond;
+        StrengthLimits limits;
+        Vec3 ra, rb;       // section centroid relative to each node's centre of mass
+        double kinv[36]{}; // inverse of the 6x6 effective mass
+        bool solvable = false;
+        Vec3 force, moment; // accumulated (warm start)
+        double health = 1;
+        bool broken = false;
+        bool removed = false;               // a free slot
+        std::vector<BearingCorner> corners; // bearing: contact points at the patch's hull corners
+    };
+    void prepare(BondState& b);
+    void removeBond(std::size_t i);
+    void apply(BondState& b, const Vec3& force, const Vec3& moment);
+    double bearingUtilisation(const BondState& b) const;
+    void solveBearing(BondState& b);
+    void gatherBearing(BondState& b);
+    void solveWeld(BondState& b);
+    void markDirty(std::uint32_t node);
+    double startSolve();
+    void reach();
+    std::vector<char> reachable() const;
+    double nodeResidual(const NodeState& n) const;
+    bool movable(std::uint32_t i) const;
+    void solveSweepBudget();
+    void solveGaussSeidel(double tolerance);
+    void solveConjugateGradient(double tolerance);
+    void finishSolve(double scale);
+    void traceSweep();
+
+    StressSettings settings_;
+    std::vector<NodeState> nodes_;
+    std::vector<BondState> bonds_;
+    std::vector<std::uint32_t> freeNodes_; // descending pops give the lowest slot first
+    std::vector<std::uint32_t> checked_;   // solve(): the nodes whose rest ends the sweeps
+    int sweeps_ = 0;
+    double residual_ = 0;
+    double scale_ = 0; // the last solve's residual scale (m/s^2)
+    std::vector<double> history_;
+    std::vector<std::size_t> freeBonds_;
+    std::vector<std::uint32_t> dirty_; // nodes whose v and w the next solve recomputes
+    bool allDirty_ = true;             // every node's (gravity changed, or never solved)
+    Vec3 gravity_;                     // the gravity v and w hold
+    std::vector<char> reached_;        // a chain of intact bonds links the node to a root
+    bool reachValid_ = false;          // reached_ matches the bonds
+    struct Orphan {                    // the load a removed node's bond put on a neighbour
+        std::uint32_t node;            // the neighbour
+        Vec3 force, moment;            // on it, the moment about the section centroid
+        Vec3 centroid, normal;         // the section's
+    };
+    void inherit();
+    void coldStart();
+    std::vector<Orphan> orphans_;          // since the last solve
+    std::vector<std::size_t> fresh_;       // bonds added since the last solve
+    std::vector<std::uint32_t> bondStamp_; // GaussSeidel: the sweep that listed the bond
+    std::vector<std::uint32_t> nodeStamp_; // ... that moved the node
+    std::uint32_t stampNow_ = 0;
+};
+
+} // namespace rubble
