@@ -3,8 +3,8 @@
 #   make test    install, build, check formatting and layering, run all tests
 #   make bench   install, build Release, run the benchmarks (CSV + PNG in bench/results/)
 #   make build   install and build (RelWithDebInfo) into build/
-#   make install     build, then install headers, libraries, CMake package, pkg-config files, the CLI and the
-#                    Python module into PREFIX (default /usr/local): cmake --install build --prefix PREFIX
+#   make install     build Release (build-release/), then install headers, stripped libraries, CMake package,
+#                    pkg-config files, the CLI and the Python module into PREFIX (default /usr/local)
 #   make sanitize    clang ASan+UBSan build of the whole test suite (build-asan/) and TSan build of the runtime
 #                    and Bullet tests (build-tsan/), both run by CTest (scripts/sanitize.sh)
 #   make sanitize-ci what CI runs after make test: make sanitize, then every libFuzzer target for a fixed seed and
@@ -47,12 +47,12 @@ $(BUILD_DIR)/build.ninja: | $(DEPS_STAMP)
 build: deps $(BUILD_DIR)/build.ninja
 	cmake --build $(BUILD_DIR) -j $(JOBS)
 
-install: build
-	cmake --install $(BUILD_DIR) --prefix $(PREFIX)
+install: release
+	cmake --install $(RELEASE_DIR) --prefix $(PREFIX) --strip
 
 release: deps
 	@[ -f $(RELEASE_DIR)/build.ninja ] || cmake -S . -B $(RELEASE_DIR) -G Ninja -DCMAKE_BUILD_TYPE=Release \
-	    -DRUBBLE_BUILD_TESTS=OFF -DRUBBLE_BUILD_PYTHON=OFF $(CMAKE_ARGS)
+	    -DRUBBLE_BUILD_TESTS=OFF $(CMAKE_ARGS)
 	cmake --build $(RELEASE_DIR) -j $(JOBS)
 
 lint: deps

@@ -23,8 +23,9 @@ function(rubble_module name)
     endif()
     target_link_libraries(${name} PUBLIC ${ARG_DEPS} PRIVATE ${ARG_PRIVATE_DEPS} rubble_warnings)
     target_compile_features(${name} PUBLIC cxx_std_20)
-    # PIC: the same objects make the shared libraries and the Python module.
-    set_target_properties(${name} PROPERTIES POSITION_INDEPENDENT_CODE ON)
+    # PIC: the same objects make the shared library. Hidden visibility: librubble.so exports what RUBBLE_API marks.
+    set_target_properties(${name} PROPERTIES POSITION_INDEPENDENT_CODE ON CXX_VISIBILITY_PRESET hidden
+        VISIBILITY_INLINES_HIDDEN ON)
 endfunction()
 
 # rubble_shared_library(TARGET OUTPUT_NAME file EXPORT_NAME name OBJECTS static... [PUBLIC deps...]

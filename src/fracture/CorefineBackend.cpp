@@ -1,16 +1,5 @@
-// Boolean backend on CGAL Polygon_mesh_processing corefinement.
-//
-// Kernel choice: Exact_predicates_exact_constructions_kernel (Epeck). Measured side by side (2-core VM):
-// 300 chained fractures (20 generations on box/sphere/torus, every third a 3-cell shatter) ran without a
-// failure with both kernels, in 4.0 s with Epeck and 6.8 s with Epick; on the cube benchmark (one cell at
-// (0.99,0,0)) the split took 12.3 ms (Epeck) vs 13.9 ms (Epick) at 10,092 triangles. Epeck is no slower and
-// keeps every intermediate result exact (intersection points are never rounded while the cells of one
-// split are cut), so it is the default. Results are rounded to double once, when converted to rubble::Mesh.
-//
-// For one cell, one corefine_and_compute_boolean_operations call yields both mesh − cell and mesh ∩ cell
-// (~0.55x the cost of two calls); several cells go through runIndependent (deterministic output). A visitor
-// carries the source triangle of every face through face splits and copies, so input attributes are
-// interpolated from the right triangle.
+// The exact boolean backend: CGAL corefinement on the Epeck kernel (why: docs/architecture.md, "The exact
+// backend").
 
 #include <array>
 #include <map>

@@ -81,14 +81,8 @@ struct Job {
     double finishMs = 0;
 };
 
-// Physics engines report contact points off the surface (a predictive CCD contact gives the projectile's
-// centre at the time of impact, a margin adds a few centimetres, and a convex part of a concave object covers
-// space the mesh does not: measured, about a fifth of the hits in performance_test.cfg landed on a hull
-// farther from the mesh than the impact's cells reach): the cells are centred on the nearest surface point so
-// that a hit on the collision shape always damages the object where it is nearest. An impact in a crater that
-// an earlier job removed (re-targeted to the remainder) breaks the crater's wall. Only a point farther than
-// the object's own size is left alone (not a contact; its job ends with NoIntersection and is recorded as a
-// miss).
+// The impact moved to the nearest surface point of the mesh; an impact farther than the object's own size is
+// left alone (docs/architecture.md, "Impacts off the surface").
 Impact onSurface(const Mesh& mesh, Impact impact, const FractureParams& params) {
     double best = std::numeric_limits<double>::infinity();
     Vec3 closest = impact.point;

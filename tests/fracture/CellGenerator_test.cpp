@@ -202,7 +202,7 @@ TEST(CellGenerator, ShatterCellsFormAComplex) {
     const Mesh box = makeSubdividedBox({-2, -2, -2}, {3, 3, 3}, 1);
     std::vector<std::pair<int, std::uint64_t>> cases;
     for (int cells : {30, 50, 100, 150, 200, 1000})
-        for (std::uint64_t seed = 1; seed <= 10; ++seed)
+        for (std::uint64_t seed : test::sweepSeeds(10, {1, 2, 8, 10}))
             cases.emplace_back(cells, seed);
     for (const auto& [k, seed] : cases) {
         FractureParams params;

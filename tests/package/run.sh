@@ -24,7 +24,7 @@ fail() {
 case "$step" in
 install)
     rm -rf "$prefix"
-    cmake --install "$build" --prefix "$prefix" >"$work.install.log" || { cat "$work.install.log"; exit 1; }
+    cmake --install "$build" --prefix "$prefix" --strip >"$work.install.log" || { cat "$work.install.log"; exit 1; }
     libdir=$(cd "$prefix" && ls -d lib*/cmake/Rubble | sed 's#/cmake/Rubble##')
     for f in "$libdir"/cmake/Rubble/RubbleConfig.cmake "$libdir"/cmake/Rubble/RubbleConfigVersion.cmake \
         "$libdir"/cmake/Rubble/RubbleTargets.cmake "$libdir"/cmake/Rubble/RubbleBulletTargets.cmake \
@@ -42,6 +42,14 @@ install)
         *) fail "librubble.so needs $lib, which docs/hello.md does not name" ;;
         esac
     done
+    # librubble.so exports Rubble's API only: no CGAL, Boost or standard-library instance.
+    exported=$(nm -D --defined-only "$prefix/$libdir/librubble.so" | awk '{print $3}' | c++filt)
+    foreign=$(echo "$exported" | grep -vE '^(rubble::|rubble_|typeinfo for rubble::|typeinfo name for rubble::|vtable for rubble::|non-virtual thunk to rubble::)' || true)
+    [ -z "$foreign" ] || fail "librubble.so exports $(echo "$foreign" | wc -l) symbols that are not Rubble's, e.g. $(echo "$foreign" | head -3)"
+    echo "librubble.so exports $(echo "$exported" | wc -l) symbols"
+    # The CLI links librubble.so instead of a second copy of the library.
+    readelf -d "$prefix/bin/rubble" | grep -q 'NEEDED.*librubble\.so' || fail "bin/rubble does not link librubble.so"
+    "$prefix/bin/rubble" --version >/dev/null || fail "the installed bin/rubble does not run"
     # Nothing installed may point back into the source or build tree.
     src=$(cd "$here/../.." && pwd)
     if grep -rl -e "$src" -e "$(cd "$build" && pwd)" "$prefix/$libdir/cmake" "$prefix/$libdir/pkgconfig"; then

@@ -42,9 +42,7 @@ std::vector<Shape> sweepShapes() {
 int sweepCount(int ciDefault) {
     if (const char* env = std::getenv("RUBBLE_SWEEP_SHATTERS"); env && std::atoi(env) > 0)
         return std::atoi(env);
-    const char* scale = std::getenv("RUBBLE_SWEEP_SCALE");
-    const double f = scale ? std::atof(scale) : 1.0;
-    return std::max(1, static_cast<int>(std::lround(ciDefault * (f > 0 ? f : 1.0))));
+    return std::max(1, static_cast<int>(std::lround(ciDefault * test::sweepScale())));
 }
 
 struct Sweep {

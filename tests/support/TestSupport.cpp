@@ -145,4 +145,19 @@ std::vector<std::array<double, 9>> triangleSoup(const Mesh& m) {
     return out;
 }
 
+double sweepScale() {
+    const char* scale = std::getenv("RUBBLE_SWEEP_SCALE");
+    const double f = scale ? std::atof(scale) : 1.0;
+    return f > 0 ? f : 1.0;
+}
+
+std::vector<std::uint64_t> sweepSeeds(int count, std::vector<std::uint64_t> kept) {
+    if (sweepScale() < 1)
+        return kept;
+    std::vector<std::uint64_t> all;
+    for (int s = 1; s <= count; ++s)
+        all.push_back(static_cast<std::uint64_t>(s));
+    return all;
+}
+
 } // namespace rubble::test

@@ -45,6 +45,11 @@ std::vector<std::array<double, 9>> triangleSoup(const Mesh& m);
 /// mass against the bounds' diagonal, inertia against its largest entry.
 double massError(const Mesh& mesh, const MassProperties& mass);
 
+/// RUBBLE_SWEEP_SCALE (1 unless set; the sanitizer runs set 0.1): the share of a long sweep a run makes.
+double sweepScale();
+/// Seeds 1..count, or only `kept` (the regressions a sweep must always replay) when sweepScale() < 1.
+std::vector<std::uint64_t> sweepSeeds(int count, std::vector<std::uint64_t> kept);
+
 } // namespace rubble::test
 
 /// Skips the current test when the seed media folder is absent (as in a user's clone).

@@ -9,6 +9,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "rubble/core/Export.hpp"
 #include "rubble/core/ParameterCheck.hpp"
 #include "rubble/core/Result.hpp"
 #include "rubble/geometry/ConvexPolytope.hpp"
@@ -19,7 +20,7 @@ namespace rubble {
 struct FractureResult;
 
 /// Parameters of a decomposition.
-struct DecompositionParams {
+struct RUBBLE_API DecompositionParams {
     int maxParts = 24;       ///< at most this many convex parts, in [1, kMaxConvexParts]
     double concavity = 0.02; ///< stop splitting a part whose concavity is below this fraction of the
                              ///< mesh's bounding-box diagonal
@@ -33,7 +34,7 @@ struct DecompositionParams {
 };
 
 /// A set of convex parts approximating a closed mesh.
-struct Decomposition {
+struct RUBBLE_API Decomposition {
     std::vector<ConvexPolytope> parts; ///< convex parts, in the mesh's coordinates
     double meshVolume = 0;             ///< volume of the mesh
     double hullVolume = 0;             ///< Σ part volumes
@@ -42,20 +43,20 @@ struct Decomposition {
 };
 
 /// The convex hull of a point set (Qhull). Fails for fewer than 4 non-coplanar points.
-Result<ConvexPolytope> convexHull(const std::vector<Vec3>& points);
+RUBBLE_API Result<ConvexPolytope> convexHull(const std::vector<Vec3>& points);
 
 /// A convex polytope containing every point with at most maxFaces faces: facet planes of the exact hull,
 /// added where it reaches farthest out, until it reaches at most half of kPartHullTolerance out of the hull
 /// (rubble/collision/CollisionTolerance.hpp); above 16 points per face, the planes of the hull of the points'
 /// extremes in maxFaces / 4 directions pushed out to the farthest point. When the exact hull has at most
 /// maxFaces faces it is returned instead. Fails for flat or too few points.
-Result<ConvexPolytope> boundedHull(const std::vector<Vec3>& points, std::size_t maxFaces);
+RUBBLE_API Result<ConvexPolytope> boundedHull(const std::vector<Vec3>& points, std::size_t maxFaces);
 
 /// Decomposes a closed mesh into at most params.maxParts convex parts; a convex mesh gives exactly one part
 /// (whatever params.concavity: a part convex to within 1e-9 of the diagonal is not split). InvalidInput for a
 /// mesh that is not closed and consistently oriented, has coordinates beyond ±kMaxCoordinate or no positive
 /// volume, and for maxParts outside [1, kMaxConvexParts].
-Result<Decomposition> decompose(const Mesh& mesh, const DecompositionParams& params = {});
+RUBBLE_API Result<Decomposition> decompose(const Mesh& mesh, const DecompositionParams& params = {});
 
 /// Incremental update at fracture time: clips the parent's parts by the cells and assigns every fragment to
 /// the piece containing it. parentParts are in the same coordinates as cells and pieces. pieceCells[i] is
@@ -64,21 +65,20 @@ Result<Decomposition> decompose(const Mesh& mesh, const DecompositionParams& par
 /// high-poly remainder first makes its least dented parent parts whole again; docs/megamesh.md). A
 /// remainder's parts stay out of the cells' debris and may number up to kCraterBudgetFactor × maxParts to do
 /// so; every piece's parts stay within kPartHullTolerance of its convex hull (docs/collision.md).
-std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<ConvexPolytope>& parentParts,
-                                                             const std::vector<ConvexPolytope>& cells,
-                                                             const std::vector<Mesh>& pieces,
-                                                             const std::vector<std::int32_t>& pieceCells,
-                                                             const DecompositionParams& params = {});
+RUBBLE_API std::vector<std::vector<ConvexPolytope>>
+updateDecomposition(const std::vector<ConvexPolytope>& parentParts, const std::vector<ConvexPolytope>& cells,
+                    const std::vector<Mesh>& pieces, const std::vector<std::int32_t>& pieceCells,
+                    const DecompositionParams& params = {});
 /// updateDecomposition for the pieces of a fracture (rubble/fracture/Fracture.hpp): one part list per piece
 /// of result.
-std::vector<std::vector<ConvexPolytope>> updateDecomposition(const std::vector<ConvexPolytope>& parentParts,
-                                                             const FractureResult& result,
-                                                             const DecompositionParams& params = {});
+RUBBLE_API std::vector<std::vector<ConvexPolytope>>
+updateDecomposition(const std::vector<ConvexPolytope>& parentParts, const FractureResult& result,
+                    const DecompositionParams& params = {});
 
 /// Thread-safe cache of decompositions keyed by Mesh::hash(), optionally persisted in a directory. The memory
 /// holds at most capacity() entries: on a miss beyond that, the least recently used entry is evicted (its
 /// file, if any, stays on disk), so a long run that adds many distinct meshes uses bounded memory.
-class DecompositionCache {
+class RUBBLE_API DecompositionCache {
 public:
     /// Default in-memory capacity (entries).
     static constexpr std::size_t kDefaultCapacity = 256;

@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "rubble/core/Export.hpp"
 #include "rubble/geometry/ConvexPolytope.hpp"
 #include "rubble/geometry/Mesh.hpp"
 
@@ -14,6 +15,7 @@ namespace rubble {
 /// fraction of the mesh's bounding-box diagonal: over samples of the surface (deterministic, area-weighted),
 /// the largest depth of a sample inside a part (a pocket the part covers) or distance outside every part (a
 /// hole in the cover). 0 for a convex mesh and its hull; a crater covered by a part counts its depth.
-double partConcavity(const Mesh& mesh, const std::vector<ConvexPolytope>& parts, std::size_t samples = 4096);
+RUBBLE_API double partConcavity(const Mesh& mesh, const std::vector<ConvexPolytope>& parts,
+                                std::size_t samples = 4096);
 
 } // namespace rubble

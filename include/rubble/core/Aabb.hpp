@@ -4,12 +4,13 @@
 
 #include <limits>
 
+#include "rubble/core/Export.hpp"
 #include "rubble/core/Vec3.hpp"
 
 namespace rubble {
 
 /// An axis-aligned bounding box; an empty box has lo > hi.
-struct Aabb {
+struct RUBBLE_API Aabb {
     Vec3 lo{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
             std::numeric_limits<double>::infinity()}; ///< minimum corner
     Vec3 hi{-std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),

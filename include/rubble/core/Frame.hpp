@@ -2,12 +2,13 @@
 /// \file Frame.hpp
 /// A rigid frame (rotation + translation) and its composition.
 
+#include "rubble/core/Export.hpp"
 #include "rubble/core/Vec3.hpp"
 
 namespace rubble {
 
 /// A rigid frame: p_parent = rotation · p_local + translation.
-struct Frame {
+struct RUBBLE_API Frame {
     Mat3 rotation = Mat3::identity(); ///< orientation
     Vec3 translation;                 ///< position
 

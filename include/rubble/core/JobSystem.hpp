@@ -4,10 +4,12 @@
 
 #include <functional>
 
+#include "rubble/core/Export.hpp"
+
 namespace rubble {
 
 /// Runs jobs off the calling thread. Implement this to run Rubble's work on a game's own scheduler.
-class JobSystem {
+class RUBBLE_API JobSystem {
 public:
     virtual ~JobSystem() = default;
     /// Schedules job to run once on some worker thread. Must be thread-safe.

@@ -6,6 +6,8 @@
 #include <functional>
 #include <string_view>
 
+#include "rubble/core/Export.hpp"
+
 namespace rubble {
 
 /// How serious a log message is.
@@ -20,12 +22,12 @@ using LogFunction = std::function<void(LogLevel level, std::string_view message)
 
 /// Replaces the log function (thread-safe). An empty function restores the default, which writes
 /// "rubble: <level>: <message>" lines to stderr; to silence the library pass a function that does nothing.
-void setLogFunction(LogFunction function);
+RUBBLE_API void setLogFunction(LogFunction function);
 
 /// Sends a message to the current log function.
-void logMessage(LogLevel level, std::string_view message);
+RUBBLE_API void logMessage(LogLevel level, std::string_view message);
 
 /// Lower-case name of a level ("info", "warning", "error").
-const char* toString(LogLevel level);
+RUBBLE_API const char* toString(LogLevel level);
 
 } // namespace rubble

@@ -7,6 +7,7 @@
 #include <string>
 #include <string_view>
 
+#include "rubble/core/Export.hpp"
 #include "rubble/core/Result.hpp"
 #include "rubble/core/Vec3.hpp"
 
@@ -21,7 +22,7 @@ enum class ParamKind : std::uint8_t {
 };
 
 /// The accepted values of one parameter.
-struct ParamRange {
+struct RUBBLE_API ParamRange {
     std::string_view name; ///< as every API spells it (C++ member, C field, Python keyword, --name)
     ParamKind kind = ParamKind::Real; ///< what it takes
     long double lo = 0;               ///< lowest accepted value (Real, Integer)
@@ -69,25 +70,25 @@ inline constexpr ParamRange kAbsoluteRoughness{"roughness", ParamKind::Real, 0, 
 inline constexpr ParamRange kAbsoluteFeatureSize{"feature_size", ParamKind::Real, 0, 1e6};
 
 /// The range of the parameter called name, or null.
-const ParamRange* findParamRange(std::string_view name);
+RUBBLE_API const ParamRange* findParamRange(std::string_view name);
 
 /// What name accepts, as the messages say it ("a finite number in [0, 1e+12]").
-std::string describeParamRange(const ParamRange& range);
+RUBBLE_API std::string describeParamRange(const ParamRange& range);
 
 /// InvalidInput "<name> must be <range>, got <value>" when value is outside name's range (or name is
 /// unknown).
-Status checkParam(std::string_view name, long double value);
+RUBBLE_API Status checkParam(std::string_view name, long double value);
 /// checkParam against a range of one's own (a Real or Integer range).
-Status checkParam(const ParamRange& range, long double value);
+RUBBLE_API Status checkParam(const ParamRange& range, long double value);
 /// checkParam for a Point or Direction parameter.
-Status checkParam(std::string_view name, const Vec3& value);
+RUBBLE_API Status checkParam(std::string_view name, const Vec3& value);
 /// checkParam for a value given as text (the CLI's): a value that is no number is refused the same way.
-Status checkParamText(std::string_view name, std::string_view text);
+RUBBLE_API Status checkParamText(std::string_view name, std::string_view text);
 
 /// The most pieces a fracture into `cells` cells repeated over `depth` levels may make: the sum over the
 /// levels of max(2, cells)^level (a piece can be broken into every cell plus remainder islands).
-long double piecesBound(int cells, int depth);
+RUBBLE_API long double piecesBound(int cells, int depth);
 /// InvalidInput when piecesBound(cells, depth) exceeds kMaxTotalPieces, with both figures in the message.
-Status checkPieceBudget(int cells, int depth);
+RUBBLE_API Status checkPieceBudget(int cells, int depth);
 
 } // namespace rubble

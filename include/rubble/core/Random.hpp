@@ -7,12 +7,13 @@
 #include <cstdint>
 #include <numbers>
 
+#include "rubble/core/Export.hpp"
 #include "rubble/core/Vec3.hpp"
 
 namespace rubble {
 
 /// SplitMix64 generator with platform-independent distributions (std distributions are not portable).
-class Rng {
+class RUBBLE_API Rng {
 public:
     /// A generator seeded with seed.
     explicit Rng(std::uint64_t seed = 0) : state_(seed) {}

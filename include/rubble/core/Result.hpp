@@ -9,6 +9,8 @@
 #include <utility>
 #include <variant>
 
+#include "rubble/core/Export.hpp"
+
 namespace rubble {
 
 /// What kind of failure an Error is.
@@ -24,16 +26,16 @@ enum class ErrorCode {
 };
 
 /// Human-readable name of an error code.
-const char* toString(ErrorCode code);
+RUBBLE_API const char* toString(ErrorCode code);
 
 /// An error: a code and a message that names what is wrong (file, line, field where known).
-struct Error {
+struct RUBBLE_API Error {
     ErrorCode code = ErrorCode::Ok; ///< the kind of failure
     std::string message;            ///< what went wrong, for people
 };
 
 /// Success or an Error, for functions without a value.
-class [[nodiscard]] Status {
+class [[nodiscard]] RUBBLE_API Status {
 public:
     /// A successful status.
     Status() = default;
@@ -56,9 +58,9 @@ private:
 
 namespace detail {
 /// Logs "Result::value() called on a failed Result: <code>: <message>" as an error and aborts.
-[[noreturn]] void failedValueAccess(const Error& error);
+[[noreturn]] RUBBLE_API void failedValueAccess(const Error& error);
 /// The Error of every successful Result (code Ok, no message).
-const Error& noError();
+RUBBLE_API const Error& noError();
 } // namespace detail
 
 /// A value of type T or an Error.

@@ -10,6 +10,7 @@
 #include <thread>
 #include <vector>
 
+#include "rubble/core/Export.hpp"
 #include "rubble/core/JobSystem.hpp"
 
 namespace rubble {
@@ -17,7 +18,7 @@ namespace rubble {
 /// A FIFO thread pool. Workers sleep on a condition variable (no busy waiting). Destruction finishes the jobs
 /// that are running and DROPS the jobs still queued (their std::function is destroyed without being called),
 /// so it never waits for a long backlog; call waitIdle() first to run everything.
-class ThreadPool final : public JobSystem {
+class RUBBLE_API ThreadPool final : public JobSystem {
 public:
     /// A pool with `workers` threads; workers <= 0 means hardware threads − 1, at least 1.
     explicit ThreadPool(int workers = -1);

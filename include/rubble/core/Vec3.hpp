@@ -4,10 +4,12 @@
 
 #include <cmath>
 
+#include "rubble/core/Export.hpp"
+
 namespace rubble {
 
 /// A 3D vector or point in double precision.
-struct Vec3 {
+struct RUBBLE_API Vec3 {
     double x = 0; ///< x coordinate
     double y = 0; ///< y coordinate
     double z = 0; ///< z coordinate
@@ -75,7 +77,7 @@ inline bool isFinite(const Vec3& v) {
 }
 
 /// A 2D vector, used for texture coordinates.
-struct Vec2 {
+struct RUBBLE_API Vec2 {
     double x = 0; ///< u / x
     double y = 0; ///< v / y
     /// Exact component-wise equality.
@@ -83,7 +85,7 @@ struct Vec2 {
 };
 
 /// A row-major 3x3 matrix (inertia tensors, rotations).
-struct Mat3 {
+struct RUBBLE_API Mat3 {
     double m[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}}; ///< m[row][column]
 
     /// The identity matrix.

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "rubble/core/Export.hpp"
 #include "rubble/core/ParameterCheck.hpp"
 #include "rubble/core/Result.hpp"
 #include "rubble/fracture/Roughness.hpp"
@@ -20,7 +21,7 @@
 namespace rubble {
 
 /// An impact on an object, in the object's mesh coordinates.
-struct Impact {
+struct RUBBLE_API Impact {
     Vec3 point; ///< where the object was hit
     Vec3 normal{0, 1,
                 0}; ///< surface normal at the hit (pointing out of the object), or the hit direction reversed
@@ -29,7 +30,7 @@ struct Impact {
 
 /// How the size of the cut region follows the impulse: size = clamp(base + scale · impulse^exponent, min,
 /// max), where size is the edge length of the cubic domain the cell is built in.
-struct CellSizeLaw {
+struct RUBBLE_API CellSizeLaw {
     double base = 0.5;     ///< size at zero impulse
     double scale = 0.05;   ///< growth factor
     double exponent = 0.5; ///< growth exponent
@@ -68,7 +69,7 @@ enum class ShatterLayout : std::uint8_t {
 };
 
 /// What one impact cuts: the pattern and the edge of its cubic domain (impactCut).
-struct ImpactCut {
+struct RUBBLE_API ImpactCut {
     CellPattern pattern = CellPattern::SingleCell; ///< SingleCell or Shatter
     double size = 0;                               ///< domain edge length
 };
@@ -80,7 +81,7 @@ inline constexpr double kShatterGrowth = 3.0;
 inline constexpr double kAdaptiveReferenceSize = 10.0;
 
 /// Parameters of one fracture.
-struct FractureParams {
+struct RUBBLE_API FractureParams {
     CellPattern pattern = CellPattern::SingleCell; ///< single cell (thesis) or shatter pattern
     int seedPoints = 15; ///< random Voronoi sites in the domain besides the impact point
     int cells = 16;      ///< K, the cells of a Shatter pattern: 1..kMaxShatterCells (fracture refuses others)
@@ -103,7 +104,7 @@ struct FractureParams {
 /// them once (e.g. when an object is added); every Piece carries them for its own mesh, so a piece that is
 /// hit again is not scanned again. They belong to one mesh, unchanged: facts whose counts do not match the
 /// mesh are ignored, and facts of another mesh with the same counts give wrong results.
-struct MeshFacts {
+struct RUBBLE_API MeshFacts {
     bool known = false;        ///< false: nothing is known (fracture checks and measures everything)
     std::size_t triangles = 0; ///< the mesh's triangle count
     std::size_t vertices = 0;  ///< the mesh's vertex count
@@ -120,10 +121,10 @@ struct MeshFacts {
 
 /// Checks that mesh is a valid closed, consistently oriented solid of positive volume (as fracture does) and
 /// returns its facts; InvalidInput otherwise.
-Result<MeshFacts> analyzeMesh(const Mesh& mesh);
+RUBBLE_API Result<MeshFacts> analyzeMesh(const Mesh& mesh);
 
 /// One output piece: a closed, outward-oriented mesh in the input's coordinates.
-struct Piece {
+struct RUBBLE_API Piece {
     Mesh mesh;              ///< closed mesh; cut faces have material kInteriorMaterial and planar UVs
     MassProperties mass;    ///< exact mass properties of mesh (density 1)
     std::int32_t cell = -1; ///< -1: part of the damaged remainder (input − cells); i ≥ 0: debris of cell i
@@ -131,7 +132,7 @@ struct Piece {
 };
 
 /// Durations of the stages of one fracture, in milliseconds.
-struct FractureTimings {
+struct RUBBLE_API FractureTimings {
     double validateMs = 0; ///< checking that the input mesh is a valid closed, oriented solid
     double cellMs = 0;     ///< building the cells
     double booleanMs = 0;  ///< difference and intersections
@@ -143,7 +144,7 @@ struct FractureTimings {
 };
 
 /// Everything one fracture produced.
-struct FractureResult {
+struct RUBBLE_API FractureResult {
     std::vector<Piece> pieces;         ///< remainder islands first, then debris islands by cell
     std::vector<ConvexPolytope> cells; ///< the cells that were cut (faces tagged with their plane index)
     double inputVolume = 0;            ///< volume of the input mesh
@@ -166,14 +167,14 @@ struct FractureResult {
 /// sizeLaw.sizeFor(impulse). Adaptive: Shatter when sizeFor(impulse) >= kShatterGrowth * sizeFor(0), else
 /// SingleCell; the size is sizeFor(impulse) * max(1, sqrt(diagonal / kAdaptiveReferenceSize)), at most
 /// sizeLaw.maxSize (demo/README.md, weapons). Pure; a function of the journaled impulse and the geometry.
-ImpactCut impactCut(const FractureParams& params, const Aabb& meshBounds, double impulse);
+RUBBLE_API ImpactCut impactCut(const FractureParams& params, const Aabb& meshBounds, double impulse);
 
 /// Builds the cutting cells of an impact on a mesh with these bounds (clamps cells); deterministic in seed.
-std::vector<ConvexPolytope> generateCells(const Aabb& meshBounds, const Impact& impact,
-                                          const FractureParams& params, std::uint64_t seed);
+RUBBLE_API std::vector<ConvexPolytope> generateCells(const Aabb& meshBounds, const Impact& impact,
+                                                     const FractureParams& params, std::uint64_t seed);
 
 /// Result of splitting a mesh by disjoint convex cells.
-struct SplitResult {
+struct RUBBLE_API SplitResult {
     Mesh remainder;             ///< mesh − ∪ cells (may be empty)
     std::vector<Mesh> inside;   ///< inside[i] = mesh ∩ cells[i] (may be empty)
     bool exactFallback = false; ///< a fast backend declined and an exact backend made this split
@@ -183,7 +184,7 @@ struct SplitResult {
 };
 
 /// A boolean implementation: splits a closed mesh by disjoint convex cells.
-class BooleanBackend {
+class RUBBLE_API BooleanBackend {
 public:
     virtual ~BooleanBackend() = default;
     /// Short name ("corefine", "nef").
@@ -194,11 +195,11 @@ public:
 };
 
 /// The backend of the given kind.
-std::unique_ptr<BooleanBackend> makeBooleanBackend(BooleanKind kind);
+RUBBLE_API std::unique_ptr<BooleanBackend> makeBooleanBackend(BooleanKind kind);
 
 /// The checks of the parameter table (rubble/core/ParameterCheck.hpp) on an impact's point, normal and
 /// impulse and on params' cells: what fracture() refuses.
-Status checkFractureParams(const Impact& impact, const FractureParams& params);
+RUBBLE_API Status checkFractureParams(const Impact& impact, const FractureParams& params);
 
 /// Fractures a closed mesh at an impact: cells, booleans, islands, mass properties, interior UVs.
 /// NoIntersection when the cells miss the mesh; InvalidInput for an open mesh or checkFractureParams'
@@ -207,8 +208,9 @@ Status checkFractureParams(const Impact& impact, const FractureParams& params);
 /// recomputation up to rounding; docs/megamesh.md); the pieces' meshes are the same either way.
 /// With known facts that carry a topology (MeshFacts::topology) and the Fast backend, fracture copies the
 /// mesh and its facts and runs the consuming overload below.
-Result<FractureResult> fracture(const Mesh& mesh, const Impact& impact, const FractureParams& params,
-                                std::uint64_t seed, const MeshFacts& known = {});
+RUBBLE_API Result<FractureResult> fracture(const Mesh& mesh, const Impact& impact,
+                                           const FractureParams& params, std::uint64_t seed,
+                                           const MeshFacts& known = {});
 
 /// fracture, consuming the mesh and its facts: with a topology in them and the Fast backend, the remainder
 /// is the input edited in place (the triangles the cut removed replaced by those it made, checked closed
@@ -216,15 +218,16 @@ Result<FractureResult> fracture(const Mesh& mesh, const Impact& impact, const Fr
 /// fallback) and keeps an updated topology, so the cost follows the cut (docs/megamesh.md). Its triangles are
 /// then in a different order than the copying path gives, and it may keep unreferenced vertices (compacted
 /// when they are many). Without a topology it is the const& overload.
-Result<FractureResult> fracture(Mesh&& mesh, const Impact& impact, const FractureParams& params,
-                                std::uint64_t seed, MeshFacts known = {});
+RUBBLE_API Result<FractureResult> fracture(Mesh&& mesh, const Impact& impact, const FractureParams& params,
+                                           std::uint64_t seed, MeshFacts known = {});
 
 /// Fractures a closed mesh with explicitly given cells (for merged impacts and tests); known as for fracture.
-Result<FractureResult> fractureWithCells(const Mesh& mesh, std::vector<ConvexPolytope> cells,
-                                         const FractureParams& params, const MeshFacts& known = {});
+RUBBLE_API Result<FractureResult> fractureWithCells(const Mesh& mesh, std::vector<ConvexPolytope> cells,
+                                                    const FractureParams& params,
+                                                    const MeshFacts& known = {});
 
 /// fractureWithCells consuming the mesh and its facts, as the consuming fracture.
-Result<FractureResult> fractureWithCells(Mesh&& mesh, std::vector<ConvexPolytope> cells,
-                                         const FractureParams& params, MeshFacts known = {});
+RUBBLE_API Result<FractureResult> fractureWithCells(Mesh&& mesh, std::vector<ConvexPolytope> cells,
+                                                    const FractureParams& params, MeshFacts known = {});
 
 } // namespace rubble

@@ -7,6 +7,7 @@
 #include <optional>
 #include <string_view>
 
+#include "rubble/core/Export.hpp"
 #include "rubble/core/ParameterCheck.hpp"
 #include "rubble/core/Result.hpp"
 #include "rubble/core/Vec3.hpp"
@@ -14,7 +15,7 @@
 namespace rubble {
 
 /// The cut-surface model of a fracture. amplitude 0 is the thesis's flat cut.
-struct Roughness {
+struct RUBBLE_API Roughness {
     double amplitude = 0;    ///< largest height of a cut face above or below its plane; 0 = flat
     double featureSize = 0;  ///< longest wavelength; 0 = 8 × amplitude
     double hurst = 0.75;     ///< Hurst (roughness) exponent in (0, 1]
@@ -31,11 +32,11 @@ struct Roughness {
 /// Checks every field of r against the parameter table (rubble/core/ParameterCheck.hpp: roughness,
 /// feature_size, hurst, octaves, grain_stretch, grain, max_triangles_per_piece); InvalidInput naming the
 /// first one refused.
-Status validateRoughness(const Roughness& r);
+RUBBLE_API Status validateRoughness(const Roughness& r);
 
 /// A cut's roughness as a caller sets it: a material's preset, then any of amplitude, hurst and feature size
 /// by hand (fractions of the cell size; an absolute preset set by hand becomes relative).
-struct RoughnessChoice {
+struct RUBBLE_API RoughnessChoice {
     std::string_view material;         ///< a material name, or empty for flat before the values set by hand
     std::optional<double> amplitude;   ///< Roughness::amplitude, unless unset
     std::optional<double> hurst;       ///< Roughness::hurst, unless unset
@@ -43,10 +44,10 @@ struct RoughnessChoice {
 };
 
 /// The roughness of choice, checked by validateRoughness; InvalidInput for a material with no preset.
-Result<Roughness> chooseRoughness(const RoughnessChoice& choice);
+RUBBLE_API Result<Roughness> chooseRoughness(const RoughnessChoice& choice);
 
 /// The roughness preset of a material name (concrete, brick, stone, wood, glass, steel; docs/roughness.md),
 /// or flat for any other name.
-Roughness roughnessPreset(std::string_view material);
+RUBBLE_API Roughness roughnessPreset(std::string_view material);
 
 } // namespace rubble

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "rubble/core/Aabb.hpp"
+#include "rubble/core/Export.hpp"
 #include "rubble/core/Frame.hpp"
 #include "rubble/geometry/Mesh.hpp"
 #include "rubble/geometry/Plane.hpp"
@@ -14,14 +15,14 @@ namespace rubble {
 
 /// One planar convex face: its outward plane, its corners counter-clockwise seen from outside, and a tag
 /// (e.g. the id of the cutting plane that created it; -1 for faces of the original shape).
-struct PolytopeFace {
+struct RUBBLE_API PolytopeFace {
     Plane plane;               ///< outward supporting plane
     std::vector<Vec3> corners; ///< counter-clockwise seen from outside
     std::int32_t tag = -1;     ///< caller-defined id of where the face came from
 };
 
 /// A bounded convex polytope. Value type; clipping returns a new polytope.
-class ConvexPolytope {
+class RUBBLE_API ConvexPolytope {
 public:
     /// An empty polytope.
     ConvexPolytope() = default;
@@ -65,6 +66,6 @@ private:
 
 /// True when the two polytopes overlap or are at most `gap` apart along every separating axis (face normals
 /// of both, and cross products of their edge directions): convex bodies that touch within a tolerance.
-bool withinGap(const ConvexPolytope& a, const ConvexPolytope& b, double gap);
+RUBBLE_API bool withinGap(const ConvexPolytope& a, const ConvexPolytope& b, double gap);
 
 } // namespace rubble

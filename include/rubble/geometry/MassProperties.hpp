@@ -2,13 +2,14 @@
 /// \file MassProperties.hpp
 /// Exact mass properties of a closed triangle mesh of uniform density.
 
+#include "rubble/core/Export.hpp"
 #include "rubble/core/Vec3.hpp"
 #include "rubble/geometry/Mesh.hpp"
 
 namespace rubble {
 
 /// Mass properties for density 1 (multiply inertia by density for a real body; mass = density · volume).
-struct MassProperties {
+struct RUBBLE_API MassProperties {
     double volume = 0;     ///< signed volume (negative for an inward-oriented mesh)
     Vec3 centerOfMass;     ///< centroid of the solid
     Mat3 inertia;          ///< inertia tensor about the centre of mass, density 1
@@ -19,7 +20,7 @@ struct MassProperties {
 /// The volume integrals of a closed mesh about a reference point: sums over its triangles of the tetrahedra
 /// they form with the point. They are additive, so the integrals of a mesh that changed in a few triangles
 /// are its old ones minus the removed triangles' terms plus the added ones' (docs/megamesh.md).
-struct VolumeIntegrals {
+struct RUBBLE_API VolumeIntegrals {
     Vec3 reference;        ///< apex of the tetrahedra
     double volume = 0;     ///< ∫ dV
     Vec3 first;            ///< ∫ (x − reference) dV
@@ -47,18 +48,18 @@ struct VolumeIntegrals {
 };
 
 /// The volume integrals of all triangles of mesh about reference.
-VolumeIntegrals volumeIntegrals(const Mesh& mesh, const Vec3& reference);
+RUBBLE_API VolumeIntegrals volumeIntegrals(const Mesh& mesh, const Vec3& reference);
 /// About the centre of the mesh's bounds (what computeMassProperties sums).
-VolumeIntegrals volumeIntegrals(const Mesh& mesh);
+RUBBLE_API VolumeIntegrals volumeIntegrals(const Mesh& mesh);
 
 /// Mass properties from volume integrals (computeMassProperties(m) is massProperties(volumeIntegrals(m))).
-MassProperties massProperties(const VolumeIntegrals& integrals);
+RUBBLE_API MassProperties massProperties(const VolumeIntegrals& integrals);
 
 /// Computes volume, centre of mass and inertia by the divergence theorem over the triangles.
 /// Exact for closed meshes; numerically stable far from the origin (computed about the bounding-box centre).
-MassProperties computeMassProperties(const Mesh& mesh);
+RUBBLE_API MassProperties computeMassProperties(const Mesh& mesh);
 
 /// Signed volume only (cheaper than computeMassProperties).
-double signedVolume(const Mesh& mesh);
+RUBBLE_API double signedVolume(const Mesh& mesh);
 
 } // namespace rubble

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "rubble/core/Aabb.hpp"
+#include "rubble/core/Export.hpp"
 #include "rubble/core/Result.hpp"
 #include "rubble/core/Vec3.hpp"
 
@@ -23,7 +24,7 @@ inline constexpr std::uint32_t kInteriorMaterial = 0xFFFF'FFFEu;
 ///
 /// Attributes are optional. When present, `normals` and `uvs` hold one entry per triangle corner
 /// (index 3*t + c) and `materials` one entry per triangle; an empty vector means "not present".
-struct Mesh {
+struct RUBBLE_API Mesh {
     std::vector<Vec3> positions;            ///< vertex positions
     std::vector<Triangle> triangles;        ///< triangles as indices into positions
     std::vector<Vec3> normals;              ///< per-corner normals (3 per triangle) or empty
@@ -79,18 +80,18 @@ struct Mesh {
 
 /// The generalized winding number of a closed mesh around p (1 inside an outward solid, 0 outside; the sum of
 /// the triangles' signed solid angles over 4π).
-double windingNumber(const Mesh& mesh, const Vec3& p);
+RUBBLE_API double windingNumber(const Mesh& mesh, const Vec3& p);
 /// Distance from p to the nearest point on any triangle of mesh (infinity for an empty mesh).
-double distanceToSurface(const Mesh& mesh, const Vec3& p);
+RUBBLE_API double distanceToSurface(const Mesh& mesh, const Vec3& p);
 
 /// An axis-aligned box mesh from lo to hi with 12 triangles, outward oriented.
-Mesh makeBox(const Vec3& lo, const Vec3& hi);
+RUBBLE_API Mesh makeBox(const Vec3& lo, const Vec3& hi);
 /// A box from lo to hi whose faces are each split into an n×n grid (12·n² triangles), like the seed's
 /// cube_N.obj.
-Mesh makeSubdividedBox(const Vec3& lo, const Vec3& hi, int n);
+RUBBLE_API Mesh makeSubdividedBox(const Vec3& lo, const Vec3& hi, int n);
 /// A UV sphere of radius r with the given numbers of slices and stacks, outward oriented.
-Mesh makeSphere(const Vec3& center, double r, int slices, int stacks);
+RUBBLE_API Mesh makeSphere(const Vec3& center, double r, int slices, int stacks);
 /// A torus in the xz-plane with major radius R and minor radius r.
-Mesh makeTorus(const Vec3& center, double R, double r, int majorSegments, int minorSegments);
+RUBBLE_API Mesh makeTorus(const Vec3& center, double R, double r, int majorSegments, int minorSegments);
 
 } // namespace rubble

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "rubble/core/Aabb.hpp"
+#include "rubble/core/Export.hpp"
 #include "rubble/core/Vec3.hpp"
 #include "rubble/geometry/Mesh.hpp"
 
@@ -19,7 +20,7 @@ namespace rubble {
 inline constexpr double kMaxCoordinate = 1e50;
 
 /// What checkMesh examines.
-struct CheckOptions {
+struct RUBBLE_API CheckOptions {
     /// Run the (CGAL) self-intersection test. It only runs on meshes that are valid polygon meshes
     /// (manifold, in-range indices, finite coordinates, no degenerate triangles).
     bool selfIntersections = true;
@@ -30,7 +31,7 @@ struct CheckOptions {
 };
 
 /// The verdict of checkMesh: counts, topology flags, geometry and a list of human-readable problems.
-struct MeshReport {
+struct RUBBLE_API MeshReport {
     std::size_t vertices = 0;  ///< number of vertices
     std::size_t triangles = 0; ///< number of triangles
 
@@ -85,18 +86,18 @@ struct MeshReport {
 
 /// Examines a mesh and reports what is wrong with it. Never fails and never throws: any exception from the
 /// geometric kernel is caught and recorded in selfIntersectionNote.
-MeshReport checkMesh(const Mesh& mesh, const CheckOptions& options = {});
+RUBBLE_API MeshReport checkMesh(const Mesh& mesh, const CheckOptions& options = {});
 
 /// Ok when every coordinate is within ±kMaxCoordinate; otherwise an InvalidInput error naming the first
 /// vertex beyond it and the bound ("what: vertex 3 has a coordinate of 1e+100, beyond ±1e+50 ...").
-Status checkCoordinateRange(const Mesh& mesh, const std::string& what);
+RUBBLE_API Status checkCoordinateRange(const Mesh& mesh, const std::string& what);
 
 /// True when the triangle abc has (numerically) zero area: its doubled area is below 1e-12 times the square
 /// of its longest edge.
-bool isDegenerateTriangle(const Vec3& a, const Vec3& b, const Vec3& c);
+RUBBLE_API bool isDegenerateTriangle(const Vec3& a, const Vec3& b, const Vec3& c);
 
 /// Result of the self-intersection test alone.
-struct SelfIntersectionResult {
+struct RUBBLE_API SelfIntersectionResult {
     bool ran = false;      ///< false when the mesh is not a valid polygon mesh or the kernel failed
     std::size_t pairs = 0; ///< intersecting pairs of non-adjacent triangles found (up to the cap)
     bool capped = false;   ///< the search stopped at the cap
@@ -107,6 +108,6 @@ struct SelfIntersectionResult {
 /// Finds pairs of intersecting triangles (CGAL Polygon_mesh_processing::self_intersections on a Surface_mesh
 /// built from the triangles). Requires a polygon mesh (manifold, finite, no degenerate triangles); returns
 /// ran = false with a note otherwise. Never throws.
-SelfIntersectionResult findSelfIntersections(const Mesh& mesh, std::size_t maxPairs = 100000);
+RUBBLE_API SelfIntersectionResult findSelfIntersections(const Mesh& mesh, std::size_t maxPairs = 100000);
 
 } // namespace rubble

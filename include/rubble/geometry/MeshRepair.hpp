@@ -7,13 +7,14 @@
 #include <string>
 #include <vector>
 
+#include "rubble/core/Export.hpp"
 #include "rubble/geometry/Mesh.hpp"
 #include "rubble/geometry/MeshCheck.hpp"
 
 namespace rubble {
 
 /// What repairMesh does.
-struct RepairOptions {
+struct RUBBLE_API RepairOptions {
     /// Vertices closer than weldTolerance × (bounding-box diagonal) are merged; 0 merges exact duplicates
     /// only.
     double weldTolerance = 1e-9;
@@ -26,7 +27,7 @@ struct RepairOptions {
 };
 
 /// What repairMesh changed and what it could not fix.
-struct RepairReport {
+struct RUBBLE_API RepairReport {
     std::size_t removedBadIndexTriangles = 0;  ///< triangles referring to vertices that do not exist
     std::size_t removedNonFiniteTriangles = 0; ///< triangles touching a vertex with a NaN/infinite coordinate
     std::size_t weldedVertices = 0;    ///< vertices merged into an earlier vertex within the tolerance
@@ -56,6 +57,6 @@ struct RepairReport {
 /// simple loop bending out of its plane by at most 5% of its width is closed by a triangulation in that
 /// plane; other holes, non-manifold edges and self-intersections are not repaired, only reported (unrepaired
 /// says what the user can do). Never fails and never throws.
-RepairReport repairMesh(Mesh& mesh, const RepairOptions& options = {});
+RUBBLE_API RepairReport repairMesh(Mesh& mesh, const RepairOptions& options = {});
 
 } // namespace rubble

@@ -7,13 +7,14 @@
 #include <vector>
 
 #include "rubble/core/Aabb.hpp"
+#include "rubble/core/Export.hpp"
 #include "rubble/geometry/MassProperties.hpp"
 #include "rubble/geometry/Mesh.hpp"
 
 namespace rubble {
 
 /// Tolerances of simplifyPlanarRegions.
-struct PlanarSimplifyParams {
+struct RUBBLE_API PlanarSimplifyParams {
     /// Largest distance of a vertex from its region's plane (and of a removed boundary vertex from the
     /// straight edge that replaces it), relative to the mesh's bounding-box diagonal.
     double planeTolerance = 1e-9;
@@ -28,7 +29,7 @@ struct PlanarSimplifyParams {
 };
 
 /// What simplifyPlanarRegions did.
-struct PlanarSimplifyReport {
+struct RUBBLE_API PlanarSimplifyReport {
     std::size_t trianglesBefore = 0;            ///< triangles of the input
     std::size_t trianglesAfter = 0;             ///< triangles of the output
     std::size_t verticesRemoved = 0;            ///< vertices that no longer exist
@@ -52,10 +53,10 @@ struct PlanarSimplifyReport {
 /// same area without changing the enclosed volume; a patch that fails keeps its vertices. Vertices on open
 /// boundaries, where the surface touches itself, or next to a repeated edge stay where they are.
 /// Deterministic.
-Mesh simplifyPlanarRegions(const Mesh& mesh, const PlanarSimplifyParams& params = {},
-                           PlanarSimplifyReport* report = nullptr);
+RUBBLE_API Mesh simplifyPlanarRegions(const Mesh& mesh, const PlanarSimplifyParams& params = {},
+                                      PlanarSimplifyReport* report = nullptr);
 /// As above; a mesh left as it is is moved into the result, not copied.
-Mesh simplifyPlanarRegions(Mesh&& mesh, const PlanarSimplifyParams& params = {},
-                           PlanarSimplifyReport* report = nullptr);
+RUBBLE_API Mesh simplifyPlanarRegions(Mesh&& mesh, const PlanarSimplifyParams& params = {},
+                                      PlanarSimplifyReport* report = nullptr);
 
 } // namespace rubble

@@ -2,12 +2,13 @@
 /// \file Plane.hpp
 /// Oriented plane n·x = d; the normal points to the outside (positive side).
 
+#include "rubble/core/Export.hpp"
 #include "rubble/core/Vec3.hpp"
 
 namespace rubble {
 
 /// An oriented plane {x : dot(normal, x) = offset}. Points with signedDistance > 0 are outside.
-struct Plane {
+struct RUBBLE_API Plane {
     Vec3 normal{0, 0, 1}; ///< unit outward normal
     double offset = 0;    ///< dot(normal, p) for any point p on the plane
 

@@ -9,6 +9,7 @@
 #include <string_view>
 #include <vector>
 
+#include "rubble/core/Export.hpp"
 #include "rubble/core/Result.hpp"
 #include "rubble/geometry/MassProperties.hpp"
 #include "rubble/geometry/Mesh.hpp"
@@ -20,13 +21,13 @@ namespace rubble {
 inline constexpr std::string_view kInteriorMaterialName = "interior";
 
 /// One object of a multi-object file (OBJ `o` statements, or `g` groups when a file has no `o`).
-struct NamedMesh {
+struct RUBBLE_API NamedMesh {
     std::string name; ///< the object's name ("" for faces before the first `o`/`g`)
     Mesh mesh;        ///< its triangles; vertices renumbered to the ones it uses
 };
 
 /// Options of writeObj.
-struct ObjWriteOptions {
+struct RUBBLE_API ObjWriteOptions {
     bool writeNormals = true; ///< write `vn` and v//vn corners when the mesh has normals
     bool writeUvs = true;     ///< write `vt` corners when the mesh has texture coordinates
     bool writeMaterials =
@@ -48,9 +49,10 @@ struct ObjWriteOptions {
 /// a normal get the flat face normal, corners without a texture coordinate get (0, 0).
 /// Non-finite coordinates ("nan", "inf") are accepted (checkMesh reports them); numbers beyond the double
 /// range are a ParseError.
-Result<Mesh> parseObj(std::string_view text, const std::string& displayName);
+RUBBLE_API Result<Mesh> parseObj(std::string_view text, const std::string& displayName);
 /// Parses OBJ text keeping objects apart (see NamedMesh); objects without faces are dropped.
-Result<std::vector<NamedMesh>> parseObjObjects(std::string_view text, const std::string& displayName);
+RUBBLE_API Result<std::vector<NamedMesh>> parseObjObjects(std::string_view text,
+                                                          const std::string& displayName);
 
 /// Parses OFF text (Rubble's own reader: numbers exact to the double, polygons of any size triangulated as in
 /// parseObj, `#` comments anywhere). The header [ST][C][N][4][n]OFF is followed by the vertex, face and
@@ -58,23 +60,24 @@ Result<std::vector<NamedMesh>> parseObjObjects(std::string_view text, const std:
 /// line `n i1 ... in` with 0-based indices; anything after the numbers a line needs (normals, colours) is
 /// ignored. The declared counts must match the file. Unreferenced vertices are dropped. Errors (ParseError,
 /// Unsupported for binary OFF and dimensions other than 3) name displayName and the line.
-Result<Mesh> parseOff(std::string_view text, const std::string& displayName);
+RUBBLE_API Result<Mesh> parseOff(std::string_view text, const std::string& displayName);
 
 /// Reads an OBJ file into one mesh (see parseObj). Errors: IoError when the file cannot be read, ParseError
 /// naming file and line when it is malformed or has no triangles.
-Result<Mesh> readObj(const std::filesystem::path& path);
+RUBBLE_API Result<Mesh> readObj(const std::filesystem::path& path);
 /// Reads an OBJ file keeping its objects apart (see parseObjObjects).
-Result<std::vector<NamedMesh>> readObjObjects(const std::filesystem::path& path);
+RUBBLE_API Result<std::vector<NamedMesh>> readObjObjects(const std::filesystem::path& path);
 
 /// Writes mesh as OBJ (exact shortest round-trip numbers), with normals and texture coordinates when present,
 /// and, when the mesh has materials, `usemtl` statements and an MTL file (same stem, .mtl) in which
 /// kInteriorMaterial is "interior" with its own colour (or its definition in options.materials). Collision
 /// parts follow as UCX_ objects. Triangles keep their order. Each file is written to a
 /// staging file next to it and renamed, so a failed write (IoError) leaves the previous file as it was.
-Status writeObj(const std::filesystem::path& path, const Mesh& mesh, const ObjWriteOptions& options = {});
+RUBBLE_API Status writeObj(const std::filesystem::path& path, const Mesh& mesh,
+                           const ObjWriteOptions& options = {});
 
 /// One node of a glTF scene written by writeGltf.
-struct GltfNode {
+struct RUBBLE_API GltfNode {
     GltfNode() = default;
     /// A node with the given fields.
     GltfNode(std::string name_, Mesh mesh_, const Vec3& origin_, std::vector<Mesh> collision_ = {},
@@ -104,13 +107,14 @@ struct GltfNode {
 /// Output is byte-identical for identical input. Errors: InvalidInput for an empty or invalid mesh, IoError
 /// naming the file (written through a staging file and a rename, as writeObj). sceneExtras, when not empty,
 /// is a JSON object stored as the scene's "extras".
-Status writeGltf(const std::filesystem::path& path, const std::vector<GltfNode>& nodes,
-                 const std::vector<AssetMaterial>& materials = {}, const std::string& sceneExtras = {});
+RUBBLE_API Status writeGltf(const std::filesystem::path& path, const std::vector<GltfNode>& nodes,
+                            const std::vector<AssetMaterial>& materials = {},
+                            const std::string& sceneExtras = {});
 
 /// The node extras Rubble writes for a piece (docs/authoring.md): {"rubble":{"level","density":1,"mass",
 /// "volume","center_of_mass":[x,y,z],"inertia":[[...],[...],[...]]}} (density 1, so mass = volume), plus
 /// "parent" when parent is not empty.
-std::string pieceExtras(const MassProperties& mass, int level, const std::string& parent = {});
+RUBBLE_API std::string pieceExtras(const MassProperties& mass, int level, const std::string& parent = {});
 
 /// Reads a mesh by extension: .obj with readObj, .off with parseOff, ASCII .ply and .stl with Rubble's own
 /// readers (exact doubles, file:line errors, equal positions welded); binary .stl and .ply, .3ds, .gltf and
@@ -119,9 +123,9 @@ std::string pieceExtras(const MassProperties& mass, int level, const std::string
 /// buffer/accessor lengths) are checked against the file before Assimp sees it, and so are glTF's JSON depth
 /// and node hierarchy (at most 256 and 1024 levels; nodes must form trees). Errors: Unsupported for other
 /// extensions, IoError, ParseError; every message names the file.
-Result<Mesh> readMesh(const std::filesystem::path& path);
+RUBBLE_API Result<Mesh> readMesh(const std::filesystem::path& path);
 
 /// The extensions readMesh accepts, lower case with the dot (".obj", ".stl", ...).
-const std::vector<std::string>& supportedMeshExtensions();
+RUBBLE_API const std::vector<std::string>& supportedMeshExtensions();
 
 } // namespace rubble

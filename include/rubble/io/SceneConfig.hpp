@@ -15,13 +15,14 @@
 #include <string>
 #include <vector>
 
+#include "rubble/core/Export.hpp"
 #include "rubble/core/Result.hpp"
 #include "rubble/core/Vec3.hpp"
 
 namespace rubble {
 
 /// One entity line of a scene file (ground, vehicle or object).
-struct SceneObject {
+struct RUBBLE_API SceneObject {
     std::size_t line = 0;              ///< 1-based line in the file
     std::string model;                 ///< model file as written (may be empty, e.g. for the ground)
     std::string texture;               ///< texture file as written (may be empty)
@@ -39,13 +40,13 @@ struct SceneObject {
 };
 
 /// Something the scene refers to that is missing; the demo substitutes a stand-in.
-struct SceneWarning {
+struct RUBBLE_API SceneWarning {
     std::size_t line = 0; ///< 1-based line in the file
     std::string message;  ///< e.g. "world.cfg:3: model 'fighter.3ds' not found"
 };
 
 /// A parsed scene file.
-struct SceneConfig {
+struct RUBBLE_API SceneConfig {
     std::filesystem::path baseDir;                    ///< folder that relative names are resolved against
     std::array<std::string, 6> skybox;                ///< top, bottom, left, right, front, back, as written
     std::array<std::filesystem::path, 6> skyboxPaths; ///< the same, resolved
@@ -58,11 +59,11 @@ struct SceneConfig {
 /// Parses a scene file. Errors (ParseError) name file, line and field, e.g.
 /// "world.cfg:4: field 'sy' (7th): expected a number, got 'abc'"; missing model, texture or skybox files are
 /// not errors but SceneWarning entries. IoError when the file cannot be read.
-Result<SceneConfig> parseSceneConfig(const std::filesystem::path& path);
+RUBBLE_API Result<SceneConfig> parseSceneConfig(const std::filesystem::path& path);
 
 /// Parses scene text; displayName prefixes messages. Relative names are resolved against baseDir, or against
 /// the folder of displayName when baseDir is empty.
-Result<SceneConfig> parseSceneConfigText(const std::string& text, const std::string& displayName,
-                                         const std::filesystem::path& baseDir = {});
+RUBBLE_API Result<SceneConfig> parseSceneConfigText(const std::string& text, const std::string& displayName,
+                                                    const std::filesystem::path& baseDir = {});
 
 } // namespace rubble

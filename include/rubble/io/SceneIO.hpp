@@ -8,13 +8,14 @@
 #include <string>
 #include <vector>
 
+#include "rubble/core/Export.hpp"
 #include "rubble/core/Result.hpp"
 #include "rubble/geometry/Mesh.hpp"
 
 namespace rubble {
 
 /// One texture map of a material: an image file, or the bytes of an image embedded in the source file.
-struct TextureMap {
+struct RUBBLE_API TextureMap {
     std::string slot;    ///< MTL statement ("map_Kd", "map_Bump", "norm", ...); glTF base colour is "map_Kd"
     std::string options; ///< MTL options before the file name ("-s 2 2 1"), kept verbatim
     std::filesystem::path
@@ -24,7 +25,7 @@ struct TextureMap {
 };
 
 /// A material as read from a file, for writers to carry over (MTL `newmtl` blocks, glTF materials).
-struct AssetMaterial {
+struct RUBBLE_API AssetMaterial {
     std::string name;                    ///< the name meshes refer to in Mesh::materialNames
     Vec3 baseColor{0.8, 0.8, 0.8};       ///< MTL Kd, glTF baseColorFactor
     std::vector<TextureMap> maps;        ///< texture maps; "map_Kd" is the base colour texture
@@ -32,7 +33,7 @@ struct AssetMaterial {
 };
 
 /// One object of a scene in scene coordinates, with the convex collision parts that belong to it.
-struct AssetObject {
+struct RUBBLE_API AssetObject {
     std::string name;            ///< node or object name ("" when the file has none)
     Mesh mesh;                   ///< render mesh (faces in material "interior" have kInteriorMaterial)
     std::vector<Mesh> collision; ///< collision parts: glTF child nodes named "*-convcolonly"/"*-colonly",
@@ -41,7 +42,7 @@ struct AssetObject {
 };
 
 /// A file read as separate objects.
-struct AssetScene {
+struct RUBBLE_API AssetScene {
     std::vector<AssetObject> objects;     ///< in file order (glTF: depth-first node order)
     std::vector<AssetMaterial> materials; ///< the materials the objects name (OBJ: from its mtllib files)
     std::vector<std::string> warnings;    ///< what was skipped (a missing .mtl or image), naming the file
@@ -49,7 +50,7 @@ struct AssetScene {
 
 /// True when a node or object name marks a collision-only shape: a Godot suffix ("-colonly", "-convcolonly")
 /// or Unreal's "UCX_" prefix.
-bool isCollisionName(const std::string& name);
+RUBBLE_API bool isCollisionName(const std::string& name);
 
 /// Reads a file as a scene. glTF/GLB: one object per node that has a mesh (node transforms applied, so
 /// positions are in scene coordinates), collision nodes attached to their nearest non-collision ancestor,
@@ -61,11 +62,11 @@ bool isCollisionName(const std::string& name);
 /// and a missing image are warnings, not errors. An image named by an absolute path is dropped with a
 /// warning, so that writers never copy files from anywhere on the machine (relative paths, "../textures/",
 /// are the model's layout).
-Result<AssetScene> readScene(const std::filesystem::path& path);
+RUBBLE_API Result<AssetScene> readScene(const std::filesystem::path& path);
 
 /// Parses MTL text into materials; map file names are resolved against folder. Unknown statements are kept
 /// in AssetMaterial::statements. Errors (ParseError) name displayName and the line.
-Result<std::vector<AssetMaterial>> parseMtl(std::string_view text, const std::string& displayName,
-                                            const std::filesystem::path& folder);
+RUBBLE_API Result<std::vector<AssetMaterial>> parseMtl(std::string_view text, const std::string& displayName,
+                                                       const std::filesystem::path& folder);
 
 } // namespace rubble

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "rubble/core/Export.hpp"
 #include "rubble/core/Result.hpp"
 #include "rubble/runtime/DestructionRuntime.hpp"
 #include "rubble/runtime/DestructionWorld.hpp"
@@ -18,7 +19,7 @@
 namespace rubble {
 
 /// A saved world.
-struct Snapshot {
+struct RUBBLE_API Snapshot {
     WorldState world;                        ///< settings, objects, frame, ids, journal position, work
     std::vector<ObjectPlacement> placements; ///< bodies (empty for a world without an engine)
     VolumeLedger volumes;     ///< where removed volume went (retired, dust, dropped; live unused)
@@ -26,25 +27,26 @@ struct Snapshot {
 };
 
 /// The snapshot of a world (and of its bodies, when placements are given).
-Snapshot takeSnapshot(const DestructionWorld& world, std::vector<ObjectPlacement> placements = {});
+RUBBLE_API Snapshot takeSnapshot(const DestructionWorld& world, std::vector<ObjectPlacement> placements = {});
 /// The snapshot of a runtime: its world, its bodies' placements, its volume ledger and its structure.
-Snapshot takeSnapshot(const DestructionRuntime& runtime);
+RUBBLE_API Snapshot takeSnapshot(const DestructionRuntime& runtime);
 /// Loads a snapshot into a world (any worker count; the world adopts the snapshot's settings); fails,
 /// changing nothing, when the state is inconsistent (DestructionWorld::loadState).
-Status restoreSnapshot(DestructionWorld& world, Snapshot snapshot);
+RUBBLE_API Status restoreSnapshot(DestructionWorld& world, Snapshot snapshot);
 /// Loads a snapshot into a runtime (DestructionRuntime::restore): its world and the bodies of its objects;
 /// fails, changing nothing, like restoreSnapshot(world, ...) or when the placements do not match the objects.
-Status restoreSnapshot(DestructionRuntime& runtime, Snapshot snapshot);
+RUBBLE_API Status restoreSnapshot(DestructionRuntime& runtime, Snapshot snapshot);
 
 /// The snapshot's bytes.
-std::vector<std::uint8_t> encodeSnapshot(const Snapshot& snapshot);
+RUBBLE_API std::vector<std::uint8_t> encodeSnapshot(const Snapshot& snapshot);
 /// Parses a snapshot; a truncated, corrupted, wrong-version or hostile input gives an error naming source,
 /// offset and field (checksum first, then every count against the bytes left, every index and number).
-Result<Snapshot> decodeSnapshot(const std::uint8_t* data, std::size_t size, const std::string& source);
+RUBBLE_API Result<Snapshot> decodeSnapshot(const std::uint8_t* data, std::size_t size,
+                                           const std::string& source);
 /// Writes a snapshot atomically (temporary file, fsync, rename).
-Status saveSnapshot(const std::filesystem::path& path, const Snapshot& snapshot);
+RUBBLE_API Status saveSnapshot(const std::filesystem::path& path, const Snapshot& snapshot);
 /// Reads a snapshot file: a regular file of at most 2 GiB (devices, FIFOs and sockets are refused without
 /// blocking).
-Result<Snapshot> loadSnapshot(const std::filesystem::path& path);
+RUBBLE_API Result<Snapshot> loadSnapshot(const std::filesystem::path& path);
 
 } // namespace rubble

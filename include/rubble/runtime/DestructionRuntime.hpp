@@ -10,6 +10,7 @@
 #include <memory>
 #include <vector>
 
+#include "rubble/core/Export.hpp"
 #include "rubble/runtime/DestructionWorld.hpp"
 #include "rubble/runtime/PhysicsBinding.hpp"
 #include "rubble/structure/BondGraph.hpp"
@@ -34,7 +35,7 @@ enum class BodyMotionState : std::uint8_t {
 };
 
 /// The runtime's record of one body.
-struct BodyRecord {
+struct RUBBLE_API BodyRecord {
     BodyId id = 0;                                    ///< its id in the PhysicsBinding
     BodyRole role = BodyRole::Scenery;                ///< role
     BodyMotionState motion = BodyMotionState::Static; ///< static, dynamic or frozen
@@ -60,7 +61,7 @@ struct BodyRecord {
 };
 
 /// When contacts become impacts (ImpactCollector).
-struct ImpactPolicy {
+struct RUBBLE_API ImpactPolicy {
     double collisionImpulseThreshold = 2500; ///< non-projectile contacts fracture only above this total
                                              ///< impulse per contact pair and step (and the object's own
                                              ///< threshold)
@@ -72,7 +73,7 @@ struct ImpactPolicy {
 };
 
 /// How fracture outcomes become bodies (PieceAdopter).
-struct AdoptionPolicy {
+struct RUBBLE_API AdoptionPolicy {
     double debrisKick = 0.5; ///< share of a hit's impulse that throws the debris of a *static* object outward
                              ///< (along the surface normal, spread away from the impact); dynamic objects
                              ///< already took the impulse from the physics engine
@@ -85,7 +86,7 @@ struct AdoptionPolicy {
 
 /// Structural support (SupportGraph): static parts stay up only while a chain of touching static bodies links
 /// them to the ground, static scenery or an anchor.
-struct SupportPolicy {
+struct RUBBLE_API SupportPolicy {
     bool collapseUnsupported =
         true;                     ///< off: the largest piece of a static object stays static, the rest falls
     double tolerance = 0.02;      ///< gap (m) between static bodies that still counts as touching
@@ -96,7 +97,7 @@ struct SupportPolicy {
 /// Structural stress (StructureMonitor, docs/structure.md): bonds between touching static bodies carry their
 /// weight and the contact forces of moving bodies on them; a bond over its material's limit breaks and what
 /// no chain of bonds holds up falls. Set at construction.
-struct StructurePolicy {
+struct RUBBLE_API StructurePolicy {
     bool enabled = false;              ///< off: support is connectivity only (SupportPolicy)
     BondSettings bonds{0.02, 1, 1e-4}; ///< what counts as a bond (gap as SupportPolicy::tolerance)
     StressSettings stress{}; ///< the solver (a sweep budget by default; StressMethod::GaussSeidel converges
@@ -115,7 +116,7 @@ struct StructurePolicy {
 };
 
 /// A bond of the structure, for debug drawing.
-struct StructureBond {
+struct RUBBLE_API StructureBond {
     BodyId a = 0, b = 0;    ///< the bodies it joins
     Vec3 centroid;          ///< interface centroid (world)
     Vec3 normal;            ///< interface normal, from a to b
@@ -127,7 +128,7 @@ struct StructureBond {
 /// Budgets of the debris governor (DebrisGovernor): what keeps thousands of pieces affordable. Every resting
 /// moving body that carries an object may be frozen, but only pieces are ever retired (the game's own objects
 /// leave only by falling out of the world).
-struct DebrisBudget {
+struct RUBBLE_API DebrisBudget {
     int maxAwakeBodies = 400;   ///< dynamic debris bodies; beyond it the slowest settling pieces
                                 ///< (below settlingSpeed) freeze, then the smallest become particles
     double settlingSpeed = 1.0; ///< m/s (and rad/s): a piece this slow for 10 frames in a row may be frozen
@@ -151,7 +152,7 @@ struct DebrisBudget {
 };
 
 /// A particle: a piece too small (or one too many) to simulate, drawn for a while. Its volume stays counted.
-struct DebrisParticle {
+struct RUBBLE_API DebrisParticle {
     Vec3 position;       ///< world position (m)
     Vec3 velocity;       ///< world velocity (m/s)
     double size = 0;     ///< edge length of a cube of the same volume (m)
@@ -160,14 +161,14 @@ struct DebrisParticle {
 };
 
 /// A recent impact, for debug drawing.
-struct ImpactMark {
+struct RUBBLE_API ImpactMark {
     Vec3 point;         ///< world position
     Vec3 normal;        ///< world normal (out of the object hit)
     double impulse = 0; ///< impulse submitted
 };
 
 /// What one frame did.
-struct FrameStats {
+struct RUBBLE_API FrameStats {
     int substeps = 0;             ///< internal physics steps
     int impactsSubmitted = 0;     ///< impacts accepted by the DestructionWorld
     int projectileHits = 0;       ///< projectiles that hit something this frame
@@ -187,7 +188,7 @@ struct FrameStats {
 };
 
 /// Pieces turned into particles, by reason.
-struct RetiredPieces {
+struct RUBBLE_API RetiredPieces {
     long long dust = 0;      ///< below DestructionWorld::Config::minPieceVolume when adopted
     long long awake = 0;     ///< over the awake-body budget (or the physics time budget)
     long long triangles = 0; ///< over the triangle budget
@@ -198,7 +199,7 @@ struct RetiredPieces {
 };
 
 /// Totals since construction.
-struct RuntimeCounters {
+struct RUBBLE_API RuntimeCounters {
     std::uint64_t frames = 0;      ///< frames stepped
     long long impacts = 0;         ///< impacts accepted by the DestructionWorld
     long long projectileHits = 0;  ///< projectile hits on anything
@@ -214,7 +215,7 @@ struct RuntimeCounters {
 };
 
 /// Where the volume of the world went (m³); live + retired + dust + dropped stays constant.
-struct VolumeLedger {
+struct RUBBLE_API VolumeLedger {
     double live = 0;    ///< bodies that carry an object (static, dynamic and frozen)
     double retired = 0; ///< bodies turned into particles (budget, fading, falling out of the world)
     double dust = 0;    ///< pieces below DestructionWorld::Config::minPieceVolume
@@ -224,7 +225,7 @@ struct VolumeLedger {
 };
 
 /// Where an object's body is and how it moves (what a snapshot or a network host sends).
-struct ObjectPlacement {
+struct RUBBLE_API ObjectPlacement {
     ObjectId object = 0;                              ///< the object
     BodyRole role = BodyRole::Object;                 ///< an object of the scene or a piece of a fracture
     BodyMotionState motion = BodyMotionState::Static; ///< static, dynamic or frozen
@@ -237,7 +238,7 @@ struct ObjectPlacement {
 constexpr std::uint64_t kSceneryNodeKey = 1ull << 63;
 
 /// What a snapshot keeps of a structure node (a static object or piece in the stress solver).
-struct StructureNodeState {
+struct RUBBLE_API StructureNodeState {
     ObjectId object = 0;       ///< the object
     ObjectId solid = 0;        ///< the scene object it was cut from (its own id for a scene object)
     std::uint8_t material = 0; ///< its material: an index into materialPresets()
@@ -248,21 +249,21 @@ struct StructureNodeState {
 
 /// What a snapshot keeps of a bond: what geometry cannot give back. Its nodes are object ids, or
 /// kSceneryNodeKey | body id for ground and scenery (the same bodies in the same order as in the saver).
-struct StructureBondState {
+struct RUBBLE_API StructureBondState {
     std::uint64_t a = 0, b = 0; ///< its nodes, a < b
     double health = 1;          ///< remaining fraction of the section
     bool broken = false;        ///< broken (it stays broken while both nodes stay)
 };
 
 /// The structure's saved state (docs/journal.md, Snapshots).
-struct StructureState {
+struct RUBBLE_API StructureState {
     bool saved = false; ///< false: not saved (no structure, a world-only or a version 2 snapshot)
     std::vector<StructureNodeState> nodes; ///< ascending object
     std::vector<StructureBondState> bonds; ///< every bond, broken ones included, ascending (a, b)
 };
 
 /// The runtime. Call everything from one (main) thread; fracture jobs run on the DestructionWorld's workers.
-class DestructionRuntime {
+class RUBBLE_API DestructionRuntime {
 public:
     /// Configuration: each component's own settings.
     struct Config {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "rubble/collision/ConvexDecomposition.hpp"
+#include "rubble/core/Export.hpp"
 #include "rubble/core/Frame.hpp"
 #include "rubble/core/JobSystem.hpp"
 #include "rubble/core/Result.hpp"
@@ -24,7 +25,7 @@ namespace rubble {
 using ObjectId = std::uint32_t;
 
 /// What an object is made of.
-struct ObjectDesc {
+struct RUBBLE_API ObjectDesc {
     Mesh mesh;                   ///< closed mesh in the object's local coordinates
     double density = 1;          ///< mass = density · volume
     bool destructible = true;    ///< false: never fractured
@@ -36,7 +37,7 @@ struct ObjectDesc {
 };
 
 /// A live object as the runtime sees it.
-struct ObjectState {
+struct RUBBLE_API ObjectState {
     ObjectId id = 0;             ///< its id
     std::uint32_t version = 0;   ///< bumped whenever its shape is replaced
     Mesh mesh;                   ///< local mesh (origin at the centre of mass for pieces)
@@ -56,7 +57,7 @@ struct ObjectState {
 /// Wall-clock timing of one impact from submission to adoption, in milliseconds. For an adopted job the
 /// stages follow one another without gaps:
 /// queue + prepare + cell + boolean + islands + decomposition + finish + handoff + adoption = total.
-struct TimingRecord {
+struct RUBBLE_API TimingRecord {
     ObjectId object = 0;        ///< the object that was hit
     std::uint64_t frame = 0;    ///< frame of submission
     int impactsMerged = 1;      ///< impacts fractured in this job
@@ -84,7 +85,7 @@ struct TimingRecord {
 };
 
 /// A piece of a fracture, ready to adopt: a new object of the world.
-struct AdoptedPiece {
+struct RUBBLE_API AdoptedPiece {
     ObjectId id = 0;        ///< the new object, already added to the world
     Frame frame;            ///< piece local frame → parent local frame (centre of mass, principal axes)
     std::int32_t cell = -1; ///< Piece::cell: −1 part of the remainder, i ≥ 0 debris of cell i
@@ -93,14 +94,14 @@ struct AdoptedPiece {
 
 /// A piece below the world's minimum volume (Config::minPieceVolume): never made an object, only reported,
 /// so that the engine can show it as a particle and keep its volume counted.
-struct DustPiece {
+struct RUBBLE_API DustPiece {
     Vec3 center;            ///< its centre of mass (parent local coordinates)
     double volume = 0;      ///< its volume
     std::int32_t cell = -1; ///< Piece::cell
 };
 
 /// A fracture ready to adopt: the parent object is replaced by the pieces.
-struct FractureOutcome {
+struct RUBBLE_API FractureOutcome {
     ObjectId parent = 0;              ///< the object that broke (removed from the world by collect())
     std::uint32_t parentVersion = 0;  ///< its version when the job started
     std::vector<AdoptedPiece> pieces; ///< the new objects
@@ -114,7 +115,7 @@ struct FractureOutcome {
 };
 
 /// Fracture work not yet adopted: a job in flight (to be relaunched on load) or impacts waiting for one.
-struct PendingWork {
+struct RUBBLE_API PendingWork {
     ObjectId object = 0;              ///< the object hit
     std::uint32_t version = 0;        ///< its version when the job started
     bool inFlight = false;            ///< a launched job (true) or impacts waiting for the object's job
@@ -125,7 +126,7 @@ struct PendingWork {
 
 /// Everything a DestructionWorld holds besides its threads and timings: what a snapshot saves. The settings
 /// that decide the geometry travel with it, so that a world loading it cuts the same pieces.
-struct WorldState {
+struct RUBBLE_API WorldState {
     std::uint64_t seed = 1;             ///< Config::seed
     std::int32_t delayFrames = 2;       ///< Config::delayFrames
     std::uint64_t crumbleTriangles = 0; ///< Config::crumbleTriangles
@@ -140,7 +141,7 @@ struct WorldState {
 };
 
 /// The runtime. All member functions are called from one (main) thread; work runs on the JobSystem.
-class DestructionWorld {
+class RUBBLE_API DestructionWorld {
 public:
     /// Configuration.
     struct Config {

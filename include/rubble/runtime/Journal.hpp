@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 
+#include "rubble/core/Export.hpp"
 #include "rubble/fracture/Fracture.hpp"
 
 namespace rubble {
@@ -19,7 +20,7 @@ enum class JournalEventKind : std::uint8_t {
 
 /// One journal event. Coordinates are in the object's local frame, in single precision: the world rounds
 /// every accepted impact to these values before it fractures with it, so a replay runs the same numbers.
-struct JournalEvent {
+struct RUBBLE_API JournalEvent {
     JournalEventKind kind = JournalEventKind::Impact; ///< impact or removal
     std::uint32_t object = 0;                         ///< the object (ObjectId)
     std::uint32_t tick = 0;                           ///< DestructionWorld::frame() when it happened

@@ -6,6 +6,7 @@
 #include <deque>
 #include <functional>
 
+#include "rubble/core/Export.hpp"
 #include "rubble/runtime/DestructionWorld.hpp"
 #include "rubble/runtime/Journal.hpp"
 
@@ -20,7 +21,7 @@ inline constexpr std::uint64_t kMaxJournalTickGap = std::uint64_t{1} << 22;
 /// same scene with the same Config (deterministic, same seed and delayFrames) as the one that recorded them.
 /// An event of tick t was recorded while the recording world's frame() was t, after that frame's collect();
 /// the player reproduces that order, so the geometry is the same on any worker count.
-class JournalPlayer {
+class RUBBLE_API JournalPlayer {
 public:
     /// A player for world (which it steps; nothing else should step it meanwhile).
     explicit JournalPlayer(DestructionWorld& world);

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "rubble/core/Export.hpp"
 #include "rubble/core/Frame.hpp"
 #include "rubble/core/Vec3.hpp"
 #include "rubble/geometry/ConvexPolytope.hpp"
@@ -17,7 +18,7 @@ namespace rubble {
 using BodyId = std::uint32_t;
 
 /// The collision shape of a body, in body coordinates (origin at the centre of mass, principal axes).
-struct BodyShape {
+struct RUBBLE_API BodyShape {
     /// How the shape is given.
     enum class Kind : std::uint8_t {
         Convex, ///< a compound of convex parts (or, without parts, the convex hull of points)
@@ -32,7 +33,7 @@ struct BodyShape {
 };
 
 /// Everything an engine needs to create a rigid body.
-struct BodyDesc {
+struct RUBBLE_API BodyDesc {
     BodyShape shape;          ///< collision shape in body coordinates
     Frame transform;          ///< world ← body
     double mass = 0;          ///< kg; 0 = static (never moves)
@@ -46,7 +47,7 @@ struct BodyDesc {
 };
 
 /// Where a body is and how it moves.
-struct BodyMotion {
+struct RUBBLE_API BodyMotion {
     Frame transform;       ///< world ← body
     Vec3 linearVelocity;   ///< m/s (world)
     Vec3 angularVelocity;  ///< rad/s (world)
@@ -54,7 +55,7 @@ struct BodyMotion {
 };
 
 /// The contact of two bodies during one step, summed over the pair's contact points.
-struct ContactReport {
+struct RUBBLE_API ContactReport {
     BodyId a = 0;          ///< first body
     BodyId b = 0;          ///< second body
     Vec3 pointOnA;         ///< deepest contact point on a (world)
@@ -66,7 +67,7 @@ struct ContactReport {
 };
 
 /// A physics engine as the runtime sees it. All calls come from the runtime's (main) thread.
-class PhysicsBinding {
+class RUBBLE_API PhysicsBinding {
 public:
     virtual ~PhysicsBinding() = default;
     /// Creates a body with the given id.

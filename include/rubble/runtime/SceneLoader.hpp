@@ -8,13 +8,14 @@
 #include <string>
 #include <vector>
 
+#include "rubble/core/Export.hpp"
 #include "rubble/io/SceneConfig.hpp"
 #include "rubble/runtime/DestructionRuntime.hpp"
 
 namespace rubble {
 
 /// How scene objects are made.
-struct SceneLoadOptions {
+struct RUBBLE_API SceneLoadOptions {
     bool loadVehicle = true;      ///< create the vehicle's body (headless scenes may skip it)
     double staticDensity = 200;   ///< density (kg/m³) of static objects, used by their moving pieces
     double impulseThreshold = 50; ///< ObjectDesc::impulseThreshold of every object
@@ -27,7 +28,7 @@ struct SceneLoadOptions {
 };
 
 /// What loading produced.
-struct LoadedScene {
+struct RUBBLE_API LoadedScene {
     BodyId ground = 0;                   ///< the ground box (0 when the scene has none)
     BodyId vehicle = 0;                  ///< the vehicle (0 when not loaded; it never sleeps)
     double groundTop = 0;                ///< height of the ground's top face
@@ -42,7 +43,7 @@ struct LoadedScene {
 /// (x, y, z), mass 0 = static but destructible. A missing or unreadable model becomes a stand-in box (a cube
 /// of edge 1 scaled by (sx, sy, sz)) with a warning; a mesh that cannot be made valid stays intact and
 /// indestructible with one warning. Never fails on a parsed scene.
-LoadedScene loadScene(const SceneConfig& scene, DestructionRuntime& runtime,
-                      const SceneLoadOptions& options = {});
+RUBBLE_API LoadedScene loadScene(const SceneConfig& scene, DestructionRuntime& runtime,
+                                 const SceneLoadOptions& options = {});
 
 } // namespace rubble

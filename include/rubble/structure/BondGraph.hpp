@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "rubble/core/Aabb.hpp"
+#include "rubble/core/Export.hpp"
 
 #include "rubble/core/Vec3.hpp"
 #include "rubble/geometry/ConvexPolytope.hpp"
@@ -15,7 +16,7 @@
 namespace rubble {
 
 /// The contact patch two solids share, as a plane section.
-struct BondInterface {
+struct RUBBLE_API BondInterface {
     double area = 0;        ///< m^2, the sum of the contact patches' areas
     double sectionArea = 0; ///< m^2, the patches projected on the plane normal to `normal` (the section that
                             ///< carries load; equal to area for a planar interface)
@@ -29,7 +30,7 @@ struct BondInterface {
 };
 
 /// A bond between nodes a < b across their interface.
-struct Bond {
+struct RUBBLE_API Bond {
     std::uint32_t a = 0;   ///< first node
     std::uint32_t b = 0;   ///< second node
     BondInterface section; ///< the shared interface, normal from a to b
@@ -38,7 +39,7 @@ struct Bond {
 };
 
 /// How touching is decided.
-struct BondSettings {
+struct RUBBLE_API BondSettings {
     double gap = 1e-3;         ///< faces at most this far apart (m) count as touching
     double angleTolerance = 1; ///< faces within this angle (degrees) of anti-parallel count as coplanar
     double minArea = 1e-6;     ///< patches below this area (m^2) make no bond
@@ -46,17 +47,17 @@ struct BondSettings {
 
 /// The interface between two solids given as convex parts (same coordinates): the overlap of their
 /// coplanar, facing faces. Area 0 when they do not touch.
-BondInterface bondInterface(const std::vector<ConvexPolytope>& a, const std::vector<ConvexPolytope>& b,
-                            const BondSettings& settings);
+RUBBLE_API BondInterface bondInterface(const std::vector<ConvexPolytope>& a,
+                                       const std::vector<ConvexPolytope>& b, const BondSettings& settings);
 
 /// Bonds between every pair of touching solids, ordered by (a, b).
-std::vector<Bond> buildBonds(const std::vector<std::vector<ConvexPolytope>>& solids,
-                             const BondSettings& settings);
+RUBBLE_API std::vector<Bond> buildBonds(const std::vector<std::vector<ConvexPolytope>>& solids,
+                                        const BondSettings& settings);
 
 /// Bonds kept up to date as solids come and go, equal to buildBonds over the solids present: an added solid
 /// bonds only to the solids whose bounds overlap its own (a uniform grid over the solids' boxes, kept across
 /// calls), a removed one takes only its own bonds. Ids are the solids' indices in buildBonds' terms.
-class BondGraph {
+class RUBBLE_API BondGraph {
 public:
     /// An empty graph; cellSize (m) is the grid's cell edge.
     explicit BondGraph(BondSettings settings = {}, double cellSize = 1);

@@ -7,6 +7,8 @@
 #include <string_view>
 #include <vector>
 
+#include "rubble/core/Export.hpp"
+
 namespace rubble {
 
 /// How a material breaks (the cell layout an impact cuts).
@@ -18,7 +20,7 @@ enum class FracturePattern : int {
 };
 
 /// A structural material. Strengths in MPa, density in kg/m^3.
-struct Material {
+struct RUBBLE_API Material {
     std::string name;                                     ///< preset name, e.g. "concrete"
     double density = 0;                                   ///< kg/m^3
     double compressiveStrength = 0;                       ///< MPa
@@ -28,12 +30,12 @@ struct Material {
 };
 
 /// The material presets, in a fixed order: concrete, brick, stone, wood, glass, steel.
-const std::vector<Material>& materialPresets();
+RUBBLE_API const std::vector<Material>& materialPresets();
 /// The preset with this name (lower case), or nullptr.
-const Material* findMaterial(std::string_view name);
+RUBBLE_API const Material* findMaterial(std::string_view name);
 /// The material of objects that name none (concrete).
-const Material& defaultMaterial();
+RUBBLE_API const Material& defaultMaterial();
 /// The preset names joined by ", " (for error messages).
-std::string materialNames();
+RUBBLE_API std::string materialNames();
 
 } // namespace rubble

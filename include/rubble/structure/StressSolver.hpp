@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "rubble/core/Export.hpp"
 #include "rubble/core/Vec3.hpp"
 #include "rubble/geometry/ConvexPolytope.hpp"
 #include "rubble/structure/BondGraph.hpp"
@@ -15,7 +16,7 @@
 namespace rubble {
 
 /// One rigid part of a structure.
-struct StructureNode {
+struct RUBBLE_API StructureNode {
     double mass = 0;   ///< kg
     Vec3 centroid;     ///< centre of mass
     Mat3 inertia;      ///< inertia tensor about the centre of mass, kg m^2
@@ -23,10 +24,10 @@ struct StructureNode {
 };
 
 /// The node of a solid of convex parts with the given density (kg/m^3).
-StructureNode structureNode(const std::vector<ConvexPolytope>& parts, double density, bool root);
+RUBBLE_API StructureNode structureNode(const std::vector<ConvexPolytope>& parts, double density, bool root);
 
 /// What a bond withstands, in Pa (0: unlimited).
-struct StrengthLimits {
+struct RUBBLE_API StrengthLimits {
     double compressive = 0; ///< Pa
     double tensile = 0;     ///< Pa
     double shear = 0;       ///< Pa
@@ -34,10 +35,10 @@ struct StrengthLimits {
 };
 
 /// The limits of a bond between two materials: the weaker of each.
-StrengthLimits bondLimits(const Material& a, const Material& b);
+RUBBLE_API StrengthLimits bondLimits(const Material& a, const Material& b);
 
 /// The stresses over a bond's section (Pa), at the current health.
-struct BondStress {
+struct RUBBLE_API BondStress {
     double compression = 0; ///< largest compressive normal stress (axial plus bending)
     double tension = 0;     ///< largest tensile normal stress (axial plus bending)
     double shear = 0;       ///< mean transverse shear plus the largest torsional shear
@@ -45,14 +46,14 @@ struct BondStress {
 
 /// How StressSolver::solve() iterates (docs/structure.md, "Convergence").
 enum class StressMethod {
-    SweepBudget, ///< Gauss-Seidel over every bond, at most `iterations` sweeps (the solver before issue #32)
+    SweepBudget, ///< Gauss-Seidel over every bond, at most `iterations` sweeps (the default)
     GaussSeidel, ///< Gauss-Seidel over the bonds of the nodes not at rest, until `residual` is met
     ConjugateGradient ///< block-Jacobi preconditioned conjugate gradient on the welds, until `residual` is
                       ///< met
 };
 
 /// Settings of the stress solver.
-struct StressSettings {
+struct RUBBLE_API StressSettings {
     int iterations = 25;       ///< Gauss-Seidel sweeps over all bonds per solve(), at most
     double tolerance = 0.01;   ///< m/s^2 (and rad/s^2): fewer sweeps once every bonded node's remaining
                                ///< acceleration is below it (a warm-started, unchanged structure needs none);
@@ -73,7 +74,7 @@ struct StressSettings {
 };
 
 /// The stress solver over one structure (nodes joined by bonds).
-class StressSolver {
+class RUBBLE_API StressSolver {
 public:
     /// An empty structure.
     explicit StressSolver(StressSettings settings = {}) : settings_(settings) {}
