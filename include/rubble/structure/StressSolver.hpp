@@ -46,8 +46,8 @@ struct RUBBLE_API BondStress {
 
 /// How StressSolver::solve() iterates (docs/structure.md, "Convergence").
 enum class StressMethod {
-    SweepBudget, ///< Gauss-Seidel over every bond, at most `iterations` sweeps (the default)
-    GaussSeidel, ///< Gauss-Seidel over the bonds of the nodes not at rest, until `residual` is met
+    SweepBudget,      ///< Gauss-Seidel over every bond, at most `iterations` sweeps (the default)
+    GaussSeidel,      ///< Gauss-Seidel over the bonds of the nodes not at rest, until `residual` is met
     ConjugateGradient ///< block-Jacobi preconditioned conjugate gradient on the welds, until `residual` is
                       ///< met
 };
