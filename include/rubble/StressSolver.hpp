@@ -252,6 +252,7 @@ private:
         Vec3 force, torque;
     };
     void route(std::vector<Route>& changes);
+    void settleAmong(const std::vector<std::uint32_t>& group, double tolerance);
     std::vector<Route> routes_;            // startSolve(): this solve's load changes
     std::vector<BondBreak> breaks_;        // since takeBreaks()
     std::vector<Orphan> orphans_;          // since the last solve

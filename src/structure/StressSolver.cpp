@@ -405,6 +405,16 @@ void StressSolver::coldStart() {
 }
 
 void StressSolver::solve() {
+    // Nodes that replace a removed one (a fracture's pieces): with routeLoads they first balance among
+    // themselves, below.
+    std::vector<std::uint32_t> newcomers;
+    if (settings_.routeLoads && settings_.method != StressMethod::SweepBudget && !allDirty_)
+        for (std::size_t k : fresh_)
+            for (std::uint32_t n : {bonds_[k].bond.a, bonds_[k].bond.b})
+                if (!nodes_[n].solved && !nodes_[n].removed)
+                    newcomers.push_back(n);
+    std::sort(newcomers.begin(), newcomers.end());
+    newcomers.erase(std::unique(newcomers.begin(), newcomers.end()), newcomers.end());
     if (!orphans_.empty())
         inherit();
     fresh_.clear();
@@ -418,6 +428,8 @@ void StressSolver::solve() {
     history_.clear();
     if (!routes_.empty())
         route(routes_);
+    if (!newcomers.empty())
+        settleAmong(newcomers, settings_.residual * scale);
     switch (settings_.method) {
     case StressMethod::SweepBudget:
         solveSweepBudget();
@@ -551,6 +563,44 @@ void StressSolver::route(std::vector<Route>& changes) {
                 e.first += force * share;
                 e.second += cross(b.bond.section.centroid - nodes_[j].node.centroid, force * share) - m;
             }
+        }
+    }
+}
+
+// Gauss-Seidel over the bonds between these nodes only (ascending), until they are at rest within the
+// tolerance or stop improving: the pieces that replaced a body carry its inherited load path among
+// themselves before the iteration spreads what is left to their neighbours.
+void StressSolver::settleAmong(const std::vector<std::uint32_t>& group, double tolerance) {
+    std::vector<std::size_t> inside;
+    for (std::uint32_t n : group)
+        for (std::size_t k : nodes_[n].bonds) {
+            const BondState& b = bonds_[k];
+            const std::uint32_t m = b.bond.other(n);
+            if (n < m && !b.broken && b.solvable && std::binary_search(group.begin(), group.end(), m) &&
+                (movable(n) || movable(m)))
+                inside.push_back(k);
+        }
+    std::sort(inside.begin(), inside.end());
+    auto worst = [&] {
+        double m = 0;
+        for (std::uint32_t n : group)
+            if (movable(n))
+                m = std::max(m, nodeResidual(nodes_[n]));
+        return m;
+    };
+    double last = worst();
+    for (int sweep = 1; sweep <= 400 && last > tolerance * tolerance; ++sweep) {
+        for (std::size_t k : inside) {
+            if (!bonds_[k].corners.empty())
+                solveBearing(bonds_[k]);
+            else
+                solveWeld(bonds_[k]);
+        }
+        if (sweep % 10 == 0) { // stop once ten sweeps gain less than 10 %
+            const double now = worst();
+            if (now > 0.81 * last)
+                break;
+            last = now;
         }
     }
 }
