@@ -307,6 +307,46 @@ namespace rubble {
 // stands unshot for a simulated minute: no bond breaks, nothing becomes dynamic, and every frame's solve is
 // converged. (With the old sweep budget at 1 sweep a frame, 10 at first, it falls; at 2 to 8 it stands on
 // solves whose residual reaches 0.02 to 0.4.)
+// assets/scenes/tower.cfg: six storeys, each a slab on four pillars (bearings). It stands unshot; without
+// the two ground-floor pillars of one side, the first slab rests on one edge, tips, and the storeys above go
+// with it: the load brings the tower down, where connectivity alone (the slab still touches two pillars)
+// leaves it standing.
+TEST(StructureRuntime, ATowerStandsUnshotAndFallsWhenOneSideOfItsBaseIsRemoved) {
+    const Result<SceneConfig> scene =
+        parseSceneConfig(std::string(RUBBLE_SOURCE_DIR) + "/assets/scenes/tower.cfg");
+    ASSERT_TRUE(scene) << scene.error().message;
+    for (const bool structure : {true, false}) {
+        SCOPED_TRACE(structure ? "stress solver" : "connectivity");
+        test::ToyPhysics engine;
+        DestructionRuntime runtime(engine, Rig::config(structure, 1, false, 0.6, StressMethod::GaussSeidel));
+        SceneLoadOptions options;
+        options.loadVehicle = false;
+        const LoadedScene loaded = loadScene(*scene, runtime, options);
+        ASSERT_EQ(loaded.objects.size(), 30u);
+        auto standing = [&] {
+            int n = 0;
+            for (ObjectId id : loaded.objects) {
+                const BodyRecord* r = runtime.bodyOf(id); // none once removed
+                n += r && r->motion == BodyMotionState::Static;
+            }
+            return n;
+        };
+        for (int i = 0; i < 30; ++i)
+            runtime.stepFrame();
+        EXPECT_EQ(standing(), 30) << "unshot";
+        EXPECT_EQ(runtime.counters().piecesCollapsed, 0);
+        for (std::size_t k : {0u, 1u}) // the ground floor's pillars at x = -2.7
+            runtime.removeBody(runtime.bodyOf(loaded.objects[k])->id);
+        for (int i = 0; i < 40; ++i) // unbalanced for 30 solves, then falling
+            runtime.stepFrame();
+        if (structure) {
+            EXPECT_EQ(standing(), 2) << "only the two pillars left at its foot";
+        } else {
+            EXPECT_EQ(standing(), 28);
+        }
+    }
+}
+
 TEST(StructureRuntime, AnUnshotBuildingStandsForASimulatedMinute) {
     Rig rig(true, 1, false, 0.6, StressMethod::GaussSeidel);
     std::vector<ObjectId> parts;
