@@ -176,6 +176,8 @@ int runScene(const SceneArgs& a) {
         rc.structure.stress.method = rubble::StressMethod::SweepBudget;
         rc.structure.stress.iterations = a.structureIterations;
         rc.structure.stress.tolerance = 0.05;
+    } else {
+        rc.structure.stress.method = rubble::StressMethod::GaussSeidel;
     }
     PhysicsWorld physics;
     BulletBinding binding(physics);
