@@ -76,12 +76,13 @@ struct SceneArgs {
     std::string framesCsv;
     std::string appendCsv;
     std::string pattern = "single";
-    int cells = 0;                // shatter cells (0: the library's default)
-    int maxAwake = 0;             // awake debris budget (0: the runtime's default)
-    double physicsBudgetMs = 0;   // physics step budget (0: the runtime's default)
-    bool structure = false;       // the stress solver on
-    double bearingFriction = 0.6; // with structure: objects rest on each other as bearings (0: welded)
-    int structureIterations = 0;  // with structure: solver sweeps per frame (0: the library's)
+    int cells = 0;                   // shatter cells (0: the library's default)
+    int maxAwake = 0;                // awake debris budget (0: the runtime's default)
+    double physicsBudgetMs = 0;      // physics step budget (0: the runtime's default)
+    bool structure = false;          // the stress solver on
+    double bearingFriction = 0.6;    // with structure: objects rest on each other as bearings (0: welded)
+    int structureIterations = 0;     // with structure: solver sweeps per frame (0: the library's)
+    bool structureConverged = false; // with structure: the converged Gauss-Seidel solve
     double projectileSpeed = 120;
     double projectileMass = 2;
     double projectileRadius = 0.25;
@@ -176,6 +177,8 @@ int runScene(const SceneArgs& a) {
         rc.structure.stress.method = rubble::StressMethod::SweepBudget;
         rc.structure.stress.iterations = a.structureIterations;
         rc.structure.stress.tolerance = 0.05;
+    } else if (a.structureConverged) {
+        rc.structure.stress.method = rubble::StressMethod::GaussSeidel;
     }
     PhysicsWorld physics;
     BulletBinding binding(physics);
@@ -466,7 +469,10 @@ rubble::tools::Registrar registrar{
          app.add_option(
              "--structure-iterations", args->structureIterations,
              "with --structure: the old solver, Gauss-Seidel with this many sweeps a frame (default: the "
-             "converged solve)");
+             "library's, a sweep budget)");
+         app.add_flag(
+             "--structure-converged", args->structureConverged,
+             "with --structure: the converged Gauss-Seidel solve (relative residual 1e-3 every frame)");
          app.add_option("--projectile-speed", args->projectileSpeed, "m/s");
          app.add_option("--projectile-mass", args->projectileMass, "kg");
          return [args] { return runScene(*args); };

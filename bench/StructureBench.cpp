@@ -311,7 +311,7 @@ std::string convergence(int k, int h, const std::vector<Solver>& list, std::vect
         const std::vector<double>& history = traced.solver.history();
         for (std::size_t i = 0; i < history.size(); ++i)
             data << (i + 1) << " " << (msTotal * static_cast<double>(i + 1) / std::max(1, count)) << " "
-                 << history[i] << "\n";
+                 << std::max(history[i], 1e-15) << "\n"; // an exact solve drops to the floor
         data << "\n\n";
         titles.push_back(solver.method == rubble::StressMethod::SweepBudget
                              ? "gauss-seidel, every bond a sweep"

@@ -95,6 +95,7 @@ struct DestructionRuntime::Impl {
     detail::ImpactCollector collector;
     detail::SupportGraph support;
     detail::StructureMonitor structure;
+    std::vector<StructureBreak> breaks;            // the bonds this frame broke
     std::map<ObjectId, const Material*> materials; // of objects (pieces inherit their parent's)
     std::map<ObjectId, std::uint64_t> solids;      // pieces: the scene object they were cut from
     detail::DebrisGovernor governor;
@@ -348,6 +349,10 @@ struct DestructionRuntime::Impl {
         const std::vector<BodyId> fallen = structure.step(binding.gravity(), broken);
         stats.structureResidual = structure.residual();
         stats.bondsBroken += broken;
+        for (StructureBreak e : structure.breaks()) {
+            e.frame = counters.frames;
+            breaks.push_back(std::move(e));
+        }
         counters.bondsBroken += broken;
         for (BodyId id : fallen) {
             makeDynamic(id);
@@ -659,6 +664,7 @@ FrameStats DestructionRuntime::stepFrame(double dt) {
     FrameStats stats;
     const auto t0 = Clock::now();
     im.contacts.clear();
+    im.breaks.clear();
     stats.substeps = im.binding.step(dt, im.contacts);
     stats.physicsMs = msSince(t0);
     const auto t1 = Clock::now();
@@ -763,6 +769,10 @@ VolumeLedger DestructionRuntime::volumes() const {
 
 std::vector<StructureBond> DestructionRuntime::structureBonds() const {
     return impl_->structure.bonds();
+}
+
+const std::vector<StructureBreak>& DestructionRuntime::structureBreaks() const {
+    return impl_->breaks;
 }
 
 std::vector<BodyId> DestructionRuntime::supportNeighbours(BodyId id) const {

@@ -120,6 +120,28 @@ std::vector<BodyId> StructureMonitor::step(const Vec3& gravity, int& broken) {
     }
     residual_ = solver_.residual();
     broken += static_cast<int>(before() - brokenBefore);
+    breaks_.clear();
+    for (const BondBreak& k : solver_.takeBreaks()) {
+        const Bond& b = solver_.bond(k.bond);
+        StructureBreak e;
+        e.a = bodyOf_[b.a];
+        e.b = bodyOf_[b.b];
+        e.position = b.section.centroid;
+        e.normal = b.section.normal;
+        e.area = b.section.area;
+        e.force = k.force;
+        e.utilisation = k.utilisation;
+        e.damaged = k.damaged;
+        if (e.a > e.b) {
+            std::swap(e.a, e.b);
+            e.normal = -e.normal;
+            e.force = -e.force;
+        }
+        for (const auto& [id, name] : {std::pair{e.a, &e.materialA}, std::pair{e.b, &e.materialB}})
+            if (const auto it = nodes_.find(id); it != nodes_.end())
+                *name = it->second.material->name;
+        breaks_.push_back(std::move(e));
+    }
     std::vector<BodyId> out;
     for (std::uint32_t n : solver_.unsupported())
         out.push_back(bodyOf_[n]);

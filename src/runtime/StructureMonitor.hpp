@@ -41,6 +41,8 @@ public:
     std::vector<StructureBond> bonds() const;
     /// Nodes.
     std::size_t size() const { return nodes_.size(); }
+    /// The bonds the last step broke, in the order they broke (frame 0).
+    const std::vector<StructureBreak>& breaks() const { return breaks_; }
     /// The relative residual of the last step's final solve.
     double residual() const { return residual_; }
 
@@ -81,6 +83,7 @@ private:
     std::vector<BodyId> bodyOf_; // solver slot -> body (0: free)
     std::vector<BodyId> unclassified_;
     double residual_ = 0;
+    std::vector<StructureBreak> breaks_;
     bool settle_ = false;
     std::vector<std::pair<Vec3, double>> pendingDamage_;
     struct Load {

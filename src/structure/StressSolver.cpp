@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <map>
 
 #include "rubble/geometry/MassProperties.hpp"
 
@@ -133,6 +134,7 @@ void StressSolver::reset(std::vector<StructureNode> nodes, std::vector<Bond> bon
     dirty_.clear();
     orphans_.clear();
     fresh_.clear();
+    breaks_.clear();
     allDirty_ = true;
     reachValid_ = false;
     for (const StructureNode& n : nodes)
@@ -403,6 +405,16 @@ void StressSolver::coldStart() {
 }
 
 void StressSolver::solve() {
+    // Nodes that replace a removed one (a fracture's pieces): with routeLoads they first balance among
+    // themselves, below.
+    std::vector<std::uint32_t> newcomers;
+    if (settings_.routeLoads && settings_.method != StressMethod::SweepBudget && !allDirty_)
+        for (std::size_t k : fresh_)
+            for (std::uint32_t n : {bonds_[k].bond.a, bonds_[k].bond.b})
+                if (!nodes_[n].solved && !nodes_[n].removed)
+                    newcomers.push_back(n);
+    std::sort(newcomers.begin(), newcomers.end());
+    newcomers.erase(std::unique(newcomers.begin(), newcomers.end()), newcomers.end());
     if (!orphans_.empty())
         inherit();
     fresh_.clear();
@@ -414,6 +426,10 @@ void StressSolver::solve() {
     const double scale = startSolve();
     scale_ = scale;
     history_.clear();
+    if (!routes_.empty())
+        route(routes_);
+    if (!newcomers.empty())
+        settleAmong(newcomers, settings_.residual * scale);
     switch (settings_.method) {
     case StressMethod::SweepBudget:
         solveSweepBudget();
@@ -430,7 +446,7 @@ void StressSolver::solve() {
 
 bool StressSolver::movable(std::uint32_t i) const {
     const NodeState& n = nodes_[i];
-    return reached_[i] && n.invMass > 0 && !n.detached;
+    return reached_[i] && n.invMass > 0 && !n.detached && !n.stalled;
 }
 
 // The squared size of a node's acceleration (v, w) in the mass metric: |v|^2 + w.I w / m, in (m/s^2)^2.
@@ -448,14 +464,20 @@ double StressSolver::startSolve() {
     gravity_ = settings_.gravity;
     if (!reachValid_)
         reach();
+    const bool routing = settings_.routeLoads && settings_.method != StressMethod::SweepBudget && !allDirty_;
+    routes_.clear();
     double scale2 = 0;
     for (std::uint32_t i = 0; i < nodes_.size(); ++i) {
         NodeState& n = nodes_[i];
+        n.stalled = false;
         Vec3 fv, fw;
         if (n.invMass > 0 && !n.detached) {
             fv = settings_.gravity + n.force * n.invMass;
             fw = n.invInertia * n.torque;
         }
+        if (routing && n.solved && movable(i) && !(fv == n.fv && fw == n.fw))
+            routes_.push_back({i, (fv - n.fv) * n.node.mass, n.node.inertia * (fw - n.fw)});
+        n.solved = true;
         n.force = n.torque = Vec3{};
         if (allDirty_ || n.dirty) {
             n.v = fv;
@@ -481,6 +503,106 @@ double StressSolver::startSolve() {
     dirty_.clear();
     allDirty_ = false;
     return std::sqrt(scale2);
+}
+
+// Load changes passed down to the ground, highest node first: each node's change goes to the welds beneath it
+// (section below its centroid, facing within 60 degrees of gravity, to a lower node or a held one), split by
+// their horizontal section area, each weld taking its share of the force and of the moment about its own
+// centroid, so the node stays balanced; the node below takes the reaction as its own change. Exact for welds;
+// what has no weld beneath (a cantilever's tip, a body on bearings) keeps its change for the iteration.
+void StressSolver::route(std::vector<Route>& changes) {
+    const double g = length(settings_.gravity);
+    if (g <= 0)
+        return;
+    const Vec3 down = settings_.gravity / g;
+    auto height = [&](std::uint32_t i) { return -dot(nodes_[i].node.centroid, down); };
+    std::map<std::pair<double, std::uint32_t>, std::pair<Vec3, Vec3>, std::greater<>> open;
+    for (const Route& r : changes) {
+        auto& e = open[{height(r.node), r.node}];
+        e.first += r.force;
+        e.second += r.torque;
+    }
+    changes.clear();
+    std::vector<std::pair<std::size_t, double>> below;
+    while (!open.empty()) {
+        const auto [key, load] = *open.begin();
+        open.erase(open.begin());
+        const std::uint32_t i = key.second;
+        const NodeState& n = nodes_[i];
+        below.clear();
+        double area = 0;
+        for (std::size_t k : n.bonds) {
+            const BondState& b = bonds_[k];
+            if (b.broken || !b.solvable || !b.corners.empty())
+                continue;
+            const BondInterface& x = b.bond.section;
+            const std::uint32_t j = b.bond.other(i);
+            const double vertical = std::abs(dot(x.normal, down));
+            if (vertical <= 0.5 || dot(x.centroid - n.node.centroid, down) <= 0 ||
+                (movable(j) && height(j) >= key.first))
+                continue;
+            below.push_back({k, x.sectionArea * vertical});
+            area += below.back().second;
+        }
+        if (area <= 0)
+            continue;
+        const auto& [force, torque] = load;
+        for (const auto& [k, a] : below) {
+            BondState& b = bonds_[k];
+            const double share = a / area;
+            const Vec3 arm = b.bond.section.centroid - n.node.centroid;
+            const Vec3 f = force * -share;                        // on node i, from the node beneath
+            const Vec3 m = (torque - cross(arm, force)) * -share; // about the section centroid
+            const double sign = b.bond.a == i ? 1.0 : -1.0;
+            b.force += f * sign;
+            b.moment += m * sign;
+            apply(b, f * sign, m * sign);
+            const std::uint32_t j = b.bond.other(i);
+            if (movable(j)) {
+                auto& e = open[{height(j), j}];
+                e.first += force * share;
+                e.second += cross(b.bond.section.centroid - nodes_[j].node.centroid, force * share) - m;
+            }
+        }
+    }
+}
+
+// Gauss-Seidel over the bonds between these nodes only (ascending), until they are at rest within the
+// tolerance or stop improving: the pieces that replaced a body carry its inherited load path among
+// themselves before the iteration spreads what is left to their neighbours.
+void StressSolver::settleAmong(const std::vector<std::uint32_t>& group, double tolerance) {
+    std::vector<std::size_t> inside;
+    for (std::uint32_t n : group)
+        for (std::size_t k : nodes_[n].bonds) {
+            const BondState& b = bonds_[k];
+            const std::uint32_t m = b.bond.other(n);
+            if (n < m && !b.broken && b.solvable && std::binary_search(group.begin(), group.end(), m) &&
+                (movable(n) || movable(m)))
+                inside.push_back(k);
+        }
+    std::sort(inside.begin(), inside.end());
+    auto worst = [&] {
+        double m = 0;
+        for (std::uint32_t n : group)
+            if (movable(n))
+                m = std::max(m, nodeResidual(nodes_[n]));
+        return m;
+    };
+    double last = worst();
+    for (int sweep = 1; sweep <= 400 && last > tolerance * tolerance; ++sweep) {
+        for (std::size_t k : inside) {
+            if (!bonds_[k].corners.empty())
+                solveBearing(bonds_[k]);
+            else
+                solveWeld(bonds_[k]);
+        }
+        if (sweep % 10 == 0) { // stop once ten sweeps gain less than 10 %
+            const double now = worst();
+            if (now > 0.81 * last)
+                break;
+            last = now;
+        }
+    }
 }
 
 // The nodes a chain of intact bonds links to a root (kept until a bond or root changes).
@@ -587,7 +709,23 @@ void StressSolver::solveGaussSeidel(double tolerance) {
     bondStamp_.resize(bonds_.size(), 0);
     nodeStamp_.resize(nodes_.size(), 0);
     auto resting = [&](std::uint32_t i) { return !movable(i) || nodeResidual(nodes_[i]) <= quiet2; };
+    const double unbalanced2 = settings_.unbalanced * settings_.unbalanced;
     for (sweeps_ = 0; sweeps_ < settings_.maxSweeps && max2 > tolerance2; ++sweeps_) {
+        if (sweeps_ > 0 && sweeps_ == settings_.stallSweeps) {
+            // What bearings did not hold in the last solve and still do not is left out: its bonds keep
+            // their forces, it counts as unbalanced again, and the rest converges around it.
+            for (std::uint32_t n : active) {
+                NodeState& s = nodes_[n];
+                s.stalled = s.bearings > 0 && s.unbalanced > 0 &&
+                            (lengthSquared(s.v) > unbalanced2 || lengthSquared(s.w) > unbalanced2);
+            }
+            std::erase_if(active, [&](std::uint32_t n) { return nodes_[n].stalled; });
+            max2 = 0;
+            for (std::uint32_t n : active)
+                max2 = std::max(max2, nodeResidual(nodes_[n]));
+            if (max2 <= tolerance2)
+                break;
+        }
         if (++stampNow_ == 0) {
             std::fill(bondStamp_.begin(), bondStamp_.end(), 0);
             std::fill(nodeStamp_.begin(), nodeStamp_.end(), 0);
@@ -596,7 +734,8 @@ void StressSolver::solveGaussSeidel(double tolerance) {
         list.clear();
         for (std::uint32_t n : active)
             for (std::size_t k : nodes_[n].bonds)
-                if (!bonds_[k].broken && bonds_[k].solvable && bondStamp_[k] != stampNow_) {
+                if (!bonds_[k].broken && bonds_[k].solvable && bondStamp_[k] != stampNow_ &&
+                    !nodes_[bonds_[k].bond.a].stalled && !nodes_[bonds_[k].bond.b].stalled) {
                     bondStamp_[k] = stampNow_;
                     list.push_back(k);
                 }
@@ -757,10 +896,11 @@ void StressSolver::finishSolve(double scale) {
     double max2 = 0;
     for (std::uint32_t i = 0; i < nodes_.size(); ++i) {
         NodeState& n = nodes_[i];
-        if (movable(i))
+        if (movable(i) || n.stalled) // what the solve left out still counts: it is not in equilibrium
             max2 = std::max(max2, nodeResidual(n));
         const bool moving = length(n.v) > settings_.unbalanced || length(n.w) > settings_.unbalanced;
         n.unbalanced = n.bearings > 0 && n.invMass > 0 && !n.detached && moving ? n.unbalanced + 1 : 0;
+        n.stalled = false;
     }
     residual_ = scale > 0 ? std::sqrt(max2) / scale : 0.0;
 }
@@ -893,7 +1033,10 @@ void StressSolver::damage(const Vec3& point, double radius, double amount) {
         const double d = length(b.bond.section.centroid - point);
         if (b.broken || d >= radius)
             continue;
-        b.health -= amount * (1 - d / radius);
+        const double hit = amount * (1 - d / radius);
+        if (b.health - hit <= 0)
+            breaks_.push_back({i, b.force, b.moment, utilisation(i), true});
+        b.health -= hit;
         if (b.health <= 0) {
             b.health = 0;
             breakBond(i);
@@ -906,11 +1049,19 @@ std::vector<std::size_t> StressSolver::breakOverstressed() {
     for (std::size_t i = 0; i < bonds_.size(); ++i) {
         if (bonds_[i].broken)
             continue;
-        if (utilisation(i) > 1)
+        if (const double u = utilisation(i); u > 1) {
             out.push_back(i);
+            breaks_.push_back({i, bonds_[i].force, bonds_[i].moment, u, false});
+        }
     }
     for (std::size_t i : out)
         breakBond(i);
+    return out;
+}
+
+std::vector<BondBreak> StressSolver::takeBreaks() {
+    std::vector<BondBreak> out;
+    out.swap(breaks_);
     return out;
 }
 

@@ -79,20 +79,31 @@ TEST(StructureRuntime, HitsNearACantileversRootWeakenItUntilItFalls) {
     EXPECT_NEAR(root().area, 0.3, 1e-9);
     EXPECT_NEAR(root().utilisation, 1.41e6 / 2.9e6, 0.01);
     // Each hit 5 cm from the root takes 0.19 of its health (2000 N s * 1e-4 * (1 - 0.05 / 1)).
+    std::vector<StructureBreak> events;
+    auto step = [&] {
+        rig.runtime.stepFrame();
+        for (const StructureBreak& e : rig.runtime.structureBreaks())
+            events.push_back(e);
+    };
     int hits = 0;
     while (rig.motionOf(slab) == BodyMotionState::Static && hits < 6) {
         rig.runtime.submitImpact(body, {0.05, 2.1, 0}, {0, 1, 0}, 2000);
-        rig.runtime.stepFrame();
+        step();
         ++hits;
         if (hits == 1) // a new static body rebuilds the bond graph: health carries over by body pair
             rig.addBox({20, 0, 20}, {21, 1, 21});
-        rig.runtime.stepFrame();
+        step();
         if (rig.motionOf(slab) == BodyMotionState::Static) {
             EXPECT_NEAR(root().health, 1 - 0.19 * hits, 1e-9);
         }
     }
     EXPECT_EQ(hits, 3) << "health 0.43 < 0.49";
     EXPECT_EQ(rig.runtime.counters().bondsBroken, 1);
+    ASSERT_EQ(events.size(), 1u) << "one break event for the one bond";
+    EXPECT_EQ(events[0].b, body);
+    EXPECT_NEAR(length(events[0].position - Vec3{0, 2.1, 0}), 0, 1e-9) << "the root's section centroid";
+    EXPECT_FALSE(events[0].damaged) << "a weakened root breaks under its load";
+    EXPECT_GT(events[0].utilisation, 1);
 }
 
 TEST(StructureRuntime, ABoxDroppedOnACantileversTipBreaksItWhenHeavyEnough) {
@@ -110,6 +121,41 @@ TEST(StructureRuntime, ABoxDroppedOnACantileversTipBreaksItWhenHeavyEnough) {
         EXPECT_EQ(rig.motionOf(slab), mass > 100 ? BodyMotionState::Dynamic : BodyMotionState::Static)
             << mass;
     }
+}
+
+// The break the dropped box causes, as the record an effect reads: the root's section, the two bodies, the
+// frame it broke in and the load it carried (at least the slab's weight, 1440 kg).
+TEST(StructureRuntime, ALoadedBeamBreakingReportsItsBreakEventAtItsRoot) {
+    Rig rig(true);
+    ASSERT_TRUE(rig.runtime.addConvexBody(makeBox({-1, 0, -2}, {0, 4, 2}).positions, Frame{}, 0));
+    const ObjectId slab = rig.addBox({0, 2, -0.75}, {2, 2.2, 0.75}, "concrete");
+    ASSERT_TRUE(
+        rig.runtime.addConvexBody(makeBox({1.8, 3.2, -0.1}, {2.0, 3.4, 0.1}).positions, Frame{}, 200));
+    const BodyId body = rig.runtime.bodyOf(slab)->id;
+    std::vector<StructureBreak> events;
+    std::uint64_t brokeIn = 0;
+    for (int i = 0; i < 40; ++i) {
+        const FrameStats stats = rig.runtime.stepFrame();
+        EXPECT_EQ(rig.runtime.structureBreaks().size(), static_cast<std::size_t>(stats.bondsBroken));
+        for (const StructureBreak& e : rig.runtime.structureBreaks()) {
+            events.push_back(e);
+            brokeIn = rig.runtime.counters().frames;
+        }
+    }
+    ASSERT_EQ(rig.motionOf(slab), BodyMotionState::Dynamic);
+    ASSERT_EQ(events.size(), 1u);
+    const StructureBreak& e = events[0];
+    EXPECT_EQ(e.frame, brokeIn);
+    EXPECT_GT(e.frame, 1u) << "the box landed first";
+    EXPECT_EQ(e.b, body);
+    EXPECT_LT(e.a, e.b);
+    EXPECT_NEAR(length(e.position - Vec3{0, 2.1, 0}), 0, 1e-9) << "the root's section centroid";
+    EXPECT_NEAR(e.normal.x, 1, 1e-9) << "from the wall to the slab";
+    EXPECT_NEAR(e.area, 0.3, 1e-9);
+    EXPECT_GT(std::abs(e.force.y), 1440 * 9.81) << "the slab's weight and the box's landing";
+    EXPECT_GT(e.utilisation, 1);
+    EXPECT_FALSE(e.damaged);
+    EXPECT_EQ(e.materialB, "concrete");
 }
 
 TEST(StructureRuntime, TheMaterialFieldOfWorldCfgReachesTheStructure) {
@@ -261,6 +307,46 @@ namespace rubble {
 // stands unshot for a simulated minute: no bond breaks, nothing becomes dynamic, and every frame's solve is
 // converged. (With the old sweep budget at 1 sweep a frame, 10 at first, it falls; at 2 to 8 it stands on
 // solves whose residual reaches 0.02 to 0.4.)
+// assets/scenes/tower.cfg: six storeys, each a slab on four pillars (bearings). It stands unshot; without
+// the two ground-floor pillars of one side, the first slab rests on one edge, tips, and the storeys above go
+// with it: the load brings the tower down, where connectivity alone (the slab still touches two pillars)
+// leaves it standing.
+TEST(StructureRuntime, ATowerStandsUnshotAndFallsWhenOneSideOfItsBaseIsRemoved) {
+    const Result<SceneConfig> scene =
+        parseSceneConfig(std::string(RUBBLE_SOURCE_DIR) + "/assets/scenes/tower.cfg");
+    ASSERT_TRUE(scene) << scene.error().message;
+    for (const bool structure : {true, false}) {
+        SCOPED_TRACE(structure ? "stress solver" : "connectivity");
+        test::ToyPhysics engine;
+        DestructionRuntime runtime(engine, Rig::config(structure, 1, false, 0.6, StressMethod::GaussSeidel));
+        SceneLoadOptions options;
+        options.loadVehicle = false;
+        const LoadedScene loaded = loadScene(*scene, runtime, options);
+        ASSERT_EQ(loaded.objects.size(), 30u);
+        auto standing = [&] {
+            int n = 0;
+            for (ObjectId id : loaded.objects) {
+                const BodyRecord* r = runtime.bodyOf(id); // none once removed
+                n += r && r->motion == BodyMotionState::Static;
+            }
+            return n;
+        };
+        for (int i = 0; i < 30; ++i)
+            runtime.stepFrame();
+        EXPECT_EQ(standing(), 30) << "unshot";
+        EXPECT_EQ(runtime.counters().piecesCollapsed, 0);
+        for (std::size_t k : {0u, 1u}) // the ground floor's pillars at x = -2.7
+            runtime.removeBody(runtime.bodyOf(loaded.objects[k])->id);
+        for (int i = 0; i < 40; ++i) // unbalanced for 30 solves, then falling
+            runtime.stepFrame();
+        if (structure) {
+            EXPECT_EQ(standing(), 2) << "only the two pillars left at its foot";
+        } else {
+            EXPECT_EQ(standing(), 28);
+        }
+    }
+}
+
 TEST(StructureRuntime, AnUnshotBuildingStandsForASimulatedMinute) {
     Rig rig(true, 1, false, 0.6, StressMethod::GaussSeidel);
     std::vector<ObjectId> parts;

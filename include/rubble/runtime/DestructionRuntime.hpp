@@ -8,6 +8,7 @@
 #include <deque>
 #include <functional>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "rubble/core/Export.hpp"
@@ -123,6 +124,20 @@ struct RUBBLE_API StructureBond {
     double area = 0;        ///< interface area (m²)
     double utilisation = 0; ///< largest stress / limit ratio (1 = breaking)
     double health = 1;      ///< remaining fraction of the section
+};
+
+/// A structure bond that broke, for effects (dust, decals, sound): a self-contained record.
+struct StructureBreak {
+    std::uint64_t frame = 0; ///< the frame it broke in (RuntimeCounters::frames)
+    BodyId a = 0, b = 0;     ///< the bodies it joined, a < b
+    Vec3 position;           ///< the interface centroid (world)
+    Vec3 normal;             ///< the interface normal, from a to b
+    double area = 0;         ///< interface area (m²)
+    Vec3 force;              ///< the force it carried the moment it broke, b on a (N)
+    double utilisation = 0;  ///< its largest stress over its limit (> 1 when its load broke it)
+    bool damaged = false;    ///< broken by impact damage (health 0), not by its load
+    std::string materialA;   ///< a's material (preset name)
+    std::string materialB;   ///< b's material
 };
 
 /// Budgets of the debris governor (DebrisGovernor): what keeps thousands of pieces affordable. Every resting
@@ -354,6 +369,9 @@ public:
     std::vector<BodyId> supportNeighbours(BodyId id) const;
     /// The structure's bonds with their stress (empty unless StructurePolicy::enabled), ordered by (a, b).
     std::vector<StructureBond> structureBonds() const;
+    /// The structure bonds the last stepFrame() broke, in the order they broke (empty unless
+    /// StructurePolicy::enabled).
+    const std::vector<StructureBreak>& structureBreaks() const;
     /// The point distant debris fades from (e.g. the camera).
     void setFocus(const Vec3& point);
 

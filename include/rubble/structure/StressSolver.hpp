@@ -69,8 +69,22 @@ struct RUBBLE_API StressSettings {
     bool deadLoadGuess = false; ///< GaussSeidel, ConjugateGradient: a structure whose bonds carry nothing yet
                                 ///< starts from its dead load passed down (off: it biases which equilibrium
                                 ///< indeterminate contacts reach; docs/structure.md)
-    bool trace = false; ///< record the relative residual after every sweep (history(); costs a pass over
-                        ///< the nodes per sweep)
+    bool trace = false;     ///< record the relative residual after every sweep (history(); costs a pass over
+                            ///< the nodes per sweep)
+    bool routeLoads = true; ///< GaussSeidel, ConjugateGradient: a change of a node's load since the last
+                            ///< solve is first passed down the welds beneath it to the ground (a warm start)
+    int stallSweeps = 64;   ///< GaussSeidel: after this many sweeps, nodes on bearings that the last solve
+                            ///< left unbalanced and that still accelerate by `unbalanced` are left out of
+                            ///< the solve (their bonds' forces kept; they count as unbalanced); 0: never
+};
+
+/// A bond that broke in breakOverstressed() or damage(), with what it carried the moment it broke.
+struct BondBreak {
+    std::size_t bond = 0;   ///< its slot (its section stays readable until the slot is reused)
+    Vec3 force;             ///< the force node b exerted on node a (N)
+    Vec3 moment;            ///< the couple node b exerted on node a about the section centroid (N m)
+    double utilisation = 0; ///< its largest stress over limit (> 1 when overstressed)
+    bool damaged = false;   ///< broken by damage (health 0), not by stress
 };
 
 /// The stress solver over one structure (nodes joined by bonds).
@@ -147,6 +161,9 @@ public:
     void breakBond(std::size_t i);
     /// Takes a node out of the structure (it fell or was removed); its bonds break.
     void detach(std::uint32_t node);
+    /// The bonds broken by breakOverstressed() and damage() since the last call, in the order they broke;
+    /// clears the list.
+    std::vector<BondBreak> takeBreaks();
     /// Nodes still in the structure that no chain of intact bonds links to a root, or that bearings have not
     /// held in equilibrium for `StressSettings::unbalancedSolves` solves in a row (tipping or sliding),
     /// ascending.
@@ -163,6 +180,8 @@ private:
         bool dirty = false; // v and w to be recomputed from the bonds at the next solve
         bool detached = false;
         bool removed = false;           // a free slot
+        bool stalled = false;           // GaussSeidel: left out of this solve (unbalanced on bearings)
+        bool solved = false;            // loads recorded by a solve (fv, fw), so a change can be routed
         int unbalanced = 0;             // solves in a row that left it accelerating
         int bearings = 0;               // bearings it rests on (or carries)
         std::vector<std::size_t> bonds; // ascending
@@ -229,6 +248,14 @@ private:
     };
     void inherit();
     void coldStart();
+    struct Route { // a load change on a node to pass down: force, and torque about its centroid
+        std::uint32_t node;
+        Vec3 force, torque;
+    };
+    void route(std::vector<Route>& changes);
+    void settleAmong(const std::vector<std::uint32_t>& group, double tolerance);
+    std::vector<Route> routes_;            // startSolve(): this solve's load changes
+    std::vector<BondBreak> breaks_;        // since takeBreaks()
     std::vector<Orphan> orphans_;          // since the last solve
     std::vector<std::size_t> fresh_;       // bonds added since the last solve
     std::vector<std::uint32_t> bondStamp_; // GaussSeidel: the sweep that listed the bond
