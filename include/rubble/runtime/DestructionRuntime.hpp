@@ -127,7 +127,7 @@ struct RUBBLE_API StructureBond {
 };
 
 /// A structure bond that broke, for effects (dust, decals, sound): a self-contained record.
-struct StructureBreak {
+struct RUBBLE_API StructureBreak {
     std::uint64_t frame = 0; ///< the frame it broke in (RuntimeCounters::frames)
     BodyId a = 0, b = 0;     ///< the bodies it joined, a < b
     Vec3 position;           ///< the interface centroid (world)

@@ -79,7 +79,7 @@ struct RUBBLE_API StressSettings {
 };
 
 /// A bond that broke in breakOverstressed() or damage(), with what it carried the moment it broke.
-struct BondBreak {
+struct RUBBLE_API BondBreak {
     std::size_t bond = 0;   ///< its slot (its section stays readable until the slot is reused)
     Vec3 force;             ///< the force node b exerted on node a (N)
     Vec3 moment;            ///< the couple node b exerted on node a about the section centroid (N m)
