@@ -29,6 +29,13 @@ using rubble::bench::fixed;
 using rubble::bench::Stats;
 using rubble::bench::timeIt;
 
+/// The kinds --mega-kinds accepts.
+std::vector<std::string> allKinds() {
+    std::vector<std::string> kinds = rubble::bench::kMegaKinds;
+    kinds.insert(kinds.end(), rubble::bench::kOrganicKinds.begin(), rubble::bench::kOrganicKinds.end());
+    return kinds;
+}
+
 struct BenchArgs {
     bool quick = false;
     int runs = 15;
@@ -197,7 +204,7 @@ const rubble::tools::Registrar registrar{
                       "decomposition_megamesh.csv/.png)");
          app.add_option("--mega-sizes", mega->sizes, "triangle counts of the --mega rows");
          app.add_option("--mega-kinds", mega->kinds, "meshes of the --mega rows")
-             ->check(CLI::IsMember(rubble::bench::kMegaKinds));
+             ->check(CLI::IsMember(allKinds()));
          app.add_option("--hits", mega->hits, "random hits per --mega mesh")->check(CLI::Range(1, 10000));
          auto writeDir = std::make_shared<std::string>();
          app.add_option("--write-mega", *writeDir,

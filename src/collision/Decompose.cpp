@@ -17,6 +17,7 @@
 #include <optional>
 
 #include "collision/MeshRegion.hpp"
+#include "collision/PolygonBvh.hpp"
 #include "geometry/OrientedShells.hpp"
 #include "rubble/ConvexDecomposition.hpp"
 #include "rubble/MassProperties.hpp"
@@ -178,6 +179,7 @@ public:
                               });
             order.resize(kProxyDepthFaces);
         }
+        const detail::PolygonBvh bvh(part.surface);
         for (std::size_t fi : order) {
             const PolytopeFace& hf = hullFaces[fi];
             bool onCut = false;
@@ -209,16 +211,7 @@ public:
                     if (nd > 1e-12)
                         tExit = std::min(tExit, (f.plane.offset - dot(f.plane.normal, o)) / nd);
                 }
-                double t = tExit;
-                for (const Polygon& poly : part.surface) {
-                    for (std::size_t k = 1; k + 1 < poly.size(); ++k) {
-                        const double h = rayTriangle(o, dir, poly[0], poly[k], poly[k + 1]);
-                        if (h >= 0 && h < t)
-                            t = h;
-                    }
-                    if (t <= delta * 2)
-                        break;
-                }
+                const double t = bvh.nearest(o, dir, tExit, delta * 2);
                 const double depth = t - delta;
                 if (depth > part.depth) {
                     part.depth = depth;
@@ -227,24 +220,6 @@ public:
                 }
             }
         }
-    }
-
-    static double rayTriangle(const Vec3& o, const Vec3& d, const Vec3& a, const Vec3& b, const Vec3& c) {
-        const Vec3 e1 = b - a, e2 = c - a;
-        const Vec3 p = cross(d, e2);
-        const double det = dot(e1, p);
-        if (std::abs(det) < 1e-300)
-            return -1;
-        const double inv = 1.0 / det;
-        const Vec3 s = o - a;
-        const double u = dot(s, p) * inv;
-        if (u < 0 || u > 1)
-            return -1;
-        const Vec3 q = cross(s, e1);
-        const double v = dot(d, q) * inv;
-        if (v < 0 || u + v > 1)
-            return -1;
-        return dot(e2, q) * inv;
     }
 
     struct Split {
