@@ -13,13 +13,16 @@
 // solid (docs/megamesh.md).
 #include <algorithm>
 #include <cmath>
+#include <condition_variable>
 #include <map>
+#include <mutex>
 #include <optional>
 
 #include "collision/MeshRegion.hpp"
 #include "collision/PolygonBvh.hpp"
 #include "geometry/OrientedShells.hpp"
 #include "rubble/ConvexDecomposition.hpp"
+#include "rubble/DecomposeControl.hpp"
 #include "rubble/MassProperties.hpp"
 #include "rubble/MeshCheck.hpp"
 
@@ -47,6 +50,8 @@ constexpr double kProxyVolumeError = 0.25;
 constexpr double kFlatDepth = 1e-9;
 /// Hull faces whose depth is sampled per part when searching a proxy.
 constexpr std::size_t kProxyDepthFaces = 64;
+/// Share of the progress that the search for cuts takes (the final part shapes take the rest).
+constexpr double kSearchShare = 0.9;
 /// Concavity below this fraction of the diagonal is rounding: such a part is convex.
 constexpr double kConvexTolerance = 1e-9;
 
@@ -54,9 +59,54 @@ class Decomposer {
 public:
     /// mesh: what the regions are searched on; exact: the mesh the parts must cover (mesh or its proxy's
     /// original).
-    Decomposer(const Mesh& mesh, const Mesh& exact, const DecompositionParams& params)
-        : mesh_(mesh), exact_(exact), params_(params) {
+    Decomposer(const Mesh& mesh, const Mesh& exact, const DecompositionParams& params,
+               const DecomposeControl& control)
+        : mesh_(mesh), exact_(exact), params_(params), control_(control) {
         diag_ = mesh.bounds().diagonal();
+    }
+
+    /// True once the caller asked to stop (its flag or its progress callback).
+    bool stopped() const {
+        return refused_ || (control_.cancel && control_.cancel->load(std::memory_order_relaxed));
+    }
+
+    /// Reports progress (never less than before); a callback that returns false cancels.
+    void report(double fraction) {
+        if (!(fraction > reported_))
+            return;
+        reported_ = std::min(fraction, 1.0);
+        if (control_.progress && !control_.progress(reported_))
+            refused_ = true;
+    }
+
+    /// Runs task(i) for every i < n, on the calling thread and the control's job system; returns when all
+    /// are done.
+    void parallelFor(std::size_t n, const std::function<void(std::size_t)>& task) {
+        const int helpers =
+            control_.jobs ? std::min(control_.jobs->workerCount(), static_cast<int>(n) - 1) : 0;
+        if (helpers <= 0) {
+            for (std::size_t i = 0; i < n; ++i)
+                task(i);
+            return;
+        }
+        std::atomic<std::size_t> next{0};
+        std::mutex mutex;
+        std::condition_variable finished;
+        int running = helpers;
+        const auto work = [&] {
+            for (std::size_t i = next++; i < n; i = next++)
+                task(i);
+        };
+        for (int h = 0; h < helpers; ++h)
+            control_.jobs->submit([&] {
+                work();
+                const std::lock_guard lock(mutex);
+                if (--running == 0)
+                    finished.notify_all();
+            });
+        work();
+        std::unique_lock lock(mutex);
+        finished.wait(lock, [&] { return running == 0; });
     }
 
     bool proxied() const { return &mesh_ != &exact_; }
@@ -128,10 +178,14 @@ public:
 
     bool inside(const Vec3& p) {
         auto key = std::make_tuple(p.x, p.y, p.z);
-        auto it = insideCache_.find(key);
-        if (it != insideCache_.end())
-            return it->second;
+        {
+            const std::lock_guard lock(insideMutex_);
+            auto it = insideCache_.find(key);
+            if (it != insideCache_.end())
+                return it->second;
+        }
         const bool in = detail::insideMesh(mesh_, p);
+        const std::lock_guard lock(insideMutex_);
         insideCache_.emplace(key, in);
         return in;
     }
@@ -320,6 +374,15 @@ public:
     }
 
     Result<Decomposition> run() {
+        auto out = search();
+        if (stopped())
+            return makeError(ErrorCode::Cancelled, "decompose: cancelled");
+        if (out)
+            report(1);
+        return out;
+    }
+
+    Result<Decomposition> search() {
         Decomposition out;
         out.meshVolume = signedVolume(exact_);
         const double searchVolume = proxied() ? signedVolume(mesh_) : out.meshVolume;
@@ -371,6 +434,8 @@ public:
         }
         std::vector<bool> done(1, false);
         while (static_cast<int>(parts.size()) < params_.maxParts) {
+            if (stopped())
+                return out;
             int best = -1;
             for (std::size_t i = 0; i < parts.size(); ++i)
                 if (!done[i] && parts[i].depth > std::max(threshold, kFlatDepth * diag_) &&
@@ -378,32 +443,41 @@ public:
                     best = static_cast<int>(i);
             if (best < 0)
                 break;
+            // The search is done when the parts reach the budget or the deepest pocket the threshold.
+            report(kSearchShare * std::max(static_cast<double>(parts.size()) / params_.maxParts,
+                                           threshold / parts[best].depth));
             const Part& part = parts[best];
+            const std::vector<Vec3> normals = candidateNormals(part);
+            std::vector<std::optional<Split>> tries(normals.size());
+            parallelFor(normals.size(), [&](std::size_t i) {
+                if (!stopped())
+                    tries[i] = trySplit(part, Plane::fromPointNormal(part.pocket, normals[i]));
+            });
             std::optional<Split> chosen;
-            for (const Vec3& n : candidateNormals(part)) {
-                for (const Vec3& through : {part.pocket}) {
-                    auto s = trySplit(part, Plane::fromPointNormal(through, n));
-                    if (s && (!chosen || s->score < chosen->score))
-                        chosen = std::move(s);
-                }
-            }
+            for (std::optional<Split>& s : tries)
+                if (s && (!chosen || s->score < chosen->score))
+                    chosen = std::move(s);
             if (!chosen || chosen->score > part.hull.volume() * (1 + 1e-9)) {
                 done[best] = true;
                 continue;
             }
             ++nextTag_;
-            measureDepth(chosen->left);
-            measureDepth(chosen->right);
+            parallelFor(2, [&](std::size_t i) { measureDepth(i == 0 ? chosen->left : chosen->right); });
             parts[best] = std::move(chosen->left);
             done[best] = false;
             parts.push_back(std::move(chosen->right));
             done.push_back(false);
         }
+        report(kSearchShare);
         const double minVol = params_.minPartVolumeFraction * out.meshVolume;
-        for (Part& p : parts) {
-            if (p.hull.volume() < minVol && parts.size() > 1)
-                continue;
-            auto shape = finalShape(p);
+        std::vector<std::optional<ConvexPolytope>> shapes(parts.size());
+        parallelFor(parts.size(), [&](std::size_t i) {
+            if (!stopped() && !(parts[i].hull.volume() < minVol && parts.size() > 1))
+                shapes[i] = finalShape(parts[i]);
+        });
+        if (stopped())
+            return out;
+        for (std::optional<ConvexPolytope>& shape : shapes) {
             if (!shape)
                 continue;
             out.hullVolume += shape->volume();
@@ -418,6 +492,10 @@ private:
     const Mesh& mesh_;
     const Mesh& exact_;
     DecompositionParams params_;
+    const DecomposeControl& control_;
+    double reported_ = 0;  // progress reported so far
+    bool refused_ = false; // the progress callback asked to stop
+    std::mutex insideMutex_;
     double diag_ = 0;
     std::int32_t nextTag_ = 0;
     double minPartVolume_ = 0;
@@ -427,6 +505,11 @@ private:
 } // namespace
 
 Result<Decomposition> decompose(const Mesh& mesh, const DecompositionParams& params) {
+    return decompose(mesh, params, DecomposeControl{});
+}
+
+Result<Decomposition> decompose(const Mesh& mesh, const DecompositionParams& params,
+                                const DecomposeControl& control) {
     if (params.maxParts < 1 || params.maxParts > kMaxConvexParts)
         return makeError(ErrorCode::InvalidInput, "decompose: maxParts " + std::to_string(params.maxParts) +
                                                       " is outside [1, " + std::to_string(kMaxConvexParts) +
@@ -447,11 +530,11 @@ Result<Decomposition> decompose(const Mesh& mesh, const DecompositionParams& par
             const Mesh proxy = detail::clusteredProxy(mesh, cells);
             if (std::abs(signedVolume(proxy) - volume) > kProxyVolumeError * std::abs(volume))
                 continue; // too coarse for a thin feature: finer, else the exact search
-            Decomposer d(proxy, mesh, params);
+            Decomposer d(proxy, mesh, params, control);
             return d.run();
         }
     }
-    Decomposer d(mesh, mesh, params);
+    Decomposer d(mesh, mesh, params, control);
     return d.run();
 }
 
