@@ -50,6 +50,8 @@ constexpr double kProxyVolumeError = 0.25;
 constexpr double kFlatDepth = 1e-9;
 /// Hull faces whose depth is sampled per part when searching a proxy.
 constexpr std::size_t kProxyDepthFaces = 64;
+/// Hull faces per job when measuring pocket depth.
+constexpr std::size_t kDepthChunk = 32;
 /// Share of the progress that the search for cuts takes (the final part shapes take the rest).
 constexpr double kSearchShare = 0.9;
 /// Concavity below this fraction of the diagonal is rounding: such a part is convex.
@@ -204,16 +206,14 @@ public:
     }
 
     /// Deepest pocket between the hull and the surface, from rays cast inward at samples of hull faces that
-    /// do not lie on a cut plane of the region.
-    void measureDepth(Part& part) const {
+    /// do not lie on a cut plane of the region. Chunks of faces run through parallelFor; each keeps its first
+    /// deepest sample and the chunks are compared in order, as one pass over the faces would.
+    void measureDepth(Part& part) {
         part.depth = 0;
-        const double delta = 1e-9 * std::max(diag_, 1.0);
-        const double planeTol = 1e-7 * std::max(diag_, 1.0);
         std::vector<const PolytopeFace*> cuts;
         for (const PolytopeFace& f : part.region.faces())
             if (f.tag >= 0)
                 cuts.push_back(&f);
-        std::vector<Vec3> samples;
         // Through a proxy, only the kProxyDepthFaces largest hull faces are sampled (pockets lie under large
         // faces that bridge them).
         const std::vector<PolytopeFace>& hullFaces = part.hull.faces();
@@ -234,44 +234,74 @@ public:
             order.resize(kProxyDepthFaces);
         }
         const detail::PolygonBvh bvh(part.surface);
-        for (std::size_t fi : order) {
-            const PolytopeFace& hf = hullFaces[fi];
-            bool onCut = false;
-            for (const PolytopeFace* c : cuts)
-                if (dot(c->plane.normal, hf.plane.normal) > 1 - 1e-9 &&
-                    std::abs(c->plane.offset - hf.plane.offset) < planeTol)
-                    onCut = true;
-            if (onCut)
-                continue;
-            Vec3 g;
-            for (const Vec3& c : hf.corners)
-                g += c;
-            g = g / static_cast<double>(hf.corners.size());
-            samples.clear();
-            samples.push_back(g);
-            const std::size_t n = hf.corners.size();
-            for (std::size_t i = 0; i < n; ++i) {
-                const Vec3& a = hf.corners[i];
-                const Vec3& b = hf.corners[(i + 1) % n];
-                samples.push_back(g + (a - g) * 0.6);
-                samples.push_back(g + ((a + b) * 0.5 - g) * 0.6);
+        std::vector<Plane> planes;
+        planes.reserve(hullFaces.size());
+        for (const PolytopeFace& f : hullFaces)
+            planes.push_back(f.plane);
+        const std::size_t chunks = (order.size() + kDepthChunk - 1) / kDepthChunk;
+        std::vector<Deepest> deepest(chunks);
+        parallelFor(chunks, [&](std::size_t chunk) {
+            const std::size_t end = std::min(order.size(), (chunk + 1) * kDepthChunk);
+            for (std::size_t k = chunk * kDepthChunk; k < end; ++k)
+                faceDepth(hullFaces[order[k]], planes, cuts, bvh, deepest[chunk]);
+        });
+        for (const Deepest& d : deepest)
+            if (d.depth > part.depth) {
+                part.depth = d.depth;
+                part.pocket = d.pocket;
+                part.pocketDir = d.dir;
             }
-            const Vec3 dir = -hf.plane.normal;
-            for (const Vec3& s : samples) {
-                const Vec3 o = s + hf.plane.normal * delta;
-                double tExit = std::numeric_limits<double>::infinity();
-                for (const PolytopeFace& f : part.hull.faces()) {
-                    const double nd = dot(f.plane.normal, dir);
-                    if (nd > 1e-12)
-                        tExit = std::min(tExit, (f.plane.offset - dot(f.plane.normal, o)) / nd);
-                }
-                const double t = bvh.nearest(o, dir, tExit, delta * 2);
-                const double depth = t - delta;
-                if (depth > part.depth) {
-                    part.depth = depth;
-                    part.pocket = o + dir * t;
-                    part.pocketDir = dir;
-                }
+    }
+
+    /// A pocket's depth, bottom and ray direction.
+    struct Deepest {
+        double depth = 0;
+        Vec3 pocket, dir;
+    };
+
+    /// The deepest pocket under the samples of one hull face, where deeper than `best` so far.
+    void faceDepth(const PolytopeFace& hf, const std::vector<Plane>& planes,
+                   const std::vector<const PolytopeFace*>& cuts, const detail::PolygonBvh& bvh,
+                   Deepest& best) const {
+        const double delta = 1e-9 * std::max(diag_, 1.0);
+        const double planeTol = 1e-7 * std::max(diag_, 1.0);
+        bool onCut = false;
+        for (const PolytopeFace* c : cuts)
+            if (dot(c->plane.normal, hf.plane.normal) > 1 - 1e-9 &&
+                std::abs(c->plane.offset - hf.plane.offset) < planeTol)
+                onCut = true;
+        if (onCut)
+            return;
+        Vec3 g;
+        for (const Vec3& c : hf.corners)
+            g += c;
+        g = g / static_cast<double>(hf.corners.size());
+        std::vector<Vec3> samples;
+        samples.push_back(g);
+        const std::size_t n = hf.corners.size();
+        for (std::size_t i = 0; i < n; ++i) {
+            const Vec3& a = hf.corners[i];
+            const Vec3& b = hf.corners[(i + 1) % n];
+            samples.push_back(g + (a - g) * 0.6);
+            samples.push_back(g + ((a + b) * 0.5 - g) * 0.6);
+        }
+        const Vec3 dir = -hf.plane.normal;
+        // The hull faces the ray can leave through, with the cosine of each (the same for every sample).
+        std::vector<std::pair<const Plane*, double>> exits;
+        for (const Plane& plane : planes)
+            if (const double nd = dot(plane.normal, dir); nd > 1e-12)
+                exits.emplace_back(&plane, nd);
+        for (const Vec3& s : samples) {
+            const Vec3 o = s + hf.plane.normal * delta;
+            double tExit = std::numeric_limits<double>::infinity();
+            for (const auto& [plane, nd] : exits)
+                tExit = std::min(tExit, (plane->offset - dot(plane->normal, o)) / nd);
+            const double t = bvh.nearest(o, dir, tExit, delta * 2);
+            const double depth = t - delta;
+            if (depth > best.depth) {
+                best.depth = depth;
+                best.pocket = o + dir * t;
+                best.dir = dir;
             }
         }
     }
@@ -462,7 +492,8 @@ public:
                 continue;
             }
             ++nextTag_;
-            parallelFor(2, [&](std::size_t i) { measureDepth(i == 0 ? chosen->left : chosen->right); });
+            measureDepth(chosen->left);
+            measureDepth(chosen->right);
             parts[best] = std::move(chosen->left);
             done[best] = false;
             parts.push_back(std::move(chosen->right));
