@@ -12,8 +12,9 @@ namespace rubble {
 
 /// How decompose() shares its work, reports progress and learns that it should stop.
 struct DecomposeControl {
-    /// Runs the candidate cuts and the final part shapes of one step in parallel with the calling thread
-    /// (null: the calling thread alone). The parts do not depend on it.
+    /// Runs the candidate cuts, depth measures and final part shapes in parallel with the calling thread
+    /// (null: the calling thread alone). The parts do not depend on it; busy workers, or the pool the caller
+    /// itself runs on, never make the call wait (the caller does what no worker took).
     JobSystem* jobs = nullptr;
     /// Called on the calling thread with the fraction done: non-decreasing, in [0, 1], 1 last on success.
     /// Returning false cancels.

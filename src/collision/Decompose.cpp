@@ -15,6 +15,7 @@
 #include <cmath>
 #include <condition_variable>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <optional>
 
@@ -82,7 +83,8 @@ public:
     }
 
     /// Runs task(i) for every i < n, on the calling thread and the control's job system; returns when all
-    /// are done.
+    /// are done. Helper jobs that start after the calling thread ran out of work do nothing, so busy workers
+    /// (or the very pool the caller runs on) never make it wait.
     void parallelFor(std::size_t n, const std::function<void(std::size_t)>& task) {
         const int helpers =
             control_.jobs ? std::min(control_.jobs->workerCount(), static_cast<int>(n) - 1) : 0;
@@ -91,24 +93,34 @@ public:
                 task(i);
             return;
         }
-        std::atomic<std::size_t> next{0};
-        std::mutex mutex;
-        std::condition_variable finished;
-        int running = helpers;
-        const auto work = [&] {
-            for (std::size_t i = next++; i < n; i = next++)
-                task(i);
+        struct Shared {
+            std::atomic<std::size_t> next{0};
+            std::mutex mutex;
+            std::condition_variable idle;
+            int active = 0;      // helpers running tasks
+            bool closed = false; // the caller is done: late helpers return at once
         };
+        const auto shared = std::make_shared<Shared>();
+        const std::function<void(std::size_t)>* work = &task; // used only by active helpers
         for (int h = 0; h < helpers; ++h)
-            control_.jobs->submit([&] {
-                work();
-                const std::lock_guard lock(mutex);
-                if (--running == 0)
-                    finished.notify_all();
+            control_.jobs->submit([shared, work, n] {
+                {
+                    const std::lock_guard lock(shared->mutex);
+                    if (shared->closed)
+                        return;
+                    ++shared->active;
+                }
+                for (std::size_t i = shared->next++; i < n; i = shared->next++)
+                    (*work)(i);
+                const std::lock_guard lock(shared->mutex);
+                if (--shared->active == 0)
+                    shared->idle.notify_all();
             });
-        work();
-        std::unique_lock lock(mutex);
-        finished.wait(lock, [&] { return running == 0; });
+        for (std::size_t i = shared->next++; i < n; i = shared->next++)
+            task(i);
+        std::unique_lock lock(shared->mutex);
+        shared->closed = true;
+        shared->idle.wait(lock, [&] { return shared->active == 0; });
     }
 
     bool proxied() const { return &mesh_ != &exact_; }

@@ -32,6 +32,14 @@ private:
     std::vector<std::thread> threads_;
 };
 
+/// A job system whose workers are busy: it runs the jobs only when asked, after decompose() returned.
+class BusyJobs final : public JobSystem {
+public:
+    void submit(std::function<void()> job) override { jobs.push_back(std::move(job)); }
+    int workerCount() const override { return 2; }
+    std::vector<std::function<void()>> jobs;
+};
+
 Mesh torus() {
     return makeTorus({0, 0, 0}, 2, 0.5, 32, 12);
 }
@@ -114,6 +122,18 @@ TEST(DecomposeControl, JobSystemGivesTheSameBytes) {
         EXPECT_EQ(coordinates(shared.value()), coordinates(alone.value()));
         EXPECT_EQ(shared->hullVolume, alone->hullVolume);
     }
+}
+
+TEST(DecomposeControl, BusyJobSystemDoesNotBlockAndLateJobsDoNothing) {
+    BusyJobs jobs;
+    DecomposeControl control;
+    control.jobs = &jobs;
+    auto d = decompose(torus(), {}, control);
+    ASSERT_TRUE(d);
+    EXPECT_EQ(coordinates(d.value()), coordinates(decompose(torus()).value()));
+    EXPECT_FALSE(jobs.jobs.empty());
+    for (auto& job : jobs.jobs)
+        job(); // after the call returned: must not touch its tasks
 }
 
 TEST(PartConcavity, SampleOnAPartsFaceIsCovered) {
