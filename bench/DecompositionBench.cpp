@@ -6,6 +6,14 @@
 // assigned to the pieces). Reference columns: the thesis's HACD decomposition times (Table 3.2) and the
 // thesis's program measured on this machine, with the speed-up of the incremental update against them.
 // Table on stdout, CSV in DIR/decomposition.csv, plot in DIR/decomposition.png (gnuplot).
+//
+// --organic: organic meshes generated here (a body with seven limbs, a bumpy potato; bench/MegaMeshes.hpp) at
+// 5k, 20k and 100k triangles, each decomposed side by side in the same run by: Rubble on one thread, on two,
+// Rubble searching through its bounded proxy at every size (the cheaper first pass), and Qhull's hull of the
+// whole (the floor: one part). Columns: wall and CPU time, parts, volume excess, Hausdorff concavity
+// (rubble/collision/PartConcavity.hpp); DIR/decomposition_organic.csv and .png.
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <filesystem>
 #include <iostream>
@@ -18,8 +26,12 @@
 #include "MegaMeshes.hpp"
 #include "Subcommand.hpp"
 #include "rubble/collision/ConvexDecomposition.hpp"
+#include "rubble/collision/DecomposeControl.hpp"
+#include "rubble/collision/PartConcavity.hpp"
 #include "rubble/core/Random.hpp"
+#include "rubble/core/ThreadPool.hpp"
 #include "rubble/fracture/Fracture.hpp"
+#include "rubble/geometry/MassProperties.hpp"
 #include "rubble/io/MeshIO.hpp"
 
 namespace {
@@ -28,6 +40,13 @@ namespace fs = std::filesystem;
 using rubble::bench::fixed;
 using rubble::bench::Stats;
 using rubble::bench::timeIt;
+
+/// The kinds --mega-kinds accepts.
+std::vector<std::string> allKinds() {
+    std::vector<std::string> kinds = rubble::bench::kMegaKinds;
+    kinds.insert(kinds.end(), rubble::bench::kOrganicKinds.begin(), rubble::bench::kOrganicKinds.end());
+    return kinds;
+}
 
 struct BenchArgs {
     bool quick = false;
@@ -182,6 +201,103 @@ int runBench(const BenchArgs& args) {
     return 0;
 }
 
+/// CPU time of this process (all threads), in milliseconds.
+double cpuMs() {
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    return (u.ru_utime.tv_sec + u.ru_stime.tv_sec) * 1e3 + (u.ru_utime.tv_usec + u.ru_stime.tv_usec) * 1e-3;
+}
+
+/// One decomposition method of the organic rows.
+struct Method {
+    std::string name;
+    int threads = 1;
+    bool hullOnly = false;          // Qhull's hull of the whole mesh
+    std::size_t proxyAbove = 20000; // DecompositionParams::proxyAboveTriangles
+};
+
+int runOrganic(const BenchArgs& args) {
+    const int runs = args.quick ? 1 : std::max(1, std::min(args.runs, 5));
+    const std::vector<std::size_t> sizes =
+        args.quick ? std::vector<std::size_t>{2000} : std::vector<std::size_t>{5000, 20000, 100000};
+    const std::vector<Method> methods = {
+        {"rubble", 1, false, rubble::DecompositionParams{}.proxyAboveTriangles},
+        {"rubble_2_threads", 2, false, rubble::DecompositionParams{}.proxyAboveTriangles},
+        {"rubble_proxy_always", 1, false, 0},
+        {"qhull_hull", 1, true, 0}};
+    const rubble::bench::CpuMeter cpu;
+    rubble::bench::Table table{
+        {"mesh", "tris", "method", "parts", "wall med ms", "cpu med ms", "excess", "concavity"}, {}};
+    rubble::bench::Table csv{{"mesh", "triangles", "method", "threads", "runs", "parts", "wall_median_ms",
+                              "wall_min_ms", "wall_max_ms", "cpu_median_ms", "excess", "concavity",
+                              "other_cpu_cores"},
+                             {}};
+    std::map<std::string, std::ostringstream> series; // kind + method -> "triangles cpu_ms concavity" lines
+    for (const std::string& kind : rubble::bench::kOrganicKinds)
+        for (std::size_t size : sizes) {
+            const rubble::Mesh mesh = rubble::bench::megaMesh(kind, size);
+            for (const Method& m : methods) {
+                std::optional<rubble::ThreadPool> pool;
+                rubble::DecomposeControl control;
+                if (m.threads > 1) {
+                    pool.emplace(m.threads - 1);
+                    control.jobs = &*pool;
+                }
+                rubble::DecompositionParams params;
+                params.proxyAboveTriangles = m.proxyAbove;
+                std::vector<double> wall, cpuTime;
+                rubble::Decomposition d;
+                for (int r = 0; r < runs; ++r) {
+                    const auto t0 = std::chrono::steady_clock::now();
+                    const double c0 = cpuMs();
+                    if (m.hullOnly) {
+                        d = {};
+                        d.parts.push_back(rubble::convexHull(mesh.positions).value());
+                        d.meshVolume = rubble::signedVolume(mesh);
+                        d.hullVolume = d.parts[0].volume();
+                    } else {
+                        d = rubble::decompose(mesh, params, control).value();
+                    }
+                    cpuTime.push_back(cpuMs() - c0);
+                    wall.push_back(rubble::bench::msSince(t0));
+                }
+                const Stats w = rubble::bench::stats(wall), c = rubble::bench::stats(cpuTime);
+                const double concavity = rubble::partConcavity(mesh, d.parts);
+                const std::string name = kind + "_" + std::to_string(mesh.triangles.size());
+                table.rows.push_back({name, std::to_string(mesh.triangles.size()), m.name,
+                                      std::to_string(d.parts.size()), fixed(w.median), fixed(c.median),
+                                      fixed(d.excess(), 4), fixed(concavity, 4)});
+                csv.rows.push_back(
+                    {name, std::to_string(mesh.triangles.size()), m.name, std::to_string(m.threads),
+                     std::to_string(runs), std::to_string(d.parts.size()), fixed(w.median), fixed(w.min),
+                     fixed(w.max), fixed(c.median), fixed(d.excess(), 5), fixed(concavity, 5), ""});
+                series[kind + " " + m.name] << mesh.triangles.size() << " " << c.median << " " << concavity
+                                            << "\n";
+            }
+        }
+    const std::string other = fixed(cpu.read().other, 2);
+    for (auto& row : csv.rows)
+        row.back() = other;
+    rubble::bench::printTable(table);
+    std::cout << "runs per case: " << runs << "; other_cpu_cores " << other
+              << " (the rest of the machine's busy cores during the run)\n";
+    if (!rubble::bench::writeCsv(fs::path(args.out) / "decomposition_organic.csv", csv))
+        return 1;
+    std::ostringstream data, plot;
+    plot << "set logscale xy\nset xlabel 'triangles'\nset ylabel 'CPU time, all threads (ms)'\nset grid\nset "
+            "key bottom right font ',8' noenhanced\nset title 'Organic meshes: decomposition time per method "
+            "(other cores busy: "
+         << other << ")'\nplot ";
+    int block = 0;
+    for (auto& [label, lines] : series) {
+        data << lines.str() << "\n\n";
+        plot << (block ? ", " : "") << "$DATA index " << block << " u 1:2 w lp t '" << label << "'";
+        ++block;
+    }
+    rubble::bench::plotPng(args.out, "decomposition_organic", data.str(), plot.str());
+    return 0;
+}
+
 const rubble::tools::Registrar registrar{
     {"decomposition", "Convex decomposition: initial and incremental update per cube size and seed model",
      [](CLI::App& app) {
@@ -189,6 +305,10 @@ const rubble::tools::Registrar registrar{
          app.add_flag("--quick", args->quick, "one repetition, small cubes only (CI smoke run)");
          app.add_option("--runs", args->runs, "repetitions per case")->check(CLI::Range(1, 10000));
          app.add_option("--out", args->out, "folder for decomposition.csv and decomposition.png");
+         auto organic = std::make_shared<bool>(false);
+         app.add_flag("--organic", *organic,
+                      "only the organic rows (limbed blob and bumpy potato at 5k, 20k, 100k triangles; "
+                      "decomposition_organic.csv/.png), Rubble beside the hull of the whole");
          auto mega = std::make_shared<rubble::bench::MegaArgs>();
          auto megaOn = std::make_shared<bool>(false);
          app.add_flag("--mega", *megaOn,
@@ -197,14 +317,16 @@ const rubble::tools::Registrar registrar{
                       "decomposition_megamesh.csv/.png)");
          app.add_option("--mega-sizes", mega->sizes, "triangle counts of the --mega rows");
          app.add_option("--mega-kinds", mega->kinds, "meshes of the --mega rows")
-             ->check(CLI::IsMember(rubble::bench::kMegaKinds));
+             ->check(CLI::IsMember(allKinds()));
          app.add_option("--hits", mega->hits, "random hits per --mega mesh")->check(CLI::Range(1, 10000));
          auto writeDir = std::make_shared<std::string>();
          app.add_option("--write-mega", *writeDir,
                         "write the --mega meshes as OBJ into this folder (kind_triangles.obj) and stop");
-         return [args, mega, megaOn, writeDir] {
+         return [args, mega, megaOn, writeDir, organic] {
              if (!writeDir->empty())
                  return rubble::bench::writeMegaMeshes(*mega, *writeDir);
+             if (*organic)
+                 return runOrganic(*args);
              if (!*megaOn)
                  return runBench(*args);
              mega->out = args->out;

@@ -6,6 +6,7 @@
 #include <map>
 #include <stdexcept>
 
+#include "rubble/core/Random.hpp"
 #include "rubble/io/MeshIO.hpp"
 
 namespace rubble::bench {
@@ -70,6 +71,30 @@ Mesh megaMesh(const std::string& kind, std::size_t triangles) {
         const int stacks = static_cast<int>(std::lround(std::sqrt(t / 4))) + 1;
         const int slices = static_cast<int>(std::lround(t / (2.0 * (stacks - 1))));
         return makeSphere({0, 0, 0}, 1.0, slices, stacks);
+    }
+    if (kind == "blob" || kind == "bumpy") { // organic: the geodesic sphere displaced along its radius
+        Mesh m = megaMesh("geosphere", triangles);
+        Rng rng(7);
+        std::vector<Vec3> lobes;
+        std::vector<double> reach, width;
+        for (int k = 0; k < 7; ++k) {
+            lobes.push_back(rng.unitVector());
+            reach.push_back(rng.uniform(0.4, 1.0));
+            width.push_back(rng.uniform(0.04, 0.12));
+        }
+        for (Vec3& p : m.positions) {
+            double r = 1;
+            if (kind == "blob") { // a body with seven limbs of Gaussian profile
+                r = 0.7;
+                for (std::size_t k = 0; k < lobes.size(); ++k)
+                    r += reach[k] * std::exp(-(1 - dot(p, lobes[k])) / width[k]);
+            } else { // a potato: smooth bumps of about a tenth of the radius
+                r += 0.12 * std::sin(5 * p.x + 1) * std::sin(4 * p.y + 2) * std::sin(6 * p.z) +
+                     0.06 * std::sin(11 * p.x + 13 * p.y);
+            }
+            p = p * r;
+        }
+        return m;
     }
     if (kind == "geosphere") { // an icosahedron's 20 faces split n² each, on the sphere: even density
         const double g = (1 + std::sqrt(5.0)) / 2;

@@ -15,11 +15,14 @@ Mesh subdivideTriangles(const Mesh& mesh, int n);
 
 /// One high-poly mesh: kind "sphere" (a UV sphere: its triangles crowd at the poles), "geosphere" (a
 /// subdivided icosahedron: even density), "torus" or "arch" (the repository's arch subdivided) with about
-/// `triangles` triangles (exactly for the sphere and torus at 100k, 250k and 1M).
+/// `triangles` triangles (exactly for the sphere and torus at 100k, 250k and 1M); the organic kinds "blob" (a
+/// body with seven limbs) and "bumpy" (a potato) are the geodesic sphere displaced along its radius.
 Mesh megaMesh(const std::string& kind, std::size_t triangles);
 
 /// The kinds of megaMesh.
 inline const std::vector<std::string> kMegaKinds = {"sphere", "geosphere", "torus", "arch"};
+/// The organic kinds of megaMesh.
+inline const std::vector<std::string> kOrganicKinds = {"blob", "bumpy"};
 
 } // namespace rubble::bench
 

@@ -16,7 +16,9 @@
 #include <vector>
 
 #include "rubble/collision/ConvexDecomposition.hpp"
+#include "rubble/collision/DecomposeControl.hpp"
 #include "rubble/core/ParameterCheck.hpp"
+#include "rubble/core/ThreadPool.hpp"
 #include "rubble/core/Version.hpp"
 #include "rubble/fracture/Fracture.hpp"
 #include "rubble/geometry/MassProperties.hpp"
@@ -310,17 +312,52 @@ void writeGltfPieces(const std::filesystem::path& path, const py::list& nodes) {
     unwrap(rubble::writeGltf(path, out));
 }
 
-py::list decomposeMesh(const rubble::Mesh& mesh, int maxParts, double concavity) {
+py::list decomposeMesh(const rubble::Mesh& mesh, int maxParts, double concavity, const py::object& progress,
+                       int threads) {
     valueCheck(rubble::checkParam("max_parts", maxParts));
+    if (threads < 1 || threads > 256)
+        throw py::value_error("threads must be in [1, 256], got " + std::to_string(threads));
     rubble::DecompositionParams params;
     params.maxParts = maxParts;
     params.concavity = concavity;
+    // Between steps: Ctrl-C (KeyboardInterrupt) or an exception or False from progress(fraction) cancels;
+    // the Python error is raised again once decompose has returned.
+    std::optional<py::error_already_set> raised;
+    rubble::DecomposeControl control;
+    control.progress = [&](double fraction) {
+        py::gil_scoped_acquire locked;
+        if (PyErr_CheckSignals() != 0) {
+            raised.emplace();
+            return false;
+        }
+        if (progress.is_none())
+            return true;
+        try {
+            const py::object answer = progress(fraction);
+            const int truth = answer.is_none() ? 1 : PyObject_IsTrue(answer.ptr());
+            if (truth < 0)
+                raised.emplace();
+            return truth == 1;
+        } catch (py::error_already_set& e) {
+            raised.emplace(std::move(e));
+            return false;
+        }
+    };
+    std::optional<rubble::ThreadPool> pool;
+    if (threads > 1) {
+        pool.emplace(threads - 1);
+        control.jobs = &*pool;
+    }
     std::vector<std::vector<rubble::Vec3>> parts;
+    rubble::Result<rubble::Decomposition> d = rubble::makeError(rubble::ErrorCode::Cancelled, "");
     {
         py::gil_scoped_release unlocked;
-        for (const rubble::ConvexPolytope& part : unwrap(rubble::decompose(mesh, params)).parts)
-            parts.push_back(part.vertices());
+        d = rubble::decompose(mesh, params, control);
     }
+    if (raised)
+        throw std::move(*raised);
+    for (const rubble::ConvexPolytope& part : unwrap(std::move(d)).parts)
+        parts.push_back(part.vertices());
     return convexPartsOf(parts);
 }
 
@@ -448,5 +485,8 @@ PYBIND11_MODULE(_rubble, m) {
           "many cells; pattern='adaptive' chips on a weak hit and shatters on a strong one; material= cuts "
           "with that material's rough cut faces, roughness= (amplitude) sets them by hand, 0 is flat).");
     m.def("decompose", &decomposeMesh, py::arg("mesh"), py::kw_only(), py::arg("max_parts") = 24,
-          py::arg("concavity") = 0.02, "Convex parts of a closed mesh, each as its corner points.");
+          py::arg("concavity") = 0.02, py::arg("progress") = py::none(), py::arg("threads") = 1,
+          "Convex parts of a closed mesh, each as its corner points. progress(fraction) is called between "
+          "steps (non-decreasing, 1 last); returning False or raising cancels, as Ctrl-C does "
+          "(KeyboardInterrupt). threads share the search; the parts do not depend on them.");
 }

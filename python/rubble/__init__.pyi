@@ -1,7 +1,7 @@
 """Typed interface of the rubble module (pybind11 extension rubble._rubble)."""
 
 import os
-from typing import Literal, Sequence
+from typing import Callable, Literal, Sequence
 
 import numpy as np
 import numpy.typing as npt
@@ -202,5 +202,15 @@ def fracture(
     value; raises Error (e.g. "invalid input" for an open mesh,
     "no intersection" when the cells miss it)."""
 
-def decompose(mesh: Mesh, *, max_parts: int = 24, concavity: float = 0.02) -> list[Float64Array]:
-    """Convex parts of a closed mesh (at most max_parts), each the (k, 3) corner points of its hull."""
+def decompose(
+    mesh: Mesh,
+    *,
+    max_parts: int = 24,
+    concavity: float = 0.02,
+    progress: Callable[[float], bool | None] | None = None,
+    threads: int = 1,
+) -> list[Float64Array]:
+    """Convex parts of a closed mesh (at most max_parts), each the (k, 3) corner points of its hull.
+
+    progress(fraction) is called between steps (non-decreasing, 1 last); returning False or raising cancels,
+    as Ctrl-C does (KeyboardInterrupt). threads share the search; the parts do not depend on them."""

@@ -50,6 +50,15 @@ private:
     char* buffer_ = nullptr;
     std::size_t size_ = 0;
 };
+/// A number increasing with atan2(y, x) over (−π, π], in (−2, 2]: the corners sort as by angle, without
+/// atan2.
+double pseudoAngle(double x, double y) {
+    if (y == 0 && x <= 0)
+        return x == 0 ? 0 : (std::signbit(y) ? -2 : 2); // atan2 gives −π for −0 and π for +0
+    const double d = y / (std::abs(x) + std::abs(y)); // in [−1, 1], increasing with the angle on each side
+    return x >= 0 ? d : (y > 0 ? 2 - d : -2 - d);
+}
+
 } // namespace
 
 Result<ConvexPolytope> convexHull(const std::vector<Vec3>& points) {
@@ -105,7 +114,7 @@ Result<ConvexPolytope> convexHull(const std::vector<Vec3>& points) {
             std::vector<std::pair<double, Vec3>> ordered;
             ordered.reserve(f.corners.size());
             for (const Vec3& p : f.corners)
-                ordered.emplace_back(std::atan2(dot(p - center, v), dot(p - center, u)), p);
+                ordered.emplace_back(pseudoAngle(dot(p - center, u), dot(p - center, v)), p);
             std::sort(ordered.begin(), ordered.end(),
                       [](const auto& a, const auto& b) { return a.first < b.first; });
             for (std::size_t i = 0; i < ordered.size(); ++i)

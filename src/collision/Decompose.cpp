@@ -13,12 +13,17 @@
 // solid (docs/megamesh.md).
 #include <algorithm>
 #include <cmath>
+#include <condition_variable>
 #include <map>
+#include <memory>
+#include <mutex>
 #include <optional>
 
 #include "collision/MeshRegion.hpp"
+#include "collision/PolygonBvh.hpp"
 #include "geometry/OrientedShells.hpp"
 #include "rubble/collision/ConvexDecomposition.hpp"
+#include "rubble/collision/DecomposeControl.hpp"
 #include "rubble/geometry/MassProperties.hpp"
 #include "rubble/geometry/MeshCheck.hpp"
 
@@ -46,6 +51,10 @@ constexpr double kProxyVolumeError = 0.25;
 constexpr double kFlatDepth = 1e-9;
 /// Hull faces whose depth is sampled per part when searching a proxy.
 constexpr std::size_t kProxyDepthFaces = 64;
+/// Hull faces per job when measuring pocket depth.
+constexpr std::size_t kDepthChunk = 32;
+/// Share of the progress that the search for cuts takes (the final part shapes take the rest).
+constexpr double kSearchShare = 0.9;
 /// Concavity below this fraction of the diagonal is rounding: such a part is convex.
 constexpr double kConvexTolerance = 1e-9;
 
@@ -53,9 +62,65 @@ class Decomposer {
 public:
     /// mesh: what the regions are searched on; exact: the mesh the parts must cover (mesh or its proxy's
     /// original).
-    Decomposer(const Mesh& mesh, const Mesh& exact, const DecompositionParams& params)
-        : mesh_(mesh), exact_(exact), params_(params) {
+    Decomposer(const Mesh& mesh, const Mesh& exact, const DecompositionParams& params,
+               const DecomposeControl& control)
+        : mesh_(mesh), exact_(exact), params_(params), control_(control) {
         diag_ = mesh.bounds().diagonal();
+    }
+
+    /// True once the caller asked to stop (its flag or its progress callback).
+    bool stopped() const {
+        return refused_ || (control_.cancel && control_.cancel->load(std::memory_order_relaxed));
+    }
+
+    /// Reports progress (never less than before); a callback that returns false cancels.
+    void report(double fraction) {
+        if (!(fraction > reported_))
+            return;
+        reported_ = std::min(fraction, 1.0);
+        if (control_.progress && !control_.progress(reported_))
+            refused_ = true;
+    }
+
+    /// Runs task(i) for every i < n, on the calling thread and the control's job system; returns when all
+    /// are done. Helper jobs that start after the calling thread ran out of work do nothing, so busy workers
+    /// (or the very pool the caller runs on) never make it wait.
+    void parallelFor(std::size_t n, const std::function<void(std::size_t)>& task) {
+        const int helpers =
+            control_.jobs ? std::min(control_.jobs->workerCount(), static_cast<int>(n) - 1) : 0;
+        if (helpers <= 0) {
+            for (std::size_t i = 0; i < n; ++i)
+                task(i);
+            return;
+        }
+        struct Shared {
+            std::atomic<std::size_t> next{0};
+            std::mutex mutex;
+            std::condition_variable idle;
+            int active = 0;      // helpers running tasks
+            bool closed = false; // the caller is done: late helpers return at once
+        };
+        const auto shared = std::make_shared<Shared>();
+        const std::function<void(std::size_t)>* work = &task; // used only by active helpers
+        for (int h = 0; h < helpers; ++h)
+            control_.jobs->submit([shared, work, n] {
+                {
+                    const std::lock_guard lock(shared->mutex);
+                    if (shared->closed)
+                        return;
+                    ++shared->active;
+                }
+                for (std::size_t i = shared->next++; i < n; i = shared->next++)
+                    (*work)(i);
+                const std::lock_guard lock(shared->mutex);
+                if (--shared->active == 0)
+                    shared->idle.notify_all();
+            });
+        for (std::size_t i = shared->next++; i < n; i = shared->next++)
+            task(i);
+        std::unique_lock lock(shared->mutex);
+        shared->closed = true;
+        shared->idle.wait(lock, [&] { return shared->active == 0; });
     }
 
     bool proxied() const { return &mesh_ != &exact_; }
@@ -127,10 +192,14 @@ public:
 
     bool inside(const Vec3& p) {
         auto key = std::make_tuple(p.x, p.y, p.z);
-        auto it = insideCache_.find(key);
-        if (it != insideCache_.end())
-            return it->second;
+        {
+            const std::lock_guard lock(insideMutex_);
+            auto it = insideCache_.find(key);
+            if (it != insideCache_.end())
+                return it->second;
+        }
         const bool in = detail::insideMesh(mesh_, p);
+        const std::lock_guard lock(insideMutex_);
         insideCache_.emplace(key, in);
         return in;
     }
@@ -149,16 +218,14 @@ public:
     }
 
     /// Deepest pocket between the hull and the surface, from rays cast inward at samples of hull faces that
-    /// do not lie on a cut plane of the region.
-    void measureDepth(Part& part) const {
+    /// do not lie on a cut plane of the region. Chunks of faces run through parallelFor; each keeps its first
+    /// deepest sample and the chunks are compared in order, as one pass over the faces would.
+    void measureDepth(Part& part) {
         part.depth = 0;
-        const double delta = 1e-9 * std::max(diag_, 1.0);
-        const double planeTol = 1e-7 * std::max(diag_, 1.0);
         std::vector<const PolytopeFace*> cuts;
         for (const PolytopeFace& f : part.region.faces())
             if (f.tag >= 0)
                 cuts.push_back(&f);
-        std::vector<Vec3> samples;
         // Through a proxy, only the kProxyDepthFaces largest hull faces are sampled (pockets lie under large
         // faces that bridge them).
         const std::vector<PolytopeFace>& hullFaces = part.hull.faces();
@@ -178,73 +245,77 @@ public:
                               });
             order.resize(kProxyDepthFaces);
         }
-        for (std::size_t fi : order) {
-            const PolytopeFace& hf = hullFaces[fi];
-            bool onCut = false;
-            for (const PolytopeFace* c : cuts)
-                if (dot(c->plane.normal, hf.plane.normal) > 1 - 1e-9 &&
-                    std::abs(c->plane.offset - hf.plane.offset) < planeTol)
-                    onCut = true;
-            if (onCut)
-                continue;
-            Vec3 g;
-            for (const Vec3& c : hf.corners)
-                g += c;
-            g = g / static_cast<double>(hf.corners.size());
-            samples.clear();
-            samples.push_back(g);
-            const std::size_t n = hf.corners.size();
-            for (std::size_t i = 0; i < n; ++i) {
-                const Vec3& a = hf.corners[i];
-                const Vec3& b = hf.corners[(i + 1) % n];
-                samples.push_back(g + (a - g) * 0.6);
-                samples.push_back(g + ((a + b) * 0.5 - g) * 0.6);
+        const detail::PolygonBvh bvh(part.surface);
+        std::vector<Plane> planes;
+        planes.reserve(hullFaces.size());
+        for (const PolytopeFace& f : hullFaces)
+            planes.push_back(f.plane);
+        const std::size_t chunks = (order.size() + kDepthChunk - 1) / kDepthChunk;
+        std::vector<Deepest> deepest(chunks);
+        parallelFor(chunks, [&](std::size_t chunk) {
+            const std::size_t end = std::min(order.size(), (chunk + 1) * kDepthChunk);
+            for (std::size_t k = chunk * kDepthChunk; k < end; ++k)
+                faceDepth(hullFaces[order[k]], planes, cuts, bvh, deepest[chunk]);
+        });
+        for (const Deepest& d : deepest)
+            if (d.depth > part.depth) {
+                part.depth = d.depth;
+                part.pocket = d.pocket;
+                part.pocketDir = d.dir;
             }
-            const Vec3 dir = -hf.plane.normal;
-            for (const Vec3& s : samples) {
-                const Vec3 o = s + hf.plane.normal * delta;
-                double tExit = std::numeric_limits<double>::infinity();
-                for (const PolytopeFace& f : part.hull.faces()) {
-                    const double nd = dot(f.plane.normal, dir);
-                    if (nd > 1e-12)
-                        tExit = std::min(tExit, (f.plane.offset - dot(f.plane.normal, o)) / nd);
-                }
-                double t = tExit;
-                for (const Polygon& poly : part.surface) {
-                    for (std::size_t k = 1; k + 1 < poly.size(); ++k) {
-                        const double h = rayTriangle(o, dir, poly[0], poly[k], poly[k + 1]);
-                        if (h >= 0 && h < t)
-                            t = h;
-                    }
-                    if (t <= delta * 2)
-                        break;
-                }
-                const double depth = t - delta;
-                if (depth > part.depth) {
-                    part.depth = depth;
-                    part.pocket = o + dir * t;
-                    part.pocketDir = dir;
-                }
-            }
-        }
     }
 
-    static double rayTriangle(const Vec3& o, const Vec3& d, const Vec3& a, const Vec3& b, const Vec3& c) {
-        const Vec3 e1 = b - a, e2 = c - a;
-        const Vec3 p = cross(d, e2);
-        const double det = dot(e1, p);
-        if (std::abs(det) < 1e-300)
-            return -1;
-        const double inv = 1.0 / det;
-        const Vec3 s = o - a;
-        const double u = dot(s, p) * inv;
-        if (u < 0 || u > 1)
-            return -1;
-        const Vec3 q = cross(s, e1);
-        const double v = dot(d, q) * inv;
-        if (v < 0 || u + v > 1)
-            return -1;
-        return dot(e2, q) * inv;
+    /// A pocket's depth, bottom and ray direction.
+    struct Deepest {
+        double depth = 0;
+        Vec3 pocket, dir;
+    };
+
+    /// The deepest pocket under the samples of one hull face, where deeper than `best` so far.
+    void faceDepth(const PolytopeFace& hf, const std::vector<Plane>& planes,
+                   const std::vector<const PolytopeFace*>& cuts, const detail::PolygonBvh& bvh,
+                   Deepest& best) const {
+        const double delta = 1e-9 * std::max(diag_, 1.0);
+        const double planeTol = 1e-7 * std::max(diag_, 1.0);
+        bool onCut = false;
+        for (const PolytopeFace* c : cuts)
+            if (dot(c->plane.normal, hf.plane.normal) > 1 - 1e-9 &&
+                std::abs(c->plane.offset - hf.plane.offset) < planeTol)
+                onCut = true;
+        if (onCut)
+            return;
+        Vec3 g;
+        for (const Vec3& c : hf.corners)
+            g += c;
+        g = g / static_cast<double>(hf.corners.size());
+        std::vector<Vec3> samples;
+        samples.push_back(g);
+        const std::size_t n = hf.corners.size();
+        for (std::size_t i = 0; i < n; ++i) {
+            const Vec3& a = hf.corners[i];
+            const Vec3& b = hf.corners[(i + 1) % n];
+            samples.push_back(g + (a - g) * 0.6);
+            samples.push_back(g + ((a + b) * 0.5 - g) * 0.6);
+        }
+        const Vec3 dir = -hf.plane.normal;
+        // The hull faces the ray can leave through, with the cosine of each (the same for every sample).
+        std::vector<std::pair<const Plane*, double>> exits;
+        for (const Plane& plane : planes)
+            if (const double nd = dot(plane.normal, dir); nd > 1e-12)
+                exits.emplace_back(&plane, nd);
+        for (const Vec3& s : samples) {
+            const Vec3 o = s + hf.plane.normal * delta;
+            double tExit = std::numeric_limits<double>::infinity();
+            for (const auto& [plane, nd] : exits)
+                tExit = std::min(tExit, (plane->offset - dot(plane->normal, o)) / nd);
+            const double t = bvh.nearest(o, dir, tExit, delta * 2);
+            const double depth = t - delta;
+            if (depth > best.depth) {
+                best.depth = depth;
+                best.pocket = o + dir * t;
+                best.dir = dir;
+            }
+        }
     }
 
     struct Split {
@@ -345,6 +416,15 @@ public:
     }
 
     Result<Decomposition> run() {
+        auto out = search();
+        if (stopped())
+            return makeError(ErrorCode::Cancelled, "decompose: cancelled");
+        if (out)
+            report(1);
+        return out;
+    }
+
+    Result<Decomposition> search() {
         Decomposition out;
         out.meshVolume = signedVolume(exact_);
         const double searchVolume = proxied() ? signedVolume(mesh_) : out.meshVolume;
@@ -396,6 +476,8 @@ public:
         }
         std::vector<bool> done(1, false);
         while (static_cast<int>(parts.size()) < params_.maxParts) {
+            if (stopped())
+                return out;
             int best = -1;
             for (std::size_t i = 0; i < parts.size(); ++i)
                 if (!done[i] && parts[i].depth > std::max(threshold, kFlatDepth * diag_) &&
@@ -403,15 +485,20 @@ public:
                     best = static_cast<int>(i);
             if (best < 0)
                 break;
+            // The search is done when the parts reach the budget or the deepest pocket the threshold.
+            report(kSearchShare * std::max(static_cast<double>(parts.size()) / params_.maxParts,
+                                           threshold / parts[best].depth));
             const Part& part = parts[best];
+            const std::vector<Vec3> normals = candidateNormals(part);
+            std::vector<std::optional<Split>> tries(normals.size());
+            parallelFor(normals.size(), [&](std::size_t i) {
+                if (!stopped())
+                    tries[i] = trySplit(part, Plane::fromPointNormal(part.pocket, normals[i]));
+            });
             std::optional<Split> chosen;
-            for (const Vec3& n : candidateNormals(part)) {
-                for (const Vec3& through : {part.pocket}) {
-                    auto s = trySplit(part, Plane::fromPointNormal(through, n));
-                    if (s && (!chosen || s->score < chosen->score))
-                        chosen = std::move(s);
-                }
-            }
+            for (std::optional<Split>& s : tries)
+                if (s && (!chosen || s->score < chosen->score))
+                    chosen = std::move(s);
             if (!chosen || chosen->score > part.hull.volume() * (1 + 1e-9)) {
                 done[best] = true;
                 continue;
@@ -424,11 +511,16 @@ public:
             parts.push_back(std::move(chosen->right));
             done.push_back(false);
         }
+        report(kSearchShare);
         const double minVol = params_.minPartVolumeFraction * out.meshVolume;
-        for (Part& p : parts) {
-            if (p.hull.volume() < minVol && parts.size() > 1)
-                continue;
-            auto shape = finalShape(p);
+        std::vector<std::optional<ConvexPolytope>> shapes(parts.size());
+        parallelFor(parts.size(), [&](std::size_t i) {
+            if (!stopped() && !(parts[i].hull.volume() < minVol && parts.size() > 1))
+                shapes[i] = finalShape(parts[i]);
+        });
+        if (stopped())
+            return out;
+        for (std::optional<ConvexPolytope>& shape : shapes) {
             if (!shape)
                 continue;
             out.hullVolume += shape->volume();
@@ -443,6 +535,10 @@ private:
     const Mesh& mesh_;
     const Mesh& exact_;
     DecompositionParams params_;
+    const DecomposeControl& control_;
+    double reported_ = 0;  // progress reported so far
+    bool refused_ = false; // the progress callback asked to stop
+    std::mutex insideMutex_;
     double diag_ = 0;
     std::int32_t nextTag_ = 0;
     double minPartVolume_ = 0;
@@ -452,6 +548,11 @@ private:
 } // namespace
 
 Result<Decomposition> decompose(const Mesh& mesh, const DecompositionParams& params) {
+    return decompose(mesh, params, DecomposeControl{});
+}
+
+Result<Decomposition> decompose(const Mesh& mesh, const DecompositionParams& params,
+                                const DecomposeControl& control) {
     if (params.maxParts < 1 || params.maxParts > kMaxConvexParts)
         return makeError(ErrorCode::InvalidInput, "decompose: maxParts " + std::to_string(params.maxParts) +
                                                       " is outside [1, " + std::to_string(kMaxConvexParts) +
@@ -472,11 +573,11 @@ Result<Decomposition> decompose(const Mesh& mesh, const DecompositionParams& par
             const Mesh proxy = detail::clusteredProxy(mesh, cells);
             if (std::abs(signedVolume(proxy) - volume) > kProxyVolumeError * std::abs(volume))
                 continue; // too coarse for a thin feature: finer, else the exact search
-            Decomposer d(proxy, mesh, params);
+            Decomposer d(proxy, mesh, params, control);
             return d.run();
         }
     }
-    Decomposer d(mesh, mesh, params);
+    Decomposer d(mesh, mesh, params, control);
     return d.run();
 }
 

@@ -16,18 +16,20 @@ namespace {
 double distanceToParts(const Vec3& p, const std::vector<ConvexPolytope>& parts,
                        const std::vector<Aabb>& bounds) {
     double inside = 0, outside = std::numeric_limits<double>::infinity();
+    bool covered = false; // p lies in (or on the boundary of) some part
     for (std::size_t k = 0; k < parts.size(); ++k) {
         double out = -std::numeric_limits<double>::infinity();
         for (const PolytopeFace& f : parts[k].faces())
             out = std::max(out, f.plane.signedDistance(p));
-        if (out <= 0)
+        if (out <= 0) {
+            covered = true;
             inside = std::max(inside, -out);
-        else
+        } else
             outside =
                 std::min(outside, std::max(out, std::sqrt(lengthSquared(
                                                     max(max(bounds[k].lo - p, p - bounds[k].hi), Vec3{})))));
     }
-    return inside > 0 || !std::isfinite(outside) ? inside : (outside <= 0 ? 0 : outside);
+    return covered || !std::isfinite(outside) ? inside : outside;
 }
 
 } // namespace

@@ -606,27 +606,20 @@ void mergeToBudget(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t
     parts = std::move(kept);
 }
 
-/// updateDecomposition on pieces held elsewhere (no copies).
-std::vector<std::vector<ConvexPolytope>> updateParts(const std::vector<ConvexPolytope>& parentParts,
-                                                     const std::vector<ConvexPolytope>& cells,
-                                                     const std::vector<const Mesh*>& pieces,
-                                                     const std::vector<std::int32_t>& pieceCells,
-                                                     const DecompositionParams& params) {
-    std::vector<std::vector<ConvexPolytope>> result(pieces.size());
-    if (pieces.empty())
-        return result;
+/// The pieces of a fracture, each with its class: its cell, or −1 for a remainder island.
+struct PieceSet {
+    const std::vector<const Mesh*>& meshes;
+    const std::vector<std::int32_t>& cells;
+    std::size_t size() const { return meshes.size(); }
+    std::int32_t cellOf(std::size_t i) const { return i < cells.size() ? cells[i] : -1; }
+};
 
-    std::size_t totalTriangles = 0;
-    for (const Mesh* piece : pieces)
-        totalTriangles += piece->triangles.size();
-    const bool highPolyParent = totalTriangles > params.proxyAboveTriangles;
-    // 1. Fragments: part ∩ cell_i, and what is left outside every cell.
-    double parentVolume = 0;
+/// Stage 1, fragments: every parent part cut into part ∩ cell_c and what is left outside every cell; adds the
+/// parts' volume to parentVolume.
+std::vector<Fragment> cutFragments(const std::vector<ConvexPolytope>& parentParts,
+                                   const std::vector<ConvexPolytope>& cells,
+                                   const std::vector<Aabb>& cellBounds, double& parentVolume) {
     std::vector<Fragment> fragments;
-    std::vector<Aabb> cellBounds;
-    cellBounds.reserve(cells.size());
-    for (const ConvexPolytope& cell : cells)
-        cellBounds.push_back(cell.bounds());
     const std::vector<OuterFace> outer = outerFaces(cells, cellBounds);
     for (std::uint32_t partIndex = 0; partIndex < parentParts.size(); ++partIndex) {
         const ConvexPolytope& part = parentParts[partIndex];
@@ -645,58 +638,79 @@ std::vector<std::vector<ConvexPolytope>> updateParts(const std::vector<ConvexPol
         for (ConvexPolytope& r : rest)
             fragments.push_back({std::move(r), -1, partIndex});
     }
+    return fragments;
+}
 
-    // 2. Drop slivers: numerical leftovers always; small fragments only when they are flat (a small but
-    //    chunky fragment may hold a piece's corner and is merged into a neighbour instead).
+/// Stage 2, slivers: numerical leftovers (volume up to `sliver`) always; fragments up to `small` only when
+/// flat (a small but chunky fragment may hold a piece's corner and is merged into a neighbour instead).
+bool isSliver(const ConvexPolytope& shape, double volume, double sliver, double small) {
+    if (volume <= sliver)
+        return true;
+    if (volume <= small) {
+        const double d = shape.bounds().diagonal();
+        if (volume < 1e-7 * d * d * d)
+            return true; // flat: thinner than about 1e-7 of its size
+    }
+    return false;
+}
+
+/// The fragments each piece received.
+struct Assignment {
+    std::vector<std::vector<ConvexPolytope>> parts;  ///< per piece
+    std::vector<std::vector<std::uint32_t>> origins; ///< parent part of each part
+    std::vector<bool> trim;                          ///< fragments are clipped to the piece's bounds
+    std::vector<Aabb> bounds;                        ///< per piece
+};
+
+/// Stage 3, assignment: every fragment that is no sliver goes to the piece of its class containing it.
+Assignment assignFragments(std::vector<Fragment>& fragments, const std::vector<ConvexPolytope>& parentParts,
+                           const PieceSet& pieces, double parentVolume, const DecompositionParams& params) {
+    std::size_t totalTriangles = 0;
+    for (const Mesh* piece : pieces.meshes)
+        totalTriangles += piece->triangles.size();
+    const bool highPolyParent = totalTriangles > params.proxyAboveTriangles;
     const double sliver = 1e-12 * parentVolume;
     const double small = params.minPartVolumeFraction * parentVolume;
-    // 3. Assign every fragment to the piece containing it.
-    std::vector<std::vector<std::uint32_t>> origins(pieces.size()); // parent part of each result part
+    Assignment a;
+    a.parts.resize(pieces.size());
+    a.origins.resize(pieces.size());
     auto give = [&](std::size_t piece, ConvexPolytope part, std::uint32_t origin) {
-        result[piece].push_back(std::move(part));
-        origins[piece].push_back(origin);
+        a.parts[piece].push_back(std::move(part));
+        a.origins[piece].push_back(origin);
     };
     // A high-poly remainder island alone in its class takes every remainder fragment as it is: its bounds
     // (a pass over its vertices) are replaced by the parent parts' (which cover it), and nothing is trimmed.
     std::size_t remainders = 0;
     for (std::size_t i = 0; i < pieces.size(); ++i)
-        remainders += (i < pieceCells.size() ? pieceCells[i] : -1) < 0 ? 1 : 0;
-    std::vector<bool> trim(pieces.size(), true);
-    std::vector<Aabb> pieceBounds(pieces.size());
+        remainders += pieces.cellOf(i) < 0 ? 1 : 0;
+    a.trim.assign(pieces.size(), true);
+    a.bounds.resize(pieces.size());
     for (std::size_t i = 0; i < pieces.size(); ++i) {
-        const bool remainder = (i < pieceCells.size() ? pieceCells[i] : -1) < 0;
-        if (remainder && remainders == 1 && pieces[i]->triangles.size() > params.proxyAboveTriangles) {
-            trim[i] = false;
+        if (pieces.cellOf(i) < 0 && remainders == 1 &&
+            pieces.meshes[i]->triangles.size() > params.proxyAboveTriangles) {
+            a.trim[i] = false;
             for (const ConvexPolytope& part : parentParts)
-                pieceBounds[i].extend(part.bounds());
+                a.bounds[i].extend(part.bounds());
         } else {
-            pieceBounds[i] = pieces[i]->bounds();
+            a.bounds[i] = pieces.meshes[i]->bounds();
         }
     }
     for (Fragment& frag : fragments) {
-        const double fragVolume = frag.shape.volume();
-        if (fragVolume <= sliver)
+        if (isSliver(frag.shape, frag.shape.volume(), sliver, small))
             continue;
-        if (fragVolume <= small) {
-            const double d = frag.shape.bounds().diagonal();
-            if (fragVolume < 1e-7 * d * d * d)
-                continue; // flat: thinner than about 1e-7 of its size
-        }
         const Aabb fb = frag.shape.bounds();
         const double tol = 1e-9 * (fb.diagonal() + 1);
         std::vector<std::size_t> candidates;
-        for (std::size_t i = 0; i < pieces.size(); ++i) {
-            const std::int32_t cell = i < pieceCells.size() ? pieceCells[i] : -1;
-            if (cell == frag.cell && pieceBounds[i].overlaps(fb, tol))
+        for (std::size_t i = 0; i < pieces.size(); ++i)
+            if (pieces.cellOf(i) == frag.cell && a.bounds[i].overlaps(fb, tol))
                 candidates.push_back(i);
-        }
         if (candidates.size() == 1) {
-            if (!trim[candidates[0]]) {
+            if (!a.trim[candidates[0]]) {
                 give(candidates[0], std::move(frag.shape), frag.part);
                 continue;
             }
             // Parent parts may reach into empty space: keep the fragment inside the piece's bounds.
-            ConvexPolytope clipped = clippedToBox(std::move(frag.shape), pieceBounds[candidates[0]]);
+            ConvexPolytope clipped = clippedToBox(std::move(frag.shape), a.bounds[candidates[0]]);
             if (!clipped.empty())
                 give(candidates[0], std::move(clipped), frag.part);
             continue;
@@ -706,13 +720,13 @@ std::vector<std::vector<ConvexPolytope>> updateParts(const std::vector<ConvexPol
             // island or the parent is high-poly, whose inside test costs a pass over the island per corner of
             // a bounded part, the fragment clipped to the island's bounds, which also holds that part).
             for (std::size_t i : candidates) {
-                if (highPolyParent || pieces[i]->triangles.size() > params.proxyAboveTriangles) {
-                    ConvexPolytope clipped = clippedToBox(frag.shape, pieceBounds[i]);
+                if (highPolyParent || pieces.meshes[i]->triangles.size() > params.proxyAboveTriangles) {
+                    ConvexPolytope clipped = clippedToBox(frag.shape, a.bounds[i]);
                     if (!clipped.empty() && clipped.volume() > sliver)
                         give(i, std::move(clipped), frag.part);
                     continue;
                 }
-                auto h = detail::hullOfMeshInRegion(*pieces[i], frag.shape);
+                auto h = detail::hullOfMeshInRegion(*pieces.meshes[i], frag.shape);
                 if (h && h->volume() > sliver)
                     give(i, std::move(h.value()), frag.part);
             }
@@ -723,100 +737,127 @@ std::vector<std::vector<ConvexPolytope>> updateParts(const std::vector<ConvexPol
         std::size_t best = 0;
         double bestDist = std::numeric_limits<double>::infinity();
         for (std::size_t i = 0; i < pieces.size(); ++i) {
-            const double d = distanceToBox(pieceBounds[i], c);
+            const double d = distanceToBox(a.bounds[i], c);
             if (d < bestDist) {
                 bestDist = d;
                 best = i;
             }
         }
         // A fragment lying in empty space away from every piece is dropped.
-        if (bestDist <= 1e-6 * (pieceBounds[best].diagonal() + fb.diagonal())) {
-            ConvexPolytope clipped = clippedToBox(std::move(frag.shape), pieceBounds[best]);
+        if (bestDist <= 1e-6 * (a.bounds[best].diagonal() + fb.diagonal())) {
+            ConvexPolytope clipped = clippedToBox(std::move(frag.shape), a.bounds[best]);
             if (!clipped.empty())
                 give(best, std::move(clipped), frag.part);
         }
     }
+    return a;
+}
 
+/// Stage 4, fitting, for piece i: one hull when its fragments fill it, else merged to the budget (a
+/// remainder's parts kept out of the cells' debris); a fresh decomposition when nothing arrived.
+void fitPiece(std::size_t i, Assignment& a, const PieceSet& pieces,
+              const std::vector<ConvexPolytope>& parentParts, const std::vector<ConvexPolytope>& cells,
+              const std::vector<Aabb>& cellBounds, const std::vector<double>& debrisVolume,
+              const DecompositionParams& params) {
+    std::vector<ConvexPolytope>& parts = a.parts[i];
+    // A remainder's parts stay out of the cells (a debris piece's stay in its own cell by construction).
+    std::optional<CellGuard> guard;
+    if (pieces.cellOf(i) < 0 && !parts.empty()) {
+        double own = 0;
+        for (const ConvexPolytope& p : parts)
+            own += p.volume();
+        std::vector<double> allowance(cells.size(), std::numeric_limits<double>::infinity());
+        for (std::size_t c = 0; c < cells.size(); ++c)
+            if (debrisVolume[c] > 0)
+                allowance[c] = kOverlapShare * kPartOverlapTolerance * std::min(own, debrisVolume[c]);
+        guard.emplace(cells, cellBounds, std::move(allowance));
+    }
+    CellGuard* g = guard ? &*guard : nullptr;
+    if (parts.empty()) {
+        auto d = decompose(*pieces.meshes[i], params);
+        if (d)
+            parts = std::move(d->parts);
+        return;
+    }
+    // A high-poly remainder island is its parent's parts (which did not fill their hull, or they would be
+    // one) and their fragments, dented by the cells: the test for whether they fill their hull (a hull of
+    // every corner) is skipped. Over the budget, its least dented parts are made whole again.
+    const bool highPoly = pieces.meshes[i]->triangles.size() > params.proxyAboveTriangles;
+    const bool dented = i < pieces.cells.size() && pieces.cells[i] < 0 && highPoly;
+    if (dented && parts.size() > static_cast<std::size_t>(params.maxParts))
+        revertToParents(parts, a.origins[i], parentParts, static_cast<std::size_t>(params.maxParts),
+                        kHighPolyFillTolerance, a.trim[i] ? &a.bounds[i] : nullptr, g);
+    // A high-poly piece's parts that nearly fill their hull become that hull (kHighPolyFillTolerance).
+    if (parts.size() > 1 && !dented) {
+        double sum = 0;
+        std::vector<Vec3> pts;
+        for (const ConvexPolytope& p : parts) {
+            sum += p.volume();
+            if (highPoly) { // corners as they are (repeats do not change a hull; welding is a sort)
+                for (const PolytopeFace& f : p.faces())
+                    pts.insert(pts.end(), f.corners.begin(), f.corners.end());
+                continue;
+            }
+            const auto v = p.vertices();
+            pts.insert(pts.end(), v.begin(), v.end());
+        }
+        // The hull of the extremes in 26 directions lies inside the full hull: when it is already larger
+        // than the parts together, they do not fill their hull (and the full hull is not computed).
+        const double fillTol = highPoly ? kHighPolyFillTolerance : 1e-6;
+        if (auto quick = convexHull(extremePoints(pts)); quick && quick->volume() > sum * (1 + fillTol)) {
+            mergeToBudget(parts, a.origins[i], params.maxParts, g);
+            return;
+        }
+        auto h = convexHull(pts);
+        if (h && h->volume() <= sum * (1 + fillTol) && (!g || g->excess(g->overlaps(*h)) <= 0)) {
+            parts.clear();
+            parts.push_back(std::move(h.value()));
+            return;
+        }
+    }
+    mergeToBudget(parts, a.origins[i], params.maxParts, g);
+}
+
+/// Stage 5, bounds: parts kept inside their piece's convex hull (kPartHullTolerance), and to a bounded size,
+/// so that the next hit clips the same few faces (a bounded part reaches at most half the tolerance out of
+/// its hull).
+void boundToHull(std::vector<ConvexPolytope>& parts, const Mesh& piece, const DecompositionParams& params) {
+    if (!parts.empty() && piece.triangles.size() <= params.proxyAboveTriangles)
+        if (auto hull = convexHull(piece.positions))
+            detail::keepInsideHull(parts, *hull, 1e-9 * piece.bounds().diagonal());
+    for (ConvexPolytope& p : parts)
+        if (p.faces().size() > params.maxPartFaces)
+            if (auto b = boundedHull(p.vertices(), params.maxPartFaces))
+                p = std::move(b.value());
+}
+
+/// updateDecomposition on pieces held elsewhere (no copies): the five stages.
+std::vector<std::vector<ConvexPolytope>> updateParts(const std::vector<ConvexPolytope>& parentParts,
+                                                     const std::vector<ConvexPolytope>& cells,
+                                                     const std::vector<const Mesh*>& meshes,
+                                                     const std::vector<std::int32_t>& pieceCells,
+                                                     const DecompositionParams& params) {
+    if (meshes.empty())
+        return {};
+    const PieceSet pieces{meshes, pieceCells};
+    std::vector<Aabb> cellBounds;
+    cellBounds.reserve(cells.size());
+    for (const ConvexPolytope& cell : cells)
+        cellBounds.push_back(cell.bounds());
+    double parentVolume = 0;
+    std::vector<Fragment> fragments = cutFragments(parentParts, cells, cellBounds, parentVolume);
+    Assignment assigned = assignFragments(fragments, parentParts, pieces, parentVolume, params);
     // Volume of the debris of each cell: what a remainder's parts must not cover (kPartOverlapTolerance).
     std::vector<double> debrisVolume(cells.size(), 0);
     for (std::size_t i = 0; i < pieces.size(); ++i)
-        if (const std::int32_t cell = i < pieceCells.size() ? pieceCells[i] : -1;
+        if (const std::int32_t cell = pieces.cellOf(i);
             cell >= 0 && static_cast<std::size_t>(cell) < cells.size())
-            debrisVolume[static_cast<std::size_t>(cell)] += std::abs(signedVolume(*pieces[i]));
-    // 4. Per piece: one hull when the fragments fill it, else merge to the budget; fresh decomposition when
-    //    nothing arrived.
-    for (std::size_t i = 0; i < pieces.size(); ++i) {
-        std::vector<ConvexPolytope>& parts = result[i];
-        // A remainder's parts stay out of the cells (a debris piece's stay in its own cell by construction).
-        std::optional<CellGuard> guard;
-        if ((i < pieceCells.size() ? pieceCells[i] : -1) < 0 && !parts.empty()) {
-            double own = 0;
-            for (const ConvexPolytope& p : parts)
-                own += p.volume();
-            std::vector<double> allowance(cells.size(), std::numeric_limits<double>::infinity());
-            for (std::size_t c = 0; c < cells.size(); ++c)
-                if (debrisVolume[c] > 0)
-                    allowance[c] = kOverlapShare * kPartOverlapTolerance * std::min(own, debrisVolume[c]);
-            guard.emplace(cells, cellBounds, std::move(allowance));
-        }
-        CellGuard* g = guard ? &*guard : nullptr;
-        if (parts.empty()) {
-            auto d = decompose(*pieces[i], params);
-            if (d)
-                parts = std::move(d->parts);
-            continue;
-        }
-        // A high-poly remainder island is its parent's parts (which did not fill their hull, or they would be
-        // one) and their fragments, dented by the cells: the test for whether they fill their hull (a hull of
-        // every corner) is skipped. Over the budget, its least dented parts are made whole again.
-        const bool highPoly = pieces[i]->triangles.size() > params.proxyAboveTriangles;
-        const bool dented = i < pieceCells.size() && pieceCells[i] < 0 && highPoly;
-        if (dented && parts.size() > static_cast<std::size_t>(params.maxParts))
-            revertToParents(parts, origins[i], parentParts, static_cast<std::size_t>(params.maxParts),
-                            kHighPolyFillTolerance, trim[i] ? &pieceBounds[i] : nullptr, g);
-        // A high-poly piece's parts that nearly fill their hull become that hull (kHighPolyFillTolerance).
-        if (parts.size() > 1 && !dented) {
-            double sum = 0;
-            std::vector<Vec3> pts;
-            for (const ConvexPolytope& p : parts) {
-                sum += p.volume();
-                if (highPoly) { // corners as they are (repeats do not change a hull; welding is a sort)
-                    for (const PolytopeFace& f : p.faces())
-                        pts.insert(pts.end(), f.corners.begin(), f.corners.end());
-                    continue;
-                }
-                const auto v = p.vertices();
-                pts.insert(pts.end(), v.begin(), v.end());
-            }
-            // The hull of the extremes in 26 directions lies inside the full hull: when it is already larger
-            // than the parts together, they do not fill their hull (and the full hull is not computed).
-            const double fillTol = highPoly ? kHighPolyFillTolerance : 1e-6;
-            if (auto quick = convexHull(extremePoints(pts)); quick && quick->volume() > sum * (1 + fillTol)) {
-                mergeToBudget(parts, origins[i], params.maxParts, g);
-                continue;
-            }
-            auto h = convexHull(pts);
-            if (h && h->volume() <= sum * (1 + fillTol) && (!g || g->excess(g->overlaps(*h)) <= 0)) {
-                parts.clear();
-                parts.push_back(std::move(h.value()));
-                continue;
-            }
-        }
-        mergeToBudget(parts, origins[i], params.maxParts, g);
-    }
-    // 5. Parts kept inside their piece's convex hull (kPartHullTolerance), and to a bounded size, so that the
-    //    next hit clips the same few faces (a bounded part reaches at most half the tolerance out of its
-    //    hull).
-    for (std::size_t i = 0; i < pieces.size(); ++i) {
-        if (!result[i].empty() && pieces[i]->triangles.size() <= params.proxyAboveTriangles)
-            if (auto hull = convexHull(pieces[i]->positions))
-                detail::keepInsideHull(result[i], *hull, 1e-9 * pieces[i]->bounds().diagonal());
-        for (ConvexPolytope& p : result[i])
-            if (p.faces().size() > params.maxPartFaces)
-                if (auto b = boundedHull(p.vertices(), params.maxPartFaces))
-                    p = std::move(b.value());
-    }
-    return result;
+            debrisVolume[static_cast<std::size_t>(cell)] += std::abs(signedVolume(*meshes[i]));
+    for (std::size_t i = 0; i < pieces.size(); ++i)
+        fitPiece(i, assigned, pieces, parentParts, cells, cellBounds, debrisVolume, params);
+    for (std::size_t i = 0; i < pieces.size(); ++i)
+        boundToHull(assigned.parts[i], *meshes[i], params);
+    return std::move(assigned.parts);
 }
 
 } // namespace

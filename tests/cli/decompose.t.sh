@@ -78,6 +78,38 @@ set -e
 [ "$code" -eq 1 ] || fail "unwritable -o should exit 1, got $code"
 grep -q "x.parts.json" "$tmp/err.txt" || fail "write error does not name the file: $(cat "$tmp/err.txt")"
 
+# Ctrl-C (SIGINT) during a long decomposition: exit 130, "cancelled" on stderr, no parts file written.
+python3 - "$tmp/bumpy.obj" <<'PY'
+import math, sys
+slices, stacks = 80, 40
+r = lambda x, y, z: 1 + 0.1 * math.sin(5 * x + 1) * math.sin(4 * y + 2) * math.sin(6 * z)
+pts = [(0, 0, 1)]
+for i in range(1, stacks):
+    t = math.pi * i / stacks
+    for j in range(slices):
+        p = 2 * math.pi * j / slices
+        u = (math.sin(t) * math.cos(p), math.sin(t) * math.sin(p), math.cos(t))
+        pts.append(tuple(c * r(*u) for c in u))
+pts.append((0, 0, -1))
+ring = lambda i, j: 1 + (i - 1) * slices + j % slices
+tris = [(0, ring(1, j), ring(1, j + 1)) for j in range(slices)]
+for i in range(1, stacks - 1):
+    for j in range(slices):
+        tris += [(ring(i, j), ring(i + 1, j), ring(i + 1, j + 1)), (ring(i, j), ring(i + 1, j + 1), ring(i, j + 1))]
+tris += [(len(pts) - 1, ring(stacks - 1, j + 1), ring(stacks - 1, j)) for j in range(slices)]
+with open(sys.argv[1], "w") as f:
+    f.writelines("v %.9f %.9f %.9f\n" % p for p in pts)
+    f.writelines("f %d %d %d\n" % (a + 1, b + 1, c + 1) for a, b, c in tris)
+PY
+set +e
+timeout --preserve-status -s INT 1 "$RUBBLE" decompose --threads 1 --max-parts 1024 --concavity 0 -o "$tmp/bumpy.parts.json" \
+    "$tmp/bumpy.obj" >/dev/null 2>"$tmp/err.txt"
+code=$?
+set -e
+[ "$code" -eq 130 ] || fail "SIGINT should exit 130, got $code: $(cat "$tmp/err.txt")"
+grep -q "cancelled" "$tmp/err.txt" || fail "SIGINT should say cancelled: $(cat "$tmp/err.txt")"
+[ ! -e "$tmp/bumpy.parts.json" ] || fail "a cancelled decomposition wrote its parts file"
+
 # Unreadable input: exit 2 with the file named.
 set +e
 "$RUBBLE" decompose "$tmp/missing.obj" >"$tmp/err.txt" 2>&1; code=$?

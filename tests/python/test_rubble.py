@@ -176,6 +176,25 @@ def test_decompose():
     assert 1 < len(rubble.decompose(torus_like, max_parts=6)) <= 6
 
 
+def test_decompose_progress_cancel_and_threads():
+    building = rubble.read_mesh(ROOT / "assets" / "models" / "building.obj")
+    seen = []
+    parts = rubble.decompose(building, max_parts=6, progress=seen.append)
+    assert seen and seen[-1] == 1 and all(0 < a < b for a, b in zip(seen, seen[1:]))
+    same = rubble.decompose(building, max_parts=6, threads=2)
+    assert len(same) == len(parts) and all(np.array_equal(a, b) for a, b in zip(parts, same))
+    with pytest.raises(rubble.Error, match="cancelled"):
+        rubble.decompose(building, max_parts=6, progress=lambda f: False)
+
+    def interrupt(fraction):
+        raise KeyboardInterrupt  # as Ctrl-C in the middle of a decomposition
+
+    with pytest.raises(KeyboardInterrupt):
+        rubble.decompose(building, max_parts=6, progress=interrupt)
+    with pytest.raises(ValueError, match="threads"):
+        rubble.decompose(building, threads=0)
+
+
 # Determinism
 
 

@@ -6,21 +6,63 @@
 // --json prints {"parts","mesh_volume","hull_volume","excess","concavity","ms"}. -o writes the parts
 // (rubble/io/DecompositionFile.hpp); as MESH's stem.parts.json beside it, a scene loads them instead of
 // decomposing. Exit codes: 0 success, 1 the mesh cannot be decomposed (e.g. open or inside out) or the parts
-// cannot be written, 2 unreadable file or usage error. With --json a failure prints {"file","error"}.
+// cannot be written, 2 unreadable file or usage error, 130 cancelled (Ctrl-C). With --json a failure prints
+// {"file","error"}. On a terminal, progress is drawn on stderr; --threads shares the search between threads.
+#include <unistd.h>
+
+#include <atomic>
 #include <chrono>
+#include <csignal>
+#include <cstdio>
 #include <iostream>
 #include <memory>
+#include <optional>
+#include <thread>
 
 #include <nlohmann/json.hpp>
 
 #include "JsonText.hpp"
 #include "Subcommand.hpp"
 #include "rubble/collision/ConvexDecomposition.hpp"
+#include "rubble/collision/DecomposeControl.hpp"
 #include "rubble/collision/PartConcavity.hpp"
+#include "rubble/core/ThreadPool.hpp"
 #include "rubble/io/DecompositionFile.hpp"
 #include "rubble/io/MeshIO.hpp"
 
 namespace {
+
+/// Exit code of a decomposition cancelled by Ctrl-C (128 + SIGINT, as a shell reports it).
+constexpr int kExitCancelled = 130;
+
+/// Set by SIGINT while a decomposition runs.
+std::atomic<bool> interrupted{false};
+static_assert(std::atomic<bool>::is_always_lock_free);
+
+extern "C" void onInterrupt(int) {
+    interrupted.store(true);
+}
+
+/// Routes SIGINT to `interrupted` while alive; restores the previous handler after.
+class InterruptToCancel {
+public:
+    InterruptToCancel() { previous_ = std::signal(SIGINT, onInterrupt); }
+    ~InterruptToCancel() { std::signal(SIGINT, previous_); }
+    InterruptToCancel(const InterruptToCancel&) = delete;
+    InterruptToCancel& operator=(const InterruptToCancel&) = delete;
+
+private:
+    void (*previous_)(int) = SIG_DFL;
+};
+
+/// Draws "decomposing [====    ]  42%" on stderr.
+void drawProgress(double fraction) {
+    const int width = 30;
+    const int filled = static_cast<int>(fraction * width);
+    std::fprintf(stderr, "\rdecomposing [%s%s] %3d%%", std::string(filled, '=').c_str(),
+                 std::string(width - filled, ' ').c_str(), static_cast<int>(fraction * 100));
+    std::fflush(stderr);
+}
 
 struct DecomposeArgs {
     std::string file;
@@ -30,6 +72,7 @@ struct DecomposeArgs {
     std::string output;
     std::size_t proxyAbove = rubble::DecompositionParams{}.proxyAboveTriangles;
     std::size_t maxPartFaces = rubble::DecompositionParams{}.maxPartFaces;
+    int threads = 0; // 0: hardware threads
 };
 
 int runDecompose(const DecomposeArgs& args) {
@@ -50,10 +93,32 @@ int runDecompose(const DecomposeArgs& args) {
     params.concavity = args.concavity;
     params.proxyAboveTriangles = args.proxyAbove;
     params.maxPartFaces = args.maxPartFaces;
+    const int threads =
+        args.threads > 0 ? args.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    std::optional<rubble::ThreadPool> pool;
+    rubble::DecomposeControl control;
+    if (threads > 1) {
+        pool.emplace(threads - 1);
+        control.jobs = &*pool;
+    }
+    const bool drawn = ::isatty(STDERR_FILENO) == 1;
+    if (drawn)
+        control.progress = [](double fraction) {
+            drawProgress(fraction);
+            return true;
+        };
+    control.cancel = &interrupted;
     const auto t0 = std::chrono::steady_clock::now();
-    auto d = rubble::decompose(mesh.value(), params);
+    auto d = [&] {
+        const InterruptToCancel routed;
+        return rubble::decompose(mesh.value(), params, control);
+    }();
     const double ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    if (drawn)
+        std::fprintf(stderr, "\n");
+    if (!d && d.error().code == rubble::ErrorCode::Cancelled)
+        return failed(kExitCancelled, args.file + ": cancelled, nothing written");
     if (!d)
         return failed(1, args.file + ": " + d.error().message);
     if (!args.output.empty()) {
@@ -86,7 +151,8 @@ const rubble::tools::Registrar registrar{
          auto args = std::make_shared<DecomposeArgs>();
          app.footer(
              "Exit codes: 0 success, 1 the mesh cannot be decomposed (open or inside out) or the parts "
-             "cannot be written, 2 unreadable file or usage error.");
+             "cannot be written, 2 unreadable file or usage error, 130 cancelled by Ctrl-C (nothing "
+             "written).");
          app.add_option("mesh", args->file, "mesh file (.obj, .off, .stl, .ply, .3ds, .gltf, .glb)")
              ->required();
          app.add_option("--max-parts", args->maxParts, "at most this many convex parts")
@@ -100,6 +166,8 @@ const rubble::tools::Registrar registrar{
                         "search meshes with more triangles through a bounded proxy (default 20000)");
          app.add_option("--max-part-faces", args->maxPartFaces, "bound parts with more faces (default 512)")
              ->check(CLI::Range(std::size_t{8}, std::size_t{1} << 30));
+         app.add_option("--threads", args->threads, "threads that share the search (default: all cores)")
+             ->check(CLI::Range(1, 256));
          app.add_option("-o,--output", args->output,
                         "write the parts as JSON (MESH-stem.parts.json beside the mesh is loaded by scenes)");
          app.add_flag("--json", args->json,

@@ -241,22 +241,36 @@ class RUBBLE_OT_export_gltf(bpy.types.Operator):
 
     def execute(self, context):
         path = bpy.path.abspath(self.filepath or context.scene.rubble.export_path)
+        wm = context.window_manager
+        objects = sorted((o for o in context.selected_objects if o.type == "MESH"), key=lambda o: o.name)
+        # Progress over all objects, 0..100: each object's decomposition fills its share.
+        wm.progress_begin(0, 100)
         try:
             rubble = load_rubble()
             nodes = []
             depsgraph = context.evaluated_depsgraph_get()
-            for obj in sorted((o for o in context.selected_objects if o.type == "MESH"), key=lambda o: o.name):
+            for k, obj in enumerate(objects):
                 verts, tris, mats, uvs = _triangulated_world_mesh(obj, depsgraph)
                 slots = [m.name if m else "" for m in obj.data.materials]
                 mats = [rubble.INTERIOR_MATERIAL if i < len(slots) and slots[i] == INTERIOR_NAME else int(i)
                         for i in mats]
                 mesh = rubble.Mesh(verts, tris, materials=mats, uvs=uvs)
-                nodes.append((obj.name, mesh, rubble.decompose(mesh)))
+
+                def progress(fraction, k=k):
+                    wm.progress_update(100 * (k + fraction) / len(objects))
+
+                parts = rubble.decompose(mesh, progress=progress, threads=os.cpu_count() or 1)
+                nodes.append((obj.name, mesh, parts))
             os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
             rubble.write_gltf(path, nodes)
+        except KeyboardInterrupt:
+            self.report({"WARNING"}, "Rubble export cancelled, nothing written")
+            return {"CANCELLED"}
         except Exception as e:
             self.report({"ERROR"}, "Rubble could not export: %s" % e)
             return {"CANCELLED"}
+        finally:
+            wm.progress_end()
         self.report({"INFO"}, "%d pieces written to %s" % (len(nodes), path))
         return {"FINISHED"}
 
