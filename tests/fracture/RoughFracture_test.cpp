@@ -388,3 +388,74 @@ TEST(RoughFracture, EdgeEnvelopesFollowTheDihedralAngle) {
     }
     EXPECT_GT(rough / flat, 1.018);
 }
+
+// Rendered normals of a rough face: the area-weighted normals of the face's own triangles around each vertex
+// (smooth across it, not mixed with the outer surface at its outline), pointing outward (out of the flat cut
+// plane: the rough face is a graph over it, so every triangle does too), each within the cone of the
+// geometric normals around its vertex; the outer surface keeps its own normals. (A corner normal can be more
+// than 90° from its own triangle's normal where the surface turns sharply: the cone bound, not a fixed
+// angle.)
+TEST(RoughFracture, NormalsAreSmoothOnTheRoughFaceAndSharpAtItsOutline) {
+    Mesh input = cube();
+    for (std::size_t t = 0; t < input.triangles.size(); ++t)
+        for (int k = 0; k < 3; ++k)
+            input.normals.push_back(normalized(input.triangleNormal(t)));
+    Roughness rough;
+    rough.relative = false;
+    rough.amplitude = 0.12;
+    rough.featureSize = 0.5;
+    rough.octaves = 2;
+    rough.maxTrianglesPerPiece = 20000;
+    FractureParams p;
+    p.roughness = rough;
+    p.simplifyPieces = false;
+    auto r = fractureWithCells(input, {ConvexPolytope::fromAabb({{0.01, -3, -3}, {3, 3, 3}})}, p);
+    ASSERT_TRUE(r) << r.error().message;
+    ASSERT_TRUE(r->rough);
+    std::size_t cutCorners = 0, outlineCorners = 0;
+    double worstExcess = -1; // angle to the triangle's normal beyond the widest neighbour's, radians
+    for (const Piece& piece : r->pieces) {
+        const Mesh& m = piece.mesh;
+        ASSERT_EQ(m.normals.size(), 3 * m.triangles.size());
+        const Vec3 outward = piece.cell == -1 ? Vec3{1, 0, 0} : Vec3{-1, 0, 0}; // out of the cut x = 0.01
+        using Key = std::tuple<double, double, double>;
+        std::map<Key, Vec3> sum;                 // area-weighted normal of the cut triangles at a point
+        std::map<Key, std::vector<Vec3>> around; // their unit normals
+        std::set<Key> outer;                     // points of outer triangles
+        for (std::size_t t = 0; t < m.triangles.size(); ++t)
+            for (const Vec3& c : m.corners(t)) {
+                const Key key{c.x, c.y, c.z};
+                if (m.materials[t] != kInteriorMaterial) {
+                    outer.insert(key);
+                    continue;
+                }
+                sum[key] += m.triangleNormal(t);
+                around[key].push_back(normalized(m.triangleNormal(t)));
+            }
+        for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+            const Vec3 tn = normalized(m.triangleNormal(t));
+            const auto c = m.corners(t);
+            for (std::size_t k = 0; k < 3; ++k) {
+                const Vec3& n = m.normals[3 * t + k];
+                EXPECT_NEAR(length(n), 1.0, 1e-9);
+                if (m.materials[t] != kInteriorMaterial) { // the outer surface keeps its flat normals
+                    EXPECT_GT(dot(n, tn), 1 - 1e-9);
+                    continue;
+                }
+                const Key key{c[k].x, c[k].y, c[k].z};
+                ++cutCorners;
+                outlineCorners += outer.count(key);
+                EXPECT_GT(dot(n, normalized(sum[key])), 1 - 1e-9) << "not the face's own smooth normal";
+                EXPECT_GT(dot(tn, outward), 0) << "a folded triangle";
+                EXPECT_GT(dot(n, outward), 0) << "points inward";
+                double widest = 0;
+                for (const Vec3& o : around[key])
+                    widest = std::max(widest, std::acos(std::clamp(dot(o, tn), -1.0, 1.0)));
+                worstExcess = std::max(worstExcess, std::acos(std::clamp(dot(n, tn), -1.0, 1.0)) - widest);
+            }
+        }
+    }
+    EXPECT_GT(cutCorners, 1000u);
+    EXPECT_GT(outlineCorners, 50u); // the outline is tested, not only the face's inside
+    EXPECT_LE(worstExcess, 1e-7);
+}
