@@ -11,6 +11,7 @@
 
 #include "io/FileBytes.hpp"
 #include "persist/Bytes.hpp"
+#include "persist/RoughnessRecord.hpp"
 #include "rubble/JournalFile.hpp"
 #include "rubble/Roughness.hpp"
 
@@ -160,15 +161,7 @@ void writeObject(ByteWriter& w, const ObjectState& o) {
     w.f64(f.minPieceVolumeFraction);
     w.f64(f.uvScale);
     w.u8(f.simplifyPieces ? 1 : 0);
-    const Roughness& rough = f.roughness;
-    for (double x : {rough.amplitude, rough.featureSize, rough.hurst})
-        w.f64(x);
-    w.i32(rough.octaves);
-    w.u8(rough.relative ? 1 : 0);
-    w.u64(rough.seed);
-    w.f64(rough.grainStretch);
-    vec(w, rough.grain);
-    w.i32(rough.maxTrianglesPerPiece);
+    persist::writeRoughness(w, f.roughness);
     w.f64(o.mass.volume);
     vec(w, o.mass.centerOfMass);
     mat(w, o.mass.inertia);

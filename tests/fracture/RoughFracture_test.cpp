@@ -117,12 +117,23 @@ double offCube(const FractureResult& r) {
 }
 
 /// A cube cut by one big cell: its part x > 0.01 (the cut is a square of area 4; x = 0 holds vertices).
-Result<FractureResult> halfCut(const Roughness& rough) {
+Result<FractureResult> halfCut(const Roughness& rough, const Mesh& input = cube()) {
     FractureParams p;
     p.roughness = rough;
     p.simplifyPieces = false;
     std::vector<ConvexPolytope> cells{ConvexPolytope::fromAabb({{0.01, -3, -3}, {3, 3, 3}})};
-    return fractureWithCells(cube(), cells, p);
+    return fractureWithCells(input, cells, p);
+}
+
+/// An absolute roughness of this amplitude, feature size, octaves and triangle budget.
+Roughness absoluteRoughness(double amplitude, double featureSize, int octaves, int budget) {
+    Roughness rough;
+    rough.relative = false;
+    rough.amplitude = amplitude;
+    rough.featureSize = featureSize;
+    rough.octaves = octaves;
+    rough.maxTrianglesPerPiece = budget;
+    return rough;
 }
 
 /// The vertices of the half cut's cut face (interior material) of the piece x < 0.
@@ -214,12 +225,7 @@ TEST(RoughFracture, PiecesDoNotSelfIntersect) {
 
 TEST(RoughFracture, TheCutIsRough) {
     // Fine roughness (amplitude 0.8 of the feature size) with a budget that resolves it.
-    Roughness rough;
-    rough.relative = false;
-    rough.amplitude = 0.12;
-    rough.featureSize = 0.15;
-    rough.octaves = 2;
-    rough.maxTrianglesPerPiece = 100000;
+    const Roughness rough = absoluteRoughness(0.12, 0.15, 2, 100000);
     auto r = halfCut(rough);
     ASSERT_TRUE(r) << r.error().message;
     ASSERT_TRUE(r->rough);
@@ -400,16 +406,7 @@ TEST(RoughFracture, NormalsAreSmoothOnTheRoughFaceAndSharpAtItsOutline) {
     for (std::size_t t = 0; t < input.triangles.size(); ++t)
         for (int k = 0; k < 3; ++k)
             input.normals.push_back(normalized(input.triangleNormal(t)));
-    Roughness rough;
-    rough.relative = false;
-    rough.amplitude = 0.12;
-    rough.featureSize = 0.5;
-    rough.octaves = 2;
-    rough.maxTrianglesPerPiece = 20000;
-    FractureParams p;
-    p.roughness = rough;
-    p.simplifyPieces = false;
-    auto r = fractureWithCells(input, {ConvexPolytope::fromAabb({{0.01, -3, -3}, {3, 3, 3}})}, p);
+    auto r = halfCut(absoluteRoughness(0.12, 0.5, 2, 20000), input);
     ASSERT_TRUE(r) << r.error().message;
     ASSERT_TRUE(r->rough);
     std::size_t cutCorners = 0, outlineCorners = 0;

@@ -11,7 +11,7 @@
 
 #include "StructureRig.hpp"
 #include "persist/Bytes.hpp"
-#include "rubble/Roughness.hpp"
+#include "persist/RoughnessRecord.hpp"
 #include "rubble/Snapshot.hpp"
 
 namespace rubble {
@@ -90,16 +90,7 @@ void expectSameNodes(const StructureState& x, const StructureState& y) {
 // The bytes of a flat roughness in a version-4 object record (versions 2 and 3 have none).
 std::vector<std::uint8_t> flatRoughnessBytes() {
     persist::ByteWriter w;
-    const Roughness r;
-    for (double x : {r.amplitude, r.featureSize, r.hurst})
-        w.f64(x);
-    w.i32(r.octaves);
-    w.u8(r.relative ? 1 : 0);
-    w.u64(r.seed);
-    w.f64(r.grainStretch);
-    for (double x : {r.grain.x, r.grain.y, r.grain.z})
-        w.f64(x);
-    w.i32(r.maxTrianglesPerPiece);
+    persist::writeRoughness(w, Roughness{});
     return w.data();
 }
 
