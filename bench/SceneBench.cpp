@@ -494,12 +494,13 @@ int runRoughVsFlat(const SceneArgs& args) {
     if (!bench::makeResultsDir(args.out) ||
         !bench::writeCsv(std::filesystem::path(args.out) / (stem + "_rough.csv"), table))
         return 1;
-    bench::plotPng(args.out, stem + "_rough", data,
-                   "set termoption noenhanced\nset style data histograms\nset style fill solid 0.6\n"
-                   "set ylabel 'frame p99 (ms)'\nset yrange [0:*]\nset grid ytics\nset key top left\nset title '" +
-                       stem +
-                       ": flat vs rough cuts by material, one process'\n"
-                       "plot $DATA u 2:xtic(1) t 'flat', '' u 3 t 'rough'");
+    bench::plotPng(
+        args.out, stem + "_rough", data,
+        "set termoption noenhanced\nset style data histograms\nset style fill solid 0.6\n"
+        "set ylabel 'frame p99 (ms)'\nset yrange [0:*]\nset grid ytics\nset key top left\nset title '" +
+            stem +
+            ": flat vs rough cuts by material, one process'\n"
+            "plot $DATA u 2:xtic(1) t 'flat', '' u 3 t 'rough'");
     return 0;
 }
 
