@@ -1,6 +1,7 @@
 // `rubble-bench scene FILE.cfg [--seconds T | --frames N] [--shots-per-second R] [--workers W] [--seed S]
 //  [--deterministic] [--unpaced] [--no-idle-adoption] [--json] [--timings-csv FILE] [--frames-csv FILE]
-//  [--append-csv FILE] [--pattern single|shatter] [--cells K] [--max-awake N]`
+//  [--append-csv FILE] [--pattern single|shatter] [--cells K] [--max-awake N] [--rough [--runs N] [--out
+//  DIR]]`
 //
 // Headless destruction run of a world.cfg scene through the runtime on the Bullet binding: seeded projectiles
 // at the destructible objects (target chosen with probability ∝ volume, aim point uniform in the central 80%
@@ -30,6 +31,10 @@
 // bench/results/scene.csv (scripts/scene-bench.sh writes it). Every report says how many cores the run used
 // and how many other processes took meanwhile (cpu_cores: own / other; see bench::CpuMeter): a run with other
 // work on the machine has inflated times.
+//
+// --rough (issue #28) runs the scene flat and with rough cuts by material (SceneLoadOptions::
+// materialRoughness, as the demo plays it), alternating, --runs times each, in one process, and writes
+// DIR/<scene>_rough.csv (frame and latency percentiles, fractures, triangles per run) and its PNG.
 #include "Subcommand.hpp"
 
 #if defined(RUBBLE_HAVE_BULLET)
@@ -86,6 +91,18 @@ struct SceneArgs {
     double projectileSpeed = 120;
     double projectileMass = 2;
     double projectileRadius = 0.25;
+    bool rough = false;             // flat vs rough-by-material runs, alternating (--rough)
+    bool materialRoughness = false; // this run's cuts are rough by material
+    int runs = 1;                   // with --rough: runs of each
+    std::string out = "bench/results";
+};
+
+// What one run measured, for the --rough table.
+struct SceneSummary {
+    double frameP50 = 0, frameP99 = 0, frameMax = 0, latencyP50 = 0, latencyP99 = 0, otherCpu = -1;
+    long long fractures = 0;
+    int maxPieces = 0;
+    std::size_t worldTriangles = 0;
 };
 
 double percentile(std::vector<double> v, double q) {
@@ -155,7 +172,7 @@ std::optional<Shot> aim(const rubble::DestructionRuntime& runtime, rubble::Rng& 
     return Shot{at + dir * distance, dir * -a.projectileSpeed};
 }
 
-int runScene(const SceneArgs& a) {
+int runScene(const SceneArgs& a, SceneSummary* summary = nullptr) {
     using namespace rubble;
     using namespace rubble::bullet;
     Result<SceneConfig> scene = parseSceneConfig(a.file);
@@ -186,6 +203,7 @@ int runScene(const SceneArgs& a) {
     DestructionWorld& destruction = runtime.world();
     SceneLoadOptions lo;
     lo.loadVehicle = false;
+    lo.materialRoughness = a.materialRoughness;
     lo.fracture.pattern = a.pattern == "shatter" ? CellPattern::Shatter : CellPattern::SingleCell;
     if (a.cells > 0)
         lo.fracture.cells = a.cells;
@@ -289,6 +307,20 @@ int runScene(const SceneArgs& a) {
     const double rss = peakRssMb();
     const rubble::bench::CpuMeter::Reading cpuUse = cpu.read();
     const int workers = a.workers > 0 ? a.workers : rubble::ThreadPool::defaultWorkerCount();
+    if (summary) {
+        *summary = {percentile(frameMs, 0.5),
+                    percentile(frameMs, 0.99),
+                    percentile(frameMs, 1.0),
+                    ts.total.p50,
+                    ts.total.p99,
+                    cpuUse.other,
+                    c.fractures,
+                    maxPieces,
+                    0};
+        for (ObjectId id : destruction.objects())
+            if (const ObjectState* st = destruction.object(id))
+                summary->worldTriangles += st->mesh.triangleCount();
+    }
 
     if (!a.timingsCsv.empty()) {
         if (Status s = destruction.writeTimingsCsv(a.timingsCsv); !s)
@@ -435,6 +467,46 @@ int runScene(const SceneArgs& a) {
     return 0;
 }
 
+// --rough: the scene flat and rough by material, alternating, and the table of both.
+int runRoughVsFlat(const SceneArgs& args) {
+    namespace bench = rubble::bench;
+    bench::Table table{{"scene", "cuts", "run", "frames", "frame_p50_ms", "frame_p99_ms", "frame_max_ms",
+                        "latency_p50_ms", "latency_p99_ms", "fractures", "max_pieces", "world_triangles",
+                        "other_cpu_cores"},
+                       {}};
+    const std::string stem = std::filesystem::path(args.file).stem().string();
+    std::string data;
+    for (int run = 0; run < args.runs; ++run)
+        for (const bool rough : {false, true}) {
+            SceneArgs a = args;
+            a.materialRoughness = rough;
+            std::printf("--- %s, %s cuts, run %d\n", stem.c_str(), rough ? "rough" : "flat", run + 1);
+            SceneSummary s;
+            if (const int code = runScene(a, &s); code != 0)
+                return code;
+            table.rows.push_back(
+                {stem, rough ? "rough" : "flat", std::to_string(run + 1),
+                 std::to_string(a.frames > 0 ? a.frames : std::lround(a.seconds * 60)),
+                 bench::fixed(s.frameP50), bench::fixed(s.frameP99), bench::fixed(s.frameMax),
+                 bench::fixed(s.latencyP50), bench::fixed(s.latencyP99), std::to_string(s.fractures),
+                 std::to_string(s.maxPieces), std::to_string(s.worldTriangles), bench::fixed(s.otherCpu, 2)});
+            data += (rough ? "" : "\"run " + std::to_string(run + 1) + "\" ") + bench::fixed(s.frameP99) +
+                    (rough ? "\n" : " ");
+        }
+    bench::printTable(table);
+    if (!bench::makeResultsDir(args.out) ||
+        !bench::writeCsv(std::filesystem::path(args.out) / (stem + "_rough.csv"), table))
+        return 1;
+    bench::plotPng(
+        args.out, stem + "_rough", data,
+        "set termoption noenhanced\nset style data histograms\nset style fill solid 0.6\n"
+        "set ylabel 'frame p99 (ms)'\nset yrange [0:*]\nset grid ytics\nset key top left\nset title '" +
+            stem +
+            ": flat vs rough cuts by material, one process'\n"
+            "plot $DATA u 2:xtic(1) t 'flat', '' u 3 t 'rough'");
+    return 0;
+}
+
 rubble::tools::Registrar registrar{
     {"scene", "headless destruction run of a world.cfg scene (Bullet + runtime)", [](CLI::App& app) {
          auto args = std::make_shared<SceneArgs>();
@@ -475,7 +547,12 @@ rubble::tools::Registrar registrar{
              "with --structure: the converged Gauss-Seidel solve (relative residual 1e-3 every frame)");
          app.add_option("--projectile-speed", args->projectileSpeed, "m/s");
          app.add_option("--projectile-mass", args->projectileMass, "kg");
-         return [args] { return runScene(*args); };
+         app.add_flag("--rough", args->rough,
+                      "run the scene flat and rough by material, alternating, in one process; writes "
+                      "OUT/<scene>_rough.csv and .png");
+         app.add_option("--runs", args->runs, "with --rough: runs of each")->check(CLI::Range(1, 100));
+         app.add_option("--out", args->out, "with --rough: results folder");
+         return [args] { return args->rough ? runRoughVsFlat(*args) : runScene(*args); };
      }}};
 
 } // namespace

@@ -176,6 +176,7 @@ bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const Game
     lo.staticDensity = 400;
     lo.impulseThreshold = settings.impulseThreshold;
     lo.fracture = settings.fracture;
+    lo.materialRoughness = settings.roughCuts;
     lo.prepareMesh = [](rubble::Mesh& m) {
         m.normals.clear();
         ensureUvs(m, 4.0);

@@ -53,6 +53,7 @@ struct GameSettings {
     bool debugAabbs = false;         ///< draw AABBs
     bool debugImpacts = false;       ///< draw impact points
     bool structure = true;           ///< stress solver: overstressed bonds break (applied on restart)
+    bool roughCuts = true;           ///< cuts rough by material preset (SceneLoadOptions::materialRoughness)
     bool debugBonds = false;         ///< draw the structure's bonds, green (idle) to red (breaking)
     bool shadows = true;             ///< shadow mapping
     bool autoLevel = true;           ///< wings level themselves when no roll key is held (L toggles)

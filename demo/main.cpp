@@ -78,6 +78,7 @@ struct Options {
     double hostWait = 0;           // game seconds at which the host holds until a client joins
     std::string join;              // HOST:PORT of a host to follow
     bool structure = true;         // the stress solver (with bearings)
+    bool rough = true;             // rough cuts by material (docs/roughness.md)
     bool bonds = false;            // draw its bonds by stress
     std::string quality = "auto";  // auto (from GL_RENDERER), software or gpu
     float targetFps = 60;          // dynamic resolution holds this rate (software quality)
@@ -346,6 +347,9 @@ int main(int argc, char** argv) {
     cli.add_flag("--structure,!--no-structure", o.structure,
                  "stress solver (default on): bonds between static parts carry their load, objects rest on "
                  "each other as bearings; --structure also draws the bonds by stress");
+    cli.add_flag("--rough,!--flat", o.rough,
+                 "rough cut surfaces by material (default on: concrete, brick and stone break rough; a "
+                 "world.cfg roughness field overrides); --flat cuts the thesis's flat Voronoi planes");
     cli.add_flag("--bonds", o.bonds, "draw the structure's bonds by stress");
     cli.add_option(
         "--render-bench", o.renderBench,
@@ -462,6 +466,7 @@ int main(int argc, char** argv) {
     app.pending.fracture.uvScale = 0.25;
     app.pending.debugShapes = app.pending.debugAabbs = app.pending.debugImpacts = o.debug;
     app.pending.structure = o.structure;
+    app.pending.roughCuts = o.rough;
     app.pending.debugBonds = o.structure && (o.bonds || cli.count("--structure") > 0);
     app.pending.showcase = o.showcase || !o.camera.empty();
 

@@ -1258,12 +1258,21 @@ def check_scene(path):
             problems.append("line 1: missing %s" % name)
     for k, ln in enumerate(lines[1:], start=2):
         fields = ln.split(";")
-        if len(fields) not in (9, 10):
-            problems.append("line %d: expected 9 fields (or 10 with a material), got %d" % (k, len(fields)))
+        if len(fields) not in (9, 10, 11):
+            problems.append("line %d: expected 9 fields (10 with a material, 11 with a roughness), got %d"
+                            % (k, len(fields)))
             continue
-        if len(fields) == 10 and fields[9] not in MATERIALS:
+        if len(fields) >= 10 and fields[9] not in MATERIALS and not (len(fields) == 11 and not fields[9]):
             problems.append("line %d: unknown material '%s'" % (k, fields[9]))
             continue
+        if len(fields) == 11 and fields[10] != "flat":
+            try:
+                rough_ok = 0 <= float(fields[10]) <= 1
+            except ValueError:
+                rough_ok = False
+            if not rough_ok:
+                problems.append("line %d: roughness '%s' is neither flat nor a number in [0, 1]" % (k, fields[10]))
+                continue
         try:
             nums = [float(x) for x in fields[2:9]]
         except ValueError:

@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <tuple>
 #include <unordered_map>
 
@@ -65,10 +66,11 @@ double valueNoise(const Vec3& p, std::uint64_t seed) {
     return c0 + (c1 - c0) * tz;
 }
 
-/// The slope of the envelope of a cut face's heights from its outline: tan 10°, so two cut faces meeting at
-/// more than 20°, and a cut face meeting the outer surface at more than 10°, cannot cross
-/// (docs/roughness.md).
+/// The slope of the envelope of a cut face's heights from where it meets the outer surface: tan 10°, so it
+/// cannot cross an outer surface it meets at more than 10° (docs/roughness.md).
 constexpr double kEnvelope = 0.17632698070846498;
+/// The steepest envelope slope along a cell edge: tan 40°.
+constexpr double kEdgeEnvelope = 0.83909963117728;
 
 /// Squared distance from p to the segment ab.
 double segmentDistance2(const Vec3& p, const Vec3& a, const Vec3& b) {
@@ -116,6 +118,34 @@ public:
     }
 
     const CutFace& operator[](std::size_t i) const { return faces_[i]; }
+
+    /// The envelope slope along the outline segment ab of face f: tan(max(θ/2 − 5°, θ/3)), at most tan 40°,
+    /// θ the smallest angle between f's plane and the plane of another cell face holding the segment; the
+    /// outer surface's kEnvelope where none does. A function of the segment and the cells: the same bits on
+    /// both sides.
+    double outlineSlope(std::size_t f, const Vec3& a, const Vec3& b) const {
+        const Vec3 nf = faces_[f].normal;
+        const Vec3 mid = (a + b) * 0.5;
+        Aabb box;
+        box.extend(a);
+        box.extend(b);
+        double largestCos = -1; // of the smallest angle
+        for (const ConvexPolytope& cell : cells_) {
+            if (cell.empty() || !cell.bounds().overlaps(box, onPlane_))
+                continue;
+            for (const PolytopeFace& g : cell.faces()) {
+                const double c = std::abs(dot(g.plane.normal, nf));
+                if (c > 0.99985 || std::abs(g.plane.signedDistance(a)) > onPlane_ || // coplanar: 1°
+                    std::abs(g.plane.signedDistance(b)) > onPlane_ || !insidePolygon(g, mid))
+                    continue;
+                largestCos = std::max(largestCos, c);
+            }
+        }
+        if (largestCos < 0)
+            return kEnvelope;
+        const double theta = std::acos(largestCos);
+        return std::min(kEdgeEnvelope, std::tan(std::max(theta / 2 - 5 * std::numbers::pi / 180, theta / 3)));
+    }
 
     /// The first face (in the order of the cells) that the triangle lies on, or -1. A function of the
     /// corners as a set, so both sides of a cut find the same face.
@@ -396,6 +426,7 @@ void roughenMesh(Mesh& m, const std::vector<std::int32_t>& faceOf, const CutFace
     for (const FaceRange& r : ranges) {
         SegmentGrid grid(s.reach);
         std::vector<std::pair<std::uint32_t, std::uint32_t>> outline;
+        std::vector<double> slope2; // squared envelope slope of each outline segment
         inner.clear();
         for (std::size_t i = r.begin; i < r.end; ++i) {
             const std::uint64_t e = std::get<1>(edges[i]);
@@ -406,6 +437,10 @@ void roughenMesh(Mesh& m, const std::vector<std::int32_t>& faceOf, const CutFace
                 const bool swap = lexLess(m.positions[b], m.positions[a]);
                 grid.add(static_cast<std::uint32_t>(outline.size()), m.positions[a], m.positions[b]);
                 outline.emplace_back(swap ? b : a, swap ? a : b);
+                const double k =
+                    faces.outlineSlope(static_cast<std::size_t>(r.face), m.positions[outline.back().first],
+                                       m.positions[outline.back().second]);
+                slope2.push_back(k * k);
             }
             for (std::uint32_t v : {a, b})
                 if (!fixed[v])
@@ -413,18 +448,17 @@ void roughenMesh(Mesh& m, const std::vector<std::int32_t>& faceOf, const CutFace
         }
         std::sort(inner.begin(), inner.end());
         inner.erase(std::unique(inner.begin(), inner.end()), inner.end());
-        // Distance to the outline (up to the reach), then the height within the envelope kEnvelope *
-        // distance.
+        // The envelope: the least over the outline's segments (up to the reach) of slope × distance.
         const double reach2 = s.reach * s.reach;
         const Vec3 n = faces[static_cast<std::size_t>(r.face)].normal;
         for (const std::uint32_t v : inner) {
             Vec3& p = m.positions[v];
-            double d2 = reach2;
+            double bound2 = kEnvelope * kEnvelope * reach2;
             grid.near(p, [&](std::uint32_t id) {
-                d2 = std::min(
-                    d2, segmentDistance2(p, m.positions[outline[id].first], m.positions[outline[id].second]));
+                bound2 = std::min(bound2, slope2[id] * segmentDistance2(p, m.positions[outline[id].first],
+                                                                        m.positions[outline[id].second]));
             });
-            const double bound = kEnvelope * std::sqrt(d2);
+            const double bound = std::sqrt(bound2);
             p = p + n * (bound * std::tanh(s.amplitude * (*s.field)(p) / bound));
         }
     }

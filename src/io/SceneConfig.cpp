@@ -11,8 +11,10 @@
 namespace rubble {
 
 namespace {
-constexpr const char* kFieldNames[9] = {"model", "texture", "x", "y", "z", "sx", "sy", "sz", "mass"};
-constexpr const char* kOrdinals[9] = {"1st", "2nd", "3rd", "4th", "5th", "6th", "7th", "8th", "9th"};
+constexpr const char* kFieldNames[11] = {"model", "texture", "x",    "y",        "z",        "sx",
+                                         "sy",    "sz",      "mass", "material", "roughness"};
+constexpr const char* kOrdinals[11] = {"1st", "2nd", "3rd", "4th",  "5th", "6th",
+                                       "7th", "8th", "9th", "10th", "11th"};
 constexpr const char* kSkyboxNames[6] = {"top", "bottom", "left", "right", "front", "back"};
 
 std::string_view trim(std::string_view s) {
@@ -143,9 +145,10 @@ private:
     Status object(std::string_view line, std::size_t entity) {
         const auto f = splitFields(line);
         const char* role = entity == 1 ? "ground" : entity == 2 ? "vehicle" : "object";
-        if (f.size() != 9 && f.size() != 10)
-            return fail(std::string("expected 9 or 10 fields for the ") + role +
-                        " (model;texture;x;y;z;sx;sy;sz;mass[;material]), got " + std::to_string(f.size()));
+        if (f.size() < 9 || f.size() > 11)
+            return fail(std::string("expected 9 to 11 fields for the ") + role +
+                        " (model;texture;x;y;z;sx;sy;sz;mass[;material[;roughness]]), got " +
+                        std::to_string(f.size()));
         SceneObject o;
         o.line = line_;
         o.model = std::string(f[0]);
@@ -163,7 +166,15 @@ private:
                             "): scale must not be 0");
         if (o.mass < 0)
             return fail("field 'mass' (9th): mass must not be negative, got '" + shown(f[8]) + "'");
-        if (f.size() == 10) {
+        if (f.size() == 11) {
+            double amplitude = 0;
+            if (f[10] != "flat" && (!number(f[10], 10, amplitude) || amplitude < 0 || amplitude > 1))
+                return fail("field 'roughness' (11th): expected 'flat' or a number in [0, 1] (the amplitude "
+                            "relative to the cell size), got '" +
+                            shown(f[10]) + "'");
+            o.roughness = amplitude;
+        }
+        if (f.size() >= 10 && !(f.size() == 11 && f[9].empty())) {
             if (!findMaterial(f[9]))
                 return fail("field 'material' (10th): unknown material '" + shown(f[9]) +
                             "'; expected one of " + materialNames());

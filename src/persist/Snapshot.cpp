@@ -11,6 +11,8 @@
 
 #include "io/FileBytes.hpp"
 #include "persist/Bytes.hpp"
+#include "persist/RoughnessRecord.hpp"
+#include "rubble/fracture/Roughness.hpp"
 #include "rubble/persist/JournalFile.hpp"
 
 namespace rubble {
@@ -69,7 +71,7 @@ void checkFinite(ByteReader& r, const std::vector<Vec2>& v, std::size_t start, c
 }
 
 // 2: decomposition settings, each object's mesh hash, the volume ledger. 3: the structure (read: 2 and 3).
-constexpr std::uint16_t kVersion = 3;
+constexpr std::uint16_t kVersion = 4;
 constexpr std::uint16_t kOldestVersion = 2;
 
 void vec(ByteWriter& w, const Vec3& v) {
@@ -159,6 +161,7 @@ void writeObject(ByteWriter& w, const ObjectState& o) {
     w.f64(f.minPieceVolumeFraction);
     w.f64(f.uvScale);
     w.u8(f.simplifyPieces ? 1 : 0);
+    persist::writeRoughness(w, f.roughness);
     w.f64(o.mass.volume);
     vec(w, o.mass.centerOfMass);
     mat(w, o.mass.inertia);
@@ -194,7 +197,7 @@ void writeObject(ByteWriter& w, const ObjectState& o) {
     text(w, o.warning);
 }
 
-ObjectState readObject(ByteReader& r, const std::uint8_t* data) {
+ObjectState readObject(ByteReader& r, const std::uint8_t* data, std::uint16_t version) {
     ObjectState o;
     o.id = r.u32("id");
     o.version = r.u32("version");
@@ -228,6 +231,21 @@ ObjectState readObject(ByteReader& r, const std::uint8_t* data) {
     f.minPieceVolumeFraction = real(r, "fracture.minPieceVolumeFraction");
     f.uvScale = real(r, "fracture.uvScale");
     f.simplifyPieces = flag(r, "fracture.simplifyPieces");
+    if (version >= 4) { // version 3 and older cut flat
+        Roughness& rough = f.roughness;
+        pos = r.offset();
+        rough.amplitude = real(r, "fracture.roughness.amplitude");
+        rough.featureSize = real(r, "fracture.roughness.featureSize");
+        rough.hurst = real(r, "fracture.roughness.hurst");
+        rough.octaves = r.i32("fracture.roughness.octaves");
+        rough.relative = flag(r, "fracture.roughness.relative");
+        rough.seed = r.u64("fracture.roughness.seed");
+        rough.grainStretch = real(r, "fracture.roughness.grainStretch");
+        rough.grain = vec(r, "fracture.roughness.grain");
+        rough.maxTrianglesPerPiece = r.i32("fracture.roughness.maxTrianglesPerPiece");
+        if (Status valid = validateRoughness(rough); r.ok() && !valid)
+            r.fail(pos, "fracture.roughness", valid.message());
+    }
     o.mass.volume = real(r, "mass.volume");
     o.mass.centerOfMass = vec(r, "mass.centerOfMass");
     o.mass.inertia = mat(r, "mass.inertia");
@@ -545,7 +563,7 @@ Result<Snapshot> decodeSnapshot(const std::uint8_t* data, std::size_t size, cons
     s.world.objects.reserve(nObjects);
     for (std::uint32_t i = 0; i < nObjects && body.ok(); ++i) {
         body.setContext("objects[" + std::to_string(i) + "].");
-        s.world.objects.push_back(readObject(body, data));
+        s.world.objects.push_back(readObject(body, data, version));
     }
     body.setContext("");
     const std::uint32_t nPlacements = body.count("placements.count", 150);

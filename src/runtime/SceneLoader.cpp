@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <cmath>
 
+#include "rubble/fracture/Roughness.hpp"
 #include "rubble/geometry/MassProperties.hpp"
 #include "rubble/io/DecompositionFile.hpp"
 #include "rubble/io/MeshIO.hpp"
+#include "rubble/structure/Material.hpp"
 
 namespace rubble {
 namespace {
@@ -81,6 +83,20 @@ double boxVolume(const Aabb& a) {
     return s.x * s.y * s.z;
 }
 
+// The roughness of o's cuts: its roughness field over its material's preset, else the options'.
+Roughness objectRoughness(const SceneObject& o, const SceneLoadOptions& options) {
+    const Roughness& base = options.fracture.roughness;
+    if (!o.roughness && !options.materialRoughness)
+        return base;
+    const std::string material = o.material.empty() ? defaultMaterial().name : o.material;
+    Result<Roughness> chosen = chooseRoughness({material, o.roughness, {}, {}});
+    if (!chosen) // the parser checked the field and the material
+        return base;
+    chosen->seed = base.seed;
+    chosen->maxTrianglesPerPiece = base.maxTrianglesPerPiece;
+    return *chosen;
+}
+
 } // namespace
 
 LoadedScene loadScene(const SceneConfig& scene, DestructionRuntime& runtime,
@@ -142,6 +158,7 @@ LoadedScene loadScene(const SceneConfig& scene, DestructionRuntime& runtime,
         desc.impulseThreshold = options.impulseThreshold;
         desc.material = o.material;
         desc.fracture = options.fracture;
+        desc.fracture.roughness = objectRoughness(o, options);
         desc.mesh = std::move(mesh);
         desc.convexParts = std::move(model.parts);
         Result<ObjectId> id =

@@ -44,6 +44,18 @@ assert d["w2"]["fractures"] == r["fractures"]
 assert d["seed2"]["state_hash"] != r["state_hash"], "another seed, another world"
 PY
 
+# --rough: the scene flat then rough by material in one process; the rough world holds more triangles.
+"$bench" scene "$scene" --seconds 2 --unpaced --deterministic --workers 1 --rough --out "$tmp/rough" \
+    >"$tmp/rough.log" || fail "--rough: exit $?"
+python3 - "$tmp/rough/$(basename "$scene" .cfg)_rough.csv" <<'PY' || fail "--rough: $(cat "$tmp/rough.log")"
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+assert [r["cuts"] for r in rows] == ["flat", "rough"], rows
+flat, rough = rows
+assert int(flat["fractures"]) >= 1 and int(rough["fractures"]) >= 1, rows
+assert int(rough["world_triangles"]) > int(flat["world_triangles"]), rows
+PY
+
 # A scene file that does not exist: exit 2, and the message names it.
 if "$bench" scene "$tmp/missing.cfg" --seconds 1 --json >"$tmp/out" 2>"$tmp/err"; then
     fail "a missing scene file must fail"

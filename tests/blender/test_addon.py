@@ -4,7 +4,7 @@ blender -b --factory-startup --python tests/blender/test_addon.py
     Registers the add-on, fractures a subdivided cube and a closed Suzanne at the 3D cursor and checks: at least
     two pieces, summed bmesh volume = the input's to 1e-6 relative, the interior material on cut faces; an open
     Suzanne is refused with a report and left untouched; rigid bodies with convex hull shapes; the batch export
-    writes -convcolonly children; a `rubble fracture --depth 2 --format gltf` file imports with its collision
+    writes -convcolonly children; the Surface presets and Set roughness make rough cuts that keep the volume; a `rubble fracture --depth 2 --format gltf` file imports with its collision
     children.
 xvfb-run -a blender --factory-startup --python tests/blender/test_addon.py
     The same with a window (Blender's undo needs one: in -b, ed.undo's poll fails), plus undo restoring the
@@ -145,6 +145,37 @@ def test_cube_and_suzanne():
     check_fracture("Suzanne", monkey, (4.2, -0.5, 0.2), cells=5)
 
 
+def rough_cut_vertices(surface, set_roughness=False):
+    """Vertices of the pieces of a 2 m cube fractured with the panel's surface settings (volume checked)."""
+    reset_scene()
+    bpy.ops.mesh.primitive_cube_add(size=2.0)
+    cube = bpy.context.active_object
+    cube.name = "RoughBox"
+    bpy.context.scene.cursor.location = (0.7, 0.2, 0.1)
+    s = bpy.context.scene.rubble
+    s.material, s.set_roughness, s.roughness, s.hurst = surface, set_roughness, 0.15, 0.6
+    try:
+        assert fracture(cube, cells=4, seed=5) == {"FINISHED"}
+    finally:
+        s.material, s.set_roughness = "FLAT", False
+    pieces = [o for o in bpy.context.scene.objects if o.get("rubble_source") == "RoughBox"]
+    total = sum(world_volume(p) for p in pieces)
+    assert abs(total - 8.0) <= 1e-6 * 8.0, (surface, total)
+    return sum(len(p.data.vertices) for p in pieces)
+
+
+def test_surface_presets():
+    flat = rough_cut_vertices("FLAT")
+    concrete = rough_cut_vertices("concrete")
+    by_hand = rough_cut_vertices("FLAT", set_roughness=True)
+    steel = rough_cut_vertices("steel")
+    # Rough cut faces are tessellated and displaced: many more vertices than the flat cut's.
+    assert concrete > 3 * flat and by_hand > 3 * flat, (flat, concrete, by_hand)
+    assert steel == flat, (steel, flat)
+    print("surface: flat %d vertices, concrete %d, roughness 0.15 by hand %d, steel %d" % (flat, concrete,
+                                                                                         by_hand, steel))
+
+
 def test_rigid_bodies_and_export(tmp):
     reset_scene()
     bpy.ops.mesh.primitive_cube_add(size=2.0)
@@ -264,6 +295,7 @@ def run_all():
         with tempfile.TemporaryDirectory() as tmp:
             test_without_numpy()
             test_cube_and_suzanne()
+            test_surface_presets()
             test_rigid_bodies_and_export(tmp)
             test_import_depth2(tmp)
     except Exception:

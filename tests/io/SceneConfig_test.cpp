@@ -53,6 +53,32 @@ TEST(SceneConfig, OptionalMaterialField) {
     EXPECT_EQ(r->ground.material, "");
 }
 
+TEST(SceneConfig, OptionalRoughnessField) {
+    const std::string text = std::string(kSky) + kGround + kVehicle +
+                             "a.obj;;0;0;0;1;1;1;0;brick;0.2\nb.obj;;0;0;0;1;1;1;0;;flat\n"
+                             "c.obj;;0;0;0;1;1;1;0;wood\nd.obj;;0;0;0;1;1;1;0;stone; 0 ;\n";
+    const auto r = parseSceneConfigText(text, "world.cfg");
+    ASSERT_TRUE(r.isOk()) << r.error().message;
+    ASSERT_EQ(r->objects.size(), 4u);
+    EXPECT_EQ(r->objects[0].material, "brick");
+    EXPECT_EQ(r->objects[0].roughness, 0.2);
+    EXPECT_EQ(r->objects[1].material, "");
+    EXPECT_EQ(r->objects[1].roughness, 0.0);
+    EXPECT_FALSE(r->objects[2].roughness.has_value());
+    EXPECT_EQ(r->objects[3].roughness, 0.0);
+    const std::string head = std::string(kSky) + kGround + kVehicle;
+    const std::string expected =
+        "world.cfg:4: field 'roughness' (11th): expected 'flat' or a number in [0, 1] "
+        "(the amplitude relative to the cell size), got ";
+    EXPECT_EQ(errorOf(head + "a.obj;;0;0;0;1;1;1;0;brick;rough\n"), expected + "'rough'");
+    EXPECT_EQ(errorOf(head + "a.obj;;0;0;0;1;1;1;0;brick;1.5\n"), expected + "'1.5'");
+    EXPECT_EQ(errorOf(head + "a.obj;;0;0;0;1;1;1;0;brick;-0.1\n"), expected + "'-0.1'");
+    EXPECT_EQ(errorOf(head + "a.obj;;0;0;0;1;1;1;0;brick;nan\n"), expected + "'nan'");
+    EXPECT_EQ(errorOf(head + "a.obj;;0;0;0;1;1;1;0;bricks;0.1\n"),
+              "world.cfg:4: field 'material' (10th): unknown material 'bricks'; expected one of concrete, "
+              "brick, stone, wood, glass, steel");
+}
+
 TEST(SceneConfig, MissingFilesAreWarningsNotErrors) {
     const auto dir = test::tempDir("SceneConfig_missing");
     test::writeFile(dir / "building.obj", "v 0 0 0\n");
@@ -83,14 +109,12 @@ TEST(SceneConfig, MalformedLinesNameFileLineAndField) {
     const std::string head = std::string(kSky) + kGround + kVehicle;
     EXPECT_EQ(errorOf(head + "building.obj;;1;2;3;1;abc;1;5\n"),
               "world.cfg:4: field 'sy' (7th): expected a number, got 'abc'");
-    EXPECT_EQ(
-        errorOf(head + "building.obj;;1;2;3;1;1;1\n"),
-        "world.cfg:4: expected 9 or 10 fields for the object (model;texture;x;y;z;sx;sy;sz;mass[;material]), "
-        "got 8");
-    EXPECT_EQ(
-        errorOf(head + "building.obj;;1;2;3;1;1;1;5;wood;6\n"),
-        "world.cfg:4: expected 9 or 10 fields for the object (model;texture;x;y;z;sx;sy;sz;mass[;material]), "
-        "got 11");
+    EXPECT_EQ(errorOf(head + "building.obj;;1;2;3;1;1;1\n"),
+              "world.cfg:4: expected 9 to 11 fields for the object "
+              "(model;texture;x;y;z;sx;sy;sz;mass[;material[;roughness]]), got 8");
+    EXPECT_EQ(errorOf(head + "building.obj;;1;2;3;1;1;1;5;wood;0.1;6\n"),
+              "world.cfg:4: expected 9 to 11 fields for the object "
+              "(model;texture;x;y;z;sx;sy;sz;mass[;material[;roughness]]), got 12");
     EXPECT_EQ(
         errorOf(head + "building.obj;;1;2;3;1;1;1;5;6\n"),
         "world.cfg:4: field 'material' (10th): unknown material '6'; expected one of concrete, brick, stone, "
@@ -113,10 +137,9 @@ TEST(SceneConfig, MalformedLinesNameFileLineAndField) {
                                   "left, right, front, back), got 3 "
                                   "fields");
     EXPECT_EQ(errorOf("a;b;c;;e;f\n"), "world.cfg:1: skybox image 4 (right) is empty");
-    EXPECT_EQ(
-        errorOf(std::string(kSky) + "\n\n;grid.jpg;0;-15;0;1000;10\n"),
-        "world.cfg:4: expected 9 or 10 fields for the ground (model;texture;x;y;z;sx;sy;sz;mass[;material]), "
-        "got 7");
+    EXPECT_EQ(errorOf(std::string(kSky) + "\n\n;grid.jpg;0;-15;0;1000;10\n"),
+              "world.cfg:4: expected 9 to 11 fields for the ground "
+              "(model;texture;x;y;z;sx;sy;sz;mass[;material[;roughness]]), got 7");
     EXPECT_EQ(errorOf(""),
               "world.cfg: missing the skybox line (line 1); a scene file needs a skybox, a ground and a "
               "vehicle line");

@@ -4,11 +4,14 @@
 // bonds, and damaged structure records are refused naming offset and field, the runtime untouched.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <set>
 #include <tuple>
 
 #include "StructureRig.hpp"
 #include "persist/Bytes.hpp"
+#include "persist/RoughnessRecord.hpp"
 #include "rubble/persist/Snapshot.hpp"
 
 namespace rubble {
@@ -82,6 +85,13 @@ void expectSameNodes(const StructureState& x, const StructureState& y) {
     expectSame(x.nodes, y.nodes, [](const StructureNodeState& n) {
         return std::tuple{n.object, n.solid, n.material, n.root, n.anchor, n.pending};
     });
+}
+
+// The bytes of a flat roughness in a version-4 object record (versions 2 and 3 have none).
+std::vector<std::uint8_t> flatRoughnessBytes() {
+    persist::ByteWriter w;
+    persist::writeRoughness(w, Roughness{});
+    return w.data();
 }
 
 Snapshot decoded(const std::vector<std::uint8_t>& bytes) {
@@ -206,6 +216,10 @@ TEST(SnapshotStructure, AVersion2SnapshotLoadsWithFreshBonds) {
     const std::size_t at = structureAt(bytes, s.structure);
     bytes.erase(bytes.begin() + static_cast<std::ptrdiff_t>(at),
                 bytes.end() - static_cast<std::ptrdiff_t>(4 + 24));
+    const std::vector<std::uint8_t> flat = flatRoughnessBytes();
+    for (auto it = std::search(bytes.begin(), bytes.end(), flat.begin(), flat.end()); it != bytes.end();
+         it = std::search(it, bytes.end(), flat.begin(), flat.end()))
+        it = bytes.erase(it, it + static_cast<std::ptrdiff_t>(flat.size()));
     bytes[4] = 2;
     refix(bytes);
     Snapshot old = decoded(bytes);

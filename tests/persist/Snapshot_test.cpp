@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <future>
 #include <random>
@@ -19,6 +20,7 @@
 #include "JournalScene.hpp"
 #include "TestSupport.hpp"
 #include "persist/Bytes.hpp"
+#include "rubble/fracture/Roughness.hpp"
 #include "rubble/persist/JournalFile.hpp"
 #include "rubble/runtime/JournalPlayer.hpp"
 
@@ -79,6 +81,60 @@ TEST(Snapshot, KeepsTheShatterLayoutOfEveryObject) {
     ASSERT_EQ(decoded->world.objects.size(), 1u);
     EXPECT_EQ(decoded->world.objects[0].fracture.layout, ShatterLayout::Radial);
     EXPECT_EQ(decoded->world.objects[0].fracture.pattern, CellPattern::Shatter);
+}
+
+// Version 4 keeps each object's roughness (a rough world loaded, or joined over the network, cuts rough).
+TEST(Snapshot, KeepsTheRoughnessOfEveryObject) {
+    DestructionWorld world(kConfig);
+    ObjectDesc d;
+    d.mesh = makeBox({-1, -1, -1}, {1, 1, 1});
+    d.fracture.roughness = roughnessPreset("wood");
+    d.fracture.roughness.seed = 99;
+    d.fracture.roughness.grain = {0, 0, 1};
+    d.fracture.roughness.maxTrianglesPerPiece = 700;
+    ASSERT_TRUE(world.addObject(std::move(d)));
+    ObjectPlacement placement;
+    placement.object = world.objects().front();
+    const std::vector<std::uint8_t> bytes = encodeSnapshot(takeSnapshot(world, {placement}));
+    Result<Snapshot> decoded = decodeSnapshot(bytes.data(), bytes.size(), "rough.rsnap");
+    ASSERT_TRUE(decoded) << decoded.error().message;
+    const Roughness& r = decoded->world.objects.at(0).fracture.roughness;
+    const Roughness wood = roughnessPreset("wood");
+    EXPECT_EQ(r.amplitude, wood.amplitude);
+    EXPECT_EQ(r.featureSize, wood.featureSize);
+    EXPECT_EQ(r.hurst, wood.hurst);
+    EXPECT_EQ(r.octaves, wood.octaves);
+    EXPECT_EQ(r.relative, wood.relative);
+    EXPECT_EQ(r.grainStretch, wood.grainStretch);
+    EXPECT_EQ(r.seed, 99u);
+    EXPECT_EQ(r.grain, (Vec3{0, 0, 1}));
+    EXPECT_EQ(r.maxTrianglesPerPiece, 700);
+    // A roughness no fracture accepts is refused, naming the field.
+    std::vector<std::uint8_t> bad = bytes;
+    const std::size_t size = bad.size();
+    DestructionWorld other(kConfig);
+    ObjectDesc e;
+    e.mesh = makeBox({-1, -1, -1}, {1, 1, 1});
+    e.fracture.roughness = wood;
+    e.fracture.roughness.hurst = 0.123456789;
+    ASSERT_TRUE(other.addObject(std::move(e)));
+    placement.object = other.objects().front();
+    bad = encodeSnapshot(takeSnapshot(other, {placement}));
+    ASSERT_EQ(bad.size(), size);
+    const double hurst = 0.123456789;
+    std::uint8_t pattern[8];
+    std::memcpy(pattern, &hurst, 8);
+    const auto at = std::search(bad.begin(), bad.end(), pattern, pattern + 8);
+    ASSERT_NE(at, bad.end());
+    const double refused = 0;
+    std::memcpy(&*at, &refused, 8);
+    refix(bad);
+    Result<Snapshot> refusedSnapshot = decodeSnapshot(bad.data(), bad.size(), "rough.rsnap");
+    ASSERT_FALSE(refusedSnapshot);
+    EXPECT_NE(refusedSnapshot.error().message.find("fracture.roughness"), std::string::npos)
+        << refusedSnapshot.error().message;
+    EXPECT_NE(refusedSnapshot.error().message.find("hurst"), std::string::npos)
+        << refusedSnapshot.error().message;
 }
 
 TEST(Snapshot, RestoresARuntimeWithTheBodiesOfItsObjects) {
@@ -336,8 +392,8 @@ TEST(Snapshot, DamagedFilesAreRefusedNamingOffsetAndFieldAndTheWorldStaysAsItWas
     refused(b, "field crc32: checksum mismatch");
     // Another version, another format.
     b = bytes;
-    b[4] = 4;
-    refused(b, "offset 4, field version: version 4 is not supported");
+    b[4] = 5;
+    refused(b, "offset 4, field version: version 5 is not supported");
     b = bytes;
     b[0] = 'X';
     refused(b, "offset 0, field magic");
@@ -349,8 +405,9 @@ TEST(Snapshot, DamagedFilesAreRefusedNamingOffsetAndFieldAndTheWorldStaysAsItWas
     refix(b);
     refused(b, "offset " + std::to_string(objectsCount) + ", field objects.count: count");
     const std::size_t firstObject = objectsCount + 4;
-    const std::size_t meshAt = firstObject + 4 + 4 + 8 + 1 + 8 + 8 + 8 + 1 + 4 + 4 + 40 + 1 + 8 + 8 + 1 + 8 +
-                               24 + 72 + 24 + 72; // positions.count
+    const std::size_t roughness = 3 * 8 + 4 + 1 + 8 + 8 + 24 + 4;
+    const std::size_t meshAt = firstObject + 4 + 4 + 8 + 1 + 8 + 8 + 8 + 1 + 4 + 4 + 40 + 1 + 8 + 8 + 1 +
+                               roughness + 8 + 24 + 72 + 24 + 72; // positions.count
     const std::uint32_t nPos = m.snapshot.world.objects[0].mesh.positions.size();
     const std::size_t firstIndex = meshAt + 4 + 24 * nPos + 4;
     b = bytes;

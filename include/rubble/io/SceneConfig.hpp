@@ -5,13 +5,16 @@
 /// Line 1: six skybox images separated by ';' (top, bottom, left, right, front, back). Line 2: the ground,
 /// line 3: the vehicle, every further line an object, all as `model;texture;x;y;z;sx;sy;sz;mass` (mass 0 =
 /// static), optionally followed by `;material` (a preset of Material.hpp: concrete, brick, stone, wood,
-/// glass, steel; objects without one are concrete). Blank lines are ignored, '#' starts a comment that runs
+/// glass, steel; objects without one are concrete), optionally followed by `;roughness`: `flat` or the
+/// amplitude of rough cuts relative to the cell size (0 = flat; the material field may then be empty).
+/// Blank lines are ignored, '#' starts a comment that runs
 /// to the end of the line, CRLF line ends and a UTF-8 byte order mark are accepted, spaces around fields are
 /// trimmed, one trailing ';' is allowed.
 
 #include <array>
 #include <cstddef>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -34,6 +37,7 @@ struct RUBBLE_API SceneObject {
     Vec3 scale{1, 1, 1};               ///< sx;sy;sz
     double mass = 0;                   ///< mass; 0 means static
     std::string material;              ///< optional 10th field, a material preset name; empty when not given
+    std::optional<double> roughness;   ///< optional 11th field, relative amplitude of rough cuts (0 = flat)
 
     /// True when the object does not move (mass 0).
     bool isStatic() const { return mass == 0; }

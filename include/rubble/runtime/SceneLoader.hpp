@@ -16,10 +16,12 @@ namespace rubble {
 
 /// How scene objects are made.
 struct RUBBLE_API SceneLoadOptions {
-    bool loadVehicle = true;      ///< create the vehicle's body (headless scenes may skip it)
-    double staticDensity = 200;   ///< density (kg/m³) of static objects, used by their moving pieces
-    double impulseThreshold = 50; ///< ObjectDesc::impulseThreshold of every object
-    FractureParams fracture;      ///< ObjectDesc::fracture of every object
+    bool loadVehicle = true;        ///< create the vehicle's body (headless scenes may skip it)
+    double staticDensity = 200;     ///< density (kg/m³) of static objects, used by their moving pieces
+    double impulseThreshold = 50;   ///< ObjectDesc::impulseThreshold of every object
+    FractureParams fracture;        ///< ObjectDesc::fracture of every object
+    bool materialRoughness = false; ///< cuts of an object without a roughness field get its material's
+                                    ///< roughness preset (roughnessPreset) instead of fracture.roughness
     double maxOverlap = 0.5; ///< an object whose bounding box overlaps an earlier one's by more than this
                              ///< share of the smaller box, one of them moving, is not loaded (with a warning)
     std::function<void(Mesh&)>
@@ -40,9 +42,10 @@ struct RUBBLE_API LoadedScene {
 
 /// Loads a scene. The ground line gives a static box of full size (sx, sy, sz) centred at (x, y, z); the
 /// vehicle line a dynamic convex body; every object line readMesh(model) scaled by (sx, sy, sz) and placed at
-/// (x, y, z), mass 0 = static but destructible. A missing or unreadable model becomes a stand-in box (a cube
-/// of edge 1 scaled by (sx, sy, sz)) with a warning; a mesh that cannot be made valid stays intact and
-/// indestructible with one warning. Never fails on a parsed scene.
+/// (x, y, z), mass 0 = static but destructible. An object's roughness field sets the amplitude of its cuts
+/// over its material's preset (SceneObject::roughness; 0 = flat). A missing or unreadable model becomes a
+/// stand-in box (a cube of edge 1 scaled by (sx, sy, sz)) with a warning; a mesh that cannot be made valid
+/// stays intact and indestructible with one warning. Never fails on a parsed scene.
 RUBBLE_API LoadedScene loadScene(const SceneConfig& scene, DestructionRuntime& runtime,
                                  const SceneLoadOptions& options = {});
 

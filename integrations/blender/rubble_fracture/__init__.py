@@ -72,6 +72,26 @@ class RubbleSettings(bpy.types.PropertyGroup):
     seed: IntProperty(name="Seed", default=1, min=0, description="Same seed, same pieces")
     impulse: FloatProperty(name="Impulse", default=400.0, min=0.0, description="Impact impulse (N s): the "
                            "size of the cut region grows with it")
+    material: EnumProperty(
+        name="Surface",
+        items=[
+            ("FLAT", "Flat", "The thesis's flat Voronoi planes"),
+            ("concrete", "Concrete", "Rough, self-affine cut faces (Hurst 0.75)"),
+            ("stone", "Stone", "Rough, a little smoother than concrete (Hurst 0.8)"),
+            ("brick", "Brick", "Rough at the mortar scale (12 mm amplitude)"),
+            ("wood", "Wood", "Fibrous: wavelengths 6 times longer along the grain"),
+            ("glass", "Glass", "Nearly flat, shallow conchoidal undulation"),
+            ("steel", "Steel", "Flat"),
+        ],
+        default="FLAT",
+        description="Cut-surface preset of a material (docs/roughness.md)",
+    )
+    set_roughness: BoolProperty(name="Set roughness", default=False, description="Set the amplitude and "
+                                "Hurst exponent by hand, over the surface preset")
+    roughness: FloatProperty(name="Roughness", default=0.1, min=0.0, max=1.0, description="Amplitude of the "
+                             "cut faces relative to the cell size (0 = flat)")
+    hurst: FloatProperty(name="Hurst", default=0.75, min=0.05, max=1.0, description="Roughness exponent: "
+                         "higher is smoother at small scales")
     depth: IntProperty(name="Depth", default=1, min=1, max=3, description="Levels: each piece is shattered "
                        "again Depth-1 times (the leaves become objects)")
     rigid_body: BoolProperty(name="Rigid bodies", default=False, description="Give every piece a rigid body "
@@ -104,10 +124,23 @@ def _triangulated_world_mesh(obj, depsgraph):
     return verts, tris, mats, uvs
 
 
+def _surface(settings):
+    """The cut-surface keywords of rubble.fracture for the panel's settings."""
+    surface = {}
+    if settings.material != "FLAT":
+        surface["material"] = settings.material
+    if settings.set_roughness:
+        surface["roughness"] = settings.roughness
+        surface["hurst"] = settings.hurst
+    return surface
+
+
 def _fracture_levels(rubble, mesh, settings, point):
     """Pieces of mesh at point, and with depth > 1 every piece shattered again around its centre of mass."""
     cells = settings.cells if settings.pattern == "SHATTER" else 1
-    pieces = rubble.fracture(mesh, point=point, impulse=settings.impulse, cells=cells, seed=settings.seed)
+    surface = _surface(settings)
+    pieces = rubble.fracture(mesh, point=point, impulse=settings.impulse, cells=cells, seed=settings.seed,
+                             **surface)
     for level in range(2, settings.depth + 1):
         deeper = []
         for i, piece in enumerate(pieces):
@@ -117,7 +150,8 @@ def _fracture_levels(rubble, mesh, settings, point):
             impulse = max(0.0, (size - 0.5) / 0.05) ** 2 + 1.0
             try:
                 sub = rubble.fracture(piece, point=piece.center_of_mass, impulse=impulse,
-                                      cells=max(2, settings.cells), seed=settings.seed * 7919 + i + level)
+                                      cells=max(2, settings.cells), seed=settings.seed * 7919 + i + level,
+                                      **surface)
             except rubble.Error:
                 sub = [piece]  # kept whole on this level
             deeper.extend(sub)
@@ -292,6 +326,12 @@ class RUBBLE_PT_panel(bpy.types.Panel):
         row.prop(settings, "cells")
         col.prop(settings, "seed")
         col.prop(settings, "impulse")
+        col.prop(settings, "material")
+        col.prop(settings, "set_roughness")
+        row = col.row()
+        row.enabled = settings.set_roughness
+        row.prop(settings, "roughness")
+        row.prop(settings, "hurst")
         col.prop(settings, "depth")
         col.prop(settings, "rigid_body")
         col.operator(RUBBLE_OT_fracture_at_cursor.bl_idname, icon="MOD_EXPLODE")
