@@ -17,6 +17,7 @@
 #include "Math.hpp"
 #include "ParticleSystem.hpp"
 #include "Renderer.hpp"
+#include "Sound.hpp"
 #include "Weapons.hpp"
 #include "rubble/DestructionRuntime.hpp"
 #include "rubble/Fracture.hpp"
@@ -83,6 +84,7 @@ struct GameCounters {
     int turnBacks = 0;                               ///< times the world bounds started turning the jet back
     std::array<int, kWeaponCount> weaponShots{};     ///< shots fired, by weapon
     std::array<int, kWeaponCount> weaponFractures{}; ///< fractures adopted whose impact came from the weapon
+    std::array<int, kSoundKinds> sounds{};           ///< sounds made, by SoundKind
 };
 
 /// The game world.
@@ -146,6 +148,8 @@ public:
         showcaseEye_ = eye;
         showcaseAt_ = target;
     }
+    /// Sounds (impacts, breaks, debris hitting the ground) made since the last call.
+    std::vector<SoundEvent> takeSounds();
     /// Latencies (impact → adopted, ms) of results adopted since the last call.
     std::vector<double> takeNewLatencies();
     /// All adopted latencies so far (ms).
@@ -194,9 +198,10 @@ private:
     };
     /// Texture and tint an object passes on to its pieces.
     struct Look {
-        int texture = 0;   ///< renderer texture
-        V3 tint{1, 1, 1};  ///< colour multiplier
-        int interior = -1; ///< cut faces' texture, by the object's material (-1: the default)
+        int texture = 0;               ///< renderer texture
+        V3 tint{1, 1, 1};              ///< colour multiplier
+        int interior = -1;             ///< cut faces' texture, by the object's material (-1: the default)
+        Timbre timbre = Timbre::Stone; ///< how the object's material sounds
     };
     void fire();
     void journaled(const rubble::JournalEvent& e);
@@ -207,6 +212,8 @@ private:
     void controlVehicle(const ControlInput& input, float dt);
     void checkCrash();
     void emitEffects(long long impactsBefore, long long retiredBefore);
+    void listenForDebris();
+    void sound(const SoundEvent& e);
     void updateCounters();
 
     GameSettings settings_;
@@ -252,6 +259,8 @@ private:
     int blastBy_ = -1;                                 // weapon whose blast is submitting impacts
     std::size_t nextTarget_ = 0;                       // --demolish: the target blasted next
     std::map<rubble::ObjectId, int> hitBy_;            // object -> weapon whose impact will fracture it
+    std::vector<SoundEvent> sounds_;                   // made since the last takeSounds()
+    std::unordered_map<rubble::BodyId, std::uint64_t> lastKnock_; // body -> frame it last hit the ground
 };
 
 } // namespace demo

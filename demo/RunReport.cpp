@@ -85,6 +85,18 @@ bool RunReport::write(const std::filesystem::path& dir, const std::string& scene
         j["weapons"][weaponSpec(static_cast<Weapon>(w)).name] = {
             {"shots", last.weaponShots[static_cast<std::size_t>(w)]},
             {"fractures", last.weaponFractures[static_cast<std::size_t>(w)]}};
+    j["audio"] = {{"device", audioDevice_},
+                  {"impacts", last.sounds[static_cast<std::size_t>(SoundKind::Impact)]},
+                  {"breaks", last.sounds[static_cast<std::size_t>(SoundKind::Break)]},
+                  {"debris", last.sounds[static_cast<std::size_t>(SoundKind::Debris)]},
+                  {"events", audio_.events},
+                  {"played", audio_.played},
+                  {"quiet", audio_.quiet},
+                  {"stolen", audio_.stolen},
+                  {"refused", audio_.refused},
+                  {"max_voices", maxVoices_},
+                  {"peak_voices", audio_.peakVoices},
+                  {"peak_level", audio_.peakLevel}};
     j["screenshots"] = screenshots;
     j["fracture_runtime"] = Game::fractureAvailable();
     std::ofstream js(dir / "report.json");

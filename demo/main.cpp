@@ -21,6 +21,7 @@
 
 #include <sys/resource.h>
 
+#include "Audio.hpp"
 #include "Autopilot.hpp"
 #include "DynamicResolution.hpp"
 #include "Game.hpp"
@@ -87,7 +88,12 @@ struct Options {
     bool json = false;             // the render bench prints JSON
     int rasterNice = 0;            // niceness of llvmpipe's rasteriser threads (0: unchanged)
     double demolish = 0;           // seconds between demolition charges on standing targets (0: none)
+    bool mute = false;             // no sound
+    std::string audioWav;          // the run's sound captured to this WAV file (no device)
 };
+
+/// Sounds at once, at most.
+constexpr int kVoices = 24;
 
 struct App {
     Options opt;
@@ -308,6 +314,9 @@ int main(int argc, char** argv) {
            "every SECONDS of game time a demolition charge blasts the next standing object or large "
            "piece until nothing stands (with --showcase and demolition_block.cfg: the block comes down)")
         ->check(CLI::Range(0.05, 60.0));
+    cli.add_flag("--mute", o.mute, "no sound (headless runs have none: no audio device is opened)");
+    cli.add_option("--audio-wav", o.audioWav,
+                   "FILE: the run's sound, mixed in step with game time, written as a WAV file (no device)");
     cli.add_option("--camera", o.camera, "EX,EY,EZ,TX,TY,TZ: a fixed camera at EX,EY,EZ looking at TX,TY,TZ");
     cli.add_flag("--bilinear", o.bilinear, "software quality: bilinear textures instead of nearest texels");
     cli.add_option("--record", o.record,
@@ -554,6 +563,7 @@ int main(int argc, char** argv) {
                  rendererName.c_str(), app.quality.name(), app.pending.shadows ? "on" : "off",
                  app.quality.pixelLighting ? "per-pixel" : "per-vertex", app.quality.minScale, reniced,
                  o.rasterNice);
+    demo::Audio audio({!headless, o.mute, o.audioWav, kVoices}); // silently no device when none opens
     demo::DynamicResolution resolution(1000.0f / o.targetFps, app.quality.minScale);
     float lastFrameMs = 0;
 
@@ -617,6 +627,12 @@ int main(int argc, char** argv) {
         if (!app.paused || autopilot)
             app.game.adoptReady();
         const double stepMs = std::chrono::duration<double, std::milli>(Clock::now() - stepStart).count();
+        { // Sound: heard from the camera, the capture in step with game time.
+            const demo::M4 view = app.game.camera().view();
+            audio.setListener(app.game.camera().eye, demo::V3{view.m[0], view.m[4], view.m[8]});
+            audio.play(app.game.takeSounds());
+            audio.advance(autopilot ? fixedDt : (app.paused ? 0.0 : std::min(realDt, 0.1)));
+        }
 
         // Scene.
         const int w = app.gl->width(), h = app.gl->height();
@@ -738,6 +754,11 @@ int main(int argc, char** argv) {
             break;
     }
 
+    if (std::string message; !audio.finish(message)) {
+        std::fprintf(stderr, "error: %s\n", message.c_str());
+        return 1;
+    }
+    report.setAudio(audio.stats(), kVoices, audio.hasDevice());
     if (!o.out.empty()) {
         std::string summary;
         const auto outDir = std::filesystem::path(o.out);
