@@ -716,6 +716,9 @@ void Game::updateCounters() {
     counters_.fractures = static_cast<int>(c.fractures);
     counters_.piecesCreated = static_cast<int>(c.piecesCreated);
     counters_.retired = static_cast<int>(c.piecesRetired);
+    counters_.retiredBy = {static_cast<int>(c.retired.dust), static_cast<int>(c.retired.awake),
+                           static_cast<int>(c.retired.triangles), static_cast<int>(c.retired.faded),
+                           static_cast<int>(c.retired.fellOut)};
     counters_.collapsed = static_cast<int>(c.piecesCollapsed);
     counters_.bondsBroken = static_cast<int>(c.bondsBroken);
     counters_.bodies = static_cast<int>(runtime_->bodyCount());

@@ -64,24 +64,25 @@ struct GameSettings {
 
 /// Counters shown in the panel and printed by --stats.
 struct GameCounters {
-    std::uint64_t frame = 0;                         ///< simulation frames (frozen while paused)
-    int shots = 0;                                   ///< projectiles fired
-    int impacts = 0;                                 ///< projectile hits (on objects or the ground)
-    int submitted = 0;                               ///< impacts accepted by the DestructionWorld
-    int fractures = 0;                               ///< fracture results adopted
-    int piecesCreated = 0;                           ///< piece bodies created
-    int retired = 0;                                 ///< pieces turned into particles
-    int collapsed = 0;                               ///< static bodies that lost their support and fell
-    int bondsBroken = 0;                             ///< structure bonds broken (stress solver on)
-    int bodies = 0;                                  ///< rigid bodies in the physics world
-    int pieces = 0;                                  ///< live piece bodies
-    int awake = 0;                                   ///< dynamic debris bodies (pieces and objects)
-    int frozen = 0;                                  ///< debris bodies frozen at rest
-    int jobs = 0;                                    ///< fracture jobs queued or running
-    int warnings = 0;                                ///< scene warnings
-    int crashes = 0;                                 ///< the jet hit the ground or an object
-    int respawns = 0;                                ///< the jet came back (2 s after a crash, or R)
-    int turnBacks = 0;                               ///< times the world bounds started turning the jet back
+    std::uint64_t frame = 0;        ///< simulation frames (frozen while paused)
+    int shots = 0;                  ///< projectiles fired
+    int impacts = 0;                ///< projectile hits (on objects or the ground)
+    int submitted = 0;              ///< impacts accepted by the DestructionWorld
+    int fractures = 0;              ///< fracture results adopted
+    int piecesCreated = 0;          ///< piece bodies created
+    int retired = 0;                ///< pieces turned into particles
+    std::array<int, 5> retiredBy{}; ///< the same by reason: dust, awake budget, triangles, faded, fell out
+    int collapsed = 0;              ///< static bodies that lost their support and fell
+    int bondsBroken = 0;            ///< structure bonds broken (stress solver on)
+    int bodies = 0;                 ///< rigid bodies in the physics world
+    int pieces = 0;                 ///< live piece bodies
+    int awake = 0;                  ///< dynamic debris bodies (pieces and objects)
+    int frozen = 0;                 ///< debris bodies frozen at rest
+    int jobs = 0;                   ///< fracture jobs queued or running
+    int warnings = 0;               ///< scene warnings
+    int crashes = 0;                ///< the jet hit the ground or an object
+    int respawns = 0;               ///< the jet came back (2 s after a crash, or R)
+    int turnBacks = 0;              ///< times the world bounds started turning the jet back
     std::array<int, kWeaponCount> weaponShots{};     ///< shots fired, by weapon
     std::array<int, kWeaponCount> weaponFractures{}; ///< fractures adopted whose impact came from the weapon
     std::array<int, kSoundKinds> sounds{};           ///< sounds made, by SoundKind

@@ -75,6 +75,11 @@ bool RunReport::write(const std::filesystem::path& dir, const std::string& scene
     j["pieces_awake"] = last.awake;
     j["pieces_frozen"] = last.frozen;
     j["pieces_retired_to_particles"] = last.retired;
+    j["pieces_retired_by"] = {{"dust", last.retiredBy[0]},
+                              {"awake", last.retiredBy[1]},
+                              {"triangles", last.retiredBy[2]},
+                              {"faded", last.retiredBy[3]},
+                              {"fell_out", last.retiredBy[4]}};
     j["bodies_collapsed"] = last.collapsed;
     j["bonds_broken"] = last.bondsBroken;
     j["latency_ms"] = {{"count", latencies.size()},
