@@ -120,6 +120,8 @@ void Game::clear(Renderer& renderer) {
     landed_.clear();
     stepImpacts_.clear();
     hitBy_.clear();
+    sounds_.clear();
+    lastKnock_.clear();
     blastBy_ = -1;
 }
 
@@ -162,6 +164,7 @@ bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const Game
                     {shell->second.weapon, toV3(runtime_->motion(b.id).transform.translation), true});
             shells_.erase(shell);
         }
+        lastKnock_.erase(b.id);
         auto it = visuals_.find(b.id);
         if (it == visuals_.end())
             return;
@@ -270,6 +273,7 @@ bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const Game
                                       : renderer.proceduralTexture("concrete");
         if (!o.material.empty()) // cut faces show the material's grain
             look.interior = renderer.materialInterior(o.material);
+        look.timbre = timbreOf(o.material);
         looks_[id] = look;
         addVisual(body->id, st->mesh, look, 0, renderer);
     }
@@ -312,6 +316,74 @@ void Game::onAdopted(const rubble::FractureOutcome& o, Renderer& renderer) {
         rb->setDamping(0.05f, 0.2f);
         looks_[piece.id] = look;
         addVisual(b->id, piece.state->mesh, look, 1.0f, renderer);
+    }
+    // one break sound at the pieces' centre, as loud as the impacts that caused it, as low as it is big
+    SoundEvent e{SoundKind::Break, look.timbre};
+    double volume = 0;
+    V3 centre{};
+    int counted = 0;
+    for (const rubble::AdoptedPiece& piece : o.pieces)
+        if (const BodyRecord* b = runtime_->bodyOf(piece.id)) {
+            volume += b->volume;
+            centre += toV3(binding_->rigid(b->id)->getCenterOfMassPosition());
+            ++counted;
+        }
+    for (const rubble::Impact& i : o.impacts)
+        e.impulse += static_cast<float>(i.impulse);
+    if (counted > 0) {
+        e.position = centre * (1.0f / static_cast<float>(counted));
+        e.size = static_cast<float>(std::cbrt(volume));
+        sound(e);
+    }
+}
+
+void Game::sound(const SoundEvent& e) {
+    sounds_.push_back(e);
+    ++counters_.sounds[static_cast<std::size_t>(e.kind)];
+}
+
+std::vector<SoundEvent> Game::takeSounds() {
+    std::vector<SoundEvent> out;
+    out.swap(sounds_);
+    return out;
+}
+
+void Game::listenForDebris() {
+    // A body that meets the ground with a velocity change over 1.5 m/s knocks (at most every 0.25 s).
+    constexpr float kKnockDeltaV = 1.5f;
+    constexpr std::uint64_t kKnockFrames = 15;
+    if (!groundBody_)
+        return;
+    const btCollisionObject* ground = binding_->rigid(groundBody_);
+    btDispatcher* dispatcher = physics_->world().getDispatcher();
+    for (int i = 0, n = dispatcher->getNumManifolds(); i < n; ++i) {
+        const btPersistentManifold* m = dispatcher->getManifoldByIndexInternal(i);
+        const btCollisionObject* other = m->getBody0() == ground   ? m->getBody1()
+                                         : m->getBody1() == ground ? m->getBody0()
+                                                                   : nullptr;
+        if (!other || m->getNumContacts() == 0)
+            continue;
+        const auto id = static_cast<BodyId>(other->getUserIndex());
+        const BodyRecord* b = runtime_->body(id);
+        if (!b || b->mass <= 0 || (b->role != BodyRole::Piece && b->role != BodyRole::Object))
+            continue;
+        float impulse = 0;
+        for (int k = 0; k < m->getNumContacts(); ++k)
+            impulse += m->getContactPoint(k).getAppliedImpulse();
+        if (impulse < kKnockDeltaV * static_cast<float>(b->mass))
+            continue;
+        auto [last, fresh] = lastKnock_.try_emplace(id, counters_.frame);
+        if (!fresh && counters_.frame - last->second < kKnockFrames)
+            continue;
+        last->second = counters_.frame;
+        SoundEvent e{SoundKind::Debris, Timbre::Stone};
+        if (b->hasObject)
+            if (auto look = looks_.find(b->object); look != looks_.end())
+                e.timbre = look->second.timbre;
+        e.position = toV3(m->getContactPoint(0).getPositionWorldOnB());
+        e.impulse = impulse;
+        e.size = static_cast<float>(std::cbrt(b->volume));
+        sound(e);
     }
 }
 
@@ -498,6 +570,17 @@ void Game::journaled(const rubble::JournalEvent& e) {
         net_->journaled(e);
     if (e.kind != rubble::JournalEventKind::Impact)
         return;
+    if (const BodyRecord* b = runtime_->bodyOf(e.object)) { // an impact sounds where it hit
+        const btTransform objectToWorld =
+            binding_->rigid(b->id)->getWorldTransform() * rubble::bullet::toBt(b->objectToBody).inverse();
+        SoundEvent s{SoundKind::Impact, Timbre::Stone};
+        if (auto look = looks_.find(e.object); look != looks_.end())
+            s.timbre = look->second.timbre;
+        s.position = toV3(objectToWorld * btVector3(e.point[0], e.point[1], e.point[2]));
+        s.impulse = e.impulse;
+        s.size = static_cast<float>(std::cbrt(b->volume));
+        sound(s);
+    }
     if (blastBy_ >= 0)
         hitBy_[e.object] = blastBy_;
     else
@@ -585,6 +668,7 @@ void Game::step(const ControlInput& input, float dt, Renderer& renderer) {
     creditHits();
     checkCrash();
     emitEffects(impactsBefore, retiredBefore);
+    listenForDebris();
     if (net_) { // clients follow by journal events and placements (10 Hz)
         net_->publish();
         if (counters_.frame % 6 == 0)
@@ -628,6 +712,9 @@ void Game::updateCounters() {
     counters_.fractures = static_cast<int>(c.fractures);
     counters_.piecesCreated = static_cast<int>(c.piecesCreated);
     counters_.retired = static_cast<int>(c.piecesRetired);
+    counters_.retiredBy = {static_cast<int>(c.retired.dust), static_cast<int>(c.retired.awake),
+                           static_cast<int>(c.retired.triangles), static_cast<int>(c.retired.faded),
+                           static_cast<int>(c.retired.fellOut)};
     counters_.collapsed = static_cast<int>(c.piecesCollapsed);
     counters_.bondsBroken = static_cast<int>(c.bondsBroken);
     counters_.bodies = static_cast<int>(runtime_->bodyCount());

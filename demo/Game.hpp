@@ -17,6 +17,7 @@
 #include "Math.hpp"
 #include "ParticleSystem.hpp"
 #include "Renderer.hpp"
+#include "Sound.hpp"
 #include "Weapons.hpp"
 #include "rubble/bullet/BulletBinding.hpp"
 #include "rubble/bullet/PhysicsWorld.hpp"
@@ -62,26 +63,28 @@ struct GameSettings {
 
 /// Counters shown in the panel and printed by --stats.
 struct GameCounters {
-    std::uint64_t frame = 0;                         ///< simulation frames (frozen while paused)
-    int shots = 0;                                   ///< projectiles fired
-    int impacts = 0;                                 ///< projectile hits (on objects or the ground)
-    int submitted = 0;                               ///< impacts accepted by the DestructionWorld
-    int fractures = 0;                               ///< fracture results adopted
-    int piecesCreated = 0;                           ///< piece bodies created
-    int retired = 0;                                 ///< pieces turned into particles
-    int collapsed = 0;                               ///< static bodies that lost their support and fell
-    int bondsBroken = 0;                             ///< structure bonds broken (stress solver on)
-    int bodies = 0;                                  ///< rigid bodies in the physics world
-    int pieces = 0;                                  ///< live piece bodies
-    int awake = 0;                                   ///< dynamic debris bodies (pieces and objects)
-    int frozen = 0;                                  ///< debris bodies frozen at rest
-    int jobs = 0;                                    ///< fracture jobs queued or running
-    int warnings = 0;                                ///< scene warnings
-    int crashes = 0;                                 ///< the jet hit the ground or an object
-    int respawns = 0;                                ///< the jet came back (2 s after a crash, or R)
-    int turnBacks = 0;                               ///< times the world bounds started turning the jet back
+    std::uint64_t frame = 0;        ///< simulation frames (frozen while paused)
+    int shots = 0;                  ///< projectiles fired
+    int impacts = 0;                ///< projectile hits (on objects or the ground)
+    int submitted = 0;              ///< impacts accepted by the DestructionWorld
+    int fractures = 0;              ///< fracture results adopted
+    int piecesCreated = 0;          ///< piece bodies created
+    int retired = 0;                ///< pieces turned into particles
+    std::array<int, 5> retiredBy{}; ///< the same by reason: dust, awake budget, triangles, faded, fell out
+    int collapsed = 0;              ///< static bodies that lost their support and fell
+    int bondsBroken = 0;            ///< structure bonds broken (stress solver on)
+    int bodies = 0;                 ///< rigid bodies in the physics world
+    int pieces = 0;                 ///< live piece bodies
+    int awake = 0;                  ///< dynamic debris bodies (pieces and objects)
+    int frozen = 0;                 ///< debris bodies frozen at rest
+    int jobs = 0;                   ///< fracture jobs queued or running
+    int warnings = 0;               ///< scene warnings
+    int crashes = 0;                ///< the jet hit the ground or an object
+    int respawns = 0;               ///< the jet came back (2 s after a crash, or R)
+    int turnBacks = 0;              ///< times the world bounds started turning the jet back
     std::array<int, kWeaponCount> weaponShots{};     ///< shots fired, by weapon
     std::array<int, kWeaponCount> weaponFractures{}; ///< fractures adopted whose impact came from the weapon
+    std::array<int, kSoundKinds> sounds{};           ///< sounds made, by SoundKind
 };
 
 /// The game world.
@@ -145,6 +148,8 @@ public:
         showcaseEye_ = eye;
         showcaseAt_ = target;
     }
+    /// Sounds (impacts, breaks, debris hitting the ground) made since the last call.
+    std::vector<SoundEvent> takeSounds();
     /// Latencies (impact → adopted, ms) of results adopted since the last call.
     std::vector<double> takeNewLatencies();
     /// All adopted latencies so far (ms).
@@ -193,9 +198,10 @@ private:
     };
     /// Texture and tint an object passes on to its pieces.
     struct Look {
-        int texture = 0;   ///< renderer texture
-        V3 tint{1, 1, 1};  ///< colour multiplier
-        int interior = -1; ///< cut faces' texture, by the object's material (-1: the default)
+        int texture = 0;               ///< renderer texture
+        V3 tint{1, 1, 1};              ///< colour multiplier
+        int interior = -1;             ///< cut faces' texture, by the object's material (-1: the default)
+        Timbre timbre = Timbre::Stone; ///< how the object's material sounds
     };
     void fire();
     void journaled(const rubble::JournalEvent& e);
@@ -206,6 +212,8 @@ private:
     void controlVehicle(const ControlInput& input, float dt);
     void checkCrash();
     void emitEffects(long long impactsBefore, long long retiredBefore);
+    void listenForDebris();
+    void sound(const SoundEvent& e);
     void updateCounters();
 
     GameSettings settings_;
@@ -251,6 +259,8 @@ private:
     int blastBy_ = -1;                                 // weapon whose blast is submitting impacts
     std::size_t nextTarget_ = 0;                       // --demolish: the target blasted next
     std::map<rubble::ObjectId, int> hitBy_;            // object -> weapon whose impact will fracture it
+    std::vector<SoundEvent> sounds_;                   // made since the last takeSounds()
+    std::unordered_map<rubble::BodyId, std::uint64_t> lastKnock_; // body -> frame it last hit the ground
 };
 
 } // namespace demo

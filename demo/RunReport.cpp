@@ -75,6 +75,11 @@ bool RunReport::write(const std::filesystem::path& dir, const std::string& scene
     j["pieces_awake"] = last.awake;
     j["pieces_frozen"] = last.frozen;
     j["pieces_retired_to_particles"] = last.retired;
+    j["pieces_retired_by"] = {{"dust", last.retiredBy[0]},
+                              {"awake", last.retiredBy[1]},
+                              {"triangles", last.retiredBy[2]},
+                              {"faded", last.retiredBy[3]},
+                              {"fell_out", last.retiredBy[4]}};
     j["bodies_collapsed"] = last.collapsed;
     j["bonds_broken"] = last.bondsBroken;
     j["latency_ms"] = {{"count", latencies.size()},
@@ -85,6 +90,18 @@ bool RunReport::write(const std::filesystem::path& dir, const std::string& scene
         j["weapons"][weaponSpec(static_cast<Weapon>(w)).name] = {
             {"shots", last.weaponShots[static_cast<std::size_t>(w)]},
             {"fractures", last.weaponFractures[static_cast<std::size_t>(w)]}};
+    j["audio"] = {{"device", audioDevice_},
+                  {"impacts", last.sounds[static_cast<std::size_t>(SoundKind::Impact)]},
+                  {"breaks", last.sounds[static_cast<std::size_t>(SoundKind::Break)]},
+                  {"debris", last.sounds[static_cast<std::size_t>(SoundKind::Debris)]},
+                  {"events", audio_.events},
+                  {"played", audio_.played},
+                  {"quiet", audio_.quiet},
+                  {"stolen", audio_.stolen},
+                  {"refused", audio_.refused},
+                  {"max_voices", maxVoices_},
+                  {"peak_voices", audio_.peakVoices},
+                  {"peak_level", audio_.peakLevel}};
     j["screenshots"] = screenshots;
     j["fracture_runtime"] = Game::fractureAvailable();
     std::ofstream js(dir / "report.json");

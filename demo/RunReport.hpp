@@ -35,6 +35,12 @@ public:
     };
     /// Adds a frame.
     void add(const Frame& f) { frames_.push_back(f); }
+    /// The audio mixer's totals at the end of the run, and whether they reached a device.
+    void setAudio(const MixerStats& stats, int maxVoices, bool device) {
+        audio_ = stats;
+        maxVoices_ = maxVoices;
+        audioDevice_ = device;
+    }
     /// Number of frames recorded.
     std::size_t size() const { return frames_.size(); }
     /// Writes frames.csv and report.json into dir; latencies are impact → adopted in ms.
@@ -43,6 +49,9 @@ public:
 
 private:
     std::vector<Frame> frames_;
+    MixerStats audio_;
+    int maxVoices_ = 0;
+    bool audioDevice_ = false;
 };
 
 /// Writes tightly packed RGB rows (top first) as PNG.

@@ -21,6 +21,7 @@
 
 #include <sys/resource.h>
 
+#include "Audio.hpp"
 #include "Autopilot.hpp"
 #include "DynamicResolution.hpp"
 #include "Game.hpp"
@@ -88,7 +89,14 @@ struct Options {
     bool json = false;             // the render bench prints JSON
     int rasterNice = 0;            // niceness of llvmpipe's rasteriser threads (0: unchanged)
     double demolish = 0;           // seconds between demolition charges on standing targets (0: none)
+    int maxAwake = 0;              // awake debris budget (0: the game's default)
+    bool mute = false;             // no sound
+    std::string audioWav;          // the run's sound captured to this WAV file (no device)
+    bool structureFlag = false;    // --structure given (its bonds are drawn)
 };
+
+/// Sounds at once, at most.
+constexpr int kVoices = 24;
 
 struct App {
     Options opt;
@@ -264,12 +272,16 @@ bool parseNumbers(const std::string& text, std::size_t n, float* out) {
     return true;
 }
 
-} // namespace
+/// How this run draws: decided by setUp from the options and the display.
+struct RunMode {
+    bool headless = false;    // EGL offscreen
+    bool autopilot = false;   // --autopilot
+    std::string rendererName; // GL_RENDERER
+    int reniced = 0;          // llvmpipe threads reniced
+};
 
-int main(int argc, char** argv) {
-    App app;
-    gApp = &app;
-    Options& o = app.opt;
+/// Parses the command line into o: -1 to go on, else the exit code (--help, a bad option).
+int parseOptions(int argc, char** argv, Options& o) {
     CLI::App cli{"rubble-demo: fly a vehicle through a world.cfg scene and shoot destructible objects.\n"
                  "Keys: W/S pitch, A/D roll, Q/E yaw, Z/X speed, Space fire/unpause, P pause, Esc quit,\n"
                  "F1 panel, F2 screenshot, F3 debug overlay, F5/F9 quick save/load, H key help."};
@@ -309,6 +321,14 @@ int main(int argc, char** argv) {
            "every SECONDS of game time a demolition charge blasts the next standing object or large "
            "piece until nothing stands (with --showcase and demolition_block.cfg: the block comes down)")
         ->check(CLI::Range(0.05, 60.0));
+    cli.add_option(
+           "--max-awake", o.maxAwake,
+           "awake debris budget: beyond it settled pieces freeze, then the smallest moving ones retire "
+           "to particles (default 400)")
+        ->check(CLI::Range(50, 20000));
+    cli.add_flag("--mute", o.mute, "no sound (headless runs have none: no audio device is opened)");
+    cli.add_option("--audio-wav", o.audioWav,
+                   "FILE: the run's sound, mixed in step with game time, written as a WAV file (no device)");
     cli.add_option("--camera", o.camera, "EX,EY,EZ,TX,TY,TZ: a fixed camera at EX,EY,EZ looking at TX,TY,TZ");
     cli.add_flag("--bilinear", o.bilinear, "software quality: bilinear textures instead of nearest texels");
     cli.add_option("--record", o.record,
@@ -365,21 +385,31 @@ int main(int argc, char** argv) {
            "before them (on a machine shared with other work they also lose to it; docs/rendering.md)")
         ->check(CLI::Range(0, 19));
     CLI11_PARSE(cli, argc, argv);
-    if (!o.renderBench.empty()) {
-        demo::RenderBenchOptions b;
-        std::string message;
-        if (!demo::parsePieceCounts(o.renderBench, b.pieces, message)) {
-            std::fprintf(stderr, "error: %s\n", message.c_str());
-            return 2;
-        }
-        b.width = o.width;
-        b.height = o.height;
-        b.frames = o.benchFrames;
-        b.json = o.json;
-        b.quality = o.quality;
-        b.out = o.out;
-        return demo::runRenderBench(b);
+    o.structureFlag = cli.count("--structure") > 0;
+    return -1;
+}
+
+/// --render-bench: the renderer alone on fields of resting pieces.
+int renderBench(const Options& o) {
+    demo::RenderBenchOptions b;
+    std::string message;
+    if (!demo::parsePieceCounts(o.renderBench, b.pieces, message)) {
+        std::fprintf(stderr, "error: %s\n", message.c_str());
+        return 2;
     }
+    b.width = o.width;
+    b.height = o.height;
+    b.frames = o.benchFrames;
+    b.json = o.json;
+    b.quality = o.quality;
+    b.out = o.out;
+    return demo::runRenderBench(b);
+}
+
+/// --hit and --camera parsed, the display mode, the scene, the settings and the GL context: -1 to go on, else
+/// the exit code.
+int setUp(App& app, RunMode& mode) {
+    const Options& o = app.opt;
     for (const std::string& text : o.hits) {
         float v[4];
         if (!parseNumbers(text, 4, v) || !(v[3] > 0)) {
@@ -467,8 +497,10 @@ int main(int argc, char** argv) {
     app.pending.debugShapes = app.pending.debugAabbs = app.pending.debugImpacts = o.debug;
     app.pending.structure = o.structure;
     app.pending.roughCuts = o.rough;
-    app.pending.debugBonds = o.structure && (o.bonds || cli.count("--structure") > 0);
+    app.pending.debugBonds = o.structure && (o.bonds || o.structureFlag);
     app.pending.showcase = o.showcase || !o.camera.empty();
+    if (o.maxAwake > 0)
+        app.pending.maxAwake = o.maxAwake;
 
     std::string error;
     app.gl = demo::GlContext::create(o.width, o.height, headless, error);
@@ -486,18 +518,33 @@ int main(int argc, char** argv) {
         app.quality.nearestTexels = false;
     app.pending.shadows = !o.noShadows && app.quality.shadows;
     const int reniced = o.rasterNice > 0 ? lowerRasterizerPriority(o.rasterNice) : 0;
-    if (!o.join.empty()) { // a follower: no game of its own, the host's world drawn
-        demo::JoinOptions j{{}, 0, o.workers, o.out, o.screenshotEvery, o.stats, o.statsEvery};
-        if (!demo::parseHostPort(o.join, j.address, j.port, error) || !prepareRenderer(app, error)) {
-            std::fprintf(stderr, "error: %s\n", error.c_str());
-            return 1;
-        }
-        app.renderer.shadows = app.pending.shadows;
-        const int status = demo::runJoin(j, *app.gl, app.renderer, app.scene);
-        app.renderer.shutdown();
-        app.gl.reset();
-        return status;
+    mode.headless = headless;
+    mode.autopilot = autopilot;
+    mode.rendererName = rendererName;
+    mode.reniced = reniced;
+    return -1;
+}
+
+/// --join: a follower with no game of its own draws the host's world.
+int joinMode(App& app) {
+    const Options& o = app.opt;
+    std::string error;
+    demo::JoinOptions j{{}, 0, o.workers, o.out, o.screenshotEvery, o.stats, o.statsEvery};
+    if (!demo::parseHostPort(o.join, j.address, j.port, error) || !prepareRenderer(app, error)) {
+        std::fprintf(stderr, "error: %s\n", error.c_str());
+        return 1;
     }
+    app.renderer.shadows = app.pending.shadows;
+    const int status = demo::runJoin(j, *app.gl, app.renderer, app.scene);
+    app.renderer.shutdown();
+    app.gl.reset();
+    return status;
+}
+
+/// Loads the scene, applies --hit and starts --host: -1 to go on, else the exit code.
+int startGame(App& app) {
+    const Options& o = app.opt;
+    std::string error;
     if (!loadScene(app, error)) {
         std::fprintf(stderr, "error: %s\n", error.c_str());
         return 1;
@@ -516,21 +563,34 @@ int main(int argc, char** argv) {
         std::printf("host: listening on %s\n", message.c_str());
         std::fflush(stdout);
     }
-    if (!o.replay.empty()) {
-        std::uint64_t hash = 0;
-        std::string message;
-        const bool ok = app.game.replayJournal(o.replay, hash, message);
-        if (ok)
-            std::printf("replay: %s (%s), geometry hash %016llx\n", o.replay.c_str(), message.c_str(),
-                        static_cast<unsigned long long>(hash));
-        else
-            std::fprintf(stderr, "error: cannot replay %s: %s\n", o.replay.c_str(), message.c_str());
-        app.game.clear(app.renderer);
-        app.renderer.shutdown();
-        app.gl.reset();
-        return ok ? 0 : 1;
-    }
+    return -1;
+}
 
+/// --replay: the journal replayed on the loaded scene, its geometry hash printed.
+int replayMode(App& app) {
+    const Options& o = app.opt;
+    std::uint64_t hash = 0;
+    std::string message;
+    const bool ok = app.game.replayJournal(o.replay, hash, message);
+    if (ok)
+        std::printf("replay: %s (%s), geometry hash %016llx\n", o.replay.c_str(), message.c_str(),
+                    static_cast<unsigned long long>(hash));
+    else
+        std::fprintf(stderr, "error: cannot replay %s: %s\n", o.replay.c_str(), message.c_str());
+    app.game.clear(app.renderer);
+    app.renderer.shutdown();
+    app.gl.reset();
+    return ok ? 0 : 1;
+}
+
+/// Play (and host): the frame loop until quit or the end of the autopilot, then the report and the journal.
+int frameLoop(App& app, const RunMode& mode) {
+    const Options& o = app.opt;
+    const bool headless = mode.headless;
+    const bool autopilot = mode.autopilot;
+    const std::string& rendererName = mode.rendererName;
+    const int reniced = mode.reniced;
+    std::string error;
     IMGUI_CHECKVERSION();
     ImGui::CreateContext();
     ImGuiIO& io = ImGui::GetIO();
@@ -559,6 +619,7 @@ int main(int argc, char** argv) {
                  rendererName.c_str(), app.quality.name(), app.pending.shadows ? "on" : "off",
                  app.quality.pixelLighting ? "per-pixel" : "per-vertex", app.quality.minScale, reniced,
                  o.rasterNice);
+    demo::Audio audio({!headless, o.mute, o.audioWav, kVoices}); // silently no device when none opens
     demo::DynamicResolution resolution(1000.0f / o.targetFps, app.quality.minScale);
     float lastFrameMs = 0;
 
@@ -622,6 +683,12 @@ int main(int argc, char** argv) {
         if (!app.paused || autopilot)
             app.game.adoptReady();
         const double stepMs = std::chrono::duration<double, std::milli>(Clock::now() - stepStart).count();
+        { // Sound: heard from the camera, the capture in step with game time.
+            const demo::M4 view = app.game.camera().view();
+            audio.setListener(app.game.camera().eye, demo::V3{view.m[0], view.m[4], view.m[8]});
+            audio.play(app.game.takeSounds());
+            audio.advance(autopilot ? fixedDt : (app.paused ? 0.0 : std::min(realDt, 0.1)));
+        }
 
         // Scene.
         const int w = app.gl->width(), h = app.gl->height();
@@ -743,6 +810,11 @@ int main(int argc, char** argv) {
             break;
     }
 
+    if (std::string message; !audio.finish(message)) {
+        std::fprintf(stderr, "error: %s\n", message.c_str());
+        return 1;
+    }
+    report.setAudio(audio.stats(), kVoices, audio.hasDevice());
     if (!o.out.empty()) {
         std::string summary;
         const auto outDir = std::filesystem::path(o.out);
@@ -788,4 +860,25 @@ int main(int argc, char** argv) {
     app.sceneTarget.release();
     app.gl.reset();
     return status;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    App app;
+    gApp = &app;
+    if (const int status = parseOptions(argc, argv, app.opt); status >= 0)
+        return status;
+    if (!app.opt.renderBench.empty())
+        return renderBench(app.opt);
+    RunMode mode;
+    if (const int status = setUp(app, mode); status >= 0)
+        return status;
+    if (!app.opt.join.empty())
+        return joinMode(app);
+    if (const int status = startGame(app); status >= 0)
+        return status;
+    if (!app.opt.replay.empty())
+        return replayMode(app);
+    return frameLoop(app, mode);
 }

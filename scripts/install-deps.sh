@@ -11,11 +11,11 @@ core=(
     libgtest-dev libgmock-dev libbenchmark-dev
     libbullet-dev libenet-dev
     pybind11-dev python3-dev python3-numpy python3-pytest
-    libglfw3-dev libimgui-dev libepoxy-dev libstb-dev libegl-dev libgl-dev libgl1-mesa-dri
+    libglfw3-dev libimgui-dev libepoxy-dev libstb-dev libegl-dev libgl-dev libgl1-mesa-dri libopenal-dev
     xvfb xauth xdotool gnuplot-nox
     blender
 )
-extra=(clang libclang-rt-14-dev)
+extra=(clang libclang-rt-14-dev ffmpeg) # ffmpeg: scripts/readme-animation.sh
 
 want=("${core[@]}")
 if [ "${1:-core}" = all ]; then want+=("${extra[@]}"); fi
