@@ -1,11 +1,14 @@
 #include "rubble/io/SceneConfig.hpp"
 
+#include "rubble/core/ParameterCheck.hpp"
+
 #include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <string_view>
 
 #include "io/FileBytes.hpp"
+#include "rubble/core/ParameterCheck.hpp"
 #include "rubble/structure/Material.hpp"
 
 namespace rubble {
@@ -168,10 +171,10 @@ private:
             return fail("field 'mass' (9th): mass must not be negative, got '" + shown(f[8]) + "'");
         if (f.size() == 11) {
             double amplitude = 0;
-            if (f[10] != "flat" && (!number(f[10], 10, amplitude) || amplitude < 0 || amplitude > 1))
-                return fail("field 'roughness' (11th): expected 'flat' or a number in [0, 1] (the amplitude "
-                            "relative to the cell size), got '" +
-                            shown(f[10]) + "'");
+            if (f[10] != "flat" && (!number(f[10], 10, amplitude) || !checkParam("roughness", amplitude)))
+                return fail("field 'roughness' (11th): expected 'flat' or " +
+                            describeParamRange(*findParamRange("roughness")) +
+                            " (the amplitude relative to the cell size), got '" + shown(f[10]) + "'");
             o.roughness = amplitude;
         }
         if (f.size() >= 10 && !(f.size() == 11 && f[9].empty())) {

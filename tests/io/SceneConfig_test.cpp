@@ -68,7 +68,7 @@ TEST(SceneConfig, OptionalRoughnessField) {
     EXPECT_EQ(r->objects[3].roughness, 0.0);
     const std::string head = std::string(kSky) + kGround + kVehicle;
     const std::string expected =
-        "world.cfg:4: field 'roughness' (11th): expected 'flat' or a number in [0, 1] "
+        "world.cfg:4: field 'roughness' (11th): expected 'flat' or a finite number in [0, 1] "
         "(the amplitude relative to the cell size), got ";
     EXPECT_EQ(errorOf(head + "a.obj;;0;0;0;1;1;1;0;brick;rough\n"), expected + "'rough'");
     EXPECT_EQ(errorOf(head + "a.obj;;0;0;0;1;1;1;0;brick;1.5\n"), expected + "'1.5'");
