@@ -12,7 +12,7 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 
 def test_version_is_the_headers_version():
-    header = (ROOT / "include" / "rubble" / "Version.hpp").read_text()
+    header = (ROOT / "include" / "rubble" / "core" / "Version.hpp").read_text()
     parts = [re.search(r"#define RUBBLE_VERSION_%s (\d+)" % p, header).group(1) for p in ("MAJOR", "MINOR", "PATCH")]
     assert rubble.__version__ == ".".join(parts)
 
