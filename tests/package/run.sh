@@ -47,6 +47,9 @@ install)
     foreign=$(echo "$exported" | grep -vE '^(rubble::|rubble_|typeinfo for rubble::|typeinfo name for rubble::|vtable for rubble::|non-virtual thunk to rubble::)' || true)
     [ -z "$foreign" ] || fail "librubble.so exports $(echo "$foreign" | wc -l) symbols that are not Rubble's, e.g. $(echo "$foreign" | head -3)"
     echo "librubble.so exports $(echo "$exported" | wc -l) symbols"
+    # The install is lean: stripped, and the CLI and the Python module share librubble.so (558 MB before).
+    size_mb=$(du -sm "$prefix" | cut -f1)
+    [ "$size_mb" -le 50 ] || fail "the installed tree takes $size_mb MB, over 50"
     # The CLI links librubble.so instead of a second copy of the library.
     readelf -d "$prefix/bin/rubble" | grep -q 'NEEDED.*librubble\.so' || fail "bin/rubble does not link librubble.so"
     "$prefix/bin/rubble" --version >/dev/null || fail "the installed bin/rubble does not run"
