@@ -7,12 +7,13 @@
 // destructible bodies) and starts N clients (`rubble-bench netplay-client`, this executable again), each
 // connecting over ENet to 127.0.0.1 through its own seeded UdpRelay (one-way delay D ms with jitter J ms each
 // way, loss L with mean bursts of B datagrams, and a partition of P s at A s into the run); the last one
-// joins at fraction F of the run (default 1/3: snapshot + journal tail), the others at once. Each frame the
-// host publishes the journal events and a sync with its geometry hash; every 6th frame the placements (10 Hz,
-// BYTES per client at most). After T seconds the host stops firing, lets the fracture jobs finish, waits (at
-// most 10 s) for every client to confirm the last sync, closes the connections; the clients print their
-// figures and exit (a client still running 15 s later is killed). Bounded in time and packets; loopback
-// addresses only.
+// joins at fraction F of the run (default 1/3: snapshot + journal tail), the others at once. Each client
+// loads the scene itself first, so the host sends its unbroken objects by id (--no-base: the snapshot brings
+// all). Each frame the host publishes the journal events and a sync with its geometry hash; every 6th frame
+// the placements (10 Hz, BYTES per client at most). After T seconds the host stops firing, lets the fracture
+// jobs finish, waits (at most 10 s) for every client to confirm the last sync, closes the connections; the
+// clients print their figures and exit (a client still running 15 s later is killed). Bounded in time and
+// packets; loopback addresses only.
 //
 // Reports per client the kbps the host offered its link (UDP payload: ENet headers included, IP/UDP headers
 // not), mean and 99th-percentile second, its mismatched hashes and placement error (the client's interpolated
@@ -54,6 +55,7 @@
 #include "rubble/Random.hpp"
 #include "rubble/SceneConfig.hpp"
 #include "rubble/SceneLoader.hpp"
+#include "rubble/Snapshot.hpp"
 #include "rubble/bullet/BulletBinding.hpp"
 #include "rubble/bullet/PhysicsWorld.hpp"
 #include "rubble/enet/NetClient.hpp"
@@ -81,6 +83,7 @@ struct Args {
     std::string out;     // folder for netplay.csv and netplay.png ("" = none)
     int port = 0;        // client: the host's port
     std::string samples; // client: where it writes its placement samples
+    bool noBase = false; // clients do not load the scene first (the snapshot brings every object)
 };
 
 // Frames between placement samples, and how far behind its latest sync a client shows placements.
@@ -152,7 +155,8 @@ Child spawn(const Args& a, std::uint16_t port, const std::string& samples) {
                           until = std::to_string(a.seconds);
         execl("/proc/self/exe", "rubble-bench", "netplay-client", "--port", p.c_str(), "--workers", w.c_str(),
               "--seed", s.c_str(), "--seconds", t.c_str(), "--samples", samples.c_str(), "--shoot",
-              shoot.c_str(), "--shoot-for", until.c_str(), static_cast<char*>(nullptr));
+              shoot.c_str(), "--shoot-for", until.c_str(), "--scene", a.noBase ? "" : a.file.c_str(),
+              static_cast<char*>(nullptr));
         _exit(127);
     }
     close(fds[1]);
@@ -224,20 +228,27 @@ void writeResults(const std::string& dir, const std::vector<std::string>& header
                            "plot $DATA u 3:xtic(2) t 'mean', '' u 4 t 'p99 second', 150 w l t '150 kbps'");
 }
 
-int runHost(const Args& a) {
-    using namespace rubble;
-    Result<SceneConfig> scene = parseSceneConfig(a.file);
+// Loads the scene's objects into a runtime (host) the same way as into a client's world (its base).
+bool loadObjects(const std::string& file, rubble::DestructionRuntime& runtime) {
+    rubble::Result<rubble::SceneConfig> scene = rubble::parseSceneConfig(file);
     if (!scene) {
         std::cerr << "rubble-bench netplay: " << scene.error().message << "\n";
-        return 2;
+        return false;
     }
+    rubble::SceneLoadOptions lo;
+    lo.loadVehicle = false;
+    (void)rubble::loadScene(*scene, runtime, lo);
+    return true;
+}
+
+int runHost(const Args& a) {
+    using namespace rubble;
     const DestructionRuntime::Config rc = runtimeConfig(a);
     bullet::PhysicsWorld physics;
     bullet::BulletBinding binding(physics);
     DestructionRuntime runtime(binding, rc);
-    SceneLoadOptions lo;
-    lo.loadVehicle = false;
-    (void)loadScene(*scene, runtime, lo);
+    if (!loadObjects(a.file, runtime))
+        return 2;
     auto server = net::NetHost::listen(runtime.world(), rc.world, "127.0.0.1", 0, a.clients);
     if (!server) {
         std::cerr << "rubble-bench netplay: " << server.error().message << "\n";
@@ -456,6 +467,10 @@ int runHost(const Args& a) {
     r["client_shots_refused"] = hs.shotsRefused;
     r["late_join_ms"] = lateJoinMs;
     r["snapshot_bytes"] = hs.snapshotBytes / std::max<long long>(1, hs.joins);
+    r["snapshot_raw_bytes"] = hs.snapshotRawBytes / std::max<long long>(1, hs.joins);
+    r["snapshot_objects_by_reference"] = hs.snapshotObjectsByReference / std::max<long long>(1, hs.joins);
+    r["clients_load_scene"] = !a.noBase;
+    r["snapshot_build_ms"] = hs.snapshotBuildMs / static_cast<double>(std::max<long long>(1, hs.joins));
     r["final_hashes_equal"] = allConverged;
     r["converge_ms"] = convergeMs;
     r["kbps_mean"] = means.empty() ? 0 : *std::max_element(means.begin(), means.end());
@@ -545,6 +560,20 @@ int runClient(const Args& a) {
     using namespace rubble;
     const DestructionRuntime::Config rc = runtimeConfig(a);
     DestructionWorld world(rc.world);
+    double baseMs = 0;
+    if (!a.file.empty()) { // the scene, as the host loaded it: the host sends these objects by id
+        const auto t0 = Clock::now();
+        bullet::PhysicsWorld physics;
+        bullet::BulletBinding binding(physics);
+        DestructionRuntime loader(binding, rc);
+        if (!loadObjects(a.file, loader))
+            return 2;
+        if (Status st = restoreSnapshot(world, takeSnapshot(loader.world())); !st) {
+            std::cout << nlohmann::json{{"error", st.message()}}.dump() << "\n";
+            return 1;
+        }
+        baseMs = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    }
     auto client = net::NetClient::connect(world, rc.world, "127.0.0.1", static_cast<std::uint16_t>(a.port));
     if (!client) {
         std::cout << nlohmann::json{{"error", client.error().message}}.dump() << "\n";
@@ -604,6 +633,8 @@ int runClient(const Args& a) {
     const net::ClientStats& st = (*client)->stats();
     nlohmann::json j{{"joined", st.joined},
                      {"join_ms", st.joinMs},
+                     {"scene_load_ms", baseMs},
+                     {"snapshot_load_ms", st.snapshotLoadMs},
                      {"events", st.events},
                      {"syncs", st.syncs},
                      {"mismatched_hashes", st.mismatchedHashes},
@@ -648,6 +679,8 @@ const rubble::tools::Registrar host{
          app.add_option("--placement-budget", a->budget, "placement bytes per client per 10 Hz publish")
              ->check(CLI::Range(100, 1000000));
          app.add_option("--out", a->out, "folder: add a row to netplay.csv, draw netplay.png");
+         app.add_flag("--no-base", a->noBase,
+                      "clients do not load the scene first: the snapshot brings every object");
          app.add_flag("--json", a->json, "one JSON object on stdout");
          return [a] { return runHost(*a); };
      }}};
@@ -666,6 +699,7 @@ const rubble::tools::Registrar client{
          app.add_option("--samples", a->samples, "file for its placement samples");
          app.add_option("--shoot", a->clientShots, "shots per second it asks the host for");
          app.add_option("--shoot-for", a->shootFor, "seconds it shoots for");
+         app.add_option("--scene", a->file, "world.cfg it loads before joining (\"\": none)");
          return [a] { return runClient(*a); };
      }}};
 

@@ -36,6 +36,9 @@ Status restoreSnapshot(DestructionWorld& world, Snapshot snapshot);
 /// fails, changing nothing, like restoreSnapshot(world, ...) or when the placements do not match the objects.
 Status restoreSnapshot(DestructionRuntime& runtime, Snapshot snapshot);
 
+/// A 64-bit hash of everything a snapshot stores of an object (its bytes there): two states with equal hashes
+/// are interchangeable, e.g. a scene object a joining client loaded itself (netplay).
+std::uint64_t objectStateHash(const ObjectState& object);
 /// The snapshot's bytes.
 std::vector<std::uint8_t> encodeSnapshot(const Snapshot& snapshot);
 /// Parses a snapshot; a truncated, corrupted, wrong-version or hostile input gives an error naming source,

@@ -7,6 +7,7 @@
 #include <algorithm>
 
 #include "Events.hpp"
+#include "JoinSnapshot.hpp"
 #include "Placements.hpp"
 #include "Protocol.hpp"
 #include "rubble/JournalFile.hpp"
@@ -136,7 +137,8 @@ struct NetClient::Impl {
             return Error{ErrorCode::ParseError, "netplay: empty message"};
         switch (static_cast<Message>(d[0])) {
         case Message::Snapshot: {
-            Result<Snapshot> s = decodeSnapshot(d + 1, n - 1, "host snapshot");
+            const Clock::time_point received = Clock::now();
+            Result<Snapshot> s = detail::decodeJoinSnapshot(d, n, world);
             if (!s)
                 return s.error();
             const double frame = static_cast<double>(s->world.frame);
@@ -155,6 +157,7 @@ struct NetClient::Impl {
             seed = hostSeed;
             stats.joined = true;
             stats.joinMs = std::chrono::duration<double, std::milli>(Clock::now() - connected).count();
+            stats.snapshotLoadMs = std::chrono::duration<double, std::milli>(Clock::now() - received).count();
             return Status::ok();
         }
         case Message::Events: {
@@ -244,6 +247,8 @@ Status NetClient::service(int timeoutMs) {
         if (e.type == ENET_EVENT_TYPE_CONNECT) {
             im.stats.connected = true;
             detail::configurePeer(im.server);
+            if (!detail::sendReliable(im.server, detail::encodeHello(im.world)))
+                return Error{ErrorCode::IoError, "netplay: cannot send the hello"};
         } else if (e.type == ENET_EVENT_TYPE_RECEIVE) {
             const Clock::time_point now = Clock::now();
             if (now - im.heard > std::chrono::milliseconds(300) && im.server)

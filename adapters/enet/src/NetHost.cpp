@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "Events.hpp"
+#include "JoinSnapshot.hpp"
 #include "Placements.hpp"
 #include "Protocol.hpp"
 #include "rubble/JournalFile.hpp"
@@ -59,24 +60,29 @@ struct NetHost::Impl {
         shotHandler(r);
     }
 
-    void join(ENetPeer* peer) {
-        detail::configurePeer(peer);
-        std::vector<std::uint8_t> msg{static_cast<std::uint8_t>(Message::Snapshot)};
+    // A client's Hello: it gets the snapshot, without the objects it has already.
+    void join(ENetPeer* peer, const detail::KnownObjects& known) {
+        const auto started = std::chrono::steady_clock::now();
         std::vector<ObjectPlacement> placements =
             placementSource ? placementSource() : std::vector<ObjectPlacement>{};
         detail::PlacementEncoder& encoder = encoders[peer] = {};
         for (const ObjectPlacement& p : placements) // the client has these from its snapshot
             encoder.setBaseline(p.object, detail::quantize(p.objectToWorld));
-        const std::vector<std::uint8_t> bytes = encodeSnapshot(takeSnapshot(world, std::move(placements)));
-        msg.insert(msg.end(), bytes.begin(), bytes.end());
-        if (!detail::sendReliable(peer, msg)) {
+        detail::JoinSnapshotSize size;
+        const std::vector<std::uint8_t> msg =
+            detail::encodeJoinSnapshot(takeSnapshot(world, std::move(placements)), known, &size);
+        if (msg.empty() || !detail::sendReliable(peer, msg)) {
             enet_peer_disconnect(peer, 0);
             return;
         }
         peers[peer] = world.journalPosition();
         joinOrder[peer] = static_cast<std::uint64_t>(stats.joins);
         ++stats.joins;
-        stats.snapshotBytes += static_cast<long long>(bytes.size());
+        stats.snapshotBuildMs +=
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started).count();
+        stats.snapshotBytes += static_cast<long long>(size.wire);
+        stats.snapshotRawBytes += static_cast<long long>(size.raw);
+        stats.snapshotObjectsByReference += static_cast<long long>(size.referenced);
         enet_host_flush(host);
     }
 
@@ -91,6 +97,12 @@ struct NetHost::Impl {
         if (packet->dataLength == 9 && d[0] == static_cast<std::uint8_t>(Message::PlacementAck)) {
             if (auto e = encoders.find(peer); e != encoders.end())
                 e->second.acked(detail::readU32(d + 1), detail::readU32(d + 5));
+            return;
+        }
+        if (d[0] == static_cast<std::uint8_t>(Message::Hello)) {
+            detail::KnownObjects known;
+            if (!peers.count(peer) && detail::decodeHello(d, packet->dataLength, known))
+                join(peer, known);
             return;
         }
         if (d[0] == static_cast<std::uint8_t>(Message::Shot))
@@ -232,8 +244,8 @@ void NetHost::service(int timeoutMs) {
     for (int r = enet_host_service(im.host, &e, static_cast<enet_uint32>(std::max(0, timeoutMs))); r > 0;
          r = enet_host_service(im.host, &e, 0)) {
         switch (e.type) {
-        case ENET_EVENT_TYPE_CONNECT:
-            im.join(e.peer);
+        case ENET_EVENT_TYPE_CONNECT: // it joins with its Hello
+            detail::configurePeer(e.peer);
             break;
         case ENET_EVENT_TYPE_RECEIVE:
             im.receive(e.peer, e.packet);

@@ -18,13 +18,14 @@ namespace rubble::net::detail {
 
 /// Message types (first byte of every packet; on channel 0, reliable and ordered, unless said).
 enum class Message : std::uint8_t {
-    Snapshot = 1,     ///< the snapshot bytes (rubble/Snapshot.hpp)
+    Snapshot = 1,     ///< objects sent by id, then the deflated snapshot (JoinSnapshot.hpp)
     Events = 2,       ///< u32 count, then count × 48-byte journal events
     Sync = 3,         ///< u64 frame, u64 journal position, u64 geometry hash
     Ack = 4,          ///< client → host: u64 frame, u64 its geometry hash after that sync
     Placements = 5,   ///< channel 1, unreliable: u32 seq, then varints and records (Placements.hpp)
     PlacementAck = 6, ///< client → host, channel 1, unreliable: u32 latest seq, u32 mask of the 32 before
-    Shot = 7, ///< client → host: 3 f32 origin, 3 f32 velocity (the host checks it, then fires it or not)
+    Shot = 7,  ///< client → host: 3 f32 origin, 3 f32 velocity (the host checks it, then fires it or not)
+    Hello = 8, ///< client → host, first: the objects it has (JoinSnapshot.hpp); the host answers a Snapshot
 };
 
 /// Appends a little-endian float.

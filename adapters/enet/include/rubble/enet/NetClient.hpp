@@ -19,6 +19,7 @@ struct ClientStats {
     bool connected = false;         ///< the host accepted the connection
     bool joined = false;            ///< the snapshot arrived and was loaded
     double joinMs = 0;              ///< connect → snapshot loaded (ms)
+    double snapshotLoadMs = 0;      ///< of joinMs: inflating, decoding and loading the snapshot (ms)
     long long events = 0;           ///< journal events applied
     long long syncs = 0;            ///< frame syncs checked
     long long mismatchedHashes = 0; ///< syncs whose geometry hash differed from the host's
@@ -28,7 +29,9 @@ struct ClientStats {
 };
 
 /// A client of a NetHost on a loopback address. Its world must be built with the host's settings (any
-/// worker count); the snapshot replaces its content.
+/// worker count); the snapshot replaces its content. Objects the world has when it connects (e.g. the scene,
+/// loaded by the client itself) are announced to the host, which then sends by id those it has in the same
+/// state: a client that loaded the host's scene joins with a much smaller snapshot.
 class NetClient {
 public:
     /// Starts connecting to address:port (a loopback address); service() completes it (ENet gives up after
