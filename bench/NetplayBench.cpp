@@ -84,6 +84,7 @@ struct Args {
     int port = 0;        // client: the host's port
     std::string samples; // client: where it writes its placement samples
     bool noBase = false; // clients do not load the scene first (the snapshot brings every object)
+    std::string replay;  // client: folder where it keeps the game when the host stops
 };
 
 // Frames between placement samples, and how far behind its latest sync a client shows placements.
@@ -358,7 +359,8 @@ int runHost(const Args& a) {
     const net::HostStats hs = host.stats();
     const double runSeconds = std::chrono::duration<double>(Clock::now() - start).count();
     const std::uint64_t hostHash = runtime.world().geometryHash();
-    server->reset(); // closes the connections: the clients report and exit
+    host.close(5000); // the clients hear that the host stops, report and exit
+    server->reset();
     nlohmann::json clients = nlohmann::json::array();
     long long mismatched = hs.mismatchedHashes;
     double lateJoinMs = -1;
@@ -600,10 +602,12 @@ int runClient(const Args& a) {
     if (!a.samples.empty())
         samples.open(a.samples, std::ios::binary);
     std::string ending = "time limit";
+    bool hostStopped = false;
     std::uint64_t lastFrame = 0;
     for (const auto t0 = Clock::now(); Clock::now() - t0 < std::chrono::duration<double>(a.seconds);) {
         if (Status s = (*client)->service(5); !s) {
             ending = s.message();
+            hostStopped = s.error().code == ErrorCode::IoError;
             break;
         }
         // What it would show now: one placement period behind its latest sync, every half second.
@@ -630,6 +634,16 @@ int runClient(const Args& a) {
             static_cast<double>(shotsSent) < since * a.clientShots)
             shootAt(static_cast<double>(frame));
     }
+    std::string replay; // the game so far, kept when the host stopped
+    if (hostStopped && !a.replay.empty()) {
+        const std::filesystem::path dir = a.replay;
+        std::error_code ec;
+        std::filesystem::create_directories(dir, ec);
+        const Status saved = (*client)->writeReplay(dir / "game.rbsn", dir / "game.rbj");
+        replay = saved ? (dir / "game.rbsn").string() + " + " + (dir / "game.rbj").string() : saved.message();
+        std::cerr << "netplay-client: " << ending << "; "
+                  << (saved ? "the game so far is in " : "cannot keep the game: ") << replay << "\n";
+    }
     const net::ClientStats& st = (*client)->stats();
     nlohmann::json j{{"joined", st.joined},
                      {"join_ms", st.joinMs},
@@ -643,7 +657,8 @@ int runClient(const Args& a) {
                      {"placements", st.placements},
                      {"placement_bytes", st.placementBytes},
                      {"shots_sent", shotsSent},
-                     {"ending", ending}};
+                     {"ending", ending},
+                     {"replay", replay}};
     std::cout << j.dump() << "\n";
     return st.joined ? 0 : 1;
 }
@@ -700,6 +715,8 @@ const rubble::tools::Registrar client{
          app.add_option("--shoot", a->clientShots, "shots per second it asks the host for");
          app.add_option("--shoot-for", a->shootFor, "seconds it shoots for");
          app.add_option("--scene", a->file, "world.cfg it loads before joining (\"\": none)");
+         app.add_option("--replay", a->replay,
+                        "folder where it keeps the game (snapshot + journal) when the host stops");
          return [a] { return runClient(*a); };
      }}};
 

@@ -54,7 +54,9 @@ struct NetClient::Impl {
     detail::PlacementDecoder decoder;
     std::deque<detail::WireEvent> held; // events received, applied when the world reaches their tick
     std::vector<detail::WireEvent> arrived;
-    std::uint64_t seed = 0; // the host world's seed (from the snapshot)
+    std::uint64_t seed = 0;             // the host world's seed (from the snapshot)
+    std::optional<Snapshot> joinedWith; // the snapshot it joined with (for a replay)
+    std::vector<JournalEvent> applied;  // every event applied since
 
     // Applies the held events of the world's current frame, with the fields the host left out.
     Status applyHeld() {
@@ -78,6 +80,7 @@ struct NetClient::Impl {
             }
             if (Status st = player.receive(e); !st)
                 return st;
+            applied.push_back(e);
         }
         return Status::ok();
     }
@@ -149,8 +152,11 @@ struct NetClient::Impl {
                 baselines.setBaseline(p.object, detail::quantize(p.objectToWorld));
             }
             const std::uint64_t hostSeed = s->world.seed;
+            Snapshot kept = *s;
             if (Status st = restoreSnapshot(world, std::move(*s)); !st)
                 return st;
+            joinedWith = std::move(kept);
+            applied.clear();
             tracks = std::move(fresh);
             decoder = std::move(baselines);
             held.clear();
@@ -312,6 +318,25 @@ Status NetClient::shoot(const Vec3& origin, const Vec3& velocity) {
         return Error{ErrorCode::IoError, "netplay: cannot send a shot"};
     enet_host_flush(impl_->host);
     return Status::ok();
+}
+
+Status NetClient::writeReplay(const std::filesystem::path& snapshot,
+                              const std::filesystem::path& journal) const {
+    const Impl& im = *impl_;
+    if (!im.joinedWith)
+        return Error{ErrorCode::InvalidInput, "netplay: no replay before the join"};
+    if (Status st = saveSnapshot(snapshot, *im.joinedWith); !st)
+        return st;
+    JournalFile file;
+    const WorldState& w = im.joinedWith->world;
+    file.header.seed = w.seed;
+    file.header.delayFrames = w.delayFrames;
+    file.header.crumbleTriangles = w.crumbleTriangles;
+    file.header.crumbleCells = w.crumbleCells;
+    file.header.minPieceVolume = w.minPieceVolume;
+    file.header.scene = snapshot.filename().string(); // what the events replay on
+    file.events = im.applied;
+    return writeJournal(journal, file);
 }
 
 std::optional<double> NetClient::placementFrame(ObjectId object) const {

@@ -38,6 +38,7 @@ struct NetHost::Impl {
     std::function<void(const ShotRequest&)> shotHandler;
     ShotRules shotRules;
     std::map<ENetPeer*, double> shotTokens; // each client's bucket
+    bool closing = false;                   // close() was called
 
     // A client's shot: fired through the handler if it passes the rules, else counted as refused.
     void shot(ENetPeer* peer, const std::uint8_t* d, std::size_t n) {
@@ -101,7 +102,7 @@ struct NetHost::Impl {
         }
         if (d[0] == static_cast<std::uint8_t>(Message::Hello)) {
             detail::KnownObjects known;
-            if (!peers.count(peer) && detail::decodeHello(d, packet->dataLength, known))
+            if (!closing && !peers.count(peer) && detail::decodeHello(d, packet->dataLength, known))
                 join(peer, known);
             return;
         }
@@ -234,6 +235,24 @@ bool NetHost::finish(int timeoutMs) {
     return confirmed();
 }
 
+bool NetHost::close(int timeoutMs) {
+    Impl& im = *impl_;
+    im.closing = true;
+    for (ENetPeer* peer = im.host->peers; peer < im.host->peers + im.host->peerCount; ++peer)
+        if (peer->state != ENET_PEER_STATE_DISCONNECTED)
+            enet_peer_disconnect(peer, 0);
+    const auto connected = [&im] {
+        for (ENetPeer* peer = im.host->peers; peer < im.host->peers + im.host->peerCount; ++peer)
+            if (peer->state != ENET_PEER_STATE_DISCONNECTED)
+                return true;
+        return false;
+    };
+    const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeoutMs);
+    while (connected() && std::chrono::steady_clock::now() < end)
+        service(5);
+    return !connected();
+}
+
 void NetHost::setPlacementSource(std::function<std::vector<ObjectPlacement>()> source) {
     impl_->placementSource = std::move(source);
 }
@@ -246,6 +265,8 @@ void NetHost::service(int timeoutMs) {
         switch (e.type) {
         case ENET_EVENT_TYPE_CONNECT: // it joins with its Hello
             detail::configurePeer(e.peer);
+            if (im.closing)
+                enet_peer_disconnect(e.peer, 0);
             break;
         case ENET_EVENT_TYPE_RECEIVE:
             im.receive(e.peer, e.packet);

@@ -4,6 +4,7 @@
 /// and checks its geometry hash against the host's at every frame sync (docs/netplay.md).
 
 #include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -53,6 +54,10 @@ public:
     /// Asks the host to fire a shot (it checks it first: docs/netplay.md, 'Trust model'). Fails when not
     /// connected.
     Status shoot(const Vec3& origin, const Vec3& velocity);
+    /// Saves what replays this game up to now: the snapshot it joined with (saveSnapshot) and every journal
+    /// event applied since (writeJournal); restoreSnapshot and a JournalPlayer then rebuild its world. Call
+    /// it when the host stopped (service() failed with an IoError) to keep the game. Fails before the join.
+    Status writeReplay(const std::filesystem::path& snapshot, const std::filesystem::path& journal) const;
     /// Host frame of the latest placement received for an object (empty when none arrived).
     std::optional<double> placementFrame(ObjectId object) const;
     /// Called for every outcome the world adopts (its pieces are in the world already).

@@ -83,6 +83,10 @@ public:
     /// Handles the network until every connected client confirmed the latest sync (or timeoutMs passed);
     /// true when they all did. Call before closing, so that the clients end in the host's state.
     bool finish(int timeoutMs);
+    /// Stops serving: tells every client the host is going (they get an IoError from service() and can keep
+    /// their replay, NetClient::writeReplay) and handles the network until they all confirmed or timeoutMs
+    /// passed; true when they all did. Later clients are refused.
+    bool close(int timeoutMs);
     /// Where joining clients' snapshots get the bodies' placements from (e.g. the runtime's placements()).
     void setPlacementSource(std::function<std::vector<ObjectPlacement>()> source);
     /// Handles the network (joins, leaves, clients' hash reports) for up to timeoutMs.
