@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <limits>
+#include <vector>
 
 namespace demo {
 
@@ -102,6 +104,30 @@ void NetView::draw(Renderer& renderer, int texture, float dt) {
         centre_ = (lo + hi) * 0.5f;
         radius_ = std::max(5.0f, 0.5f * len(hi - lo));
     }
+}
+
+bool NetView::shoot(const V3& eye, int index) {
+    if (!client_ || !client_->stats().joined)
+        return false;
+    const double frame = static_cast<double>(client_->stats().frame) - kViewLag;
+    std::vector<rubble::Vec3> targets;
+    for (rubble::ObjectId id : world_->objects()) {
+        const rubble::ObjectState* o = world_->object(id);
+        if (const std::optional<rubble::Frame> at = client_->placement(id, frame); o->destructible && at)
+            targets.push_back(at->apply(o->mesh.bounds().center()));
+    }
+    if (targets.empty())
+        return false;
+    const rubble::Vec3 from{eye.x, eye.y, eye.z};
+    const rubble::Vec3 to = targets[static_cast<std::size_t>(index) % targets.size()];
+    return static_cast<bool>(client_->shoot(from, rubble::normalized(to - from) * 120.0));
+}
+
+rubble::Status NetView::writeReplay(const std::string& folder) const {
+    if (!client_)
+        return rubble::Error{rubble::ErrorCode::InvalidInput, "not connected"};
+    const std::filesystem::path dir = folder;
+    return client_->writeReplay(dir / "game.rbsn", dir / "game.rbj");
 }
 
 void NetView::clear(Renderer& renderer) {

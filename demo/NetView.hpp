@@ -33,6 +33,11 @@ public:
     /// interpolated between the host's placements even when one was lost); renderer meshes follow the world's
     /// objects.
     void draw(Renderer& renderer, int texture, float dt);
+    /// Asks the host to fire a shot from `eye` at the centre of a destructible object it draws (the
+    /// index-th of them, counted round), at 120 m/s; the host checks it first. False when there is none.
+    bool shoot(const V3& eye, int index);
+    /// Keeps the game so far (NetClient::writeReplay) as folder/game.rbsn and folder/game.rbj.
+    rubble::Status writeReplay(const std::string& folder) const;
     /// Frees the renderer meshes.
     void clear(Renderer& renderer);
 

@@ -77,6 +77,7 @@ struct Options {
     int host = 0;                  // port to host loopback multiplayer on
     double hostWait = 0;           // game seconds at which the host holds until a client joins
     std::string join;              // HOST:PORT of a host to follow
+    double joinFire = 0;           // with --join: seconds between automatic shots
     bool structure = true;         // the stress solver (with bearings)
     bool bonds = false;            // draw its bonds by stress
     std::string quality = "auto";  // auto (from GL_RENDERER), software or gpu
@@ -329,8 +330,13 @@ int main(int argc, char** argv) {
     cli.add_option(
            "--join", o.join,
            "follow a --host game at HOST:PORT (loopback) in a window: the client cuts the pieces from "
-           "the host's journal and draws them at the host's placements; A/D orbit, W/S zoom")
+           "the host's journal and draws them at the host's placements; A/D orbit, W/S zoom, Space asks "
+           "the host for a shot")
         ->excludes("--host");
+    cli.add_option("--join-fire", o.joinFire,
+                   "with --join: ask the host for a shot at an object every SECONDS (the host checks it)")
+        ->needs("--join")
+        ->check(CLI::PositiveNumber);
     cli.add_option(
            "--quality", o.quality,
            "renderer quality: auto (software GL gets the software level), software (per-vertex light, "
@@ -482,7 +488,7 @@ int main(int argc, char** argv) {
     app.pending.shadows = !o.noShadows && app.quality.shadows;
     const int reniced = o.rasterNice > 0 ? lowerRasterizerPriority(o.rasterNice) : 0;
     if (!o.join.empty()) { // a follower: no game of its own, the host's world drawn
-        demo::JoinOptions j{{}, 0, o.workers, o.out, o.screenshotEvery, o.stats, o.statsEvery};
+        demo::JoinOptions j{{}, 0, o.workers, o.out, o.screenshotEvery, o.stats, o.statsEvery, o.joinFire};
         if (!demo::parseHostPort(o.join, j.address, j.port, error) || !prepareRenderer(app, error)) {
             std::fprintf(stderr, "error: %s\n", error.c_str());
             return 1;

@@ -3,11 +3,14 @@
 # load the same scene and join it, one of them shooting (NetClient::shoot, checked by the server). Asserts:
 # the server fired clients' shots and fractured, no mismatched hash anywhere, both clients end in the server's
 # geometry hash, both hear that the server stops and keep the game (snapshot + journal) and say so.
-# Usage: server_e2e.sh PATH/TO/rubble-server PATH/TO/rubble-bench SCENE.cfg
+# With rubble-demo as a 4th argument, a headless `rubble-demo --join` window joins as well and shoots every
+# 0.4 s (--join-fire): its shots count, and it ends in the server's hash and keeps the game too.
+# Usage: server_e2e.sh PATH/TO/rubble-server PATH/TO/rubble-bench SCENE.cfg [PATH/TO/rubble-demo]
 set -uo pipefail
 server=${1:?usage: server_e2e.sh rubble-server rubble-bench SCENE}
 bench=${2:?usage}
 scene=${3:?usage}
+demo=${4:-}
 work=$(mktemp -d /tmp/rubble-server-e2e.XXXXXX)
 pids=()
 trap 'for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done; wait 2>/dev/null; rm -rf "$work"' EXIT
@@ -34,14 +37,20 @@ for c in 0 1; do
         --shoot "$shoot" --shoot-for 3 --replay "$work/replay$c" >"$work/client$c.log" 2>"$work/client$c.err.log" &
     pids+=($!)
 done
+if [ -n "$demo" ]; then
+    env -u DISPLAY timeout 120 "$demo" --headless --no-panel --join "127.0.0.1:$port" --scene "$scene" \
+        --width 320 --height 180 --join-fire 0.4 --out "$work/demo" >"$work/demo.log" 2>&1 &
+    pids+=($!)
+fi
 for p in "${pids[@]}"; do wait "$p" || fail "process $p exited with $?"; done
 pids=()
 
-python3 - "$work" <<'PY' || fail "the clients did not follow the server"
-import json, os, sys
+python3 - "$work" $demo <<'PY' || fail "the clients did not follow the server"
+import json, os, re, sys
 work = sys.argv[1]
 server = json.loads(open(f"{work}/server.log").read().splitlines()[-1])
-assert server["joins"] == 2, server
+demo = len(sys.argv) > 2
+assert server["joins"] == 2 + demo, server
 assert server["shots_accepted"] > 0 and server["fractures"] > 0, server
 assert server["mismatched_hashes"] == 0 and server["clients_told"], server
 for c in (0, 1):
@@ -52,6 +61,13 @@ for c in (0, 1):
     for f in ("game.rbsn", "game.rbj"):
         assert os.path.getsize(f"{work}/replay{c}/{f}") > 0, f
     assert "the game so far is in" in open(f"{work}/client{c}.err.log").read()
-print(f"ok: server {server['shots_accepted']} shots accepted, {server['fractures']} fractures, "
+if demo:
+    log = open(f"{work}/demo.log").read()
+    m = re.search(r"join: netplay: the host closed the connection; joined yes .* (\d+) mismatched hashes, .*"
+                  r" (\d+) shots asked, geometry hash ([0-9a-f]+)", log)
+    assert m and m.group(1) == "0" and int(m.group(2)) > 0, log
+    assert int(m.group(3), 16) == int(server["geometry_hash"]), (m.group(3), server)
+    assert "the game so far is in" in log and os.path.getsize(f"{work}/demo/game.rbj") > 0, log
+print(f"ok: server {server['shots_accepted']} shots accepted ({2 + demo} clients), {server['fractures']} fractures, "
       f"hash {server['geometry_hash']} on both clients; both kept the game")
 PY
