@@ -418,7 +418,10 @@ int runHost(const Args& a) {
         allSafeErrors.insert(allSafeErrors.end(), errorsAt[kSafeViewLag].begin(),
                              errorsAt[kSafeViewLag].end());
         // In play: the seconds after its snapshot arrived (the join's burst is reported apart).
-        const double joined = spawned[c] + (report.is_object() ? report.value("join_ms", 0.0) : 0.0) / 1000;
+        const double joined = // it connects once it loaded the scene
+            spawned[c] +
+            (report.is_object() ? report.value("scene_load_ms", 0.0) + report.value("join_ms", 0.0) : 0.0) /
+                1000;
         std::vector<double> play, joining;
         for (std::size_t k = 0; k < kbps[c].size(); ++k)
             (secondEnds[c][k] - 1 > joined ? play : joining).push_back(kbps[c][k]);
