@@ -43,7 +43,7 @@ int runJoin(const JoinOptions& options, GlContext& gl, Renderer& renderer, const
     using Clock = std::chrono::steady_clock;
     NetView view;
     std::string error;
-    if (!view.connect(options.address, options.port, options.workers, error)) {
+    if (!view.connect(options.address, options.port, options.workers, scene, error)) {
         std::fprintf(stderr, "error: cannot join %s:%u: %s\n", options.address.c_str(), options.port,
                      error.c_str());
         return 1;

@@ -6,6 +6,11 @@
 #include <limits>
 #include <vector>
 
+#include "rubble/SceneLoader.hpp"
+#include "rubble/Snapshot.hpp"
+#include "rubble/bullet/BulletBinding.hpp"
+#include "rubble/bullet/PhysicsWorld.hpp"
+
 namespace demo {
 
 namespace {
@@ -27,11 +32,26 @@ M4 toM4(const rubble::Frame& f) {
 NetView::NetView() = default;
 NetView::~NetView() = default;
 
-bool NetView::connect(const std::string& address, std::uint16_t port, int workers, std::string& error) {
+bool NetView::connect(const std::string& address, std::uint16_t port, int workers,
+                      const rubble::SceneConfig& scene, std::string& error) {
     rubble::DestructionWorld::Config config; // the snapshot brings the host's settings
     config.deterministic = true;
     config.workers = workers;
     world_ = std::make_unique<rubble::DestructionWorld>(config);
+    {
+        rubble::bullet::PhysicsWorld physics;
+        rubble::bullet::BulletBinding binding(physics);
+        rubble::DestructionRuntime::Config rc;
+        rc.world = config;
+        rubble::DestructionRuntime loader(binding, rc);
+        rubble::SceneLoadOptions lo;
+        lo.loadVehicle = false; // as rubble-server loads it
+        (void)rubble::loadScene(scene, loader, lo);
+        if (rubble::Status st = rubble::restoreSnapshot(*world_, rubble::takeSnapshot(loader.world())); !st) {
+            error = st.message();
+            return false;
+        }
+    }
     auto client = rubble::net::NetClient::connect(*world_, config, address, port);
     if (!client) {
         error = client.error().message;

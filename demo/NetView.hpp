@@ -11,6 +11,7 @@
 #include "Math.hpp"
 #include "Renderer.hpp"
 #include "rubble/DestructionWorld.hpp"
+#include "rubble/SceneConfig.hpp"
 #include "rubble/enet/NetClient.hpp"
 
 namespace demo {
@@ -24,8 +25,10 @@ public:
     NetView& operator=(const NetView&) = delete;
 
     /// Starts connecting to address:port (a loopback address) with a deterministic world of `workers`
-    /// fracture workers; false with a message.
-    bool connect(const std::string& address, std::uint16_t port, int workers, std::string& error);
+    /// fracture workers, holding the scene's objects loaded as rubble-server loads them (the host then sends
+    /// those it has unbroken by id); false with a message.
+    bool connect(const std::string& address, std::uint16_t port, int workers,
+                 const rubble::SceneConfig& scene, std::string& error);
     /// Receives what arrived within timeoutMs; an IoError once the connection ended (the host closed it or
     /// never answered), another error when the host sent something the world refused.
     rubble::Status service(int timeoutMs);

@@ -127,6 +127,8 @@ int main(int argc, char** argv) {
                                  {"shots_accepted", hs.shotsAccepted},
                                  {"shots_refused", hs.shotsRefused},
                                  {"mismatched_hashes", hs.mismatchedHashes},
+                                 {"snapshot_bytes", hs.snapshotBytes},
+                                 {"snapshot_objects_by_reference", hs.snapshotObjectsByReference},
                                  {"clients_confirmed_last_sync", confirmed},
                                  {"clients_told", closed},
                                  {"geometry_hash", std::to_string(runtime.world().geometryHash())}};
