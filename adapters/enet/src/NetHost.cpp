@@ -48,6 +48,7 @@ struct NetHost::Impl {
         std::vector<bool> acked;
         std::vector<std::chrono::steady_clock::time_point> sent; // last sent (epoch: never)
         std::uint64_t frame = 0;                                 // the snapshot's frame
+        std::chrono::steady_clock::time_point started;
     };
     std::map<ENetPeer*, Transfer> transfers;
     std::chrono::steady_clock::time_point lastPump;
@@ -60,6 +61,15 @@ struct NetHost::Impl {
         if (transfers.empty() || now - lastPump < std::chrono::milliseconds(8))
             return; // paced: at most 64 datagrams per 8 ms per client
         lastPump = now;
+        for (auto it = transfers.begin();
+             it != transfers.end();) { // a client that never has it all is dropped
+            if (now - it->second.started > std::chrono::seconds(30)) {
+                enet_peer_disconnect(it->first, 0);
+                it = transfers.erase(it);
+            } else {
+                ++it;
+            }
+        }
         for (auto& [peer, t] : transfers) {
             const auto resend =
                 std::chrono::milliseconds(10 + peer->roundTripTime + peer->roundTripTimeVariance);
@@ -156,6 +166,7 @@ struct NetHost::Impl {
         t.acked.assign(chunks, false);
         t.sent.assign(chunks, {});
         t.frame = world.frame();
+        t.started = std::chrono::steady_clock::now();
         peers[peer] = world.journalPosition();
         joinOrder[peer] = static_cast<std::uint64_t>(stats.joins);
         ++stats.joins;
