@@ -7,12 +7,13 @@
 // destructible bodies) and starts N clients (`rubble-bench netplay-client`, this executable again), each
 // connecting over ENet to 127.0.0.1 through its own seeded UdpRelay (one-way delay D ms with jitter J ms each
 // way, loss L with mean bursts of B datagrams, and a partition of P s at A s into the run); the last one
-// joins at fraction F of the run (default 1/3: snapshot + journal tail), the others at once. Each frame the
-// host publishes the journal events and a sync with its geometry hash; every 6th frame the placements (10 Hz,
-// BYTES per client at most). After T seconds the host stops firing, lets the fracture jobs finish, waits (at
-// most 10 s) for every client to confirm the last sync, closes the connections; the clients print their
-// figures and exit (a client still running 15 s later is killed). Bounded in time and packets; loopback
-// addresses only.
+// joins at fraction F of the run (default 1/3: snapshot + journal tail), the others at once. Each client
+// loads the scene itself first, so the host sends its unbroken objects by id (--no-base: the snapshot brings
+// all). Each frame the host publishes the journal events and a sync with its geometry hash; every 6th frame
+// the placements (10 Hz, BYTES per client at most). After T seconds the host stops firing, lets the fracture
+// jobs finish, waits (at most 10 s) for every client to confirm the last sync, closes the connections; the
+// clients print their figures and exit (a client still running 15 s later is killed). Bounded in time and
+// packets; loopback addresses only.
 //
 // Reports per client the kbps the host offered its link (UDP payload: ENet headers included, IP/UDP headers
 // not), mean and 99th-percentile second, its mismatched hashes and placement error (the client's interpolated
@@ -57,6 +58,7 @@
 #include "rubble/enet/NetHost.hpp"
 #include "rubble/enet/UdpRelay.hpp"
 #include "rubble/io/SceneConfig.hpp"
+#include "rubble/persist/Snapshot.hpp"
 #include "rubble/runtime/DestructionRuntime.hpp"
 #include "rubble/runtime/SceneLoader.hpp"
 
@@ -81,6 +83,8 @@ struct Args {
     std::string out;     // folder for netplay.csv and netplay.png ("" = none)
     int port = 0;        // client: the host's port
     std::string samples; // client: where it writes its placement samples
+    bool noBase = false; // clients do not load the scene first (the snapshot brings every object)
+    std::string replay;  // client: folder where it keeps the game when the host stops
 };
 
 // Frames between placement samples, and how far behind its latest sync a client shows placements.
@@ -152,7 +156,8 @@ Child spawn(const Args& a, std::uint16_t port, const std::string& samples) {
                           until = std::to_string(a.seconds);
         execl("/proc/self/exe", "rubble-bench", "netplay-client", "--port", p.c_str(), "--workers", w.c_str(),
               "--seed", s.c_str(), "--seconds", t.c_str(), "--samples", samples.c_str(), "--shoot",
-              shoot.c_str(), "--shoot-for", until.c_str(), static_cast<char*>(nullptr));
+              shoot.c_str(), "--shoot-for", until.c_str(), "--scene", a.noBase ? "" : a.file.c_str(),
+              static_cast<char*>(nullptr));
         _exit(127);
     }
     close(fds[1]);
@@ -224,20 +229,27 @@ void writeResults(const std::string& dir, const std::vector<std::string>& header
                            "plot $DATA u 3:xtic(2) t 'mean', '' u 4 t 'p99 second', 150 w l t '150 kbps'");
 }
 
-int runHost(const Args& a) {
-    using namespace rubble;
-    Result<SceneConfig> scene = parseSceneConfig(a.file);
+// Loads the scene's objects into a runtime (host) the same way as into a client's world (its base).
+bool loadObjects(const std::string& file, rubble::DestructionRuntime& runtime) {
+    rubble::Result<rubble::SceneConfig> scene = rubble::parseSceneConfig(file);
     if (!scene) {
         std::cerr << "rubble-bench netplay: " << scene.error().message << "\n";
-        return 2;
+        return false;
     }
+    rubble::SceneLoadOptions lo;
+    lo.loadVehicle = false;
+    (void)rubble::loadScene(*scene, runtime, lo);
+    return true;
+}
+
+int runHost(const Args& a) {
+    using namespace rubble;
     const DestructionRuntime::Config rc = runtimeConfig(a);
     bullet::PhysicsWorld physics;
     bullet::BulletBinding binding(physics);
     DestructionRuntime runtime(binding, rc);
-    SceneLoadOptions lo;
-    lo.loadVehicle = false;
-    (void)loadScene(*scene, runtime, lo);
+    if (!loadObjects(a.file, runtime))
+        return 2;
     auto server = net::NetHost::listen(runtime.world(), rc.world, "127.0.0.1", 0, a.clients);
     if (!server) {
         std::cerr << "rubble-bench netplay: " << server.error().message << "\n";
@@ -347,7 +359,8 @@ int runHost(const Args& a) {
     const net::HostStats hs = host.stats();
     const double runSeconds = std::chrono::duration<double>(Clock::now() - start).count();
     const std::uint64_t hostHash = runtime.world().geometryHash();
-    server->reset(); // closes the connections: the clients report and exit
+    host.close(5000); // the clients hear that the host stops, report and exit
+    server->reset();
     nlohmann::json clients = nlohmann::json::array();
     long long mismatched = hs.mismatchedHashes;
     double lateJoinMs = -1;
@@ -405,7 +418,10 @@ int runHost(const Args& a) {
         allSafeErrors.insert(allSafeErrors.end(), errorsAt[kSafeViewLag].begin(),
                              errorsAt[kSafeViewLag].end());
         // In play: the seconds after its snapshot arrived (the join's burst is reported apart).
-        const double joined = spawned[c] + (report.is_object() ? report.value("join_ms", 0.0) : 0.0) / 1000;
+        const double joined = // it connects once it loaded the scene
+            spawned[c] +
+            (report.is_object() ? report.value("scene_load_ms", 0.0) + report.value("join_ms", 0.0) : 0.0) /
+                1000;
         std::vector<double> play, joining;
         for (std::size_t k = 0; k < kbps[c].size(); ++k)
             (secondEnds[c][k] - 1 > joined ? play : joining).push_back(kbps[c][k]);
@@ -456,6 +472,10 @@ int runHost(const Args& a) {
     r["client_shots_refused"] = hs.shotsRefused;
     r["late_join_ms"] = lateJoinMs;
     r["snapshot_bytes"] = hs.snapshotBytes / std::max<long long>(1, hs.joins);
+    r["snapshot_raw_bytes"] = hs.snapshotRawBytes / std::max<long long>(1, hs.joins);
+    r["snapshot_objects_by_reference"] = hs.snapshotObjectsByReference / std::max<long long>(1, hs.joins);
+    r["clients_load_scene"] = !a.noBase;
+    r["snapshot_build_ms"] = hs.snapshotBuildMs / static_cast<double>(std::max<long long>(1, hs.joins));
     r["final_hashes_equal"] = allConverged;
     r["converge_ms"] = convergeMs;
     r["kbps_mean"] = means.empty() ? 0 : *std::max_element(means.begin(), means.end());
@@ -545,6 +565,20 @@ int runClient(const Args& a) {
     using namespace rubble;
     const DestructionRuntime::Config rc = runtimeConfig(a);
     DestructionWorld world(rc.world);
+    double baseMs = 0;
+    if (!a.file.empty()) { // the scene, as the host loaded it: the host sends these objects by id
+        const auto t0 = Clock::now();
+        bullet::PhysicsWorld physics;
+        bullet::BulletBinding binding(physics);
+        DestructionRuntime loader(binding, rc);
+        if (!loadObjects(a.file, loader))
+            return 2;
+        if (Status st = restoreSnapshot(world, takeSnapshot(loader.world())); !st) {
+            std::cout << nlohmann::json{{"error", st.message()}}.dump() << "\n";
+            return 1;
+        }
+        baseMs = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    }
     auto client = net::NetClient::connect(world, rc.world, "127.0.0.1", static_cast<std::uint16_t>(a.port));
     if (!client) {
         std::cout << nlohmann::json{{"error", client.error().message}}.dump() << "\n";
@@ -571,10 +605,12 @@ int runClient(const Args& a) {
     if (!a.samples.empty())
         samples.open(a.samples, std::ios::binary);
     std::string ending = "time limit";
+    bool hostStopped = false;
     std::uint64_t lastFrame = 0;
     for (const auto t0 = Clock::now(); Clock::now() - t0 < std::chrono::duration<double>(a.seconds);) {
         if (Status s = (*client)->service(5); !s) {
             ending = s.message();
+            hostStopped = s.error().code == ErrorCode::IoError;
             break;
         }
         // What it would show now: one placement period behind its latest sync, every half second.
@@ -601,9 +637,21 @@ int runClient(const Args& a) {
             static_cast<double>(shotsSent) < since * a.clientShots)
             shootAt(static_cast<double>(frame));
     }
+    std::string replay; // the game so far, kept when the host stopped
+    if (hostStopped && !a.replay.empty()) {
+        const std::filesystem::path dir = a.replay;
+        std::error_code ec;
+        std::filesystem::create_directories(dir, ec);
+        const Status saved = (*client)->writeReplay(dir / "game.rbsn", dir / "game.rbj");
+        replay = saved ? (dir / "game.rbsn").string() + " + " + (dir / "game.rbj").string() : saved.message();
+        std::cerr << "netplay-client: " << ending << "; "
+                  << (saved ? "the game so far is in " : "cannot keep the game: ") << replay << "\n";
+    }
     const net::ClientStats& st = (*client)->stats();
     nlohmann::json j{{"joined", st.joined},
                      {"join_ms", st.joinMs},
+                     {"scene_load_ms", baseMs},
+                     {"snapshot_load_ms", st.snapshotLoadMs},
                      {"events", st.events},
                      {"syncs", st.syncs},
                      {"mismatched_hashes", st.mismatchedHashes},
@@ -612,7 +660,8 @@ int runClient(const Args& a) {
                      {"placements", st.placements},
                      {"placement_bytes", st.placementBytes},
                      {"shots_sent", shotsSent},
-                     {"ending", ending}};
+                     {"ending", ending},
+                     {"replay", replay}};
     std::cout << j.dump() << "\n";
     return st.joined ? 0 : 1;
 }
@@ -648,6 +697,8 @@ const rubble::tools::Registrar host{
          app.add_option("--placement-budget", a->budget, "placement bytes per client per 10 Hz publish")
              ->check(CLI::Range(100, 1000000));
          app.add_option("--out", a->out, "folder: add a row to netplay.csv, draw netplay.png");
+         app.add_flag("--no-base", a->noBase,
+                      "clients do not load the scene first: the snapshot brings every object");
          app.add_flag("--json", a->json, "one JSON object on stdout");
          return [a] { return runHost(*a); };
      }}};
@@ -666,6 +717,9 @@ const rubble::tools::Registrar client{
          app.add_option("--samples", a->samples, "file for its placement samples");
          app.add_option("--shoot", a->clientShots, "shots per second it asks the host for");
          app.add_option("--shoot-for", a->shootFor, "seconds it shoots for");
+         app.add_option("--scene", a->file, "world.cfg it loads before joining (\"\": none)");
+         app.add_option("--replay", a->replay,
+                        "folder where it keeps the game (snapshot + journal) when the host stops");
          return [a] { return runClient(*a); };
      }}};
 

@@ -43,7 +43,7 @@ int runJoin(const JoinOptions& options, GlContext& gl, Renderer& renderer, const
     using Clock = std::chrono::steady_clock;
     NetView view;
     std::string error;
-    if (!view.connect(options.address, options.port, options.workers, error)) {
+    if (!view.connect(options.address, options.port, options.workers, scene, error)) {
         std::fprintf(stderr, "error: cannot join %s:%u: %s\n", options.address.c_str(), options.port,
                      error.c_str());
         return 1;
@@ -74,9 +74,11 @@ int runJoin(const JoinOptions& options, GlContext& gl, Renderer& renderer, const
     long framesDrawn = 0, renderFrames = 0;
     int screenshots = 0;
     long nextShot = 0; // host frame of the next screenshot
-    bool userClosed = false;
+    bool userClosed = false, spaceDown = false;
     rubble::Status ending;
     auto last = Clock::now();
+    auto lastShot = last;
+    int shots = 0;
     while (true) {
         const auto now = Clock::now();
         const float dt = std::min(0.1f, std::chrono::duration<float>(now - last).count());
@@ -116,6 +118,17 @@ int runJoin(const JoinOptions& options, GlContext& gl, Renderer& renderer, const
         fv.focus = centre;
         renderer.render(fv);
         ++renderFrames;
+        bool fire =
+            options.fireEvery > 0 && now - lastShot >= std::chrono::duration<double>(options.fireEvery);
+        if (GLFWwindow* w = gl.window()) { // Space: one shot per press
+            const bool down = glfwGetKey(w, GLFW_KEY_SPACE) == GLFW_PRESS;
+            fire = fire || (down && !spaceDown);
+            spaceDown = down;
+        }
+        if (fire && view.shoot(fv.eye, shots)) {
+            ++shots;
+            lastShot = now;
+        }
         framesDrawn += view.drawn() > 0;
 
         const rubble::net::ClientStats& st = view.stats();
@@ -143,10 +156,16 @@ int runJoin(const JoinOptions& options, GlContext& gl, Renderer& renderer, const
 
     const rubble::net::ClientStats& st = view.stats();
     const bool hostClosed = !ending && ending.error().code == rubble::ErrorCode::IoError && st.joined;
+    if (hostClosed && !options.out.empty()) {
+        const rubble::Status kept = view.writeReplay(options.out);
+        std::printf("join: the host stopped; %s%s\n",
+                    kept ? "the game so far is in " : "cannot keep the game: ",
+                    kept ? (options.out + "/game.rbsn + game.rbj").c_str() : kept.message().c_str());
+    }
     std::printf("join: %s; joined %s (%.0f ms), %lld events, %lld syncs checked, %lld mismatched hashes, "
-                "%lld placements, %ld frames drawn, geometry hash %016llx\n",
+                "%lld placements, %ld frames drawn, %d shots asked, geometry hash %016llx\n",
                 userClosed ? "closed" : ending.message().c_str(), st.joined ? "yes" : "no", st.joinMs,
-                st.events, st.syncs, st.mismatchedHashes, st.placements, framesDrawn,
+                st.events, st.syncs, st.mismatchedHashes, st.placements, framesDrawn, shots,
                 static_cast<unsigned long long>(view.geometryHash()));
     std::fflush(stdout);
     view.clear(renderer);

@@ -21,13 +21,16 @@ struct JoinOptions {
     double screenshotEvery = 0; ///< host seconds between screenshots (0: none)
     bool stats = false;         ///< print a stats line every statsEvery drawn frames
     int statsEvery = 30;        ///< drawn frames between stats lines
+    double fireEvery = 0;       ///< seconds between automatic shots (0: only Space fires)
 };
 
 /// Splits "HOST:PORT"; false with a message naming the bad part.
 bool parseHostPort(const std::string& text, std::string& address, std::uint16_t& port, std::string& error);
 
 /// Follows the host until it closes the connection (or Esc, or the window closes), drawing the scene's
-/// ground and sky and the client world's objects; prints a `join:` summary line. Returns 0 when the client
+/// ground and sky and the client world's objects; Space (or every fireEvery seconds) asks the host for a shot
+/// from the camera at an object. When the host stops, keeps the game in `out` (game.rbsn + game.rbj) and says
+/// so. Prints a `join:` summary line. Returns 0 when the client
 /// joined and every sync's geometry hash matched the host's, else 1.
 int runJoin(const JoinOptions& options, GlContext& gl, Renderer& renderer, const rubble::SceneConfig& scene);
 

@@ -2,7 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <limits>
+#include <vector>
+
+#include "rubble/bullet/BulletBinding.hpp"
+#include "rubble/bullet/PhysicsWorld.hpp"
+#include "rubble/persist/Snapshot.hpp"
+#include "rubble/runtime/SceneLoader.hpp"
 
 namespace demo {
 
@@ -25,11 +32,26 @@ M4 toM4(const rubble::Frame& f) {
 NetView::NetView() = default;
 NetView::~NetView() = default;
 
-bool NetView::connect(const std::string& address, std::uint16_t port, int workers, std::string& error) {
+bool NetView::connect(const std::string& address, std::uint16_t port, int workers,
+                      const rubble::SceneConfig& scene, std::string& error) {
     rubble::DestructionWorld::Config config; // the snapshot brings the host's settings
     config.deterministic = true;
     config.workers = workers;
     world_ = std::make_unique<rubble::DestructionWorld>(config);
+    {
+        rubble::bullet::PhysicsWorld physics;
+        rubble::bullet::BulletBinding binding(physics);
+        rubble::DestructionRuntime::Config rc;
+        rc.world = config;
+        rubble::DestructionRuntime loader(binding, rc);
+        rubble::SceneLoadOptions lo;
+        lo.loadVehicle = false; // as rubble-server loads it
+        (void)rubble::loadScene(scene, loader, lo);
+        if (rubble::Status st = rubble::restoreSnapshot(*world_, rubble::takeSnapshot(loader.world())); !st) {
+            error = st.message();
+            return false;
+        }
+    }
     auto client = rubble::net::NetClient::connect(*world_, config, address, port);
     if (!client) {
         error = client.error().message;
@@ -102,6 +124,30 @@ void NetView::draw(Renderer& renderer, int texture, float dt) {
         centre_ = (lo + hi) * 0.5f;
         radius_ = std::max(5.0f, 0.5f * len(hi - lo));
     }
+}
+
+bool NetView::shoot(const V3& eye, int index) {
+    if (!client_ || !client_->stats().joined)
+        return false;
+    const double frame = static_cast<double>(client_->stats().frame) - kViewLag;
+    std::vector<rubble::Vec3> targets;
+    for (rubble::ObjectId id : world_->objects()) {
+        const rubble::ObjectState* o = world_->object(id);
+        if (const std::optional<rubble::Frame> at = client_->placement(id, frame); o->destructible && at)
+            targets.push_back(at->apply(o->mesh.bounds().center()));
+    }
+    if (targets.empty())
+        return false;
+    const rubble::Vec3 from{eye.x, eye.y, eye.z};
+    const rubble::Vec3 to = targets[static_cast<std::size_t>(index) % targets.size()];
+    return static_cast<bool>(client_->shoot(from, rubble::normalized(to - from) * 120.0));
+}
+
+rubble::Status NetView::writeReplay(const std::string& folder) const {
+    if (!client_)
+        return rubble::Error{rubble::ErrorCode::InvalidInput, "not connected"};
+    const std::filesystem::path dir = folder;
+    return client_->writeReplay(dir / "game.rbsn", dir / "game.rbj");
 }
 
 void NetView::clear(Renderer& renderer) {

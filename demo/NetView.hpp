@@ -11,7 +11,9 @@
 #include "Math.hpp"
 #include "Renderer.hpp"
 #include "rubble/enet/NetClient.hpp"
+#include "rubble/io/SceneConfig.hpp"
 #include "rubble/rubble.hpp"
+#include "rubble/runtime/DestructionWorld.hpp"
 
 namespace demo {
 
@@ -24,8 +26,10 @@ public:
     NetView& operator=(const NetView&) = delete;
 
     /// Starts connecting to address:port (a loopback address) with a deterministic world of `workers`
-    /// fracture workers; false with a message.
-    bool connect(const std::string& address, std::uint16_t port, int workers, std::string& error);
+    /// fracture workers, holding the scene's objects loaded as rubble-server loads them (the host then sends
+    /// those it has unbroken by id); false with a message.
+    bool connect(const std::string& address, std::uint16_t port, int workers,
+                 const rubble::SceneConfig& scene, std::string& error);
     /// Receives what arrived within timeoutMs; an IoError once the connection ended (the host closed it or
     /// never answered), another error when the host sent something the world refused.
     rubble::Status service(int timeoutMs);
@@ -33,6 +37,11 @@ public:
     /// interpolated between the host's placements even when one was lost); renderer meshes follow the world's
     /// objects.
     void draw(Renderer& renderer, int texture, float dt);
+    /// Asks the host to fire a shot from `eye` at the centre of a destructible object it draws (the
+    /// index-th of them, counted round), at 120 m/s; the host checks it first. False when there is none.
+    bool shoot(const V3& eye, int index);
+    /// Keeps the game so far (NetClient::writeReplay) as folder/game.rbsn and folder/game.rbj.
+    rubble::Status writeReplay(const std::string& folder) const;
     /// Frees the renderer meshes.
     void clear(Renderer& renderer);
 

@@ -78,6 +78,7 @@ struct Options {
     int host = 0;                  // port to host loopback multiplayer on
     double hostWait = 0;           // game seconds at which the host holds until a client joins
     std::string join;              // HOST:PORT of a host to follow
+    double joinFire = 0;           // with --join: seconds between automatic shots
     bool structure = true;         // the stress solver (with bearings)
     bool rough = true;             // rough cuts by material (docs/roughness.md)
     bool bonds = false;            // draw its bonds by stress
@@ -350,8 +351,13 @@ int parseOptions(int argc, char** argv, Options& o) {
     cli.add_option(
            "--join", o.join,
            "follow a --host game at HOST:PORT (loopback) in a window: the client cuts the pieces from "
-           "the host's journal and draws them at the host's placements; A/D orbit, W/S zoom")
+           "the host's journal and draws them at the host's placements; A/D orbit, W/S zoom, Space asks "
+           "the host for a shot")
         ->excludes("--host");
+    cli.add_option("--join-fire", o.joinFire,
+                   "with --join: ask the host for a shot at an object every SECONDS (the host checks it)")
+        ->needs("--join")
+        ->check(CLI::PositiveNumber);
     cli.add_option(
            "--quality", o.quality,
            "renderer quality: auto (software GL gets the software level), software (per-vertex light, "
@@ -529,7 +535,7 @@ int setUp(App& app, RunMode& mode) {
 int joinMode(App& app) {
     const Options& o = app.opt;
     std::string error;
-    demo::JoinOptions j{{}, 0, o.workers, o.out, o.screenshotEvery, o.stats, o.statsEvery};
+    demo::JoinOptions j{{}, 0, o.workers, o.out, o.screenshotEvery, o.stats, o.statsEvery, o.joinFire};
     if (!demo::parseHostPort(o.join, j.address, j.port, error) || !prepareRenderer(app, error)) {
         std::fprintf(stderr, "error: %s\n", error.c_str());
         return 1;

@@ -450,6 +450,15 @@ Status restoreSnapshot(DestructionRuntime& runtime, Snapshot snapshot) {
                            snapshot.structure);
 }
 
+std::uint64_t objectStateHash(const ObjectState& object) {
+    ByteWriter w;
+    writeObject(w, object);
+    std::uint64_t h = 0xcbf29ce484222325ULL; // FNV-1a, 64 bits
+    for (std::uint8_t b : w.data())
+        h = (h ^ b) * 0x100000001b3ULL;
+    return h;
+}
+
 std::vector<std::uint8_t> encodeSnapshot(const Snapshot& s) {
     ByteWriter w;
     std::size_t estimate = 64 + 10 * s.structure.nodes.size() + 25 * s.structure.bonds.size();

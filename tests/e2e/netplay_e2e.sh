@@ -51,7 +51,7 @@ host, join = open(sys.argv[1]).read(), open(sys.argv[2]).read()
 h = re.search(r"host: (\d+) clients joined, (\d+) syncs sent, (\d+) acknowledged, (\d+) mismatched hashes, "
               r"geometry hash ([0-9a-f]+)", host)
 j = re.search(r"join: (.*); joined yes \(([\d.]+) ms\), (\d+) events, (\d+) syncs checked, (\d+) mismatched hashes, "
-              r"(\d+) placements, (\d+) frames drawn, geometry hash ([0-9a-f]+)", join)
+              r"(\d+) placements, (\d+) frames drawn, \d+ shots asked, geometry hash ([0-9a-f]+)", join)
 assert h and j, (host[-500:], join[-500:])
 assert "host closed the connection" in j.group(1), j.group(0)
 assert int(h.group(1)) == 1 and int(h.group(4)) == 0, h.group(0)

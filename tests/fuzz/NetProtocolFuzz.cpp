@@ -1,14 +1,16 @@
-// Fuzz target: the netplay message decoders (adapters/enet: placements, journal events, placement acks). The
-// first byte picks what the rest is: a placements datagram for a decoder that holds baselines, an events
-// message, or acknowledgements for an encoder with datagrams in flight. Decoding must never crash; an
-// accepted placements datagram must decode the same again, and accepted events must encode back to the same
-// bytes when their fields are in range.
+// Fuzz target: the netplay message decoders (adapters/enet: placements, journal events, placement acks,
+// hello, join snapshot). The first byte picks what the rest is: a placements datagram for a decoder that
+// holds baselines, an events message, or acknowledgements for an encoder with datagrams in flight (byte % 3);
+// from 250 on, a client's hello (even) or a host's snapshot message for an empty world (odd). Decoding must
+// never crash; an accepted placements datagram must decode the same again, and accepted events must encode
+// back to the same bytes when their fields are in range.
 #include <cstdint>
 #include <cstdio>
 #include <vector>
 
 #include "Events.hpp"
 #include "FuzzInput.hpp"
+#include "JoinSnapshot.hpp"
 #include "Placements.hpp"
 
 namespace {
@@ -34,7 +36,8 @@ Quantized state(std::uint32_t i) {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     fuzz::FuzzInput in(data, size);
-    const std::uint8_t mode = in.byte() % 3;
+    const std::uint8_t first = in.byte();
+    const int mode = first >= 250 ? 3 + first % 2 : first % 3;
     const std::uint8_t* body = data + (size > 0 ? 1 : 0);
     const std::size_t n = size > 0 ? size - 1 : 0;
     if (mode == 0) {
@@ -70,6 +73,18 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         } else if (!out.empty()) {
             fail("a refused events message added events");
         }
+    } else if (mode == 3) {
+        KnownObjects known, again;
+        if (decodeHello(body, n, known) && (!decodeHello(body, n, again) || again != known))
+            fail("an accepted hello decodes differently the second time");
+    } else if (mode == 4) {
+        static DestructionWorld empty([] {
+            DestructionWorld::Config c;
+            c.workers = 1;
+            c.deterministic = true;
+            return c;
+        }());
+        (void)decodeJoinSnapshot(body, n, empty);
     } else {
         PlacementEncoder encoder;
         std::vector<std::pair<ObjectId, Quantized>> now;

@@ -11,6 +11,10 @@
 
 #include "JournalScene.hpp"
 #include "NetWait.hpp"
+#include "TestSupport.hpp"
+#include "rubble/persist/JournalFile.hpp"
+#include "rubble/persist/Snapshot.hpp"
+#include "rubble/runtime/JournalPlayer.hpp"
 
 namespace rubble {
 namespace {
@@ -124,6 +128,67 @@ TEST(NetLoopback, ClientsConvergeToTheHostsGeometryHash) {
         "bytes\n",
         h.stats().eventsSent, bytesPerEvent, h.stats().snapshotBytes, second->stats().joinMs,
         h.stats().placementBytes);
+}
+
+TEST(NetLoopback, AClientKeepsAReplayOfTheGameWhenTheHostStops) {
+    test::JournalRig host(1);
+    const DestructionWorld::Config config = test::journalConfig(1).world;
+    auto server = net::NetHost::listen(host.runtime.world(), config, "127.0.0.1", 0);
+    ASSERT_TRUE(server) << server.error().message;
+    host.play(30); // some fractures before the client joins, more after
+    DestructionWorld world(config);
+    auto client = net::NetClient::connect(world, config, "127.0.0.1", (*server)->port());
+    ASSERT_TRUE(client) << client.error().message;
+    EXPECT_FALSE((*client)->writeReplay(test::tempDir("net_replay") / "early.rbsn",
+                                        test::tempDir("net_replay") / "early.rbj"));
+    Status ending;
+    const auto pump = [&] {
+        if (*server)
+            (*server)->service(1);
+        ending = (*client)->service(1);
+        return ending.ok();
+    };
+    ASSERT_TRUE(test::waitFor([&] { return (*client)->stats().joined; }, pump));
+    const std::uint64_t joinedAt = host.runtime.world().frame();
+    for (int frame = 0; frame < 120; ++frame) {
+        host.play(1);
+        (*server)->publish();
+        ASSERT_TRUE(pump());
+    }
+    host.settle();
+    (*server)->publish();
+    const std::uint64_t last = host.runtime.world().frame(), hash = host.runtime.world().geometryHash();
+    ASSERT_TRUE(test::waitFor([&] { return (*client)->stats().frame == last; }, pump));
+    bool closed = false; // the host stops: the client hears it at once, not after ENet's timeout
+    ASSERT_TRUE(test::waitFor([&] { return closed && !ending; },
+                              [&] {
+                                  closed = closed || (*server)->close(10);
+                                  if (ending)
+                                      ending = (*client)->service(1);
+                                  return true;
+                              }));
+    server->reset();
+    EXPECT_EQ(ending.error().code, ErrorCode::IoError);
+    EXPECT_NE(ending.message().find("closed"), std::string::npos) << ending.message();
+    ASSERT_EQ(world.geometryHash(), hash);
+
+    const std::filesystem::path dir = test::tempDir("net_replay");
+    ASSERT_TRUE((*client)->writeReplay(dir / "game.rbsn", dir / "game.rbj"));
+    Result<Snapshot> snapshot = loadSnapshot(dir / "game.rbsn");
+    Result<JournalFile> journal = readJournal(dir / "game.rbj");
+    ASSERT_TRUE(snapshot) << snapshot.error().message;
+    ASSERT_TRUE(journal) << journal.error().message;
+    EXPECT_EQ(snapshot->world.frame, joinedAt);
+    ASSERT_TRUE(checkJournalHeader(journal->header, config));
+    ASSERT_FALSE(journal->events.empty()) << "fractures after the join";
+    DestructionWorld replay(config);
+    ASSERT_TRUE(restoreSnapshot(replay, std::move(*snapshot)));
+    ASSERT_NE(replay.geometryHash(), hash);
+    JournalPlayer player(replay);
+    for (const JournalEvent& e : journal->events)
+        ASSERT_TRUE(player.receive(e));
+    ASSERT_TRUE(player.advanceTo(last));
+    EXPECT_EQ(replay.geometryHash(), hash);
 }
 
 TEST(NetLoopback, OnlyLoopbackAddressesAndDeterministicWorlds) {

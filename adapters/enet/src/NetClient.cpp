@@ -7,6 +7,7 @@
 #include <algorithm>
 
 #include "Events.hpp"
+#include "JoinSnapshot.hpp"
 #include "Placements.hpp"
 #include "Protocol.hpp"
 #include "rubble/core/Random.hpp"
@@ -53,7 +54,9 @@ struct NetClient::Impl {
     detail::PlacementDecoder decoder;
     std::deque<detail::WireEvent> held; // events received, applied when the world reaches their tick
     std::vector<detail::WireEvent> arrived;
-    std::uint64_t seed = 0; // the host world's seed (from the snapshot)
+    std::uint64_t seed = 0;             // the host world's seed (from the snapshot)
+    std::optional<Snapshot> joinedWith; // the snapshot it joined with (for a replay)
+    std::vector<JournalEvent> applied;  // every event applied since
 
     // Applies the held events of the world's current frame, with the fields the host left out.
     Status applyHeld() {
@@ -77,6 +80,7 @@ struct NetClient::Impl {
             }
             if (Status st = player.receive(e); !st)
                 return st;
+            applied.push_back(e);
         }
         return Status::ok();
     }
@@ -129,14 +133,81 @@ struct NetClient::Impl {
         detail::sendUnreliable(server, ack);
     }
 
-    Status receive(const ENetPacket* packet) {
-        const std::uint8_t* d = packet->data;
-        const std::size_t n = packet->dataLength;
+    // The snapshot's chunks as they arrive (Message::SnapshotChunk), and what it acknowledges.
+    struct Incoming {
+        std::uint32_t id = 0, total = 0;
+        std::vector<std::uint8_t> bytes;
+        std::vector<bool> got;
+        std::size_t left = 0;
+    } incoming;
+    std::uint32_t doneTransfer = 0; // the transfer it has whole (its chunks are acknowledged, all of them)
+    std::size_t doneChunks = 0;
+    bool ackDue = false;
+    std::vector<std::vector<std::uint8_t>> early; // events messages that came before the snapshot was whole
+
+    // A chunk of the snapshot; the whole message is loaded once every chunk is in. Malformed chunks (the
+    // unreliable channel) are dropped.
+    Status chunk(const std::uint8_t* d, std::size_t n) {
+        if (n < 13)
+            return Status::ok();
+        const std::uint32_t id = detail::readU32(d + 1), index = detail::readU32(d + 5),
+                            total = detail::readU32(d + 9);
+        ackDue = true;
+        if (id == doneTransfer || (stats.joined && id != incoming.id) || total == 0 || total > (1u << 30))
+            return Status::ok();
+        const std::size_t count = (total + detail::kSnapshotChunk - 1) / detail::kSnapshotChunk;
+        if (incoming.id != id) {
+            incoming = {id, total, std::vector<std::uint8_t>(total), std::vector<bool>(count), count};
+        }
+        const std::size_t at = static_cast<std::size_t>(index) * detail::kSnapshotChunk;
+        if (incoming.total != total || index >= count ||
+            n != 13 + std::min(detail::kSnapshotChunk, total - at))
+            return Status::ok();
+        if (!incoming.got[index]) {
+            std::copy(d + 13, d + n, incoming.bytes.begin() + static_cast<std::ptrdiff_t>(at));
+            incoming.got[index] = true;
+            --incoming.left;
+        }
+        if (incoming.left > 0)
+            return Status::ok();
+        doneTransfer = id;
+        doneChunks = count;
+        const std::vector<std::uint8_t> whole = std::move(incoming.bytes);
+        incoming = {};
+        if (Status st = receive(whole.data(), whole.size()); !st)
+            return st;
+        for (const std::vector<std::uint8_t>& m : early) // then what came meanwhile, in order
+            if (Status st = receive(m.data(), m.size()); !st)
+                return st;
+        early.clear();
+        return Status::ok();
+    }
+
+    // Tells the host which chunks it has (once per service, when chunks came).
+    void acknowledgeChunks() {
+        if (!ackDue || !server)
+            return;
+        ackDue = false;
+        const std::uint32_t id = doneTransfer ? doneTransfer : incoming.id;
+        const std::size_t count = doneTransfer ? doneChunks : incoming.got.size();
+        std::vector<std::uint8_t> ack{static_cast<std::uint8_t>(Message::SnapshotAck)};
+        for (int b = 0; b < 4; ++b)
+            ack.push_back(static_cast<std::uint8_t>(id >> (8 * b)));
+        ack.resize(5 + (count + 7) / 8, 0);
+        for (std::size_t i = 0; i < count; ++i)
+            if (doneTransfer || incoming.got[i])
+                ack[5 + i / 8] |= static_cast<std::uint8_t>(1u << (i % 8));
+        detail::sendUnreliable(server, ack);
+        enet_host_flush(host);
+    }
+
+    Status receive(const std::uint8_t* d, std::size_t n) {
         if (n == 0)
             return Error{ErrorCode::ParseError, "netplay: empty message"};
         switch (static_cast<Message>(d[0])) {
         case Message::Snapshot: {
-            Result<Snapshot> s = decodeSnapshot(d + 1, n - 1, "host snapshot");
+            const Clock::time_point received = Clock::now();
+            Result<Snapshot> s = detail::decodeJoinSnapshot(d, n, world);
             if (!s)
                 return s.error();
             const double frame = static_cast<double>(s->world.frame);
@@ -147,19 +218,25 @@ struct NetClient::Impl {
                 baselines.setBaseline(p.object, detail::quantize(p.objectToWorld));
             }
             const std::uint64_t hostSeed = s->world.seed;
+            Snapshot kept = *s;
             if (Status st = restoreSnapshot(world, std::move(*s)); !st)
                 return st;
+            joinedWith = std::move(kept);
+            applied.clear();
             tracks = std::move(fresh);
             decoder = std::move(baselines);
             held.clear();
             seed = hostSeed;
             stats.joined = true;
             stats.joinMs = std::chrono::duration<double, std::milli>(Clock::now() - connected).count();
+            stats.snapshotLoadMs = std::chrono::duration<double, std::milli>(Clock::now() - received).count();
             return Status::ok();
         }
         case Message::Events: {
-            if (!stats.joined)
-                return Error{ErrorCode::InvalidInput, "netplay: events before the snapshot"};
+            if (!stats.joined) { // the snapshot is still on its way
+                early.emplace_back(d, d + n);
+                return Status::ok();
+            }
             arrived.clear();
             if (!detail::decodeEvents(d, n, arrived))
                 return Error{ErrorCode::ParseError,
@@ -198,6 +275,8 @@ struct NetClient::Impl {
         case Message::Placements:
             placements(d, n);
             return Status::ok();
+        case Message::SnapshotChunk:
+            return chunk(d, n);
         default:
             return Error{ErrorCode::ParseError, "netplay: unknown message type " + std::to_string(d[0])};
         }
@@ -244,12 +323,14 @@ Status NetClient::service(int timeoutMs) {
         if (e.type == ENET_EVENT_TYPE_CONNECT) {
             im.stats.connected = true;
             detail::configurePeer(im.server);
+            if (!detail::sendReliable(im.server, detail::encodeHello(im.world)))
+                return Error{ErrorCode::IoError, "netplay: cannot send the hello"};
         } else if (e.type == ENET_EVENT_TYPE_RECEIVE) {
             const Clock::time_point now = Clock::now();
             if (now - im.heard > std::chrono::milliseconds(300) && im.server)
                 detail::retransmitSoon(im.server); // the host was silent: an outage ended
             im.heard = now;
-            Status s = im.receive(e.packet);
+            Status s = im.receive(e.packet->data, e.packet->dataLength);
             enet_packet_destroy(e.packet);
             if (!s)
                 return s;
@@ -259,6 +340,7 @@ Status NetClient::service(int timeoutMs) {
                                                                 : "netplay: no host answered"};
         }
     }
+    im.acknowledgeChunks();
     if (r < 0)
         return Error{ErrorCode::IoError, "netplay: ENet service failed"};
     return Status::ok();
@@ -307,6 +389,25 @@ Status NetClient::shoot(const Vec3& origin, const Vec3& velocity) {
         return Error{ErrorCode::IoError, "netplay: cannot send a shot"};
     enet_host_flush(impl_->host);
     return Status::ok();
+}
+
+Status NetClient::writeReplay(const std::filesystem::path& snapshot,
+                              const std::filesystem::path& journal) const {
+    const Impl& im = *impl_;
+    if (!im.joinedWith)
+        return Error{ErrorCode::InvalidInput, "netplay: no replay before the join"};
+    if (Status st = saveSnapshot(snapshot, *im.joinedWith); !st)
+        return st;
+    JournalFile file;
+    const WorldState& w = im.joinedWith->world;
+    file.header.seed = w.seed;
+    file.header.delayFrames = w.delayFrames;
+    file.header.crumbleTriangles = w.crumbleTriangles;
+    file.header.crumbleCells = w.crumbleCells;
+    file.header.minPieceVolume = w.minPieceVolume;
+    file.header.scene = snapshot.filename().string(); // what the events replay on
+    file.events = im.applied;
+    return writeJournal(journal, file);
 }
 
 std::optional<double> NetClient::placementFrame(ObjectId object) const {

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "Events.hpp"
+#include "JoinSnapshot.hpp"
 #include "Placements.hpp"
 #include "Protocol.hpp"
 #include "rubble/persist/JournalFile.hpp"
@@ -26,6 +27,7 @@ struct NetHost::Impl {
     std::map<ENetPeer*, std::uint64_t> peers;      // journal position each client has been sent up to
     std::map<ENetPeer*, std::uint64_t> acked;      // the latest frame each client confirmed
     std::uint64_t lastSync = 0;                    // frame of the latest sync sent
+    std::uint64_t lastSyncPosition = 0;            // the journal position it named
     std::map<std::uint64_t, std::uint64_t> hashes; // frame → geometry hash sent in its sync (recent ones)
     HostStats stats;
     std::function<std::vector<ObjectPlacement>()> placementSource;
@@ -37,6 +39,89 @@ struct NetHost::Impl {
     std::function<void(const ShotRequest&)> shotHandler;
     ShotRules shotRules;
     std::map<ENetPeer*, double> shotTokens; // each client's bucket
+    bool closing = false;                   // close() was called
+    // A snapshot on its way to a client in datagram-sized chunks on channel 1, each sent again until the
+    // client acknowledged it: no reliable window, so it goes at the pace below whatever the round trip.
+    struct Transfer {
+        std::uint32_t id = 0;
+        std::vector<std::uint8_t> bytes; // the Snapshot message
+        std::vector<bool> acked;
+        std::vector<std::chrono::steady_clock::time_point> sent; // last sent (epoch: never)
+        std::uint64_t frame = 0;                                 // the snapshot's frame
+        std::chrono::steady_clock::time_point started;
+    };
+    std::map<ENetPeer*, Transfer> transfers;
+    std::chrono::steady_clock::time_point lastPump;
+    std::uint32_t nextTransfer = 1;
+
+    // Sends each transfer's chunks that are new or unacknowledged for longer than a round trip, at most
+    // `budget` per client.
+    void pump(std::size_t budget) {
+        const auto now = std::chrono::steady_clock::now();
+        if (transfers.empty() || now - lastPump < std::chrono::milliseconds(8))
+            return; // paced: at most 64 datagrams per 8 ms per client
+        lastPump = now;
+        for (auto it = transfers.begin();
+             it != transfers.end();) { // a client that never has it all is dropped
+            if (now - it->second.started > std::chrono::seconds(30)) {
+                enet_peer_disconnect(it->first, 0);
+                it = transfers.erase(it);
+            } else {
+                ++it;
+            }
+        }
+        for (auto& [peer, t] : transfers) {
+            const auto resend =
+                std::chrono::milliseconds(10 + peer->roundTripTime + peer->roundTripTimeVariance);
+            std::size_t n = 0;
+            for (std::size_t i = 0; i < t.acked.size() && n < budget; ++i) {
+                if (t.acked[i] || (t.sent[i].time_since_epoch().count() != 0 && now - t.sent[i] < resend))
+                    continue;
+                const std::size_t at = i * detail::kSnapshotChunk;
+                const std::size_t len = std::min(detail::kSnapshotChunk, t.bytes.size() - at);
+                std::vector<std::uint8_t> msg{static_cast<std::uint8_t>(Message::SnapshotChunk)};
+                for (std::uint32_t v :
+                     {t.id, static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(t.bytes.size())})
+                    for (int b = 0; b < 4; ++b)
+                        msg.push_back(static_cast<std::uint8_t>(v >> (8 * b)));
+                msg.insert(msg.end(), t.bytes.begin() + static_cast<std::ptrdiff_t>(at),
+                           t.bytes.begin() + static_cast<std::ptrdiff_t>(at + len));
+                detail::sendUnreliable(peer, msg);
+                t.sent[i] = now;
+                ++n;
+            }
+        }
+        enet_host_flush(host);
+    }
+
+    // A sync: everything sent so far, applied up to `frame`, gives `hash`.
+    void sendSync(ENetPeer* peer, std::uint64_t frame, std::uint64_t position, std::uint64_t hash) {
+        std::vector<std::uint8_t> sync{static_cast<std::uint8_t>(Message::Sync)};
+        detail::appendU64(sync, frame);
+        detail::appendU64(sync, position);
+        detail::appendU64(sync, hash);
+        detail::sendReliable(peer, sync);
+        ++stats.syncs;
+    }
+
+    // A client's SnapshotAck: the chunks it has are not sent again; once it has all, the transfer ends.
+    void snapshotAck(ENetPeer* peer, const std::uint8_t* d, std::size_t n) {
+        const auto t = transfers.find(peer);
+        if (t == transfers.end() || n < 5 || detail::readU32(d + 1) != t->second.id ||
+            n != 5 + (t->second.acked.size() + 7) / 8)
+            return;
+        bool all = true;
+        for (std::size_t i = 0; i < t->second.acked.size(); ++i) {
+            t->second.acked[i] = t->second.acked[i] || ((d[5 + i / 8] >> (i % 8)) & 1);
+            all = all && t->second.acked[i];
+        }
+        if (!all)
+            return;
+        const std::uint64_t frame = t->second.frame;
+        transfers.erase(t);
+        if (lastSync >= frame && hashes.count(lastSync)) // the latest sync, which it was not sent
+            sendSync(peer, lastSync, lastSyncPosition, hashes[lastSync]);
+    }
 
     // A client's shot: fired through the handler if it passes the rules, else counted as refused.
     void shot(ENetPeer* peer, const std::uint8_t* d, std::size_t n) {
@@ -59,24 +144,37 @@ struct NetHost::Impl {
         shotHandler(r);
     }
 
-    void join(ENetPeer* peer) {
-        detail::configurePeer(peer);
-        std::vector<std::uint8_t> msg{static_cast<std::uint8_t>(Message::Snapshot)};
+    // A client's Hello: it gets the snapshot, without the objects it has already.
+    void join(ENetPeer* peer, const detail::KnownObjects& known) {
+        const auto started = std::chrono::steady_clock::now();
         std::vector<ObjectPlacement> placements =
             placementSource ? placementSource() : std::vector<ObjectPlacement>{};
         detail::PlacementEncoder& encoder = encoders[peer] = {};
         for (const ObjectPlacement& p : placements) // the client has these from its snapshot
             encoder.setBaseline(p.object, detail::quantize(p.objectToWorld));
-        const std::vector<std::uint8_t> bytes = encodeSnapshot(takeSnapshot(world, std::move(placements)));
-        msg.insert(msg.end(), bytes.begin(), bytes.end());
-        if (!detail::sendReliable(peer, msg)) {
+        detail::JoinSnapshotSize size;
+        const std::vector<std::uint8_t> msg =
+            detail::encodeJoinSnapshot(takeSnapshot(world, std::move(placements)), known, &size);
+        if (msg.empty()) {
             enet_peer_disconnect(peer, 0);
             return;
         }
+        Transfer& t = transfers[peer];
+        t.id = nextTransfer++;
+        t.bytes = msg;
+        const std::size_t chunks = (msg.size() + detail::kSnapshotChunk - 1) / detail::kSnapshotChunk;
+        t.acked.assign(chunks, false);
+        t.sent.assign(chunks, {});
+        t.frame = world.frame();
+        t.started = std::chrono::steady_clock::now();
         peers[peer] = world.journalPosition();
         joinOrder[peer] = static_cast<std::uint64_t>(stats.joins);
         ++stats.joins;
-        stats.snapshotBytes += static_cast<long long>(bytes.size());
+        stats.snapshotBuildMs +=
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started).count();
+        stats.snapshotBytes += static_cast<long long>(size.wire);
+        stats.snapshotRawBytes += static_cast<long long>(size.raw);
+        stats.snapshotObjectsByReference += static_cast<long long>(size.referenced);
         enet_host_flush(host);
     }
 
@@ -93,6 +191,14 @@ struct NetHost::Impl {
                 e->second.acked(detail::readU32(d + 1), detail::readU32(d + 5));
             return;
         }
+        if (d[0] == static_cast<std::uint8_t>(Message::Hello)) {
+            detail::KnownObjects known;
+            if (!closing && !peers.count(peer) && detail::decodeHello(d, packet->dataLength, known))
+                join(peer, known);
+            return;
+        }
+        if (d[0] == static_cast<std::uint8_t>(Message::SnapshotAck))
+            return snapshotAck(peer, d, packet->dataLength);
         if (d[0] == static_cast<std::uint8_t>(Message::Shot))
             return shot(peer, d, packet->dataLength);
         if (packet->dataLength != 17 || d[0] != static_cast<std::uint8_t>(Message::Ack) || !peers.count(peer))
@@ -153,6 +259,7 @@ void NetHost::publish() {
     for (auto& [peer, tokens] : im.shotTokens) // the shot buckets refill per frame (60 Hz)
         tokens = std::min(im.shotRules.burst, tokens + im.shotRules.perSecond / 60);
     im.lastSync = frame;
+    im.lastSyncPosition = end;
     while (im.hashes.size() > 4096)
         im.hashes.erase(im.hashes.begin());
     for (auto& [peer, position] : im.peers) {
@@ -167,17 +274,14 @@ void NetHost::publish() {
             im.stats.eventBytes += static_cast<long long>(msg.size());
             position = end;
         }
-        std::vector<std::uint8_t> sync{static_cast<std::uint8_t>(Message::Sync)};
-        detail::appendU64(sync, frame);
-        detail::appendU64(sync, end);
-        detail::appendU64(sync, hash);
-        detail::sendReliable(peer, sync);
-        ++im.stats.syncs;
+        if (!im.transfers.count(peer)) // else its snapshot is on its way: it keeps the events meanwhile
+            im.sendSync(peer, frame, end, hash);
     }
     // Every client has been sent everything, and a client that joins later gets a snapshot: nothing to keep.
     im.journal.clear();
     im.base = end;
     enet_host_flush(im.host);
+    im.pump(64);
 }
 
 void NetHost::publishPlacements(const std::vector<ObjectPlacement>& placements) {
@@ -222,6 +326,24 @@ bool NetHost::finish(int timeoutMs) {
     return confirmed();
 }
 
+bool NetHost::close(int timeoutMs) {
+    Impl& im = *impl_;
+    im.closing = true;
+    for (ENetPeer* peer = im.host->peers; peer < im.host->peers + im.host->peerCount; ++peer)
+        if (peer->state != ENET_PEER_STATE_DISCONNECTED)
+            enet_peer_disconnect(peer, 0);
+    const auto connected = [&im] {
+        for (ENetPeer* peer = im.host->peers; peer < im.host->peers + im.host->peerCount; ++peer)
+            if (peer->state != ENET_PEER_STATE_DISCONNECTED)
+                return true;
+        return false;
+    };
+    const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeoutMs);
+    while (connected() && std::chrono::steady_clock::now() < end)
+        service(5);
+    return !connected();
+}
+
 void NetHost::setPlacementSource(std::function<std::vector<ObjectPlacement>()> source) {
     impl_->placementSource = std::move(source);
 }
@@ -232,8 +354,10 @@ void NetHost::service(int timeoutMs) {
     for (int r = enet_host_service(im.host, &e, static_cast<enet_uint32>(std::max(0, timeoutMs))); r > 0;
          r = enet_host_service(im.host, &e, 0)) {
         switch (e.type) {
-        case ENET_EVENT_TYPE_CONNECT:
-            im.join(e.peer);
+        case ENET_EVENT_TYPE_CONNECT: // it joins with its Hello
+            detail::configurePeer(e.peer);
+            if (im.closing)
+                enet_peer_disconnect(e.peer, 0);
             break;
         case ENET_EVENT_TYPE_RECEIVE:
             im.receive(e.peer, e.packet);
@@ -245,12 +369,14 @@ void NetHost::service(int timeoutMs) {
             im.encoders.erase(e.peer);
             im.heard.erase(e.peer);
             im.joinOrder.erase(e.peer);
+            im.transfers.erase(e.peer);
             im.shotTokens.erase(e.peer);
             break;
         default:
             break;
         }
     }
+    im.pump(64);
     im.stats.clients = static_cast<int>(im.peers.size());
 }
 

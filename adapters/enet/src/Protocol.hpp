@@ -18,13 +18,17 @@ namespace rubble::net::detail {
 
 /// Message types (first byte of every packet; on channel 0, reliable and ordered, unless said).
 enum class Message : std::uint8_t {
-    Snapshot = 1,     ///< the snapshot bytes (rubble/persist/Snapshot.hpp)
+    Snapshot = 1,     ///< objects sent by id, then the deflated snapshot (JoinSnapshot.hpp)
     Events = 2,       ///< u32 count, then count × 48-byte journal events
     Sync = 3,         ///< u64 frame, u64 journal position, u64 geometry hash
     Ack = 4,          ///< client → host: u64 frame, u64 its geometry hash after that sync
     Placements = 5,   ///< channel 1, unreliable: u32 seq, then varints and records (Placements.hpp)
     PlacementAck = 6, ///< client → host, channel 1, unreliable: u32 latest seq, u32 mask of the 32 before
-    Shot = 7, ///< client → host: 3 f32 origin, 3 f32 velocity (the host checks it, then fires it or not)
+    Shot = 7,  ///< client → host: 3 f32 origin, 3 f32 velocity (the host checks it, then fires it or not)
+    Hello = 8, ///< client → host, first: the objects it has (JoinSnapshot.hpp); the host answers a Snapshot
+    SnapshotChunk =
+        9, ///< channel 1: u32 transfer, u32 index, u32 total bytes, then a piece of a Snapshot message
+    SnapshotAck = 10, ///< client → host, channel 1: u32 transfer, then one bit per chunk it has
 };
 
 /// Appends a little-endian float.
@@ -113,6 +117,9 @@ inline bool sendUnreliable(ENetPeer* peer, const std::vector<std::uint8_t>& byte
     }
     return true;
 }
+
+/// Bytes of a Snapshot message per SnapshotChunk (one datagram each).
+inline constexpr std::size_t kSnapshotChunk = 1100;
 
 /// Sends bytes reliably on channel 0.
 inline bool sendReliable(ENetPeer* peer, const std::vector<std::uint8_t>& bytes) {

@@ -37,6 +37,9 @@ RUBBLE_API Status restoreSnapshot(DestructionWorld& world, Snapshot snapshot);
 /// fails, changing nothing, like restoreSnapshot(world, ...) or when the placements do not match the objects.
 RUBBLE_API Status restoreSnapshot(DestructionRuntime& runtime, Snapshot snapshot);
 
+/// A 64-bit hash of everything a snapshot stores of an object (its bytes there): two states with equal hashes
+/// are interchangeable, e.g. a scene object a joining client loaded itself (netplay).
+RUBBLE_API std::uint64_t objectStateHash(const ObjectState& object);
 /// The snapshot's bytes.
 RUBBLE_API std::vector<std::uint8_t> encodeSnapshot(const Snapshot& snapshot);
 /// Parses a snapshot; a truncated, corrupted, wrong-version or hostile input gives an error naming source,

@@ -4,6 +4,7 @@
 /// and checks its geometry hash against the host's at every frame sync (docs/netplay.md).
 
 #include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -19,6 +20,7 @@ struct ClientStats {
     bool connected = false;         ///< the host accepted the connection
     bool joined = false;            ///< the snapshot arrived and was loaded
     double joinMs = 0;              ///< connect → snapshot loaded (ms)
+    double snapshotLoadMs = 0;      ///< of joinMs: inflating, decoding and loading the snapshot (ms)
     long long events = 0;           ///< journal events applied
     long long syncs = 0;            ///< frame syncs checked
     long long mismatchedHashes = 0; ///< syncs whose geometry hash differed from the host's
@@ -28,7 +30,9 @@ struct ClientStats {
 };
 
 /// A client of a NetHost on a loopback address. Its world must be built with the host's settings (any
-/// worker count); the snapshot replaces its content.
+/// worker count); the snapshot replaces its content. Objects the world has when it connects (e.g. the scene,
+/// loaded by the client itself) are announced to the host, which then sends by id those it has in the same
+/// state: a client that loaded the host's scene joins with a much smaller snapshot.
 class NetClient {
 public:
     /// Starts connecting to address:port (a loopback address); service() completes it (ENet gives up after
@@ -50,6 +54,10 @@ public:
     /// Asks the host to fire a shot (it checks it first: docs/netplay.md, 'Trust model'). Fails when not
     /// connected.
     Status shoot(const Vec3& origin, const Vec3& velocity);
+    /// Saves what replays this game up to now: the snapshot it joined with (saveSnapshot) and every journal
+    /// event applied since (writeJournal); restoreSnapshot and a JournalPlayer then rebuild its world. Call
+    /// it when the host stopped (service() failed with an IoError) to keep the game. Fails before the join.
+    Status writeReplay(const std::filesystem::path& snapshot, const std::filesystem::path& journal) const;
     /// Host frame of the latest placement received for an object (empty when none arrived).
     std::optional<double> placementFrame(ObjectId object) const;
     /// Called for every outcome the world adopts (its pieces are in the world already).

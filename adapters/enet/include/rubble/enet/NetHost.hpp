@@ -1,7 +1,8 @@
 #pragma once
 /// \file NetHost.hpp
-/// The authoritative side of loopback multiplayer: sends a joining client a snapshot, then every journal
-/// event and, once per frame, the frame number with the geometry hash it must match (docs/netplay.md).
+/// The authoritative side of loopback multiplayer: sends a joining client a snapshot (deflated, without the
+/// objects it announced it has in the same state), then every journal event and, once per frame, the frame
+/// number with the geometry hash it must match (docs/netplay.md).
 
 #include <cstdint>
 #include <functional>
@@ -17,14 +18,17 @@ namespace rubble::net {
 
 /// Totals of a host.
 struct HostStats {
-    int clients = 0;              ///< clients connected now
-    long long joins = 0;          ///< clients that joined (each got a snapshot)
-    long long eventsSent = 0;     ///< journal events sent (per client)
-    long long eventBytes = 0;     ///< bytes of journal event messages sent (per client, payload)
-    long long snapshotBytes = 0;  ///< bytes of snapshots sent
-    long long syncs = 0;          ///< frame syncs sent (per client)
-    long long impactEvents = 0;   ///< of eventsSent: impacts (the rest are removals)
-    long long placementBytes = 0; ///< bytes of placement messages sent (per client, payload)
+    int clients = 0;                          ///< clients connected now
+    long long joins = 0;                      ///< clients that joined (each got a snapshot)
+    long long eventsSent = 0;                 ///< journal events sent (per client)
+    long long eventBytes = 0;                 ///< bytes of journal event messages sent (per client, payload)
+    long long snapshotBytes = 0;              ///< bytes of snapshot messages sent (deflated)
+    long long snapshotRawBytes = 0;           ///< what they inflate to (the objects the clients did not have)
+    long long snapshotObjectsByReference = 0; ///< objects sent by id: the client had them in that state
+    double snapshotBuildMs = 0;               ///< time spent taking, encoding and deflating snapshots (ms)
+    long long syncs = 0;                      ///< frame syncs sent (per client)
+    long long impactEvents = 0;               ///< of eventsSent: impacts (the rest are removals)
+    long long placementBytes = 0;             ///< bytes of placement messages sent (per client, payload)
     long long legacyPlacementBytes =
         0;                          ///< what the 32-byte float records of every dynamic body would have been
     long long acks = 0;             ///< clients' hash reports received
@@ -79,6 +83,10 @@ public:
     /// Handles the network until every connected client confirmed the latest sync (or timeoutMs passed);
     /// true when they all did. Call before closing, so that the clients end in the host's state.
     bool finish(int timeoutMs);
+    /// Stops serving: tells every client the host is going (they get an IoError from service() and can keep
+    /// their replay, NetClient::writeReplay) and handles the network until they all confirmed or timeoutMs
+    /// passed; true when they all did. Later clients are refused.
+    bool close(int timeoutMs);
     /// Where joining clients' snapshots get the bodies' placements from (e.g. the runtime's placements()).
     void setPlacementSource(std::function<std::vector<ObjectPlacement>()> source);
     /// Handles the network (joins, leaves, clients' hash reports) for up to timeoutMs.
