@@ -340,6 +340,10 @@ int runMegaImpact(const MegaArgs& args) {
                "other_cpu_cores"},
               {}};
     std::ostringstream data;
+    Table worldTable{{"mesh", "tris", "hits", "kernel med ms", "world med ms", "max", "world/kernel",
+                      "prepare", "boolean", "islands", "parts", "finish", "adoption", "shapes", "B/tri"},
+                     {}};
+    Table worldCsv{worldRowHeader(), {}};
     for (const std::string& kind : args.kinds)
         for (std::size_t size : args.sizes) {
             const Mesh mesh = withAttributes(megaMesh(kind, size));
@@ -352,12 +356,17 @@ int runMegaImpact(const MegaArgs& args) {
             // What an object knows of its mesh once it is added (checked and measured once, untimed).
             const MeshFacts facts = args.facts ? analyzeMesh(mesh).value() : MeshFacts{};
             HitSamples s;
+            std::vector<Impact> impacts;
             for (int h = 0; h < args.hits; ++h) {
                 const Impact impact = randomHit(mesh, static_cast<std::uint64_t>(h));
+                impacts.push_back(impact);
                 hitOnce(mesh, roomyCopy(mesh), roomyCopy(facts), d->parts, impact,
                         static_cast<std::uint64_t>(h), s);
             }
             addImpactRows(name, kind, mesh.triangles.size(), s, false, table, csv, data);
+            if (args.world && !addWorldRow(name, mesh, d->parts, hitParams(mesh), impacts,
+                                           stats(s.withParts).median, worldTable, worldCsv))
+                return 1;
         }
     // Chained hits: the largest piece of each hit is hit again, with the parts its update gave it.
     Table hits; // one row per hit of the chains (thread CPU ms), to find the slow ones and what they did
@@ -414,6 +423,8 @@ int runMegaImpact(const MegaArgs& args) {
                   << " triangles)\n";
     }
     if (args.chain > 0 && !writeCsv(std::filesystem::path(args.out) / "impact_megamesh_chain.csv", hits))
+        return 1;
+    if (args.world && !finishTable(cpu, worldTable, worldCsv, args.out, "impact_megamesh_world.csv"))
         return 1;
     if (!finishTable(cpu, table, csv, args.out, "impact_megamesh.csv"))
         return 1;
