@@ -341,7 +341,7 @@ int runMegaImpact(const MegaArgs& args) {
               {}};
     std::ostringstream data;
     Table worldTable{{"mesh", "tris", "hits", "kernel med ms", "world med ms", "max", "world/kernel",
-                      "prepare", "boolean", "islands", "parts", "finish", "adoption", "shapes", "B/tri"},
+                      "prepare", "boolean", "islands", "parts", "finish", "adoption", "shapes", "heap B/tri"},
                      {}};
     Table worldCsv{worldRowHeader(), {}};
     for (const std::string& kind : args.kinds)

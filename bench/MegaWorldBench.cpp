@@ -7,6 +7,7 @@
 #include <iostream>
 #include <sstream>
 
+#include <malloc.h>
 #include <unistd.h>
 
 #include "BenchUtil.hpp"
@@ -25,6 +26,12 @@ double residentMb() {
     long pages = 0, resident = 0;
     in >> pages >> resident;
     return static_cast<double>(resident) * static_cast<double>(sysconf(_SC_PAGESIZE)) / (1024.0 * 1024.0);
+}
+
+// Bytes the heap holds in use (freed blocks that malloc keeps are not counted, unlike in resident memory).
+double heapInUseMb() {
+    const struct mallinfo2 m = mallinfo2();
+    return static_cast<double>(m.uordblks + m.hblkhd) / (1024.0 * 1024.0);
 }
 
 std::vector<std::string> worldRowHeader() {
@@ -66,20 +73,21 @@ bool addWorldRow(const std::string& name, const Mesh& mesh, const std::vector<Co
     DestructionRuntime runtime(binding, rc);
     std::vector<double> total, queue, prepare, cell, boolean, islands, decomposition, finish, handoff,
         adoption, mainAdopt, shapes, pieces;
-    double objectMb = 0;
+    double objectMb = 0, objectHeapMb = 0;
     int failures = 0;
     for (const Impact& hit : hits) {
         ObjectDesc desc;
         desc.mesh = mesh;
         desc.convexParts = parts;
         desc.fracture = params;
-        const double before = residentMb();
+        const double before = residentMb(), heapBefore = heapInUseMb();
         auto id = runtime.addObject(std::move(desc), Frame{}, true);
         if (!id) {
             std::cerr << name << ": " << id.error().message << "\n";
             return false;
         }
         objectMb = std::max(objectMb, residentMb() - before);
+        objectHeapMb = std::max(objectHeapMb, heapInUseMb() - heapBefore);
         const BodyId body = runtime.bodyOf(*id)->id;
         const std::size_t records = runtime.world().timings().size();
         if (!runtime.submitImpact(body, hit.point, hit.normal, hit.impulse)) {
@@ -125,7 +133,7 @@ bool addWorldRow(const std::string& name, const Mesh& mesh, const std::vector<Co
     const auto med = [](const std::vector<double>& v) { return stats(v).median; };
     const Stats w = stats(total);
     const double ratio = kernelMedianMs > 0 ? w.median / kernelMedianMs : -1;
-    const double bytesPerTriangle = objectMb * 1024 * 1024 / static_cast<double>(mesh.triangles.size());
+    const double bytesPerTriangle = objectHeapMb * 1024 * 1024 / static_cast<double>(mesh.triangles.size());
     table.rows.push_back({name + " world", std::to_string(mesh.triangles.size()),
                           std::to_string(total.size()), fixed(kernelMedianMs), fixed(w.median), fixed(w.max),
                           fixed(ratio, 2), fixed(med(prepare)), fixed(med(boolean)), fixed(med(islands)),
@@ -142,11 +150,13 @@ bool addWorldRow(const std::string& name, const Mesh& mesh, const std::vector<Co
     for (const auto* v : {&queue, &prepare, &cell, &boolean, &islands, &decomposition, &finish, &handoff,
                           &adoption, &mainAdopt, &shapes})
         row.push_back(fixed(med(*v)));
-    row.insert(row.end(), {fixed(med(pieces), 0), fixed(objectMb, 1), fixed(bytesPerTriangle, 0), ""});
+    row.insert(row.end(), {fixed(med(pieces), 0), fixed(objectMb, 1), fixed(objectHeapMb, 1),
+                           fixed(bytesPerTriangle, 0), ""});
     csv.rows.push_back(std::move(row));
     std::cout << name << " in the world: median " << fixed(w.median) << " ms (" << fixed(ratio, 2)
               << "x the kernel's " << fixed(kernelMedianMs) << "), finish " << fixed(med(finish))
-              << " ms, object " << fixed(objectMb, 1) << " MB resident" << std::endl;
+              << " ms, object " << fixed(objectHeapMb, 1) << " MB in use (" << fixed(objectMb, 1)
+              << " MB resident)" << std::endl;
     return true;
 }
 #else

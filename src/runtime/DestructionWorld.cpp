@@ -10,6 +10,7 @@
 #include <mutex>
 #include <set>
 #include <string>
+#include <utility>
 
 #include "geometry/ClosestPoint.hpp"
 #include "rubble/Log.hpp"
@@ -122,6 +123,31 @@ VolumeIntegrals integralsOf(const MassProperties& m) {
     return v;
 }
 
+// v with 1/16 spare capacity: the growth an in-place edit asks for, so that it does not copy the arrays
+// again.
+template <class T>
+std::vector<T> withRoom(const std::vector<T>& v) {
+    std::vector<T> out;
+    out.reserve(v.size() + v.size() / 16);
+    out.assign(v.begin(), v.end());
+    return out;
+}
+
+// The job's own copy of an object's mesh and facts for a fracture that edits it in place (the object's stays
+// as it is, shared with the engine, until the result is adopted).
+std::pair<Mesh, MeshFacts> editableCopy(const Mesh& m, const MeshFacts& f) {
+    Mesh c;
+    c.positions = withRoom(m.positions);
+    c.triangles = withRoom(m.triangles);
+    c.normals = withRoom(m.normals);
+    c.uvs = withRoom(m.uvs);
+    c.materials = withRoom(m.materials);
+    c.materialNames = m.materialNames;
+    MeshFacts cf = f;
+    cf.topology.twin = withRoom(f.topology.twin);
+    return {std::move(c), std::move(cf)};
+}
+
 // A remainder above kTopologyAboveTriangles that the kernel edited in place (its facts fit, with a topology):
 // it keeps its parent's frame, the kernel's facts and mass properties.
 bool keepsParentFrame(const Piece& piece, const Mesh& mesh) {
@@ -150,7 +176,13 @@ void runJob(Job& job) {
         job.facts.integrals = integralsOf(job.object->mass);
     job.prepareMs = msBetween(job.started, Clock::now());
     Result<FractureResult> r = Error{ErrorCode::NoIntersection, "no cells"};
-    if (job.impacts.size() == 1) {
+    // With a topology the fracture edits a copy in place: made here with room to grow, not by fracture.
+    const bool edits = job.facts.topology.fits(mesh);
+    if (job.impacts.size() == 1 && edits) {
+        auto [copy, facts] = editableCopy(mesh, job.facts);
+        r = fracture(std::move(copy), job.impacts.front().impact, job.params, mixSeed(job.seed, 0),
+                     std::move(facts));
+    } else if (job.impacts.size() == 1) {
         r = fracture(mesh, job.impacts.front().impact, job.params, mixSeed(job.seed, 0), job.facts);
     } else {
         // Union of the cells of every merged impact; a cell overlapping an accepted one is skipped so that
@@ -170,7 +202,12 @@ void runJob(Job& job) {
             }
         }
         job.cellMs = msBetween(tc, Clock::now());
-        r = fractureWithCells(mesh, std::move(cells), job.params, job.facts);
+        if (edits) {
+            auto [copy, facts] = editableCopy(mesh, job.facts);
+            r = fractureWithCells(std::move(copy), std::move(cells), job.params, std::move(facts));
+        } else {
+            r = fractureWithCells(mesh, std::move(cells), job.params, job.facts);
+        }
     }
     if (!r) {
         job.errorCode = r.error().code;
