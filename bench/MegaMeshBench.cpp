@@ -426,6 +426,31 @@ int runMegaImpact(const MegaArgs& args) {
         return 1;
     if (args.world && !finishTable(cpu, worldTable, worldCsv, args.out, "impact_megamesh_world.csv"))
         return 1;
+    if (args.world) { // per mesh: the kernel's median beside the world's stages (medians, ms)
+        std::ostringstream world;
+        for (const auto& r : worldCsv.rows) {
+            world << r[0];
+            for (std::size_t c : {4, 8, 9, 10, 11, 12, 13, 14, 15, 16})
+                world << ' ' << r[c];
+            world << '\n';
+        }
+        plotPng(args.out, "impact_megamesh_world", world.str(),
+                "set style data histograms\nset style histogram rowstacked\nset style fill solid 0.8\n"
+                "set boxwidth 0.35\nset ylabel 'ms (medians)'\nset key outside right\nset grid y\n"
+                "set xtics rotate by -20\n"
+                "set termoption noenhanced\nset title 'Impact to adopted pieces: kernel (left) and the "
+                "world stages (right)'\n"
+                "plot $DATA u ($0-0.2):2:(0.35) w boxes lc rgb 'gray' t 'kernel with parts', "
+                "'' u ($0+0.2):($3+$4+$5+$6+$7+$8+$9+$10+$11):(0.35):xtic(1) w boxes t 'adoption', "
+                "'' u ($0+0.2):($3+$4+$5+$6+$7+$8+$9+$10):(0.35) w boxes t 'handoff', "
+                "'' u ($0+0.2):($3+$4+$5+$6+$7+$8+$9):(0.35) w boxes t 'finish', "
+                "'' u ($0+0.2):($3+$4+$5+$6+$7+$8):(0.35) w boxes t 'parts', "
+                "'' u ($0+0.2):($3+$4+$5+$6+$7):(0.35) w boxes t 'islands', "
+                "'' u ($0+0.2):($3+$4+$5+$6):(0.35) w boxes t 'boolean', "
+                "'' u ($0+0.2):($3+$4+$5):(0.35) w boxes t 'cells', "
+                "'' u ($0+0.2):($3+$4):(0.35) w boxes t 'prepare', "
+                "'' u ($0+0.2):3:(0.35) w boxes t 'queue'");
+    }
     if (!finishTable(cpu, table, csv, args.out, "impact_megamesh.csv"))
         return 1;
     plotPng(

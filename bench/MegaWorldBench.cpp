@@ -55,8 +55,9 @@ std::vector<std::string> worldRowHeader() {
             "main_adopt_median_ms",
             "shapes_median_ms",
             "pieces_median",
-            "object_mb",
-            "bytes_per_triangle",
+            "object_rss_mb",
+            "object_heap_mb",
+            "heap_bytes_per_triangle",
             "other_cpu_cores"};
 }
 
@@ -76,11 +77,11 @@ bool addWorldRow(const std::string& name, const Mesh& mesh, const std::vector<Co
     double objectMb = 0, objectHeapMb = 0;
     int failures = 0;
     for (const Impact& hit : hits) {
+        const double before = residentMb(), heapBefore = heapInUseMb(); // the copy below is the object's
         ObjectDesc desc;
         desc.mesh = mesh;
         desc.convexParts = parts;
         desc.fracture = params;
-        const double before = residentMb(), heapBefore = heapInUseMb();
         auto id = runtime.addObject(std::move(desc), Frame{}, true);
         if (!id) {
             std::cerr << name << ": " << id.error().message << "\n";
