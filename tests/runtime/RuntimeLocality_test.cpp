@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include "TestSupport.hpp"
+#include "ToyPhysics.hpp"
+#include "rubble/DestructionRuntime.hpp"
 #include "rubble/DestructionWorld.hpp"
 #include "rubble/MassProperties.hpp"
 #include "rubble/MeshTopology.hpp"
@@ -74,6 +76,53 @@ TEST(RuntimeLocality, TrianglesTouchedPerHitFollowTheCutNotTheMesh) {
     // the same cut on four times the triangles: a pass over the remainder would read four times as many
     EXPECT_LT(large.touched, 2 * small.touched + 2000);
     EXPECT_LT(large.touched, large.remainderTriangles / 4);
+}
+
+// In the runtime, such a remainder stays where its parent was, and its body sits at its centre of mass: the
+// offset between body and mesh is its mass properties' frame.
+TEST(RuntimeLocality, ALargeRemainderStaysInPlaceWithItsBodyAtItsCentreOfMass) {
+    test::ToyPhysics engine;
+    DestructionRuntime::Config c;
+    c.world.workers = 1;
+    c.world.deterministic = true;
+    DestructionRuntime runtime(engine, c);
+    ObjectDesc d;
+    d.mesh = makeSphere({0, 0, 0}, 1, 160, 80);
+    d.convexParts = {ConvexPolytope::fromAabb(d.mesh.bounds())};
+    d.fracture.sizeLaw.base = 0.4;
+    d.fracture.sizeLaw.scale = 0;
+    Frame placement; // a quarter turn about y, then up and aside
+    placement.rotation.m[0][0] = placement.rotation.m[2][2] = 0;
+    placement.rotation.m[0][2] = 1;
+    placement.rotation.m[2][0] = -1;
+    placement.translation = {3, 2, 1};
+    const ObjectId id = runtime.addObject(std::move(d), placement, true).value();
+    const BodyId body = runtime.bodyOf(id)->id;
+    ASSERT_TRUE(runtime.submitImpact(body, placement.apply({1 - 1e-3, 0.01, 0.02}),
+                                     placement.rotation * Vec3{1, 0, 0}, 10));
+    std::vector<AdoptedPiece> pieces;
+    runtime.setOnAdopted([&](const FractureOutcome& o) { pieces = o.pieces; });
+    for (int i = 0; i < 10 && pieces.empty(); ++i)
+        runtime.stepFrame();
+    ASSERT_FALSE(pieces.empty());
+    int remainders = 0;
+    for (const AdoptedPiece& p : pieces) {
+        if (p.cell >= 0)
+            continue;
+        ++remainders;
+        const Vec3 com = p.state->mass.centerOfMass;
+        EXPECT_GT(length(com), 1e-4); // the chip at +x moved it
+        const BodyRecord* r = runtime.bodyOf(p.id);
+        ASSERT_NE(r, nullptr);
+        const Frame bodyFrame = runtime.motion(r->id).transform;
+        EXPECT_LT(length(bodyFrame.translation - placement.apply(com)), 1e-9);
+        const Frame objectToWorld = bodyFrame * r->objectToBody.inverse();
+        EXPECT_LT(length(objectToWorld.translation - placement.translation), 1e-9);
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j)
+                EXPECT_NEAR(objectToWorld.rotation.m[i][j], placement.rotation.m[i][j], 1e-9);
+    }
+    EXPECT_EQ(remainders, 1);
 }
 
 } // namespace
