@@ -63,7 +63,8 @@ struct TimingRecord {
     std::uint64_t frame = 0;    ///< frame of submission
     int impactsMerged = 1;      ///< impacts fractured in this job
     double queueMs = 0;         ///< waiting for a worker (and for an in-flight job on the same object)
-    double prepareMs = 0;       ///< moving the impacts onto the surface and checking the input mesh
+    double prepareMs = 0;       ///< moving the impacts onto the surface, checking the input mesh, and the
+                                ///< job's copy of a large mesh that the fracture edits in place
     double cellMs = 0;          ///< building cells
     double booleanMs = 0;       ///< booleans (with the check that the pieces close up)
     double islandsMs = 0;       ///< islands, cut-face attributes, simplification, mass properties

@@ -174,14 +174,17 @@ void runJob(Job& job) {
     // integrals are those of the saved mass properties, so that a loaded world cuts with the same ones.
     if (mesh.triangles.size() > kTopologyAboveTriangles)
         job.facts.integrals = integralsOf(job.object->mass);
+    // With a topology the fracture edits a copy in place: made here with room to grow, not by fracture (the
+    // copy is part of prepare).
+    const bool edits = job.facts.topology.fits(mesh);
+    std::pair<Mesh, MeshFacts> editable;
+    if (edits)
+        editable = editableCopy(mesh, job.facts);
     job.prepareMs = msBetween(job.started, Clock::now());
     Result<FractureResult> r = Error{ErrorCode::NoIntersection, "no cells"};
-    // With a topology the fracture edits a copy in place: made here with room to grow, not by fracture.
-    const bool edits = job.facts.topology.fits(mesh);
     if (job.impacts.size() == 1 && edits) {
-        auto [copy, facts] = editableCopy(mesh, job.facts);
-        r = fracture(std::move(copy), job.impacts.front().impact, job.params, mixSeed(job.seed, 0),
-                     std::move(facts));
+        r = fracture(std::move(editable.first), job.impacts.front().impact, job.params, mixSeed(job.seed, 0),
+                     std::move(editable.second));
     } else if (job.impacts.size() == 1) {
         r = fracture(mesh, job.impacts.front().impact, job.params, mixSeed(job.seed, 0), job.facts);
     } else {
@@ -203,8 +206,8 @@ void runJob(Job& job) {
         }
         job.cellMs = msBetween(tc, Clock::now());
         if (edits) {
-            auto [copy, facts] = editableCopy(mesh, job.facts);
-            r = fractureWithCells(std::move(copy), std::move(cells), job.params, std::move(facts));
+            r = fractureWithCells(std::move(editable.first), std::move(cells), job.params,
+                                  std::move(editable.second));
         } else {
             r = fractureWithCells(mesh, std::move(cells), job.params, job.facts);
         }
