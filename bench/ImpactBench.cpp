@@ -466,6 +466,9 @@ const rubble::tools::Registrar registrar{
              "--no-facts", [mega](std::int64_t) { mega->facts = false; },
              "--mega: fracture without the meshes' known facts (every hit validates and measures the "
              "whole mesh)");
+         app.add_flag("--world", mega->world,
+                      "--mega: also run each mesh's hits through a DestructionRuntime on the Bullet binding, "
+                      "side by side with the kernel (impact_megamesh_world.csv)");
          app.add_option("--chain", mega->chain,
                         "chained hits on the 250k UV sphere and geodesic sphere in --mega (0: none)")
              ->check(CLI::Range(0, 100000));

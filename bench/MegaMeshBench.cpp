@@ -340,6 +340,10 @@ int runMegaImpact(const MegaArgs& args) {
                "other_cpu_cores"},
               {}};
     std::ostringstream data;
+    Table worldTable{{"mesh", "tris", "hits", "kernel med ms", "world med ms", "max", "world/kernel",
+                      "prepare", "boolean", "islands", "parts", "finish", "adoption", "shapes", "heap B/tri"},
+                     {}};
+    Table worldCsv{worldRowHeader(), {}};
     for (const std::string& kind : args.kinds)
         for (std::size_t size : args.sizes) {
             const Mesh mesh = withAttributes(megaMesh(kind, size));
@@ -352,12 +356,17 @@ int runMegaImpact(const MegaArgs& args) {
             // What an object knows of its mesh once it is added (checked and measured once, untimed).
             const MeshFacts facts = args.facts ? analyzeMesh(mesh).value() : MeshFacts{};
             HitSamples s;
+            std::vector<Impact> impacts;
             for (int h = 0; h < args.hits; ++h) {
                 const Impact impact = randomHit(mesh, static_cast<std::uint64_t>(h));
+                impacts.push_back(impact);
                 hitOnce(mesh, roomyCopy(mesh), roomyCopy(facts), d->parts, impact,
                         static_cast<std::uint64_t>(h), s);
             }
             addImpactRows(name, kind, mesh.triangles.size(), s, false, table, csv, data);
+            if (args.world && !addWorldRow(name, mesh, d->parts, hitParams(mesh), impacts,
+                                           stats(s.withParts).median, worldTable, worldCsv))
+                return 1;
         }
     // Chained hits: the largest piece of each hit is hit again, with the parts its update gave it.
     Table hits; // one row per hit of the chains (thread CPU ms), to find the slow ones and what they did
@@ -415,6 +424,33 @@ int runMegaImpact(const MegaArgs& args) {
     }
     if (args.chain > 0 && !writeCsv(std::filesystem::path(args.out) / "impact_megamesh_chain.csv", hits))
         return 1;
+    if (args.world && !finishTable(cpu, worldTable, worldCsv, args.out, "impact_megamesh_world.csv"))
+        return 1;
+    if (args.world) { // per mesh: the kernel's median beside the world's stages (medians, ms)
+        std::ostringstream world;
+        for (const auto& r : worldCsv.rows) {
+            world << r[0];
+            for (std::size_t c : {4, 8, 9, 10, 11, 12, 13, 14, 15, 16})
+                world << ' ' << r[c];
+            world << '\n';
+        }
+        plotPng(args.out, "impact_megamesh_world", world.str(),
+                "set style data histograms\nset style histogram rowstacked\nset style fill solid 0.8\n"
+                "set boxwidth 0.35\nset ylabel 'ms (medians)'\nset key outside right\nset grid y\n"
+                "set xtics rotate by -20\n"
+                "set termoption noenhanced\nset title 'Impact to adopted pieces: kernel (left) and the "
+                "world stages (right)'\n"
+                "plot $DATA u ($0-0.2):2:(0.35) w boxes lc rgb 'gray' t 'kernel with parts', "
+                "'' u ($0+0.2):($3+$4+$5+$6+$7+$8+$9+$10+$11):(0.35):xtic(1) w boxes t 'adoption', "
+                "'' u ($0+0.2):($3+$4+$5+$6+$7+$8+$9+$10):(0.35) w boxes t 'handoff', "
+                "'' u ($0+0.2):($3+$4+$5+$6+$7+$8+$9):(0.35) w boxes t 'finish', "
+                "'' u ($0+0.2):($3+$4+$5+$6+$7+$8):(0.35) w boxes t 'parts', "
+                "'' u ($0+0.2):($3+$4+$5+$6+$7):(0.35) w boxes t 'islands', "
+                "'' u ($0+0.2):($3+$4+$5+$6):(0.35) w boxes t 'boolean', "
+                "'' u ($0+0.2):($3+$4+$5):(0.35) w boxes t 'cells', "
+                "'' u ($0+0.2):($3+$4):(0.35) w boxes t 'prepare', "
+                "'' u ($0+0.2):3:(0.35) w boxes t 'queue'");
+    }
     if (!finishTable(cpu, table, csv, args.out, "impact_megamesh.csv"))
         return 1;
     plotPng(

@@ -5,6 +5,9 @@
 #include <string>
 #include <vector>
 
+#include "BenchUtil.hpp"
+#include "rubble/fracture/Fracture.hpp"
+#include "rubble/geometry/ConvexPolytope.hpp"
 #include "rubble/geometry/Mesh.hpp"
 
 namespace rubble::bench {
@@ -33,14 +36,27 @@ struct MegaArgs {
     std::vector<std::size_t> sizes{100000, 250000, 1000000}; ///< triangle counts
     std::vector<std::string> kinds = kMegaKinds;             ///< which meshes
     int hits = 20;                                           ///< random hits per mesh
-    int chain = 100;   ///< chained hits on the 250k UV and geodesic spheres (0: none)
-    std::string out;   ///< results folder
-    bool facts = true; ///< pass each mesh's known facts to fracture (analyzeMesh once, then Piece::facts)
+    int chain = 100;    ///< chained hits on the 250k UV and geodesic spheres (0: none)
+    std::string out;    ///< results folder
+    bool facts = true;  ///< pass each mesh's known facts to fracture (analyzeMesh once, then Piece::facts)
+    bool world = false; ///< also run each mesh's hits through a DestructionRuntime on Bullet (the world row)
 };
 
 /// `rubble-bench impact --mega`: impact → pieces with convex parts per mesh over random hits, the stages, the
 /// clip-only bound, and chained hits; impact_megamesh.csv / .png in args.out.
 int runMegaImpact(const MegaArgs& args);
+
+/// The columns of impact_megamesh_world.csv.
+std::vector<std::string> worldRowHeader();
+
+/// This process's resident memory (MB).
+double residentMb();
+
+/// The world row of one mesh (MegaWorldBench.cpp): hits through a DestructionRuntime on the Bullet binding,
+/// beside the kernel's median; false when it cannot run.
+bool addWorldRow(const std::string& name, const Mesh& mesh, const std::vector<ConvexPolytope>& parts,
+                 const FractureParams& params, const std::vector<Impact>& hits, double kernelMedianMs,
+                 Table& table, Table& csv);
 
 /// Writes each mesh of args as OBJ into dir (kind_triangles.obj), for `rubble decompose` and `rubble
 /// fracture`.

@@ -259,7 +259,9 @@ typedef struct rubble_outcome {
 typedef struct rubble_outcome_piece {
     uint32_t id;           ///< its object id
     double rotation[9];    ///< row-major; piece frame -> parent frame: p_parent = R p_piece + t
-    double translation[3]; ///< t (the piece's centre of mass in the parent's coordinates)
+    double translation[3]; ///< t (the piece's centre of mass in the parent's coordinates; R = 1 and t = 0
+                           ///< for a remainder above 20,000 triangles cut in place: its mesh keeps the
+                           ///< parent's frame, and its centre of mass is in its object info)
     int32_t cell;          ///< -1: part of the remainder; i >= 0: debris of cell i
 } rubble_outcome_piece;
 
@@ -275,7 +277,8 @@ typedef struct rubble_object_info {
     uint32_t id;                 ///< its id
     uint32_t version;            ///< bumped when its shape changes
     int destructible;            ///< 0 when it never breaks
-    rubble_mass_properties mass; ///< mass properties of its mesh (density 1; pieces are centred at 0)
+    rubble_mass_properties mass; ///< mass properties of its mesh (density 1; pieces are centred at 0 but
+                                 ///< for a large remainder that keeps its parent's frame)
     double density;              ///< its density
     size_t triangle_count;       ///< triangles of its mesh
     size_t convex_part_count;    ///< its convex collision parts

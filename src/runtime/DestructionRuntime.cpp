@@ -47,10 +47,17 @@ std::uint64_t mix(std::uint64_t h, std::uint64_t v) {
     return h * 0x100000001B3ull;
 }
 
-// Distance of the farthest mesh vertex from the body origin.
-double boundingRadius(const Mesh& mesh, const Frame& objectToBody) {
+// Distance of the farthest mesh vertex from the body origin; above kTopologyAboveTriangles, of the farthest
+// corner of the convex parts (they cover the mesh), so that adopting a large remainder reads no vertex.
+double boundingRadius(const ObjectState& st, const Frame& objectToBody) {
     double r2 = 0;
-    for (const Vec3& p : mesh.positions)
+    if (st.mesh.triangles.size() > kTopologyAboveTriangles && !st.convexParts.empty()) {
+        for (const ConvexPolytope& part : st.convexParts)
+            for (const Vec3& p : part.vertices())
+                r2 = std::max(r2, lengthSquared(p - objectToBody.translation));
+        return std::sqrt(r2);
+    }
+    for (const Vec3& p : st.mesh.positions)
         r2 = std::max(r2, lengthSquared(p - objectToBody.translation));
     return std::sqrt(r2);
 }
@@ -77,7 +84,7 @@ BodyRecord objectRecord(ObjectId object, BodyRole role, BodyMotionState motion, 
     rec.mass = s.mass;
     rec.inertia = s.inertia;
     rec.triangles = s.triangles;
-    rec.radius = boundingRadius(st.mesh, s.objectToBody);
+    rec.radius = boundingRadius(st, s.objectToBody);
     return rec;
 }
 

@@ -10,6 +10,7 @@
 #include <mutex>
 #include <set>
 #include <string>
+#include <utility>
 
 #include "geometry/ClosestPoint.hpp"
 #include "rubble/core/Log.hpp"
@@ -73,7 +74,8 @@ struct Job {
     std::vector<MassProperties> localMass;
     std::vector<MeshFacts> localFacts; // analyzeMesh(localMeshes[i]) (not validated again: fracture's output)
     std::vector<std::vector<ConvexPolytope>> localParts;
-    std::vector<std::uint64_t> meshHashes; // localMeshes[i].hash(), computed by the worker
+    std::vector<std::uint64_t> meshHashes; // localMeshes[i].hash() by the worker, or 0: when it is read
+    std::uint64_t touched = 0;             // triangles the job's own passes read (TimingRecord)
     double queueMs = 0;
     double prepareMs = 0;
     double cellMs = 0;
@@ -102,6 +104,51 @@ Impact onSurface(const Mesh& mesh, Impact impact, const FractureParams& params) 
     return impact;
 }
 
+// The volume integrals of a solid with these mass properties, about its centre of mass (the covariance C
+// from inertia = trace(C)·I − C).
+VolumeIntegrals integralsOf(const MassProperties& m) {
+    VolumeIntegrals v;
+    v.reference = m.centerOfMass;
+    v.volume = m.volume;
+    const double half = 0.5 * (m.inertia.m[0][0] + m.inertia.m[1][1] + m.inertia.m[2][2]);
+    for (int i = 0; i < 3; ++i)
+        for (int j = i; j < 3; ++j)
+            v.cov[i][j] = (i == j ? half : 0.0) - m.inertia.m[i][j];
+    return v;
+}
+
+// v with 1/16 spare capacity: the growth an in-place edit asks for, so that it does not copy the arrays
+// again.
+template <class T>
+std::vector<T> withRoom(const std::vector<T>& v) {
+    std::vector<T> out;
+    out.reserve(v.size() + v.size() / 16);
+    out.assign(v.begin(), v.end());
+    return out;
+}
+
+// The job's own copy of an object's mesh and facts for a fracture that edits it in place (the object's stays
+// as it is, shared with the engine, until the result is adopted).
+std::pair<Mesh, MeshFacts> editableCopy(const Mesh& m, const MeshFacts& f) {
+    Mesh c;
+    c.positions = withRoom(m.positions);
+    c.triangles = withRoom(m.triangles);
+    c.normals = withRoom(m.normals);
+    c.uvs = withRoom(m.uvs);
+    c.materials = withRoom(m.materials);
+    c.materialNames = m.materialNames;
+    MeshFacts cf = f;
+    cf.topology.twin = withRoom(f.topology.twin);
+    return {std::move(c), std::move(cf)};
+}
+
+// A remainder above kTopologyAboveTriangles that the kernel edited in place (its facts fit, with a topology):
+// it keeps its parent's frame, the kernel's facts and mass properties.
+bool keepsParentFrame(const Piece& piece, const Mesh& mesh) {
+    return piece.cell < 0 && mesh.triangles.size() > kTopologyAboveTriangles && piece.facts.fit(mesh) &&
+           piece.facts.topology.fits(mesh);
+}
+
 void runJob(Job& job) {
     const Mesh& mesh = job.object->mesh;
     for (PendingImpact& p : job.impacts)
@@ -117,9 +164,22 @@ void runJob(Job& job) {
         }
         job.facts = facts.value();
     }
+    // Above the threshold a remainder's mass properties come by difference, not from its mesh: its facts'
+    // integrals are those of the saved mass properties, so that a loaded world cuts with the same ones.
+    if (mesh.triangles.size() > kTopologyAboveTriangles)
+        job.facts.integrals = integralsOf(job.object->mass);
+    // With a topology the fracture edits a copy in place: made here with room to grow, not by fracture (the
+    // copy is part of prepare).
+    const bool edits = job.facts.topology.fits(mesh);
+    std::pair<Mesh, MeshFacts> editable;
+    if (edits)
+        editable = editableCopy(mesh, job.facts);
     job.prepareMs = msBetween(job.started, Clock::now());
     Result<FractureResult> r = Error{ErrorCode::NoIntersection, "no cells"};
-    if (job.impacts.size() == 1) {
+    if (job.impacts.size() == 1 && edits) {
+        r = fracture(std::move(editable.first), job.impacts.front().impact, job.params, mixSeed(job.seed, 0),
+                     std::move(editable.second));
+    } else if (job.impacts.size() == 1) {
         r = fracture(mesh, job.impacts.front().impact, job.params, mixSeed(job.seed, 0), job.facts);
     } else {
         // Union of the cells of every merged impact; a cell overlapping an accepted one is skipped so that
@@ -139,7 +199,12 @@ void runJob(Job& job) {
             }
         }
         job.cellMs = msBetween(tc, Clock::now());
-        r = fractureWithCells(mesh, std::move(cells), job.params, job.facts);
+        if (edits) {
+            r = fractureWithCells(std::move(editable.first), std::move(cells), job.params,
+                                  std::move(editable.second));
+        } else {
+            r = fractureWithCells(mesh, std::move(cells), job.params, job.facts);
+        }
     }
     if (!r) {
         job.errorCode = r.error().code;
@@ -160,11 +225,21 @@ void runJob(Job& job) {
         updateDecomposition(job.object->convexParts, job.result.cells, meshes, pieceCells, job.decomposition);
     job.finishStart = Clock::now();
     job.decompositionMs = msBetween(t1, job.finishStart);
-    // Each piece in its principal frame, with the mass properties of that mesh (computed here, not by the
-    // main thread at adoption). The remainder's mass properties found by difference may differ from a full
-    // sum in the last bits: its frame comes from the full sum, so that facts change no piece's bytes.
+    // A large remainder edited in place keeps its parent's frame and the kernel's facts (mass properties by
+    // difference): no pass over its triangles here, and its hash waits until it is read
+    // (docs/runtime-locality.md). Every other piece goes into its principal frame, with the mass properties
+    // of that mesh (computed here, not by the main thread at adoption); a small remainder's frame comes from
+    // a full sum, so that facts change no piece's bytes.
     for (std::size_t i = 0; i < meshes.size(); ++i) {
         Piece& piece = job.result.pieces[i];
+        if (keepsParentFrame(piece, meshes[i])) {
+            job.localMass.push_back(piece.mass);
+            job.localFacts.push_back(std::move(piece.facts));
+            job.meshHashes.push_back(0);
+            job.localParts.push_back(i < parts.size() ? std::move(parts[i]) : std::vector<ConvexPolytope>{});
+            job.frames.push_back(Frame{});
+            continue;
+        }
         const MassProperties m = piece.cell < 0 ? computeMassProperties(meshes[i]) : piece.mass;
         Frame f{m.principalAxes, m.centerOfMass};
         const Mat3 rt = f.rotation.transposed();
@@ -179,6 +254,8 @@ void runJob(Job& job) {
         job.localMass.push_back(massProperties(facts.integrals));
         job.localFacts.push_back(std::move(facts));
         job.meshHashes.push_back(meshes[i].hash());
+        // mass, transform, integrals and hash: four passes over the piece
+        job.touched += 4 * meshes[i].triangles.size();
         std::vector<ConvexPolytope> lp;
         if (i < parts.size())
             for (const auto& p : parts[i])
@@ -220,7 +297,8 @@ struct DestructionWorld::Impl {
     std::vector<HandedOut> handedOut; // outcomes of the latest collect() not yet finished by the engine
     std::function<void(const JournalEvent&)> journalSink;
     std::uint64_t journalLength = 0;
-    std::uint64_t geometrySum = 0; // Σ geometryTerm over live objects (wrapping)
+    std::uint64_t geometrySum = 0; // Σ geometryTerm over live objects with a mesh hash (wrapping)
+    std::set<ObjectId> unhashed;   // live objects whose meshHash is not computed yet (0)
     // analyzeMesh of live objects' meshes where known (not saved: a function of the mesh, found again)
     std::map<ObjectId, MeshFacts> facts;
 
@@ -228,14 +306,28 @@ struct DestructionWorld::Impl {
         return mixSeed(mixSeed(o.id, o.version), o.meshHash);
     }
     void insertObject(std::shared_ptr<const ObjectState> s) {
-        geometrySum += geometryTerm(*s);
         const ObjectId id = s->id;
+        if (s->meshHash == 0)
+            unhashed.insert(id);
+        else
+            geometrySum += geometryTerm(*s);
         objects.emplace(id, std::move(s));
     }
     void eraseObject(std::map<ObjectId, std::shared_ptr<const ObjectState>>::iterator it) {
-        geometrySum -= geometryTerm(*it->second);
+        if (unhashed.erase(it->first) == 0)
+            geometrySum -= geometryTerm(*it->second);
         facts.erase(it->first);
         objects.erase(it);
+    }
+    // Computes the mesh hashes not computed yet (a large remainder's waits until something reads it). Object
+    // states are made non-const (make_shared<ObjectState>) and no job reads meshHash, so it is written here.
+    void hashPending() {
+        for (ObjectId id : unhashed) {
+            auto& o = const_cast<ObjectState&>(*objects.at(id));
+            o.meshHash = o.mesh.hash();
+            geometrySum += geometryTerm(o);
+        }
+        unhashed.clear();
     }
     std::uint64_t jobSeed(const ObjectState& o) const {
         return mixSeed(mixSeed(config.seed, o.id), o.version);
@@ -529,6 +621,7 @@ Status DestructionWorld::applyJournalEvent(const JournalEvent& e) {
 
 WorldState DestructionWorld::saveState() const {
     const Impl& im = *impl_;
+    impl_->hashPending();
     WorldState w;
     w.seed = im.config.seed;
     w.delayFrames = im.config.delayFrames;
@@ -604,6 +697,7 @@ Status DestructionWorld::loadState(WorldState w) {
     im.objects.clear();
     im.facts.clear();
     im.geometrySum = 0;
+    im.unhashed.clear();
     for (ObjectState& o : w.objects) {
         if (o.meshHash == 0) // a saved state brings its hashes: hashing every mesh again is most of a load
             o.meshHash = o.mesh.hash();
@@ -632,6 +726,7 @@ Status DestructionWorld::loadState(WorldState w) {
 }
 
 std::uint64_t DestructionWorld::geometryHash() const {
+    impl_->hashPending();
     return mixSeed(impl_->geometrySum, impl_->objects.size());
 }
 
@@ -680,6 +775,7 @@ std::vector<FractureOutcome> DestructionWorld::collect() {
         rec.finishMs = job->finishMs;
         rec.handoffMs = msBetween(job->finishedAt, a0);
         rec.crumbled = job->crumble;
+        rec.touchedTriangles = job->touched;
         auto it = im.objects.find(job->id);
         std::vector<PendingImpact> later;
         if (auto w = im.waiting.find(job->id); w != im.waiting.end()) {

@@ -38,9 +38,10 @@ struct RUBBLE_API ObjectDesc {
 
 /// A live object as the runtime sees it.
 struct RUBBLE_API ObjectState {
-    ObjectId id = 0;             ///< its id
-    std::uint32_t version = 0;   ///< bumped whenever its shape is replaced
-    Mesh mesh;                   ///< local mesh (origin at the centre of mass for pieces)
+    ObjectId id = 0;           ///< its id
+    std::uint32_t version = 0; ///< bumped whenever its shape is replaced
+    Mesh mesh; ///< local mesh: a piece's is in its principal frame (origin at the centre of mass), but for
+               ///< a remainder above kTopologyAboveTriangles cut in place, which keeps its parent's frame
     MassProperties mass;         ///< mass properties of mesh, density 1
     double density = 1;          ///< density
     bool destructible = true;    ///< false when never fractured (also: mesh could not be made valid)
@@ -51,7 +52,8 @@ struct RUBBLE_API ObjectState {
     std::size_t crumbleAbove = 0; ///< a hit on it crumbles it once its mesh has more triangles than this
                                   ///< (see Config::crumbleTriangles; pieces inherit their parent's)
     std::uint64_t meshHash = 0;   ///< mesh.hash(), computed once when the object is made (loadState takes
-                                  ///< a saved one as it is; 0 there: computed)
+                                  ///< a saved one as it is; 0 there: computed), or for a remainder cut in
+                                  ///< place when first read (0 until geometryHash() or saveState())
 };
 
 /// Wall-clock timing of one impact from submission to adoption, in milliseconds. For an adopted job the
@@ -62,7 +64,8 @@ struct RUBBLE_API TimingRecord {
     std::uint64_t frame = 0;    ///< frame of submission
     int impactsMerged = 1;      ///< impacts fractured in this job
     double queueMs = 0;         ///< waiting for a worker (and for an in-flight job on the same object)
-    double prepareMs = 0;       ///< moving the impacts onto the surface and checking the input mesh
+    double prepareMs = 0;       ///< moving the impacts onto the surface, checking the input mesh, and the
+                                ///< job's copy of a large mesh that the fracture edits in place
     double cellMs = 0;          ///< building cells
     double booleanMs = 0;       ///< booleans (with the check that the pieces close up)
     double islandsMs = 0;       ///< islands, cut-face attributes, simplification, mass properties
@@ -82,12 +85,15 @@ struct RUBBLE_API TimingRecord {
                          ///< impacts that waited on the job are retried
     bool crumbled =
         false; ///< the object was over its triangle limit: the hit crumbled it (Config::crumbleTriangles)
+    std::uint64_t touchedTriangles = 0; ///< triangles the job's own passes after the kernel read (a piece
+                                        ///< moved into its frame, measured and hashed counts 4 per triangle)
 };
 
 /// A piece of a fracture, ready to adopt: a new object of the world.
 struct RUBBLE_API AdoptedPiece {
     ObjectId id = 0;        ///< the new object, already added to the world
-    Frame frame;            ///< piece local frame → parent local frame (centre of mass, principal axes)
+    Frame frame;            ///< piece local frame → parent local frame (centre of mass, principal axes;
+                            ///< the identity for a remainder that keeps its parent's frame)
     std::int32_t cell = -1; ///< Piece::cell: −1 part of the remainder, i ≥ 0 debris of cell i
     std::shared_ptr<const ObjectState> state; ///< its mesh, mass properties and convex parts
 };
