@@ -43,6 +43,8 @@ typedef RUBBLE_C_ENUM(rubble_status){
 
 /// The version of the C API the library implements (RUBBLE_C_API_VERSION it was built with).
 RUBBLE_C_API uint32_t rubble_api_version(void);
+/// The library's version, "MAJOR.MINOR.PATCH" (RUBBLE_VERSION_STRING of rubble/core/Version.hpp); static.
+RUBBLE_C_API const char* rubble_version(void);
 /// The message of the last failed call on this thread ("" after a successful one); valid until the next call.
 RUBBLE_C_API const char* rubble_last_error(void);
 /// A static, lower-case name of a status ("ok", "invalid input", ...).

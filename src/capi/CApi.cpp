@@ -14,6 +14,7 @@
 #include "rubble/collision/ConvexDecomposition.hpp"
 #include "rubble/core/Log.hpp"
 #include "rubble/core/ParameterCheck.hpp"
+#include "rubble/core/Version.hpp"
 #include "rubble/fracture/Fracture.hpp"
 #include "rubble/geometry/MassProperties.hpp"
 #include "rubble/geometry/Mesh.hpp"
@@ -213,6 +214,10 @@ extern "C" {
 
 uint32_t rubble_api_version(void) {
     return RUBBLE_C_API_VERSION;
+}
+
+const char* rubble_version(void) {
+    return RUBBLE_VERSION_STRING;
 }
 
 const char* rubble_last_error(void) {

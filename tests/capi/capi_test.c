@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rubble/core/Version.hpp"
 #include "rubble/rubble.h"
 
 static int failures = 0;
@@ -34,6 +35,7 @@ static void count_log(int level, const char* message, void* user) {
 
 static void test_status_and_version(void) {
     CHECK(rubble_api_version() == RUBBLE_C_API_VERSION);
+    CHECK(strcmp(rubble_version(), RUBBLE_VERSION_STRING) == 0);
     CHECK(strcmp(rubble_status_name(RUBBLE_OK), "ok") == 0);
     CHECK(strcmp(rubble_status_name(RUBBLE_ERROR_INVALID_INPUT), "invalid input") == 0);
     CHECK(strcmp(rubble_status_name(RUBBLE_ERROR_INVALID_ARGUMENT), "invalid argument") == 0);
