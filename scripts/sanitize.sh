@@ -41,52 +41,71 @@ elapsed() { echo "$(($(date +%s) - $1)) s"; }
 asan() {
     local t0
     t0=$(date +%s)
-    configure build-asan address,undefined -DRUBBLE_BUILD_FUZZERS=ON
-    cmake --build build-asan -j "$jobs"
+    configure build-asan address,undefined -DRUBBLE_BUILD_FUZZERS=ON || return 1
+    cmake --build build-asan -j "$jobs" || return 1
     echo "sanitize: ASan+UBSan build took $(elapsed "$t0")"
+    local status=0
     t0=$(date +%s)
     # Leak checking is on (ASan's default on Linux).
     ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1 \
         UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
         RUBBLE_STRESS_IMPACTS=${RUBBLE_STRESS_IMPACTS:-300} RUBBLE_SWEEP_SCALE=${RUBBLE_SWEEP_SCALE:-0.1} \
-        ctest --test-dir build-asan --output-on-failure -j "$jobs" --timeout 1200 -LE e2e
+        ctest --test-dir build-asan --output-on-failure -j "$jobs" --timeout 1200 -LE e2e || status=1
     echo "sanitize: ASan+UBSan tests took $(elapsed "$t0")"
+    return $status
 }
 
 tsan() {
     local t0
     t0=$(date +%s)
-    configure build-tsan thread
+    configure build-tsan thread || return 1
     # Only the threaded code: the runtime's tests, the Bullet bridge (which drives DestructionWorld) and the
     # scene bench's smoke run (the whole game loop with fracture workers).
     local targets
     targets=$(ninja -C build-tsan -t targets all | sed -n 's#^tests/\(\(runtime\|bullet\|persist\|net\)_[A-Za-z]*_test\):.*#\1#p')
     # shellcheck disable=SC2086
-    cmake --build build-tsan -j "$jobs" --target $targets rubble-bench
+    cmake --build build-tsan -j "$jobs" --target $targets rubble-bench || return 1
     echo "sanitize: TSan build took $(elapsed "$t0")"
+    local status=0
     t0=$(date +%s)
     # Clang 14's TSan cannot map its shadow with the larger ASLR entropy of recent kernels: run without ASLR.
     local norand=()
     if [ "$(cat /proc/sys/vm/mmap_rnd_bits 2>/dev/null || echo 28)" -gt 28 ]; then norand=(setarch "$(uname -m)" -R); fi
     TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1 \
         "${norand[@]}" ctest --test-dir build-tsan --output-on-failure -j "$jobs" --timeout 1200 \
-        -L 'runtime|bullet|bench|persist|net' -E '_quick$'
+        -L 'runtime|bullet|bench|persist|net' -E '_quick$' || status=1
     echo "sanitize: TSan tests took $(elapsed "$t0")"
+    return $status
 }
 
 fuzz() {
     local t0
     t0=$(date +%s)
-    bash scripts/fuzz.sh ci
+    local status=0
+    bash scripts/fuzz.sh ci || status=1
     echo "sanitize: fuzzing took $(elapsed "$t0")"
+    return $status
+}
+
+# Runs every stage named, even after one failed, and fails if any did. (A stage is called in a condition, where
+# bash ignores `set -e` inside it: each stage returns its own status.)
+run() {
+    local failed=()
+    for stage in "$@"; do
+        "$stage" || failed+=("$stage")
+    done
+    if [ ${#failed[@]} -gt 0 ]; then
+        echo "sanitize: FAILED: ${failed[*]}" >&2
+        return 1
+    fi
 }
 
 case "$what" in
-    all) asan && tsan ;;
-    asan) asan ;;
-    tsan) tsan ;;
-    fuzz) fuzz ;;
-    ci) asan && tsan && fuzz ;;
+    all) run asan tsan ;;
+    asan) run asan ;;
+    tsan) run tsan ;;
+    fuzz) run fuzz ;;
+    ci) run asan tsan fuzz ;;
     configure-asan) configure "${2:-build-asan}" address,undefined -DRUBBLE_BUILD_FUZZERS=ON ;;
     configure-tsan) configure build-tsan thread ;;
     *)
