@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cctype>
 #include <charconv>
+#include <cmath>
 #include <map>
 
 #include "io/FileBytes.hpp"
@@ -232,6 +233,9 @@ Result<std::vector<AssetMaterial>> parseMtl(std::string_view text, const std::st
             if (n == 0)
                 return makeError(ErrorCode::ParseError,
                                  where + ": Kd needs a colour, got '" + std::string(rest) + "'");
+            if (!std::isfinite(c[0]) || !std::isfinite(c[1]) || !std::isfinite(c[2]))
+                return makeError(ErrorCode::ParseError,
+                                 where + ": Kd needs finite numbers, got '" + std::string(rest) + "'");
             m.baseColor = n == 3 ? Vec3{c[0], c[1], c[2]} : Vec3{c[0], c[0], c[0]};
         } else if (isMapStatement(key)) {
             TextureMap map;
