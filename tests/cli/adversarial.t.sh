@@ -5,13 +5,8 @@
 set -eu
 root="$(cd "$(dirname "$0")/../.." && pwd)"
 data="$root/tests/data/meshes"
-tmp="$(mktemp -d)"
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "adversarial.t.sh: $*"; exit 1; }
-# run OUT CMD...: runs CMD with stdout in OUT and stderr in OUT.err; its exit code in $c.
-run() { local out=$1; shift; set +e; "$@" >"$out" 2>"$out.err"; c=$?; set -e; }
-# Parses JSON file $1 and evaluates the Python expression $2 on it as d.
-json_ok() { python3 -c "import json,sys; d=json.load(open(sys.argv[1])); assert $2, d" "$1"; }
+# shellcheck source=tests/support/cli.sh
+source "$(dirname "$0")/../support/cli.sh"
 # cubes FILE [NAME:CX:HALF[:in]]...: one OBJ object per cube centred at (CX,0,0) with half-size HALF, faces
 # outward (inward with ":in"); NAME "-" writes no `o` statement.
 cubes() {

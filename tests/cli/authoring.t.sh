@@ -5,9 +5,8 @@
 set -eu
 root="$(cd "$(dirname "$0")/../.." && pwd)"
 models="$root/assets/models"
-tmp="$(mktemp -d)"
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "authoring.t.sh: $*"; exit 1; }
+# shellcheck source=tests/support/cli.sh
+source "$(dirname "$0")/../support/cli.sh"
 
 # glTF with collision, read back: every node valid, each with convex parts inside its hull (rubble check tests
 # both), textures copied.

@@ -2,9 +2,8 @@
 # `rubble check`: verdicts, JSON fields, exit codes (0 valid, 1 invalid, 2 unreadable) and --repair.
 set -eu
 data="$(cd "$(dirname "$0")/../data/meshes" && pwd)"
-tmp="$(mktemp -d)"
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "check.t.sh: $*"; exit 1; }
+# shellcheck source=tests/support/cli.sh
+source "$(dirname "$0")/../support/cli.sh"
 
 # A valid cube: exit 0, text and JSON verdicts.
 "$RUBBLE" check "$data/cube.obj" >"$tmp/out.txt" || fail "valid cube should exit 0"

@@ -2,9 +2,8 @@
 # `rubble decompose`: JSON fields, convex input gives one part, --max-parts, -o parts file, exit codes.
 set -eu
 data="$(cd "$(dirname "$0")/../data/meshes" && pwd)"
-tmp="$(mktemp -d)"
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "decompose.t.sh: $*"; exit 1; }
+# shellcheck source=tests/support/cli.sh
+source "$(dirname "$0")/../support/cli.sh"
 
 "$RUBBLE" decompose --json "$data/cube.obj" >"$tmp/cube.json" || fail "cube should exit 0"
 python3 - "$tmp/cube.json" <<'PY' || fail "cube JSON: $(cat "$tmp/cube.json")"

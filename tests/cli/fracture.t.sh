@@ -5,9 +5,8 @@ set -eu
 root="$(cd "$(dirname "$0")/../.." && pwd)"
 models="$root/assets/models"
 data="$root/tests/data/meshes"
-tmp="$(mktemp -d)"
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "fracture.t.sh: $*"; exit 1; }
+# shellcheck source=tests/support/cli.sh
+source "$(dirname "$0")/../support/cli.sh"
 
 # Validates a single-mesh JSON document ($1) against the schema and the invariants; prints the piece count.
 check_json() {

@@ -4,10 +4,7 @@
 set -eu
 root="$(cd "$(dirname "$0")/../.." && pwd)"
 data="$root/tests/data/meshes"
-tmp="$(mktemp -d)"
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "json_errors.t.sh: $*"; exit 1; }
-# shellcheck source=../support/cli.sh
+# shellcheck source=tests/support/cli.sh
 source "$root/tests/support/cli.sh"
 
 # An open mesh is refused (exit 2) with the reason in {"error"}.

@@ -5,9 +5,8 @@
 set -eu
 root="$(cd "$(dirname "$0")/../.." && pwd)"
 cube="$root/tests/data/meshes/cube.obj"
-tmp="$(mktemp -d)"
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "parameters.t.sh: $*"; exit 1; }
+# shellcheck source=tests/support/cli.sh
+source "$(dirname "$0")/../support/cli.sh"
 
 rows=0
 while IFS=$'\t' read -r faces name value message; do

@@ -4,10 +4,7 @@
 set -eu
 root="$(cd "$(dirname "$0")/../.." && pwd)"
 data="$root/tests/data/meshes"
-tmp="$(mktemp -d)"
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "robustness.t.sh: $*"; exit 1; }
-# shellcheck source=../support/cli.sh
+# shellcheck source=tests/support/cli.sh
 source "$root/tests/support/cli.sh"
 
 # --- JSON output never aborts on bytes that are not UTF-8 ------------------------------------------------------
