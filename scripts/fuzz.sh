@@ -37,8 +37,7 @@ if [ ! -f "$dir/build.ninja" ]; then
 else
     cmake "$dir" >/dev/null # pick up new targets
 fi
-# Builds every target first, then runs them JOBS at a time (each fuzzer is one process on one core); each run's
-# summary is printed when it ends.
+# Every target is built first, then run JOBS at a time; summaries print in target order.
 built=()
 status=0
 for t in "${targets[@]}"; do

@@ -87,8 +87,7 @@ fuzz() {
     return $status
 }
 
-# Runs every stage named, even after one failed, and fails if any did. (A stage is called in a condition, where
-# bash ignores `set -e` inside it: each stage returns its own status.)
+# Runs every stage named, even after one failed; fails if any did (each stage returns its own status).
 run() {
     local failed=()
     for stage in "$@"; do

@@ -695,8 +695,7 @@ double stageSum(const TimingRecord& r) {
            r.handoffMs + r.adoptionMs;
 }
 
-// Checks that the stages do not overlap; returns the time outside every stage. A thread descheduled between
-// two stages adds to it, so a test bounds the smallest gap of several records.
+// Checks that the stages do not overlap; returns the time outside every stage (preemption included).
 double expectStagesAddUp(const TimingRecord& r) {
     for (double stage : {r.queueMs, r.prepareMs, r.cellMs, r.booleanMs, r.islandsMs, r.decompositionMs,
                          r.finishMs, r.handoffMs, r.adoptionMs})
