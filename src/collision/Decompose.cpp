@@ -547,16 +547,29 @@ private:
 
 } // namespace
 
+Status checkDecompositionParams(const DecompositionParams& params) {
+    auto bad = [](const std::string& what) { return makeError(ErrorCode::InvalidInput, what); };
+    if (params.maxParts < 1 || params.maxParts > kMaxConvexParts)
+        return bad("maxParts " + std::to_string(params.maxParts) + " is outside [1, " +
+                   std::to_string(kMaxConvexParts) + "]");
+    if (!(params.concavity >= 0 && params.concavity < 1e300))
+        return bad("concavity " + std::to_string(params.concavity) + " is not a finite number >= 0");
+    if (!(params.minPartVolumeFraction >= 0 && params.minPartVolumeFraction <= 1))
+        return bad("minPartVolumeFraction " + std::to_string(params.minPartVolumeFraction) +
+                   " is outside [0, 1]");
+    if (params.maxPartFaces < 4)
+        return bad("maxPartFaces " + std::to_string(params.maxPartFaces) + " is below 4");
+    return {};
+}
+
 Result<Decomposition> decompose(const Mesh& mesh, const DecompositionParams& params) {
     return decompose(mesh, params, DecomposeControl{});
 }
 
 Result<Decomposition> decompose(const Mesh& mesh, const DecompositionParams& params,
                                 const DecomposeControl& control) {
-    if (params.maxParts < 1 || params.maxParts > kMaxConvexParts)
-        return makeError(ErrorCode::InvalidInput, "decompose: maxParts " + std::to_string(params.maxParts) +
-                                                      " is outside [1, " + std::to_string(kMaxConvexParts) +
-                                                      "]");
+    if (const Status s = checkDecompositionParams(params); !s)
+        return makeError(ErrorCode::InvalidInput, "decompose: " + s.message());
     if (const Status s = mesh.validate(); !s)
         return s.error();
     if (const Status s = checkCoordinateRange(mesh, "decompose"); !s)

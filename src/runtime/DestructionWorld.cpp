@@ -471,7 +471,26 @@ ShatterLayout shatterLayout(FracturePattern p) {
 }
 } // namespace
 
+Status DestructionWorld::checkConfig(const Config& c) {
+    auto bad = [](const std::string& what) {
+        return Status{Error{ErrorCode::InvalidInput, "world config: " + what}};
+    };
+    if (const Status s = checkDecompositionParams(c.decomposition); !s)
+        return bad("decomposition: " + s.message());
+    if (c.delayFrames < 0 || c.crumbleCells < 0 || c.workers < -1)
+        return bad("delayFrames " + std::to_string(c.delayFrames) + ", crumbleCells " +
+                   std::to_string(c.crumbleCells) + " and workers " + std::to_string(c.workers) +
+                   " must not be negative (workers -1: automatic)");
+    if (!(c.minPieceVolume >= 0 && c.minPieceVolume < 1e300) ||
+        !(c.adoptionBudgetMs >= 0 && c.adoptionBudgetMs < 1e300))
+        return bad("minPieceVolume " + std::to_string(c.minPieceVolume) + " and adoptionBudgetMs " +
+                   std::to_string(c.adoptionBudgetMs) + " must be finite numbers >= 0");
+    return {};
+}
+
 Result<ObjectId> DestructionWorld::addObject(ObjectDesc desc) {
+    if (const Status st = checkConfig(impl_->config); !st)
+        return Error{ErrorCode::InvalidInput, "addObject: " + st.message()};
     if (desc.mesh.triangles.empty() || desc.mesh.positions.empty())
         return Error{ErrorCode::InvalidInput, "addObject: empty mesh"};
     for (Status st : {checkParam("density", desc.density), checkParam("cells", desc.fracture.cells)})
@@ -659,13 +678,8 @@ Status DestructionWorld::loadState(WorldState w) {
         return bad("settings out of range (delayFrames " + std::to_string(w.delayFrames) + ", crumbleCells " +
                    std::to_string(w.crumbleCells) + ", minPieceVolume " + std::to_string(w.minPieceVolume) +
                    ")");
-    const DecompositionParams& d = w.decomposition;
-    if (d.maxParts < 1 || d.maxParts > kMaxConvexParts || !(d.concavity >= 0 && d.concavity < 1e300) ||
-        !(d.minPartVolumeFraction >= 0 && d.minPartVolumeFraction <= 1) || d.maxPartFaces < 4)
-        return bad("decomposition settings out of range (maxParts " + std::to_string(d.maxParts) +
-                   ", concavity " + std::to_string(d.concavity) + ", minPartVolumeFraction " +
-                   std::to_string(d.minPartVolumeFraction) + ", maxPartFaces " +
-                   std::to_string(d.maxPartFaces) + ")");
+    if (const Status s = checkDecompositionParams(w.decomposition); !s)
+        return bad("decomposition settings out of range: " + s.message());
     ObjectId last = 0;
     std::map<ObjectId, std::uint32_t> versions;
     for (const ObjectState& o : w.objects) {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "TestSupport.hpp"
+#include "rubble/collision/ConvexDecomposition.hpp"
 #include "rubble/core/ParameterCheck.hpp"
 #include "rubble/fracture/Fracture.hpp"
 #include "rubble/runtime/DestructionWorld.hpp"
@@ -148,6 +149,37 @@ TEST(ParameterCheck, ASubmittedImpactOutOfRangeIsIgnored) {
     EXPECT_FALSE(world.submitImpact(*id, bad));
     bad.impulse = 10;
     EXPECT_TRUE(world.submitImpact(*id, bad));
+}
+
+TEST(ParameterCheck, AWorldConfigOutOfRangeRefusesEveryObjectAndSaysWhich) {
+    ObjectDesc desc;
+    desc.mesh = makeBox({0, 0, 0}, {1, 1, 1});
+    auto refusal = [&](DestructionWorld::Config c) {
+        EXPECT_FALSE(DestructionWorld::checkConfig(c));
+        DestructionWorld world(c);
+        const Result<ObjectId> id = world.addObject(desc);
+        EXPECT_FALSE(id);
+        EXPECT_TRUE(world.objects().empty());
+        return id ? std::string() : id.error().message;
+    };
+    DestructionWorld::Config c;
+    EXPECT_TRUE(DestructionWorld::checkConfig(c));
+    c.decomposition.maxParts = 5000;
+    EXPECT_EQ(refusal(c), "addObject: world config: decomposition: maxParts 5000 is outside [1, 1024]");
+    c = {};
+    c.decomposition.concavity = std::nan("");
+    EXPECT_NE(refusal(c).find("concavity nan"), std::string::npos);
+    c = {};
+    c.minPieceVolume = -1;
+    EXPECT_NE(refusal(c).find("minPieceVolume -1"), std::string::npos);
+    c = {};
+    c.crumbleCells = -2;
+    EXPECT_NE(refusal(c).find("crumbleCells -2"), std::string::npos);
+    DecompositionParams none;
+    none.maxParts = 0;
+    const auto parts = decompose(desc.mesh, none);
+    ASSERT_FALSE(parts);
+    EXPECT_EQ(parts.error().message, "decompose: maxParts 0 is outside [1, 1024]");
 }
 
 } // namespace

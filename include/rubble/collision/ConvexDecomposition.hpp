@@ -33,6 +33,10 @@ struct RUBBLE_API DecompositionParams {
     std::size_t maxPartFaces = 512;
 };
 
+/// InvalidInput naming the first setting out of range: maxParts in [1, kMaxConvexParts], concavity finite and
+/// ≥ 0, minPartVolumeFraction in [0, 1], maxPartFaces ≥ 4. The check decompose() and DestructionWorld apply.
+RUBBLE_API Status checkDecompositionParams(const DecompositionParams& params);
+
 /// A set of convex parts approximating a closed mesh.
 struct RUBBLE_API Decomposition {
     std::vector<ConvexPolytope> parts; ///< convex parts, in the mesh's coordinates

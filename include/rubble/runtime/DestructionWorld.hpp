@@ -172,6 +172,9 @@ public:
         double minPieceVolume = 0;
     };
 
+    /// InvalidInput naming the first setting out of range (the decomposition's, delayFrames, crumbleCells,
+    /// minPieceVolume, adoptionBudgetMs, workers). A world built with such a config refuses every addObject.
+    static Status checkConfig(const Config& config);
     /// A world with the given configuration.
     explicit DestructionWorld(Config config);
     /// Waits for in-flight jobs to finish (or discards their results); never hangs.
