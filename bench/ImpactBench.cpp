@@ -198,7 +198,7 @@ bool chainCase(Case& c, int chain) {
     return true;
 }
 
-/// The rough rows (issue #28): flat and concrete-rough twins, Fast backend, interleaved in one run; the
+/// The rough rows: flat and concrete-rough twins, Fast backend, interleaved in one run; the
 /// 10k cube with one cell and with a 16-cell shatter, and a 250k geodesic sphere.
 std::vector<Case> roughCases(bool quick) {
     std::vector<Case> cases;

@@ -1,6 +1,6 @@
 // `rubble-bench journal [--quick] [--impacts N] [--workers N] [--out DIR]`
 //
-// The journal and snapshots at scale (issue #17): N impacts (default 1,000) recorded on the 10,092-triangle
+// The journal and snapshots at scale: N impacts (default 1,000) recorded on the 10,092-triangle
 // cube (shatter, 8 cells; each impact hits a live object chosen with probability ∝ volume, at its top
 // corner, ten per frame), then
 // replayed from the journal on a fresh world: ms per impact for recording (the fractures themselves) and for

@@ -1,4 +1,4 @@
-// The million-triangle rows (issue #14), run by `rubble-bench impact --mega` and `rubble-bench decomposition
+// The million-triangle rows, run by `rubble-bench impact --mega` and `rubble-bench decomposition
 // --mega`: a UV sphere, a geodesic sphere, a torus and the arch asset subdivided, at 100k, 250k and 1M
 // triangles. Every hit is a single cell of edge a quarter of the mesh's largest extent at a random surface
 // point (seed = hit index).

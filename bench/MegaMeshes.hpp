@@ -1,5 +1,5 @@
 #pragma once
-// High-poly test meshes of the million-triangle rows (issue #14): a sphere, a torus and the arch asset
+// High-poly test meshes of the million-triangle rows: a sphere, a torus and the arch asset
 // subdivided, at a given triangle count.
 
 #include <string>

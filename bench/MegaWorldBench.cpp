@@ -1,4 +1,4 @@
-// The runtime row of the million-triangle bench (issue #29), run by `rubble-bench impact --mega --world`:
+// The runtime row of the million-triangle bench, run by `rubble-bench impact --mega --world`:
 // the kernel row's meshes and hit points through a DestructionRuntime on the Bullet binding. Each hit lands
 // on a fresh static object (added untimed, with the kernel row's convex parts); the stages are those of the
 // world's TimingRecord, the main thread's adoption is timed around adoptReady(), and the binding's shape

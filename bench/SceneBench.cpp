@@ -32,7 +32,7 @@
 // and how many other processes took meanwhile (cpu_cores: own / other; see bench::CpuMeter): a run with other
 // work on the machine has inflated times.
 //
-// --rough (issue #28) runs the scene flat and with rough cuts by material (SceneLoadOptions::
+// --rough runs the scene flat and with rough cuts by material (SceneLoadOptions::
 // materialRoughness, as the demo plays it), alternating, --runs times each, in one process, and writes
 // DIR/<scene>_rough.csv (frame and latency percentiles, fractures, triangles per run) and its PNG.
 #include "Subcommand.hpp"
@@ -190,7 +190,7 @@ int runScene(const SceneArgs& a, SceneSummary* summary = nullptr) {
         rc.debris.physicsBudgetMs = a.physicsBudgetMs;
     rc.structure.enabled = a.structure;
     rc.structure.bearingFriction = a.bearingFriction;
-    if (a.structureIterations > 0) { // the solver before issue #32: a sweep budget
+    if (a.structureIterations > 0) { // a sweep budget per frame
         rc.structure.stress.method = rubble::StressMethod::SweepBudget;
         rc.structure.stress.iterations = a.structureIterations;
         rc.structure.stress.tolerance = 0.05;
