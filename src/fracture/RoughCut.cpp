@@ -622,8 +622,12 @@ double RoughField::operator()(const Vec3& p) const {
     return value * norm_;
 }
 
-RoughCutReport roughenSplit(SplitResult& split, const std::vector<ConvexPolytope>& cells, const Roughness& r,
-                            double uvScale, const Aabb& meshBox, double onPlane) {
+namespace {
+
+/// roughenSplit on these outputs; the first one's integrals (or null) are kept exact.
+RoughCutReport roughenOutputs(const std::vector<Mesh*>& outputs, VolumeIntegrals* firstIntegrals,
+                              const std::vector<ConvexPolytope>& cells, const Roughness& r, double uvScale,
+                              const Aabb& meshBox, double onPlane) {
     RoughCutReport report;
     // The cell size: the cube root of the cells' mean volume.
     double volume = 0;
@@ -643,9 +647,6 @@ RoughCutReport roughenSplit(SplitResult& split, const std::vector<ConvexPolytope
         return report;
 
     const CutFaces faces(cells, onPlane);
-    std::vector<Mesh*> outputs{&split.remainder};
-    for (Mesh& m : split.inside)
-        outputs.push_back(&m);
     std::vector<std::vector<std::int32_t>> faceOf(outputs.size());
     Aabb focus;
     for (const ConvexPolytope& c : cells)
@@ -694,7 +695,7 @@ RoughCutReport roughenSplit(SplitResult& split, const std::vector<ConvexPolytope
         if (std::none_of(faceOf[o].begin(), faceOf[o].end(), [](std::int32_t f) { return f >= 0; }))
             continue;
         rough.emplace_back();
-        rough.back().integrals = o == 0 && split.remainderIntegrals ? &*split.remainderIntegrals : nullptr;
+        rough.back().integrals = o == 0 ? firstIntegrals : nullptr;
         tessellate(rough.back(), *outputs[o], faceOf[o], faces, s);
     }
     std::map<SegmentKey, double> cosines;
@@ -705,6 +706,59 @@ RoughCutReport roughenSplit(SplitResult& split, const std::vector<ConvexPolytope
         for (std::uint32_t mat : o.mesh->materials)
             report.faces += mat == kInteriorMaterial ? 1 : 0;
     }
+    return report;
+}
+
+} // namespace
+
+RoughCutReport roughenSplit(SplitResult& split, const std::vector<ConvexPolytope>& cells, const Roughness& r,
+                            double uvScale, const Aabb& meshBox, double onPlane) {
+    std::vector<Mesh*> outputs{&split.remainder};
+    for (Mesh& m : split.inside)
+        outputs.push_back(&m);
+    return roughenOutputs(outputs, split.remainderIntegrals ? &*split.remainderIntegrals : nullptr, cells, r,
+                          uvScale, meshBox, onPlane);
+}
+
+RoughCutReport roughenEdit(SplitEdit& split, const Mesh& mesh, const std::vector<ConvexPolytope>& cells,
+                           const Roughness& r, double uvScale, const Aabb& meshBox, double onPlane) {
+    // The remainder's new triangles as a mesh of their own, numbered in order of first use.
+    RemainderEdit& edit = split.remainder;
+    const auto nV = static_cast<std::uint32_t>(mesh.positions.size());
+    Mesh local;
+    std::unordered_map<std::uint32_t, std::uint32_t> toLocal;
+    std::vector<std::uint32_t> toGlobal;
+    local.triangles = std::move(edit.added.triangles);
+    for (Triangle& tri : local.triangles)
+        for (std::uint32_t& v : tri) {
+            auto [it, fresh] = toLocal.emplace(v, static_cast<std::uint32_t>(toGlobal.size()));
+            if (fresh) {
+                toGlobal.push_back(v);
+                local.positions.push_back(v < nV ? mesh.positions[v] : edit.newPositions[v - nV]);
+            }
+            v = it->second;
+        }
+    local.normals = std::move(edit.added.normals);
+    local.uvs = std::move(edit.added.uvs);
+    local.materials = std::move(edit.added.materials);
+    std::vector<Mesh*> outputs{&local};
+    for (Mesh& m : split.inside)
+        outputs.push_back(&m);
+    const RoughCutReport report =
+        roughenOutputs(outputs, &split.remainderIntegrals, cells, r, uvScale, meshBox, onPlane);
+    // Back into the edit: moved points in place, the bisections' points after the edit's own.
+    for (std::size_t v = 0; v < toGlobal.size(); ++v)
+        if (toGlobal[v] >= nV)
+            edit.newPositions[toGlobal[v] - nV] = local.positions[v];
+    for (std::size_t v = toGlobal.size(); v < local.positions.size(); ++v) {
+        toGlobal.push_back(nV + static_cast<std::uint32_t>(edit.newPositions.size()));
+        edit.newPositions.push_back(local.positions[v]);
+    }
+    for (Triangle& tri : local.triangles)
+        for (std::uint32_t& v : tri)
+            v = toGlobal[v];
+    edit.added = {std::move(local.triangles), std::move(local.normals), std::move(local.uvs),
+                  std::move(local.materials)};
     return report;
 }
 

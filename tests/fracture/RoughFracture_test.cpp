@@ -480,3 +480,70 @@ TEST(RoughFracture, ACutGrazingTheOuterSurfaceDoesNotCrossIt) {
         EXPECT_EQ(report.selfIntersections, 0u) << "piece of cell " << piece.cell;
     }
 }
+
+namespace {
+
+/// A rough hit edited in place (docs/megamesh.md): on a UV sphere of radius r (slices 160 r, stacks 80 r: the
+/// same triangle size, ~25k r² triangles) by one cell of fixed size, the remainder's triangles that differ
+/// from the input's slot by slot.
+struct RoughHit {
+    std::size_t triangles = 0; // of the input
+    std::size_t changed = 0;   // remainder slots that differ from the input's, and slots added or dropped
+    std::size_t remainder = 0; // triangles of the remainder
+    std::set<std::array<double, 9>> cut; // the cut triangles of every piece (oriented keys)
+};
+
+RoughHit roughHitInPlace(int radius, bool inPlace) {
+    Mesh sphere = makeSphere({0, 0, 0}, radius, 160 * radius, 80 * radius);
+    RoughHit h;
+    h.triangles = sphere.triangles.size();
+    const Mesh input = sphere;
+    auto facts = analyzeMesh(sphere);
+    EXPECT_TRUE(facts);
+    if (!facts)
+        return h;
+    FractureParams p = roughParams();
+    p.sizeLaw.base = 0.4;
+    const Impact impact{{radius - 1e-3, 0.01, 0.02}, {1, 0, 0}, 10};
+    auto r = inPlace ? fracture(std::move(sphere), impact, p, 5, std::move(*facts))
+                     : fracture(input, impact, p, 5);
+    EXPECT_TRUE(r) << (r ? "" : r.error().message);
+    if (!r)
+        return h;
+    const std::string what = "sphere " + std::to_string(radius) + (inPlace ? " in place" : " copied");
+    EXPECT_TRUE(r->rough) << what;
+    EXPECT_EQ(r->editedInPlace, inPlace) << what;
+    expectSoundPieces(input, *r, what);
+    expectCutsCoincide(*r, what);
+    for (const Piece& piece : r->pieces) {
+        const Mesh& m = piece.mesh;
+        for (std::size_t t = 0; t < m.triangles.size(); ++t)
+            if (m.materials[t] == kInteriorMaterial)
+                h.cut.insert(orientedKey(m, t, false));
+        if (piece.cell != -1 || m.triangles.size() < h.remainder)
+            continue;
+        h.remainder = m.triangles.size();
+        h.changed = std::max(m.triangles.size(), input.triangles.size()) -
+                    std::min(m.triangles.size(), input.triangles.size());
+        for (std::size_t t = 0; t < std::min(m.triangles.size(), input.triangles.size()); ++t)
+            h.changed += m.corners(t) != input.corners(t) ? 1 : 0;
+    }
+    return h;
+}
+
+} // namespace
+
+// A rough cut on a mesh above kTopologyAboveTriangles is made in place, as a flat one: the remainder's edit
+// is roughened as a mesh of its own, so the triangles it changes follow the cut, not the mesh, and the rough
+// surface is the copying path's, point for point.
+TEST(RoughFracture, RoughCutsOnLargeMeshesAreMadeInPlace) {
+    const RoughHit small = roughHitInPlace(1, true), large = roughHitInPlace(2, true);
+    ASSERT_GT(small.remainder, 0u);
+    ASSERT_GT(large.remainder, 0u);
+    EXPECT_GT(large.triangles, 3 * small.triangles);
+    // the same cut on four times the triangles: a copy would change every slot after the first removed one
+    EXPECT_LT(large.changed, 2 * small.changed + 2000);
+    EXPECT_LT(large.changed, large.remainder / 20);
+    EXPECT_GT(small.cut.size(), 100u);
+    EXPECT_EQ(roughHitInPlace(1, false).cut, small.cut);
+}
