@@ -491,6 +491,7 @@ struct RoughHit {
     std::size_t changed = 0;   // remainder slots that differ from the input's, and slots added or dropped
     std::size_t remainder = 0; // triangles of the remainder
     std::set<std::array<double, 9>> cut; // the cut triangles of every piece (oriented keys)
+    std::uint64_t hash = 0;              // of the pieces
 };
 
 RoughHit roughHitInPlace(int radius, bool inPlace) {
@@ -516,6 +517,7 @@ RoughHit roughHitInPlace(int radius, bool inPlace) {
     EXPECT_FALSE(r->islandsLabelledFully) << what; // the walk around the cut proved the remainder one shell
     expectSoundPieces(input, *r, what);
     expectCutsCoincide(*r, what);
+    h.hash = test::hashPieces(*r);
     for (const Piece& piece : r->pieces) {
         const Mesh& m = piece.mesh;
         for (std::size_t t = 0; t < m.triangles.size(); ++t)
@@ -547,4 +549,5 @@ TEST(RoughFracture, RoughCutsOnLargeMeshesAreMadeInPlace) {
     EXPECT_LT(large.changed, large.remainder / 20);
     EXPECT_GT(small.cut.size(), 100u);
     EXPECT_EQ(roughHitInPlace(1, false).cut, small.cut);
+    EXPECT_EQ(roughHitInPlace(1, true).hash, small.hash); // same seed, same bytes
 }
