@@ -112,6 +112,7 @@ public:
     CutFaces(const std::vector<ConvexPolytope>& cells, double onPlane) : cells_(cells), onPlane_(onPlane) {
         for (const ConvexPolytope& c : cells) {
             first_.push_back(faces_.size());
+            bounds_.push_back(c.bounds());
             for (const PolytopeFace& f : c.faces()) {
                 CutFace cf{&f, f.plane.normal, {}, {}};
                 int big = 0;
@@ -139,10 +140,10 @@ public:
         box.extend(a);
         box.extend(b);
         double largestCos = -1; // of the smallest angle
-        for (const ConvexPolytope& cell : cells_) {
-            if (cell.empty() || !cell.bounds().overlaps(box, onPlane_))
+        for (std::size_t k = 0; k < cells_.size(); ++k) {
+            if (cells_[k].empty() || !bounds_[k].overlaps(box, onPlane_))
                 continue;
-            for (const PolytopeFace& g : cell.faces()) {
+            for (const PolytopeFace& g : cells_[k].faces()) {
                 const double c = std::abs(dot(g.plane.normal, nf));
                 if (c > 0.99985 || std::abs(g.plane.signedDistance(a)) > onPlane_ || // coplanar: 1°
                     std::abs(g.plane.signedDistance(b)) > onPlane_ || !insidePolygon(g, mid))
@@ -167,7 +168,7 @@ public:
         const Vec3 tn = cross(c[1] - c[0], c[2] - c[0]);
         const double tl = length(tn);
         for (std::size_t k = 0; k < cells_.size(); ++k) {
-            if (cells_[k].empty() || !cells_[k].bounds().overlaps(box, onPlane_))
+            if (cells_[k].empty() || !bounds_[k].overlaps(box, onPlane_))
                 continue;
             const auto& faces = cells_[k].faces();
             for (std::size_t j = 0; j < faces.size(); ++j) {
@@ -201,6 +202,7 @@ private:
     const std::vector<ConvexPolytope>& cells_;
     double onPlane_;
     std::vector<std::size_t> first_;
+    std::vector<Aabb> bounds_; // of each cell
     std::vector<CutFace> faces_;
 };
 
