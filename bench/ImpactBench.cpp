@@ -84,6 +84,14 @@ struct Case {
     std::map<rubble::BooleanKind, Samples> samples;
 };
 
+/// to = from with 1/16 spare capacity, as the runtime copies a mesh that a fracture edits in place
+/// (DestructionWorld.cpp, editableCopy): an edit that adds triangles does not reallocate the arrays.
+template <class T>
+void assignWithRoom(std::vector<T>& to, const std::vector<T>& from) {
+    to.reserve(from.size() + from.size() / 16);
+    to = from;
+}
+
 void runOnce(Case& c, rubble::BooleanKind kind, std::uint64_t seed) {
     rubble::FractureParams params;
     params.backend = kind;
@@ -93,8 +101,17 @@ void runOnce(Case& c, rubble::BooleanKind kind, std::uint64_t seed) {
     params.cells = c.cells;
     params.roughness = c.roughness;
     Samples& s = c.samples[kind];
-    rubble::Mesh work = c.known ? c.mesh : rubble::Mesh{}; // the copy the runtime makes, not timed
+    rubble::Mesh work; // the copy the runtime makes, not timed
     rubble::MeshFacts facts = c.known ? *c.known : rubble::MeshFacts{};
+    if (c.known) {
+        assignWithRoom(work.positions, c.mesh.positions);
+        assignWithRoom(work.triangles, c.mesh.triangles);
+        assignWithRoom(work.normals, c.mesh.normals);
+        assignWithRoom(work.uvs, c.mesh.uvs);
+        assignWithRoom(work.materials, c.mesh.materials);
+        work.materialNames = c.mesh.materialNames;
+        assignWithRoom(facts.topology.twin, c.known->topology.twin);
+    }
     const auto t0 = Clock::now();
     auto r = c.known ? rubble::fracture(std::move(work), c.impact, params, seed, std::move(facts))
                      : rubble::fracture(c.mesh, c.impact, params, seed);
