@@ -425,7 +425,7 @@ int runBench(const BenchArgs& args) {
     if (!rubble::bench::writeCsv(fs::path(args.out) / (args.rough ? "impact_rough.csv" : "impact.csv"),
                                  table))
         return 1;
-    if (args.rough) { // rough over flat, per case: with parts, and pieces alone
+    if (args.rough) { // rough over flat, per case: impact → pieces in the fracture's CPU time
         std::string data;
         for (const Case& c : cases) {
             const auto flat = std::find_if(cases.begin(), cases.end(),
@@ -435,13 +435,13 @@ int runBench(const BenchArgs& args) {
                 continue;
             const Samples &r = c.samples.at(rubble::BooleanKind::Fast),
                           &f = flat->samples.at(rubble::BooleanKind::Fast);
-            data += "\"" + flat->name + "\" " + fixed(stats(f.withParts).median) + " " +
-                    fixed(stats(r.withParts).median) + "\n";
+            data += "\"" + flat->name + "\" " + fixed(stats(f.piecesCpu).median) + " " +
+                    fixed(stats(r.piecesCpu).median) + "\n";
         }
         rubble::bench::plotPng(args.out, "impact_rough", data,
                                "set termoption noenhanced\nset style data histograms\nset style fill solid "
-                               "0.6\nset ylabel 'impact -> "
-                               "pieces + convex parts (ms)'\nset grid ytics\nset key top left\n"
+                               "0.6\nset ylabel 'impact -> pieces, CPU ms of the fracture'\n"
+                               "set xtics rotate by -15\nset grid ytics\nset key top left\n"
                                "set title 'Flat vs rough (concrete) cut faces, fast backend, one run'\n"
                                "plot $DATA u 2:xtic(1) t 'flat', '' u 3 t 'rough'");
         return 0;
