@@ -471,7 +471,7 @@ Result<FractureResult> runInPlace(Mesh& mesh, MeshTopology& topology, std::vecto
                                   const FractureParams& params, const BooleanBackend& backend, bool exactRedo,
                                   double inputVolume) {
     const auto* editing = dynamic_cast<const detail::EditingBackend*>(&backend);
-    if (!editing || !topology.fits(mesh) || params.roughness.active())
+    if (!editing || !topology.fits(mesh))
         return runPipeline(mesh, std::move(cells), params, backend, exactRedo, inputVolume, true);
     const Stopwatch t0;
     FractureResult res;
@@ -481,6 +481,14 @@ Result<FractureResult> runInPlace(Mesh& mesh, MeshTopology& topology, std::vecto
     const std::size_t nT = mesh.triangles.size();
 
     auto split = editing->splitAsEdit(mesh, cells, meshBox);
+    const double onPlane = 1e-7 * meshBox.diagonal();
+    // Rough cut faces: the edit's new triangles and the cells' pieces, before the checks.
+    res.rough = split && params.roughness.active();
+    if (res.rough)
+        detail::roughenEdit(*split, mesh, cells, params.roughness, params.uvScale, meshBox, onPlane);
+    // Rough pieces are not simplified (as in runPipeline).
+    FractureParams finish = params;
+    finish.simplifyPieces = params.simplifyPieces && !res.rough;
     const Stopwatch tv;
     std::vector<detail::OutputShells> shells;
     std::optional<std::vector<std::uint32_t>> slots;
@@ -533,9 +541,10 @@ Result<FractureResult> runInPlace(Mesh& mesh, MeshTopology& topology, std::vecto
 
     const Stopwatch t1;
     const Aabb focus = cutFocus(cells, meshBox);
-    const double onPlane = 1e-7 * meshBox.diagonal();
-    finishCutFaces(mesh, cells, params.uvScale, focus, onPlane, &*slots);
-    finishInsideCutFaces(split->inside, cells, params, focus, onPlane);
+    if (!res.rough) { // roughenEdit gave the rough faces theirs
+        finishCutFaces(mesh, cells, params.uvScale, focus, onPlane, &*slots);
+        finishInsideCutFaces(split->inside, cells, params, focus, onPlane);
+    }
     // One shell when a walk around the cut joins all new triangles (the kept ones next to the cut touch
     // them); else the full labelling.
     detail::OutputShells rest;
@@ -578,19 +587,19 @@ Result<FractureResult> runInPlace(Mesh& mesh, MeshTopology& topology, std::vecto
         one = count == 1;
     }
     t1.set(res, &FractureTimings::massMs);
-    if (one && params.simplifyPieces) {
+    if (one && finish.simplifyPieces) {
         const Stopwatch ts;
         simplifyAroundCut(mesh, topology, *slots, focus, meshBox.diagonal(), restIntegrals);
         ts.add(res, &FractureTimings::simplifyMs);
     }
     const double minVolume = std::max(0.0, params.minPieceVolumeFraction) * inputVolume;
-    addPieces(std::move(mesh), rest, -1, minVolume, params.simplifyPieces && !one, focus, &restIntegrals, res,
+    addPieces(std::move(mesh), rest, -1, minVolume, finish.simplifyPieces && !one, focus, &restIntegrals, res,
               one ? &topology : nullptr, true);
     for (Mesh& chip : chips) // measured: they are small
-        addPieces(std::move(chip), detail::OutputShells{{}, 1}, -1, minVolume, params.simplifyPieces, focus,
+        addPieces(std::move(chip), detail::OutputShells{{}, 1}, -1, minVolume, finish.simplifyPieces, focus,
                   nullptr, res, nullptr, true);
     const InsideInPlace debris{split->insideKept, meshBox.diagonal()};
-    return finishPieces(std::move(split->inside), shells, std::move(cells), params, minVolume, focus, true,
+    return finishPieces(std::move(split->inside), shells, std::move(cells), finish, minVolume, focus, true,
                         t0, t1, std::move(res), &debris);
 }
 
@@ -618,8 +627,7 @@ Result<FractureResult> withValidation(const Mesh& mesh, const MeshFacts& known, 
 
 /// True when mesh is fractured in place: known facts with a topology, the Fast backend.
 bool inPlace(const Mesh& mesh, const MeshFacts& known, const FractureParams& params) {
-    return params.backend == BooleanKind::Fast && !params.roughness.active() && known.fit(mesh) &&
-           known.topology.fits(mesh);
+    return params.backend == BooleanKind::Fast && known.fit(mesh) && known.topology.fits(mesh);
 }
 
 } // namespace
@@ -773,10 +781,11 @@ Result<FractureResult> fracture(Mesh&& mesh, const Impact& impact, const Fractur
                                 std::uint64_t seed, MeshFacts known) {
     if (!inPlace(mesh, known, params))
         return fracture(std::as_const(mesh), impact, params, seed, known);
+    const FractureParams p = seeded(params, seed);
     return fractureBy(
-        mesh, impact, params, seed, known,
+        mesh, impact, p, seed, known,
         [&](std::vector<ConvexPolytope> cells, const BooleanBackend& backend, bool exactRedo, double volume) {
-            return runInPlace(mesh, known.topology, std::move(cells), params, backend, exactRedo, volume);
+            return runInPlace(mesh, known.topology, std::move(cells), p, backend, exactRedo, volume);
         });
 }
 

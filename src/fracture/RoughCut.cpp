@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <numbers>
 #include <tuple>
 #include <unordered_map>
@@ -66,11 +67,19 @@ double valueNoise(const Vec3& p, std::uint64_t seed) {
     return c0 + (c1 - c0) * tz;
 }
 
-/// The slope of the envelope of a cut face's heights from where it meets the outer surface: tan 10°, so it
-/// cannot cross an outer surface it meets at more than 10° (docs/roughness.md).
+/// The envelope slope along an outer-surface segment whose angle with the outer surface is unknown: tan 10°.
 constexpr double kEnvelope = 0.17632698070846498;
-/// The steepest envelope slope along a cell edge: tan 40°.
+/// The steepest envelope slope: tan 40°.
 constexpr double kEdgeEnvelope = 0.83909963117728;
+/// The least envelope slope (a cut grazing the outer surface): tan 0.5°.
+constexpr double kLeastEnvelope = 0.0087268677907587893;
+
+/// The envelope slope along a segment where a cut face meets the outer surface at the angle psi (radians, at
+/// most 90°): tan(max(psi − 10°, 2 psi / 3)), between tan 0.5° and tan 40°.
+double outerSlope(double psi) {
+    const double alpha = std::max(psi - 10 * std::numbers::pi / 180, 2 * psi / 3);
+    return std::clamp(std::tan(alpha), kLeastEnvelope, kEdgeEnvelope);
+}
 
 /// Squared distance from p to the segment ab.
 double segmentDistance2(const Vec3& p, const Vec3& a, const Vec3& b) {
@@ -103,6 +112,7 @@ public:
     CutFaces(const std::vector<ConvexPolytope>& cells, double onPlane) : cells_(cells), onPlane_(onPlane) {
         for (const ConvexPolytope& c : cells) {
             first_.push_back(faces_.size());
+            bounds_.push_back(c.bounds());
             for (const PolytopeFace& f : c.faces()) {
                 CutFace cf{&f, f.plane.normal, {}, {}};
                 int big = 0;
@@ -120,9 +130,9 @@ public:
     const CutFace& operator[](std::size_t i) const { return faces_[i]; }
 
     /// The envelope slope along the outline segment ab of face f: tan(max(θ/2 − 5°, θ/3)), at most tan 40°,
-    /// θ the smallest angle between f's plane and the plane of another cell face holding the segment; the
-    /// outer surface's kEnvelope where none does. A function of the segment and the cells: the same bits on
-    /// both sides.
+    /// θ the smallest angle between f's plane and the plane of another cell face holding the segment; 0 where
+    /// none does (the segment is on the outer surface). A function of the segment and the cells: the same
+    /// bits on both sides.
     double outlineSlope(std::size_t f, const Vec3& a, const Vec3& b) const {
         const Vec3 nf = faces_[f].normal;
         const Vec3 mid = (a + b) * 0.5;
@@ -130,10 +140,10 @@ public:
         box.extend(a);
         box.extend(b);
         double largestCos = -1; // of the smallest angle
-        for (const ConvexPolytope& cell : cells_) {
-            if (cell.empty() || !cell.bounds().overlaps(box, onPlane_))
+        for (std::size_t k = 0; k < cells_.size(); ++k) {
+            if (cells_[k].empty() || !bounds_[k].overlaps(box, onPlane_))
                 continue;
-            for (const PolytopeFace& g : cell.faces()) {
+            for (const PolytopeFace& g : cells_[k].faces()) {
                 const double c = std::abs(dot(g.plane.normal, nf));
                 if (c > 0.99985 || std::abs(g.plane.signedDistance(a)) > onPlane_ || // coplanar: 1°
                     std::abs(g.plane.signedDistance(b)) > onPlane_ || !insidePolygon(g, mid))
@@ -142,7 +152,7 @@ public:
             }
         }
         if (largestCos < 0)
-            return kEnvelope;
+            return 0;
         const double theta = std::acos(largestCos);
         return std::min(kEdgeEnvelope, std::tan(std::max(theta / 2 - 5 * std::numbers::pi / 180, theta / 3)));
     }
@@ -158,7 +168,7 @@ public:
         const Vec3 tn = cross(c[1] - c[0], c[2] - c[0]);
         const double tl = length(tn);
         for (std::size_t k = 0; k < cells_.size(); ++k) {
-            if (cells_[k].empty() || !cells_[k].bounds().overlaps(box, onPlane_))
+            if (cells_[k].empty() || !bounds_[k].overlaps(box, onPlane_))
                 continue;
             const auto& faces = cells_[k].faces();
             for (std::size_t j = 0; j < faces.size(); ++j) {
@@ -192,6 +202,7 @@ private:
     const std::vector<ConvexPolytope>& cells_;
     double onPlane_;
     std::vector<std::size_t> first_;
+    std::vector<Aabb> bounds_; // of each cell
     std::vector<CutFace> faces_;
 };
 
@@ -244,8 +255,7 @@ private:
 /// The shared settings of one rough split.
 struct RoughSettings {
     double amplitude = 0;
-    double reach = 0; // distances to the outline are measured up to here (the envelope is then 2 amplitudes)
-    double edge = 0;  // longest cut-face edge after tessellation
+    double edge = 0; // longest cut-face edge after tessellation
     const RoughField* field = nullptr;
     double uvScale = 1;
 };
@@ -327,24 +337,62 @@ void splitTriangles(std::vector<WorkTriangle>& work,
     work = std::move(out);
 }
 
-/// Roughens one output: its cut triangles (faceOf >= 0) and the triangles along their edges.
-void roughenMesh(Mesh& m, const std::vector<std::int32_t>& faceOf, const CutFaces& faces,
-                 const RoughSettings& s, VolumeIntegrals* integrals) {
+/// A face's edges in an output's sorted edge list.
+struct FaceRange {
+    std::int32_t face;
+    std::size_t begin, end;
+};
+
+/// An outline segment of a cut face: the face and its ends' positions in lexicographic order (the same bits
+/// in both outputs that hold the face).
+using SegmentKey = std::tuple<std::int32_t, double, double, double, double, double, double>;
+
+SegmentKey segmentKey(std::int32_t face, Vec3 a, Vec3 b) {
+    if (lexLess(b, a))
+        std::swap(a, b);
+    return {face, a.x, a.y, a.z, b.x, b.y, b.z};
+}
+
+/// One output being roughened: its triangles around the cut, tessellated, and its cut faces' outlines.
+struct RoughOutput {
+    Mesh* mesh = nullptr;
+    VolumeIntegrals* integrals = nullptr;
+    std::size_t inputTriangles = 0;
+    std::vector<std::uint8_t> taken; // input triangles that work replaces
+    std::vector<WorkTriangle> work;
+    std::vector<std::tuple<std::int32_t, std::uint64_t, std::uint32_t>> edges; // face, edge, triangle; sorted
+    std::vector<FaceRange> ranges;                                             // per cut face, in edges
+    std::vector<std::uint8_t> fixed;                                           // outline vertices
+
+    /// True when edges[i] (of the face range r) is on the face's outline: used by one of its triangles.
+    bool isOutline(std::size_t i, const FaceRange& r) const {
+        const std::uint64_t e = std::get<1>(edges[i]);
+        return !((i > r.begin && std::get<1>(edges[i - 1]) == e) ||
+                 (i + 1 < r.end && std::get<1>(edges[i + 1]) == e));
+    }
+};
+
+/// Takes an output's cut triangles (faceOf >= 0) and the triangles along their edges, bisects every cut-face
+/// edge longer than the target until none is, finds each cut face's outline and gives the cut faces the UVs
+/// of their flat positions.
+void tessellate(RoughOutput& o, Mesh& m, const std::vector<std::int32_t>& faceOf, const CutFaces& faces,
+                const RoughSettings& s) {
+    o.mesh = &m;
     const std::size_t nT = m.triangles.size();
+    o.inputTriangles = nT;
     const bool normals = m.hasNormals();
     std::vector<std::uint8_t> cutVertex(m.positions.size(), 0);
     for (std::size_t t = 0; t < nT; ++t)
         if (faceOf[t] >= 0)
             for (std::uint32_t v : m.triangles[t])
                 cutVertex[v] = 1;
-    std::vector<std::uint8_t> taken(nT, 0);
-    std::vector<WorkTriangle> work;
+    o.taken.assign(nT, 0);
     for (std::size_t t = 0; t < nT; ++t) {
         const Triangle& tri = m.triangles[t];
         const int onCut = cutVertex[tri[0]] + cutVertex[tri[1]] + cutVertex[tri[2]];
         if (faceOf[t] < 0 && onCut < 2)
             continue;
-        taken[t] = 1;
+        o.taken[t] = 1;
         WorkTriangle w;
         w.v = {tri[0], tri[1], tri[2]};
         for (std::size_t k = 0; k < 3; ++k) {
@@ -354,10 +402,11 @@ void roughenMesh(Mesh& m, const std::vector<std::int32_t>& faceOf, const CutFace
         }
         w.material = m.materials[t];
         w.face = faceOf[t];
-        work.push_back(w);
-        if (integrals)
-            integrals->remove(m, t);
+        o.work.push_back(w);
+        if (o.integrals)
+            o.integrals->remove(m, t);
     }
+    std::vector<WorkTriangle>& work = o.work;
     // Bisect every cut-face edge longer than the target until none is.
     const double edge2 = s.edge * s.edge;
     for (int pass = 0; pass < 40; ++pass) {
@@ -382,38 +431,27 @@ void roughenMesh(Mesh& m, const std::vector<std::int32_t>& faceOf, const CutFace
         splitTriangles(work, mid, m.positions, normals);
     }
     // Per cut face: its outline (edges of one of its triangles only); outline vertices stay.
-    std::vector<std::tuple<std::int32_t, std::uint64_t, std::uint32_t>> edges; // face, edge, triangle
     for (std::uint32_t i = 0; i < work.size(); ++i)
         if (work[i].face >= 0)
             for (int k = 0; k < 3; ++k)
-                edges.emplace_back(work[i].face, edgeKey(work[i].v[k], work[i].v[(k + 1) % 3]), i);
-    std::sort(edges.begin(), edges.end());
-    std::vector<std::uint8_t> fixed(m.positions.size(), 0);
-    struct FaceRange {
-        std::int32_t face;
-        std::size_t begin, end; // in edges
-    };
-    std::vector<FaceRange> ranges;
-    for (std::size_t i = 0; i < edges.size();) {
+                o.edges.emplace_back(work[i].face, edgeKey(work[i].v[k], work[i].v[(k + 1) % 3]), i);
+    std::sort(o.edges.begin(), o.edges.end());
+    o.fixed.assign(m.positions.size(), 0);
+    for (std::size_t i = 0; i < o.edges.size();) {
         std::size_t j = i;
-        while (j < edges.size() && std::get<0>(edges[j]) == std::get<0>(edges[i]))
+        while (j < o.edges.size() && std::get<0>(o.edges[j]) == std::get<0>(o.edges[i]))
             ++j;
-        ranges.push_back({std::get<0>(edges[i]), i, j});
+        o.ranges.push_back({std::get<0>(o.edges[i]), i, j});
         i = j;
     }
-    auto isOutline = [&](std::size_t i, std::size_t begin, std::size_t end) {
-        const std::uint64_t e = std::get<1>(edges[i]);
-        return !((i > begin && std::get<1>(edges[i - 1]) == e) ||
-                 (i + 1 < end && std::get<1>(edges[i + 1]) == e));
-    };
-    for (const FaceRange& r : ranges)
+    for (const FaceRange& r : o.ranges)
         for (std::size_t i = r.begin; i < r.end; ++i)
-            if (isOutline(i, r.begin, r.end)) {
-                const std::uint64_t e = std::get<1>(edges[i]);
-                fixed[e >> 32] = 1;
-                fixed[e & 0xFFFFFFFFu] = 1;
+            if (o.isOutline(i, r)) {
+                const std::uint64_t e = std::get<1>(o.edges[i]);
+                o.fixed[e >> 32] = 1;
+                o.fixed[e & 0xFFFFFFFFu] = 1;
             }
-    // UVs of the flat cut (continuous across the displaced surface), then the displacement.
+    // UVs of the flat cut (continuous across the displaced surface).
     for (WorkTriangle& t : work)
         if (t.face >= 0) {
             const CutFace& f = faces[static_cast<std::size_t>(t.face)];
@@ -422,38 +460,89 @@ void roughenMesh(Mesh& m, const std::vector<std::int32_t>& faceOf, const CutFace
                 t.uv[k] = {dot(p, f.u) * s.uvScale, dot(p, f.v) * s.uvScale};
             }
         }
+}
+
+/// Records, for every outline segment of a cut face that a triangle not of a cut face (the outer surface)
+/// borders in this output, the largest |cos| of the angle between that triangle's plane and the face's.
+void recordOuterAngles(const RoughOutput& o, const CutFaces& faces, std::map<SegmentKey, double>& cosines) {
+    const std::vector<Vec3>& pos = o.mesh->positions;
+    std::unordered_map<std::uint64_t, std::uint32_t> outer; // edge -> a triangle not of a cut face
+    for (std::uint32_t i = 0; i < o.work.size(); ++i)
+        if (o.work[i].face < 0)
+            for (int k = 0; k < 3; ++k)
+                outer[edgeKey(o.work[i].v[k], o.work[i].v[(k + 1) % 3])] = i;
+    for (const FaceRange& r : o.ranges)
+        for (std::size_t i = r.begin; i < r.end; ++i) {
+            if (!o.isOutline(i, r))
+                continue;
+            const std::uint64_t e = std::get<1>(o.edges[i]);
+            const auto it = outer.find(e);
+            if (it == outer.end())
+                continue;
+            const WorkTriangle& t = o.work[it->second];
+            const Vec3 n = cross(pos[t.v[1]] - pos[t.v[0]], pos[t.v[2]] - pos[t.v[0]]);
+            const double l = length(n);
+            if (!(l > 0))
+                continue;
+            const double c = std::abs(dot(n, faces[static_cast<std::size_t>(r.face)].normal)) / l;
+            auto [slot, fresh] = cosines.emplace(
+                segmentKey(r.face, pos[static_cast<std::uint32_t>(e >> 32)], pos[e & 0xFFFFFFFFu]), c);
+            if (!fresh)
+                slot->second = std::max(slot->second, c);
+        }
+}
+
+/// Moves every vertex inside a cut face along the face's normal by the enveloped height field, then sets the
+/// cut faces' normals and writes the output back: its untouched triangles in their order, then the worked
+/// ones.
+void displace(RoughOutput& o, const CutFaces& faces, const RoughSettings& s,
+              const std::map<SegmentKey, double>& cosines) {
+    Mesh& m = *o.mesh;
+    const bool normals = m.hasNormals();
     std::vector<std::uint32_t> inner;
-    for (const FaceRange& r : ranges) {
-        SegmentGrid grid(s.reach);
+    for (const FaceRange& r : o.ranges) {
         std::vector<std::pair<std::uint32_t, std::uint32_t>> outline;
         std::vector<double> slope2; // squared envelope slope of each outline segment
         inner.clear();
+        Aabb box;
+        double least = kEdgeEnvelope;
         for (std::size_t i = r.begin; i < r.end; ++i) {
-            const std::uint64_t e = std::get<1>(edges[i]);
+            const std::uint64_t e = std::get<1>(o.edges[i]);
             const auto a = static_cast<std::uint32_t>(e >> 32),
                        b = static_cast<std::uint32_t>(e & 0xFFFFFFFFu);
-            if (isOutline(i, r.begin,
-                          r.end)) { // ends in the order of their positions: the same bits both sides
+            box.extend(m.positions[a]);
+            box.extend(m.positions[b]);
+            if (o.isOutline(i, r)) { // ends in the order of their positions: the same bits both sides
                 const bool swap = lexLess(m.positions[b], m.positions[a]);
-                grid.add(static_cast<std::uint32_t>(outline.size()), m.positions[a], m.positions[b]);
                 outline.emplace_back(swap ? b : a, swap ? a : b);
-                const double k =
-                    faces.outlineSlope(static_cast<std::size_t>(r.face), m.positions[outline.back().first],
-                                       m.positions[outline.back().second]);
+                const Vec3 &p = m.positions[outline.back().first], &q = m.positions[outline.back().second];
+                double k = faces.outlineSlope(static_cast<std::size_t>(r.face), p, q);
+                if (k == 0) { // on the outer surface: its angle, as both sides recorded it
+                    const auto it = cosines.find(segmentKey(r.face, p, q));
+                    k = it == cosines.end() ? kEnvelope : outerSlope(std::acos(std::min(1.0, it->second)));
+                }
+                least = std::min(least, k);
                 slope2.push_back(k * k);
             }
             for (std::uint32_t v : {a, b})
-                if (!fixed[v])
+                if (!o.fixed[v])
                     inner.push_back(v);
         }
         std::sort(inner.begin(), inner.end());
         inner.erase(std::unique(inner.begin(), inner.end()), inner.end());
-        // The envelope: the least over the outline's segments (up to the reach) of slope × distance.
-        const double reach2 = s.reach * s.reach;
+        // The envelope: the least over the outline's segments of slope × distance, at most 2 amplitudes; a
+        // segment farther than the reach cannot lower it.
+        const double cap2 = 4 * s.amplitude * s.amplitude;
+        const double reach = std::min(2 * s.amplitude / least, box.diagonal());
+        if (!(reach > 0))
+            continue;
+        SegmentGrid grid(reach);
+        for (std::uint32_t id = 0; id < outline.size(); ++id)
+            grid.add(id, m.positions[outline[id].first], m.positions[outline[id].second]);
         const Vec3 n = faces[static_cast<std::size_t>(r.face)].normal;
         for (const std::uint32_t v : inner) {
             Vec3& p = m.positions[v];
-            double bound2 = kEnvelope * kEnvelope * reach2;
+            double bound2 = cap2;
             grid.near(p, [&](std::uint32_t id) {
                 bound2 = std::min(bound2, slope2[id] * segmentDistance2(p, m.positions[outline[id].first],
                                                                         m.positions[outline[id].second]));
@@ -462,6 +551,10 @@ void roughenMesh(Mesh& m, const std::vector<std::int32_t>& faceOf, const CutFace
             p = p + n * (bound * std::tanh(s.amplitude * (*s.field)(p) / bound));
         }
     }
+    std::vector<WorkTriangle>& work = o.work;
+    const std::size_t nT = o.inputTriangles;
+    const std::vector<std::uint8_t>& taken = o.taken;
+    VolumeIntegrals* integrals = o.integrals;
     // Normals of the displaced surface: smooth across a cut face, its own at the outline.
     if (normals) {
         std::unordered_map<std::uint64_t, Vec3> sum; // (face, vertex) -> area-weighted normal
@@ -510,7 +603,6 @@ void roughenMesh(Mesh& m, const std::vector<std::int32_t>& faceOf, const CutFace
     }
     m = std::move(out);
 }
-
 } // namespace
 
 RoughField::RoughField(const Roughness& r, double featureSize, int octavesUsed, const Vec3& grain)
@@ -532,8 +624,12 @@ double RoughField::operator()(const Vec3& p) const {
     return value * norm_;
 }
 
-RoughCutReport roughenSplit(SplitResult& split, const std::vector<ConvexPolytope>& cells, const Roughness& r,
-                            double uvScale, const Aabb& meshBox, double onPlane) {
+namespace {
+
+/// roughenSplit on these outputs; the first one's integrals (or null) are kept exact.
+RoughCutReport roughenOutputs(const std::vector<Mesh*>& outputs, VolumeIntegrals* firstIntegrals,
+                              const std::vector<ConvexPolytope>& cells, const Roughness& r, double uvScale,
+                              const Aabb& meshBox, double onPlane) {
     RoughCutReport report;
     // The cell size: the cube root of the cells' mean volume.
     double volume = 0;
@@ -553,9 +649,6 @@ RoughCutReport roughenSplit(SplitResult& split, const std::vector<ConvexPolytope
         return report;
 
     const CutFaces faces(cells, onPlane);
-    std::vector<Mesh*> outputs{&split.remainder};
-    for (Mesh& m : split.inside)
-        outputs.push_back(&m);
     std::vector<std::vector<std::int32_t>> faceOf(outputs.size());
     Aabb focus;
     for (const ConvexPolytope& c : cells)
@@ -596,16 +689,78 @@ RoughCutReport roughenSplit(SplitResult& split, const std::vector<ConvexPolytope
                                                  : Vec3{0, 0, 1};
     }
     const RoughField field(r, report.featureSize, report.octaves, grain);
-    RoughSettings s{report.amplitude, 2 * report.amplitude / kEnvelope, report.edge, &field, uvScale};
+    const RoughSettings s{report.amplitude, report.edge, &field, uvScale};
+    // Tessellate every output, record the outer surface's angle along each cut face's outline from both
+    // sides, then displace: the two sides of a segment read the same recorded angle.
+    std::vector<RoughOutput> rough;
     for (std::size_t o = 0; o < outputs.size(); ++o) {
         if (std::none_of(faceOf[o].begin(), faceOf[o].end(), [](std::int32_t f) { return f >= 0; }))
             continue;
-        VolumeIntegrals* integrals =
-            o == 0 && split.remainderIntegrals ? &*split.remainderIntegrals : nullptr;
-        roughenMesh(*outputs[o], faceOf[o], faces, s, integrals);
-        for (std::uint32_t mat : outputs[o]->materials)
+        rough.emplace_back();
+        rough.back().integrals = o == 0 ? firstIntegrals : nullptr;
+        tessellate(rough.back(), *outputs[o], faceOf[o], faces, s);
+    }
+    std::map<SegmentKey, double> cosines;
+    for (const RoughOutput& o : rough)
+        recordOuterAngles(o, faces, cosines);
+    for (RoughOutput& o : rough) {
+        displace(o, faces, s, cosines);
+        for (std::uint32_t mat : o.mesh->materials)
             report.faces += mat == kInteriorMaterial ? 1 : 0;
     }
+    return report;
+}
+
+} // namespace
+
+RoughCutReport roughenSplit(SplitResult& split, const std::vector<ConvexPolytope>& cells, const Roughness& r,
+                            double uvScale, const Aabb& meshBox, double onPlane) {
+    std::vector<Mesh*> outputs{&split.remainder};
+    for (Mesh& m : split.inside)
+        outputs.push_back(&m);
+    return roughenOutputs(outputs, split.remainderIntegrals ? &*split.remainderIntegrals : nullptr, cells, r,
+                          uvScale, meshBox, onPlane);
+}
+
+RoughCutReport roughenEdit(SplitEdit& split, const Mesh& mesh, const std::vector<ConvexPolytope>& cells,
+                           const Roughness& r, double uvScale, const Aabb& meshBox, double onPlane) {
+    // The remainder's new triangles as a mesh of their own, numbered in order of first use.
+    RemainderEdit& edit = split.remainder;
+    const auto nV = static_cast<std::uint32_t>(mesh.positions.size());
+    Mesh local;
+    std::unordered_map<std::uint32_t, std::uint32_t> toLocal;
+    std::vector<std::uint32_t> toGlobal;
+    local.triangles = std::move(edit.added.triangles);
+    for (Triangle& tri : local.triangles)
+        for (std::uint32_t& v : tri) {
+            auto [it, fresh] = toLocal.emplace(v, static_cast<std::uint32_t>(toGlobal.size()));
+            if (fresh) {
+                toGlobal.push_back(v);
+                local.positions.push_back(v < nV ? mesh.positions[v] : edit.newPositions[v - nV]);
+            }
+            v = it->second;
+        }
+    local.normals = std::move(edit.added.normals);
+    local.uvs = std::move(edit.added.uvs);
+    local.materials = std::move(edit.added.materials);
+    std::vector<Mesh*> outputs{&local};
+    for (Mesh& m : split.inside)
+        outputs.push_back(&m);
+    const RoughCutReport report =
+        roughenOutputs(outputs, &split.remainderIntegrals, cells, r, uvScale, meshBox, onPlane);
+    // Back into the edit: moved points in place, the bisections' points after the edit's own.
+    for (std::size_t v = 0; v < toGlobal.size(); ++v)
+        if (toGlobal[v] >= nV)
+            edit.newPositions[toGlobal[v] - nV] = local.positions[v];
+    for (std::size_t v = toGlobal.size(); v < local.positions.size(); ++v) {
+        toGlobal.push_back(nV + static_cast<std::uint32_t>(edit.newPositions.size()));
+        edit.newPositions.push_back(local.positions[v]);
+    }
+    for (Triangle& tri : local.triangles)
+        for (std::uint32_t& v : tri)
+            v = toGlobal[v];
+    edit.added = {std::move(local.triangles), std::move(local.normals), std::move(local.uvs),
+                  std::move(local.materials)};
     return report;
 }
 

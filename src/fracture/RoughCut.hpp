@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "BooleanBackends.hpp"
 #include "rubble/fracture/Fracture.hpp"
 #include "rubble/fracture/Roughness.hpp"
 #include "rubble/geometry/ConvexPolytope.hpp"
@@ -48,5 +49,11 @@ struct RoughCutReport {
 /// focus: the cells' bounds; onPlane: the tolerance to recognise a cut face on a cell face.
 RoughCutReport roughenSplit(SplitResult& split, const std::vector<ConvexPolytope>& cells, const Roughness& r,
                             double uvScale, const Aabb& meshBox, double onPlane);
+
+/// roughenSplit on a split whose remainder is an edit of mesh: the edit's new triangles are roughened as a
+/// mesh of their own (the rest of mesh is not read), the bisections' points appended to its new points, and
+/// remainderIntegrals kept exact.
+RoughCutReport roughenEdit(SplitEdit& split, const Mesh& mesh, const std::vector<ConvexPolytope>& cells,
+                           const Roughness& r, double uvScale, const Aabb& meshBox, double onPlane);
 
 } // namespace rubble::detail
