@@ -238,16 +238,18 @@ struct DestructionRuntime::Impl {
         return it != solids.end() ? it->second : id;
     }
 
-    void submit(const detail::PendingImpact& p, FrameStats& stats) {
+    // Submits an impact; false when the world's filter refuses it.
+    bool submit(const detail::PendingImpact& p, FrameStats& stats) {
         if (config.structure.enabled)
             structure.damage(p.worldPoint, p.impact.impulse);
         if (!world.submitImpact(p.object, p.impact))
-            return;
+            return false;
         ++stats.impactsSubmitted;
         ++counters.impacts;
         marks.push_back({p.worldPoint, p.worldNormal, p.impact.impulse});
         while (static_cast<int>(marks.size()) > config.impacts.maxImpactMarks)
             marks.pop_front();
+        return true;
     }
 
     void adopt(const FractureOutcome& outcome, FrameStats& stats) {
@@ -639,9 +641,7 @@ bool DestructionRuntime::submitImpact(BodyId id, const Vec3& worldPoint, const V
     p.worldPoint = worldPoint;
     p.worldNormal = worldNormal;
     FrameStats ignored;
-    const long long before = im.counters.impacts;
-    im.submit(p, ignored);
-    return im.counters.impacts > before;
+    return im.submit(p, ignored);
 }
 
 int DestructionRuntime::blast(const Vec3& center, double radius, double impulse, double edgeShare) {

@@ -556,15 +556,20 @@ std::vector<ObjectId> DestructionWorld::objects() const {
     return ids;
 }
 
-bool DestructionWorld::submitImpact(ObjectId id, const Impact& impact) {
+bool DestructionWorld::accepts(ObjectId id, const Impact& impact) const {
     auto it = impl_->objects.find(id);
     if (it == impl_->objects.end() || !it->second->destructible)
         return false;
     const Impact rounded = journalPrecision(impact);
-    if (!(rounded.impulse >= it->second->impulseThreshold) ||
-        !checkFractureParams(rounded, it->second->fracture))
+    return rounded.impulse >= it->second->impulseThreshold &&
+           checkFractureParams(rounded, it->second->fracture);
+}
+
+bool DestructionWorld::submitImpact(ObjectId id, const Impact& impact) {
+    if (!accepts(id, impact))
         return false;
-    const ObjectState& o = *it->second;
+    const Impact rounded = journalPrecision(impact);
+    const ObjectState& o = *impl_->objects.at(id);
     JournalEvent e;
     e.kind = JournalEventKind::Impact;
     e.object = id;

@@ -8,6 +8,7 @@
 #include <limits>
 #include <string>
 #include <thread>
+#include <tuple>
 #include <vector>
 
 #include "TestSupport.hpp"
@@ -98,6 +99,29 @@ TEST(DestructionWorld, ImpactBelowThresholdIgnored) {
     i.impulse = 0.5;
     EXPECT_FALSE(w.submitImpact(id.value(), i));
     EXPECT_EQ(w.jobsInFlight(), 0);
+}
+
+// accepts() is the one impact filter: submitImpact takes exactly what it accepts, at journal precision (an
+// impulse just below the threshold that rounds up to it counts, as it does when the journal is replayed).
+TEST(DestructionWorld, SubmitImpactTakesExactlyWhatTheFilterAccepts) {
+    HeldJobs jobs;
+    DestructionWorld w(heldConfig(jobs));
+    const ObjectId id = *w.addObject(boxDesc()); // threshold 1
+    ObjectDesc fixed = boxDesc();
+    fixed.destructible = false;
+    const ObjectId wall = *w.addObject(std::move(fixed));
+    Impact below = centreHit(), rounded = centreHit(), noNormal = centreHit();
+    below.impulse = 0.99;
+    rounded.impulse = 1 - 1e-9; // 1.0f at single precision
+    noNormal.normal = {0, 0, 0};
+    const std::tuple<ObjectId, Impact, bool> cases[] = {{id, below, false},         {id, noNormal, false},
+                                                        {wall, centreHit(), false}, {999, centreHit(), false},
+                                                        {id, rounded, true},        {id, centreHit(), true}};
+    for (const auto& [object, impact, expected] : cases) {
+        EXPECT_EQ(w.accepts(object, impact), expected) << object << " " << impact.impulse;
+        EXPECT_EQ(w.submitImpact(object, impact), expected) << object << " " << impact.impulse;
+    }
+    EXPECT_EQ(w.journalPosition(), 2u);
 }
 
 TEST(DestructionWorld, OpenMeshWithAPlanarHoleIsClosedAndDestructible) {

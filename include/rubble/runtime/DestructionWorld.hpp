@@ -189,10 +189,13 @@ public:
     /// Ids of all live objects, ascending.
     std::vector<ObjectId> objects() const;
 
-    /// Submits an impact in the object's local coordinates. Returns false when it is ignored (unknown or
-    /// indestructible object, impulse below threshold, impact refused by checkFractureParams). An impact on
-    /// an object with a job in flight is merged into the next job for that object. Accepted: rounded to
-    /// single precision (journalPrecision) and journaled.
+    /// The impact filter: whether submitImpact accepts this impact (object-local): a live destructible
+    /// object, the impulse at single precision (journalPrecision) at least the object's threshold, and an
+    /// impact checkFractureParams accepts.
+    bool accepts(ObjectId id, const Impact& impact) const;
+    /// Submits an impact in the object's local coordinates. Returns false when accepts() refuses it. An
+    /// impact on an object with a job in flight is merged into the next job for that object. Accepted:
+    /// rounded to single precision (journalPrecision) and journaled.
     bool submitImpact(ObjectId id, const Impact& impact);
 
     /// Called with every journal event as it happens: each accepted impact and each removal of a live object.
