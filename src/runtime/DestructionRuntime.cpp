@@ -143,15 +143,13 @@ struct DestructionRuntime::Impl {
         return Aabb{c - e, c + e};
     }
 
-    // Removes a body; what a resting body held is re-checked (support) or woken (frozen debris).
-    void destroy(BodyId id, bool removeObject, bool wakeResting = true) {
-        BodyRecord* r = bodies.find(id);
+    // Removes a body from the engine and from every component; its object stays in the world.
+    void dropBody(BodyId id) {
+        const BodyRecord* r = bodies.find(id);
         if (!r)
             return;
         if (onRemoved)
             onRemoved(*r);
-        if (wakeResting && r->role != BodyRole::Projectile && !moving(*r))
-            governor.wakeNear(boundsOf(*r), config.support.tolerance);
         support.remove(id);
         structure.remove(id);
         governor.removed(id);
@@ -161,9 +159,22 @@ struct DestructionRuntime::Impl {
             materials.erase(r->object);
             solids.erase(r->object);
         }
-        if (r->hasObject && removeObject)
-            world.removeObject(r->object);
         bodies.erase(id);
+    }
+
+    // Removes a body and its object; what a resting body held is re-checked (support) or woken (frozen
+    // debris).
+    void destroy(BodyId id) {
+        const BodyRecord* r = bodies.find(id);
+        if (!r)
+            return;
+        if (r->role != BodyRole::Projectile && !moving(*r))
+            governor.wakeNear(boundsOf(*r), config.support.tolerance);
+        const bool hasObject = r->hasObject;
+        const ObjectId object = r->object;
+        dropBody(id);
+        if (hasObject)
+            world.removeObject(object);
     }
 
     void retire(BodyId id, detail::RetireReason reason, FrameStats& stats) {
@@ -190,7 +201,7 @@ struct DestructionRuntime::Impl {
             ++counters.retired.fellOut;
             break;
         }
-        destroy(id, true);
+        destroy(id);
     }
 
     // A static or frozen body becomes dynamic (wake rules: docs/architecture.md).
@@ -252,16 +263,16 @@ struct DestructionRuntime::Impl {
         return true;
     }
 
+    // Adopts a split: the parent's body goes, the pieces' bodies are made, then the world commits the split.
     void adopt(const FractureOutcome& outcome, FrameStats& stats) {
         ledger.dropped += outcome.droppedVolume;
         ledger.dust += outcome.dustVolume();
         const BodyRecord* parentPtr = bodies.findObject(outcome.parent);
-        if (!parentPtr) { // no body to replace: the pieces cannot be placed; their volume counts as retired
+        if (!parentPtr) { // no body carries the parent: it goes, and its pieces' volume counts as retired
             ++counters.staleOutcomes;
-            for (const AdoptedPiece& p : outcome.pieces) {
+            for (const AdoptedPiece& p : outcome.pieces)
                 ledger.retired += std::abs(p.state->mass.volume);
-                world.removeObject(p.id);
-            }
+            world.removeObject(outcome.parent);
             return;
         }
         const BodyRecord parent = *parentPtr;
@@ -274,8 +285,8 @@ struct DestructionRuntime::Impl {
         const bool parentResting = !moving(parent);
         const std::uint64_t parentSolid = solidOf(parent.object);
         const bool parentAnchored = structure.anchored(parent.id); // its pieces may float as it did
-        // The world removed the parent object already; what it held wakes near its flying debris (below).
-        destroy(parent.id, false, false);
+        // The parent object goes when the split is committed; what it held wakes near its flying debris.
+        dropBody(parent.id);
         ++stats.fractures;
         ++counters.fractures;
         for (std::size_t i = 0; i < plan.spawns.size(); ++i) {
@@ -306,8 +317,8 @@ struct DestructionRuntime::Impl {
         counters.piecesRetired += static_cast<long long>(plan.particles.size());
         counters.retired.dust += static_cast<long long>(plan.particles.size());
         particles.add(plan.particles);
-        settleSupport(stats);          // before the callback, so that it sees the pieces' final motion
-        world.finishAdoption(outcome); // the pieces' bodies exist: the impact's timing record ends here
+        world.commit(outcome); // the pieces' bodies exist
+        settleSupport(stats);  // before the callback, so that it sees the pieces' final motion
         if (onAdopted)
             onAdopted(outcome);
     }
@@ -481,7 +492,7 @@ struct DestructionRuntime::Impl {
                 expired.push_back(id);
         }
         for (BodyId id : expired)
-            destroy(id, false);
+            destroy(id);
     }
 };
 
@@ -622,7 +633,7 @@ BodyId DestructionRuntime::fireProjectile(const Vec3& from, const Vec3& velocity
 }
 
 void DestructionRuntime::removeBody(BodyId id) {
-    impl_->destroy(id, true);
+    impl_->destroy(id);
 }
 
 bool DestructionRuntime::submitImpact(BodyId id, const Vec3& worldPoint, const Vec3& worldNormal,
@@ -834,7 +845,7 @@ Status DestructionRuntime::restore(WorldState state, const std::vector<ObjectPla
     if (Status s = im.world.loadState(std::move(state)); !s)
         return s;
     for (BodyId id : old)
-        im.destroy(id, false);
+        im.dropBody(id);
     im.ledger = VolumeLedger{0, volumes.retired, volumes.dust, volumes.dropped};
     for (ObjectId id : im.world.objects()) {
         const ObjectState& st = *im.world.object(id);
