@@ -88,6 +88,15 @@ BodyRecord objectRecord(ObjectId object, BodyRole role, BodyMotionState motion, 
     return rec;
 }
 
+// What the stages of one frame share.
+struct FrameContext {
+    double dt = 0;                        // the frame's time step (s)
+    FrameStats stats;                     // what the frame did
+    detail::ImpactBatch impacts;          // the impacts its contacts amount to
+    std::vector<FractureOutcome> adopted; // the splits it adopted, for the callbacks
+    Clock::time_point afterPhysics;       // where the runtime's own part of the frame starts
+};
+
 } // namespace
 
 struct DestructionRuntime::Impl {
@@ -264,7 +273,8 @@ struct DestructionRuntime::Impl {
     }
 
     // Adopts a split: the parent's body goes, the pieces' bodies are made, then the world commits the split.
-    void adopt(const FractureOutcome& outcome, FrameStats& stats) {
+    // False when no body carries the parent.
+    bool adopt(const FractureOutcome& outcome, FrameStats& stats) {
         ledger.dropped += outcome.droppedVolume;
         ledger.dust += outcome.dustVolume();
         const BodyRecord* parentPtr = bodies.findObject(outcome.parent);
@@ -273,7 +283,7 @@ struct DestructionRuntime::Impl {
             for (const AdoptedPiece& p : outcome.pieces)
                 ledger.retired += std::abs(p.state->mass.volume);
             world.removeObject(outcome.parent);
-            return;
+            return false;
         }
         const BodyRecord parent = *parentPtr;
         const Material& material = materialOf(outcome.parent);
@@ -318,9 +328,7 @@ struct DestructionRuntime::Impl {
         counters.retired.dust += static_cast<long long>(plan.particles.size());
         particles.add(plan.particles);
         world.commit(outcome); // the pieces' bodies exist
-        settleSupport(stats);  // before the callback, so that it sees the pieces' final motion
-        if (onAdopted)
-            onAdopted(outcome);
+        return true;
     }
 
     void settleSupport(FrameStats& stats) {
@@ -379,9 +387,7 @@ struct DestructionRuntime::Impl {
             ++stats.piecesCollapsed;
             ++counters.piecesCollapsed;
         }
-        stats.structureMs += msSince(t0);
-        if (!fallen.empty())
-            settleSupport(stats);
+        stats.structureMs += msSince(t0); // what rested on the fallen is checked at the next support stage
     }
 
     // A saved structure names static objects (nodes once each) and, in bonds, nodes or this runtime's
@@ -456,10 +462,74 @@ struct DestructionRuntime::Impl {
         structure.settleNext();
     }
 
-    void adoptResults(FrameStats& stats) {
-        for (const FractureOutcome& o : world.collect())
-            adopt(o, stats);
-        settleSupport(stats);
+    // The stages of a frame (stepFrame) and of an adoption between frames (adoptReady), over a FrameContext.
+    void stepPhysics(FrameContext& f) {
+        const auto t0 = Clock::now();
+        contacts.clear();
+        breaks.clear();
+        f.stats.substeps = binding.step(f.dt, contacts);
+        f.stats.physicsMs = msSince(t0);
+        f.afterPhysics = Clock::now();
+        ++counters.frames;
+        searchesLeft = config.support.maxSearchesPerFrame;
+    }
+    void submitImpacts(FrameContext& f) {
+        collector.gather(contacts, bodies, world, binding, counters.frames);
+        f.impacts = collector.take();
+        f.stats.projectileHits = f.impacts.projectileHits;
+        counters.projectileHits += f.impacts.projectileHits;
+        for (const detail::PendingImpact& p : f.impacts.impacts)
+            submit(p, f.stats);
+        world.beginFrame();
+    }
+    void classifyAnchors(FrameContext& f) {
+        const auto t0 = Clock::now();
+        for (BodyId a : support.classify())
+            if (BodyRecord* r = bodies.find(a))
+                r->anchor = true;
+        f.stats.supportMs += msSince(t0);
+    }
+    void adoptSplits(FrameContext& f) {
+        for (FractureOutcome& o : world.collect())
+            if (adopt(o, f.stats))
+                f.adopted.push_back(std::move(o));
+    }
+    void settleSupportStage(FrameContext& f) { settleSupport(f.stats); }
+    void reportAdopted(FrameContext& f) { // after the support stage: the pieces' motion is final
+        if (onAdopted)
+            for (const FractureOutcome& o : f.adopted)
+                onAdopted(o);
+    }
+    void governDebris(FrameContext& f) { govern(f.impacts.frozenHits, f.dt, f.stats); }
+    void settleStructureStage(FrameContext& f) {
+        feedContactLoads(f.dt);
+        settleStructure(f.stats);
+    }
+    void advanceStage(FrameContext& f) { advance(f.dt); }
+
+    struct Stage {
+        const char* name;
+        void (Impl::*run)(FrameContext&);
+    };
+    // One frame, in order; support settles once, after the adoption.
+    static constexpr Stage kFrame[] = {{"physics", &Impl::stepPhysics},
+                                       {"impacts", &Impl::submitImpacts},
+                                       {"anchors", &Impl::classifyAnchors},
+                                       {"adopt", &Impl::adoptSplits},
+                                       {"support", &Impl::settleSupportStage},
+                                       {"adopted callbacks", &Impl::reportAdopted},
+                                       {"debris", &Impl::governDebris},
+                                       {"structure", &Impl::settleStructureStage},
+                                       {"particles and projectiles", &Impl::advanceStage}};
+    // The adoption of results ready between frames.
+    static constexpr Stage kBetweenFrames[] = {{"adopt", &Impl::adoptSplits},
+                                               {"support", &Impl::settleSupportStage},
+                                               {"adopted callbacks", &Impl::reportAdopted}};
+
+    template <std::size_t N>
+    void run(const Stage (&stages)[N], FrameContext& f) {
+        for (const Stage& stage : stages)
+            (this->*stage.run)(f);
     }
 
     void govern(const std::map<BodyId, double>& frozenHits, double dt, FrameStats& stats) {
@@ -678,46 +748,21 @@ int DestructionRuntime::blast(const Vec3& center, double radius, double impulse,
 }
 
 FrameStats DestructionRuntime::stepFrame(double dt) {
-    Impl& im = *impl_;
-    FrameStats stats;
-    const auto t0 = Clock::now();
-    im.contacts.clear();
-    im.breaks.clear();
-    stats.substeps = im.binding.step(dt, im.contacts);
-    stats.physicsMs = msSince(t0);
-    const auto t1 = Clock::now();
-    ++im.counters.frames;
-    im.searchesLeft = im.config.support.maxSearchesPerFrame;
-    im.collector.gather(im.contacts, im.bodies, im.world, im.binding, im.counters.frames);
-    const detail::ImpactBatch batch = im.collector.take();
-    stats.projectileHits = batch.projectileHits;
-    im.counters.projectileHits += batch.projectileHits;
-    for (const detail::PendingImpact& p : batch.impacts)
-        im.submit(p, stats);
-    im.world.beginFrame();
-    const auto t2 = Clock::now();
-    for (BodyId a : im.support.classify())
-        if (BodyRecord* r = im.bodies.find(a))
-            r->anchor = true;
-    stats.supportMs += msSince(t2);
-    im.adoptResults(stats);
-    im.govern(batch.frozenHits, dt, stats);
-    im.settleSupport(stats);
-    im.feedContactLoads(dt);
-    im.settleStructure(stats);
-    im.advance(dt);
-    stats.adoptMs = msSince(t1);
-    return stats;
+    FrameContext f;
+    f.dt = dt;
+    impl_->run(Impl::kFrame, f);
+    f.stats.adoptMs = msSince(f.afterPhysics);
+    return f.stats;
 }
 
 FrameStats DestructionRuntime::adoptReady() {
-    FrameStats stats;
+    FrameContext f;
     const auto t0 = Clock::now();
     if (!impl_->world.waitForResult(t0)) // nothing ready, or deterministic: adoption is frame-bound
-        return stats;
-    impl_->adoptResults(stats);
-    stats.adoptMs = msSince(t0);
-    return stats;
+        return f.stats;
+    impl_->run(Impl::kBetweenFrames, f);
+    f.stats.adoptMs = msSince(t0);
+    return f.stats;
 }
 
 const BodyRecord* DestructionRuntime::body(BodyId id) const {
