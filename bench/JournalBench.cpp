@@ -28,6 +28,12 @@
 
 namespace {
 
+// Collects the world's splits and commits each at once (no engine).
+void adoptAll(rubble::DestructionWorld& world) {
+    for (const rubble::FractureOutcome& split : world.collect())
+        world.commit(split);
+}
+
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 using rubble::bench::fixed;
@@ -140,11 +146,11 @@ int runBench(const BenchArgs& args) {
                 ++submitted;
         }
         recorder.beginFrame();
-        (void)recorder.collect();
+        adoptAll(recorder);
     }
     while (recorder.jobsInFlight() > 0) {
         recorder.beginFrame();
-        (void)recorder.collect();
+        adoptAll(recorder);
     }
     const double recordMs = msSince(r0);
     // Replay from the journal's bytes on a fresh world.
@@ -187,14 +193,14 @@ int runBench(const BenchArgs& args) {
         const rubble::ObjectId id = *pieces.addObject(std::move(box));
         (void)pieces.submitImpact(id, rubble::Impact{c + rubble::Vec3{0.5, 0.2, 0.1}, {1, 0, 0}, 100});
         pieces.beginFrame();
-        (void)pieces.collect();
+        adoptAll(pieces);
         if (i > 20 * targetPieces)
             break;
     }
     pieces.waitIdle();
     for (int i = 0; i < 4; ++i) {
         pieces.beginFrame();
-        (void)pieces.collect();
+        adoptAll(pieces);
     }
     const SnapshotTiming pieceSnap = timeSnapshot(pieces, worldConfig(args.workers), scratch);
     const double otherCpu = cpu.read().other;

@@ -52,6 +52,7 @@ int main() {
             std::printf("  id %u: volume %.4f, %zu convex parts, body at (%.3f, %.3f, %.3f)\n", piece->id,
                         piece->mass.volume, piece->convexParts.size(), at.x, at.y, at.z);
         }
+        world.commit(outcome); // the pieces' bodies exist: the pieces replace the parent in the world
     }
     const double conserved = total - broken->inputVolume;
     return broken->pieces.size() >= 2 && conserved * conserved < 1e-12 ? 0 : 1;

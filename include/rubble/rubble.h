@@ -246,8 +246,9 @@ RUBBLE_C_API rubble_status rubble_world_submit_impact(rubble_world* world, uint3
 RUBBLE_C_API rubble_status rubble_world_begin_frame(rubble_world* world);
 /// Blocks until no fracture job is running or queued (tools, tests, loading screens).
 RUBBLE_C_API rubble_status rubble_world_wait_idle(rubble_world* world);
-/// Adopts the results ready this frame: each parent object is replaced by its pieces. Writes the number of
-/// outcomes, which stay readable until the next collect.
+/// Adopts the results ready this frame: each parent object is replaced by its pieces (the splits are
+/// collected and committed at once). Writes the number of outcomes, which stay readable until the next
+/// collect.
 RUBBLE_C_API rubble_status rubble_world_collect(rubble_world* world, size_t* outcome_count);
 
 /// One result of the latest collect.

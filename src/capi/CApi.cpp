@@ -641,6 +641,8 @@ rubble_status rubble_world_collect(rubble_world* world, size_t* outcome_count) {
         if (!valid(world) || !outcome_count)
             return invalid(fn, "world or outcome_count is null or invalid");
         world->outcomes = world->world->collect();
+        for (const rubble::FractureOutcome& o : world->outcomes)
+            world->world->commit(o);
         *outcome_count = world->outcomes.size();
         return ok();
     });

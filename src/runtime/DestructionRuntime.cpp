@@ -88,6 +88,15 @@ BodyRecord objectRecord(ObjectId object, BodyRole role, BodyMotionState motion, 
     return rec;
 }
 
+// What the stages of one frame share.
+struct FrameContext {
+    double dt = 0;                        // the frame's time step (s)
+    FrameStats stats;                     // what the frame did
+    detail::ImpactBatch impacts;          // the impacts its contacts amount to
+    std::vector<FractureOutcome> adopted; // the splits it adopted, for the callbacks
+    Clock::time_point afterPhysics;       // where the runtime's own part of the frame starts
+};
+
 } // namespace
 
 struct DestructionRuntime::Impl {
@@ -143,15 +152,13 @@ struct DestructionRuntime::Impl {
         return Aabb{c - e, c + e};
     }
 
-    // Removes a body; what a resting body held is re-checked (support) or woken (frozen debris).
-    void destroy(BodyId id, bool removeObject, bool wakeResting = true) {
-        BodyRecord* r = bodies.find(id);
+    // Removes a body from the engine and from every component; its object stays in the world.
+    void dropBody(BodyId id) {
+        const BodyRecord* r = bodies.find(id);
         if (!r)
             return;
         if (onRemoved)
             onRemoved(*r);
-        if (wakeResting && r->role != BodyRole::Projectile && !moving(*r))
-            governor.wakeNear(boundsOf(*r), config.support.tolerance);
         support.remove(id);
         structure.remove(id);
         governor.removed(id);
@@ -161,9 +168,22 @@ struct DestructionRuntime::Impl {
             materials.erase(r->object);
             solids.erase(r->object);
         }
-        if (r->hasObject && removeObject)
-            world.removeObject(r->object);
         bodies.erase(id);
+    }
+
+    // Removes a body and its object; what a resting body held is re-checked (support) or woken (frozen
+    // debris).
+    void destroy(BodyId id) {
+        const BodyRecord* r = bodies.find(id);
+        if (!r)
+            return;
+        if (r->role != BodyRole::Projectile && !moving(*r))
+            governor.wakeNear(boundsOf(*r), config.support.tolerance);
+        const bool hasObject = r->hasObject;
+        const ObjectId object = r->object;
+        dropBody(id);
+        if (hasObject)
+            world.removeObject(object);
     }
 
     void retire(BodyId id, detail::RetireReason reason, FrameStats& stats) {
@@ -190,7 +210,7 @@ struct DestructionRuntime::Impl {
             ++counters.retired.fellOut;
             break;
         }
-        destroy(id, true);
+        destroy(id);
     }
 
     // A static or frozen body becomes dynamic (wake rules: docs/architecture.md).
@@ -238,29 +258,32 @@ struct DestructionRuntime::Impl {
         return it != solids.end() ? it->second : id;
     }
 
-    void submit(const detail::PendingImpact& p, FrameStats& stats) {
+    // Submits an impact; false when the world's filter refuses it.
+    bool submit(const detail::PendingImpact& p, FrameStats& stats) {
         if (config.structure.enabled)
             structure.damage(p.worldPoint, p.impact.impulse);
         if (!world.submitImpact(p.object, p.impact))
-            return;
+            return false;
         ++stats.impactsSubmitted;
         ++counters.impacts;
         marks.push_back({p.worldPoint, p.worldNormal, p.impact.impulse});
         while (static_cast<int>(marks.size()) > config.impacts.maxImpactMarks)
             marks.pop_front();
+        return true;
     }
 
-    void adopt(const FractureOutcome& outcome, FrameStats& stats) {
+    // Adopts a split: the parent's body goes, the pieces' bodies are made, then the world commits the split.
+    // False when no body carries the parent.
+    bool adopt(const FractureOutcome& outcome, FrameStats& stats) {
         ledger.dropped += outcome.droppedVolume;
         ledger.dust += outcome.dustVolume();
         const BodyRecord* parentPtr = bodies.findObject(outcome.parent);
-        if (!parentPtr) { // no body to replace: the pieces cannot be placed; their volume counts as retired
+        if (!parentPtr) { // no body carries the parent: it goes, and its pieces' volume counts as retired
             ++counters.staleOutcomes;
-            for (const AdoptedPiece& p : outcome.pieces) {
+            for (const AdoptedPiece& p : outcome.pieces)
                 ledger.retired += std::abs(p.state->mass.volume);
-                world.removeObject(p.id);
-            }
-            return;
+            world.removeObject(outcome.parent);
+            return false;
         }
         const BodyRecord parent = *parentPtr;
         const Material& material = materialOf(outcome.parent);
@@ -272,8 +295,8 @@ struct DestructionRuntime::Impl {
         const bool parentResting = !moving(parent);
         const std::uint64_t parentSolid = solidOf(parent.object);
         const bool parentAnchored = structure.anchored(parent.id); // its pieces may float as it did
-        // The world removed the parent object already; what it held wakes near its flying debris (below).
-        destroy(parent.id, false, false);
+        // The parent object goes when the split is committed; what it held wakes near its flying debris.
+        dropBody(parent.id);
         ++stats.fractures;
         ++counters.fractures;
         for (std::size_t i = 0; i < plan.spawns.size(); ++i) {
@@ -304,10 +327,8 @@ struct DestructionRuntime::Impl {
         counters.piecesRetired += static_cast<long long>(plan.particles.size());
         counters.retired.dust += static_cast<long long>(plan.particles.size());
         particles.add(plan.particles);
-        settleSupport(stats);          // before the callback, so that it sees the pieces' final motion
-        world.finishAdoption(outcome); // the pieces' bodies exist: the impact's timing record ends here
-        if (onAdopted)
-            onAdopted(outcome);
+        world.commit(outcome); // the pieces' bodies exist
+        return true;
     }
 
     void settleSupport(FrameStats& stats) {
@@ -366,9 +387,7 @@ struct DestructionRuntime::Impl {
             ++stats.piecesCollapsed;
             ++counters.piecesCollapsed;
         }
-        stats.structureMs += msSince(t0);
-        if (!fallen.empty())
-            settleSupport(stats);
+        stats.structureMs += msSince(t0); // what rested on the fallen is checked at the next support stage
     }
 
     // A saved structure names static objects (nodes once each) and, in bonds, nodes or this runtime's
@@ -443,10 +462,74 @@ struct DestructionRuntime::Impl {
         structure.settleNext();
     }
 
-    void adoptResults(FrameStats& stats) {
-        for (const FractureOutcome& o : world.collect())
-            adopt(o, stats);
-        settleSupport(stats);
+    // The stages of a frame (stepFrame) and of an adoption between frames (adoptReady), over a FrameContext.
+    void stepPhysics(FrameContext& f) {
+        const auto t0 = Clock::now();
+        contacts.clear();
+        breaks.clear();
+        f.stats.substeps = binding.step(f.dt, contacts);
+        f.stats.physicsMs = msSince(t0);
+        f.afterPhysics = Clock::now();
+        ++counters.frames;
+        searchesLeft = config.support.maxSearchesPerFrame;
+    }
+    void submitImpacts(FrameContext& f) {
+        collector.gather(contacts, bodies, world, binding, counters.frames);
+        f.impacts = collector.take();
+        f.stats.projectileHits = f.impacts.projectileHits;
+        counters.projectileHits += f.impacts.projectileHits;
+        for (const detail::PendingImpact& p : f.impacts.impacts)
+            submit(p, f.stats);
+        world.beginFrame();
+    }
+    void classifyAnchors(FrameContext& f) {
+        const auto t0 = Clock::now();
+        for (BodyId a : support.classify())
+            if (BodyRecord* r = bodies.find(a))
+                r->anchor = true;
+        f.stats.supportMs += msSince(t0);
+    }
+    void adoptSplits(FrameContext& f) {
+        for (FractureOutcome& o : world.collect())
+            if (adopt(o, f.stats))
+                f.adopted.push_back(std::move(o));
+    }
+    void settleSupportStage(FrameContext& f) { settleSupport(f.stats); }
+    void reportAdopted(FrameContext& f) { // after the support stage: the pieces' motion is final
+        if (onAdopted)
+            for (const FractureOutcome& o : f.adopted)
+                onAdopted(o);
+    }
+    void governDebris(FrameContext& f) { govern(f.impacts.frozenHits, f.dt, f.stats); }
+    void settleStructureStage(FrameContext& f) {
+        feedContactLoads(f.dt);
+        settleStructure(f.stats);
+    }
+    void advanceStage(FrameContext& f) { advance(f.dt); }
+
+    struct Stage {
+        const char* name;
+        void (Impl::*run)(FrameContext&);
+    };
+    // One frame, in order; support settles once, after the adoption.
+    static constexpr Stage kFrame[] = {{"physics", &Impl::stepPhysics},
+                                       {"impacts", &Impl::submitImpacts},
+                                       {"anchors", &Impl::classifyAnchors},
+                                       {"adopt", &Impl::adoptSplits},
+                                       {"support", &Impl::settleSupportStage},
+                                       {"adopted callbacks", &Impl::reportAdopted},
+                                       {"debris", &Impl::governDebris},
+                                       {"structure", &Impl::settleStructureStage},
+                                       {"particles and projectiles", &Impl::advanceStage}};
+    // The adoption of results ready between frames.
+    static constexpr Stage kBetweenFrames[] = {{"adopt", &Impl::adoptSplits},
+                                               {"support", &Impl::settleSupportStage},
+                                               {"adopted callbacks", &Impl::reportAdopted}};
+
+    template <std::size_t N>
+    void run(const Stage (&stages)[N], FrameContext& f) {
+        for (const Stage& stage : stages)
+            (this->*stage.run)(f);
     }
 
     void govern(const std::map<BodyId, double>& frozenHits, double dt, FrameStats& stats) {
@@ -479,7 +562,7 @@ struct DestructionRuntime::Impl {
                 expired.push_back(id);
         }
         for (BodyId id : expired)
-            destroy(id, false);
+            destroy(id);
     }
 };
 
@@ -620,7 +703,7 @@ BodyId DestructionRuntime::fireProjectile(const Vec3& from, const Vec3& velocity
 }
 
 void DestructionRuntime::removeBody(BodyId id) {
-    impl_->destroy(id, true);
+    impl_->destroy(id);
 }
 
 bool DestructionRuntime::submitImpact(BodyId id, const Vec3& worldPoint, const Vec3& worldNormal,
@@ -639,9 +722,7 @@ bool DestructionRuntime::submitImpact(BodyId id, const Vec3& worldPoint, const V
     p.worldPoint = worldPoint;
     p.worldNormal = worldNormal;
     FrameStats ignored;
-    const long long before = im.counters.impacts;
-    im.submit(p, ignored);
-    return im.counters.impacts > before;
+    return im.submit(p, ignored);
 }
 
 int DestructionRuntime::blast(const Vec3& center, double radius, double impulse, double edgeShare) {
@@ -667,46 +748,21 @@ int DestructionRuntime::blast(const Vec3& center, double radius, double impulse,
 }
 
 FrameStats DestructionRuntime::stepFrame(double dt) {
-    Impl& im = *impl_;
-    FrameStats stats;
-    const auto t0 = Clock::now();
-    im.contacts.clear();
-    im.breaks.clear();
-    stats.substeps = im.binding.step(dt, im.contacts);
-    stats.physicsMs = msSince(t0);
-    const auto t1 = Clock::now();
-    ++im.counters.frames;
-    im.searchesLeft = im.config.support.maxSearchesPerFrame;
-    im.collector.gather(im.contacts, im.bodies, im.world, im.binding, im.counters.frames);
-    const detail::ImpactBatch batch = im.collector.take();
-    stats.projectileHits = batch.projectileHits;
-    im.counters.projectileHits += batch.projectileHits;
-    for (const detail::PendingImpact& p : batch.impacts)
-        im.submit(p, stats);
-    im.world.beginFrame();
-    const auto t2 = Clock::now();
-    for (BodyId a : im.support.classify())
-        if (BodyRecord* r = im.bodies.find(a))
-            r->anchor = true;
-    stats.supportMs += msSince(t2);
-    im.adoptResults(stats);
-    im.govern(batch.frozenHits, dt, stats);
-    im.settleSupport(stats);
-    im.feedContactLoads(dt);
-    im.settleStructure(stats);
-    im.advance(dt);
-    stats.adoptMs = msSince(t1);
-    return stats;
+    FrameContext f;
+    f.dt = dt;
+    impl_->run(Impl::kFrame, f);
+    f.stats.adoptMs = msSince(f.afterPhysics);
+    return f.stats;
 }
 
 FrameStats DestructionRuntime::adoptReady() {
-    FrameStats stats;
+    FrameContext f;
     const auto t0 = Clock::now();
     if (!impl_->world.waitForResult(t0)) // nothing ready, or deterministic: adoption is frame-bound
-        return stats;
-    impl_->adoptResults(stats);
-    stats.adoptMs = msSince(t0);
-    return stats;
+        return f.stats;
+    impl_->run(Impl::kBetweenFrames, f);
+    f.stats.adoptMs = msSince(t0);
+    return f.stats;
 }
 
 const BodyRecord* DestructionRuntime::body(BodyId id) const {
@@ -834,7 +890,7 @@ Status DestructionRuntime::restore(WorldState state, const std::vector<ObjectPla
     if (Status s = im.world.loadState(std::move(state)); !s)
         return s;
     for (BodyId id : old)
-        im.destroy(id, false);
+        im.dropBody(id);
     im.ledger = VolumeLedger{0, volumes.retired, volumes.dust, volumes.dropped};
     for (ObjectId id : im.world.objects()) {
         const ObjectState& st = *im.world.object(id);

@@ -290,11 +290,16 @@ struct DestructionWorld::Impl {
     std::vector<std::shared_ptr<Job>> inflight;             // in submission order
     std::vector<TimingRecord> timings;
     std::uint64_t recordsErased = 0; // records dropped from the front of `timings` (sequence numbers stay)
-    struct HandedOut {
-        std::uint64_t record = 0;    // sequence number of its TimingRecord
-        Clock::time_point recordEnd; // where that record's adoption ended so far
+    // A split handed out by collect() and not committed yet: its parent stays until commit() replaces it.
+    struct OpenSplit {
+        std::uint32_t version = 0;                        // the parent's version
+        std::vector<AdoptedPiece> pieces;                 // as handed out
+        std::vector<std::shared_ptr<ObjectState>> states; // the pieces' states (hashed when read)
+        std::vector<MeshFacts> facts;                     // analyzeMesh of each piece's mesh
+        std::uint64_t record = 0;                         // sequence number of its TimingRecord
+        Clock::time_point recordEnd;                      // where that record's adoption ends so far
     };
-    std::vector<HandedOut> handedOut; // outcomes of the latest collect() not yet finished by the engine
+    std::map<ObjectId, OpenSplit> open; // by parent
     std::function<void(const JournalEvent&)> journalSink;
     std::uint64_t journalLength = 0;
     std::uint64_t geometrySum = 0; // Σ geometryTerm over live objects with a mesh hash (wrapping)
@@ -365,8 +370,15 @@ struct DestructionWorld::Impl {
         return seq;
     }
 
+    // A job in flight or a split not committed: impacts on it wait.
     bool busy(ObjectId id) const {
-        return std::any_of(inflight.begin(), inflight.end(), [&](const auto& j) { return j->id == id; });
+        return open.count(id) > 0 ||
+               std::any_of(inflight.begin(), inflight.end(), [&](const auto& j) { return j->id == id; });
+    }
+
+    // The timing record with this sequence number, or null when it was dropped already.
+    TimingRecord* recordAt(std::uint64_t seq) {
+        return seq < recordsErased ? nullptr : &timings[static_cast<std::size_t>(seq - recordsErased)];
     }
 
     std::shared_ptr<Job> launch(ObjectId id, std::vector<PendingImpact> impacts) {
@@ -424,6 +436,44 @@ struct DestructionWorld::Impl {
             s->done.notify_all();
         });
         return job;
+    }
+
+    // The split event of a finished job on a current parent, opened until commit(): the pieces get their ids
+    // and states; pieces below the minimum volume become dust.
+    FractureOutcome split(Job& job, const ObjectState& parent) {
+        FractureOutcome o;
+        OpenSplit s;
+        s.version = job.version;
+        o.parent = job.id;
+        o.parentVersion = job.version;
+        for (const auto& p : job.impacts)
+            o.impacts.push_back(p.impact);
+        o.droppedVolume = job.result.droppedVolume;
+        for (std::size_t i = 0; i < job.localMeshes.size(); ++i) {
+            const std::int32_t cell = job.result.pieces[i].cell;
+            if (std::abs(job.localMass[i].volume) < config.minPieceVolume) {
+                o.dust.push_back({job.frames[i].translation, std::abs(job.localMass[i].volume), cell});
+                continue;
+            }
+            auto st = std::make_shared<ObjectState>();
+            st->id = nextId++;
+            st->version = 0;
+            st->mesh = std::move(job.localMeshes[i]);
+            st->mass = job.localMass[i];
+            st->density = parent.density;
+            st->destructible = parent.destructible;
+            st->impulseThreshold = parent.impulseThreshold;
+            st->fracture = parent.fracture;
+            st->crumbleAbove = parent.crumbleAbove;
+            st->convexParts = std::move(job.localParts[i]);
+            st->meshHash = job.meshHashes[i];
+            o.pieces.push_back({st->id, job.frames[i], cell, st});
+            s.states.push_back(std::move(st));
+            s.facts.push_back(std::move(job.localFacts[i]));
+        }
+        s.pieces = o.pieces;
+        open[job.id] = std::move(s);
+        return o;
     }
 
     bool isFinished(const Job& j) {
@@ -549,6 +599,11 @@ Result<ObjectId> DestructionWorld::addObject(ObjectDesc desc) {
 }
 
 void DestructionWorld::removeObject(ObjectId id) {
+    if (auto o = impl_->open.find(id); o != impl_->open.end()) { // its split is never committed
+        if (TimingRecord* r = impl_->recordAt(o->second.record))
+            r->stale = true;
+        impl_->open.erase(o);
+    }
     if (auto it = impl_->objects.find(id); it != impl_->objects.end()) {
         JournalEvent e;
         e.kind = JournalEventKind::Remove;
@@ -575,15 +630,20 @@ std::vector<ObjectId> DestructionWorld::objects() const {
     return ids;
 }
 
-bool DestructionWorld::submitImpact(ObjectId id, const Impact& impact) {
+bool DestructionWorld::accepts(ObjectId id, const Impact& impact) const {
     auto it = impl_->objects.find(id);
     if (it == impl_->objects.end() || !it->second->destructible)
         return false;
     const Impact rounded = journalPrecision(impact);
-    if (!(rounded.impulse >= it->second->impulseThreshold) ||
-        !checkFractureParams(rounded, it->second->fracture))
+    return rounded.impulse >= it->second->impulseThreshold &&
+           checkFractureParams(rounded, it->second->fracture);
+}
+
+bool DestructionWorld::submitImpact(ObjectId id, const Impact& impact) {
+    if (!accepts(id, impact))
         return false;
-    const ObjectState& o = *it->second;
+    const Impact rounded = journalPrecision(impact);
+    const ObjectState& o = *impl_->objects.at(id);
     JournalEvent e;
     e.kind = JournalEventKind::Impact;
     e.object = id;
@@ -707,7 +767,7 @@ Status DestructionWorld::loadState(WorldState w) {
     // Consistent: replace everything. Jobs of the old state finish on their own; their results are dropped.
     im.inflight.clear();
     im.waiting.clear();
-    im.handedOut.clear();
+    im.open.clear();
     im.objects.clear();
     im.facts.clear();
     im.geometrySum = 0;
@@ -756,7 +816,6 @@ std::vector<FractureOutcome> DestructionWorld::collect() {
     std::vector<FractureOutcome> out;
     const auto start = Clock::now();
     Impl& im = *impl_;
-    im.handedOut.clear();
     for (std::size_t k = 0; k < im.inflight.size();) {
         auto job = im.inflight[k];
         if (im.config.deterministic) {
@@ -775,7 +834,6 @@ std::vector<FractureOutcome> DestructionWorld::collect() {
         }
         im.inflight.erase(im.inflight.begin() + static_cast<std::ptrdiff_t>(k));
         const auto a0 = Clock::now();
-        bool adopted = false;
         TimingRecord rec;
         rec.object = job->id;
         rec.frame = job->frame;
@@ -791,75 +849,19 @@ std::vector<FractureOutcome> DestructionWorld::collect() {
         rec.crumbled = job->crumble;
         rec.touchedTriangles = job->touched;
         auto it = im.objects.find(job->id);
-        std::vector<PendingImpact> later;
-        if (auto w = im.waiting.find(job->id); w != im.waiting.end()) {
-            later = std::move(w->second);
-            im.waiting.erase(w);
+        const bool current = it != im.objects.end() && it->second->version == job->version;
+        if (current && job->ok) {
+            out.push_back(im.split(*job, *it->second));
+            Impl::OpenSplit& s = im.open.at(job->id);
+            rec.pieces = static_cast<int>(s.pieces.size());
+            s.recordEnd = Clock::now();
+            rec.adoptionMs = msBetween(a0, s.recordEnd);
+            rec.totalMs = msBetween(job->impacts.front().time, s.recordEnd);
+            s.record = im.record(rec);
+            continue;
         }
-        if (it == im.objects.end() || it->second->version != job->version) {
+        if (!current) {
             rec.stale = true; // the object was removed or replaced meanwhile: the result is discarded
-        } else if (job->ok) {
-            const std::shared_ptr<const ObjectState> parent = it->second;
-            im.eraseObject(it);
-            FractureOutcome o;
-            o.parent = job->id;
-            o.parentVersion = job->version;
-            for (const auto& p : job->impacts)
-                o.impacts.push_back(p.impact);
-            o.droppedVolume = job->result.droppedVolume;
-            for (std::size_t i = 0; i < job->localMeshes.size(); ++i) {
-                const std::int32_t cell = job->result.pieces[i].cell;
-                if (std::abs(job->localMass[i].volume) < im.config.minPieceVolume) {
-                    o.dust.push_back({job->frames[i].translation, std::abs(job->localMass[i].volume), cell});
-                    continue;
-                }
-                auto s = std::make_shared<ObjectState>();
-                s->id = im.nextId++;
-                s->version = 0;
-                s->mesh = std::move(job->localMeshes[i]);
-                s->mass = job->localMass[i];
-                s->density = parent->density;
-                s->destructible = parent->destructible;
-                s->impulseThreshold = parent->impulseThreshold;
-                s->fracture = parent->fracture;
-                s->crumbleAbove = parent->crumbleAbove;
-                s->convexParts = std::move(job->localParts[i]);
-                s->meshHash = job->meshHashes[i];
-                o.pieces.push_back({s->id, job->frames[i], cell, s});
-                im.facts[s->id] = std::move(job->localFacts[i]);
-                im.insertObject(std::move(s));
-            }
-            // Impacts that arrived while this job ran go to the piece nearest to their point.
-            if (o.pieces.empty())
-                im.recordDropped(job->id, later);
-            for (auto& p : o.pieces.empty() ? std::vector<PendingImpact>{} : later) {
-                // the piece whose bounds are nearest to the point (containing it: distance 0); among equally
-                // near pieces the largest, so that a waiting impact rarely lands on a sliver
-                double best = 1e300, bestVolume = 0;
-                const AdoptedPiece* target = &o.pieces.front();
-                for (const AdoptedPiece& piece : o.pieces) {
-                    const Aabb b = piece.state->mesh.bounds();
-                    const Vec3 q = piece.frame.applyInverse(p.impact.point);
-                    const Vec3 outside = max(b.lo - q, max(q - b.hi, Vec3{}));
-                    const double d = length(outside);
-                    if (d < best - 1e-9 || (d <= best + 1e-9 && piece.state->mass.volume > bestVolume)) {
-                        best = std::min(best, d);
-                        bestVolume = piece.state->mass.volume;
-                        target = &piece;
-                    }
-                }
-                PendingImpact q = p;
-                q.impact.point = target->frame.applyInverse(p.impact.point);
-                q.impact.normal = target->frame.rotation.transposed() * p.impact.normal;
-                if (im.busy(target->id))
-                    im.waiting[target->id].push_back(q);
-                else
-                    im.launch(target->id, {q});
-            }
-            later.clear();
-            rec.pieces = static_cast<int>(o.pieces.size());
-            out.push_back(std::move(o));
-            adopted = true;
         } else if (job->errorCode == ErrorCode::NoIntersection) {
             if (job->facts.fit(it->second->mesh)) // what the worker found, for the next hit
                 im.facts[job->id] = job->facts;
@@ -869,38 +871,73 @@ std::vector<FractureOutcome> DestructionWorld::collect() {
         }
         // A missed, failed or stale job: impacts that waited on it run now on the (unchanged) object if it
         // still exists.
+        std::vector<PendingImpact> later;
+        if (auto w = im.waiting.find(job->id); w != im.waiting.end()) {
+            later = std::move(w->second);
+            im.waiting.erase(w);
+        }
         const bool relaunch = !later.empty() && im.objects.count(job->id) > 0;
         if (relaunch)
             im.launch(job->id, std::move(later));
         const auto a1 = Clock::now();
         rec.adoptionMs = msBetween(a0, a1);
         rec.totalMs = msBetween(job->impacts.front().time, a1);
-        const std::uint64_t seq = im.record(rec);
-        if (adopted) {
-            out.back().record = seq;
-            im.handedOut.push_back({seq, a1});
-        }
+        im.record(rec);
         if (!relaunch)
             im.recordDropped(job->id, later);
     }
     return out;
 }
 
-void DestructionWorld::finishAdoption(const FractureOutcome& outcome) {
+void DestructionWorld::commit(const FractureOutcome& split) {
     Impl& im = *impl_;
-    const auto now = Clock::now();
-    auto h = std::find_if(im.handedOut.begin(), im.handedOut.end(),
-                          [&](const Impl::HandedOut& x) { return x.record == outcome.record; });
-    if (h == im.handedOut.end()) // an earlier collect()'s outcome, or finished already
+    auto o = im.open.find(split.parent);
+    if (o == im.open.end() || o->second.version != split.parentVersion) // committed, or its parent removed
         return;
-    const Impl::HandedOut handed = *h;
-    im.handedOut.erase(h);
-    if (handed.record < im.recordsErased)
-        return; // dropped from timings() already
-    TimingRecord& r = im.timings[static_cast<std::size_t>(handed.record - im.recordsErased)];
-    const double engineMs = msBetween(handed.recordEnd, now);
-    r.adoptionMs += engineMs;
-    r.totalMs += engineMs;
+    Impl::OpenSplit s = std::move(o->second);
+    im.open.erase(o);
+    im.eraseObject(im.objects.find(split.parent));
+    for (std::size_t i = 0; i < s.states.size(); ++i) {
+        im.facts[s.states[i]->id] = std::move(s.facts[i]);
+        im.insertObject(std::move(s.states[i]));
+    }
+    std::vector<PendingImpact> later;
+    if (auto w = im.waiting.find(split.parent); w != im.waiting.end()) {
+        later = std::move(w->second);
+        im.waiting.erase(w);
+    }
+    // Impacts that arrived while the job ran go to the piece nearest to their point.
+    if (s.pieces.empty())
+        im.recordDropped(split.parent, later);
+    for (auto& p : s.pieces.empty() ? std::vector<PendingImpact>{} : later) {
+        // the piece whose bounds are nearest to the point (containing it: distance 0); among equally near
+        // pieces the largest, so that a waiting impact rarely lands on a sliver
+        double best = 1e300, bestVolume = 0;
+        const AdoptedPiece* target = &s.pieces.front();
+        for (const AdoptedPiece& piece : s.pieces) {
+            const Aabb b = piece.state->mesh.bounds();
+            const Vec3 q = piece.frame.applyInverse(p.impact.point);
+            const Vec3 outside = max(b.lo - q, max(q - b.hi, Vec3{}));
+            const double d = length(outside);
+            if (d < best - 1e-9 || (d <= best + 1e-9 && piece.state->mass.volume > bestVolume)) {
+                best = std::min(best, d);
+                bestVolume = piece.state->mass.volume;
+                target = &piece;
+            }
+        }
+        PendingImpact q = p;
+        q.impact.point = target->frame.applyInverse(p.impact.point);
+        q.impact.normal = target->frame.rotation.transposed() * p.impact.normal;
+        if (im.busy(target->id))
+            im.waiting[target->id].push_back(q);
+        else
+            im.launch(target->id, {q});
+    }
+    if (TimingRecord* r = im.recordAt(s.record)) { // the adoption ends now that the engine's bodies exist
+        const double engineMs = msBetween(s.recordEnd, Clock::now());
+        r->adoptionMs += engineMs;
+        r->totalMs += engineMs;
+    }
 }
 
 bool DestructionWorld::waitForResult(Clock::time_point deadline) {

@@ -54,13 +54,15 @@ void ImpactCollector::gather(const std::vector<ContactReport>& contacts, BodyTab
             if (!breakable(other))
                 continue;
             const ObjectState* st = world.object(other.object);
-            if (!st || !st->destructible || other.volume < policy_.minFractureVolume)
+            if (!st || other.volume < policy_.minFractureVolume)
                 continue;
             const double speed = length(c.relativeVelocity);
             const double impulse = std::max({proj.mass * speed, c.impulse, st->impulseThreshold});
             const Vec3 point = aProj ? c.pointOnB : c.pointOnA;
             const Vec3 normal = aProj ? c.normalOnB : -c.normalOnB; // out of the object hit
-            projectileImpacts_.push_back(makeImpact(other, point, normal, impulse, binding));
+            PendingImpact p = makeImpact(other, point, normal, impulse, binding);
+            if (world.accepts(p.object, p.impact))
+                projectileImpacts_.push_back(std::move(p));
             continue;
         }
         for (BodyRecord* frozen : {a, b})
@@ -79,15 +81,14 @@ void ImpactCollector::gather(const std::vector<ContactReport>& contacts, BodyTab
                 continue;
             if (target->volume < policy_.minFractureVolume)
                 continue;
-            const ObjectState* st = world.object(target->object);
-            if (!st || !st->destructible || c.impulse < st->impulseThreshold)
-                continue;
             auto it = collisionImpacts_.find(target->object);
             if (it != collisionImpacts_.end() && it->second.impact.impulse >= c.impulse)
                 continue;
             const bool isA = target == a;
-            collisionImpacts_[target->object] = makeImpact(
-                *target, isA ? c.pointOnA : c.pointOnB, isA ? -c.normalOnB : c.normalOnB, c.impulse, binding);
+            PendingImpact p = makeImpact(*target, isA ? c.pointOnA : c.pointOnB,
+                                         isA ? -c.normalOnB : c.normalOnB, c.impulse, binding);
+            if (world.accepts(p.object, p.impact))
+                collisionImpacts_[target->object] = std::move(p);
         }
     }
 }

@@ -30,6 +30,8 @@ struct ImpactBatch {
 /// Applies the ImpactPolicy to contact reports: a projectile's first hit on a destructible object always
 /// counts (impulse ≥ the object's threshold), other contacts only above the policy's impulse and approach
 /// speed and outside a new piece's grace period; each object keeps its strongest collision impact per frame.
+/// Whether the object takes an impact is DestructionWorld::accepts, the one impact filter: every impact in a
+/// batch is accepted when submitted in the same frame.
 class ImpactCollector {
 public:
     /// Reads the policy at every call.

@@ -35,9 +35,11 @@ Status JournalPlayer::receive(const JournalEvent& event) {
 
 Status JournalPlayer::step() {
     world_.beginFrame();
-    for (const FractureOutcome& o : world_.collect())
+    for (const FractureOutcome& o : world_.collect()) {
+        world_.commit(o);
         if (onOutcome_)
             onOutcome_(o);
+    }
     while (!pending_.empty() && pending_.front().tick == world_.frame()) {
         const JournalEvent e = pending_.front();
         pending_.pop_front();

@@ -337,7 +337,7 @@ TEST(BulletRuntime, IdleAdoptionAdoptsBeforeTheNextStepFrame) {
 }
 
 // Issue #5: "impact → adopted" ends when the pieces' bodies and collision shapes exist, so the engine's part
-// of the adoption is in the impact's timing record (the runtime calls DestructionWorld::finishAdoption). The
+// of the adoption is in the impact's timing record (the runtime commits the split once the bodies exist). The
 // parent's removal callback runs inside the adoption; made slow, it must show in the record.
 TEST(BulletRuntime, TimingRecordIncludesTheEnginesAdoption) {
     using namespace std::chrono_literals;

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "JournalScene.hpp"
+#include "WorldSteps.hpp"
 #include "persist/Bytes.hpp"
 #include "rubble/persist/JournalFile.hpp"
 #include "rubble/runtime/JournalPlayer.hpp"
@@ -62,7 +63,7 @@ std::vector<JournalEvent> recordGoldenJournal() {
                 world.removeObject(world.objects().front());
         }
         world.beginFrame();
-        (void)world.collect();
+        (void)collectAndCommit(world);
     }
     return events;
 }

@@ -19,6 +19,7 @@
 
 #include "JournalScene.hpp"
 #include "TestSupport.hpp"
+#include "WorldSteps.hpp"
 #include "persist/Bytes.hpp"
 #include "rubble/fracture/Roughness.hpp"
 #include "rubble/persist/JournalFile.hpp"
@@ -314,7 +315,7 @@ void expectALoadedWorldContinuesBitForBit(Mesh wallMesh) {
     auto frames = [](DestructionWorld& w, int n) {
         for (int i = 0; i < n; ++i) {
             w.beginFrame();
-            (void)w.collect();
+            (void)collectAndCommit(w);
         }
     };
     DestructionWorld host(config(1));

@@ -105,6 +105,30 @@ TEST(DestructionRuntime, APlacementThatIsNoRigidMotionIsRefused) {
     EXPECT_TRUE(rig.runtime.world().objects().empty());
 }
 
+// A split whose parent no body carries (an object added to the world directly) is never committed: the
+// parent goes (one Remove event), no piece is ever made, and the pieces' volume counts as retired.
+TEST(DestructionRuntime, ASplitWhoseParentHasNoBodyRemovesTheParentAndMakesNoPiece) {
+    ToyRig rig;
+    std::vector<JournalEvent> events;
+    rig.runtime.world().setJournalSink([&](const JournalEvent& e) { events.push_back(e); });
+    ObjectDesc d;
+    d.mesh = makeBox({-1, -1, -1}, {1, 1, 1});
+    d.fracture = cubeCell(1.2);
+    const ObjectId orphan = *rig.runtime.world().addObject(std::move(d));
+    int adopted = 0;
+    rig.runtime.setOnAdopted([&](const FractureOutcome&) { ++adopted; });
+    ASSERT_TRUE(rig.runtime.world().submitImpact(orphan, Impact{{1, 0, 0}, {1, 0, 0}, 100}));
+    rig.step(10);
+    EXPECT_EQ(rig.runtime.counters().staleOutcomes, 1);
+    EXPECT_EQ(adopted, 0);
+    EXPECT_TRUE(rig.runtime.world().objects().empty());
+    ASSERT_EQ(events.size(), 2u);
+    EXPECT_EQ(events[1].kind, JournalEventKind::Remove);
+    EXPECT_EQ(events[1].object, orphan);
+    EXPECT_NEAR(rig.runtime.volumes().total(), 8.0, 1e-6);
+    EXPECT_GT(rig.runtime.volumes().retired, 7.0);
+}
+
 TEST(DestructionRuntime, ColumnCutOnTheToyEngineKeepsItsFootAndDropsWhatItHeld) {
     ToyRig rig;
     const ObjectId column = rig.addBox({0.5, 4, 0.5}, {0, 4, 0}, true, cubeCell(2.4));

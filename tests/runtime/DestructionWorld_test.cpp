@@ -8,9 +8,11 @@
 #include <limits>
 #include <string>
 #include <thread>
+#include <tuple>
 #include <vector>
 
 #include "TestSupport.hpp"
+#include "WorldSteps.hpp"
 #include "rubble/core/Log.hpp"
 #include "rubble/core/Random.hpp"
 #include "rubble/core/ThreadPool.hpp"
@@ -100,6 +102,29 @@ TEST(DestructionWorld, ImpactBelowThresholdIgnored) {
     EXPECT_EQ(w.jobsInFlight(), 0);
 }
 
+// accepts() is the one impact filter: submitImpact takes exactly what it accepts, at journal precision (an
+// impulse just below the threshold that rounds up to it counts, as it does when the journal is replayed).
+TEST(DestructionWorld, SubmitImpactTakesExactlyWhatTheFilterAccepts) {
+    HeldJobs jobs;
+    DestructionWorld w(heldConfig(jobs));
+    const ObjectId id = *w.addObject(boxDesc()); // threshold 1
+    ObjectDesc fixed = boxDesc();
+    fixed.destructible = false;
+    const ObjectId wall = *w.addObject(std::move(fixed));
+    Impact below = centreHit(), rounded = centreHit(), noNormal = centreHit();
+    below.impulse = 0.99;
+    rounded.impulse = 1 - 1e-9; // 1.0f at single precision
+    noNormal.normal = {0, 0, 0};
+    const std::tuple<ObjectId, Impact, bool> cases[] = {{id, below, false},         {id, noNormal, false},
+                                                        {wall, centreHit(), false}, {999, centreHit(), false},
+                                                        {id, rounded, true},        {id, centreHit(), true}};
+    for (const auto& [object, impact, expected] : cases) {
+        EXPECT_EQ(w.accepts(object, impact), expected) << object << " " << impact.impulse;
+        EXPECT_EQ(w.submitImpact(object, impact), expected) << object << " " << impact.impulse;
+    }
+    EXPECT_EQ(w.journalPosition(), 2u);
+}
+
 TEST(DestructionWorld, OpenMeshWithAPlanarHoleIsClosedAndDestructible) {
     HeldJobs jobs;
     DestructionWorld w(heldConfig(jobs));
@@ -150,7 +175,7 @@ TEST(DestructionWorld, ImpactConservesVolumeAndMass) {
     ASSERT_TRUE(w.submitImpact(id, centreHit()));
     jobs.runAll();
     w.beginFrame();
-    auto out = w.collect();
+    auto out = collectAndCommit(w);
     ASSERT_EQ(out.size(), 1u);
     EXPECT_EQ(w.object(id), nullptr);
     double v = out[0].droppedVolume;
@@ -179,7 +204,7 @@ TEST(DestructionWorld, PiecesBelowTheMinimumVolumeBecomeDust) {
     ASSERT_TRUE(w.submitImpact(id, centreHit()));
     jobs.runAll();
     w.beginFrame();
-    auto out = w.collect();
+    auto out = collectAndCommit(w);
     ASSERT_EQ(out.size(), 1u);
     ASSERT_FALSE(out[0].dust.empty()) << "a 16-cell shatter leaves small pieces";
     double v = out[0].droppedVolume + out[0].dustVolume();
@@ -209,13 +234,13 @@ TEST(DestructionWorld, ImpactsDuringJobAreMergedNotLost) {
     ASSERT_TRUE(w.submitImpact(id, k));
     jobs.runAll();
     w.beginFrame();
-    ASSERT_EQ(w.collect().size(), 1u);
+    ASSERT_EQ(collectAndCommit(w).size(), 1u);
     // The two waiting impacts were forwarded to pieces: a job is in flight for them.
     EXPECT_GE(w.jobsInFlight(), 1);
     for (int round = 0; round < 4 && w.jobsInFlight() > 0; ++round) {
         jobs.runAll();
         w.beginFrame();
-        w.collect();
+        collectAndCommit(w);
     }
     int handled = 0;
     for (const auto& r : w.timings())
@@ -240,12 +265,12 @@ TEST(DestructionWorld, ImpactsWaitingOnAMissedJobAreMergedIntoOneJob) {
     ASSERT_TRUE(w.submitImpact(id, k));
     jobs.runAll();
     w.beginFrame();
-    EXPECT_TRUE(w.collect().empty());
+    EXPECT_TRUE(collectAndCommit(w).empty());
     ASSERT_NE(w.object(id), nullptr);
     ASSERT_EQ(w.jobsInFlight(), 1);
     jobs.runAll();
     w.beginFrame();
-    const auto out = w.collect();
+    const auto out = collectAndCommit(w);
     ASSERT_EQ(out.size(), 1u);
     EXPECT_EQ(out[0].impacts.size(), 2u);
     ASSERT_EQ(w.timings().size(), 2u);
@@ -271,7 +296,7 @@ TEST(DestructionWorld, ImpactReportedOffTheSurfaceStillFractures) {
     ASSERT_TRUE(w.submitImpact(id, i));
     jobs.runAll();
     w.beginFrame();
-    const auto out = w.collect();
+    const auto out = collectAndCommit(w);
     ASSERT_EQ(out.size(), 1u);
     EXPECT_GE(out[0].pieces.size(), 2u);
     double v = out[0].droppedVolume;
@@ -288,7 +313,7 @@ TEST(DestructionWorld, StaleResultDiscarded) {
     w.removeObject(id);
     jobs.runAll();
     w.beginFrame();
-    EXPECT_TRUE(w.collect().empty());
+    EXPECT_TRUE(collectAndCommit(w).empty());
     ASSERT_EQ(w.timings().size(), 1u);
     EXPECT_TRUE(w.timings()[0].stale);
 }
@@ -303,7 +328,7 @@ std::vector<std::uint64_t> pieceHashes(DestructionWorld::Config cfg, const Rough
     std::vector<std::uint64_t> h;
     for (int f = 0; f < 5; ++f) {
         w.beginFrame();
-        for (const auto& o : w.collect())
+        for (const auto& o : collectAndCommit(w))
             for (const ObjectId p : ids(o))
                 h.push_back(w.object(p)->mesh.hash());
     }
@@ -361,7 +386,7 @@ TEST(DestructionWorld, RemoveObjectRecordsItsWaitingImpacts) {
     EXPECT_EQ(w.timings()[0].object, id);
     jobs.runAll();
     w.beginFrame();
-    EXPECT_TRUE(w.collect().empty());
+    EXPECT_TRUE(collectAndCommit(w).empty());
     EXPECT_EQ(w.jobsInFlight(), 0);
     ASSERT_EQ(w.timings().size(), 2u); // and the running job, discarded as stale
     EXPECT_TRUE(w.timings()[1].stale);
@@ -384,7 +409,7 @@ TEST(DestructionWorld, DeterministicModeAdoptsExactlyDelayFramesAfterLaunch) {
     std::vector<std::uint64_t> adoptedAt;
     for (int f = 0; f < 12; ++f) {
         w.beginFrame();
-        for (const auto& o : w.collect()) {
+        for (const auto& o : collectAndCommit(w)) {
             (void)o;
             adoptedAt.push_back(w.frame());
         }
@@ -435,12 +460,12 @@ TEST(DestructionWorld, EveryAcceptedImpactEndsInExactlyOneRecord) {
         if (rng.uniform(0, 1) < 0.15)
             w.removeObject(ids.front());
         w.beginFrame();
-        w.collect();
+        collectAndCommit(w);
     }
     for (int round = 0; round < 50 && w.jobsInFlight() > 0; ++round) {
         w.waitIdle();
         w.beginFrame();
-        w.collect();
+        collectAndCommit(w);
     }
     EXPECT_EQ(w.jobsInFlight(), 0);
     int recorded = 0;
@@ -469,7 +494,7 @@ TEST(DestructionWorld, RemovedPiecesLeaveNoStateBehindOverChainedFractures) {
         ASSERT_TRUE(w.submitImpact(live, i)) << "round " << r;
         jobs.runAll();
         w.beginFrame();
-        auto out = w.collect();
+        auto out = collectAndCommit(w);
         ASSERT_LE(out.size(), 1u);
         EXPECT_EQ(w.timings().size(), static_cast<std::size_t>(r + 1)) << "one record per job, no more";
         if (out.empty())
@@ -504,7 +529,7 @@ TEST(DestructionWorld, WaitForResultReportsAFinishedJobForAdoptionInTheSameFrame
     w.beginFrame();
     ASSERT_TRUE(w.submitImpact(id, centreHit()));
     ASSERT_TRUE(w.waitForResult(soon()));
-    const auto out = w.collect(); // no beginFrame in between: the frame of the impact
+    const auto out = collectAndCommit(w); // no beginFrame in between: the frame of the impact
     ASSERT_EQ(out.size(), 1u);
     EXPECT_EQ(out[0].parent, id);
     ASSERT_EQ(w.timings().size(), 1u);
@@ -521,7 +546,7 @@ TEST(DestructionWorld, WaitForResultTimesOutWhileTheJobHasNotRun) {
     EXPECT_FALSE(w.waitForResult(std::chrono::steady_clock::now() - std::chrono::seconds(1))); // a poll
     jobs.runAll();
     EXPECT_TRUE(w.waitForResult(std::chrono::steady_clock::now() - std::chrono::seconds(1)));
-    EXPECT_EQ(w.collect().size(), 1u);
+    EXPECT_EQ(collectAndCommit(w).size(), 1u);
 }
 
 TEST(DestructionWorld, WaitForResultIsAlwaysFalseInDeterministicMode) {
@@ -535,10 +560,10 @@ TEST(DestructionWorld, WaitForResultIsAlwaysFalseInDeterministicMode) {
     w.waitIdle(); // finished, but not due before frame 2
     EXPECT_FALSE(w.waitForResult(std::chrono::steady_clock::now() + std::chrono::minutes(1)));
     w.beginFrame();
-    EXPECT_TRUE(w.collect().empty());
-    EXPECT_TRUE(w.collect().empty()) << "collect() again in the same frame adopts nothing early";
+    EXPECT_TRUE(collectAndCommit(w).empty());
+    EXPECT_TRUE(collectAndCommit(w).empty()) << "collect() again in the same frame adopts nothing early";
     w.beginFrame();
-    EXPECT_EQ(w.collect().size(), 1u);
+    EXPECT_EQ(collectAndCommit(w).size(), 1u);
 }
 
 // An impact that waited on an in-flight job is re-targeted to the nearest piece; when its point lies deep in
@@ -561,7 +586,7 @@ TEST(DestructionWorld, ReTargetedImpactInTheCraterBreaksTheCraterWall) {
     ASSERT_TRUE(w.submitImpact(id, small)); // waits for the first job
     jobs.runAll();
     w.beginFrame();
-    const auto out = w.collect();
+    const auto out = collectAndCommit(w);
     ASSERT_EQ(out.size(), 1u);
     ObjectId largest = 0;
     for (const ObjectId p : ids(out[0]))
@@ -571,7 +596,7 @@ TEST(DestructionWorld, ReTargetedImpactInTheCraterBreaksTheCraterWall) {
     ASSERT_EQ(w.jobsInFlight(), 1); // the waiting impact, re-targeted
     jobs.runAll();
     w.beginFrame();
-    const auto again = w.collect();
+    const auto again = collectAndCommit(w);
     ASSERT_EQ(again.size(), 1u) << "the impact moved onto the nearest surface: the crater's wall";
     ASSERT_EQ(w.timings().size(), 2u);
     const TimingRecord& r = w.timings()[1];
@@ -597,7 +622,7 @@ TEST(DestructionWorld, AnImpactFarFromTheObjectIsAMissNotAFailure) {
     ASSERT_TRUE(w.submitImpact(id, far));
     jobs.runAll();
     w.beginFrame();
-    EXPECT_TRUE(w.collect().empty());
+    EXPECT_TRUE(collectAndCommit(w).empty());
     ASSERT_EQ(w.timings().size(), 1u);
     EXPECT_TRUE(w.timings()[0].missed);
     EXPECT_FALSE(w.timings()[0].failed);
@@ -632,7 +657,7 @@ TEST(DestructionWorld, AnObjectOverItsTriangleLimitCrumbles) {
         ASSERT_TRUE(w.submitImpact(live, i));
         jobs.runAll();
         w.beginFrame();
-        auto out = w.collect();
+        auto out = collectAndCommit(w);
         if (out.empty())
             continue;
         EXPECT_EQ(w.timings().back().crumbled, over) << "round " << r;
@@ -678,7 +703,7 @@ TEST(DestructionWorld, TimingRecordsKeepOnlyTheLatest) {
         ASSERT_TRUE(w.submitImpact(id, far));
         jobs.runAll();
         w.beginFrame();
-        w.collect();
+        collectAndCommit(w);
         ASSERT_GE(w.timings().size(), std::min<std::size_t>(3, static_cast<std::size_t>(i + 1)));
         ASSERT_LE(w.timings().size(), 6u);
         EXPECT_EQ(w.timings().back().frame + 1, w.frame()) << "the latest is kept (submitted last frame)";
@@ -720,7 +745,7 @@ TEST(DestructionWorld, TimingStagesAddUpToTheTotal) {
     jobs.runAll();
     std::this_thread::sleep_for(5ms); // finished, waiting for the main thread
     w.beginFrame();
-    auto out = w.collect();
+    auto out = collectAndCommit(w);
     ASSERT_EQ(out.size(), 1u);
     ASSERT_EQ(w.timings().size(), 1u);
     const TimingRecord& r = w.timings()[0];
@@ -739,10 +764,10 @@ TEST(DestructionWorld, TimingStagesAddUpToTheTotal) {
     ASSERT_TRUE(w.submitImpact(piece, b)); // waits on the first job
     jobs.runAll();
     w.beginFrame();
-    w.collect(); // the first job; the waiting impact runs now on the largest piece near it
+    collectAndCommit(w); // the first job; the waiting impact runs now on the largest piece near it
     jobs.runAll();
     w.beginFrame();
-    w.collect();
+    collectAndCommit(w);
     ASSERT_EQ(w.timings().size(), 3u);
     for (const TimingRecord& t : w.timings())
         if (!t.stale && !t.missed && !t.failed)
@@ -750,7 +775,10 @@ TEST(DestructionWorld, TimingStagesAddUpToTheTotal) {
     EXPECT_LT(smallestGap, 0.25) << "time outside every stage, in every record";
 }
 
-TEST(DestructionWorld, FinishAdoptionEndsTheRecordWhenTheEngineIsDone) {
+// A split changes the world only when it is committed (after the engine made its bodies): until then the
+// parent stays and impacts on it wait; commit replaces it by the pieces once, sends the waiting impacts to
+// them and ends the timing record there.
+TEST(DestructionWorld, CommitReplacesTheParentOnceAndEndsTheRecord) {
     using namespace std::chrono_literals;
     HeldJobs jobs;
     DestructionWorld w(heldConfig(jobs));
@@ -758,35 +786,45 @@ TEST(DestructionWorld, FinishAdoptionEndsTheRecordWhenTheEngineIsDone) {
     ASSERT_TRUE(w.submitImpact(id, centreHit()));
     jobs.runAll();
     w.beginFrame();
+    const std::uint64_t hash = w.geometryHash();
     auto out = w.collect();
     ASSERT_EQ(out.size(), 1u);
+    ASSERT_GE(out[0].pieces.size(), 2u);
+    EXPECT_NE(w.object(id), nullptr) << "the parent stays until the split is committed";
+    for (const AdoptedPiece& p : out[0].pieces)
+        EXPECT_EQ(w.object(p.id), nullptr);
+    EXPECT_EQ(w.geometryHash(), hash);
+    ASSERT_TRUE(w.submitImpact(id, centreHit()));
+    EXPECT_EQ(w.jobsInFlight(), 0) << "an impact on an uncommitted parent waits for the split";
     const TimingRecord before = w.timings().back();
-    EXPECT_EQ(out[0].record, w.firstTimingRecord() + w.timings().size() - 1)
-        << "the outcome names its record";
     std::this_thread::sleep_for(10ms); // the engine builds the pieces' bodies
-    w.finishAdoption(out[0]);
+    w.commit(out[0]);
+    EXPECT_EQ(w.object(id), nullptr);
+    for (const AdoptedPiece& p : out[0].pieces)
+        EXPECT_EQ(w.object(p.id), p.state.get());
+    EXPECT_NE(w.geometryHash(), hash);
+    EXPECT_EQ(w.jobsInFlight(), 1) << "the waiting impact went to a piece";
     const TimingRecord after = w.timings().back();
     EXPECT_GE(after.adoptionMs - before.adoptionMs, 10);
     EXPECT_NEAR(after.totalMs - before.totalMs, after.adoptionMs - before.adoptionMs, 1e-9);
     (void)expectStagesAddUp(after);
-    w.finishAdoption(out[0]); // twice: no effect
+    const std::vector<ObjectId> objects = w.objects();
+    w.commit(out[0]); // twice: no effect
+    EXPECT_EQ(w.objects(), objects);
     EXPECT_EQ(w.timings().back().totalMs, after.totalMs);
+    EXPECT_EQ(w.jobsInFlight(), 1);
 
-    // An outcome of an earlier collect() (never finished) is not extended any more.
-    ASSERT_TRUE(w.submitImpact(out[0].pieces.front().id, centreHit()));
+    // A parent removed before its split is committed: the split is dropped, its record stale.
     jobs.runAll();
     w.beginFrame();
-    const auto unfinished = w.collect();
-    ASSERT_EQ(unfinished.size(), 1u);
-    const double unfinishedTotal = w.timings().back().totalMs;
-    ASSERT_TRUE(w.submitImpact(unfinished[0].pieces.front().id, centreHit()));
-    jobs.runAll();
-    w.beginFrame();
-    ASSERT_EQ(w.collect().size(), 1u);
-    std::this_thread::sleep_for(1ms);
-    w.finishAdoption(unfinished[0]);
-    const std::size_t n = w.timings().size();
-    EXPECT_EQ(w.timings()[n - 2].totalMs, unfinishedTotal);
+    const auto dropped = w.collect();
+    ASSERT_EQ(dropped.size(), 1u);
+    w.removeObject(dropped[0].parent);
+    EXPECT_TRUE(w.timings().back().stale);
+    w.commit(dropped[0]);
+    for (const AdoptedPiece& p : dropped[0].pieces)
+        EXPECT_EQ(w.object(p.id), nullptr);
+    EXPECT_EQ(w.object(dropped[0].parent), nullptr);
 }
 
 } // namespace

@@ -4,6 +4,7 @@
 
 #include "TestSupport.hpp"
 #include "ToyPhysics.hpp"
+#include "WorldSteps.hpp"
 #include "rubble/core/ThreadPool.hpp"
 #include "rubble/geometry/MassProperties.hpp"
 #include "rubble/geometry/MeshTopology.hpp"
@@ -38,7 +39,7 @@ Hit hitSphere(int r) {
     const double volume = w.object(id)->mass.volume;
     EXPECT_TRUE(w.submitImpact(id, Impact{{r - 1e-3, 0.01, 0.02}, {1, 0, 0}, 10}));
     w.beginFrame();
-    const auto out = w.collect();
+    const auto out = collectAndCommit(w);
     EXPECT_EQ(out.size(), 1u);
     if (out.size() != 1)
         return h;

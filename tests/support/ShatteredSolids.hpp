@@ -7,6 +7,7 @@
 #include <chrono>
 #include <vector>
 
+#include "WorldSteps.hpp"
 #include "rubble/geometry/ConvexPolytope.hpp"
 #include "rubble/geometry/Mesh.hpp"
 #include "rubble/runtime/DestructionWorld.hpp"
@@ -45,7 +46,7 @@ inline std::vector<std::vector<ConvexPolytope>> shatteredSolids(const std::vecto
         for (int frame = 0; frame < 20 && done.empty(); ++frame) {
             world.beginFrame();
             (void)world.waitForResult(std::chrono::steady_clock::now() + std::chrono::seconds(10));
-            done = world.collect();
+            done = collectAndCommit(world);
         }
         EXPECT_EQ(done.size(), 1u);
         for (const FractureOutcome& o : done)

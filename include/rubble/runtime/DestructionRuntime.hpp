@@ -331,10 +331,12 @@ public:
     /// Returns the impacts accepted.
     int blast(const Vec3& center, double radius, double impulse, double edgeShare = 0.4);
 
-    /// One frame: physics step, contacts → impacts, outcomes adopted, support settled, debris governed,
-    /// particles and projectiles advanced.
+    /// One frame, a list of stages: physics step, contacts → impacts, anchors classified, splits adopted
+    /// (bodies made, then each split committed), support settled (once a frame), the onAdopted callbacks,
+    /// debris governed, structure solved, particles and projectiles advanced.
     FrameStats stepFrame(double dt = 1.0 / 60);
-    /// Adopts the results ready now, between frames (nothing in deterministic mode).
+    /// Adopts the results ready now, between frames (nothing in deterministic mode): the adoption, support
+    /// and callback stages of stepFrame.
     FrameStats adoptReady();
 
     /// The record of a body, or null.
@@ -396,7 +398,8 @@ public:
     /// volume ledger: equal runs give equal hashes.
     std::uint64_t stateHash() const;
 
-    /// Called for every adopted outcome after its piece bodies exist (e.g. for the renderer).
+    /// Called for every adopted split once the frame's support has settled: its piece bodies exist and move
+    /// as they will (e.g. for the renderer).
     void setOnAdopted(std::function<void(const FractureOutcome&)> callback);
     /// Called before a body is removed (e.g. for the renderer).
     void setOnRemoved(std::function<void(const BodyRecord&)> callback);

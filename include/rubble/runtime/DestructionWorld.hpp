@@ -72,8 +72,8 @@ struct RUBBLE_API TimingRecord {
     double decompositionMs = 0; ///< convex parts of the pieces
     double finishMs = 0;        ///< pieces moved into their principal frames, with their mass properties
     double handoffMs = 0;       ///< the finished job waiting for the main thread to collect it
-    double adoptionMs = 0;      ///< main-thread adoption: the world's part in collect(), then the engine's
-                                ///< until finishAdoption() (its bodies and collision shapes)
+    double adoptionMs = 0;      ///< main-thread adoption: from collect() handing the split out to commit()
+                                ///< (the engine's bodies and collision shapes included)
     double totalMs = 0;         ///< submission → adopted
     int pieces = 0;             ///< pieces produced
     bool stale = false;         ///< discarded because the object changed meanwhile
@@ -89,9 +89,9 @@ struct RUBBLE_API TimingRecord {
                                         ///< moved into its frame, measured and hashed counts 4 per triangle)
 };
 
-/// A piece of a fracture, ready to adopt: a new object of the world.
+/// A child of a split: a new object of the world once the split is committed.
 struct RUBBLE_API AdoptedPiece {
-    ObjectId id = 0;        ///< the new object, already added to the world
+    ObjectId id = 0;        ///< the new object's id (added to the world by DestructionWorld::commit)
     Frame frame;            ///< piece local frame → parent local frame (centre of mass, principal axes;
                             ///< the identity for a remainder that keeps its parent's frame)
     std::int32_t cell = -1; ///< Piece::cell: −1 part of the remainder, i ≥ 0 debris of cell i
@@ -106,15 +106,15 @@ struct RUBBLE_API DustPiece {
     std::int32_t cell = -1; ///< Piece::cell
 };
 
-/// A fracture ready to adopt: the parent object is replaced by the pieces.
+/// A split event: one self-contained record of a fracture ready to adopt, the parent object and the pieces
+/// that replace it (their frames, meshes, mass properties and convex parts) when it is committed.
 struct RUBBLE_API FractureOutcome {
-    ObjectId parent = 0;              ///< the object that broke (removed from the world by collect())
+    ObjectId parent = 0;              ///< the object that broke (replaced by DestructionWorld::commit)
     std::uint32_t parentVersion = 0;  ///< its version when the job started
     std::vector<AdoptedPiece> pieces; ///< the new objects
     std::vector<DustPiece> dust;      ///< pieces too small to become objects
     std::vector<Impact> impacts;      ///< the impacts (parent local coordinates) that caused it
     double droppedVolume = 0;         ///< volume of slivers the kernel dropped (for volume bookkeeping)
-    std::uint64_t record = 0;         ///< sequence number of its TimingRecord (for finishAdoption)
 
     /// Σ volume of dust.
     double dustVolume() const;
@@ -192,10 +192,13 @@ public:
     /// Ids of all live objects, ascending.
     std::vector<ObjectId> objects() const;
 
-    /// Submits an impact in the object's local coordinates. Returns false when it is ignored (unknown or
-    /// indestructible object, impulse below threshold, impact refused by checkFractureParams). An impact on
-    /// an object with a job in flight is merged into the next job for that object. Accepted: rounded to
-    /// single precision (journalPrecision) and journaled.
+    /// The impact filter: whether submitImpact accepts this impact (object-local): a live destructible
+    /// object, the impulse at single precision (journalPrecision) at least the object's threshold, and an
+    /// impact checkFractureParams accepts.
+    bool accepts(ObjectId id, const Impact& impact) const;
+    /// Submits an impact in the object's local coordinates. Returns false when accepts() refuses it. An
+    /// impact on an object with a job in flight is merged into the next job for that object. Accepted:
+    /// rounded to single precision (journalPrecision) and journaled.
     bool submitImpact(ObjectId id, const Impact& impact);
 
     /// Called with every journal event as it happens: each accepted impact and each removal of a live object.
@@ -222,19 +225,19 @@ public:
     void beginFrame();
     /// The current frame number.
     std::uint64_t frame() const;
-    /// Results ready for adoption this frame (within the adoption budget). Pieces are added to the world and
-    /// the parent removed before this returns; the caller replaces its bodies accordingly.
+    /// The split events ready this frame (within the adoption budget), one per broken object. The world does
+    /// not change yet: the caller makes the pieces' bodies, then calls commit() once for each split.
     std::vector<FractureOutcome> collect();
+    /// Commits a split of collect() once the engine's bodies exist: the pieces replace the parent object,
+    /// impacts that waited for its job go to the piece nearest to them, and the split's TimingRecord ends
+    /// (its adoptionMs and totalMs include the engine's part). Until then the parent stays, and impacts on
+    /// it wait. No effect when called again, or when the parent was removed meanwhile (the record is stale).
+    void commit(const FractureOutcome& split);
     /// Blocks until a finished job waits for collect() or until deadline passes; true when one does. For
     /// adopting results in the main thread's idle time between frames (collect() may be called again in
     /// the same frame). Returns false at once when no job is in flight, and always in deterministic mode,
     /// where adoption stays bound to frames so that replays are identical. A deadline in the past polls.
     bool waitForResult(std::chrono::steady_clock::time_point deadline);
-    /// Tells the world that the engine has adopted an outcome of the latest collect() (its bodies and
-    /// collision shapes exist): the outcome's TimingRecord then ends now, so that its adoptionMs and totalMs
-    /// include the engine's part. Without this call a record ends when collect() hands the outcome out. Has
-    /// no effect on outcomes of earlier collect() calls or when called twice.
-    void finishAdoption(const FractureOutcome& outcome);
     /// Blocks until no job is in flight or queued (for tools, tests and shutdown).
     void waitIdle();
 

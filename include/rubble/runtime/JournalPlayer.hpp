@@ -31,7 +31,8 @@ public:
     /// frames after the previous event (or the world's frame), or one the world refuses
     /// (DestructionWorld::applyJournalEvent), is an error and changes nothing.
     Status receive(const JournalEvent& event);
-    /// Steps the world (beginFrame, collect, then the kept events of the new frame) until frame() == tick.
+    /// Steps the world (beginFrame, collect and commit, then the kept events of the new frame) until frame()
+    /// == tick.
     Status advanceTo(std::uint64_t tick);
     /// Steps until no job is in flight and no event is kept.
     Status drain();
