@@ -17,6 +17,7 @@
 
 #include "rubble/collision/ConvexDecomposition.hpp"
 #include "rubble/collision/DecomposeControl.hpp"
+#include "rubble/collision/PartConcavity.hpp"
 #include "rubble/core/ParameterCheck.hpp"
 #include "rubble/core/ThreadPool.hpp"
 #include "rubble/core/Version.hpp"
@@ -166,6 +167,7 @@ struct PyPiece : rubble::Mesh {
     rubble::MassProperties mass;
     std::int32_t cell = -1;
     std::vector<std::vector<rubble::Vec3>> convexParts; // corner points per part
+    double concavity = -1;                              // of the convex parts; -1: not measured
 };
 
 py::list convexPartsOf(const std::vector<std::vector<rubble::Vec3>>& parts) {
@@ -270,16 +272,19 @@ std::vector<PyPiece> fractureMesh(const rubble::Mesh& mesh, const py::object& po
     py::gil_scoped_release unlocked;
     rubble::FractureResult result = unwrap(rubble::fracture(mesh, impact, params, seed));
     std::vector<std::vector<rubble::ConvexPolytope>> parts;
+    std::vector<double> concavity;
     if (convexParts) {
         rubble::DecompositionParams dp;
         dp.maxParts = maxParts;
         parts = rubble::updateDecomposition(unwrap(rubble::decompose(mesh, dp)).parts, result, dp);
+        concavity = rubble::pieceConcavity(result, parts);
     }
     for (std::size_t i = 0; i < result.pieces.size(); ++i) {
         PyPiece& p = pieces.emplace_back();
         static_cast<rubble::Mesh&>(p) = std::move(result.pieces[i].mesh);
         p.mass = result.pieces[i].mass;
         p.cell = result.pieces[i].cell;
+        p.concavity = i < concavity.size() ? concavity[i] : -1.0;
         if (i < parts.size())
             for (const rubble::ConvexPolytope& part : parts[i])
                 p.convexParts.push_back(part.vertices());
@@ -427,6 +432,12 @@ PYBIND11_MODULE(_rubble, m) {
         .def_property_readonly("principal_axes", [](const PyPiece& p) { return mat3(p.mass.principalAxes); })
         .def_readonly("cell", &PyPiece::cell)
         .def_property_readonly("convex_parts", [](const PyPiece& p) { return convexPartsOf(p.convexParts); })
+        .def_property_readonly("concavity",
+                               [](const PyPiece& p) -> std::optional<double> {
+                                   if (p.concavity < 0)
+                                       return std::nullopt;
+                                   return p.concavity;
+                               })
         .def("__repr__", [](const PyPiece& p) {
             return "<rubble.Piece " + std::to_string(p.triangleCount()) + " triangles, volume " +
                    std::to_string(p.mass.volume) + ", cell " + std::to_string(p.cell) + ">";

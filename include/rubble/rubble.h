@@ -24,7 +24,7 @@ extern "C" {
 #endif
 
 /// Version of this C API; bumped when a struct or a function signature changes.
-#define RUBBLE_C_API_VERSION 1
+#define RUBBLE_C_API_VERSION 2
 
 /// What a call returned: RUBBLE_OK or why it failed (1-7 are the library's rubble::ErrorCode values).
 typedef RUBBLE_C_ENUM(rubble_status){
@@ -193,6 +193,8 @@ typedef struct rubble_piece {
     rubble_mass_properties mass; ///< its mass properties (density 1)
     int32_t cell;                ///< -1: part of the damaged remainder; i >= 0: debris of cell i
     size_t convex_part_count;    ///< convex collision parts (0 when they were not computed)
+    double concavity;            ///< how far the parts stray from the piece's surface, as a fraction of its
+                                 ///< bounding-box diagonal (one-sided Hausdorff); -1 without parts
 } rubble_piece;
 
 /// Totals of a fracture.

@@ -150,6 +150,10 @@ class Piece(Mesh):
     @property
     def convex_parts(self) -> list[Float64Array]:
         """Convex collision parts, each the (k, 3) corner points of its hull (empty without convex_parts)."""
+    @property
+    def concavity(self) -> float | None:
+        """How far the convex parts stray from the piece's surface (one-sided Hausdorff distance, as a fraction
+        of its bounding-box diagonal, as decompose's); None without convex_parts."""
 
 def read_mesh(path: str | os.PathLike[str]) -> Mesh:
     """Reads .obj, .off, .stl, .ply, .3ds, .gltf or .glb; Error names the file and line."""

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "rubble/collision/ConvexDecomposition.hpp"
+#include "rubble/collision/PartConcavity.hpp"
 #include "rubble/core/Log.hpp"
 #include "rubble/core/ParameterCheck.hpp"
 #include "rubble/core/Version.hpp"
@@ -50,6 +51,7 @@ struct rubble_fracture {
     rubble::FractureResult result;
     std::vector<std::unique_ptr<rubble_mesh>> meshes;                 // one per piece
     std::vector<std::vector<std::vector<rubble::Vec3>>> convexPoints; // [piece][part] corner points
+    std::vector<double> concavity;                                    // of each piece's parts (-1: none)
 };
 
 struct rubble_world {
@@ -454,14 +456,17 @@ rubble_status rubble_fracture_mesh(const rubble_mesh* mesh, const rubble_impact*
             rubble::Result<rubble::Decomposition> parent = rubble::decompose(mesh->mesh, dp);
             if (!parent)
                 return fail(parent.error());
-            for (const std::vector<rubble::ConvexPolytope>& parts :
-                 rubble::updateDecomposition(parent->parts, handle->result, dp)) {
+            const std::vector<std::vector<rubble::ConvexPolytope>> pieceParts =
+                rubble::updateDecomposition(parent->parts, handle->result, dp);
+            handle->concavity = rubble::pieceConcavity(handle->result, pieceParts);
+            for (const std::vector<rubble::ConvexPolytope>& parts : pieceParts) {
                 auto& points = handle->convexPoints.emplace_back();
                 for (const rubble::ConvexPolytope& part : parts)
                     points.push_back(part.vertices());
             }
         }
         handle->convexPoints.resize(handle->result.pieces.size());
+        handle->concavity.resize(handle->result.pieces.size(), -1.0);
         for (rubble::Piece& piece : handle->result.pieces) {
             auto m = std::make_unique<rubble_mesh>();
             m->ownedByFracture = true;
@@ -502,6 +507,7 @@ rubble_status rubble_fracture_get_piece(const rubble_fracture* fracture, size_t 
         copy(piece.mass, out->mass);
         out->cell = piece.cell;
         out->convex_part_count = fracture->convexPoints[index].size();
+        out->concavity = fracture->concavity[index];
         return ok();
     });
 }

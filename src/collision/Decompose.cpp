@@ -198,7 +198,12 @@ public:
             if (it != insideCache_.end())
                 return it->second;
         }
-        const bool in = detail::insideMesh(mesh_, p);
+        // The signed crossings of a ray through the mesh's tree; the winding number's sum where the ray
+        // passes near an edge or p lies on the surface.
+        std::call_once(meshTreeOnce_, [this] { meshTree_ = std::make_unique<detail::PolygonBvh>(mesh_); });
+        const Vec3 ray = normalized(Vec3{0.3141592653589793, 0.5772156649015329, 0.7071067811865476});
+        const std::optional<int> w = meshTree_->winding(p, ray, 1e-9 * std::max(diag_, 1e-300));
+        const bool in = w ? *w > 0 : detail::insideMesh(mesh_, p);
         const std::lock_guard lock(insideMutex_);
         insideCache_.emplace(key, in);
         return in;
@@ -250,12 +255,17 @@ public:
         planes.reserve(hullFaces.size());
         for (const PolytopeFace& f : hullFaces)
             planes.push_back(f.plane);
+        // The hull's box, padded: a ray leaves it no earlier than it leaves the hull.
+        Aabb hullBox = part.hull.bounds();
+        const double boxPad = 1e-6 * (hullBox.diagonal() + diag_) + 1e-300;
+        hullBox.lo -= Vec3{boxPad, boxPad, boxPad};
+        hullBox.hi += Vec3{boxPad, boxPad, boxPad};
         const std::size_t chunks = (order.size() + kDepthChunk - 1) / kDepthChunk;
         std::vector<Deepest> deepest(chunks);
         parallelFor(chunks, [&](std::size_t chunk) {
             const std::size_t end = std::min(order.size(), (chunk + 1) * kDepthChunk);
             for (std::size_t k = chunk * kDepthChunk; k < end; ++k)
-                faceDepth(hullFaces[order[k]], planes, cuts, bvh, deepest[chunk]);
+                faceDepth(hullFaces[order[k]], planes, cuts, bvh, hullBox, deepest[chunk]);
         });
         for (const Deepest& d : deepest)
             if (d.depth > part.depth) {
@@ -274,7 +284,7 @@ public:
     /// The deepest pocket under the samples of one hull face, where deeper than `best` so far.
     void faceDepth(const PolytopeFace& hf, const std::vector<Plane>& planes,
                    const std::vector<const PolytopeFace*>& cuts, const detail::PolygonBvh& bvh,
-                   Deepest& best) const {
+                   const Aabb& box, Deepest& best) const {
         const double delta = 1e-9 * std::max(diag_, 1.0);
         const double planeTol = 1e-7 * std::max(diag_, 1.0);
         bool onCut = false;
@@ -303,12 +313,10 @@ public:
         for (const Plane& plane : planes)
             if (const double nd = dot(plane.normal, dir); nd > 1e-12)
                 exits.emplace_back(&plane, nd);
+        const double stop = delta * 2;
         for (const Vec3& s : samples) {
             const Vec3 o = s + hf.plane.normal * delta;
-            double tExit = std::numeric_limits<double>::infinity();
-            for (const auto& [plane, nd] : exits)
-                tExit = std::min(tExit, (plane->offset - dot(plane->normal, o)) / nd);
-            const double t = bvh.nearest(o, dir, tExit, delta * 2);
+            const double t = depthAlong(o, dir, exits, box, stop, bvh);
             const double depth = t - delta;
             if (depth > best.depth) {
                 best.depth = depth;
@@ -316,6 +324,37 @@ public:
                 best.dir = dir;
             }
         }
+    }
+
+    /// min(first surface hit, exit from the hull) along o + t·dir, as bvh.nearest(o, dir, exit, stop) gives
+    /// it; exits are the hull planes the ray can leave through, with their cosines. The hit is found first,
+    /// bounded by the exit from box (which holds the hull), so that only the planes the ray may leave through
+    /// before it are divided out.
+    static double depthAlong(const Vec3& o, const Vec3& dir,
+                             const std::vector<std::pair<const Plane*, double>>& exits, const Aabb& box,
+                             double stop, const detail::PolygonBvh& bvh) {
+        auto exactExit = [&] {
+            double tExit = std::numeric_limits<double>::infinity();
+            for (const auto& [plane, nd] : exits)
+                tExit = std::min(tExit, (plane->offset - dot(plane->normal, o)) / nd);
+            return tExit;
+        };
+        double boxExit = std::numeric_limits<double>::infinity();
+        for (int a = 0; a < 3; ++a)
+            if (dir[a] != 0)
+                boxExit = std::min(boxExit, ((dir[a] > 0 ? box.hi[a] : box.lo[a]) - o[a]) / dir[a]);
+        if (!(boxExit > stop) || !std::isfinite(boxExit))
+            return bvh.nearest(o, dir, exactExit(), stop);
+        const double hit = bvh.nearest(o, dir, boxExit, stop);
+        // Planes left through before max(hit, stop) (with room for rounding); the others exit later.
+        const double reach = std::max(hit, stop) * (1 + 1e-9);
+        double tExit = std::numeric_limits<double>::infinity();
+        for (const auto& [plane, nd] : exits)
+            if (const double a = plane->offset - dot(plane->normal, o); a <= reach * nd)
+                tExit = std::min(tExit, a / nd);
+        if (!(tExit > stop)) // leaves at once: the search stops at its first leaf, as before
+            return bvh.nearest(o, dir, exactExit(), stop);
+        return std::min(hit, tExit);
     }
 
     struct Split {
@@ -543,6 +582,8 @@ private:
     std::int32_t nextTag_ = 0;
     double minPartVolume_ = 0;
     std::map<std::tuple<double, double, double>, bool> insideCache_;
+    std::once_flag meshTreeOnce_;
+    std::unique_ptr<detail::PolygonBvh> meshTree_; // mesh_'s triangles, for inside()
 };
 
 } // namespace

@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <cstring>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 #include "rubble/collision/ConvexDecomposition.hpp"
+#include "rubble/collision/DecomposeControl.hpp"
 
 namespace rubble {
 
@@ -150,16 +152,30 @@ void DecompositionCache::store(std::uint64_t key, const Decomposition& d) {
 }
 
 Result<Decomposition> DecompositionCache::get(const Mesh& mesh, const DecompositionParams& params) {
+    return get(mesh, params, DecomposeControl{});
+}
+
+Result<Decomposition> DecompositionCache::get(const Mesh& mesh, const DecompositionParams& params,
+                                              const DecomposeControl& control) {
     const std::uint64_t key = keyOf(mesh, params);
+    // A hit is done at once: its progress is 1.
+    auto hit = [&control](Decomposition d) -> Result<Decomposition> {
+        if (control.progress)
+            control.progress(1.0);
+        return d;
+    };
+    std::optional<Decomposition> held;
     {
         std::lock_guard lock(mutex_);
         auto it = memory_.find(key);
         if (it != memory_.end()) {
             ++hits_;
             recency_.splice(recency_.begin(), recency_, it->second.recency);
-            return it->second.decomposition;
+            held = it->second.decomposition;
         }
     }
+    if (held)
+        return hit(std::move(*held));
     char name[32];
     std::snprintf(name, sizeof name, "%016llx.rdc", static_cast<unsigned long long>(key));
     const std::filesystem::path file = directory_.empty() ? std::filesystem::path{} : directory_ / name;
@@ -170,14 +186,16 @@ Result<Decomposition> DecompositionCache::get(const Mesh& mesh, const Decomposit
             ss << in.rdbuf();
             Decomposition d;
             if (deserialize(ss.str(), key, d)) {
-                std::lock_guard lock(mutex_);
-                ++hits_;
-                store(key, d);
-                return d;
+                {
+                    std::lock_guard lock(mutex_);
+                    ++hits_;
+                    store(key, d);
+                }
+                return hit(std::move(d));
             }
         }
     }
-    auto d = decompose(mesh, params);
+    auto d = decompose(mesh, params, control);
     if (!d)
         return d;
     if (!file.empty()) {

@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "rubble/core/Random.hpp"
+#include "rubble/fracture/Fracture.hpp"
 
 namespace rubble {
 
@@ -65,6 +66,18 @@ double partConcavity(const Mesh& mesh, const std::vector<ConvexPolytope>& parts,
         worst = std::max(worst, distanceToParts(p, parts, bounds));
     }
     return worst / diagonal;
+}
+
+std::vector<double> pieceConcavity(const FractureResult& result,
+                                   const std::vector<std::vector<ConvexPolytope>>& parts,
+                                   std::size_t samples) {
+    std::vector<double> out;
+    out.reserve(result.pieces.size());
+    for (std::size_t i = 0; i < result.pieces.size(); ++i)
+        out.push_back(i < parts.size() && !parts[i].empty()
+                          ? partConcavity(result.pieces[i].mesh, parts[i], samples)
+                          : -1.0);
+    return out;
 }
 
 } // namespace rubble

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include "collision/MeshRegion.hpp"
@@ -39,6 +40,73 @@ public:
         for (const Polygon& poly : polygons)
             for (std::size_t k = 1; k + 1 < poly.size(); ++k)
                 tris_.push_back({poly[0], poly[k], poly[k + 1]});
+        index();
+    }
+    /// The triangles of a mesh, in their orientation.
+    explicit PolygonBvh(const Mesh& mesh) {
+        tris_.reserve(mesh.triangles.size());
+        for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+            const auto c = mesh.corners(t);
+            tris_.push_back({c[0], c[1], c[2]});
+        }
+        index();
+    }
+
+    /// The winding number of closed triangles around o, counted as signed crossings of the ray o + t·d
+    /// (t > 0; +1 where it leaves through a triangle's front); nullopt when the ray passes within about
+    /// 1e-9 of an edge, grazes a triangle's plane or o lies within epsilon of a triangle it crosses.
+    std::optional<int> winding(const Vec3& o, const Vec3& d, double epsilon) const {
+        if (nodes_.empty())
+            return 0;
+        constexpr double kEdge = 1e-9;
+        int w = 0;
+        const Vec3 inv{1 / d.x, 1 / d.y, 1 / d.z};
+        const double far = std::numeric_limits<double>::infinity();
+        std::uint32_t stack[128];
+        int top = 0;
+        stack[top++] = 0;
+        while (top > 0) {
+            const Node& n = nodes_[stack[--top]];
+            if (!hitsBox(n.box, o, d, inv, far))
+                continue;
+            if (n.count == 0) {
+                stack[top++] = n.first;
+                stack[top++] = n.second;
+                continue;
+            }
+            for (std::uint32_t i = n.first; i < n.first + n.count; ++i) {
+                const Tri& tri = tris_[order_[i]];
+                const Vec3 e1 = tri[1] - tri[0], e2 = tri[2] - tri[0];
+                const Vec3 p = cross(d, e2);
+                const double det = dot(e1, p);
+                const Vec3 s = o - tri[0];
+                if (std::abs(det) <= kEdge * length(e1) * length(e2)) {
+                    // Parallel to the plane: harmless unless the ray runs in it.
+                    if (std::abs(dot(s, cross(e1, e2))) <= epsilon * length(cross(e1, e2)))
+                        return std::nullopt;
+                    continue;
+                }
+                const double inv_det = 1.0 / det;
+                const double u = dot(s, p) * inv_det;
+                const Vec3 q = cross(s, e1);
+                const double v = dot(d, q) * inv_det;
+                if (u < -kEdge || v < -kEdge || u + v > 1 + kEdge)
+                    continue;
+                const double t = dot(e2, q) * inv_det;
+                if (std::abs(t) <= epsilon)
+                    return std::nullopt; // o on the triangle
+                if (t < 0)
+                    continue;
+                if (u <= kEdge || v <= kEdge || u + v >= 1 - kEdge)
+                    return std::nullopt; // through an edge or a corner
+                w += det < 0 ? 1 : -1;
+            }
+        }
+        return w;
+    }
+
+private:
+    void index() {
         order_.resize(tris_.size());
         for (std::size_t i = 0; i < order_.size(); ++i)
             order_[i] = static_cast<std::uint32_t>(i);
@@ -51,6 +119,7 @@ public:
             build(0, static_cast<std::uint32_t>(tris_.size()));
     }
 
+public:
     /// The smallest t in [0, tMax) where the ray o + t·d hits a triangle (tMax when none); the search stops
     /// early once t <= stopBelow.
     double nearest(const Vec3& o, const Vec3& d, double tMax, double stopBelow) const {

@@ -230,6 +230,8 @@ static void test_fracture(void) {
     for (i = 0; i < info.piece_count; ++i) {
         CHECK_OK(rubble_fracture_get_piece(broken, i, &piece));
         CHECK(piece.mass.volume > 0 && piece.convex_part_count >= 1);
+        /* The parts' concavity: a fraction of the piece's diagonal, measured (not -1). */
+        CHECK(piece.concavity >= 0 && piece.concavity < 0.5);
         if (piece.cell < 0)
             ++remainder;
         else
@@ -283,7 +285,7 @@ static void test_fracture(void) {
     CHECK(info.piece_count >= 3);
     CHECK(fabs(sum_piece_volumes(shattered) - 8) < 1e-9 * 8);
     CHECK_OK(rubble_fracture_get_piece(shattered, 0, &piece));
-    CHECK(piece.convex_part_count == 0);
+    CHECK(piece.convex_part_count == 0 && piece.concavity == -1);
 
     /* Adaptive: a weak hit chips one cell, a strong one shatters into `cells`. */
     {

@@ -22,7 +22,9 @@ assert set(d["timings_ms"]) == {"cell", "boolean", "islands", "decomposition", "
 assert all(isinstance(v, (int, float)) and v >= 0 for v in d["timings_ms"].values()), d["timings_ms"]
 assert len(d["pieces"]) >= 2, "expected at least two pieces"
 for p in d["pieces"]:
-    assert set(p) == {"volume", "triangles", "closed", "oriented", "center_of_mass", "convex_parts"}, p.keys()
+    assert set(p) == {"volume", "triangles", "closed", "oriented", "center_of_mass", "convex_parts",
+                      "concavity"}, p.keys()
+    assert 0 <= p["concavity"] < 0.5, p
     assert p["closed"] is True and p["oriented"] is True, p
     assert p["volume"] > 0 and p["triangles"] >= 4 and p["convex_parts"] >= 1, p
     assert len(p["center_of_mass"]) == 3 and all(isinstance(c, float) for c in p["center_of_mass"]), p

@@ -1,13 +1,17 @@
-// decompose() under a DecomposeControl: progress, cancelling, a job system; and partConcavity's coverage.
+// decompose() and the decomposition cache under a DecomposeControl: progress, cancelling, a job system;
+// partConcavity's coverage and the concavity of a fracture's pieces.
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <filesystem>
 #include <mutex>
 #include <thread>
 #include <vector>
 
+#include "TestSupport.hpp"
 #include "rubble/collision/DecomposeControl.hpp"
 #include "rubble/collision/PartConcavity.hpp"
+#include "rubble/fracture/Fracture.hpp"
 
 namespace rubble {
 namespace {
@@ -134,6 +138,79 @@ TEST(DecomposeControl, BusyJobSystemDoesNotBlockAndLateJobsDoNothing) {
     EXPECT_FALSE(jobs.jobs.empty());
     for (auto& job : jobs.jobs)
         job(); // after the call returned: must not touch its tasks
+}
+
+TEST(DecomposeControl, CacheDecomposesUnderControlAndKeepsNoCancelledEntry) {
+    const std::filesystem::path dir = test::tempDir("decompose_cache_control");
+    DecompositionCache cache(dir);
+    std::atomic<bool> cancel{true};
+    DecomposeControl cancelled;
+    cancelled.cancel = &cancel;
+    auto d = cache.get(torus(), {}, cancelled);
+    ASSERT_FALSE(d);
+    EXPECT_EQ(d.error().code, ErrorCode::Cancelled);
+    EXPECT_EQ(cache.size(), 0u);
+    EXPECT_TRUE(std::filesystem::is_empty(dir)); // nothing written
+
+    // A miss decomposes with the control's jobs and progress, to the bytes of decompose().
+    ThreadPerJob jobs;
+    std::vector<double> seen;
+    DecomposeControl control;
+    control.jobs = &jobs;
+    control.progress = [&](double f) {
+        seen.push_back(f);
+        return true;
+    };
+    d = cache.get(torus(), {}, control);
+    ASSERT_TRUE(d) << d.error().message;
+    EXPECT_GT(jobs.submitted, 0);
+    ASSERT_GE(seen.size(), 2u);
+    EXPECT_EQ(seen.back(), 1.0);
+    EXPECT_EQ(coordinates(d.value()), coordinates(decompose(torus()).value()));
+    EXPECT_EQ(cache.hits(), 0u);
+
+    // A hit, in memory and then from the file, reports 1 at once (even with the cancel flag set).
+    control.cancel = &cancel;
+    DecompositionCache fromDisk(dir);
+    for (DecompositionCache* which : {&cache, &fromDisk}) {
+        seen.clear();
+        auto again = which->get(torus(), {}, control);
+        ASSERT_TRUE(again);
+        EXPECT_EQ(seen, std::vector<double>{1.0});
+        EXPECT_EQ(which->hits(), 1u);
+        EXPECT_EQ(coordinates(again.value()), coordinates(d.value()));
+    }
+}
+
+TEST(PieceConcavity, EveryPieceOfAFractureAsPartConcavity) {
+    const Mesh cube = makeSubdividedBox({-1, -1, -1}, {1, 1, 1}, 7);
+    Impact hit;
+    hit.point = {0.3, 1, 0.2};
+    hit.normal = {0, 1, 0};
+    hit.impulse = 40;
+    auto fr = fracture(cube, hit, FractureParams{}, 7);
+    ASSERT_TRUE(fr) << fr.error().message;
+    ASSERT_GE(fr->pieces.size(), 2u);
+    const auto parts = updateDecomposition(decompose(cube)->parts, *fr);
+    const std::vector<double> measured = pieceConcavity(*fr, parts);
+    ASSERT_EQ(measured.size(), fr->pieces.size());
+    for (std::size_t i = 0; i < fr->pieces.size(); ++i) {
+        EXPECT_EQ(measured[i], partConcavity(fr->pieces[i].mesh, parts[i])) << i;
+        EXPECT_GE(measured[i], 0) << i;
+    }
+    // The remainder's parts keep its bite open; its convex hull alone covers the bite and scores its depth.
+    std::size_t remainder = 0;
+    while (remainder < fr->pieces.size() && fr->pieces[remainder].cell >= 0)
+        ++remainder;
+    ASSERT_LT(remainder, fr->pieces.size());
+    std::vector<std::vector<ConvexPolytope>> hullOnly(fr->pieces.size());
+    hullOnly[remainder].push_back(convexHull(fr->pieces[remainder].mesh.positions).value());
+    const std::vector<double> covered = pieceConcavity(*fr, hullOnly);
+    EXPECT_GT(covered[remainder], 2 * measured[remainder] + 0.01);
+    for (std::size_t i = 0; i < fr->pieces.size(); ++i)
+        if (i != remainder) {
+            EXPECT_EQ(covered[i], -1) << i; // no parts: not measured
+        }
 }
 
 TEST(PartConcavity, SampleOnAPartsFaceIsCovered) {

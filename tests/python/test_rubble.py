@@ -139,6 +139,16 @@ def test_convex_parts_cover_each_piece():
     assert all(p.convex_parts == [] for p in fracture_cube(convex_parts=False))
 
 
+def test_each_piece_reports_the_concavity_of_its_parts():
+    # A piece of a cube is convex or a cube with a bite: its parts stray at most a few % of its diagonal.
+    pieces = fracture_cube(max_parts=8)
+    assert all(p.concavity is not None and 0 <= p.concavity < 0.05 for p in pieces), [p.concavity for p in pieces]
+    # A single part for a bitten remainder covers the bite: its concavity is the bite's depth.
+    bitten = [p for p in fracture_cube(max_parts=1) if p.cell < 0]
+    assert bitten and max(p.concavity for p in bitten) > 0.01, [p.concavity for p in bitten]
+    assert all(p.concavity is None for p in fracture_cube(convex_parts=False))
+
+
 def test_shatter_and_backends_conserve_volume():
     for backend in ("fast", "corefine"):
         pieces = fracture_cube(cells=4, backend=backend)

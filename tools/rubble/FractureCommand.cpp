@@ -24,9 +24,10 @@
 // usage error (nothing written); 3 the impact misses a mesh (no pieces for it; the other meshes are written).
 // --json prints
 // {"input":{"volume","triangles","closed"},"cut","dropped_volume","pieces":[{"volume","triangles",
-// "closed","oriented","center_of_mass":[x,y,z],"convex_parts"}],"timings_ms":{"cell","boolean","islands",
-// "decomposition","total"}} (with "error" added when the fracture failed); "cut" is false when no piece has a
-// cut face (the one piece is the input), "dropped_volume" the volume of pieces below the drop fraction. With
+// "closed","oriented","center_of_mass":[x,y,z],"convex_parts","concavity"}],"timings_ms":{"cell","boolean",
+// "islands","decomposition","total"}} (with "error" added when the fracture failed); "cut" is false when no
+// piece has a cut face (the one piece is the input), "dropped_volume" the volume of pieces below the drop
+// fraction, "concavity" the parts' partConcavity (a fraction of the piece's diagonal; -1 without parts). With
 // several meshes {"results":[...]} with one such object per mesh plus "file". A multi-object input adds
 // "object" (the name of the object fractured) and "kept" (objects written unchanged); --depth D > 1 adds
 // "levels":[{"level","pieces","volume","dropped_volume","bonds","failed"}] for levels 1..D. Every exit prints
@@ -57,6 +58,7 @@
 #include "Staging.hpp"
 #include "Subcommand.hpp"
 #include "rubble/collision/ConvexDecomposition.hpp"
+#include "rubble/collision/PartConcavity.hpp"
 #include "rubble/core/ParameterCheck.hpp"
 #include "rubble/core/ThreadPool.hpp"
 #include "rubble/fracture/Fracture.hpp"
@@ -108,6 +110,7 @@ struct PieceOut {
     std::vector<rubble::Mesh> partMeshes;      // the parts as written (read from the file for kept objects)
     int parent = -1;                           // index of the parent chunk in MeshJob::pieces
     int level = 1;                             // 0: an object of the input written unchanged
+    double concavity = -1;                     // of the parts (partConcavity); -1: not measured
 };
 
 // A bond between two sibling chunks (indices into MeshJob::pieces).
@@ -240,6 +243,7 @@ Fractured piecesOf(rubble::FractureResult& fr, const std::vector<rubble::ConvexP
         }
     }
     out.decompositionMs = msSince(td);
+    const std::vector<double> concavity = rubble::pieceConcavity(fr, parts);
     rubble::CheckOptions noSelfIntersections;
     noSelfIntersections.selfIntersections = false;
     for (std::size_t i = 0; i < fr.pieces.size(); ++i) {
@@ -253,6 +257,7 @@ Fractured piecesOf(rubble::FractureResult& fr, const std::vector<rubble::ConvexP
         for (const rubble::ConvexPolytope& part : p.parts)
             p.partMeshes.push_back(part.toMesh());
         p.mass = fr.pieces[i].mass;
+        p.concavity = concavity[i];
         p.mesh = std::move(fr.pieces[i].mesh);
         p.parent = parent;
         p.level = level;
@@ -414,7 +419,8 @@ nlohmann::json jsonOf(const MeshJob& job, bool withFile) {
                                {"closed", p.closed},
                                {"oriented", p.oriented},
                                {"center_of_mass", {c.x, c.y, c.z}},
-                               {"convex_parts", p.partMeshes.size()}});
+                               {"convex_parts", p.partMeshes.size()},
+                               {"concavity", p.concavity}});
     }
     if (job.multiObject) {
         j["object"] = rubble::tools::utf8Escaped(job.scene.objects[job.target].name);

@@ -18,6 +18,7 @@
 namespace rubble {
 
 struct FractureResult;
+struct DecomposeControl;
 
 /// Parameters of a decomposition.
 struct RUBBLE_API DecompositionParams {
@@ -92,6 +93,10 @@ public:
                                 std::size_t capacity = kDefaultCapacity);
     /// The cached decomposition of mesh, computing and storing it on a miss.
     Result<Decomposition> get(const Mesh& mesh, const DecompositionParams& params = {});
+    /// get, decomposing a miss under control (rubble/collision/DecomposeControl.hpp): its threads, progress
+    /// and cancel. A hit reports progress 1 at once; a cancelled decomposition is neither kept nor written.
+    Result<Decomposition> get(const Mesh& mesh, const DecompositionParams& params,
+                              const DecomposeControl& control);
     /// Number of lookups answered from the cache (memory or disk).
     std::size_t hits() const;
     /// Number of entries held in memory (never more than capacity()).

@@ -11,11 +11,19 @@
 
 namespace rubble {
 
+struct FractureResult;
+
 /// The one-sided Hausdorff distance from a closed mesh's surface to the boundary of its convex parts, as a
 /// fraction of the mesh's bounding-box diagonal: over samples of the surface (deterministic, area-weighted),
 /// the largest depth of a sample inside a part (a pocket the part covers) or distance outside every part (a
 /// hole in the cover). 0 for a convex mesh and its hull; a crater covered by a part counts its depth.
 RUBBLE_API double partConcavity(const Mesh& mesh, const std::vector<ConvexPolytope>& parts,
                                 std::size_t samples = 4096);
+
+/// partConcavity of every piece of a fracture (rubble/fracture/Fracture.hpp) with parts[i], one part list per
+/// piece as updateDecomposition returns them; -1 for a piece without parts.
+RUBBLE_API std::vector<double> pieceConcavity(const FractureResult& result,
+                                              const std::vector<std::vector<ConvexPolytope>>& parts,
+                                              std::size_t samples = 4096);
 
 } // namespace rubble
