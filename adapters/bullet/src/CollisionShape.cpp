@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include <BulletCollision/BroadphaseCollision/btDbvt.h>
 #include <BulletCollision/CollisionShapes/btShapeHull.h>
 
 #include "rubble/bullet/Convert.hpp"
@@ -41,6 +42,27 @@ int CollisionShape::childCount() const {
     if (compound_)
         return compound_->getNumChildShapes();
     return root_ && root_->getShapeType() == CONVEX_HULL_SHAPE_PROXYTYPE ? 1 : 0;
+}
+
+CollisionShape::Bytes CollisionShape::bytes() const {
+    Bytes b;
+    b.shapes = sizeof(CollisionShape) + children_.capacity() * sizeof(children_[0]);
+    if (compound_) {
+        b.shapes += sizeof(btCompoundShape) +
+                    static_cast<std::size_t>(compound_->getNumChildShapes()) * sizeof(btCompoundShapeChild);
+        if (const btDbvt* tree = compound_->getDynamicAabbTree())
+            b.shapes += sizeof(btDbvt) + (2 * static_cast<std::size_t>(tree->m_leaves)) * sizeof(btDbvtNode);
+    }
+    for (const auto& child : children_)
+        if (child->getShapeType() == CONVEX_HULL_SHAPE_PROXYTYPE) {
+            const int n = static_cast<const btConvexHullShape&>(*child).getNumPoints();
+            b.shapes += sizeof(btConvexHullShape) + static_cast<std::size_t>(n) * sizeof(btVector3);
+            b.points += static_cast<std::size_t>(n);
+        } else {
+            b.shapes += sizeof(btBoxShape);
+        }
+    b.edges = edges_.capacity() * sizeof(edges_[0]);
+    return b;
 }
 
 std::unique_ptr<CollisionShape> CollisionShape::fromParts(const std::vector<ConvexPolytope>& parts,

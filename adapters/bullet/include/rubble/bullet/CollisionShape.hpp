@@ -42,6 +42,15 @@ public:
     /// Edges of the parts in body coordinates (for debug drawing).
     const std::vector<std::array<Vec3, 2>>& edges() const { return edges_; }
 
+    /// Heap bytes held: the Bullet shapes (hull points included), the debug edges, and the hull points.
+    struct Bytes {
+        std::size_t shapes = 0; ///< Bullet shapes, their point arrays and the compound's tree
+        std::size_t edges = 0;  ///< the debug edges
+        std::size_t points = 0; ///< hull points (a count, not bytes)
+    };
+    /// What this shape holds on the heap.
+    Bytes bytes() const;
+
 private:
     CollisionShape() = default;
     btCollisionShape* root_ = nullptr;
