@@ -8,9 +8,9 @@
 // arrays, convex parts, the binding's hulls and edges, bodies; the rest is bookkeeping and allocator
 // headers). The templates as adopted are measured too (their arrays' spare capacity included). Large
 // objects: each --large-kinds mesh (a geodesic sphere, the arch) of --triangles triangles added static
-// (decomposed on add). Table on stdout,
-// memory.csv and memory.png in DIR (rows appended to an existing memory.csv with another label, so that a
-// before and an after run share one file).
+// (decomposed on add); the work arrays that the thread checking a mesh keeps for the next one are reported
+// apart (thread scratch). Table on stdout, memory.csv and memory.png in DIR (rows of another --label already
+// in memory.csv stay, so that a before and an after run share one file).
 #include <malloc.h>
 
 #include <cmath>
@@ -153,11 +153,10 @@ Templates makeTemplates(std::size_t want) {
         return t;
     }
     for (int round = 0; round < 400 && static_cast<std::size_t>(runtime.livePieces()) < want; ++round) {
-        BodyId target = 0; // the largest static object left
+        BodyId target = 0; // the largest object left (pieces of pieces, as in a demolition)
         double volume = 0;
         for (BodyId id : runtime.bodies())
-            if (const BodyRecord* r = runtime.body(id);
-                r && r->hasObject && r->motion == BodyMotionState::Static && r->volume > volume)
+            if (const BodyRecord* r = runtime.body(id); r && r->hasObject && r->volume > volume)
                 target = id, volume = r->volume;
         if (volume == 0)
             break;
@@ -189,6 +188,7 @@ struct Row {
     std::size_t count = 0; // pieces, or triangles of the large object
     double heapBytes = 0;  // heap growth
     double worldBytes = 0; // heap growth of a DestructionWorld alone given the same objects
+    double scratch = 0;    // kept by the thread that checked the mesh (the first large add only)
     double residentMb = 0; // resident growth
     Split s;
     double seconds = 0;
@@ -243,7 +243,11 @@ Row largeRow(const std::string& kind, std::size_t triangles) {
         ObjectDesc d;
         d.mesh = mesh;
         d.fracture = shatter();
+        // the first add of the largest mesh so far also grows the calling thread's kept work arrays
+        // (closedOrientedShells); the second measures the object alone
+        const double first = worldOnlyBytes({d}, 1);
         row.worldBytes = worldOnlyBytes({d}, 1);
+        row.scratch = first - row.worldBytes;
     }
     PhysicsWorld physics;
     BulletBinding binding(physics);
@@ -275,6 +279,7 @@ std::vector<std::string> csvRow(const std::string& label, const Row& r, double o
             std::to_string(r.count),
             fixed(r.heapBytes / n, 1),
             fixed(r.worldBytes / n, 1),
+            fixed(r.scratch / n, 1),
             fixed(r.residentMb, 1),
             fixed(s.meshTriangles / pieces, 1),
             fixed(s.parts_ / pieces, 2),
@@ -328,6 +333,8 @@ int runBench(const BenchArgs& args) {
                               "case",
                               "count",
                               "heap_bytes_per_unit",
+                              "world_alone_bytes_per_unit",
+                              "thread_scratch_bytes_per_unit",
                               "resident_growth_mb",
                               "triangles_per_piece",
                               "parts_per_piece",
@@ -362,12 +369,13 @@ int runBench(const BenchArgs& args) {
     }
     for (const Row& r : rows)
         csv.rows.push_back(csvRow(args.label, r, otherCpu));
-    rubble::bench::Table table{{"label", "case", "count", "B/unit", "tri/piece", "positions", "triangles",
-                                "normals", "uvs", "parts", "hulls", "edges", "bodies", "other"},
+    rubble::bench::Table table{{"label", "case", "count", "B/unit", "world alone", "scratch", "tri/piece",
+                                "positions", "triangles", "normals", "uvs", "spare", "parts", "hulls",
+                                "edges", "bodies", "other"},
                                {}};
     for (const auto& c : csv.rows)
-        table.rows.push_back(
-            {c[0], c[1], c[2], c[3], c[5], c[8], c[9], c[10], c[11], c[14], c[15], c[16], c[17], c[18]});
+        table.rows.push_back({c[0], c[1], c[2], c[3], c[4], c[5], c[7], c[10], c[11], c[12], c[13], c[15],
+                              c[16], c[17], c[18], c[19], c[20]});
     rubble::bench::printTable(table);
     std::cout << "(bytes per piece, or per triangle for the large object; other = heap growth not in the "
                  "columns: bookkeeping and allocator headers)\n";
