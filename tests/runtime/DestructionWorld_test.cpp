@@ -164,6 +164,34 @@ TEST(DestructionWorld, ImpactConservesVolumeAndMass) {
     ASSERT_EQ(w.timings().size(), 1u);
 }
 
+// A piece holds no spare capacity in its mesh's arrays (the kernel grows them as it cuts).
+TEST(DestructionWorld, PiecesHoldNoSpareCapacity) {
+    HeldJobs jobs;
+    DestructionWorld w(heldConfig(jobs));
+    ObjectDesc d = boxDesc();
+    d.mesh.computeFlatNormals();
+    for (std::size_t c = 0; c < 3 * d.mesh.triangles.size(); ++c)
+        d.mesh.uvs.push_back({0.1 * static_cast<double>(c % 7), 0.2 * static_cast<double>(c % 5)});
+    d.fracture.pattern = CellPattern::Shatter;
+    d.fracture.cells = 8;
+    auto id = w.addObject(std::move(d)).value();
+    ASSERT_TRUE(w.submitImpact(id, centreHit()));
+    jobs.runAll();
+    w.beginFrame();
+    auto out = w.collect();
+    ASSERT_EQ(out.size(), 1u);
+    ASSERT_GT(out[0].pieces.size(), 2u);
+    for (const ObjectId p : ids(out[0])) {
+        const Mesh& m = w.object(p)->mesh;
+        ASSERT_TRUE(m.hasNormals() && m.hasUvs());
+        EXPECT_EQ(m.positions.capacity(), m.positions.size());
+        EXPECT_EQ(m.triangles.capacity(), m.triangles.size());
+        EXPECT_EQ(m.normals.capacity(), m.normals.size());
+        EXPECT_EQ(m.uvs.capacity(), m.uvs.size());
+        EXPECT_EQ(m.materials.capacity(), m.materials.size());
+    }
+}
+
 // Pieces below Config::minPieceVolume never become objects: the outcome reports them as dust, and pieces +
 // dust + dropped slivers still add up to the parent.
 TEST(DestructionWorld, PiecesBelowTheMinimumVolumeBecomeDust) {
