@@ -1,4 +1,5 @@
-// `rubble-bench memory [--pieces N...] [--triangles N] [--quick] [--label TEXT] [--out DIR]`
+// `rubble-bench memory [--pieces N...] [--triangles N] [--large-kinds K...] [--attributes] [--quick]
+//  [--label TEXT] [--out DIR]`
 //
 // What the world holds per debris piece and per triangle of a large object, on the Bullet binding.
 // Pieces: a facade (assets/models/facade_x.obj, with normals and UVs) is shattered through a
@@ -40,6 +41,7 @@ struct BenchArgs {
     std::vector<int> pieces{10000, 40000};
     std::size_t triangles = 1000000;
     std::vector<std::string> kinds{"geosphere", "arch"};
+    bool attributes = false;
     bool quick = false;
     std::string label = "current";
     std::string out = rubble::bench::kResultsDir;
@@ -234,10 +236,21 @@ Row piecesRow(const Templates& t, int n) {
     return row;
 }
 
-Row largeRow(const std::string& kind, std::size_t triangles) {
+// The mesh with per-corner flat normals and planar texture coordinates, as an OBJ asset brings them.
+Mesh withAttributes(Mesh m) {
+    m.computeFlatNormals();
+    m.uvs.reserve(3 * m.triangles.size());
+    for (const Triangle& t : m.triangles)
+        for (std::uint32_t v : t)
+            m.uvs.push_back({m.positions[v].x, m.positions[v].z});
+    return m;
+}
+
+Row largeRow(const std::string& kind, std::size_t triangles, bool attributes) {
     Row row;
-    const Mesh mesh = rubble::bench::megaMesh(kind, triangles);
-    row.name = kind + "_" + std::to_string(mesh.triangles.size());
+    const Mesh mesh = attributes ? withAttributes(rubble::bench::megaMesh(kind, triangles))
+                                 : rubble::bench::megaMesh(kind, triangles);
+    row.name = kind + "_" + std::to_string(mesh.triangles.size()) + (attributes ? "_attributes" : "");
     row.count = mesh.triangles.size();
     {
         ObjectDesc d;
@@ -316,14 +329,17 @@ int runBench(const BenchArgs& args) {
     adopted.s = t.adopted;
     rows.push_back(adopted);
     for (int n : args.pieces) {
+        if (n == 0)
+            continue;
         rows.push_back(piecesRow(t, args.quick ? std::min(n, 200) : n));
         std::cout << rows.back().name << ": "
                   << fixed(rows.back().heapBytes / std::max(1.0, double(rows.back().count)), 0)
                   << " bytes per piece" << std::endl;
     }
     for (const std::string& kind : args.triangles > 0 ? args.kinds : std::vector<std::string>{}) {
-        rows.push_back(
-            largeRow(kind, args.quick ? std::min<std::size_t>(args.triangles, 20000) : args.triangles));
+        rows.push_back(largeRow(kind,
+                                args.quick ? std::min<std::size_t>(args.triangles, 20000) : args.triangles,
+                                args.attributes));
         std::cout << rows.back().name << ": "
                   << fixed(rows.back().heapBytes / std::max(1.0, double(rows.back().count)), 1)
                   << " bytes per triangle" << std::endl;
@@ -406,10 +422,13 @@ const rubble::tools::Registrar registrar{
     {"memory", "Heap bytes per debris piece and per triangle of a large object in the world",
      [](CLI::App& app) {
          auto args = std::make_shared<BenchArgs>();
-         app.add_option("--pieces", args->pieces, "debris pieces per row")->check(CLI::Range(1, 1000000));
+         app.add_option("--pieces", args->pieces, "debris pieces per row (0: none)")
+             ->check(CLI::Range(0, 1000000));
          app.add_option("--triangles", args->triangles, "triangles of the large object (0: none)");
          app.add_option("--large-kinds", args->kinds, "meshes of the large-object rows")
              ->check(CLI::IsMember(rubble::bench::kMegaKinds));
+         app.add_flag("--attributes", args->attributes,
+                      "the large objects with per-corner normals and texture coordinates");
          app.add_flag("--quick", args->quick, "200 pieces and a 20k-triangle object (CI smoke run)");
          app.add_option("--label", args->label, "names this run's rows in memory.csv (e.g. before, after)");
          app.add_option("--out", args->out, "folder for memory.csv and memory.png");
