@@ -13,6 +13,7 @@
 #include <utility>
 
 #include "geometry/ClosestPoint.hpp"
+#include "geometry/ShellScratch.hpp"
 #include "rubble/core/Log.hpp"
 #include "rubble/core/ParameterCheck.hpp"
 #include "rubble/core/Random.hpp"
@@ -533,6 +534,8 @@ Result<ObjectId> DestructionWorld::addObject(ObjectDesc desc) {
     }
     s.mesh = std::move(desc.mesh);
     s.meshHash = s.mesh.hash();
+    // the calling (main) thread checks meshes only when they are added: it keeps no large work arrays
+    detail::trimShellScratch(std::size_t{1} << 20);
     const ObjectId id = s.id;
     impl_->insertObject(std::move(state));
     if (facts)

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "TestSupport.hpp"
+#include "geometry/ShellScratch.hpp"
 #include "rubble/core/Log.hpp"
 #include "rubble/core/Random.hpp"
 #include "rubble/core/ThreadPool.hpp"
@@ -190,6 +191,19 @@ TEST(DestructionWorld, PiecesHoldNoSpareCapacity) {
         EXPECT_EQ(m.uvs.capacity(), m.uvs.size());
         EXPECT_EQ(m.materials.capacity(), m.materials.size());
     }
+}
+
+// The thread that adds a large object keeps no large work arrays of the mesh check (a fracture worker does).
+TEST(DestructionWorld, AddingALargeMeshLeavesNoLargeWorkArraysOnTheCallingThread) {
+    HeldJobs jobs;
+    DestructionWorld w(heldConfig(jobs));
+    ObjectDesc d;
+    d.mesh = makeSphere({0, 0, 0}, 1, 200, 100); // 40k triangles
+    d.convexParts = {ConvexPolytope::fromAabb(d.mesh.bounds())};
+    ASSERT_TRUE(analyzeMesh(d.mesh)); // as addObject does
+    ASSERT_GT(detail::shellScratchBytes(), std::size_t{1} << 20); // what the check keeps on its own
+    ASSERT_TRUE(w.addObject(std::move(d)));
+    EXPECT_LE(detail::shellScratchBytes(), std::size_t{1} << 20);
 }
 
 // Pieces below Config::minPieceVolume never become objects: the outcome reports them as dust, and pieces +
