@@ -125,12 +125,25 @@ FractureParams shatter() {
     return p;
 }
 
+// A runtime on Bullet with one fracture worker and no adoption budget.
+struct Rig {
+    static DestructionRuntime::Config config() {
+        DestructionRuntime::Config c;
+        c.world.workers = 1;
+        c.world.adoptionBudgetMs = 1e9;
+        return c;
+    }
+    PhysicsWorld physics;
+    BulletBinding binding{physics};
+    DestructionRuntime runtime{binding, config()};
+};
+
 // Debris pieces as the runtime adopts them: the facade shattered until `want` pieces are live.
 struct Templates {
     std::vector<ObjectDesc> descs;
     Split adopted; // the adopted pieces' containers
-    double heapPerPiece =
-        0; // heap growth over the fractures per live piece (remainders and records included)
+    // heap growth over the fractures per live piece (remainders and records included)
+    double heapPerPiece = 0;
 };
 
 Templates makeTemplates(std::size_t want) {
@@ -140,12 +153,9 @@ Templates makeTemplates(std::size_t want) {
         std::cerr << "memory: " << mesh.error().message << "\n";
         return t;
     }
-    PhysicsWorld physics;
-    BulletBinding binding(physics);
-    DestructionRuntime::Config rc;
-    rc.world.workers = 1;
-    rc.world.adoptionBudgetMs = 1e9;
-    DestructionRuntime runtime(binding, rc);
+    Rig rig;
+    DestructionRuntime& runtime = rig.runtime;
+    BulletBinding& binding = rig.binding;
     const double heap0 = heapInUseBytes();
     ObjectDesc desc;
     desc.mesh = std::move(*mesh);
@@ -207,32 +217,40 @@ double worldOnlyBytes(const std::vector<ObjectDesc>& descs, std::size_t n) {
     return heapInUseBytes() - heap0;
 }
 
+// Heap growth and its split while `add` runs on a fresh rig.
+template <class Add>
+bool measure(Row& row, Add&& add) {
+    Rig rig;
+    const auto t0 = std::chrono::steady_clock::now();
+    const double heap0 = heapInUseBytes(), rss0 = rubble::bench::residentMb();
+    if (!add(rig.runtime))
+        return false;
+    row.heapBytes = heapInUseBytes() - heap0;
+    row.residentMb = rubble::bench::residentMb() - rss0;
+    row.seconds = rubble::bench::msSince(t0) / 1000;
+    row.s = split(rig.runtime, rig.binding, false);
+    return true;
+}
+
 Row piecesRow(const Templates& t, int n) {
     Row row;
     row.name = "pieces_" + std::to_string(n);
     row.count = static_cast<std::size_t>(n);
     row.worldBytes = worldOnlyBytes(t.descs, row.count);
-    PhysicsWorld physics;
-    BulletBinding binding(physics);
-    DestructionRuntime::Config rc;
-    rc.world.workers = 1;
-    DestructionRuntime runtime(binding, rc);
     const int side = static_cast<int>(std::ceil(std::cbrt(static_cast<double>(n))));
-    const auto t0 = std::chrono::steady_clock::now();
-    const double heap0 = heapInUseBytes(), rss0 = rubble::bench::residentMb();
-    for (int i = 0; i < n; ++i) {
-        ObjectDesc d = t.descs[static_cast<std::size_t>(i) % t.descs.size()];
-        Frame placement;
-        placement.translation = Vec3{3.0 * (i % side), 3.0 * ((i / side) % side), 3.0 * (i / (side * side))};
-        if (!runtime.addObject(std::move(d), placement, false)) {
-            std::cerr << "memory: piece " << i << " was refused\n";
-            return row;
+    measure(row, [&](DestructionRuntime& runtime) {
+        for (int i = 0; i < n; ++i) {
+            ObjectDesc d = t.descs[static_cast<std::size_t>(i) % t.descs.size()];
+            Frame placement;
+            placement.translation =
+                Vec3{3.0 * (i % side), 3.0 * ((i / side) % side), 3.0 * (i / (side * side))};
+            if (!runtime.addObject(std::move(d), placement, false)) {
+                std::cerr << "memory: piece " << i << " was refused\n";
+                return false;
+            }
         }
-    }
-    row.heapBytes = heapInUseBytes() - heap0;
-    row.residentMb = rubble::bench::residentMb() - rss0;
-    row.seconds = rubble::bench::msSince(t0) / 1000;
-    row.s = split(runtime, binding, false);
+        return true;
+    });
     return row;
 }
 
@@ -262,24 +280,16 @@ Row largeRow(const std::string& kind, std::size_t triangles, bool attributes) {
         row.worldBytes = worldOnlyBytes({d}, 1);
         row.scratch = first - row.worldBytes;
     }
-    PhysicsWorld physics;
-    BulletBinding binding(physics);
-    DestructionRuntime::Config rc;
-    rc.world.workers = 1;
-    DestructionRuntime runtime(binding, rc);
-    const auto t0 = std::chrono::steady_clock::now();
-    const double heap0 = heapInUseBytes(), rss0 = rubble::bench::residentMb();
-    ObjectDesc d;
-    d.mesh = mesh; // the object's own copy is counted
-    d.fracture = shatter();
-    if (!runtime.addObject(std::move(d), Frame{}, true)) {
-        std::cerr << "memory: the large object was refused\n";
-        return row;
-    }
-    row.heapBytes = heapInUseBytes() - heap0;
-    row.residentMb = rubble::bench::residentMb() - rss0;
-    row.seconds = rubble::bench::msSince(t0) / 1000;
-    row.s = split(runtime, binding, false);
+    measure(row, [&](DestructionRuntime& runtime) {
+        ObjectDesc d;
+        d.mesh = mesh; // the object's own copy is counted
+        d.fracture = shatter();
+        if (!runtime.addObject(std::move(d), Frame{}, true)) {
+            std::cerr << "memory: the large object was refused\n";
+            return false;
+        }
+        return true;
+    });
     return row;
 }
 
@@ -287,29 +297,16 @@ std::vector<std::string> csvRow(const std::string& label, const Row& r, double o
     const double n = static_cast<double>(std::max<std::size_t>(1, r.count));
     const double pieces = static_cast<double>(std::max<std::size_t>(1, r.s.pieces));
     const Split& s = r.s;
-    return {label,
-            r.name,
-            std::to_string(r.count),
-            fixed(r.heapBytes / n, 1),
-            fixed(r.worldBytes / n, 1),
-            fixed(r.scratch / n, 1),
-            fixed(r.residentMb, 1),
-            fixed(s.meshTriangles / pieces, 1),
-            fixed(s.parts_ / pieces, 2),
-            fixed(s.hullPoints / pieces, 1),
-            fixed(s.positions / n, 1),
-            fixed(s.triangles / n, 1),
-            fixed(s.normals / n, 1),
-            fixed(s.uvs / n, 1),
-            fixed(s.materials / n, 1),
-            fixed(s.spare / n, 1),
-            fixed(s.parts / n, 1),
-            fixed(s.hulls / n, 1),
-            fixed(s.edges / n, 1),
-            fixed(s.bodies / n, 1),
-            fixed((r.heapBytes - s.accounted()) / n, 1),
-            fixed(r.seconds, 2),
-            fixed(otherCpu, 2)};
+    std::vector<std::string> row{label, r.name, std::to_string(r.count)};
+    for (double v : {r.heapBytes, r.worldBytes, r.scratch})
+        row.push_back(fixed(v / n, 1));
+    row.insert(row.end(), {fixed(r.residentMb, 1), fixed(s.meshTriangles / pieces, 1),
+                           fixed(s.parts_ / pieces, 2), fixed(s.hullPoints / pieces, 1)});
+    for (double v : {s.positions, s.triangles, s.normals, s.uvs, s.materials, s.spare, s.parts, s.hulls,
+                     s.edges, s.bodies, r.heapBytes - s.accounted()})
+        row.push_back(fixed(v / n, 1));
+    row.insert(row.end(), {fixed(r.seconds, 2), fixed(otherCpu, 2)});
+    return row;
 }
 
 int runBench(const BenchArgs& args) {

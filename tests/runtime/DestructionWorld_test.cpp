@@ -200,7 +200,7 @@ TEST(DestructionWorld, AddingALargeMeshLeavesNoLargeWorkArraysOnTheCallingThread
     ObjectDesc d;
     d.mesh = makeSphere({0, 0, 0}, 1, 200, 100); // 40k triangles
     d.convexParts = {ConvexPolytope::fromAabb(d.mesh.bounds())};
-    ASSERT_TRUE(analyzeMesh(d.mesh)); // as addObject does
+    ASSERT_TRUE(analyzeMesh(d.mesh));                             // as addObject does
     ASSERT_GT(detail::shellScratchBytes(), std::size_t{1} << 20); // what the check keeps on its own
     ASSERT_TRUE(w.addObject(std::move(d)));
     EXPECT_LE(detail::shellScratchBytes(), std::size_t{1} << 20);
