@@ -14,6 +14,7 @@
 // in memory.csv stay, so that a before and an after run share one file).
 #include <malloc.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -313,18 +314,21 @@ int runBench(const BenchArgs& args) {
     if (!rubble::bench::makeResultsDir(args.out))
         return 2;
     rubble::bench::CpuMeter cpu;
-    const Templates t = makeTemplates(args.quick ? 20 : 300);
-    if (t.descs.empty()) {
+    const bool pieceRows = std::any_of(args.pieces.begin(), args.pieces.end(), [](int n) { return n > 0; });
+    const Templates t = pieceRows ? makeTemplates(args.quick ? 20 : 300) : Templates{};
+    if (pieceRows && t.descs.empty()) {
         std::cerr << "memory: no debris pieces to measure\n";
         return 1;
     }
     std::vector<Row> rows;
-    Row adopted;
-    adopted.name = "adopted_" + std::to_string(t.adopted.pieces);
-    adopted.count = t.adopted.pieces;
-    adopted.heapBytes = t.heapPerPiece * static_cast<double>(t.adopted.pieces);
-    adopted.s = t.adopted;
-    rows.push_back(adopted);
+    if (pieceRows) {
+        Row adopted;
+        adopted.name = "adopted_" + std::to_string(t.adopted.pieces);
+        adopted.count = t.adopted.pieces;
+        adopted.heapBytes = t.heapPerPiece * static_cast<double>(t.adopted.pieces);
+        adopted.s = t.adopted;
+        rows.push_back(adopted);
+    }
     for (int n : args.pieces) {
         if (n == 0)
             continue;
@@ -397,8 +401,11 @@ int runBench(const BenchArgs& args) {
     std::ostringstream data;
     int x = 0;
     for (const auto& c : csv.rows)
-        if (c[1].rfind("pieces_", 0) == 0)
-            data << x++ << " \"" << c[0] << " " << c[1] << "\" " << c[3] << " " << c[4] << "\n";
+        if (c[1].rfind("pieces_", 0) == 0 || c[1].rfind("adopted_", 0) == 0) {
+            std::string name = c[0] + " " + c[1];
+            std::replace(name.begin(), name.end(), '_', ' '); // no subscripts in gnuplot's labels
+            data << x++ << " \"" << name << "\" " << c[3] << " " << c[4] << "\n";
+        }
     rubble::bench::plotPng(
         args.out, "memory", data.str(),
         "set style fill solid 0.6\nset boxwidth 0.6\nset ylabel 'heap bytes per piece'\n"
