@@ -6,6 +6,7 @@
 
 #include "geometry/OrientedShells.hpp"
 #include "geometry/RayParity.hpp"
+#include "geometry/ShellScratch.hpp"
 #include "rubble/geometry/MassProperties.hpp"
 
 namespace rubble {
@@ -98,11 +99,23 @@ private:
         return s;
     }
     ShellScratch& s_;
+    friend void detail::trimShellScratch(std::size_t);
+    friend std::size_t detail::shellScratchBytes();
 };
 
 } // namespace
 
 namespace detail {
+
+std::size_t shellScratchBytes() {
+    return ScratchLease::scratch().bytes();
+}
+
+void trimShellScratch(std::size_t keepBytes) {
+    ShellScratch& s = ScratchLease::scratch();
+    if (s.bytes() > keepBytes)
+        s = ShellScratch{};
+}
 
 std::int64_t closedOrientedShells(const Mesh& mesh, std::vector<std::uint32_t>* triangleShell) {
     const std::size_t nv = mesh.positions.size(), nt = mesh.triangles.size();

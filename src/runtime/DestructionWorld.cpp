@@ -13,6 +13,7 @@
 #include <utility>
 
 #include "geometry/ClosestPoint.hpp"
+#include "geometry/ShellScratch.hpp"
 #include "rubble/core/Log.hpp"
 #include "rubble/core/ParameterCheck.hpp"
 #include "rubble/core/Random.hpp"
@@ -149,6 +150,16 @@ bool keepsParentFrame(const Piece& piece, const Mesh& mesh) {
            piece.facts.topology.fits(mesh);
 }
 
+// Frees the spare capacity of a piece's arrays (the kernel grows them as it cuts).
+void shrinkToFit(Mesh& mesh) {
+    mesh.positions.shrink_to_fit();
+    mesh.triangles.shrink_to_fit();
+    mesh.normals.shrink_to_fit();
+    mesh.uvs.shrink_to_fit();
+    mesh.materials.shrink_to_fit();
+    mesh.materialNames.shrink_to_fit();
+}
+
 void runJob(Job& job) {
     const Mesh& mesh = job.object->mesh;
     for (PendingImpact& p : job.impacts)
@@ -240,6 +251,7 @@ void runJob(Job& job) {
             job.frames.push_back(Frame{});
             continue;
         }
+        shrinkToFit(meshes[i]);
         const MassProperties m = piece.cell < 0 ? computeMassProperties(meshes[i]) : piece.mass;
         Frame f{m.principalAxes, m.centerOfMass};
         const Mat3 rt = f.rotation.transposed();
@@ -591,6 +603,8 @@ Result<ObjectId> DestructionWorld::addObject(ObjectDesc desc) {
     }
     s.mesh = std::move(desc.mesh);
     s.meshHash = s.mesh.hash();
+    // the calling (main) thread checks meshes only when they are added: it keeps no large work arrays
+    detail::trimShellScratch(std::size_t{1} << 20);
     const ObjectId id = s.id;
     impl_->insertObject(std::move(state));
     if (facts)

@@ -2,6 +2,8 @@
 // of mass.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "rubble/bullet/CollisionShape.hpp"
 #include "rubble/bullet/Convert.hpp"
 #include "rubble/bullet/PhysicsWorld.hpp"
@@ -31,6 +33,44 @@ TEST(CollisionShape, ErodedHullPlusMarginMatchesThePart) {
     EXPECT_NEAR(hi.y() + m, 0.5, 1e-5);
     EXPECT_NEAR(hi.z() + m, 2.0, 1e-5);
     EXPECT_EQ(shape->edges().size(), 12u);
+}
+
+// The debug edges are the parts' polygon edges in body coordinates, each corner held once, and every hull
+// holds exactly its points.
+TEST(CollisionShape, EdgesShareTheirCornersAndHullsHoldTheirPoints) {
+    const ConvexPolytope part =
+        ConvexPolytope::fromAabb(Aabb{{0, 0, 0}, {2, 1, 4}})
+            .clipped(Plane{normalized(Vec3{1, 1, 1}), 3.5}); // a box with a corner cut
+    Frame objectToBody{Mat3::identity(), {1, 0.5, 2}};       // turned by 0.4 rad about z
+    objectToBody.rotation.m[0][0] = objectToBody.rotation.m[1][1] = std::cos(0.4);
+    objectToBody.rotation.m[1][0] = std::sin(0.4);
+    objectToBody.rotation.m[0][1] = -std::sin(0.4);
+    auto shape = CollisionShape::fromParts({part}, {}, objectToBody, 0.05);
+    ASSERT_TRUE(shape);
+    std::vector<std::array<Vec3, 2>>
+        expected; // each polygon edge once, from its lexicographically smaller end
+    auto less = [](const Vec3& a, const Vec3& b) {
+        return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z;
+    };
+    auto toBody = [&](const Vec3& p) {
+        return objectToBody.rotation.transposed() * (p - objectToBody.translation);
+    };
+    for (const PolytopeFace& f : part.faces())
+        for (std::size_t i = 0; i < f.corners.size(); ++i) {
+            const Vec3& a = f.corners[i];
+            const Vec3& c = f.corners[(i + 1) % f.corners.size()];
+            if (less(a, c))
+                expected.push_back({toBody(a), toBody(c)});
+        }
+    const std::size_t corners = part.vertices().size();
+    ASSERT_EQ(expected.size(), corners + part.faces().size() - 2); // Euler: E = V + F - 2
+    EXPECT_EQ(shape->edges(), expected);
+    EXPECT_EQ(shape->edgeCount(), expected.size());
+    const CollisionShape::Bytes bytes = shape->bytes();
+    EXPECT_EQ(bytes.edges, corners * sizeof(Vec3) + expected.size() * 2 * sizeof(std::uint32_t));
+    auto* hull = static_cast<btConvexHullShape*>(shape->shape());
+    EXPECT_EQ(bytes.points, static_cast<std::size_t>(hull->getNumPoints()));
+    EXPECT_EQ(bytes.points, corners); // the eroded hull keeps the part's combinatorics here
 }
 
 TEST(CollisionShape, SeveralPartsMakeACompound) {

@@ -13,6 +13,7 @@
 
 #include "TestSupport.hpp"
 #include "WorldSteps.hpp"
+#include "geometry/ShellScratch.hpp"
 #include "rubble/core/Log.hpp"
 #include "rubble/core/Random.hpp"
 #include "rubble/core/ThreadPool.hpp"
@@ -187,6 +188,47 @@ TEST(DestructionWorld, ImpactConservesVolumeAndMass) {
     }
     EXPECT_NEAR(v, v0, 1e-6 * v0);
     ASSERT_EQ(w.timings().size(), 1u);
+}
+
+// A piece holds no spare capacity in its mesh's arrays (the kernel grows them as it cuts).
+TEST(DestructionWorld, PiecesHoldNoSpareCapacity) {
+    HeldJobs jobs;
+    DestructionWorld w(heldConfig(jobs));
+    ObjectDesc d = boxDesc();
+    d.mesh.computeFlatNormals();
+    for (std::size_t c = 0; c < 3 * d.mesh.triangles.size(); ++c)
+        d.mesh.uvs.push_back({0.1 * static_cast<double>(c % 7), 0.2 * static_cast<double>(c % 5)});
+    d.fracture.pattern = CellPattern::Shatter;
+    d.fracture.cells = 8;
+    auto id = w.addObject(std::move(d)).value();
+    ASSERT_TRUE(w.submitImpact(id, centreHit()));
+    jobs.runAll();
+    w.beginFrame();
+    auto out = collectAndCommit(w);
+    ASSERT_EQ(out.size(), 1u);
+    ASSERT_GT(out[0].pieces.size(), 2u);
+    for (const ObjectId p : ids(out[0])) {
+        const Mesh& m = w.object(p)->mesh;
+        ASSERT_TRUE(m.hasNormals() && m.hasUvs());
+        EXPECT_EQ(m.positions.capacity(), m.positions.size());
+        EXPECT_EQ(m.triangles.capacity(), m.triangles.size());
+        EXPECT_EQ(m.normals.capacity(), m.normals.size());
+        EXPECT_EQ(m.uvs.capacity(), m.uvs.size());
+        EXPECT_EQ(m.materials.capacity(), m.materials.size());
+    }
+}
+
+// The thread that adds a large object keeps no large work arrays of the mesh check (a fracture worker does).
+TEST(DestructionWorld, AddingALargeMeshLeavesNoLargeWorkArraysOnTheCallingThread) {
+    HeldJobs jobs;
+    DestructionWorld w(heldConfig(jobs));
+    ObjectDesc d;
+    d.mesh = makeSphere({0, 0, 0}, 1, 200, 100); // 40k triangles
+    d.convexParts = {ConvexPolytope::fromAabb(d.mesh.bounds())};
+    ASSERT_TRUE(analyzeMesh(d.mesh));                             // as addObject does
+    ASSERT_GT(detail::shellScratchBytes(), std::size_t{1} << 20); // what the check keeps on its own
+    ASSERT_TRUE(w.addObject(std::move(d)));
+    EXPECT_LE(detail::shellScratchBytes(), std::size_t{1} << 20);
 }
 
 // Pieces below Config::minPieceVolume never become objects: the outcome reports them as dust, and pieces +

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include <BulletCollision/BroadphaseCollision/btDbvt.h>
 #include <BulletCollision/CollisionShapes/btShapeHull.h>
 
 #include "rubble/bullet/Convert.hpp"
@@ -43,6 +44,42 @@ int CollisionShape::childCount() const {
     return root_ && root_->getShapeType() == CONVEX_HULL_SHAPE_PROXYTYPE ? 1 : 0;
 }
 
+CollisionShape::Bytes CollisionShape::bytes() const {
+    Bytes b;
+    b.shapes = sizeof(CollisionShape) + children_.capacity() * sizeof(children_[0]);
+    if (compound_) {
+        b.shapes += sizeof(btCompoundShape) +
+                    static_cast<std::size_t>(compound_->getNumChildShapes()) * sizeof(btCompoundShapeChild);
+        if (const btDbvt* tree = compound_->getDynamicAabbTree())
+            b.shapes += sizeof(btDbvt) + (2 * static_cast<std::size_t>(tree->m_leaves)) * sizeof(btDbvtNode);
+    }
+    for (const auto& child : children_)
+        if (child->getShapeType() == CONVEX_HULL_SHAPE_PROXYTYPE) {
+            const int n = static_cast<const btConvexHullShape&>(*child).getNumPoints();
+            b.shapes += sizeof(btConvexHullShape) + static_cast<std::size_t>(n) * sizeof(btVector3);
+            b.points += static_cast<std::size_t>(n);
+        } else {
+            b.shapes += sizeof(btBoxShape);
+        }
+    b.edges = edgePoints_.capacity() * sizeof(Vec3) + edgeIndex_.capacity() * sizeof(edgeIndex_[0]);
+    return b;
+}
+
+std::vector<std::array<Vec3, 2>> CollisionShape::edges() const {
+    std::vector<std::array<Vec3, 2>> out;
+    out.reserve(edgeIndex_.size());
+    for (const auto& e : edgeIndex_)
+        out.push_back({edgePoints_[e[0]], edgePoints_[e[1]]});
+    return out;
+}
+
+void CollisionShape::addEdge(const Vec3& a, const Vec3& b) {
+    const auto i = static_cast<std::uint32_t>(edgePoints_.size());
+    edgePoints_.push_back(a);
+    edgePoints_.push_back(b);
+    edgeIndex_.push_back({i, i + 1});
+}
+
 std::unique_ptr<CollisionShape> CollisionShape::fromParts(const std::vector<ConvexPolytope>& parts,
                                                           const std::vector<Vec3>& fallbackPoints,
                                                           const Frame& objectToBody, double margin) {
@@ -68,19 +105,32 @@ std::unique_ptr<CollisionShape> CollisionShape::fromParts(const std::vector<Conv
         const std::vector<Vec3> verts = core.vertices();
         if (verts.size() < 4)
             continue;
-        auto hull = std::make_unique<btConvexHullShape>();
+        std::vector<btVector3> points; // copied once into a hull of exactly this size
+        points.reserve(verts.size());
         for (const Vec3& v : verts)
-            hull->addPoint(toBt(toBody(objectToBody, v)), false);
+            points.push_back(toBt(toBody(objectToBody, v)));
+        auto hull = std::make_unique<btConvexHullShape>(&points[0].x(), static_cast<int>(points.size()),
+                                                        static_cast<int>(sizeof(btVector3)));
         hull->setMargin(static_cast<btScalar>(std::max(m, 1e-4)));
         hull->recalcLocalAabb();
         s->compound_->addChildShape(identity, hull.get());
         s->children_.push_back(std::move(hull));
+        // each corner once, each edge as two indices
+        std::vector<Vec3> corners = part.vertices();
+        std::sort(corners.begin(), corners.end(), lexLess);
+        const auto base = static_cast<std::uint32_t>(s->edgePoints_.size());
+        for (const Vec3& c : corners)
+            s->edgePoints_.push_back(toBody(objectToBody, c));
+        auto index = [&](const Vec3& p) {
+            return base + static_cast<std::uint32_t>(
+                              std::lower_bound(corners.begin(), corners.end(), p, lexLess) - corners.begin());
+        };
         for (const PolytopeFace& f : part.faces())
             for (std::size_t i = 0; i < f.corners.size(); ++i) {
                 const Vec3& a = f.corners[i];
                 const Vec3& c = f.corners[(i + 1) % f.corners.size()];
                 if (lexLess(a, c))
-                    s->edges_.push_back({toBody(objectToBody, a), toBody(objectToBody, c)});
+                    s->edgeIndex_.push_back({index(a), index(c)});
             }
     }
     if (s->children_.empty()) {
@@ -106,11 +156,13 @@ std::unique_ptr<CollisionShape> CollisionShape::fromParts(const std::vector<Conv
             for (int e = 0; e < 3; ++e) {
                 const btVector3& a = reducer.getVertexPointer()[idx[t + e]];
                 const btVector3& c = reducer.getVertexPointer()[idx[t + (e + 1) % 3]];
-                s->edges_.push_back({fromBt(a), fromBt(c)});
+                s->addEdge(fromBt(a), fromBt(c));
             }
         s->compound_->addChildShape(identity, hull.get());
         s->children_.push_back(std::move(hull));
     }
+    s->edgePoints_.shrink_to_fit();
+    s->edgeIndex_.shrink_to_fit();
     s->root_ = s->compound_.get();
     if (s->children_.size() == 1) { // one hull collides without the compound's per-pair bookkeeping
         s->compound_.reset();
@@ -139,7 +191,7 @@ std::unique_ptr<CollisionShape> CollisionShape::box(const Vec3& halfExtents) {
                 lo = {u * h.x, v * h.y, -h.z};
                 hi = {u * h.x, v * h.y, h.z};
             }
-            s->edges_.push_back({lo, hi});
+            s->addEdge(lo, hi);
         }
     return s;
 }
@@ -159,7 +211,7 @@ std::unique_ptr<CollisionShape> CollisionShape::sphere(double radius) {
                 p[(axis + 2) % 3] = radius * std::sin(a);
                 return p;
             };
-            s->edges_.push_back({pt(a0), pt(a1)});
+            s->addEdge(pt(a0), pt(a1));
         }
     return s;
 }

@@ -4,6 +4,7 @@
 /// edges of its parts kept for debug drawing.
 
 #include <array>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -40,14 +41,27 @@ public:
     /// Number of convex hulls (0 for a plain box or sphere).
     int childCount() const;
     /// Edges of the parts in body coordinates (for debug drawing).
-    const std::vector<std::array<Vec3, 2>>& edges() const { return edges_; }
+    std::vector<std::array<Vec3, 2>> edges() const;
+    /// Number of edges.
+    std::size_t edgeCount() const { return edgeIndex_.size(); }
+
+    /// Heap bytes held: the Bullet shapes (hull points included), the debug edges, and the hull points.
+    struct Bytes {
+        std::size_t shapes = 0; ///< Bullet shapes, their point arrays and the compound's tree
+        std::size_t edges = 0;  ///< the debug edges
+        std::size_t points = 0; ///< hull points (a count, not bytes)
+    };
+    /// What this shape holds on the heap.
+    Bytes bytes() const;
 
 private:
     CollisionShape() = default;
     btCollisionShape* root_ = nullptr;
     std::unique_ptr<btCompoundShape> compound_;
     std::vector<std::unique_ptr<btCollisionShape>> children_;
-    std::vector<std::array<Vec3, 2>> edges_;
+    void addEdge(const Vec3& a, const Vec3& b);
+    std::vector<Vec3> edgePoints_; // corners of the edges (a part's shared by its edges)
+    std::vector<std::array<std::uint32_t, 2>> edgeIndex_; // edges as pairs of edgePoints_
 };
 
 } // namespace rubble::bullet
