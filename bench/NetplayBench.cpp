@@ -1,6 +1,6 @@
 // `rubble-bench netplay SCENE.cfg [--seconds T] [--clients N] [--shots-per-second R] [--workers W] [--seed S]
 //  [--late-join F] [--delay-ms D] [--jitter-ms J] [--loss L] [--burst B] [--partition-at A --partition-s P]
-//  [--placement-budget BYTES] [--json] [--out DIR]`
+//  [--placement-budget BYTES] [--placement-peak BYTES] [--placement-reserve BYTES] [--json] [--out DIR]`
 //
 // Multiplayer as separate processes over a network that misbehaves: this process hosts the scene on the
 // Bullet binding in deterministic mode (fixed 1/60 s frames paced at 60 Hz, seeded projectiles at
@@ -79,7 +79,7 @@ struct Args {
     bool json = false;
     double delayMs = 0, jitterMs = 0, loss = 0, burst = 1;
     double partitionAt = -1, partitionS = 0;
-    int budget = 1200;
+    rubble::net::PlacementBudget budget;
     std::string out;     // folder for netplay.csv and netplay.png ("" = none)
     int port = 0;        // client: the host's port
     std::string samples; // client: where it writes its placement samples
@@ -98,6 +98,7 @@ struct Sample {
     std::uint32_t frame, object;
     float x, y, z;
     std::uint32_t lag; // kViewLag or kSafeViewLag
+    float newest;      // the frame of the latest placement the client has of it
 };
 
 double percentile(std::vector<double> v, double q) {
@@ -257,7 +258,7 @@ int runHost(const Args& a) {
     }
     net::NetHost& host = **server;
     host.setPlacementSource([&] { return runtime.placements(); });
-    host.setPlacementBudget(static_cast<std::size_t>(a.budget));
+    host.setPlacementBudget(a.budget);
     const std::string tmp =
         (std::filesystem::temp_directory_path() / ("rubble-netplay-" + std::to_string(getpid()) + "-"))
             .string();
@@ -390,13 +391,17 @@ int runHost(const Args& a) {
         }
         // Placement error against the host, for bodies dynamic at the sampled frame.
         std::map<std::uint32_t, std::vector<double>> errorsAt; // lag → errors
+        nlohmann::json worst = nlohmann::json::array();        // samples off by more than 50 cm
         long long missing = 0;
         {
             const std::string path = tmp + std::to_string(c);
             std::ifstream in(path, std::ios::binary);
             std::map<std::uint32_t, std::map<std::uint64_t, std::map<ObjectId, Vec3>>> seen;
-            for (Sample smp{}; in.read(reinterpret_cast<char*>(&smp), sizeof smp);)
+            std::map<std::pair<std::uint64_t, ObjectId>, float> newest;
+            for (Sample smp{}; in.read(reinterpret_cast<char*>(&smp), sizeof smp);) {
                 seen[smp.lag][smp.frame][smp.object] = Vec3{smp.x, smp.y, smp.z};
+                newest[{smp.frame, smp.object}] = smp.newest;
+            }
             std::filesystem::remove(path);
             for (const auto& [lag, sampled] : seen)
                 for (const auto& [fr, bodies] : sampled) {
@@ -410,6 +415,12 @@ int runHost(const Args& a) {
                             continue;
                         }
                         errorsAt[lag].push_back(length(v->second - at) * 100);
+                        if (errorsAt[lag].back() > 50)
+                            worst.push_back({{"cm", errorsAt[lag].back()},
+                                             {"object", id},
+                                             {"frame", fr},
+                                             {"lag", lag},
+                                             {"newest", newest[{fr, id}]}});
                     }
                 }
         }
@@ -440,6 +451,7 @@ int runHost(const Args& a) {
                                    {"p99", percentile(errors, 0.99)},
                                    {"samples", errors.size()},
                                    {"missing", missing}};
+        j["placement_errors_over_50cm"] = worst;
         j["placement_error_cm_lag12"] = {{"p50", percentile(errorsAt[kSafeViewLag], 0.5)},
                                          {"p99", percentile(errorsAt[kSafeViewLag], 0.99)}};
         j["link"] = {{"down_lost", relays[c]->down().lost},
@@ -457,7 +469,11 @@ int runHost(const Args& a) {
     r["seconds"] = runSeconds;
     r["link"] = {{"delay_ms", a.delayMs}, {"jitter_ms", a.jitterMs},       {"loss", a.loss},
                  {"burst", a.burst},      {"partition_at", a.partitionAt}, {"partition_s", a.partitionS}};
-    r["placement_budget"] = a.budget;
+    r["placement_budget"] = {{"mean", a.budget.mean}, {"peak", a.budget.peak}, {"reserve", a.budget.reserve}};
+    r["placements_deferred_per_publish"] =
+        static_cast<double>(hs.placementsDeferred) / perClient / (runSeconds * 10);
+    r["placement_publishes_full_share"] =
+        static_cast<double>(hs.placementPublishesFull) / perClient / (runSeconds * 10);
     r["impacts"] = runtime.counters().impacts;
     r["fractures"] = runtime.counters().fractures;
     r["geometry_bytes_per_impact"] = impacts > 0 ? perClientEventBytes / impacts : 0;
@@ -607,6 +623,7 @@ int runClient(const Args& a) {
     std::string ending = "time limit";
     bool hostStopped = false;
     std::uint64_t lastFrame = 0;
+    std::vector<double> behind; // at each sample: newest placement frame received − the world's frame
     for (const auto t0 = Clock::now(); Clock::now() - t0 < std::chrono::duration<double>(a.seconds);) {
         if (Status s = (*client)->service(5); !s) {
             ending = s.message();
@@ -620,6 +637,11 @@ int runClient(const Args& a) {
                 (frame - static_cast<std::uint64_t>(lag)) % kSampleEvery != 0)
                 continue;
             const double view = static_cast<double>(frame - static_cast<std::uint64_t>(lag));
+            double newest = static_cast<double>(frame);
+            for (ObjectId id : world.objects())
+                newest = std::max(newest, (*client)->placementFrame(id).value_or(0));
+            if (lag == kViewLag)
+                behind.push_back(newest - static_cast<double>(frame));
             for (ObjectId id : world.objects()) {
                 const std::optional<double> latest = (*client)->placementFrame(id);
                 if (!latest || *latest < view - 120)
@@ -627,7 +649,8 @@ int runClient(const Args& a) {
                 const Frame at = *(*client)->placement(id, view);
                 const Sample smp{static_cast<std::uint32_t>(view),     id,
                                  static_cast<float>(at.translation.x), static_cast<float>(at.translation.y),
-                                 static_cast<float>(at.translation.z), static_cast<std::uint32_t>(lag)};
+                                 static_cast<float>(at.translation.z), static_cast<std::uint32_t>(lag),
+                                 static_cast<float>(*latest)};
                 samples.write(reinterpret_cast<const char*>(&smp), sizeof smp);
             }
         }
@@ -660,6 +683,8 @@ int runClient(const Args& a) {
                      {"placements", st.placements},
                      {"placement_bytes", st.placementBytes},
                      {"shots_sent", shotsSent},
+                     {"sync_behind_placements_frames",
+                      {{"p50", percentile(behind, 0.5)}, {"p99", percentile(behind, 0.99)}}},
                      {"ending", ending},
                      {"replay", replay}};
     std::cout << j.dump() << "\n";
@@ -694,8 +719,13 @@ const rubble::tools::Registrar host{
          app.add_option("--partition-at", a->partitionAt, "seconds into the run when every link goes dead");
          app.add_option("--partition-s", a->partitionS, "how long the links stay dead")
              ->check(CLI::Range(0.0, 60.0));
-         app.add_option("--placement-budget", a->budget, "placement bytes per client per 10 Hz publish")
+         app.add_option("--placement-budget", a->budget.mean,
+                        "placement bytes per client per 10 Hz publish, mean")
              ->check(CLI::Range(100, 1000000));
+         app.add_option("--placement-peak", a->budget.peak, "placement bytes per client in one publish")
+             ->check(CLI::Range(100, 1000000));
+         app.add_option("--placement-reserve", a->budget.reserve, "placement bytes a client may save up")
+             ->check(CLI::Range(100, 10000000));
          app.add_option("--out", a->out, "folder: add a row to netplay.csv, draw netplay.png");
          app.add_flag("--no-base", a->noBase,
                       "clients do not load the scene first: the snapshot brings every object");

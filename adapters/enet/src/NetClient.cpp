@@ -20,8 +20,9 @@ namespace rubble::net {
 using detail::Message;
 using Clock = std::chrono::steady_clock;
 
-/// Placements kept per body: enough to show it two placement periods behind with one datagram lost.
-constexpr std::size_t kTrackPoints = 4;
+/// Host frames of placements kept per body: a client whose world lags the placements it receives (it is still
+/// cutting pieces) can show any frame of the last two seconds between two placements.
+constexpr double kTrackFrames = 120;
 
 struct NetClient::Impl {
     Impl(DestructionWorld& w, const DestructionWorld::Config& c) : world(w), config(c), player(w) {
@@ -35,18 +36,18 @@ struct NetClient::Impl {
     Clock::time_point connected;
     Clock::time_point heard; // when the host was last heard
     ClientStats stats;
-    /// The latest placements of a body, by host frame (ascending, at most kTrackPoints).
+    /// The latest placements of a body, by host frame (ascending, within kTrackFrames of the newest).
     struct Track {
         std::vector<std::pair<double, Frame>> points;
         void add(double frame, const Frame& f) {
+            if (!points.empty() && frame < points.back().first - kTrackFrames)
+                return; // older than all it keeps
             auto at = std::lower_bound(points.begin(), points.end(), frame,
                                        [](const auto& p, double x) { return p.first < x; });
             if (at != points.end() && at->first == frame)
                 return; // a duplicate
-            if (at == points.begin() && points.size() >= kTrackPoints)
-                return; // older than all it keeps
             points.insert(at, {frame, f});
-            if (points.size() > kTrackPoints)
+            while (points.size() > 2 && points.front().first < points.back().first - kTrackFrames)
                 points.erase(points.begin());
         }
     };

@@ -32,7 +32,8 @@ struct NetHost::Impl {
     HostStats stats;
     std::function<std::vector<ObjectPlacement>()> placementSource;
     std::map<ENetPeer*, detail::PlacementEncoder> encoders; // per client: its baselines and priorities
-    std::size_t placementBudget = 1200;                     // bytes per client per publishPlacements
+    PlacementBudget placementBudget;
+    std::map<ENetPeer*, detail::PlacementAllowance> allowances; // per client: its saved placement bytes
 
     std::map<ENetPeer*, std::chrono::steady_clock::time_point> heard; // when each client was last heard
     std::map<ENetPeer*, std::uint64_t> joinOrder;                     // 0 for the first to join
@@ -298,18 +299,27 @@ void NetHost::publishPlacements(const std::vector<ObjectPlacement>& placements) 
     for (auto& [peer, position] : im.peers) {
         if (!im.acked.count(peer))
             continue; // still loading its snapshot: nothing to compare against yet
-        for (const std::vector<std::uint8_t>& msg :
-             im.encoders[peer].encode(im.world.frame(), now, im.placementBudget)) {
+        detail::PlacementEncoder& encoder = im.encoders[peer];
+        const PlacementBudget& b = im.placementBudget;
+        detail::PlacementAllowance& allowance =
+            im.allowances.try_emplace(peer, b.mean, b.peak, b.reserve).first->second;
+        std::size_t spent = 0;
+        for (const std::vector<std::uint8_t>& msg : encoder.encode(im.world.frame(), now, allowance.next())) {
             detail::sendUnreliable(peer, msg);
-            im.stats.placementBytes += static_cast<long long>(msg.size());
+            spent += msg.size();
         }
+        allowance.spent(spent);
+        im.stats.placementBytes += static_cast<long long>(spent);
+        im.stats.placementsDeferred += static_cast<long long>(encoder.deferred());
+        im.stats.placementPublishesFull += encoder.deferred() > 0;
         im.stats.legacyPlacementBytes += legacy;
     }
     enet_host_flush(im.host);
 }
 
-void NetHost::setPlacementBudget(std::size_t bytes) {
-    impl_->placementBudget = bytes;
+void NetHost::setPlacementBudget(const PlacementBudget& budget) {
+    impl_->placementBudget = budget;
+    impl_->allowances.clear();
 }
 
 bool NetHost::finish(int timeoutMs) {
@@ -367,6 +377,7 @@ void NetHost::service(int timeoutMs) {
             im.peers.erase(e.peer);
             im.acked.erase(e.peer);
             im.encoders.erase(e.peer);
+            im.allowances.erase(e.peer);
             im.heard.erase(e.peer);
             im.joinOrder.erase(e.peer);
             im.transfers.erase(e.peer);
