@@ -65,7 +65,7 @@ struct NetHost::Impl {
         for (auto it = transfers.begin();
              it != transfers.end();) { // a client that never has it all is dropped
             if (now - it->second.started > std::chrono::seconds(30)) {
-                enet_peer_disconnect(it->first, 0);
+                enet_peer_disconnect(it->first, detail::kGoodbye);
                 it = transfers.erase(it);
             } else {
                 ++it;
@@ -157,7 +157,7 @@ struct NetHost::Impl {
         const std::vector<std::uint8_t> msg =
             detail::encodeJoinSnapshot(takeSnapshot(world, std::move(placements)), known, &size);
         if (msg.empty()) {
-            enet_peer_disconnect(peer, 0);
+            enet_peer_disconnect(peer, detail::kGoodbye);
             return;
         }
         Transfer& t = transfers[peer];
@@ -218,7 +218,7 @@ NetHost::~NetHost() {
     impl_->world.setJournalSink({});
     if (impl_->host) {
         for (auto& [peer, position] : impl_->peers)
-            enet_peer_disconnect_now(peer, 0);
+            enet_peer_disconnect_now(peer, detail::kGoodbye);
         enet_host_destroy(impl_->host);
     }
 }
@@ -341,7 +341,7 @@ bool NetHost::close(int timeoutMs) {
     im.closing = true;
     for (ENetPeer* peer = im.host->peers; peer < im.host->peers + im.host->peerCount; ++peer)
         if (peer->state != ENET_PEER_STATE_DISCONNECTED)
-            enet_peer_disconnect(peer, 0);
+            enet_peer_disconnect(peer, detail::kGoodbye);
     const auto connected = [&im] {
         for (ENetPeer* peer = im.host->peers; peer < im.host->peers + im.host->peerCount; ++peer)
             if (peer->state != ENET_PEER_STATE_DISCONNECTED)
@@ -367,7 +367,7 @@ void NetHost::service(int timeoutMs) {
         case ENET_EVENT_TYPE_CONNECT: // it joins with its Hello
             detail::configurePeer(e.peer);
             if (im.closing)
-                enet_peer_disconnect(e.peer, 0);
+                enet_peer_disconnect(e.peer, detail::kGoodbye);
             break;
         case ENET_EVENT_TYPE_RECEIVE:
             im.receive(e.peer, e.packet);

@@ -61,6 +61,9 @@ public:
     Status writeReplay(const std::filesystem::path& snapshot, const std::filesystem::path& journal) const;
     /// Host frame of the latest placement received for an object (empty when none arrived).
     std::optional<double> placementFrame(ObjectId object) const;
+    /// How long the host may be silent before service() fails with an IoError saying it stopped answering
+    /// (default 10 s: a partition shorter than that is survived, a host killed without closing is noticed).
+    void setTimeout(int ms);
     /// Called for every outcome the world adopts (its pieces are in the world already).
     void setOnOutcome(std::function<void(const FractureOutcome&)> callback);
     /// Totals.
