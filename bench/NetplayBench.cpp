@@ -296,6 +296,7 @@ int runHost(const Args& a) {
     const auto partitionEnd = start + std::chrono::duration_cast<Clock::duration>(
                                           std::chrono::duration<double>(a.partitionAt + a.partitionS));
     double convergeMs = -1;
+    long long partitioned = -1; // clients joined when the partition ended
     long shots = 0, f = 0;
     std::vector<net::ShotRequest> requested; // clients' shots that passed the host's checks
     host.setShotHandler([&](const net::ShotRequest& r) { requested.push_back(r); });
@@ -335,7 +336,10 @@ int runHost(const Args& a) {
             }
         }
         if (a.partitionS > 0 && convergeMs < 0 && Clock::now() >= partitionEnd) {
-            const std::vector<std::uint64_t> confirmed = host.confirmedFrames();
+            if (partitioned < 0) // the clients that lived through it (a later joiner has nothing to recover)
+                partitioned = host.stats().joins;
+            std::vector<std::uint64_t> confirmed = host.confirmedFrames(); // in join order
+            confirmed.resize(std::min<std::size_t>(confirmed.size(), static_cast<std::size_t>(partitioned)));
             if (!confirmed.empty() && *std::min_element(confirmed.begin(), confirmed.end()) + 12 >= now)
                 convergeMs = std::chrono::duration<double, std::milli>(Clock::now() - partitionEnd).count();
         }
@@ -452,6 +456,16 @@ int runHost(const Args& a) {
                                    {"samples", errors.size()},
                                    {"missing", missing}};
         j["placement_errors_over_50cm"] = worst;
+        if (a.partitionS > 0 && report.is_object() && report.contains("outage")) {
+            const double end = std::chrono::duration<double>(partitionEnd.time_since_epoch()).count();
+            const nlohmann::json& o = report["outage"];
+            const auto after = [&](const char* k) {
+                return o.value(k, -1.0) < 0 ? -1.0 : (o.value(k, -1.0) - end) * 1000;
+            };
+            j["outage"] = {{"heard_again_ms", after("heard_again_s")},
+                           {"caught_up_ms", after("caught_up_s")},
+                           {"service_ms", o.value("service_ms", 0.0)}};
+        }
         j["placement_error_cm_lag12"] = {{"p50", percentile(errorsAt[kSafeViewLag], 0.5)},
                                          {"p99", percentile(errorsAt[kSafeViewLag], 0.99)}};
         j["link"] = {{"down_lost", relays[c]->down().lost},
@@ -492,6 +506,7 @@ int runHost(const Args& a) {
     r["snapshot_objects_by_reference"] = hs.snapshotObjectsByReference / std::max<long long>(1, hs.joins);
     r["clients_load_scene"] = !a.noBase;
     r["snapshot_build_ms"] = hs.snapshotBuildMs / static_cast<double>(std::max<long long>(1, hs.joins));
+    r["snapshot_transfer_ms"] = hs.snapshotTransferMs / static_cast<double>(std::max<long long>(1, hs.joins));
     r["final_hashes_equal"] = allConverged;
     r["converge_ms"] = convergeMs;
     r["kbps_mean"] = means.empty() ? 0 : *std::max_element(means.begin(), means.end());
@@ -624,11 +639,39 @@ int runClient(const Args& a) {
     bool hostStopped = false;
     std::uint64_t lastFrame = 0;
     std::vector<double> behind; // at each sample: newest placement frame received − the world's frame
+    // After an outage (nothing heard for 1 s): when the host was heard again, when the world caught up with
+    // the placements received (within 12 frames), and the time spent in service() in between.
+    Clock::time_point quietSince = Clock::now(), heardAgain{}, caughtUp{};
+    long long lastHeard = 0;
+    double busyMs = 0;
+    const auto monotonic = [](Clock::time_point t) { // monotonic seconds, comparable across processes
+        return t.time_since_epoch().count() == 0
+                   ? -1.0
+                   : std::chrono::duration<double>(t.time_since_epoch()).count();
+    };
     for (const auto t0 = Clock::now(); Clock::now() - t0 < std::chrono::duration<double>(a.seconds);) {
+        const auto serviced = Clock::now();
         if (Status s = (*client)->service(5); !s) {
             ending = s.message();
             hostStopped = s.error().code == ErrorCode::IoError;
             break;
+        }
+        const auto now = Clock::now();
+        const long long heard = (*client)->stats().placements + (*client)->stats().syncs;
+        if (heard != lastHeard) {
+            if (heardAgain.time_since_epoch().count() == 0 && (*client)->stats().joined &&
+                now - quietSince > std::chrono::seconds(1))
+                heardAgain = now;
+            quietSince = now;
+            lastHeard = heard;
+        }
+        if (heardAgain.time_since_epoch().count() != 0 && caughtUp.time_since_epoch().count() == 0) {
+            busyMs += std::chrono::duration<double, std::milli>(now - serviced).count();
+            double newest = 0;
+            for (ObjectId id : world.objects())
+                newest = std::max(newest, (*client)->placementFrame(id).value_or(0));
+            if (static_cast<double>((*client)->stats().frame) + 12 >= newest)
+                caughtUp = now;
         }
         // What it would show now: one placement period behind its latest sync, every half second.
         const std::uint64_t frame = (*client)->stats().frame;
@@ -683,6 +726,10 @@ int runClient(const Args& a) {
                      {"placements", st.placements},
                      {"placement_bytes", st.placementBytes},
                      {"shots_sent", shotsSent},
+                     {"outage",
+                      {{"heard_again_s", monotonic(heardAgain)},
+                       {"caught_up_s", monotonic(caughtUp)},
+                       {"service_ms", busyMs}}},
                      {"sync_behind_placements_frames",
                       {{"p50", percentile(behind, 0.5)}, {"p99", percentile(behind, 0.99)}}},
                      {"ending", ending},

@@ -119,6 +119,9 @@ struct NetHost::Impl {
         if (!all)
             return;
         const std::uint64_t frame = t->second.frame;
+        stats.snapshotTransferMs +=
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t->second.started)
+                .count();
         transfers.erase(t);
         if (lastSync >= frame && hashes.count(lastSync)) // the latest sync, which it was not sent
             sendSync(peer, lastSync, lastSyncPosition, hashes[lastSync]);

@@ -27,9 +27,11 @@ struct HostStats {
     long long snapshotRawBytes = 0;           ///< what they inflate to (the objects the clients did not have)
     long long snapshotObjectsByReference = 0; ///< objects sent by id: the client had them in that state
     double snapshotBuildMs = 0;               ///< time spent taking, encoding and deflating snapshots (ms)
-    long long syncs = 0;                      ///< frame syncs sent (per client)
-    long long impactEvents = 0;               ///< of eventsSent: impacts (the rest are removals)
-    long long placementBytes = 0;             ///< bytes of placement messages sent (per client, payload)
+    double snapshotTransferMs =
+        0;               ///< time from sending snapshots' first chunks to their last acknowledgement (ms)
+    long long syncs = 0; ///< frame syncs sent (per client)
+    long long impactEvents = 0;   ///< of eventsSent: impacts (the rest are removals)
+    long long placementBytes = 0; ///< bytes of placement messages sent (per client, payload)
     long long legacyPlacementBytes =
         0; ///< what the 32-byte float records of every dynamic body would have been
     long long placementsDeferred = 0; ///< changed bodies left for a later publish by the budget (per client)
