@@ -659,7 +659,7 @@ int runClient(const Args& a) {
         const auto now = Clock::now();
         const long long heard = (*client)->stats().placements + (*client)->stats().syncs;
         if (heard != lastHeard) {
-            if (heardAgain.time_since_epoch().count() == 0 && (*client)->stats().joined &&
+            if (heardAgain.time_since_epoch().count() == 0 && lastHeard != 0 &&
                 now - quietSince > std::chrono::seconds(1))
                 heardAgain = now;
             quietSince = now;

@@ -34,11 +34,12 @@ inline constexpr std::uint64_t kInFlightEncodes = 5;
 inline constexpr std::size_t kMaxPlacementDatagram = 1200;
 
 /// A client's allowance of placement bytes per publish: `mean` on average, at most `peak` at once; what quiet
-/// publishes leave unspent is saved, up to `reserve`, for when many bodies move.
+/// publishes leave unspent is saved, up to `reserve`, for when many bodies move. It starts full: a client
+/// that just joined has every body that moved during its snapshot's transfer to catch up on.
 class PlacementAllowance {
 public:
     PlacementAllowance(std::size_t mean, std::size_t peak, std::size_t reserve)
-        : mean_(mean), peak_(std::max(peak, mean)), reserve_(std::max(reserve, mean)) {}
+        : mean_(mean), peak_(std::max(peak, mean)), reserve_(std::max(reserve, mean)), credit_(reserve_) {}
     /// Bytes the next publish may spend (its share added to the credit first).
     std::size_t next() {
         credit_ = std::min(credit_ + mean_, reserve_);
@@ -49,7 +50,7 @@ public:
 
 private:
     std::size_t mean_, peak_, reserve_;
-    std::size_t credit_ = 0;
+    std::size_t credit_;
 };
 
 /// The host's side for one client: what it acknowledged, what is in flight, and each body's priority.
