@@ -20,9 +20,11 @@
 // placement one placement period behind its latest sync against the host's at that frame, every half second,
 // for bodies that were dynamic then: cm, p50 and p99); in all: geometry_bytes_per_impact (journal event
 // messages sent to one client / impacts), the placement bytes against the previous protocol's (32-byte
-// float records of every dynamic body, every time) in the same run, converge_ms (partition end → every client
-// confirmed a frame at most 12 frames behind the host), late_join_ms, snapshot_bytes. With --out, one row is
-// added to DIR/netplay.csv and DIR/netplay.png is drawn again.
+// float records of every dynamic body, every time) in the same run, converge_ms (partition end → the last of
+// the clients it cut off to have confirmed a frame at most 12 frames behind the host; each client's first
+// such moment counts, since with loss some client's reliable acks are usually held up behind a lost one, and
+// all at once may take long), late_join_ms, snapshot_bytes. With --out, one row is added to DIR/netplay.csv
+// and DIR/netplay.png is drawn again.
 //
 // With --client-shots R each client asks the host for R shots a second at objects it sees; the host checks
 // them (NetHost::setShotHandler) and fires those it accepts. With --shots-per-second 0 as well, the host is a
@@ -296,7 +298,8 @@ int runHost(const Args& a) {
     const auto partitionEnd = start + std::chrono::duration_cast<Clock::duration>(
                                           std::chrono::duration<double>(a.partitionAt + a.partitionS));
     double convergeMs = -1;
-    long long partitioned = -1; // clients joined when the partition ended
+    long long partitioned = -1;    // clients joined when the partition ended
+    std::vector<double> recovered; // per one of those: ms after the partition until it was within 12 frames
     long shots = 0, f = 0;
     std::vector<net::ShotRequest> requested; // clients' shots that passed the host's checks
     host.setShotHandler([&](const net::ShotRequest& r) { requested.push_back(r); });
@@ -338,10 +341,15 @@ int runHost(const Args& a) {
         if (a.partitionS > 0 && convergeMs < 0 && Clock::now() >= partitionEnd) {
             if (partitioned < 0) // the clients that lived through it (a later joiner has nothing to recover)
                 partitioned = host.stats().joins;
-            std::vector<std::uint64_t> confirmed = host.confirmedFrames(); // in join order
-            confirmed.resize(std::min<std::size_t>(confirmed.size(), static_cast<std::size_t>(partitioned)));
-            if (!confirmed.empty() && *std::min_element(confirmed.begin(), confirmed.end()) + 12 >= now)
-                convergeMs = std::chrono::duration<double, std::milli>(Clock::now() - partitionEnd).count();
+            const std::vector<std::uint64_t> confirmed = host.confirmedFrames(); // in join order
+            const auto n = std::min<std::size_t>(confirmed.size(), static_cast<std::size_t>(partitioned));
+            recovered.resize(n, -1);
+            const double ms = std::chrono::duration<double, std::milli>(Clock::now() - partitionEnd).count();
+            for (std::size_t i = 0; i < n; ++i) // the first time each one confirmed a frame within 12 of now
+                if (recovered[i] < 0 && confirmed[i] + 12 >= now)
+                    recovered[i] = ms;
+            if (n > 0 && std::all_of(recovered.begin(), recovered.end(), [](double r) { return r >= 0; }))
+                convergeMs = *std::max_element(recovered.begin(), recovered.end());
         }
         ++f;
     };
