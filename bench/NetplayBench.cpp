@@ -1,6 +1,6 @@
 // `rubble-bench netplay SCENE.cfg [--seconds T] [--clients N] [--shots-per-second R] [--workers W] [--seed S]
 //  [--late-join F] [--delay-ms D] [--jitter-ms J] [--loss L] [--burst B] [--partition-at A --partition-s P]
-//  [--placement-budget BYTES] [--json] [--out DIR]`
+//  [--placement-budget BYTES] [--placement-peak BYTES] [--placement-reserve BYTES] [--json] [--out DIR]`
 //
 // Multiplayer as separate processes over a network that misbehaves: this process hosts the scene on the
 // Bullet binding in deterministic mode (fixed 1/60 s frames paced at 60 Hz, seeded projectiles at
@@ -20,9 +20,11 @@
 // placement one placement period behind its latest sync against the host's at that frame, every half second,
 // for bodies that were dynamic then: cm, p50 and p99); in all: geometry_bytes_per_impact (journal event
 // messages sent to one client / impacts), the placement bytes against the previous protocol's (32-byte
-// float records of every dynamic body, every time) in the same run, converge_ms (partition end → every client
-// confirmed a frame at most 12 frames behind the host), late_join_ms, snapshot_bytes. With --out, one row is
-// added to DIR/netplay.csv and DIR/netplay.png is drawn again.
+// float records of every dynamic body, every time) in the same run, converge_ms (partition end → the last of
+// the clients it cut off to have confirmed a frame at most 12 frames behind the host; each client's first
+// such moment counts, since with loss some client's reliable acks are usually held up behind a lost one, and
+// all at once may take long), late_join_ms, snapshot_bytes. With --out, one row is added to DIR/netplay.csv
+// and DIR/netplay.png is drawn again.
 //
 // With --client-shots R each client asks the host for R shots a second at objects it sees; the host checks
 // them (NetHost::setShotHandler) and fires those it accepts. With --shots-per-second 0 as well, the host is a
@@ -79,7 +81,7 @@ struct Args {
     bool json = false;
     double delayMs = 0, jitterMs = 0, loss = 0, burst = 1;
     double partitionAt = -1, partitionS = 0;
-    int budget = 1200;
+    rubble::net::PlacementBudget budget;
     std::string out;     // folder for netplay.csv and netplay.png ("" = none)
     int port = 0;        // client: the host's port
     std::string samples; // client: where it writes its placement samples
@@ -98,6 +100,7 @@ struct Sample {
     std::uint32_t frame, object;
     float x, y, z;
     std::uint32_t lag; // kViewLag or kSafeViewLag
+    float newest;      // the frame of the latest placement the client has of it
 };
 
 double percentile(std::vector<double> v, double q) {
@@ -257,7 +260,7 @@ int runHost(const Args& a) {
     }
     net::NetHost& host = **server;
     host.setPlacementSource([&] { return runtime.placements(); });
-    host.setPlacementBudget(static_cast<std::size_t>(a.budget));
+    host.setPlacementBudget(a.budget);
     const std::string tmp =
         (std::filesystem::temp_directory_path() / ("rubble-netplay-" + std::to_string(getpid()) + "-"))
             .string();
@@ -295,6 +298,8 @@ int runHost(const Args& a) {
     const auto partitionEnd = start + std::chrono::duration_cast<Clock::duration>(
                                           std::chrono::duration<double>(a.partitionAt + a.partitionS));
     double convergeMs = -1;
+    long long partitioned = -1;    // clients joined when the partition ended
+    std::vector<double> recovered; // per one of those: ms after the partition until it was within 12 frames
     long shots = 0, f = 0;
     std::vector<net::ShotRequest> requested; // clients' shots that passed the host's checks
     host.setShotHandler([&](const net::ShotRequest& r) { requested.push_back(r); });
@@ -334,9 +339,17 @@ int runHost(const Args& a) {
             }
         }
         if (a.partitionS > 0 && convergeMs < 0 && Clock::now() >= partitionEnd) {
-            const std::vector<std::uint64_t> confirmed = host.confirmedFrames();
-            if (!confirmed.empty() && *std::min_element(confirmed.begin(), confirmed.end()) + 12 >= now)
-                convergeMs = std::chrono::duration<double, std::milli>(Clock::now() - partitionEnd).count();
+            if (partitioned < 0) // the clients that lived through it (a later joiner has nothing to recover)
+                partitioned = host.stats().joins;
+            const std::vector<std::uint64_t> confirmed = host.confirmedFrames(); // in join order
+            const auto n = std::min<std::size_t>(confirmed.size(), static_cast<std::size_t>(partitioned));
+            recovered.resize(n, -1);
+            const double ms = std::chrono::duration<double, std::milli>(Clock::now() - partitionEnd).count();
+            for (std::size_t i = 0; i < n; ++i) // the first time each one confirmed a frame within 12 of now
+                if (recovered[i] < 0 && confirmed[i] + 12 >= now)
+                    recovered[i] = ms;
+            if (n > 0 && std::all_of(recovered.begin(), recovered.end(), [](double r) { return r >= 0; }))
+                convergeMs = *std::max_element(recovered.begin(), recovered.end());
         }
         ++f;
     };
@@ -390,13 +403,17 @@ int runHost(const Args& a) {
         }
         // Placement error against the host, for bodies dynamic at the sampled frame.
         std::map<std::uint32_t, std::vector<double>> errorsAt; // lag → errors
+        nlohmann::json worst = nlohmann::json::array();        // samples off by more than 50 cm
         long long missing = 0;
         {
             const std::string path = tmp + std::to_string(c);
             std::ifstream in(path, std::ios::binary);
             std::map<std::uint32_t, std::map<std::uint64_t, std::map<ObjectId, Vec3>>> seen;
-            for (Sample smp{}; in.read(reinterpret_cast<char*>(&smp), sizeof smp);)
+            std::map<std::pair<std::uint64_t, ObjectId>, float> newest;
+            for (Sample smp{}; in.read(reinterpret_cast<char*>(&smp), sizeof smp);) {
                 seen[smp.lag][smp.frame][smp.object] = Vec3{smp.x, smp.y, smp.z};
+                newest[{smp.frame, smp.object}] = smp.newest;
+            }
             std::filesystem::remove(path);
             for (const auto& [lag, sampled] : seen)
                 for (const auto& [fr, bodies] : sampled) {
@@ -410,6 +427,12 @@ int runHost(const Args& a) {
                             continue;
                         }
                         errorsAt[lag].push_back(length(v->second - at) * 100);
+                        if (errorsAt[lag].back() > 50)
+                            worst.push_back({{"cm", errorsAt[lag].back()},
+                                             {"object", id},
+                                             {"frame", fr},
+                                             {"lag", lag},
+                                             {"newest", newest[{fr, id}]}});
                     }
                 }
         }
@@ -440,6 +463,17 @@ int runHost(const Args& a) {
                                    {"p99", percentile(errors, 0.99)},
                                    {"samples", errors.size()},
                                    {"missing", missing}};
+        j["placement_errors_over_50cm"] = worst;
+        if (a.partitionS > 0 && report.is_object() && report.contains("outage")) {
+            const double end = std::chrono::duration<double>(partitionEnd.time_since_epoch()).count();
+            const nlohmann::json& o = report["outage"];
+            const auto after = [&](const char* k) {
+                return o.value(k, -1.0) < 0 ? -1.0 : (o.value(k, -1.0) - end) * 1000;
+            };
+            j["outage"] = {{"heard_again_ms", after("heard_again_s")},
+                           {"caught_up_ms", after("caught_up_s")},
+                           {"service_ms", o.value("service_ms", 0.0)}};
+        }
         j["placement_error_cm_lag12"] = {{"p50", percentile(errorsAt[kSafeViewLag], 0.5)},
                                          {"p99", percentile(errorsAt[kSafeViewLag], 0.99)}};
         j["link"] = {{"down_lost", relays[c]->down().lost},
@@ -457,7 +491,11 @@ int runHost(const Args& a) {
     r["seconds"] = runSeconds;
     r["link"] = {{"delay_ms", a.delayMs}, {"jitter_ms", a.jitterMs},       {"loss", a.loss},
                  {"burst", a.burst},      {"partition_at", a.partitionAt}, {"partition_s", a.partitionS}};
-    r["placement_budget"] = a.budget;
+    r["placement_budget"] = {{"mean", a.budget.mean}, {"peak", a.budget.peak}, {"reserve", a.budget.reserve}};
+    r["placements_deferred_per_publish"] =
+        static_cast<double>(hs.placementsDeferred) / perClient / (runSeconds * 10);
+    r["placement_publishes_full_share"] =
+        static_cast<double>(hs.placementPublishesFull) / perClient / (runSeconds * 10);
     r["impacts"] = runtime.counters().impacts;
     r["fractures"] = runtime.counters().fractures;
     r["geometry_bytes_per_impact"] = impacts > 0 ? perClientEventBytes / impacts : 0;
@@ -476,6 +514,7 @@ int runHost(const Args& a) {
     r["snapshot_objects_by_reference"] = hs.snapshotObjectsByReference / std::max<long long>(1, hs.joins);
     r["clients_load_scene"] = !a.noBase;
     r["snapshot_build_ms"] = hs.snapshotBuildMs / static_cast<double>(std::max<long long>(1, hs.joins));
+    r["snapshot_transfer_ms"] = hs.snapshotTransferMs / static_cast<double>(std::max<long long>(1, hs.joins));
     r["final_hashes_equal"] = allConverged;
     r["converge_ms"] = convergeMs;
     r["kbps_mean"] = means.empty() ? 0 : *std::max_element(means.begin(), means.end());
@@ -607,11 +646,40 @@ int runClient(const Args& a) {
     std::string ending = "time limit";
     bool hostStopped = false;
     std::uint64_t lastFrame = 0;
+    std::vector<double> behind; // at each sample: newest placement frame received − the world's frame
+    // After an outage (nothing heard for 1 s): when the host was heard again, when the world caught up with
+    // the placements received (within 12 frames), and the time spent in service() in between.
+    Clock::time_point quietSince = Clock::now(), heardAgain{}, caughtUp{};
+    long long lastHeard = 0;
+    double busyMs = 0;
+    const auto monotonic = [](Clock::time_point t) { // monotonic seconds, comparable across processes
+        return t.time_since_epoch().count() == 0
+                   ? -1.0
+                   : std::chrono::duration<double>(t.time_since_epoch()).count();
+    };
     for (const auto t0 = Clock::now(); Clock::now() - t0 < std::chrono::duration<double>(a.seconds);) {
+        const auto serviced = Clock::now();
         if (Status s = (*client)->service(5); !s) {
             ending = s.message();
             hostStopped = s.error().code == ErrorCode::IoError;
             break;
+        }
+        const auto now = Clock::now();
+        const long long heard = (*client)->stats().placements + (*client)->stats().syncs;
+        if (heard != lastHeard) {
+            if (heardAgain.time_since_epoch().count() == 0 && lastHeard != 0 &&
+                now - quietSince > std::chrono::seconds(1))
+                heardAgain = now;
+            quietSince = now;
+            lastHeard = heard;
+        }
+        if (heardAgain.time_since_epoch().count() != 0 && caughtUp.time_since_epoch().count() == 0) {
+            busyMs += std::chrono::duration<double, std::milli>(now - serviced).count();
+            double newest = 0;
+            for (ObjectId id : world.objects())
+                newest = std::max(newest, (*client)->placementFrame(id).value_or(0));
+            if (static_cast<double>((*client)->stats().frame) + 12 >= newest)
+                caughtUp = now;
         }
         // What it would show now: one placement period behind its latest sync, every half second.
         const std::uint64_t frame = (*client)->stats().frame;
@@ -620,6 +688,11 @@ int runClient(const Args& a) {
                 (frame - static_cast<std::uint64_t>(lag)) % kSampleEvery != 0)
                 continue;
             const double view = static_cast<double>(frame - static_cast<std::uint64_t>(lag));
+            double newest = static_cast<double>(frame);
+            for (ObjectId id : world.objects())
+                newest = std::max(newest, (*client)->placementFrame(id).value_or(0));
+            if (lag == kViewLag)
+                behind.push_back(newest - static_cast<double>(frame));
             for (ObjectId id : world.objects()) {
                 const std::optional<double> latest = (*client)->placementFrame(id);
                 if (!latest || *latest < view - 120)
@@ -627,7 +700,8 @@ int runClient(const Args& a) {
                 const Frame at = *(*client)->placement(id, view);
                 const Sample smp{static_cast<std::uint32_t>(view),     id,
                                  static_cast<float>(at.translation.x), static_cast<float>(at.translation.y),
-                                 static_cast<float>(at.translation.z), static_cast<std::uint32_t>(lag)};
+                                 static_cast<float>(at.translation.z), static_cast<std::uint32_t>(lag),
+                                 static_cast<float>(*latest)};
                 samples.write(reinterpret_cast<const char*>(&smp), sizeof smp);
             }
         }
@@ -660,6 +734,12 @@ int runClient(const Args& a) {
                      {"placements", st.placements},
                      {"placement_bytes", st.placementBytes},
                      {"shots_sent", shotsSent},
+                     {"outage",
+                      {{"heard_again_s", monotonic(heardAgain)},
+                       {"caught_up_s", monotonic(caughtUp)},
+                       {"service_ms", busyMs}}},
+                     {"sync_behind_placements_frames",
+                      {{"p50", percentile(behind, 0.5)}, {"p99", percentile(behind, 0.99)}}},
                      {"ending", ending},
                      {"replay", replay}};
     std::cout << j.dump() << "\n";
@@ -694,8 +774,13 @@ const rubble::tools::Registrar host{
          app.add_option("--partition-at", a->partitionAt, "seconds into the run when every link goes dead");
          app.add_option("--partition-s", a->partitionS, "how long the links stay dead")
              ->check(CLI::Range(0.0, 60.0));
-         app.add_option("--placement-budget", a->budget, "placement bytes per client per 10 Hz publish")
+         app.add_option("--placement-budget", a->budget.mean,
+                        "placement bytes per client per 10 Hz publish, mean")
              ->check(CLI::Range(100, 1000000));
+         app.add_option("--placement-peak", a->budget.peak, "placement bytes per client in one publish")
+             ->check(CLI::Range(100, 1000000));
+         app.add_option("--placement-reserve", a->budget.reserve, "placement bytes a client may save up")
+             ->check(CLI::Range(100, 10000000));
          app.add_option("--out", a->out, "folder: add a row to netplay.csv, draw netplay.png");
          app.add_flag("--no-base", a->noBase,
                       "clients do not load the scene first: the snapshot brings every object");

@@ -1,5 +1,5 @@
 // `rubble-server SCENE.cfg [--port P] [--clients N] [--seconds T] [--workers W] [--seed S] [--shot-rate R]
-//  [--placement-budget BYTES]`
+//  [--placement-budget BYTES] [--placement-peak BYTES] [--placement-reserve BYTES]`
 //
 // A dedicated, headless netplay server (docs/netplay.md, 'Dedicated server'): it loads a world.cfg scene on
 // the Bullet binding in deterministic mode, listens on 127.0.0.1:P (0 = any free port) and runs the
@@ -42,7 +42,8 @@ int main(int argc, char** argv) {
     using Clock = std::chrono::steady_clock;
     CLI::App app{"rubble-server: a headless, authoritative netplay host for a world.cfg scene"};
     std::string file;
-    int port = 7777, clients = 12, workers = -1, budget = 1200;
+    int port = 7777, clients = 12, workers = -1;
+    net::PlacementBudget budget;
     double seconds = 0, shotRate = 10;
     std::uint64_t seed = 1;
     app.add_option("scene", file, "world.cfg scene")->required()->check(CLI::ExistingFile);
@@ -54,8 +55,12 @@ int main(int argc, char** argv) {
     app.add_option("--seed", seed, "world seed");
     app.add_option("--shot-rate", shotRate, "shots per second each client may fire")
         ->check(CLI::Range(0.0, 100.0));
-    app.add_option("--placement-budget", budget, "placement bytes per client per 10 Hz publish")
+    app.add_option("--placement-budget", budget.mean, "placement bytes per client per 10 Hz publish, mean")
         ->check(CLI::Range(100, 1000000));
+    app.add_option("--placement-peak", budget.peak, "placement bytes per client in one publish, at most")
+        ->check(CLI::Range(100, 1000000));
+    app.add_option("--placement-reserve", budget.reserve, "placement bytes a client may have saved up")
+        ->check(CLI::Range(100, 10000000));
     CLI11_PARSE(app, argc, argv);
 
     Result<SceneConfig> scene = parseSceneConfig(file);
@@ -83,7 +88,7 @@ int main(int argc, char** argv) {
     }
     net::NetHost& host = **server;
     host.setPlacementSource([&] { return runtime.placements(); });
-    host.setPlacementBudget(static_cast<std::size_t>(budget));
+    host.setPlacementBudget(budget);
     std::vector<net::ShotRequest> shots;
     net::ShotRules rules;
     rules.perSecond = shotRate;

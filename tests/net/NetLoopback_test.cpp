@@ -191,6 +191,44 @@ TEST(NetLoopback, AClientKeepsAReplayOfTheGameWhenTheHostStops) {
     EXPECT_EQ(replay.geometryHash(), hash);
 }
 
+TEST(NetLoopback, AClientWhoseWorldLagsShowsThoseFramesBetweenPlacements) {
+    test::JournalRig host(1);
+    const DestructionWorld::Config config = test::journalConfig(1).world;
+    auto server = net::NetHost::listen(host.runtime.world(), config, "127.0.0.1", 0);
+    ASSERT_TRUE(server) << server.error().message;
+    net::NetHost& h = **server;
+    h.setPlacementSource([&] { return host.runtime.placements(); });
+    h.publish(); // the sync a joining client gets once its snapshot is in
+    DestructionWorld world(config);
+    auto client = net::NetClient::connect(world, config, "127.0.0.1", h.port());
+    ASSERT_TRUE(client) << client.error().message;
+    const auto pump = [&] {
+        h.service(1);
+        return static_cast<bool>((*client)->service(1));
+    };
+    ASSERT_TRUE(test::waitFor([&] { return h.stats().acks > 0; }, pump)); // joined, and confirmed that sync
+    // The host moves a body 1 cm a frame for 3 s and sends its placements at 10 Hz; the client's world stays
+    // at its join frame (no syncs), as one busy cutting pieces would.
+    ObjectPlacement moving = host.runtime.placements().front();
+    const Vec3 start = moving.objectToWorld.translation;
+    const double first = static_cast<double>(host.runtime.world().frame());
+    for (int publish = 0; publish < 30; ++publish) {
+        for (int i = 0; i < 6; ++i)
+            host.runtime.stepFrame();
+        const double frame = static_cast<double>(host.runtime.world().frame());
+        moving.objectToWorld.translation = start + Vec3{0.01 * (frame - first), 0, 0};
+        h.publishPlacements({moving});
+        ASSERT_TRUE(test::waitFor(
+            [&] { return (*client)->placementFrame(moving.object) == std::optional(frame); }, pump));
+    }
+    const double last = static_cast<double>(host.runtime.world().frame());
+    for (const double back : {0.0, 30.0, 63.0, 100.0}) { // 100 frames back: 17 placements
+        const std::optional<Frame> f = (*client)->placement(moving.object, last - back);
+        ASSERT_TRUE(f);
+        EXPECT_NEAR(f->translation.x, start.x + 0.01 * (last - back - first), 1e-3) << back << " frames back";
+    }
+}
+
 TEST(NetLoopback, OnlyLoopbackAddressesAndDeterministicWorlds) {
     DestructionWorld::Config config = test::journalConfig(1).world;
     DestructionWorld world(config);

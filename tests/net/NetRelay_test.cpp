@@ -1,6 +1,7 @@
 // Multiplayer on a network that misbehaves: three clients, each through its own seeded relay (delay, jitter,
 // burst loss, reordering, duplication), one of them partitioned and healed, one killed and replaced; and a
-// host that rogue traffic neither crashes nor changes. Every wait is for a condition, with a deadline.
+// host that rogue traffic neither crashes nor changes; a host gone silent is noticed after the client's
+// timeout. Every wait is for a condition, with a deadline.
 #include "rubble/enet/NetClient.hpp"
 #include "rubble/enet/NetHost.hpp"
 #include "rubble/enet/UdpRelay.hpp"
@@ -162,6 +163,32 @@ TEST(NetRelay, ClientsThroughMisbehavingLinksConvergeAfterAPartitionAndAReplacem
     }
     EXPECT_GT(lost, 0);
     EXPECT_GT(duplicated, 0);
+}
+
+TEST(NetRelay, AClientNoticesAHostThatStoppedAnsweringAfterItsTimeout) {
+    test::JournalRig host(1);
+    const DestructionWorld::Config config = test::journalConfig(1).world;
+    auto server = net::NetHost::listen(host.runtime.world(), config, "127.0.0.1", 0);
+    ASSERT_TRUE(server) << server.error().message;
+    net::NetHost& h = **server;
+    h.publish();
+    Follower f(h.port(), 31);
+    f.client->setTimeout(1000);
+    ASSERT_TRUE(test::waitFor([&] { return h.stats().acks > 0; },
+                              [&] {
+                                  h.service(1);
+                                  return static_cast<bool>(f.client->service(1));
+                              }));
+    // The host goes silent as if killed (no goodbye): every datagram is dropped from now on.
+    f.relay->setPartitioned(true);
+    Status st = Status::ok();
+    for (const auto end = Clock::now() + std::chrono::seconds(12); st && Clock::now() < end;) {
+        h.service(1);
+        st = f.client->service(1);
+    }
+    ASSERT_FALSE(st) << "still waiting 12 s after the host went silent, with a 1 s timeout";
+    EXPECT_EQ(st.error().code, ErrorCode::IoError);
+    EXPECT_NE(st.message().find("stopped answering"), std::string::npos) << st.message();
 }
 
 TEST(NetRelay, RogueTrafficNeitherCrashesTheHostNorChangesItsWorld) {

@@ -1,5 +1,6 @@
 // Placement compression: the grid's error bounds, delta coding against acknowledged baselines under loss,
-// bodies at rest costing nothing, the byte budget with a priority accumulator, malformed datagrams.
+// bodies at rest costing nothing, the byte budget with a priority accumulator and a reserve, bodies on their
+// way not sent twice, malformed datagrams.
 #include "Placements.hpp"
 
 #include <gtest/gtest.h>
@@ -186,6 +187,75 @@ TEST(Placements, TheBudgetIsKeptAndEveryBodyGetsItsTurn) {
     // About 100 records fit in a frame's budget, so a body waits about 10 frames; the accumulator favours
     // the bodies that moved most, but no one waits much longer.
     EXPECT_LT(worstWait, 25);
+}
+
+TEST(Placements, TheAllowanceSavesWhatQuietPublishesLeaveForWhenManyBodiesMove) {
+    net::detail::PlacementAllowance busy(1200, 3600, 24000);
+    std::size_t total = 0, first = 0;
+    for (int i = 0; i < 100; ++i) { // always something to send: the full reserve, then the mean
+        const std::size_t bytes = busy.next();
+        EXPECT_LE(bytes, 3600u);
+        busy.spent(bytes);
+        total += bytes;
+        first = i == 0 ? bytes : first;
+    }
+    EXPECT_EQ(first, 3600u) << "a client that just joined catches up at the peak";
+    EXPECT_LE(total, 24000u + 100 * 1200);
+    EXPECT_GE(total, 24000u + 99 * 1200);
+    net::detail::PlacementAllowance quiet(1200, 3600, 24000);
+    for (int i = 0; i < 40; ++i) // nothing moves for 4 s
+        (void)quiet.next();
+    std::size_t burst = 0;
+    int full = 0;
+    for (int i = 0; i < 30; ++i) { // then a collapse: 3 s with more to send than the mean
+        const std::size_t bytes = quiet.next();
+        full += bytes == 3600;
+        quiet.spent(bytes);
+        burst += bytes;
+    }
+    EXPECT_GE(full, 8) << "the reserve is spent at the peak rate";
+    EXPECT_LE(burst, 24000u + 30 * 1200);
+    EXPECT_GE(burst, 24000u + 29 * 1200);
+    net::detail::PlacementAllowance fixed(1200, 1200, 1200); // no reserve: the old fixed budget
+    for (int i = 0; i < 40; ++i)
+        (void)fixed.next();
+    EXPECT_EQ(fixed.next(), 1200u);
+}
+
+TEST(Placements, ABodyOnItsWayIsNotSentAgainUnlessItsDatagramIsLost) {
+    Link link(200, 0);
+    const State now = link.step();
+    const auto first = link.host.encode(1, now, 100000);
+    ASSERT_FALSE(first.empty());
+    EXPECT_TRUE(link.host.encode(2, now, 100000).empty()) << "every state is on its way: nothing to send";
+    // The client got all but the first datagram and says so: the bodies in that one go again.
+    std::vector<DecodedPlacement> out;
+    for (std::size_t i = 1; i < first.size(); ++i) {
+        std::uint64_t f = 0;
+        ASSERT_TRUE(link.client.decode(first[i].data(), first[i].size(), f, out));
+    }
+    link.host.acked(link.client.latest(), link.client.mask());
+    std::set<ObjectId> got, again;
+    for (const auto& r : out)
+        got.insert(r.id);
+    for (const auto& d : link.host.encode(3, now, 100000)) {
+        std::uint64_t f = 0;
+        std::vector<DecodedPlacement> more;
+        ASSERT_TRUE(link.client.decode(d.data(), d.size(), f, more));
+        for (const auto& r : more)
+            again.insert(r.id);
+    }
+    EXPECT_EQ(got.size() + again.size(), 200u);
+    for (ObjectId id : again)
+        EXPECT_FALSE(got.count(id)) << id << " arrived and was sent again";
+    // No acknowledgement at all (the acks are lost): after a few publishes the host sends them again.
+    PlacementEncoder silent;
+    ASSERT_FALSE(silent.encode(1, now, 100000).empty());
+    std::size_t resent = 0;
+    for (std::uint64_t f = 2; f < 2 + net::detail::kInFlightEncodes + 1; ++f)
+        for (const auto& d : silent.encode(f, now, 100000))
+            resent += d.size();
+    EXPECT_GT(resent, 0u);
 }
 
 TEST(Placements, MalformedDatagramsAreRefusedAndChangeNothing) {

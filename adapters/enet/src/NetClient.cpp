@@ -20,8 +20,9 @@ namespace rubble::net {
 using detail::Message;
 using Clock = std::chrono::steady_clock;
 
-/// Placements kept per body: enough to show it two placement periods behind with one datagram lost.
-constexpr std::size_t kTrackPoints = 4;
+/// Host frames of placements kept per body: a client whose world lags the placements it receives (it is still
+/// cutting pieces) can show any frame of the last two seconds between two placements.
+constexpr double kTrackFrames = 120;
 
 struct NetClient::Impl {
     Impl(DestructionWorld& w, const DestructionWorld::Config& c) : world(w), config(c), player(w) {
@@ -34,20 +35,43 @@ struct NetClient::Impl {
     ENetPeer* server = nullptr;
     Clock::time_point connected;
     Clock::time_point heard; // when the host was last heard
+    enet_uint32 timeoutMs = detail::kPeerTimeoutMs;
     ClientStats stats;
-    /// The latest placements of a body, by host frame (ascending, at most kTrackPoints).
+    /// The latest placements of a body, by host frame (ascending, within kTrackFrames of the newest).
     struct Track {
         std::vector<std::pair<double, Frame>> points;
         void add(double frame, const Frame& f) {
+            if (!points.empty() && frame < points.back().first - kTrackFrames)
+                return; // older than all it keeps
             auto at = std::lower_bound(points.begin(), points.end(), frame,
                                        [](const auto& p, double x) { return p.first < x; });
             if (at != points.end() && at->first == frame)
                 return; // a duplicate
-            if (at == points.begin() && points.size() >= kTrackPoints)
-                return; // older than all it keeps
             points.insert(at, {frame, f});
-            if (points.size() > kTrackPoints)
+            while (points.size() > 2 && points.front().first < points.back().first - kTrackFrames)
                 points.erase(points.begin());
+        }
+        /// Where it is at `frame`: interpolated between two points, held at the ends (not empty).
+        Frame at(double frame) const {
+            if (frame <= points.front().first)
+                return points.front().second;
+            if (frame >= points.back().first)
+                return points.back().second;
+            std::size_t k = 0;
+            while (points[k + 1].first < frame)
+                ++k;
+            const Frame &a = points[k].second, &b = points[k + 1].second;
+            const double s = (frame - points[k].first) / (points[k + 1].first - points[k].first);
+            Frame f;
+            f.translation = a.translation * (1 - s) + b.translation * s;
+            auto qa = detail::toQuaternion(a.rotation), qb = detail::toQuaternion(b.rotation);
+            const double dot = qa[0] * qb[0] + qa[1] * qb[1] + qa[2] * qb[2] + qa[3] * qb[3];
+            const double sign = dot < 0 ? -1 : 1; // the shorter way round
+            std::array<double, 4> q{};
+            for (int i = 0; i < 4; ++i)
+                q[i] = qa[i] * (1 - s) + sign * qb[i] * s;
+            f.rotation = detail::fromQuaternion(q);
+            return f;
         }
     };
     std::map<ObjectId, Track> tracks; // also of pieces the world does not have yet
@@ -104,9 +128,11 @@ struct NetClient::Impl {
         if (auto t = tracks.find(o.parent); t != tracks.end()) {
             const Track parent = t->second;
             tracks.erase(t);
-            for (const AdoptedPiece& p : o.pieces) // piece → parent local → world, unless the host said
-                tracks.try_emplace(
-                    p.id, Track{{{parent.points.back().first, parent.points.back().second * p.frame}}});
+            const double born = static_cast<double>(world.frame()); // piece → parent local → world
+            const Frame where = parent.points.empty() ? Frame{} : parent.at(born);
+            if (!parent.points.empty())
+                for (const AdoptedPiece& p : o.pieces)
+                    tracks[p.id].add(born, where * p.frame);
         }
         if (onOutcome)
             onOutcome(o);
@@ -288,7 +314,7 @@ NetClient::NetClient(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 NetClient::~NetClient() {
     if (impl_->host) {
         if (impl_->server)
-            enet_peer_disconnect_now(impl_->server, 0);
+            enet_peer_disconnect_now(impl_->server, detail::kGoodbye);
         enet_host_destroy(impl_->host);
     }
 }
@@ -322,7 +348,7 @@ Status NetClient::service(int timeoutMs) {
     for (; r > 0; r = enet_host_service(im.host, &e, 0)) {
         if (e.type == ENET_EVENT_TYPE_CONNECT) {
             im.stats.connected = true;
-            detail::configurePeer(im.server);
+            detail::configurePeer(im.server, im.timeoutMs);
             if (!detail::sendReliable(im.server, detail::encodeHello(im.world)))
                 return Error{ErrorCode::IoError, "netplay: cannot send the hello"};
         } else if (e.type == ENET_EVENT_TYPE_RECEIVE) {
@@ -336,8 +362,12 @@ Status NetClient::service(int timeoutMs) {
                 return s;
         } else if (e.type == ENET_EVENT_TYPE_DISCONNECT) {
             im.server = nullptr;
-            return Error{ErrorCode::IoError, im.stats.connected ? "netplay: the host closed the connection"
-                                                                : "netplay: no host answered"};
+            if (!im.stats.connected)
+                return Error{ErrorCode::IoError, "netplay: no host answered"};
+            return Error{ErrorCode::IoError, e.data == detail::kGoodbye
+                                                 ? "netplay: the host closed the connection"
+                                                 : "netplay: the host stopped answering (no reply for " +
+                                                       std::to_string(im.timeoutMs) + " ms)"};
         }
     }
     im.acknowledgeChunks();
@@ -346,36 +376,21 @@ Status NetClient::service(int timeoutMs) {
     return Status::ok();
 }
 
+void NetClient::setTimeout(int ms) {
+    impl_->timeoutMs = static_cast<enet_uint32>(std::max(1, ms));
+    if (impl_->server && impl_->stats.connected)
+        detail::configurePeer(impl_->server, impl_->timeoutMs);
+}
+
 void NetClient::setOnOutcome(std::function<void(const FractureOutcome&)> callback) {
     impl_->onOutcome = std::move(callback);
 }
 
 std::optional<Frame> NetClient::placement(ObjectId object, double frame) const {
     auto it = impl_->tracks.find(object);
-    if (it == impl_->tracks.end())
+    if (it == impl_->tracks.end() || it->second.points.empty())
         return std::nullopt;
-    const auto& points = it->second.points;
-    if (points.empty())
-        return std::nullopt;
-    if (frame <= points.front().first)
-        return points.front().second;
-    if (frame >= points.back().first)
-        return points.back().second;
-    std::size_t k = 0;
-    while (points[k + 1].first < frame)
-        ++k;
-    const Frame &a = points[k].second, &b = points[k + 1].second;
-    const double s = (frame - points[k].first) / (points[k + 1].first - points[k].first);
-    Frame f;
-    f.translation = a.translation * (1 - s) + b.translation * s;
-    auto qa = detail::toQuaternion(a.rotation), qb = detail::toQuaternion(b.rotation);
-    const double dot = qa[0] * qb[0] + qa[1] * qb[1] + qa[2] * qb[2] + qa[3] * qb[3];
-    const double sign = dot < 0 ? -1 : 1; // the shorter way round
-    std::array<double, 4> q{};
-    for (int i = 0; i < 4; ++i)
-        q[i] = qa[i] * (1 - s) + sign * qb[i] * s;
-    f.rotation = detail::fromQuaternion(q);
-    return f;
+    return it->second.at(frame);
 }
 
 Status NetClient::shoot(const Vec3& origin, const Vec3& velocity) {

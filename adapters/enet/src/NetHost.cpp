@@ -32,7 +32,8 @@ struct NetHost::Impl {
     HostStats stats;
     std::function<std::vector<ObjectPlacement>()> placementSource;
     std::map<ENetPeer*, detail::PlacementEncoder> encoders; // per client: its baselines and priorities
-    std::size_t placementBudget = 1200;                     // bytes per client per publishPlacements
+    PlacementBudget placementBudget;
+    std::map<ENetPeer*, detail::PlacementAllowance> allowances; // per client: its saved placement bytes
 
     std::map<ENetPeer*, std::chrono::steady_clock::time_point> heard; // when each client was last heard
     std::map<ENetPeer*, std::uint64_t> joinOrder;                     // 0 for the first to join
@@ -64,7 +65,7 @@ struct NetHost::Impl {
         for (auto it = transfers.begin();
              it != transfers.end();) { // a client that never has it all is dropped
             if (now - it->second.started > std::chrono::seconds(30)) {
-                enet_peer_disconnect(it->first, 0);
+                enet_peer_disconnect(it->first, detail::kGoodbye);
                 it = transfers.erase(it);
             } else {
                 ++it;
@@ -118,6 +119,9 @@ struct NetHost::Impl {
         if (!all)
             return;
         const std::uint64_t frame = t->second.frame;
+        stats.snapshotTransferMs +=
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t->second.started)
+                .count();
         transfers.erase(t);
         if (lastSync >= frame && hashes.count(lastSync)) // the latest sync, which it was not sent
             sendSync(peer, lastSync, lastSyncPosition, hashes[lastSync]);
@@ -156,7 +160,7 @@ struct NetHost::Impl {
         const std::vector<std::uint8_t> msg =
             detail::encodeJoinSnapshot(takeSnapshot(world, std::move(placements)), known, &size);
         if (msg.empty()) {
-            enet_peer_disconnect(peer, 0);
+            enet_peer_disconnect(peer, detail::kGoodbye);
             return;
         }
         Transfer& t = transfers[peer];
@@ -217,7 +221,7 @@ NetHost::~NetHost() {
     impl_->world.setJournalSink({});
     if (impl_->host) {
         for (auto& [peer, position] : impl_->peers)
-            enet_peer_disconnect_now(peer, 0);
+            enet_peer_disconnect_now(peer, detail::kGoodbye);
         enet_host_destroy(impl_->host);
     }
 }
@@ -298,18 +302,27 @@ void NetHost::publishPlacements(const std::vector<ObjectPlacement>& placements) 
     for (auto& [peer, position] : im.peers) {
         if (!im.acked.count(peer))
             continue; // still loading its snapshot: nothing to compare against yet
-        for (const std::vector<std::uint8_t>& msg :
-             im.encoders[peer].encode(im.world.frame(), now, im.placementBudget)) {
+        detail::PlacementEncoder& encoder = im.encoders[peer];
+        const PlacementBudget& b = im.placementBudget;
+        detail::PlacementAllowance& allowance =
+            im.allowances.try_emplace(peer, b.mean, b.peak, b.reserve).first->second;
+        std::size_t spent = 0;
+        for (const std::vector<std::uint8_t>& msg : encoder.encode(im.world.frame(), now, allowance.next())) {
             detail::sendUnreliable(peer, msg);
-            im.stats.placementBytes += static_cast<long long>(msg.size());
+            spent += msg.size();
         }
+        allowance.spent(spent);
+        im.stats.placementBytes += static_cast<long long>(spent);
+        im.stats.placementsDeferred += static_cast<long long>(encoder.deferred());
+        im.stats.placementPublishesFull += encoder.deferred() > 0;
         im.stats.legacyPlacementBytes += legacy;
     }
     enet_host_flush(im.host);
 }
 
-void NetHost::setPlacementBudget(std::size_t bytes) {
-    impl_->placementBudget = bytes;
+void NetHost::setPlacementBudget(const PlacementBudget& budget) {
+    impl_->placementBudget = budget;
+    impl_->allowances.clear();
 }
 
 bool NetHost::finish(int timeoutMs) {
@@ -331,7 +344,7 @@ bool NetHost::close(int timeoutMs) {
     im.closing = true;
     for (ENetPeer* peer = im.host->peers; peer < im.host->peers + im.host->peerCount; ++peer)
         if (peer->state != ENET_PEER_STATE_DISCONNECTED)
-            enet_peer_disconnect(peer, 0);
+            enet_peer_disconnect(peer, detail::kGoodbye);
     const auto connected = [&im] {
         for (ENetPeer* peer = im.host->peers; peer < im.host->peers + im.host->peerCount; ++peer)
             if (peer->state != ENET_PEER_STATE_DISCONNECTED)
@@ -357,7 +370,7 @@ void NetHost::service(int timeoutMs) {
         case ENET_EVENT_TYPE_CONNECT: // it joins with its Hello
             detail::configurePeer(e.peer);
             if (im.closing)
-                enet_peer_disconnect(e.peer, 0);
+                enet_peer_disconnect(e.peer, detail::kGoodbye);
             break;
         case ENET_EVENT_TYPE_RECEIVE:
             im.receive(e.peer, e.packet);
@@ -367,6 +380,7 @@ void NetHost::service(int timeoutMs) {
             im.peers.erase(e.peer);
             im.acked.erase(e.peer);
             im.encoders.erase(e.peer);
+            im.allowances.erase(e.peer);
             im.heard.erase(e.peer);
             im.joinOrder.erase(e.peer);
             im.transfers.erase(e.peer);

@@ -124,20 +124,23 @@ PlacementEncoder::encode(std::uint64_t frame, const std::vector<std::pair<Object
     };
     std::vector<Candidate> candidates;
     std::map<ObjectId, Body> kept; // bodies that are gone are forgotten
+    ++encodes_;
     for (const auto& [id, q] : now) {
         auto it = bodies_.find(id);
         Body& b = kept[id] = it != bodies_.end() ? it->second : Body{};
-        if (b.hasBase && b.base == q) {
-            b.priority = 0; // unchanged (asleep, frozen, static): costs nothing
+        if (b.sentSeq != 0 && encodes_ - b.sentAt > kInFlightEncodes)
+            b.sentSeq = 0; // never acknowledged: lost
+        if ((b.hasBase && b.base == q) || (b.sentSeq != 0 && b.sent == q)) {
+            b.priority = 0; // unchanged (asleep, frozen, static) or on its way: costs nothing
             continue;
         }
+        const Quantized* has = b.sentSeq != 0 ? &b.sent : b.hasBase ? &b.base : nullptr;
         double cm = 100; // no baseline: a new piece
-        if (b.hasBase)
-            cm = std::sqrt(std::pow(double(q.p[0] - b.base.p[0]), 2) +
-                           std::pow(double(q.p[1] - b.base.p[1]), 2) +
-                           std::pow(double(q.p[2] - b.base.p[2]), 2)) /
+        if (has)
+            cm = std::sqrt(std::pow(double(q.p[0] - has->p[0]), 2) + std::pow(double(q.p[1] - has->p[1]), 2) +
+                           std::pow(double(q.p[2] - has->p[2]), 2)) /
                  10;
-        b.priority += 1 + std::min(100.0, cm);
+        b.priority += 1 + std::min(1000.0, cm);
         candidates.push_back({id, &q, nullptr});
     }
     bodies_ = std::move(kept);
@@ -173,7 +176,9 @@ PlacementEncoder::encode(std::uint64_t frame, const std::vector<std::pair<Object
         total += cost;
     }
     std::vector<std::vector<std::uint8_t>> out;
+    deferred_ = candidates.size();
     for (auto& group : groups) {
+        deferred_ -= group.size();
         std::sort(group.begin(), group.end(),
                   [](const Candidate* a, const Candidate* b) { return a->id < b->id; });
         const std::uint32_t seq = ++seq_;
@@ -191,6 +196,9 @@ PlacementEncoder::encode(std::uint64_t frame, const std::vector<std::pair<Object
             previous = c->id;
             sent.emplace_back(c->id, *c->q);
             c->body->priority = 0;
+            c->body->sentSeq = seq;
+            c->body->sent = *c->q;
+            c->body->sentAt = encodes_;
         }
         out.push_back(std::move(msg));
     }
@@ -200,21 +208,23 @@ PlacementEncoder::encode(std::uint64_t frame, const std::vector<std::pair<Object
 }
 
 void PlacementEncoder::acked(std::uint32_t latest, std::uint32_t mask) {
-    for (int i = -1; i < 32; ++i) {
-        if (i >= 0 && !(mask >> i & 1))
-            continue;
-        const std::uint32_t seq = latest - 1 - static_cast<std::uint32_t>(i);
-        auto it = pending_.find(seq);
-        if (it == pending_.end())
-            continue;
-        for (const auto& [id, q] : it->second)
-            if (auto b = bodies_.find(id);
-                b != bodies_.end() && (!b->second.hasBase || seq > b->second.baseSeq)) {
-                b->second.hasBase = true;
-                b->second.baseSeq = seq;
-                b->second.base = q;
+    for (auto it = pending_.begin(); it != pending_.end() && it->first <= latest;) {
+        const std::uint32_t seq = it->first;
+        const bool got = seq == latest || (latest - seq <= 32 && (mask >> (latest - seq - 1) & 1));
+        for (const auto& [id, q] : it->second) {
+            const auto b = bodies_.find(id);
+            if (b == bodies_.end())
+                continue;
+            Body& body = b->second;
+            if (body.sentSeq == seq)
+                body.sentSeq = 0; // arrived, or lost: what the client has is its baseline either way
+            if (got && (!body.hasBase || seq > body.baseSeq)) {
+                body.hasBase = true;
+                body.baseSeq = seq;
+                body.base = q;
             }
-        pending_.erase(it);
+        }
+        it = got || latest - seq > 32 ? pending_.erase(it) : std::next(it);
     }
 }
 

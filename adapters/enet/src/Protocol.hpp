@@ -133,10 +133,16 @@ inline bool sendReliable(ENetPeer* peer, const std::vector<std::uint8_t>& bytes)
     return true;
 }
 
+/// Milliseconds without an answer after which a peer counts as gone (a partition shorter than this is
+/// survived; a process killed without saying goodbye is noticed this late).
+inline constexpr enet_uint32 kPeerTimeoutMs = 10000;
+/// The data of a disconnect that a side sends on purpose (a timeout carries 0).
+inline constexpr enet_uint32 kGoodbye = 1;
+
 /// A peer for a link that misbehaves: unreliable packets are not throttled (placements keep their own byte
-/// budget), and an outage of up to 15 s (a partition) does not end the connection.
-inline void configurePeer(ENetPeer* peer) {
-    enet_peer_timeout(peer, 0, 15000, 30000);
+/// budget), and it counts as gone after timeoutMs without an answer.
+inline void configurePeer(ENetPeer* peer, enet_uint32 timeoutMs = kPeerTimeoutMs) {
+    enet_peer_timeout(peer, 0, timeoutMs, timeoutMs);
     enet_peer_throttle_configure(peer, ENET_PEER_PACKET_THROTTLE_INTERVAL, 0, 0);
 }
 

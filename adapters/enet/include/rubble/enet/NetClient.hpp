@@ -47,9 +47,10 @@ public:
     /// Receives and applies what arrived within timeoutMs. Fails when the host sent something the world
     /// refuses (a corrupted snapshot or an event out of order) or the connection was lost.
     Status service(int timeoutMs = 0);
-    /// Where an object is at (fractional) host frame `frame`: interpolated between the latest four placements
-    /// the host sent for it (position linearly, rotation by normalised quaternion blend), held at the ends.
-    /// A new piece starts where its parent was. Empty for an object the client has no placement of.
+    /// Where an object is at (fractional) host frame `frame`: interpolated between the placements the host
+    /// sent for it in its last 120 frames (position linearly, rotation by normalised quaternion blend), held
+    /// at the ends. A new piece starts where its parent was. Empty for an object the client has no placement
+    /// of.
     std::optional<Frame> placement(ObjectId object, double frame) const;
     /// Asks the host to fire a shot (it checks it first: docs/netplay.md, 'Trust model'). Fails when not
     /// connected.
@@ -60,6 +61,9 @@ public:
     Status writeReplay(const std::filesystem::path& snapshot, const std::filesystem::path& journal) const;
     /// Host frame of the latest placement received for an object (empty when none arrived).
     std::optional<double> placementFrame(ObjectId object) const;
+    /// How long the host may be silent before service() fails with an IoError saying it stopped answering
+    /// (default 10 s: a partition shorter than that is survived, a host killed without closing is noticed).
+    void setTimeout(int ms);
     /// Called for every outcome the world adopts (its pieces are in the world already).
     void setOnOutcome(std::function<void(const FractureOutcome&)> callback);
     /// Totals.

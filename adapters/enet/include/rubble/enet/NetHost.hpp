@@ -4,6 +4,7 @@
 /// objects it announced it has in the same state), then every journal event and, once per frame, the frame
 /// number with the geometry hash it must match (docs/netplay.md).
 
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -26,15 +27,27 @@ struct HostStats {
     long long snapshotRawBytes = 0;           ///< what they inflate to (the objects the clients did not have)
     long long snapshotObjectsByReference = 0; ///< objects sent by id: the client had them in that state
     double snapshotBuildMs = 0;               ///< time spent taking, encoding and deflating snapshots (ms)
-    long long syncs = 0;                      ///< frame syncs sent (per client)
-    long long impactEvents = 0;               ///< of eventsSent: impacts (the rest are removals)
-    long long placementBytes = 0;             ///< bytes of placement messages sent (per client, payload)
+    double snapshotTransferMs =
+        0;               ///< time from sending snapshots' first chunks to their last acknowledgement (ms)
+    long long syncs = 0; ///< frame syncs sent (per client)
+    long long impactEvents = 0;   ///< of eventsSent: impacts (the rest are removals)
+    long long placementBytes = 0; ///< bytes of placement messages sent (per client, payload)
     long long legacyPlacementBytes =
-        0;                          ///< what the 32-byte float records of every dynamic body would have been
-    long long acks = 0;             ///< clients' hash reports received
+        0; ///< what the 32-byte float records of every dynamic body would have been
+    long long placementsDeferred = 0; ///< changed bodies left for a later publish by the budget (per client)
+    long long placementPublishesFull = 0; ///< publishes per client whose budget ran out
+    long long acks = 0;                   ///< clients' hash reports received
     long long mismatchedHashes = 0; ///< reports whose geometry hash differed from the host's at that frame
     long long shotsAccepted = 0;    ///< clients' shots that passed the checks (handed to the shot handler)
     long long shotsRefused = 0; ///< clients' shots refused: malformed, implausible, too many, or no handler
+};
+
+/// Placement bytes per client: `mean` per publishPlacements on average (10 Hz: 96 kbps), at most `peak` in
+/// one; what quiet publishes leave unspent is saved, up to `reserve`, and spent while many bodies move.
+struct PlacementBudget {
+    std::size_t mean = 1200;
+    std::size_t peak = 3600;
+    std::size_t reserve = 24000;
 };
 
 /// What a client may ask for: a shot, checked by the host before anything happens.
@@ -78,8 +91,8 @@ public:
     /// quantized, delta-coded, the most overdue first within the budget): the host is authoritative for
     /// motion. Bodies at rest cost nothing. Call at a modest rate (10 Hz).
     void publishPlacements(const std::vector<ObjectPlacement>& placements);
-    /// Bytes of placements per client per publishPlacements (default 1200).
-    void setPlacementBudget(std::size_t bytes);
+    /// Bytes of placements per client (PlacementBudget: a mean, a peak and a reserve).
+    void setPlacementBudget(const PlacementBudget& budget);
     /// Handles the network until every connected client confirmed the latest sync (or timeoutMs passed);
     /// true when they all did. Call before closing, so that the clients end in the host's state.
     bool finish(int timeoutMs);
