@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <map>
 
@@ -93,6 +95,15 @@ std::vector<Vec2> bearingCorners(const std::vector<Vec2>& corners) {
 
 } // namespace
 
+// The direct solve's factorisation, kept across solves while the structure and the active set stay.
+struct StressSolver::DirectCache {
+    std::vector<std::size_t> key; // the movable nodes in unknown order, then each bond's slot and nodes
+    std::vector<char> flags;      // each corner's active and slip flags the factorisation holds
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
+    bool analysed = false;
+    bool factored = false; // the numeric factorisation matches the nodes and bonds (until one changes)
+};
+
 StructureNode structureNode(const std::vector<ConvexPolytope>& parts, double density, bool root) {
     StructureNode n;
     n.root = root;
@@ -145,6 +156,8 @@ void StressSolver::reset(std::vector<StructureNode> nodes, std::vector<Bond> bon
 }
 
 std::uint32_t StressSolver::addNode(const StructureNode& node) {
+    if (direct_)
+        direct_->factored = false;
     NodeState s;
     s.node = node;
     if (!node.root && node.mass > 0) {
@@ -163,6 +176,8 @@ std::uint32_t StressSolver::addNode(const StructureNode& node) {
 }
 
 void StressSolver::removeNode(std::uint32_t node) {
+    if (direct_)
+        direct_->factored = false;
     NodeState& n = nodes_[node];
     if (n.removed)
         return;
@@ -185,6 +200,8 @@ void StressSolver::removeNode(std::uint32_t node) {
 }
 
 std::size_t StressSolver::addBond(Bond bond, StrengthLimits limits) {
+    if (direct_)
+        direct_->factored = false;
     BondState s;
     s.bond = std::move(bond);
     s.limits = limits;
@@ -209,6 +226,8 @@ std::size_t StressSolver::addBond(Bond bond, StrengthLimits limits) {
 }
 
 void StressSolver::removeBond(std::size_t i) {
+    if (direct_)
+        direct_->factored = false;
     BondState& b = bonds_[i];
     for (std::uint32_t n : {b.bond.a, b.bond.b}) {
         std::erase(nodes_[n].bonds, i);
@@ -222,6 +241,8 @@ void StressSolver::removeBond(std::size_t i) {
 }
 
 void StressSolver::setRoot(std::uint32_t node, bool root) {
+    if (direct_)
+        direct_->factored = false;
     NodeState& n = nodes_[node];
     n.node.root = root;
     n.invMass = 0;
@@ -893,19 +914,14 @@ void StressSolver::solveConjugateGradient(double tolerance) {
     }
 }
 
-struct StressSolver::DirectCache {
-    std::vector<std::size_t> key; // the movable nodes in unknown order, then each bond's slot and nodes
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
-    bool analysed = false;
-};
-
 // The regularised bond system in node unknowns: the new accelerations a' of the movable nodes minimise
 // (a' - a)^T M (a' - a) + sum over held constraints (J a')^2 / e, e = compliance times the constraint's own
 // inverse effective mass, so (M + J^T E^-1 J) a' = M a, and the constraint forces change by -E^-1 J a'
 // (augmented Lagrangian: repeated, the forces converge to J a = 0 from the warm start). A bearing's corners
-// are held (normal and friction, sticking) while they press; a corner pulling leaves the set and one
-// penetrating joins it, each change a numeric refactorisation of the same pattern. Gauss-Seidel then meets
-// the residual with the friction limits.
+// are held (normal and friction, sticking); a corner pulling leaves the set, one penetrating rejoins it and
+// one sticking past friction slips (its friction a force at the limit from then on), each change a numeric
+// refactorisation of the same pattern (at most three a solve). The set and the factorisation are kept
+// across solves until a node, bond or corner changes. Gauss-Seidel then meets the residual.
 void StressSolver::solveDirect(double tolerance) {
     using Vec6 = Eigen::Matrix<double, 6, 1>;
     using Sparse = Eigen::SparseMatrix<double>;
@@ -930,7 +946,10 @@ void StressSolver::solveDirect(double tolerance) {
     for (std::size_t k : pattern)
         if (!bonds_[k].broken)
             held.push_back(k);
-    if (order.empty()) {
+    double start = 0;
+    for (std::uint32_t i : order)
+        start = std::max(start, nodeResidual(nodes_[i]));
+    if (order.empty() || start <= tolerance * tolerance) { // nothing to solve (an unchanged structure)
         solveGaussSeidel(tolerance);
         return;
     }
@@ -953,16 +972,33 @@ void StressSolver::solveDirect(double tolerance) {
         v = {x[o], x[o + 1], x[o + 2]};
         w = {x[o + 3], x[o + 4], x[o + 5]};
     };
-    for (std::size_t k : held) // the warm start's active set: the pressing corners (all of a new bearing)
-        if (BondState& b = bonds_[k]; !b.corners.empty()) {
-            bool pressed = false;
-            for (const BearingCorner& c : b.corners)
-                pressed = pressed || c.press > 0;
-            for (BearingCorner& c : b.corners) {
-                c.active = !pressed || c.press > 0;
-                c.slip = false;
+    // A bond's 12 x 12 block of J^T E^-1 J over its two nodes (its held constraints).
+    std::vector<Eigen::Matrix<double, 12, 12>> blocks(pattern.size());
+    std::vector<char> stale(pattern.size(), 1);
+    auto blockOf = [&](const BondState& b, Eigen::Matrix<double, 12, 12>& block) {
+        block.setZero();
+        if (!b.broken && b.corners.empty()) {
+            Eigen::Matrix<double, 6, 12> j;
+            j.leftCols<6>() = weldJ(b.ra, 1);
+            j.rightCols<6>() = weldJ(b.rb, -1);
+            const Eigen::Map<const Eigen::Matrix<double, 6, 6, Eigen::RowMajor>> kinv(b.kinv);
+            block = j.transpose() * kinv * j / delta;
+        } else if (!b.broken) {
+            const BondInterface& x = b.bond.section;
+            const Vec3 dir[3] = {x.normal, x.u, x.v};
+            for (const BearingCorner& c : b.corners) {
+                if (!c.active)
+                    continue;
+                const double kk[3] = {c.kn, c.ku, c.kv};
+                for (int d = 0; d < (c.slip ? 1 : 3); ++d) {
+                    Eigen::Matrix<double, 12, 1> row;
+                    row << vec6(dir[d], c.ca[d]), -vec6(dir[d], c.cb[d]);
+                    if (kk[d] > 0)
+                        block += row * row.transpose() / (delta * kk[d]);
+                }
             }
         }
+    };
     const Eigen::Index n = static_cast<Eigen::Index>(6 * order.size());
     std::vector<Eigen::Triplet<double>> triplets;
     auto assemble = [&] {
@@ -976,59 +1012,49 @@ void StressSolver::solveDirect(double tolerance) {
                     triplets.emplace_back(o + 3 + r, o + 3 + c, s.node.inertia.m[r][c]);
             }
         }
-        Eigen::Matrix<double, 12, 12> block;
-        for (std::size_t k : pattern) {
-            const BondState& b = bonds_[k];
-            Eigen::Matrix<double, 6, 12> j;
-            block.setZero();
-            if (!b.broken && b.corners.empty()) {
-                j.leftCols<6>() = weldJ(b.ra, 1);
-                j.rightCols<6>() = weldJ(b.rb, -1);
-                const Eigen::Map<const Eigen::Matrix<double, 6, 6, Eigen::RowMajor>> kinv(b.kinv);
-                block = j.transpose() * kinv * j / delta;
-            } else if (!b.broken) {
-                const BondInterface& x = b.bond.section;
-                const Vec3 dir[3] = {x.normal, x.u, x.v};
-                for (const BearingCorner& c : b.corners) {
-                    if (!c.active)
-                        continue;
-                    const double kk[3] = {c.kn, c.ku, c.kv};
-                    for (int d = 0; d < (c.slip ? 1 : 3); ++d) {
-                        Eigen::Matrix<double, 12, 1> row;
-                        row << vec6(dir[d], c.ca[d]), -vec6(dir[d], c.cb[d]);
-                        if (kk[d] > 0)
-                            block += row * row.transpose() / (delta * kk[d]);
-                    }
-                }
-            }
+        for (std::size_t p = 0; p < pattern.size(); ++p) {
+            const BondState& b = bonds_[pattern[p]];
+            if (stale[p]) // else unchanged since the last round
+                blockOf(b, blocks[p]);
+            stale[p] = 0;
+            const Eigen::Matrix<double, 12, 12>& block = blocks[p];
             const int ends[2] = {index[b.bond.a], index[b.bond.b]};
-            for (int p = 0; p < 2; ++p)
-                for (int q = 0; q < 2; ++q)
-                    if (ends[p] >= 0 && ends[q] >= 0)
+            for (int e = 0; e < 2; ++e)
+                for (int f = 0; f < 2; ++f)
+                    if (ends[e] >= 0 && ends[f] >= 0)
                         for (int r = 0; r < 6; ++r)
                             for (int c = 0; c < 6; ++c)
-                                triplets.emplace_back(6 * ends[p] + r, 6 * ends[q] + c,
-                                                      block(6 * p + r, 6 * q + c));
+                                triplets.emplace_back(6 * ends[e] + r, 6 * ends[f] + c,
+                                                      block(6 * e + r, 6 * f + c));
         }
         Sparse m(n, n);
         m.setFromTriplets(triplets.begin(), triplets.end());
         return m;
     };
+    std::vector<std::size_t> key(order.begin(), order.end());
+    key.push_back(nodes_.size());
+    for (std::size_t k : pattern)
+        key.insert(key.end(), {k, bonds_[k].bond.a, bonds_[k].bond.b});
     auto factorize = [&] {
-        const Sparse m = assemble();
-        std::vector<std::size_t> key(order.begin(), order.end());
-        key.push_back(nodes_.size());
+        std::vector<char> flags;
         for (std::size_t k : pattern)
-            key.insert(key.end(), {k, bonds_[k].bond.a, bonds_[k].bond.b});
+            for (const BearingCorner& c : bonds_[k].corners)
+                flags.push_back(static_cast<char>(c.active + 2 * c.slip));
+        if (cache.factored && cache.key == key && cache.flags == flags)
+            return true; // the structure and the active set are the last factorisation's
+        const Sparse m = assemble();
+        cache.factored = false;
         if (!cache.analysed || cache.key != key) {
             cache.ldlt.analyzePattern(m);
-            cache.key = std::move(key);
+            cache.key = key;
             cache.analysed = true;
             ++analyses_;
         }
         cache.ldlt.factorize(m);
         ++factorizations_;
-        return cache.ldlt.info() == Eigen::Success;
+        cache.flags = std::move(flags);
+        cache.factored = cache.ldlt.info() == Eigen::Success;
+        return cache.factored;
     };
     auto worst = [&] {
         double m = 0;
@@ -1118,38 +1144,42 @@ void StressSolver::solveDirect(double tolerance) {
     };
     const double target2 = tolerance * tolerance / 4;
     sweeps_ = 0;
-    for (int round = 0; round < 16 && factorize(); ++round) {
+    for (int round = 0; round < 3 && factorize(); ++round) {
         double last = worst();
-        for (int i = 0; i < 40 && last > target2; ++i) {
+        for (int i = 0; i < 12 && last > target2; ++i) {
             step();
             const double now = worst();
             if (now > 0.9 * last && i >= 2)
                 break;
             last = now;
         }
+        const bool settled = last <= target2; // then only corners that pull or slip change the set
         bool changed = false;
-        for (std::size_t k : held) {
-            BondState& b = bonds_[k];
+        for (std::size_t p = 0; p < pattern.size(); ++p) {
+            BondState& b = bonds_[pattern[p]];
+            if (b.broken)
+                continue;
+            double total = 0;
+            for (const BearingCorner& c : b.corners)
+                total += std::abs(c.press);
             for (BearingCorner& c : b.corners) {
-                if (c.active && c.press < 0) {
+                bool moved = false;
+                if (c.active && c.press < -1e-6 * total) {
                     release(b, c);
-                    changed = true;
-                } else if (c.active) {
-                    // sticking past the friction limit: it slips from now on (its friction a force at the
-                    // limit)
+                    moved = true;
+                } else if (c.active) { // sticking past the friction limit: it slips (its friction a force)
                     const bool cut = limit(b, c);
-                    changed = changed || (cut && !c.slip);
+                    moved = cut && !c.slip;
                     c.slip = c.slip || cut;
-                } else {
+                } else if (!settled) {
                     const NodeState& na = nodes_[b.bond.a];
                     const NodeState& nb = nodes_[b.bond.b];
                     const double rel =
                         dot(na.v - nb.v, b.bond.section.normal) + dot(na.w, c.ca[0]) - dot(nb.w, c.cb[0]);
-                    if (rel > tolerance) {
-                        c.active = true;
-                        changed = true;
-                    }
+                    c.active = moved = rel > tolerance;
                 }
+                stale[p] = stale[p] || moved;
+                changed = changed || moved;
             }
         }
         if (!changed)
@@ -1350,6 +1380,8 @@ void StressSolver::setHealth(std::size_t i, double health) {
 }
 
 void StressSolver::breakBond(std::size_t i) {
+    if (direct_)
+        direct_->factored = false;
     if (!bonds_[i].broken) {
         markDirty(bonds_[i].bond.a);
         markDirty(bonds_[i].bond.b);
