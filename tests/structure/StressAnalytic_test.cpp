@@ -394,36 +394,42 @@ TEST(StressAnalytic, TheDirectSolveGivesConvergedGaussSeidelsForces) {
     }
 }
 
-// A rigid beam on three knife-edge bearings with its load's resultant 1.8 m right of the middle one, 0.2 m
-// left of the right one: holding every corner (the first active set) pulls on the left one, so the active set
-// lets it lift off and the lever rule between the other two gives 0.1 and 0.9 of the load. Gauss-Seidel
-// reaches one of the admissible distributions (the left pier between 0 and 0.05 of the load).
-TEST(StressAnalytic, ABeamOnThreeBearingsLiftsOffTheOneThatWouldPull) {
+// A beam of ten welded segments on three knife-edge bearings 2 m apart, its load's resultant 0.2 m inside
+// the right one: statics leaves the left one between 0 and 0.05 of the load (the middle one 0.1 less twice
+// that). Holding every corner (the first active set) pulls on one of them, so the active set lets it lift
+// off and the other two carry the load by the lever rule, before the Gauss-Seidel that follows (clamping the
+// pull and iterating instead needs more sweeps along the beam). Gauss-Seidel alone lands inside the range.
+TEST(StressAnalytic, ABeamOnThreeBearingsLiftsOffOneThatWouldPull) {
     Lattice l;
     const double edge = 0.004, rho = 2400;
-    std::vector<std::uint32_t> piers;
-    for (const double x : {-2.0, 0.0, 2.0})
+    std::vector<std::uint32_t> piers, segs;
+    for (const double x : {-1.75, 0.25, 2.25})
         piers.push_back(l.add(box({x - edge / 2, -1, -0.5}, {x + edge / 2, 0, 0.5}), rho, true, 0.6));
-    const std::uint32_t beam = l.add(box({-2.5, 0, -0.5}, {2.5, 0.4, 0.5}), rho, false, 0.6);
-    const double weight = l.mass(beam) * kG, load = 4.5 * weight, total = weight + load;
+    for (int i = 0; i < 10; ++i)
+        segs.push_back(l.add(box({-2.5 + 0.5 * i, 0, -0.5}, {-2 + 0.5 * i, 0.4, 0.5}), rho));
+    double weight = 0;
+    for (std::uint32_t i : segs)
+        weight += l.mass(i) * kG;
+    const double load = weight * 2.05 / (2.4 - 2.05), total = weight + load; // resultant at x = 2.05
+    const std::uint32_t over[3] = {segs[1], segs[5], segs[9]};
     for (const StressSettings& settings : withBearings()) {
         SCOPED_TRACE(name(settings));
         StressSolver s = l.solver(settings);
-        s.addLoad(beam, {0, -load, 0}, {2.2, 0.4, 0});
+        s.addLoad(segs[9], {0, -load, 0}, {2.4, 0.4, 0});
         s.solve();
         EXPECT_LE(s.residual(), settings.residual);
         double r[3];
         for (int i = 0; i < 3; ++i)
-            r[i] = forceOn(s, bondBetween(s, piers[static_cast<std::size_t>(i)], beam), beam).y;
-        EXPECT_NEAR(r[0] + r[1] + r[2], total, 1e-3 * total);
+            r[i] = forceOn(s, bondBetween(s, piers[static_cast<std::size_t>(i)], over[i]), over[i]).y;
+        EXPECT_NEAR(r[0] + r[1] + r[2], total, 1e-2 * total);
+        EXPECT_GE(r[0], -1e-3 * total);
+        EXPECT_GE(r[1], -1e-3 * total);
+        EXPECT_NEAR(r[1], 0.1 * total - 2 * r[0], 0.01 * total);
+        EXPECT_NEAR(r[2], 0.9 * total + r[0], 0.01 * total);
         if (settings.method == StressMethod::Direct) {
-            EXPECT_GE(s.factorizations(), 2) << "the left pier's corners left the active set";
-            EXPECT_NEAR(r[0], 0, 1e-3 * total) << "the left bearing lifts off";
-            EXPECT_NEAR(r[1], 0.1 * total, 0.01 * total);
-            EXPECT_NEAR(r[2], 0.9 * total, 0.01 * total);
-        } else {
-            EXPECT_GE(r[0], -1e-3 * total);
-            EXPECT_LE(r[0], 0.06 * total);
+            EXPECT_GE(s.factorizations(), 2) << "a pulling pier's corners left the active set";
+            EXPECT_LE(s.sweeps(), 12) << "the active set settles it, not the Gauss-Seidel that follows";
+            EXPECT_NEAR(std::min(r[0], r[1]), 0, 1e-3 * total) << "one bearing lifts off";
         }
         EXPECT_TRUE(s.unsupported().empty());
     }
