@@ -102,6 +102,7 @@ struct StressSolver::DirectCache {
     Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
     bool analysed = false;
     bool factored = false; // the numeric factorisation matches the nodes and bonds (until one changes)
+    double compliance = 0; // the one it was made with
 };
 
 StructureNode structureNode(const std::vector<ConvexPolytope>& parts, double density, bool root) {
@@ -1040,7 +1041,7 @@ void StressSolver::solveDirect(double tolerance) {
         for (std::size_t k : pattern)
             for (const BearingCorner& c : bonds_[k].corners)
                 flags.push_back(static_cast<char>(c.active + 2 * c.slip));
-        if (cache.factored && cache.key == key && cache.flags == flags)
+        if (cache.factored && cache.key == key && cache.flags == flags && cache.compliance == delta)
             return true; // the structure and the active set are the last factorisation's
         const Sparse m = assemble();
         cache.factored = false;
@@ -1053,6 +1054,7 @@ void StressSolver::solveDirect(double tolerance) {
         cache.ldlt.factorize(m);
         ++factorizations_;
         cache.flags = std::move(flags);
+        cache.compliance = delta;
         cache.factored = cache.ldlt.info() == Eigen::Success;
         return cache.factored;
     };
