@@ -88,6 +88,7 @@ struct SceneArgs {
     double bearingFriction = 0.6;    // with structure: objects rest on each other as bearings (0: welded)
     int structureIterations = 0;     // with structure: solver sweeps per frame (0: the library's)
     bool structureConverged = false; // with structure: the converged Gauss-Seidel solve
+    std::string structureSolver;     // with structure: gauss-seidel, conjugate-gradient, direct (or empty)
     double projectileSpeed = 120;
     double projectileMass = 2;
     double projectileRadius = 0.25;
@@ -194,7 +195,11 @@ int runScene(const SceneArgs& a, SceneSummary* summary = nullptr) {
         rc.structure.stress.method = rubble::StressMethod::SweepBudget;
         rc.structure.stress.iterations = a.structureIterations;
         rc.structure.stress.tolerance = 0.05;
-    } else if (a.structureConverged) {
+    } else if (a.structureSolver == "direct") {
+        rc.structure.stress.method = rubble::StressMethod::Direct;
+    } else if (a.structureSolver == "conjugate-gradient") {
+        rc.structure.stress.method = rubble::StressMethod::ConjugateGradient;
+    } else if (a.structureConverged || a.structureSolver == "gauss-seidel") {
         rc.structure.stress.method = rubble::StressMethod::GaussSeidel;
     }
     PhysicsWorld physics;
@@ -545,6 +550,9 @@ rubble::tools::Registrar registrar{
          app.add_flag(
              "--structure-converged", args->structureConverged,
              "with --structure: the converged Gauss-Seidel solve (relative residual 1e-3 every frame)");
+         app.add_option("--structure-solver", args->structureSolver,
+                        "with --structure: the converged solve to use (relative residual 1e-3 every frame)")
+             ->check(CLI::IsMember({"gauss-seidel", "conjugate-gradient", "direct"}));
          app.add_option("--projectile-speed", args->projectileSpeed, "m/s");
          app.add_option("--projectile-mass", args->projectileMass, "kg");
          app.add_flag("--rough", args->rough,

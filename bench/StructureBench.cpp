@@ -1,15 +1,17 @@
-// `rubble-bench structure [--quick] [--frames N] [--iterations N] [--json] [--convergence] [--out DIR]`
+// `rubble-bench structure [--quick] [--frames N] [--iterations N] [--solvers A,B] [--sizes K,..] [--json]
+// [--convergence] [--out DIR]`
 //
 // Stress-solver cost per frame under fire against bond count, one row per solver: a block of stacked bricks
 // (k x h x k, 1 x 0.5 x 1 m each) on a ground root, each brick welded to its face neighbours; every frame one
 // brick is replaced by its Voronoi pieces and debris loads land on random bricks, then one solve (thread CPU
-// time) with its relative residual. Solvers: the converged Gauss-Seidel and conjugate gradient, and the old
-// sweep budget at 12 sweeps (and at --iterations, default 25, as Blast). Also the first solve's cost, and
-// what one fracture costs the structure: a brick replaced by its pieces, updated incrementally (BondGraph and
-// the solver's add/remove, as StructureMonitor does) against a from-scratch rebuild (buildBonds and reset).
-// Table on stdout (or with --json one row per graph size and solver: {"bonds", "solver", "solve_ms": {"p50",
-// "p99"}, "residual": {"p50", "max"}, ...}), CSV in DIR/structure.csv, plots in DIR/structure.png and
-// DIR/structure_convergence.png (residual against time of a first solve from zero forces, per solver).
+// time) with its relative residual. Solvers: the converged Gauss-Seidel, conjugate gradient and direct
+// (sparse LDLT with an active set), and the old sweep budget at 12 sweeps (and at --iterations, default 25,
+// as Blast). Also the first solve's cost, and what one fracture costs the structure: a brick replaced by its
+// pieces, updated incrementally (BondGraph and the solver's add/remove, as StructureMonitor does) against a
+// from-scratch rebuild (buildBonds and reset). Table on stdout (or with --json one row per graph size and
+// solver: {"bonds", "solver", "solve_ms": {"p50", "p99"}, "residual": {"p50", "max"}, ...}), CSV in
+// DIR/structure.csv, plots in DIR/structure.png and DIR/structure_convergence.png (residual against time of a
+// first solve from zero forces, per solver).
 #include <algorithm>
 #include <chrono>
 #include <ctime>
@@ -35,6 +37,8 @@ struct BenchArgs {
     bool convergenceOnly = false;
     int frames = 60;
     int iterations = 25;
+    std::vector<std::string> solvers; // only these rows (empty: all)
+    std::vector<int> sizes;           // block sizes k (k x h x k, h as in the default list; empty: all)
     std::string out = rubble::bench::kResultsDir;
 };
 
@@ -106,6 +110,7 @@ struct Solver {
 std::vector<Solver> solvers(int iterations) {
     std::vector<Solver> out{{"gauss-seidel", rubble::StressMethod::GaussSeidel, 0},
                             {"conjugate-gradient", rubble::StressMethod::ConjugateGradient, 0},
+                            {"direct", rubble::StressMethod::Direct, 0},
                             {"sweeps-12", rubble::StressMethod::SweepBudget, 12}};
     if (iterations != 12)
         out.push_back(
@@ -323,10 +328,18 @@ std::string convergence(int k, int h, const std::vector<Solver>& list, std::vect
 int runBench(const BenchArgs& args) {
     const int frames = args.quick ? 5 : std::max(1, args.frames);
     // (k, h): bonds ~ 3 k^2 h.
-    const std::vector<std::pair<int, int>> sizes =
+    std::vector<std::pair<int, int>> sizes =
         args.quick ? std::vector<std::pair<int, int>>{{4, 4}, {8, 8}}
                    : std::vector<std::pair<int, int>>{{4, 4}, {8, 8}, {12, 12}, {16, 26}, {20, 34}};
-    const std::vector<Solver> list = solvers(args.iterations);
+    if (!args.sizes.empty())
+        std::erase_if(sizes, [&](const auto& s) {
+            return std::find(args.sizes.begin(), args.sizes.end(), s.first) == args.sizes.end();
+        });
+    std::vector<Solver> list = solvers(args.iterations);
+    if (!args.solvers.empty())
+        std::erase_if(list, [&](const Solver& s) {
+            return std::find(args.solvers.begin(), args.solvers.end(), s.name) == args.solvers.end();
+        });
     const rubble::bench::CpuMeter cpu;
     std::vector<Row> rows;
     for (const auto& [k, h] : sizes)
@@ -424,6 +437,13 @@ const rubble::tools::Registrar registrar{
          app.add_option("--frames", args->frames, "timed frames per case")->check(CLI::Range(1, 100000));
          app.add_option("--iterations", args->iterations, "sweeps a frame of a second sweep-budget row")
              ->check(CLI::Range(1, 1000));
+         app.add_option("--solvers", args->solvers,
+                        "only these rows (gauss-seidel, conjugate-gradient, direct, sweeps-12, sweeps-N)")
+             ->delimiter(',');
+         app.add_option("--sizes", args->sizes,
+                        "only these block sizes k (4, 8, 12, 16, 20; 16: 19,136 bonds)")
+             ->delimiter(',')
+             ->check(CLI::IsMember({4, 8, 12, 16, 20}));
          app.add_option("--out", args->out, "folder for structure.csv and structure.png");
          return [args] { return runBench(*args); };
      }}};

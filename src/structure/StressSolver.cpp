@@ -1,9 +1,12 @@
 #include "rubble/structure/StressSolver.hpp"
 
 #include <Eigen/Dense>
+#include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <map>
 
@@ -92,6 +95,16 @@ std::vector<Vec2> bearingCorners(const std::vector<Vec2>& corners) {
 
 } // namespace
 
+// The direct solve's factorisation, kept across solves while the structure and the active set stay.
+struct StressSolver::DirectCache {
+    std::vector<std::size_t> key; // the movable nodes in unknown order, then each bond's slot and nodes
+    std::vector<char> flags;      // each corner's active and slip flags the factorisation holds
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
+    bool analysed = false;
+    bool factored = false; // the numeric factorisation matches the nodes and bonds (until one changes)
+    double compliance = 0; // the one it was made with
+};
+
 StructureNode structureNode(const std::vector<ConvexPolytope>& parts, double density, bool root) {
     StructureNode n;
     n.root = root;
@@ -144,6 +157,8 @@ void StressSolver::reset(std::vector<StructureNode> nodes, std::vector<Bond> bon
 }
 
 std::uint32_t StressSolver::addNode(const StructureNode& node) {
+    if (direct_)
+        direct_->factored = false;
     NodeState s;
     s.node = node;
     if (!node.root && node.mass > 0) {
@@ -162,6 +177,8 @@ std::uint32_t StressSolver::addNode(const StructureNode& node) {
 }
 
 void StressSolver::removeNode(std::uint32_t node) {
+    if (direct_)
+        direct_->factored = false;
     NodeState& n = nodes_[node];
     if (n.removed)
         return;
@@ -184,6 +201,8 @@ void StressSolver::removeNode(std::uint32_t node) {
 }
 
 std::size_t StressSolver::addBond(Bond bond, StrengthLimits limits) {
+    if (direct_)
+        direct_->factored = false;
     BondState s;
     s.bond = std::move(bond);
     s.limits = limits;
@@ -208,6 +227,8 @@ std::size_t StressSolver::addBond(Bond bond, StrengthLimits limits) {
 }
 
 void StressSolver::removeBond(std::size_t i) {
+    if (direct_)
+        direct_->factored = false;
     BondState& b = bonds_[i];
     for (std::uint32_t n : {b.bond.a, b.bond.b}) {
         std::erase(nodes_[n].bonds, i);
@@ -221,6 +242,8 @@ void StressSolver::removeBond(std::size_t i) {
 }
 
 void StressSolver::setRoot(std::uint32_t node, bool root) {
+    if (direct_)
+        direct_->factored = false;
     NodeState& n = nodes_[node];
     n.node.root = root;
     n.invMass = 0;
@@ -426,10 +449,11 @@ void StressSolver::solve() {
     const double scale = startSolve();
     scale_ = scale;
     history_.clear();
-    if (!routes_.empty())
+    if (!routes_.empty() && settings_.method != StressMethod::Direct)
         route(routes_);
-    if (!newcomers.empty())
+    if (!newcomers.empty() && settings_.method != StressMethod::Direct)
         settleAmong(newcomers, settings_.residual * scale);
+    factorizations_ = 0;
     switch (settings_.method) {
     case StressMethod::SweepBudget:
         solveSweepBudget();
@@ -439,6 +463,9 @@ void StressSolver::solve() {
         break;
     case StressMethod::ConjugateGradient:
         solveConjugateGradient(settings_.residual * scale);
+        break;
+    case StressMethod::Direct:
+        solveDirect(settings_.residual * scale);
         break;
     }
     finishSolve(scale);
@@ -888,6 +915,289 @@ void StressSolver::solveConjugateGradient(double tolerance) {
     }
 }
 
+// The regularised bond system in node unknowns: the new accelerations a' of the movable nodes minimise
+// (a' - a)^T M (a' - a) + sum over held constraints (J a')^2 / e, e = compliance times the constraint's own
+// inverse effective mass, so (M + J^T E^-1 J) a' = M a, and the constraint forces change by -E^-1 J a'
+// (augmented Lagrangian: repeated, the forces converge to J a = 0 from the warm start). A bearing's corners
+// are held (normal and friction, sticking); a corner pulling leaves the set, one penetrating rejoins it and
+// one sticking past friction slips (its friction a force at the limit from then on), each change a numeric
+// refactorisation of the same pattern (at most three a solve). The set and the factorisation are kept
+// across solves until a node, bond or corner changes. Gauss-Seidel then meets the residual.
+void StressSolver::solveDirect(double tolerance) {
+    using Vec6 = Eigen::Matrix<double, 6, 1>;
+    using Sparse = Eigen::SparseMatrix<double>;
+    const double delta = std::max(settings_.compliance, 1e-12);
+    if (!direct_ || direct_.use_count() > 1)
+        direct_ = std::make_shared<DirectCache>();
+    DirectCache& cache = *direct_;
+    std::vector<std::uint32_t> order;
+    std::vector<int> index(nodes_.size(), -1);
+    for (std::uint32_t i = 0; i < nodes_.size(); ++i)
+        if (movable(i)) {
+            index[i] = static_cast<int>(order.size());
+            order.push_back(i);
+        }
+    std::vector<std::size_t> pattern;
+    for (std::size_t k = 0; k < bonds_.size(); ++k) {
+        const BondState& b = bonds_[k];
+        if (!b.removed && b.solvable && (index[b.bond.a] >= 0 || index[b.bond.b] >= 0))
+            pattern.push_back(k); // broken ones too (zero blocks): a break keeps the symbolic factorisation
+    }
+    std::vector<std::size_t> held;
+    for (std::size_t k : pattern)
+        if (!bonds_[k].broken)
+            held.push_back(k);
+    double start = 0;
+    for (std::uint32_t i : order)
+        start = std::max(start, nodeResidual(nodes_[i]));
+    if (order.empty() || start <= tolerance * tolerance) { // nothing to solve (an unchanged structure)
+        solveGaussSeidel(tolerance);
+        return;
+    }
+    // A node's Jacobian for a weld: relative (linear, angular) acceleration from the node's (v, w).
+    auto weldJ = [](const Vec3& r, double sign) {
+        Mat6 j = Mat6::Identity();
+        j.topRightCorner<3, 3>() = -skew(r);
+        return Mat6(j * sign);
+    };
+    auto vec6 = [](const Vec3& a, const Vec3& b) {
+        return (Vec6() << a.x, a.y, a.z, b.x, b.y, b.z).finished();
+    };
+    const Vec3 none;
+    auto accel = [&](const Eigen::VectorXd& x, std::uint32_t n, Vec3& v, Vec3& w) {
+        if (index[n] < 0) {
+            v = w = none;
+            return;
+        }
+        const Eigen::Index o = 6 * index[n];
+        v = {x[o], x[o + 1], x[o + 2]};
+        w = {x[o + 3], x[o + 4], x[o + 5]};
+    };
+    // A bond's 12 x 12 block of J^T E^-1 J over its two nodes (its held constraints).
+    std::vector<Eigen::Matrix<double, 12, 12>> blocks(pattern.size());
+    std::vector<char> stale(pattern.size(), 1);
+    auto blockOf = [&](const BondState& b, Eigen::Matrix<double, 12, 12>& block) {
+        block.setZero();
+        if (!b.broken && b.corners.empty()) {
+            Eigen::Matrix<double, 6, 12> j;
+            j.leftCols<6>() = weldJ(b.ra, 1);
+            j.rightCols<6>() = weldJ(b.rb, -1);
+            const Eigen::Map<const Eigen::Matrix<double, 6, 6, Eigen::RowMajor>> kinv(b.kinv);
+            block = j.transpose() * kinv * j / delta;
+        } else if (!b.broken) {
+            const BondInterface& x = b.bond.section;
+            const Vec3 dir[3] = {x.normal, x.u, x.v};
+            for (const BearingCorner& c : b.corners) {
+                if (!c.active)
+                    continue;
+                const double kk[3] = {c.kn, c.ku, c.kv};
+                for (int d = 0; d < (c.slip ? 1 : 3); ++d) {
+                    Eigen::Matrix<double, 12, 1> row;
+                    row << vec6(dir[d], c.ca[d]), -vec6(dir[d], c.cb[d]);
+                    if (kk[d] > 0)
+                        block += row * row.transpose() / (delta * kk[d]);
+                }
+            }
+        }
+    };
+    const Eigen::Index n = static_cast<Eigen::Index>(6 * order.size());
+    std::vector<Eigen::Triplet<double>> triplets;
+    auto assemble = [&] {
+        triplets.clear();
+        for (std::uint32_t i : order) {
+            const NodeState& s = nodes_[i];
+            const int o = 6 * index[i];
+            for (int r = 0; r < 3; ++r) {
+                triplets.emplace_back(o + r, o + r, s.node.mass);
+                for (int c = 0; c < 3; ++c)
+                    triplets.emplace_back(o + 3 + r, o + 3 + c, s.node.inertia.m[r][c]);
+            }
+        }
+        for (std::size_t p = 0; p < pattern.size(); ++p) {
+            const BondState& b = bonds_[pattern[p]];
+            if (stale[p]) // else unchanged since the last round
+                blockOf(b, blocks[p]);
+            stale[p] = 0;
+            const Eigen::Matrix<double, 12, 12>& block = blocks[p];
+            const int ends[2] = {index[b.bond.a], index[b.bond.b]};
+            for (int e = 0; e < 2; ++e)
+                for (int f = 0; f < 2; ++f)
+                    if (ends[e] >= 0 && ends[f] >= 0)
+                        for (int r = 0; r < 6; ++r)
+                            for (int c = 0; c < 6; ++c)
+                                triplets.emplace_back(6 * ends[e] + r, 6 * ends[f] + c,
+                                                      block(6 * e + r, 6 * f + c));
+        }
+        Sparse m(n, n);
+        m.setFromTriplets(triplets.begin(), triplets.end());
+        return m;
+    };
+    std::vector<std::size_t> key(order.begin(), order.end());
+    key.push_back(nodes_.size());
+    for (std::size_t k : pattern)
+        key.insert(key.end(), {k, bonds_[k].bond.a, bonds_[k].bond.b});
+    auto factorize = [&] {
+        std::vector<char> flags;
+        for (std::size_t k : pattern)
+            for (const BearingCorner& c : bonds_[k].corners)
+                flags.push_back(static_cast<char>(c.active + 2 * c.slip));
+        if (cache.factored && cache.key == key && cache.flags == flags && cache.compliance == delta)
+            return true; // the structure and the active set are the last factorisation's
+        const Sparse m = assemble();
+        cache.factored = false;
+        if (!cache.analysed || cache.key != key) {
+            cache.ldlt.analyzePattern(m);
+            cache.key = key;
+            cache.analysed = true;
+            ++analyses_;
+        }
+        cache.ldlt.factorize(m);
+        ++factorizations_;
+        cache.flags = std::move(flags);
+        cache.compliance = delta;
+        cache.factored = cache.ldlt.info() == Eigen::Success;
+        return cache.factored;
+    };
+    auto worst = [&] {
+        double m = 0;
+        for (std::uint32_t i : order)
+            m = std::max(m, nodeResidual(nodes_[i]));
+        return m;
+    };
+    // One augmented-Lagrangian step: solve for a', move every held constraint's force by -E^-1 J a'.
+    Eigen::VectorXd rhs(n), x(n);
+    auto step = [&] {
+        for (std::uint32_t i : order) {
+            const NodeState& s = nodes_[i];
+            const Vec3 lw = s.node.inertia * s.w;
+            rhs.segment<6>(6 * index[i]) = vec6(s.v * s.node.mass, lw);
+        }
+        x = cache.ldlt.solve(rhs);
+        for (std::size_t k : held) {
+            BondState& b = bonds_[k];
+            Vec3 va, wa, vb, wb;
+            accel(x, b.bond.a, va, wa);
+            accel(x, b.bond.b, vb, wb);
+            if (b.corners.empty()) {
+                const Vec3 lin = (va + cross(wa, b.ra)) - (vb + cross(wb, b.rb)), ang = wa - wb;
+                const Vec6 rel = vec6(lin, ang);
+                const Eigen::Map<const Eigen::Matrix<double, 6, 6, Eigen::RowMajor>> kinv(b.kinv);
+                const Vec6 d = -(kinv * rel) / delta;
+                const Vec3 df{d[0], d[1], d[2]}, dm{d[3], d[4], d[5]};
+                b.force += df;
+                b.moment += dm;
+                apply(b, df, dm);
+                continue;
+            }
+            const BondInterface& sec = b.bond.section;
+            const Vec3 dir[3] = {sec.normal, sec.u, sec.v};
+            NodeState& na = nodes_[b.bond.a];
+            NodeState& nb = nodes_[b.bond.b];
+            for (BearingCorner& c : b.corners) {
+                if (!c.active)
+                    continue;
+                const double kk[3] = {c.kn, c.ku, c.kv};
+                for (int d = 0; d < (c.slip ? 1 : 3); ++d) {
+                    if (kk[d] <= 0)
+                        continue;
+                    const double rel = dot(va - vb, dir[d]) + dot(wa, c.ca[d]) - dot(wb, c.cb[d]);
+                    const double l = -rel / (delta * kk[d]); // along dir[d] on a, its opposite on b
+                    na.v += dir[d] * (l * na.invMass);
+                    na.w += c.ia[d] * l;
+                    nb.v -= dir[d] * (l * nb.invMass);
+                    nb.w -= c.ib[d] * l;
+                    (d == 0 ? c.press : d == 1 ? c.gu : c.gv) += d == 0 ? -l : l;
+                }
+            }
+        }
+        ++sweeps_;
+        traceSweep();
+    };
+    // Sets a corner's forces (press, friction along u and v), applying the change to its nodes.
+    auto set = [&](BondState& b, BearingCorner& c, double press, double gu, double gv) {
+        NodeState& na = nodes_[b.bond.a];
+        NodeState& nb = nodes_[b.bond.b];
+        const BondInterface& sec = b.bond.section;
+        const Vec3 dir[3] = {sec.normal, sec.u, sec.v};
+        const double l[3] = {c.press - press, gu - c.gu, gv - c.gv};
+        for (int d = 0; d < 3; ++d) {
+            na.v += dir[d] * (l[d] * na.invMass);
+            na.w += c.ia[d] * l[d];
+            nb.v -= dir[d] * (l[d] * nb.invMass);
+            nb.w -= c.ib[d] * l[d];
+        }
+        c.press = press;
+        c.gu = gu;
+        c.gv = gv;
+    };
+    // A corner leaves the set: its forces go.
+    auto release = [&](BondState& b, BearingCorner& c) {
+        set(b, c, 0, 0, 0);
+        c.active = false;
+    };
+    // Friction within its limit; returns true when it had to be cut (the corner then slips).
+    auto limit = [&](BondState& b, BearingCorner& c) {
+        const double grip = b.limits.friction * std::max(c.press, 0.0), g = std::hypot(c.gu, c.gv);
+        if (g <= grip * (1 + 1e-9))
+            return false;
+        const double f = g > 0 ? grip / g : 0.0;
+        set(b, c, c.press, c.gu * f, c.gv * f);
+        return true;
+    };
+    const double target2 = tolerance * tolerance / 4;
+    sweeps_ = 0;
+    for (int round = 0; round < 3 && factorize(); ++round) {
+        double last = worst();
+        for (int i = 0; i < 12 && last > target2; ++i) {
+            step();
+            const double now = worst();
+            if (now > 0.9 * last && i >= 2)
+                break;
+            last = now;
+        }
+        const bool settled = last <= target2; // then only corners that pull or slip change the set
+        bool changed = false;
+        for (std::size_t p = 0; p < pattern.size(); ++p) {
+            BondState& b = bonds_[pattern[p]];
+            if (b.broken)
+                continue;
+            double total = 0;
+            for (const BearingCorner& c : b.corners)
+                total += std::abs(c.press);
+            for (BearingCorner& c : b.corners) {
+                bool moved = false;
+                if (c.active && c.press < -1e-6 * total) {
+                    release(b, c);
+                    moved = true;
+                } else if (c.active) { // sticking past the friction limit: it slips (its friction a force)
+                    const bool cut = limit(b, c);
+                    moved = cut && !c.slip;
+                    c.slip = c.slip || cut;
+                } else if (!settled) {
+                    const NodeState& na = nodes_[b.bond.a];
+                    const NodeState& nb = nodes_[b.bond.b];
+                    const double rel =
+                        dot(na.v - nb.v, b.bond.section.normal) + dot(na.w, c.ca[0]) - dot(nb.w, c.cb[0]);
+                    c.active = moved = rel > tolerance;
+                }
+                stale[p] = stale[p] || moved;
+                changed = changed || moved;
+            }
+        }
+        if (!changed)
+            break;
+    }
+    const int directSweeps = sweeps_;
+    for (std::size_t k : held) // what still pulls lets go; Gauss-Seidel takes it from here
+        for (BearingCorner& c : bonds_[k].corners) {
+            if (c.press < 0)
+                release(bonds_[k], c);
+            limit(bonds_[k], c);
+        }
+    solveGaussSeidel(tolerance);
+    sweeps_ += directSweeps;
+}
+
 // Bearings' resultants, the residual, and the count of solves each node has been left unbalanced.
 void StressSolver::finishSolve(double scale) {
     for (BondState& b : bonds_)
@@ -1072,6 +1382,8 @@ void StressSolver::setHealth(std::size_t i, double health) {
 }
 
 void StressSolver::breakBond(std::size_t i) {
+    if (direct_)
+        direct_->factored = false;
     if (!bonds_[i].broken) {
         markDirty(bonds_[i].bond.a);
         markDirty(bonds_[i].bond.b);

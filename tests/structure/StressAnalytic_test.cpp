@@ -56,16 +56,25 @@ using test::bondBetween;
 
 // The converged solvers (one solve from zero forces reaches the residual).
 std::vector<StressSettings> converged() {
-    StressSettings gs, cg;
+    StressSettings gs, cg, direct;
     gs.method = StressMethod::GaussSeidel;
     cg.method = StressMethod::ConjugateGradient;
-    gs.residual = cg.residual = 1e-3;
-    gs.maxSweeps = cg.maxSweeps = 100000;
-    return {gs, cg};
+    direct.method = StressMethod::Direct;
+    gs.residual = cg.residual = direct.residual = 1e-3;
+    gs.maxSweeps = cg.maxSweeps = direct.maxSweeps = 100000;
+    return {gs, cg, direct};
+}
+
+// The solvers that handle bearings exactly (projected Gauss-Seidel, the active set).
+std::vector<StressSettings> withBearings() {
+    const std::vector<StressSettings> all = converged();
+    return {all.front(), all.back()};
 }
 
 const char* name(const StressSettings& s) {
-    return s.method == StressMethod::GaussSeidel ? "gauss-seidel" : "conjugate gradient";
+    return s.method == StressMethod::GaussSeidel         ? "gauss-seidel"
+           : s.method == StressMethod::ConjugateGradient ? "conjugate gradient"
+                                                         : "direct";
 }
 
 // The force node b exerts on node a (a < b as bonds store it), as seen from `on`.
@@ -207,76 +216,82 @@ ConvexPolytope rafter(double foot, double t, double crown, double rise, double d
 // thrust at each foot is H = W e / f (W a rafter's weight, e its centroid's distance from the foot's hinge,
 // f the crown's height above it), within 1 %; the feet carry it by friction.
 TEST(StressAnalytic, ThreeHingedArchThrustsHorizontallyAsStaticsSays) {
-    StressSettings settings = converged().front();
-    Lattice l;
-    const double half = 2.0, rise = 2.5, t = 0.3, d = 0.15, depth = 0.4, edge = 0.004, key = 0.1, rho = 2400;
-    const double hingeL = -half - t / 2, hingeR = half + t / 2;
-    const std::uint32_t footL =
-        l.add(box({hingeL - edge / 2, -1, -depth / 2}, {hingeL + edge / 2, 0, depth / 2}), rho, true, 0.6);
-    const std::uint32_t footR =
-        l.add(box({hingeR - edge / 2, -1, -depth / 2}, {hingeR + edge / 2, 0, depth / 2}), rho, true, 0.6);
-    const std::uint32_t left = l.add(rafter(-half - t, t, -key / 2, rise, d, depth), rho, false, 0.6);
-    const std::uint32_t right = l.add(rafter(half + t, t, key / 2, rise, d, depth), rho, false, 0.6);
-    const std::uint32_t crown = l.add(
-        box({-key / 2, rise - edge / 2, -depth / 2}, {key / 2, rise + edge / 2, depth / 2}), rho, false, 0.6);
-    StressSolver s = l.solver(settings);
-    s.solve();
-    EXPECT_LE(s.residual(), settings.residual);
-    const StructureNode r = structureNode(l.solids[left], rho, false);
-    const double keyWeight = l.mass(crown) * kG;
-    // Moments about the left foot's hinge: H f = W e + (key weight / 2) (crown's x - hinge)
-    const double thrust =
-        (r.mass * kG * (r.centroid.x - hingeL) + keyWeight / 2 * (-key / 2 - hingeL)) / rise;
-    const Vec3 fl = forceOn(s, bondBetween(s, footL, left), left);
-    const Vec3 fr = forceOn(s, bondBetween(s, footR, right), right);
-    EXPECT_NEAR(fl.x, thrust, 0.01 * thrust);
-    EXPECT_NEAR(-fr.x, thrust, 0.01 * thrust);
-    EXPECT_NEAR(fl.y, r.mass * kG + keyWeight / 2, 0.01 * r.mass * kG);
-    EXPECT_LT(thrust, 0.6 * fl.y) << "friction holds the feet";
-    const Vec3 atCrown = forceOn(s, bondBetween(s, left, crown), crown);
-    EXPECT_NEAR(atCrown.x, thrust, 0.01 * thrust) << "the key carries the thrust across";
-    EXPECT_TRUE(s.unsupported().empty());
+    for (const StressSettings& settings : withBearings()) {
+        SCOPED_TRACE(name(settings));
+        Lattice l;
+        const double half = 2.0, rise = 2.5, t = 0.3, d = 0.15, depth = 0.4, edge = 0.004, key = 0.1,
+                     rho = 2400;
+        const double hingeL = -half - t / 2, hingeR = half + t / 2;
+        const std::uint32_t footL = l.add(
+            box({hingeL - edge / 2, -1, -depth / 2}, {hingeL + edge / 2, 0, depth / 2}), rho, true, 0.6);
+        const std::uint32_t footR = l.add(
+            box({hingeR - edge / 2, -1, -depth / 2}, {hingeR + edge / 2, 0, depth / 2}), rho, true, 0.6);
+        const std::uint32_t left = l.add(rafter(-half - t, t, -key / 2, rise, d, depth), rho, false, 0.6);
+        const std::uint32_t right = l.add(rafter(half + t, t, key / 2, rise, d, depth), rho, false, 0.6);
+        const std::uint32_t crown =
+            l.add(box({-key / 2, rise - edge / 2, -depth / 2}, {key / 2, rise + edge / 2, depth / 2}), rho,
+                  false, 0.6);
+        StressSolver s = l.solver(settings);
+        s.solve();
+        EXPECT_LE(s.residual(), settings.residual);
+        const StructureNode r = structureNode(l.solids[left], rho, false);
+        const double keyWeight = l.mass(crown) * kG;
+        // Moments about the left foot's hinge: H f = W e + (key weight / 2) (crown's x - hinge)
+        const double thrust =
+            (r.mass * kG * (r.centroid.x - hingeL) + keyWeight / 2 * (-key / 2 - hingeL)) / rise;
+        const Vec3 fl = forceOn(s, bondBetween(s, footL, left), left);
+        const Vec3 fr = forceOn(s, bondBetween(s, footR, right), right);
+        EXPECT_NEAR(fl.x, thrust, 0.01 * thrust);
+        EXPECT_NEAR(-fr.x, thrust, 0.01 * thrust);
+        EXPECT_NEAR(fl.y, r.mass * kG + keyWeight / 2, 0.01 * r.mass * kG);
+        EXPECT_LT(thrust, 0.6 * fl.y) << "friction holds the feet";
+        const Vec3 atCrown = forceOn(s, bondBetween(s, left, crown), crown);
+        EXPECT_NEAR(atCrown.x, thrust, 0.01 * thrust) << "the key carries the thrust across";
+        EXPECT_TRUE(s.unsupported().empty());
+    }
 }
 
 // Three blocks stacked on bearings, the top one pushed sideways: each interface carries the weight above in
 // compression and the push in friction; a push over mu times the top block's weight slides it off, and the
 // blocks below, pressed harder, hold.
 TEST(StressAnalytic, StackOnBearingsCarriesWeightAndFrictionUpToItsLimit) {
-    for (const double ratio : {0.9, 1.3}) {
-        SCOPED_TRACE(ratio);
-        StressSettings settings = converged().front();
-        settings.maxSweeps = 2000; // a block that slides never converges
-        Lattice l;
-        const double rho = 2400;
-        const std::uint32_t ground = l.add(box({-2, -1, -2}, {2, 0, 2}), rho, true, 0.6);
-        std::vector<std::uint32_t> blocks;
-        for (int i = 0; i < 3; ++i)
-            blocks.push_back(l.add(box({-0.5, 0.5 * i, -0.5}, {0.5, 0.5 * (i + 1), 0.5}), rho, false, 0.6));
-        StressSolver s = l.solver(settings);
-        const double top = l.mass(blocks[2]) * kG, push = ratio * 0.6 * top;
-        for (int frame = 0; frame < settings.unbalancedSolves + 1; ++frame) {
-            s.addLoad(blocks[2], {push, 0, 0}, {0, 1.25, 0});
-            s.solve();
-            if (frame > 0) { // the sliding block is left out after stallSweeps, not iterated to maxSweeps
-                EXPECT_LT(s.sweeps(), 256) << "frame " << frame;
+    for (StressSettings settings : withBearings())
+        for (const double ratio : {0.9, 1.3}) {
+            SCOPED_TRACE(name(settings));
+            SCOPED_TRACE(ratio);
+            settings.maxSweeps = 2000; // a block that slides never converges
+            Lattice l;
+            const double rho = 2400;
+            const std::uint32_t ground = l.add(box({-2, -1, -2}, {2, 0, 2}), rho, true, 0.6);
+            std::vector<std::uint32_t> blocks;
+            for (int i = 0; i < 3; ++i)
+                blocks.push_back(
+                    l.add(box({-0.5, 0.5 * i, -0.5}, {0.5, 0.5 * (i + 1), 0.5}), rho, false, 0.6));
+            StressSolver s = l.solver(settings);
+            const double top = l.mass(blocks[2]) * kG, push = ratio * 0.6 * top;
+            for (int frame = 0; frame < settings.unbalancedSolves + 1; ++frame) {
+                s.addLoad(blocks[2], {push, 0, 0}, {0, 1.25, 0});
+                s.solve();
+                if (frame > 0) { // the sliding block is left out after stallSweeps, not iterated to maxSweeps
+                    EXPECT_LT(s.sweeps(), 256) << "frame " << frame;
+                }
+            }
+            if (ratio < 1) {
+                EXPECT_LE(s.residual(), settings.residual);
+                EXPECT_TRUE(s.unsupported().empty());
+                for (int i = 0; i < 3; ++i) {
+                    const std::uint32_t below = i ? blocks[static_cast<std::size_t>(i - 1)] : ground;
+                    const Vec3 f = forceOn(s, bondBetween(s, below, blocks[static_cast<std::size_t>(i)]),
+                                           blocks[static_cast<std::size_t>(i)]);
+                    const double weight = top * (3 - i);
+                    EXPECT_NEAR(f.y, weight, 0.01 * weight) << "interface " << i;
+                    EXPECT_NEAR(-f.x, push, 0.01 * push) << "interface " << i;
+                }
+            } else {
+                EXPECT_GT(s.residual(), settings.residual) << "no equilibrium to converge to";
+                EXPECT_EQ(s.unsupported(), std::vector<std::uint32_t>{blocks[2]});
             }
         }
-        if (ratio < 1) {
-            EXPECT_LE(s.residual(), settings.residual);
-            EXPECT_TRUE(s.unsupported().empty());
-            for (int i = 0; i < 3; ++i) {
-                const std::uint32_t below = i ? blocks[static_cast<std::size_t>(i - 1)] : ground;
-                const Vec3 f = forceOn(s, bondBetween(s, below, blocks[static_cast<std::size_t>(i)]),
-                                       blocks[static_cast<std::size_t>(i)]);
-                const double weight = top * (3 - i);
-                EXPECT_NEAR(f.y, weight, 0.01 * weight) << "interface " << i;
-                EXPECT_NEAR(-f.x, push, 0.01 * push) << "interface " << i;
-            }
-        } else {
-            EXPECT_GT(s.residual(), settings.residual) << "no equilibrium to converge to";
-            EXPECT_EQ(s.unsupported(), std::vector<std::uint32_t>{blocks[2]});
-        }
-    }
 }
 
 // A load that changes between solves is passed down the welds beneath it before the iteration: a welded
@@ -344,4 +359,114 @@ TEST(StressAnalytic, TheSweepBudgetLeavesATallColumnUnconvergedInAFrame) {
     const std::size_t foot = bondBetween(now, ground, ground + 1);
     EXPECT_NEAR(now.bondForce(foot).y, -weight, 0.01 * weight);
     EXPECT_GT(std::abs(old.bondForce(foot).y + weight), 0.1 * weight);
+}
+
+// The direct solve against Gauss-Seidel, both to a residual of 1e-5: on the column and the cantilever
+// (statically determinate, one answer) every joint's force and couple agree to 1e-3 of the largest.
+TEST(StressAnalytic, TheDirectSolveGivesConvergedGaussSeidelsForces) {
+    for (const bool cantilever : {false, true}) {
+        SCOPED_TRACE(cantilever ? "cantilever" : "column");
+        Lattice l;
+        l.add(box({-2, -1, -2}, {0, 2, 2}), 2400, true);
+        for (int i = 0; i < 12; ++i)
+            l.add(cantilever ? box({0.25 * i, 0, -0.15}, {0.25 * (i + 1), 0.4, 0.15})
+                             : box({-0.2, 2 + 0.25 * i, -0.15}, {0, 2 + 0.25 * (i + 1), 0.15}),
+                  2400);
+        StressSettings tight = converged().front(), direct = converged().back();
+        tight.residual = direct.residual = 1e-5;
+        StressSolver reference = l.solver(tight), s = l.solver(direct);
+        for (StressSolver* solver : {&reference, &s}) {
+            solver->addLoad(12, {1e3, -2e4, 0}, {cantilever ? 3.0 : -0.1, cantilever ? 0.4 : 5.0, 0});
+            solver->solve();
+        }
+        ASSERT_LE(reference.residual(), 1e-5);
+        EXPECT_LE(s.residual(), 1e-5) << s.sweeps() << " solves and sweeps, " << s.factorizations();
+        EXPECT_GE(s.factorizations(), 1);
+        double force = 0, moment = 0;
+        for (std::size_t k = 0; k < s.bondCount(); ++k) {
+            force = std::max(force, length(reference.bondForce(k)));
+            moment = std::max(moment, length(reference.bondMoment(k)));
+        }
+        for (std::size_t k = 0; k < s.bondCount(); ++k) {
+            EXPECT_LE(length(s.bondForce(k) - reference.bondForce(k)), 1e-3 * force) << "bond " << k;
+            EXPECT_LE(length(s.bondMoment(k) - reference.bondMoment(k)), 1e-3 * moment) << "bond " << k;
+        }
+    }
+}
+
+// A beam of ten welded segments on three knife-edge bearings 2 m apart, its load's resultant 0.2 m inside
+// the right one: statics leaves the left one between 0 and 0.05 of the load (the middle one 0.1 less twice
+// that). Holding every corner (the first active set) pulls on one of them, so the active set lets it lift
+// off and the other two carry the load by the lever rule, before the Gauss-Seidel that follows (clamping the
+// pull and iterating instead needs more sweeps along the beam). Gauss-Seidel alone lands inside the range.
+TEST(StressAnalytic, ABeamOnThreeBearingsLiftsOffOneThatWouldPull) {
+    Lattice l;
+    const double edge = 0.004, rho = 2400;
+    std::vector<std::uint32_t> piers, segs;
+    for (const double x : {-1.75, 0.25, 2.25})
+        piers.push_back(l.add(box({x - edge / 2, -1, -0.5}, {x + edge / 2, 0, 0.5}), rho, true, 0.6));
+    for (int i = 0; i < 10; ++i)
+        segs.push_back(l.add(box({-2.5 + 0.5 * i, 0, -0.5}, {-2 + 0.5 * i, 0.4, 0.5}), rho));
+    double weight = 0;
+    for (std::uint32_t i : segs)
+        weight += l.mass(i) * kG;
+    const double load = weight * 2.05 / (2.4 - 2.05), total = weight + load; // resultant at x = 2.05
+    const std::uint32_t over[3] = {segs[1], segs[5], segs[9]};
+    for (const StressSettings& settings : withBearings()) {
+        SCOPED_TRACE(name(settings));
+        StressSolver s = l.solver(settings);
+        s.addLoad(segs[9], {0, -load, 0}, {2.4, 0.4, 0});
+        s.solve();
+        EXPECT_LE(s.residual(), settings.residual);
+        double r[3];
+        for (int i = 0; i < 3; ++i)
+            r[i] = forceOn(s, bondBetween(s, piers[static_cast<std::size_t>(i)], over[i]), over[i]).y;
+        EXPECT_NEAR(r[0] + r[1] + r[2], total, 1e-2 * total);
+        EXPECT_GE(r[0], -1e-3 * total);
+        EXPECT_GE(r[1], -1e-3 * total);
+        EXPECT_NEAR(r[1], 0.1 * total - 2 * r[0], 0.01 * total);
+        EXPECT_NEAR(r[2], 0.9 * total + r[0], 0.01 * total);
+        if (settings.method == StressMethod::Direct) {
+            EXPECT_GE(s.factorizations(), 2) << "a pulling pier's corners left the active set";
+            EXPECT_LE(s.sweeps(), 12) << "the active set settles it, not the Gauss-Seidel that follows";
+            EXPECT_NEAR(std::min(r[0], r[1]), 0, 1e-3 * total) << "one bearing lifts off";
+        }
+        EXPECT_TRUE(s.unsupported().empty());
+    }
+}
+
+// A propped cantilever whose prop lets go: the direct solve after the break reuses the symbolic
+// factorisation (the broken bond stays in the pattern) and gives the forces a fresh solver finds for the
+// cantilever alone (statically determinate) to 1e-3 of the root's.
+TEST(StressAnalytic, AFactorisationReusedAfterABreakMatchesAFreshOne) {
+    Lattice l;
+    const double rho = 2400;
+    const std::uint32_t ground = l.add(box({-2, -1, -2}, {6, 0, 2}), rho, true);
+    for (const double x : {0.0, 4.0})
+        for (int i = 0; i < 4; ++i)
+            l.add(box({x - 0.2, 0.5 * i, -0.2}, {x + 0.2, 0.5 * (i + 1), 0.2}), rho);
+    std::vector<std::uint32_t> arm;
+    for (int j = 0; j < 9; ++j)
+        arm.push_back(l.add(box({-0.2 + 0.5 * j, 2, -0.2}, {0.3 + 0.5 * j, 2.4, 0.2}), rho));
+    const std::uint32_t propTop = ground + 8;
+    StressSettings direct = converged().back();
+    StressSolver reused = l.solver(direct), fresh = l.solver(direct);
+    const std::size_t prop = bondBetween(reused, propTop, arm.back());
+    reused.solve();
+    ASSERT_LE(reused.residual(), 1e-3);
+    EXPECT_LT(reused.bondForce(prop).y, 0) << "the prop carries the arm";
+    reused.breakBond(prop);
+    reused.solve();
+    fresh.breakBond(prop);
+    fresh.solve();
+    EXPECT_LE(reused.residual(), 1e-3);
+    EXPECT_LE(fresh.residual(), 1e-3);
+    EXPECT_EQ(reused.analyses(), 1) << "the break kept the symbolic factorisation";
+    const std::size_t root = bondBetween(fresh, ground + 4, arm.front());
+    const double force = length(fresh.bondForce(root)), moment = length(fresh.bondMoment(root));
+    for (std::size_t k = 0; k < fresh.bondCount(); ++k) {
+        EXPECT_LE(length(reused.bondForce(k) - fresh.bondForce(k)), 1e-3 * force) << "bond " << k;
+        EXPECT_LE(length(reused.bondMoment(k) - fresh.bondMoment(k)), 1e-3 * moment) << "bond " << k;
+    }
+    EXPECT_TRUE(reused.unsupported().empty());
 }

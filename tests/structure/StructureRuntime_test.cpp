@@ -315,10 +315,13 @@ TEST(StructureRuntime, ATowerStandsUnshotAndFallsWhenOneSideOfItsBaseIsRemoved) 
     const Result<SceneConfig> scene =
         parseSceneConfig(std::string(RUBBLE_SOURCE_DIR) + "/assets/scenes/tower.cfg");
     ASSERT_TRUE(scene) << scene.error().message;
-    for (const bool structure : {true, false}) {
-        SCOPED_TRACE(structure ? "stress solver" : "connectivity");
+    for (const int mode : {0, 1, 2}) { // Gauss-Seidel, direct, connectivity
+        const bool structure = mode < 2;
+        SCOPED_TRACE(mode == 0 ? "gauss-seidel" : mode == 1 ? "direct" : "connectivity");
         test::ToyPhysics engine;
-        DestructionRuntime runtime(engine, Rig::config(structure, 1, false, 0.6, StressMethod::GaussSeidel));
+        DestructionRuntime runtime(engine,
+                                   Rig::config(structure, 1, false, 0.6,
+                                               mode == 1 ? StressMethod::Direct : StressMethod::GaussSeidel));
         SceneLoadOptions options;
         options.loadVehicle = false;
         const LoadedScene loaded = loadScene(*scene, runtime, options);
@@ -348,28 +351,31 @@ TEST(StructureRuntime, ATowerStandsUnshotAndFallsWhenOneSideOfItsBaseIsRemoved) 
 }
 
 TEST(StructureRuntime, AnUnshotBuildingStandsForASimulatedMinute) {
-    Rig rig(true, 1, false, 0.6, StressMethod::GaussSeidel);
-    std::vector<ObjectId> parts;
-    for (int storey = 0; storey < 2; ++storey) {
-        const double y = storey * 3.3;
-        for (const double x : {0.0, 4.6})
-            for (const double z : {0.0, 4.6})
-                parts.push_back(rig.addBox({x, y, z}, {x + 0.4, y + 3, z + 0.4}, "concrete"));
-        parts.push_back(rig.addBox({0, y + 3, 0}, {5, y + 3.3, 5}, "concrete"));
+    for (const StressMethod method : {StressMethod::GaussSeidel, StressMethod::Direct}) {
+        SCOPED_TRACE(method == StressMethod::Direct ? "direct" : "gauss-seidel");
+        Rig rig(true, 1, false, 0.6, method);
+        std::vector<ObjectId> parts;
+        for (int storey = 0; storey < 2; ++storey) {
+            const double y = storey * 3.3;
+            for (const double x : {0.0, 4.6})
+                for (const double z : {0.0, 4.6})
+                    parts.push_back(rig.addBox({x, y, z}, {x + 0.4, y + 3, z + 0.4}, "concrete"));
+            parts.push_back(rig.addBox({0, y + 3, 0}, {5, y + 3.3, 5}, "concrete"));
+        }
+        parts.push_back(rig.addBox({0.4, 0, 0.1}, {4.6, 3, 0.3}, "brick")); // a wall under the first slab
+        parts.push_back(rig.addBox({1.5, 6.6, 1.5}, {3.5, 7.6, 3.5}, "concrete")); // a tank on the roof
+        const int frames = 3600;
+        double worst = 0;
+        for (int i = 0; i < frames; ++i) {
+            const FrameStats fs = rig.runtime.stepFrame();
+            worst = std::max(worst, fs.structureResidual);
+        }
+        EXPECT_EQ(rig.runtime.counters().bondsBroken, 0);
+        EXPECT_EQ(rig.runtime.counters().piecesCollapsed, 0);
+        for (ObjectId id : parts)
+            EXPECT_EQ(rig.motionOf(id), BodyMotionState::Static) << "object " << id;
+        EXPECT_LE(worst, 1e-3) << "every frame acted on a converged solve";
     }
-    parts.push_back(rig.addBox({0.4, 0, 0.1}, {4.6, 3, 0.3}, "brick"));        // a wall under the first slab
-    parts.push_back(rig.addBox({1.5, 6.6, 1.5}, {3.5, 7.6, 3.5}, "concrete")); // a tank on the roof
-    const int frames = 3600;
-    double worst = 0;
-    for (int i = 0; i < frames; ++i) {
-        const FrameStats fs = rig.runtime.stepFrame();
-        worst = std::max(worst, fs.structureResidual);
-    }
-    EXPECT_EQ(rig.runtime.counters().bondsBroken, 0);
-    EXPECT_EQ(rig.runtime.counters().piecesCollapsed, 0);
-    for (ObjectId id : parts)
-        EXPECT_EQ(rig.motionOf(id), BodyMotionState::Static) << "object " << id;
-    EXPECT_LE(worst, 1e-3) << "every frame acted on a converged solve";
 }
 
 } // namespace rubble

@@ -5,6 +5,7 @@
 /// breaking and damage. Theory and validation in docs/structure.md.
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "rubble/core/Export.hpp"
@@ -46,10 +47,12 @@ struct RUBBLE_API BondStress {
 
 /// How StressSolver::solve() iterates (docs/structure.md, "Convergence").
 enum class StressMethod {
-    SweepBudget,      ///< Gauss-Seidel over every bond, at most `iterations` sweeps (the default)
-    GaussSeidel,      ///< Gauss-Seidel over the bonds of the nodes not at rest, until `residual` is met
-    ConjugateGradient ///< block-Jacobi preconditioned conjugate gradient on the welds, until `residual` is
-                      ///< met
+    SweepBudget,       ///< Gauss-Seidel over every bond, at most `iterations` sweeps (the default)
+    GaussSeidel,       ///< Gauss-Seidel over the bonds of the nodes not at rest, until `residual` is met
+    ConjugateGradient, ///< block-Jacobi preconditioned conjugate gradient on the welds, until `residual` is
+                       ///< met
+    Direct ///< sparse LDLT of the regularised bond system with an active set for bearings, then Gauss-Seidel
+           ///< until `residual` is met (friction limits, what bearings cannot hold)
 };
 
 /// Settings of the stress solver.
@@ -73,9 +76,10 @@ struct RUBBLE_API StressSettings {
                             ///< the nodes per sweep)
     bool routeLoads = true; ///< GaussSeidel, ConjugateGradient: a change of a node's load since the last
                             ///< solve is first passed down the welds beneath it to the ground (a warm start)
-    int stallSweeps = 64;   ///< GaussSeidel: after this many sweeps, nodes on bearings that the last solve
-                            ///< left unbalanced and that still accelerate by `unbalanced` are left out of
-                            ///< the solve (their bonds' forces kept; they count as unbalanced); 0: never
+    double compliance = 1e-6; ///< Direct: each constraint's regularisation, relative to its effective mass
+    int stallSweeps = 64; ///< GaussSeidel, Direct: after this many sweeps, nodes on bearings that the last
+                          ///< solve left unbalanced and that still accelerate by `unbalanced` are left out of
+                          ///< the solve (their bonds' forces kept; they count as unbalanced); 0: never
 };
 
 /// A bond that broke in breakOverstressed() or damage(), with what it carried the moment it broke.
@@ -120,8 +124,14 @@ public:
     /// Runs the bounded iterations, starting from the previous solve's bond forces; consumes the loads.
     void solve();
 
-    /// Sweeps (or conjugate-gradient iterations) the last solve() ran.
+    /// Sweeps (or conjugate-gradient iterations; Direct: solves with the factorisation plus Gauss-Seidel
+    /// sweeps) the last solve() ran.
     int sweeps() const { return sweeps_; }
+    /// Direct: numeric factorisations the last solve() ran (one per active set of bearing corners; 0 when
+    /// the last solve's still holds).
+    int factorizations() const { return factorizations_; }
+    /// Direct: symbolic analyses so far (a new one only when the nodes or the bonds present change).
+    int analyses() const { return analyses_; }
     /// The last solve()'s relative residual: the largest remaining acceleration of a supported node (its
     /// linear and angular parts in the mass metric, m/s^2) over the largest acceleration the loads alone
     /// give.
@@ -194,6 +204,8 @@ private:
         double gu = 0, gv = 0;         // accumulated friction along u and v (|g| <= friction * press)
         Vec3 ca[3], cb[3];             // ra x d and rb x d for d = normal, u, v
         Vec3 ia[3], ib[3];             // the inverse inertias times those: the spin an impulse along d gives
+        bool active = true;            // Direct: in the active set (held as an equality)
+        bool slip = false;             // Direct: friction at its limit (a force, not held)
     };
     struct BondState {
         Bond bond;
@@ -223,6 +235,7 @@ private:
     void solveSweepBudget();
     void solveGaussSeidel(double tolerance);
     void solveConjugateGradient(double tolerance);
+    void solveDirect(double tolerance);
     void finishSolve(double scale);
     void traceSweep();
 
@@ -232,6 +245,10 @@ private:
     std::vector<std::uint32_t> freeNodes_; // descending pops give the lowest slot first
     std::vector<std::uint32_t> checked_;   // solve(): the nodes whose rest ends the sweeps
     int sweeps_ = 0;
+    int factorizations_ = 0;
+    int analyses_ = 0;
+    struct DirectCache;                   // Direct: the symbolic factorisation and its pattern
+    std::shared_ptr<DirectCache> direct_; // (a copy shares it until its next solve)
     double residual_ = 0;
     double scale_ = 0; // the last solve's residual scale (m/s^2)
     std::vector<double> history_;
