@@ -278,11 +278,13 @@ struct DestructionRuntime::Impl {
         ledger.dropped += outcome.droppedVolume;
         ledger.dust += outcome.dustVolume();
         const BodyRecord* parentPtr = bodies.findObject(outcome.parent);
-        if (!parentPtr) { // no body carries the parent: it goes, and its pieces' volume counts as retired
+        if (!parentPtr) { // no body carries the parent: its pieces go at once, their volume retired
             ++counters.staleOutcomes;
-            for (const AdoptedPiece& p : outcome.pieces)
+            world.commit(outcome); // as a journal replay commits it, so the journal's removals replay
+            for (const AdoptedPiece& p : outcome.pieces) {
                 ledger.retired += std::abs(p.state->mass.volume);
-            world.removeObject(outcome.parent);
+                world.removeObject(p.id);
+            }
             return false;
         }
         const BodyRecord parent = *parentPtr;
