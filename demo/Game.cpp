@@ -721,6 +721,7 @@ void Game::updateCounters() {
     counters_.pieces = runtime_->livePieces();
     counters_.awake = runtime_->awakeDebris();
     counters_.frozen = runtime_->frozenDebris();
+    counters_.light = runtime_->lightDebris();
     counters_.jobs = runtime_->world().jobsInFlight();
 }
 

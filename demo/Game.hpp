@@ -77,6 +77,7 @@ struct GameCounters {
     int pieces = 0;                 ///< live piece bodies
     int awake = 0;                  ///< dynamic debris bodies (pieces and objects)
     int frozen = 0;                 ///< debris bodies frozen at rest
+    int light = 0;                  ///< awake debris over the budget, colliding with static bodies only
     int jobs = 0;                   ///< fracture jobs queued or running
     int warnings = 0;               ///< scene warnings
     int crashes = 0;                ///< the jet hit the ground or an object

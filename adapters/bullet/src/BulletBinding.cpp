@@ -128,6 +128,18 @@ void BulletBinding::setVelocity(BodyId id, const Vec3& linear, const Vec3& angul
     e.rigid->activate(true);
 }
 
+void BulletBinding::setCollidesWithMoving(BodyId id, bool collides) {
+    btRigidBody& rb = *entry(id).rigid;
+    if (rb.isStaticOrKinematicObject())
+        return;
+    btDiscreteDynamicsWorld& world = physics_.world();
+    world.removeRigidBody(&rb); // re-added with the new filter; its pairs go with it
+    if (collides)
+        world.addRigidBody(&rb);
+    else
+        world.addRigidBody(&rb, btBroadphaseProxy::DebrisFilter, btBroadphaseProxy::StaticFilter);
+}
+
 BodyMotion BulletBinding::motion(BodyId id) const {
     const btRigidBody& rb = *entry(id).rigid;
     BodyMotion m;
