@@ -147,6 +147,7 @@ bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const Game
     rc.world.minPieceVolume = settings.minPieceVolume;
     rc.impacts.collisionImpulseThreshold = settings.collisionImpulse;
     rc.debris.maxAwakeBodies = settings.maxAwake;
+    rc.debris.lightPerAwake = settings.lightPerAwake;
     rc.support.collapseUnsupported = settings.collapseUnsupported;
     rc.structure.enabled = settings.structure;
     rc.projectileLifetime = 3;

@@ -49,6 +49,9 @@ struct GameSettings {
     float fireInterval = 0.14f;      ///< s between shots while Space is held
     float minPieceVolume = 0.02f;    ///< m^3: smaller pieces become debris particles (applied on restart)
     int maxAwake = 400;              ///< awake debris budget: beyond it the smallest retire to particles
+    double lightPerAwake =
+        4; ///< moving pieces over the budget collide with static bodies only, up to this many
+           ///< per budgeted awake body, before any retires (DebrisBudget::lightPerAwake)
     bool collapseUnsupported = true; ///< static pieces with nothing static under them fall (live)
     bool debugShapes = false;        ///< draw collision shapes
     bool debugAabbs = false;         ///< draw AABBs
