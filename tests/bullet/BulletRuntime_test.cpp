@@ -746,3 +746,31 @@ TEST(BulletBinding, ALightBodyPassesThroughMovingBodiesAndLandsOnStaticOnes) {
                   static_cast<int>(btBroadphaseProxy::DefaultFilter));
     }
 }
+
+// A frozen body (made static by setMass) stops a moving body but lets a light one through to the ground: a
+// light body it froze around would otherwise be thrown out of it.
+TEST(BulletBinding, ALightBodyPassesThroughFrozenBodies) {
+    for (const bool light : {false, true}) {
+        PhysicsWorld physics;
+        BulletBinding binding(physics);
+        BodyDesc d;
+        d.shape.kind = BodyShape::Kind::Box;
+        d.shape.halfExtents = {5, 5, 5};
+        d.transform.translation = {0, -5, 0};
+        binding.createBody(1, d); // the ground, static from the start
+        d.shape.halfExtents = {0.5, 0.5, 0.5};
+        d.mass = 1;
+        d.inertia = Vec3{1, 1, 1} / 6;
+        d.transform.translation = {0, 0.5, 0};
+        binding.createBody(2, d);
+        binding.setMass(2, 0, {}); // frozen where it rests
+        d.shape.halfExtents = {0.25, 0.25, 0.25};
+        d.transform.translation = {0, 3, 0};
+        binding.createBody(3, d);
+        binding.setCollidesWithMoving(3, !light);
+        std::vector<ContactReport> contacts;
+        for (int i = 0; i < 120; ++i)
+            binding.step(1.0 / 60, contacts);
+        EXPECT_NEAR(binding.motion(3).transform.translation.y, light ? 0.25 : 1.25, 0.05) << light;
+    }
+}
