@@ -84,6 +84,7 @@ struct SceneArgs {
     int cells = 0;                   // shatter cells (0: the library's default)
     int maxAwake = 0;                // awake debris budget (0: the runtime's default)
     double physicsBudgetMs = 0;      // physics step budget (0: the runtime's default)
+    double lightPerAwake = -1;       // light pieces per budgeted awake body (< 0: the runtime's default)
     bool structure = false;          // the stress solver on
     double bearingFriction = 0.6;    // with structure: objects rest on each other as bearings (0: welded)
     int structureIterations = 0;     // with structure: solver sweeps per frame (0: the library's)
@@ -189,6 +190,8 @@ int runScene(const SceneArgs& a, SceneSummary* summary = nullptr) {
         rc.debris.maxAwakeBodies = a.maxAwake;
     if (a.physicsBudgetMs > 0)
         rc.debris.physicsBudgetMs = a.physicsBudgetMs;
+    if (a.lightPerAwake >= 0)
+        rc.debris.lightPerAwake = a.lightPerAwake;
     rc.structure.enabled = a.structure;
     rc.structure.bearingFriction = a.bearingFriction;
     if (a.structureIterations > 0) { // a sweep budget per frame
@@ -381,10 +384,12 @@ int runScene(const SceneArgs& a, SceneSummary* summary = nullptr) {
         j["pieces_max"] = maxPieces;
         j["awake_pieces"] = runtime.awakeDebris();
         j["frozen_pieces"] = runtime.frozenDebris();
+        j["light_pieces"] = runtime.lightDebris();
         j["pieces_collapsed"] = c.piecesCollapsed;
         j["bonds_broken"] = c.bondsBroken;
         j["pieces_frozen"] = c.piecesFrozen;
         j["pieces_woken"] = c.piecesWoken;
+        j["pieces_light"] = c.piecesLight;
         const VolumeLedger v = runtime.volumes();
         j["volume"] = {{"start", startVolume},
                        {"live", v.live},
@@ -394,7 +399,8 @@ int runScene(const SceneArgs& a, SceneSummary* summary = nullptr) {
         j["shots"] = shots;
         j["pieces_retired"] = c.piecesRetired;
         j["debris_budget"] = {{"max_awake_bodies", runtime.config().debris.maxAwakeBodies},
-                              {"physics_ms", runtime.config().debris.physicsBudgetMs}};
+                              {"physics_ms", runtime.config().debris.physicsBudgetMs},
+                              {"light_per_awake", runtime.config().debris.lightPerAwake}};
         j["retired_by"] = {{"dust", c.retired.dust},
                            {"awake_budget", c.retired.awake},
                            {"triangle_budget", c.retired.triangles},
@@ -456,14 +462,16 @@ int runScene(const SceneArgs& a, SceneSummary* summary = nullptr) {
     std::printf("%-28s %10d\n", "stale results", ts.stale);
     std::printf("%-28s %10d\n", "missed (cells off the mesh)", ts.missed);
     std::printf("%-28s %10d\n", "failed (geometry)", ts.failed);
-    std::printf("%-28s %10d (max %d; %d awake, %d frozen)\n", "pieces alive", runtime.livePieces(), maxPieces,
-                runtime.awakeDebris(), runtime.frozenDebris());
+    std::printf("%-28s %10d (max %d; %d awake of which %d light, %d frozen)\n", "pieces alive",
+                runtime.livePieces(), maxPieces, runtime.awakeDebris(), runtime.lightDebris(),
+                runtime.frozenDebris());
     std::printf(
         "%-28s %10lld (dust %lld, awake budget %lld, triangle budget %lld, faded %lld, fell out %lld)\n",
         "pieces retired", c.piecesRetired, c.retired.dust, c.retired.awake, c.retired.triangles,
         c.retired.faded, c.retired.fellOut);
     std::printf("%-28s %10lld\n", "pieces collapsed", c.piecesCollapsed);
     std::printf("%-28s %10lld (%lld woken)\n", "pieces frozen", c.piecesFrozen, c.piecesWoken);
+    std::printf("%-28s %10lld\n", "pieces made light", c.piecesLight);
     std::printf("%-28s %10.3g\n", "volume error", volumeError);
     std::printf("%-28s %10s\n", "state hash", hashText);
     std::printf("%-28s %10.1f\n", "peak RSS (MB)", rss);
@@ -539,6 +547,9 @@ rubble::tools::Registrar registrar{
          app.add_option("--max-awake", args->maxAwake, "awake debris budget (default: the runtime's)");
          app.add_option("--physics-budget-ms", args->physicsBudgetMs,
                         "physics step time the debris governor holds (default: the runtime's, for 60 Hz)");
+         app.add_option("--light-per-awake", args->lightPerAwake,
+                        "light pieces (colliding with static bodies only) per budgeted awake body; 0: "
+                        "pieces over the awake budget retire (default: the runtime's)");
          app.add_flag("--structure", args->structure, "stress solver on (bonds, breaking under load)");
          app.add_option("--bearing-friction", args->bearingFriction,
                         "with --structure: objects rest on each other as bearings with this friction "

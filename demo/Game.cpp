@@ -147,6 +147,7 @@ bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const Game
     rc.world.minPieceVolume = settings.minPieceVolume;
     rc.impacts.collisionImpulseThreshold = settings.collisionImpulse;
     rc.debris.maxAwakeBodies = settings.maxAwake;
+    rc.debris.lightPerAwake = settings.lightPerAwake;
     rc.support.collapseUnsupported = settings.collapseUnsupported;
     rc.structure.enabled = settings.structure;
     rc.projectileLifetime = 3;
@@ -721,6 +722,7 @@ void Game::updateCounters() {
     counters_.pieces = runtime_->livePieces();
     counters_.awake = runtime_->awakeDebris();
     counters_.frozen = runtime_->frozenDebris();
+    counters_.light = runtime_->lightDebris();
     counters_.jobs = runtime_->world().jobsInFlight();
 }
 

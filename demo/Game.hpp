@@ -49,6 +49,9 @@ struct GameSettings {
     float fireInterval = 0.14f;      ///< s between shots while Space is held
     float minPieceVolume = 0.02f;    ///< m^3: smaller pieces become debris particles (applied on restart)
     int maxAwake = 400;              ///< awake debris budget: beyond it the smallest retire to particles
+    double lightPerAwake =
+        4; ///< moving pieces over the budget collide with static bodies only, up to this many
+           ///< per budgeted awake body, before any retires (DebrisBudget::lightPerAwake)
     bool collapseUnsupported = true; ///< static pieces with nothing static under them fall (live)
     bool debugShapes = false;        ///< draw collision shapes
     bool debugAabbs = false;         ///< draw AABBs
@@ -77,6 +80,7 @@ struct GameCounters {
     int pieces = 0;                 ///< live piece bodies
     int awake = 0;                  ///< dynamic debris bodies (pieces and objects)
     int frozen = 0;                 ///< debris bodies frozen at rest
+    int light = 0;                  ///< awake debris over the budget, colliding with static bodies only
     int jobs = 0;                   ///< fracture jobs queued or running
     int warnings = 0;               ///< scene warnings
     int crashes = 0;                ///< the jet hit the ground or an object

@@ -74,6 +74,7 @@ bool RunReport::write(const std::filesystem::path& dir, const std::string& scene
     j["pieces_live"] = last.pieces;
     j["pieces_awake"] = last.awake;
     j["pieces_frozen"] = last.frozen;
+    j["pieces_light"] = last.light;
     j["pieces_retired_to_particles"] = last.retired;
     j["pieces_retired_by"] = {{"dust", last.retiredBy[0]},
                               {"awake", last.retiredBy[1]},

@@ -91,6 +91,7 @@ struct Options {
     int rasterNice = 0;            // niceness of llvmpipe's rasteriser threads (0: unchanged)
     double demolish = 0;           // seconds between demolition charges on standing targets (0: none)
     int maxAwake = 0;              // awake debris budget (0: the game's default)
+    double lightPerAwake = -1;     // light pieces per budgeted awake body (< 0: the game's default)
     bool mute = false;             // no sound
     std::string audioWav;          // the run's sound captured to this WAV file (no device)
     bool structureFlag = false;    // --structure given (its bonds are drawn)
@@ -327,6 +328,10 @@ int parseOptions(int argc, char** argv, Options& o) {
            "awake debris budget: beyond it settled pieces freeze, then the smallest moving ones retire "
            "to particles (default 400)")
         ->check(CLI::Range(50, 20000));
+    cli.add_option("--light-per-awake", o.lightPerAwake,
+                   "moving pieces over the awake budget collide with static bodies only, up to this many per "
+                   "budgeted awake body, before any retire (default 4; 0: they retire)")
+        ->check(CLI::Range(0.0, 100.0));
     cli.add_flag("--mute", o.mute, "no sound (headless runs have none: no audio device is opened)");
     cli.add_option("--audio-wav", o.audioWav,
                    "FILE: the run's sound, mixed in step with game time, written as a WAV file (no device)");
@@ -507,6 +512,8 @@ int setUp(App& app, RunMode& mode) {
     app.pending.showcase = o.showcase || !o.camera.empty();
     if (o.maxAwake > 0)
         app.pending.maxAwake = o.maxAwake;
+    if (o.lightPerAwake >= 0)
+        app.pending.lightPerAwake = o.lightPerAwake;
 
     std::string error;
     app.gl = demo::GlContext::create(o.width, o.height, headless, error);

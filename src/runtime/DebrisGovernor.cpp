@@ -50,6 +50,7 @@ void DebrisGovernor::frozen(BodyId id, const Vec3& center, double radius) {
 
 void DebrisGovernor::thawed(BodyId id) {
     awake_.erase(id);
+    light_.erase(id);
     auto it = frozen_.find(id);
     if (it == frozen_.end())
         return;
@@ -130,6 +131,7 @@ GovernorActions DebrisGovernor::update(const BodyTable& bodies, const PhysicsBin
         double volume, speed;
         bool settled; // slow for kSettledFrames: resting on something, not at the top of a fall
         bool young;   // awake for fewer frames: it may yet settle, so it is not retired
+        bool light;   // collides with static bodies only: outside the awake budget
         BodyId id;
     };
     std::vector<Awake> stillAwake; // pieces: the game's own objects are never retired
@@ -168,7 +170,8 @@ GovernorActions DebrisGovernor::update(const BodyTable& bodies, const PhysicsBin
             continue;
         }
         if (piece)
-            stillAwake.push_back({r.volume, speed, settle >= kSettledFrames, age < kSettledFrames, id});
+            stillAwake.push_back(
+                {r.volume, speed, settle >= kSettledFrames, age<kSettledFrames, light_.count(id)> 0, id});
         else
             ++awakeObjects;
     }
@@ -182,7 +185,8 @@ GovernorActions DebrisGovernor::update(const BodyTable& bodies, const PhysicsBin
         const bool load = over && (lastOver_ || smoothedMs_ > kHoldLow * limit);
         lastOver_ = over;
         if (load || smoothedMs_ > kHoldHigh * limit)
-            b = std::min(b, static_cast<int>(0.9 * static_cast<double>(bodies.awake())));
+            b = std::min(b, static_cast<int>(
+                                0.9 * static_cast<double>(bodies.awake() - static_cast<int>(light_.size()))));
         else if (smoothedMs_ < kHoldLow * limit && physicsMs < kHoldHigh * limit)
             b += std::max(1, b / 50);
         awakeBudget_ = std::clamp(b, std::min(32, budget_.maxAwakeBodies), budget_.maxAwakeBodies);
@@ -190,8 +194,28 @@ GovernorActions DebrisGovernor::update(const BodyTable& bodies, const PhysicsBin
         awakeBudget_ = -1;
     }
     // Over the awake budget: settled pieces freeze where they are (slowest first), then the smallest of the
-    // moving ones retire. A piece awake for fewer than kSettledFrames, or slow, is left to settle first.
-    int excess = static_cast<int>(stillAwake.size() + out.wake.size()) + awakeObjects - awakeBudget();
+    // moving ones become light (while there is room for them) or retire. A piece awake for fewer than
+    // kSettledFrames, or slow, is left to settle first. Light pieces are outside the awake budget.
+    const int lightCap =
+        binding.filtersMovingPairs()
+            ? static_cast<int>(std::max(0.0, budget_.lightPerAwake) * static_cast<double>(awakeBudget()))
+            : 0;
+    int lights = 0;
+    for (const Awake& a : stillAwake)
+        lights += a.light ? 1 : 0;
+    auto shed = [&](const Awake& a) {
+        if (lights < lightCap) {
+            out.lighten.push_back(a.id);
+            light_.insert(a.id);
+            ++lights;
+        } else {
+            out.retire.push_back({a.id, RetireReason::Awake});
+            leaving.insert(a.id);
+        }
+    };
+    auto skip = [&](const Awake& a) { return a.light || leaving.count(a.id) || light_.count(a.id); };
+    int excess = static_cast<int>(stillAwake.size()) - lights + static_cast<int>(out.wake.size()) +
+                 awakeObjects - awakeBudget();
     if (excess > 0) {
         std::sort(stillAwake.begin(), stillAwake.end(), [](const Awake& a, const Awake& b) {
             return a.speed < b.speed || (a.speed == b.speed && a.id < b.id);
@@ -199,7 +223,7 @@ GovernorActions DebrisGovernor::update(const BodyTable& bodies, const PhysicsBin
         for (const Awake& a : stillAwake) {
             if (excess <= 0)
                 break;
-            if (!a.settled)
+            if (!a.settled || a.light)
                 continue;
             out.freeze.push_back(a.id);
             leaving.insert(a.id);
@@ -211,21 +235,33 @@ GovernorActions DebrisGovernor::update(const BodyTable& bodies, const PhysicsBin
         for (const Awake& a : stillAwake) {
             if (excess <= 0)
                 break;
-            if (leaving.count(a.id) || a.young || a.speed < budget_.settlingSpeed)
+            if (skip(a) || a.young || a.speed < budget_.settlingSpeed)
                 continue; // a slow piece is about to settle and freeze
-            out.retire.push_back({a.id, RetireReason::Awake});
-            leaving.insert(a.id);
+            shed(a);
             --excess;
         }
         // Beyond the overshoot the budget is hard: the smallest of the waiting pieces retire too.
         for (const Awake& a : stillAwake) {
             if (excess <= std::max(0, budget_.awakeOvershoot))
                 break;
-            if (leaving.count(a.id))
+            if (skip(a))
+                continue;
+            shed(a);
+            --excess;
+        }
+    }
+    if (lights > lightCap) { // the budget shrank: the smallest light pieces retire
+        std::sort(stillAwake.begin(), stillAwake.end(), [](const Awake& a, const Awake& b) {
+            return a.volume < b.volume || (a.volume == b.volume && a.id < b.id);
+        });
+        for (const Awake& a : stillAwake) {
+            if (lights <= lightCap)
+                break;
+            if (!a.light || leaving.count(a.id))
                 continue;
             out.retire.push_back({a.id, RetireReason::Awake});
             leaving.insert(a.id);
-            --excess;
+            --lights;
         }
     }
 
@@ -254,6 +290,7 @@ GovernorActions DebrisGovernor::update(const BodyTable& bodies, const PhysicsBin
     }
     for (BodyId id : leaving) {
         awake_.erase(id);
+        light_.erase(id);
     }
     return out;
 }

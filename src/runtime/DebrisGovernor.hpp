@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <map>
+#include <set>
 #include <unordered_map>
 #include <vector>
 
@@ -19,6 +20,7 @@ enum class RetireReason { Awake, Triangles, Fade, FellOut };
 struct GovernorActions {
     std::vector<BodyId> freeze;                          ///< make static
     std::vector<BodyId> wake;                            ///< make dynamic again
+    std::vector<BodyId> lighten;                         ///< collide with static bodies only
     std::vector<std::pair<BodyId, RetireReason>> retire; ///< turn into particles
 };
 
@@ -47,6 +49,8 @@ public:
     void wakeNear(const Aabb& box, double margin);
     /// The awake budget in force.
     int awakeBudget() const { return awakeBudget_ < 0 ? budget_.maxAwakeBodies : awakeBudget_; }
+    /// Light pieces (over the awake budget, colliding with static bodies only), ascending.
+    const std::set<BodyId>& light() const { return light_; }
 
 private:
     using Cell = std::uint64_t;
@@ -72,6 +76,7 @@ private:
     std::map<BodyId, WokenEntry> watched_; // woken bodies whose old neighbourhood still rests on their place
     std::unordered_map<Cell, std::vector<BodyId>> grid_;
     std::vector<BodyId> toWake_;
+    std::set<BodyId> light_;
     int awakeBudget_ = -1;  // < 0: the configured maximum
     double smoothedMs_ = 0; // moving average of the physics step
     bool lastOver_ = false; // the previous frame's step was over the budget

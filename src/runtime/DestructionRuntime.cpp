@@ -547,6 +547,10 @@ struct DestructionRuntime::Impl {
             ++stats.piecesFrozen;
             ++counters.piecesFrozen;
         }
+        for (BodyId id : a.lighten) {
+            binding.setCollidesWithMoving(id, false);
+            ++counters.piecesLight;
+        }
         for (const auto& [id, reason] : a.retire)
             retire(id, reason, stats);
     }
@@ -797,6 +801,10 @@ int DestructionRuntime::livePieces() const {
 
 int DestructionRuntime::awakeDebris() const {
     return impl_->bodies.awake();
+}
+
+int DestructionRuntime::lightDebris() const {
+    return static_cast<int>(impl_->governor.light().size());
 }
 
 int DestructionRuntime::frozenDebris() const {

@@ -8,12 +8,19 @@
 namespace rubble {
 namespace {
 
-// Forty falling pieces, and a governor over them.
+test::ToyPhysics::Config toyConfig(bool filtersPairs) {
+    test::ToyPhysics::Config c;
+    c.filtersPairs = filtersPairs;
+    return c;
+}
+
+// Falling pieces (forty by default), and a governor over them.
 struct GovernorRig {
-    explicit GovernorRig(double budgetMs) {
+    explicit GovernorRig(double budgetMs, int pieces = 40, bool filtersPairs = false)
+        : physics(toyConfig(filtersPairs)) {
         budget.maxAwakeBodies = 50;
         budget.physicsBudgetMs = budgetMs;
-        for (BodyId id = 1; id <= 40; ++id) {
+        for (BodyId id = 1; id <= static_cast<BodyId>(pieces); ++id) {
             BodyDesc d;
             d.shape.kind = BodyShape::Kind::Box;
             d.mass = 1;
@@ -34,6 +41,20 @@ struct GovernorRig {
         for (int i = 0; i < frames; ++i)
             (void)governor.update(bodies, physics, {}, ms, deterministic, Vec3{}, 1.0 / 60);
         return governor.awakeBudget();
+    }
+    // One frame whose step took `ms`, its decisions applied as the runtime does; returns the retirements.
+    int apply(double ms, bool deterministic) {
+        const detail::GovernorActions a =
+            governor.update(bodies, physics, {}, ms, deterministic, Vec3{}, 1.0 / 60);
+        for (BodyId id : a.lighten)
+            physics.setCollidesWithMoving(id, false);
+        for (const auto& [id, why] : a.retire) {
+            EXPECT_EQ(why, detail::RetireReason::Awake);
+            governor.removed(id);
+            bodies.erase(id);
+            physics.removeBody(id);
+        }
+        return static_cast<int>(a.retire.size());
     }
 
     DebrisBudget budget;
@@ -120,6 +141,40 @@ TEST(DebrisGovernor, APieceFreezesOnlyOnceItRestsNeverInFlight) {
     ASSERT_GE(thrown, 0);
     EXPECT_LT(thrownAt, 0.25) << "frozen on the ground, not at the top of its arc";
     EXPECT_GT(thrown, dropped);
+}
+
+// Moving pieces over the awake budget become light (static bodies only) while there is room for
+// lightPerAwake of them per budgeted awake body; only the rest retire, as all do without pair filtering.
+TEST(DebrisGovernor, MovingPiecesOverTheBudgetBecomeLightBeforeAnyRetires) {
+    for (const bool filters : {true, false}) {
+        GovernorRig rig(8, 40, filters);
+        rig.budget.maxAwakeBodies = 10;
+        rig.budget.lightPerAwake = 2;
+        int retired = 0;
+        for (int f = 0; f < 30; ++f)
+            retired += rig.apply(0, true);
+        EXPECT_EQ(retired, filters ? 10 : 30) << filters;
+        EXPECT_EQ(rig.governor.light().size(), filters ? 20u : 0u) << filters;
+        for (BodyId id : rig.governor.light())
+            EXPECT_FALSE(rig.physics.collidesWithMoving(id));
+        EXPECT_EQ(rig.bodies.awake(), filters ? 30 : 10) << "the full ones stay within the budget";
+    }
+}
+
+// When a slow step shrinks the awake budget, the room for light pieces shrinks with it: light pieces retire.
+TEST(DebrisGovernor, LightPiecesRetireWhenTheBudgetShrinks) {
+    GovernorRig rig(8, 100, true);
+    rig.budget.lightPerAwake = 1;
+    for (int f = 0; f < 20; ++f)
+        EXPECT_EQ(rig.apply(0, true), 0);
+    EXPECT_EQ(rig.governor.light().size(), 50u);
+    int retired = 0;
+    for (int f = 0; f < 20; ++f)
+        retired += rig.apply(100, false);
+    EXPECT_EQ(rig.governor.awakeBudget(), 32) << "the floor";
+    EXPECT_GT(retired, 0);
+    EXPECT_LE(static_cast<int>(rig.governor.light().size()), rig.governor.awakeBudget());
+    EXPECT_LE(rig.bodies.awake() - static_cast<int>(rig.governor.light().size()), rig.governor.awakeBudget());
 }
 
 } // namespace

@@ -44,6 +44,13 @@ void ToyPhysics::setMass(BodyId id, double mass, const Vec3&) {
     b.velocity = b.angular = Vec3{};
     b.sleeping = false;
     b.slowSteps = 0;
+    b.light = false;
+}
+
+void ToyPhysics::setCollidesWithMoving(BodyId id, bool collides) {
+    Body& b = bodies_.at(id);
+    if (config_.filtersPairs && b.mass > 0)
+        b.light = !collides;
 }
 
 void ToyPhysics::setVelocity(BodyId id, const Vec3& linear, const Vec3& angular) {

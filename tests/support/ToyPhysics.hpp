@@ -22,6 +22,7 @@ public:
         double sleepSpeed = 0.05;  ///< m/s
         int sleepSteps = 20;       ///< steps below sleepSpeed before sleeping
         double stepDelayMs = 0;    ///< wall time each step() call takes (a slow engine)
+        bool filtersPairs = false; ///< setCollidesWithMoving is honoured (bodies only land on static ones)
     };
 
     /// A toy world with the given tunables.
@@ -36,6 +37,11 @@ public:
     BodyMotion motion(BodyId id) const override;
     int step(double dt, std::vector<ContactReport>& contacts) override;
     Vec3 gravity() const override { return config_.gravity; }
+    bool filtersMovingPairs() const override { return config_.filtersPairs; }
+    void setCollidesWithMoving(BodyId id, bool collides) override;
+
+    /// Whether a body collides with moving bodies (false after setCollidesWithMoving(id, false)).
+    bool collidesWithMoving(BodyId id) const { return !bodies_.at(id).light; }
 
     /// Bodies in the world.
     std::size_t size() const { return bodies_.size(); }
@@ -53,6 +59,7 @@ private:
         bool spent = false; // a projectile that hit something: it stays where it hit
         bool sleeping = false;
         bool neverSleeps = false;
+        bool light = false; // collides with static bodies only
         int slowSteps = 0;
     };
     Aabb worldBounds(const Body& b) const;

@@ -7,6 +7,8 @@
 namespace rubble::bullet {
 namespace {
 
+constexpr int kFrozenFilter = 64; // collision filter group of bodies made static by setMass
+
 std::uint32_t roleColor(BodyRole role, BodyMotionState motion) {
     if (motion == BodyMotionState::Frozen)
         return 0x8080C0FFu;
@@ -115,8 +117,13 @@ void BulletBinding::setMass(BodyId id, double mass, const Vec3& inertia) {
     if (dynamic) {
         rb.forceActivationState(ACTIVE_TAG);
         rb.setDeactivationTime(0);
+        world.addRigidBody(&rb);
+        return;
     }
-    world.addRigidBody(&rb);
+    // Frozen: light bodies pass it (one overlapping it would be thrown out), static ones never pair with it.
+    world.addRigidBody(&rb, kFrozenFilter,
+                       btBroadphaseProxy::AllFilter ^ (btBroadphaseProxy::StaticFilter | kFrozenFilter |
+                                                       btBroadphaseProxy::DebrisFilter));
 }
 
 void BulletBinding::setVelocity(BodyId id, const Vec3& linear, const Vec3& angular) {
@@ -126,6 +133,18 @@ void BulletBinding::setVelocity(BodyId id, const Vec3& linear, const Vec3& angul
     e.preLinear = e.rigid->getLinearVelocity();
     e.preAngular = e.rigid->getAngularVelocity();
     e.rigid->activate(true);
+}
+
+void BulletBinding::setCollidesWithMoving(BodyId id, bool collides) {
+    btRigidBody& rb = *entry(id).rigid;
+    if (rb.isStaticOrKinematicObject())
+        return;
+    btDiscreteDynamicsWorld& world = physics_.world();
+    world.removeRigidBody(&rb); // re-added with the new filter; its pairs go with it
+    if (collides)
+        world.addRigidBody(&rb);
+    else
+        world.addRigidBody(&rb, btBroadphaseProxy::DebrisFilter, btBroadphaseProxy::StaticFilter);
 }
 
 BodyMotion BulletBinding::motion(BodyId id) const {

@@ -150,6 +150,10 @@ struct RUBBLE_API DebrisBudget {
                                 ///< to hold the awake budget
     int awakeOvershoot = 16;    ///< pieces beyond maxAwakeBodies that may stay awake while they settle (new
                                 ///< pieces get 10 frames, slow ones until they freeze); beyond it, hard
+    double lightPerAwake = 4;   ///< moving pieces over the awake budget stop colliding with moving bodies
+                                ///< (they still land on static and frozen ones) instead of retiring, up to
+                                ///< this many per budgeted awake body (0, or an engine that cannot filter
+                                ///< pairs: they retire)
     double physicsBudgetMs = 8; ///< physics step time no frame should exceed: the awake budget shrinks on a
                                 ///< frame over it and holds the average at 55-75 % of it (ignored in
                                 ///< deterministic mode, where time must not matter)
@@ -226,6 +230,7 @@ struct RUBBLE_API RuntimeCounters {
     long long bondsBroken = 0;     ///< structure bonds broken
     long long piecesFrozen = 0;    ///< debris bodies frozen
     long long piecesWoken = 0;     ///< frozen bodies woken
+    long long piecesLight = 0;     ///< moving pieces over the awake budget made light (DebrisBudget)
     long long staleOutcomes = 0;   ///< outcomes whose parent had no body
 };
 
@@ -353,6 +358,8 @@ public:
     int livePieces() const;
     /// Dynamic debris bodies (pieces and objects).
     int awakeDebris() const;
+    /// Of those, the light ones: over the awake budget, colliding with static bodies only.
+    int lightDebris() const;
     /// Frozen debris bodies.
     int frozenDebris() const;
     /// Triangles of all debris bodies (what DebrisBudget::maxTriangles bounds).

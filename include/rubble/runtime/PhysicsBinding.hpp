@@ -85,6 +85,11 @@ public:
     virtual int step(double dt, std::vector<ContactReport>& contacts) = 0;
     /// Gravity (m/s²), for particles.
     virtual Vec3 gravity() const = 0;
+    /// Whether setCollidesWithMoving takes effect (an engine that cannot filter pairs leaves it a no-op).
+    virtual bool filtersMovingPairs() const { return false; }
+    /// A dynamic body collides with static bodies only (false) or with every body (true, as created);
+    /// setMass resets it to true.
+    virtual void setCollidesWithMoving(BodyId /*id*/, bool /*collides*/) {}
 };
 
 } // namespace rubble

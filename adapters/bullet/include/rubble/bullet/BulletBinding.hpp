@@ -42,6 +42,8 @@ public:
     BodyMotion motion(BodyId id) const override;
     int step(double dt, std::vector<ContactReport>& contacts) override;
     Vec3 gravity() const override;
+    bool filtersMovingPairs() const override { return true; }
+    void setCollidesWithMoving(BodyId id, bool collides) override;
 
     /// The Bullet body (for engine-specific settings such as friction or damping), or null.
     btRigidBody* rigid(BodyId id) const;
