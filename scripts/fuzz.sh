@@ -19,7 +19,7 @@
 # input is also printed in base64, so it can be taken from the CI log.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-declare -A ci_runs=([obj]=500000 [json]=500000 [off]=400000 [ply_stl]=500000 [scene]=400000 [mesh_repair]=70000 [convex_clip]=18000 [fracture]=1500 [snapshot]=120000 [net_protocol]=150000 [mtl]=300000 [gltf]=8000)
+declare -A ci_runs=([obj]=500000 [json]=500000 [off]=400000 [ply_stl]=500000 [scene]=400000 [mesh_repair]=70000 [convex_clip]=18000 [fracture]=1500 [snapshot]=120000 [net_protocol]=150000 [mtl]=300000 [gltf]=100000)
 ci_cap=150
 ci=0
 if [ "${1:-}" = ci ]; then
