@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -14,7 +15,9 @@
 namespace {
 const std::filesystem::path& folder() {
     static const std::filesystem::path dir = [] {
-        auto d = std::filesystem::temp_directory_path() / ("rubble-fuzz-gltf-" + std::to_string(::getpid()));
+        char pid[16]; // zero-padded: every run's paths, and so its messages, have the same length
+        std::snprintf(pid, sizeof pid, "%010d", static_cast<int>(::getpid()));
+        auto d = std::filesystem::path("/tmp") / (std::string("rubble-fuzz-gltf-") + pid);
         std::filesystem::create_directories(d);
         return d;
     }();
