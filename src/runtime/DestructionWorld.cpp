@@ -290,6 +290,7 @@ double FractureOutcome::dustVolume() const {
 
 struct DestructionWorld::Impl {
     Config config;
+    Status configStatus; // checkConfig(config), decided once at construction
     std::unique_ptr<ThreadPool> ownedPool;
     JobSystem* jobs = nullptr;
     std::shared_ptr<Sync> sync = std::make_shared<Sync>();
@@ -500,6 +501,7 @@ struct DestructionWorld::Impl {
 
 DestructionWorld::DestructionWorld(Config config) : impl_(std::make_unique<Impl>()) {
     impl_->config = config;
+    impl_->configStatus = checkConfig(config);
     if (config.jobs) {
         impl_->jobs = config.jobs;
     } else {
@@ -551,8 +553,8 @@ Status DestructionWorld::checkConfig(const Config& c) {
 }
 
 Result<ObjectId> DestructionWorld::addObject(ObjectDesc desc) {
-    if (const Status st = checkConfig(impl_->config); !st)
-        return Error{ErrorCode::InvalidInput, "addObject: " + st.message()};
+    if (!impl_->configStatus)
+        return Error{ErrorCode::InvalidInput, "addObject: " + impl_->configStatus.message()};
     if (desc.mesh.triangles.empty() || desc.mesh.positions.empty())
         return Error{ErrorCode::InvalidInput, "addObject: empty mesh"};
     for (Status st : {checkParam("density", desc.density), checkParam("cells", desc.fracture.cells)})
