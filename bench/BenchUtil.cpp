@@ -12,6 +12,14 @@ namespace rubble::bench {
 
 namespace fs = std::filesystem;
 
+fs::path sourceDir() {
+    return RUBBLE_SOURCE_DIR;
+}
+
+std::string resultsDir() {
+    return (sourceDir() / "bench" / "results").string();
+}
+
 Stats stats(std::vector<double> samples) {
     if (samples.empty())
         return {};
@@ -198,7 +206,7 @@ std::vector<std::filesystem::path> repoModels() {
     namespace fs = std::filesystem;
     std::vector<fs::path> files;
     std::error_code ec;
-    for (const auto& e : fs::directory_iterator(fs::path(RUBBLE_SOURCE_DIR) / "assets" / "models", ec))
+    for (const auto& e : fs::directory_iterator(sourceDir() / "assets" / "models", ec))
         if (e.path().extension() == ".obj" && e.path().stem().string().rfind("cube_", 0) != 0)
             files.push_back(e.path());
     std::sort(files.begin(), files.end());

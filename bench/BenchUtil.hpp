@@ -9,8 +9,11 @@
 
 namespace rubble::bench {
 
+/// The source tree this bench was built from.
+std::filesystem::path sourceDir();
+
 /// The default results folder (bench/results in the source tree).
-inline constexpr const char* kResultsDir = RUBBLE_SOURCE_DIR "/bench/results";
+std::string resultsDir();
 
 /// Median, minimum and maximum of a set of samples (milliseconds).
 struct Stats {

@@ -37,7 +37,7 @@ struct BenchArgs {
     bool quick = false;
     int runs = 10;
     std::uint64_t seed = 1;
-    std::string out = rubble::bench::kResultsDir;
+    std::string out = rubble::bench::resultsDir();
 };
 
 constexpr rubble::BooleanKind kKinds[] = {rubble::BooleanKind::Nef, rubble::BooleanKind::Corefine,

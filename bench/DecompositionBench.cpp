@@ -51,7 +51,7 @@ std::vector<std::string> allKinds() {
 struct BenchArgs {
     bool quick = false;
     int runs = 15;
-    std::string out = rubble::bench::kResultsDir;
+    std::string out = rubble::bench::resultsDir();
 };
 
 /// The Voronoi cell of `site` among 15 random sites in a cube of edge `size` around it.
@@ -136,7 +136,7 @@ int runBench(const BenchArgs& args) {
         }
         rows.push_back(r);
     }
-    const fs::path media = fs::path(RUBBLE_SOURCE_DIR) / ".." / "shared" / "seed" / "media";
+    const fs::path media = rubble::bench::sourceDir() / ".." / "shared" / "seed" / "media";
     if (!args.quick && fs::is_directory(media)) {
         for (const char* name : {"building.obj", "missile.obj", "ship.obj", "empty.obj"}) {
             auto mesh = rubble::readMesh(media / name);

@@ -40,7 +40,7 @@ struct BenchArgs {
     int runs = 15;
     std::string only; // run only the cases whose name contains this
     std::vector<std::string> backends{"corefine", "fast", "nef"}; // which backends run
-    std::string out = rubble::bench::kResultsDir;
+    std::string out = rubble::bench::resultsDir();
     bool rough = false; // only the rough rows beside their flat twins (impact_rough.csv)
 };
 

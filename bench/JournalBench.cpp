@@ -43,7 +43,7 @@ struct BenchArgs {
     bool quick = false;
     int impacts = 1000;
     int workers = -1;
-    std::string out = rubble::bench::kResultsDir;
+    std::string out = rubble::bench::resultsDir();
 };
 
 rubble::DestructionWorld::Config worldConfig(int workers) {

@@ -115,7 +115,7 @@ Mesh megaMesh(const std::string& kind, std::size_t triangles) {
         return makeTorus({0, 0, 0}, 1.0, 0.3, major, minor);
     }
     if (kind == "arch") {
-        auto arch = readMesh(RUBBLE_SOURCE_DIR "/assets/models/arch.obj");
+        auto arch = readMesh(sourceDir() / "assets/models/arch.obj");
         if (!arch)
             throw std::runtime_error(arch.error().message);
         Mesh m = std::move(arch.value());

@@ -45,7 +45,7 @@ struct BenchArgs {
     bool attributes = false;
     bool quick = false;
     std::string label = "current";
-    std::string out = rubble::bench::kResultsDir;
+    std::string out = rubble::bench::resultsDir();
 };
 
 #ifdef RUBBLE_HAVE_BULLET
@@ -149,7 +149,7 @@ struct Templates {
 
 Templates makeTemplates(std::size_t want) {
     Templates t;
-    auto mesh = readObj(fs::path(RUBBLE_SOURCE_DIR) / "assets/models/facade_x.obj");
+    auto mesh = readObj(rubble::bench::sourceDir() / "assets/models/facade_x.obj");
     if (!mesh) {
         std::cerr << "memory: " << mesh.error().message << "\n";
         return t;

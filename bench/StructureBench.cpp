@@ -39,7 +39,7 @@ struct BenchArgs {
     int iterations = 25;
     std::vector<std::string> solvers; // only these rows (empty: all)
     std::vector<int> sizes;           // block sizes k (k x h x k, h as in the default list; empty: all)
-    std::string out = rubble::bench::kResultsDir;
+    std::string out = rubble::bench::resultsDir();
 };
 
 struct Row {

@@ -313,7 +313,7 @@ namespace rubble {
 // leaves it standing.
 TEST(StructureRuntime, ATowerStandsUnshotAndFallsWhenOneSideOfItsBaseIsRemoved) {
     const Result<SceneConfig> scene =
-        parseSceneConfig(std::string(RUBBLE_SOURCE_DIR) + "/assets/scenes/tower.cfg");
+        parseSceneConfig(test::sourceDir() / "assets/scenes/tower.cfg");
     ASSERT_TRUE(scene) << scene.error().message;
     for (const int mode : {0, 1, 2}) { // Gauss-Seidel, direct, connectivity
         const bool structure = mode < 2;
