@@ -13,15 +13,26 @@
 #include "rubble/io/SceneIO.hpp"
 
 namespace {
-const std::filesystem::path& folder() {
-    static const std::filesystem::path dir = [] {
+// The per-process folder, removed when the process exits normally.
+struct Folder {
+    std::filesystem::path dir;
+    Folder() {
         char pid[16]; // zero-padded: every run's paths, and so its messages, have the same length
         std::snprintf(pid, sizeof pid, "%010d", static_cast<int>(::getpid()));
-        auto d = std::filesystem::path("/tmp") / (std::string("rubble-fuzz-gltf-") + pid);
-        std::filesystem::create_directories(d);
-        return d;
-    }();
-    return dir;
+        dir = std::filesystem::path("/tmp") / (std::string("rubble-fuzz-gltf-") + pid);
+        std::filesystem::create_directories(dir);
+    }
+    Folder(const Folder&) = delete;
+    Folder& operator=(const Folder&) = delete;
+    ~Folder() {
+        std::error_code ec;
+        std::filesystem::remove_all(dir, ec);
+    }
+};
+
+const std::filesystem::path& folder() {
+    static const Folder f;
+    return f.dir;
 }
 
 // A parsed mesh must be structurally sound; the error of a refused one must name the file.
