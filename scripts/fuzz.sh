@@ -9,7 +9,7 @@
 # Exploration keeps the inputs that grew the coverage in <tree>/corpus/<target>/ for the next run (the repository's
 # corpus is only read). RUBBLE_FUZZ_SEED and RUBBLE_FUZZ_RUNS (libFuzzer's -seed and -runs; the time limit still
 # caps the run) make it reproducible.
-# CI mode runs each target from seed 1 for the input count in ci_runs below (sized to about a minute each on the
+# CI mode runs each target from seed 1 for the input count in ci_runs below (sized to 5-40 s each on the
 # 2-core CI machine), starting from the repository's corpus and an empty work corpus (<tree>/corpus-ci/), with
 # ASLR off, a fixed environment and libFuzzer's timed corpus reload off: otherwise two runs of the same seed
 # diverge after a few hundred inputs (the targets' coverage depends on addresses, heap and stack, and reloads
@@ -19,7 +19,7 @@
 # input is also printed in base64, so it can be taken from the CI log.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-declare -A ci_runs=([obj]=500000 [json]=500000 [off]=400000 [ply_stl]=500000 [scene]=400000 [mesh_repair]=70000 [convex_clip]=18000 [fracture]=1500 [snapshot]=120000 [net_protocol]=150000 [mtl]=300000 [gltf]=100000)
+declare -A ci_runs=([obj]=500000 [json]=500000 [off]=250000 [ply_stl]=300000 [scene]=400000 [mesh_repair]=40000 [convex_clip]=14000 [fracture]=800 [snapshot]=60000 [net_protocol]=150000 [mtl]=300000 [gltf]=60000)
 ci_cap=150
 ci=0
 if [ "${1:-}" = ci ]; then
