@@ -506,10 +506,16 @@ Result<FractureResult> runInPlace(Mesh& mesh, MeshTopology& topology, std::vecto
             if (!hit)
                 return cellsCutNothing();
             const bool noUvs = mesh.uvs.empty(), noMaterials = mesh.materials.empty();
-            if (noUvs) // the layout every split output has
+            // The layout every split output has, with room for the edit (as the caller's copy has).
+            const std::size_t room = std::max(nT, mesh.triangles.capacity());
+            if (noUvs) {
+                mesh.uvs.reserve(3 * room);
                 mesh.uvs.assign(3 * nT, Vec2{});
-            if (noMaterials)
+            }
+            if (noMaterials) {
+                mesh.materials.reserve(room);
                 mesh.materials.assign(nT, 0u);
+            }
             slots = detail::replaceTriangles(mesh, topology, edit.removed, edit.newPositions,
                                              std::move(edit.added));
             if (!slots && noUvs)
