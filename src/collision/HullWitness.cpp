@@ -3,9 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <numbers>
 #include <optional>
 
+#include "collision/MeshRegion.hpp"
+#include "geometry/ClosestPoint.hpp"
 #include "rubble/collision/ConvexDecomposition.hpp"
 
 namespace rubble::detail {
@@ -23,20 +24,6 @@ double segmentDistance(const Vec3& p, const Vec3& a, const Vec3& b) {
     const double len2 = lengthSquared(ab);
     const double t = len2 > 0 ? std::clamp(dot(p - a, ab) / len2, 0.0, 1.0) : 0.0;
     return length(p - (a + ab * t));
-}
-
-/// Distance from p to the triangle abc.
-double triangleDistance(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
-    const Vec3 n = cross(b - a, c - a);
-    const double n2 = lengthSquared(n);
-    if (n2 > 0) {
-        const double d = dot(p - a, n) / n2;
-        const Vec3 q = p - n * d; // p projected on the plane
-        if (dot(cross(b - a, q - a), n) >= 0 && dot(cross(c - b, q - b), n) >= 0 &&
-            dot(cross(a - c, q - c), n) >= 0)
-            return std::abs(d) * std::sqrt(n2);
-    }
-    return std::min({segmentDistance(p, a, b), segmentDistance(p, b, c), segmentDistance(p, c, a)});
 }
 
 } // namespace
@@ -74,15 +61,7 @@ HullWitness::HullWitness(const Mesh& mesh, double reach)
         const int cell[3] = {cellOf(0, p.x), cellOf(1, p.y), cellOf(2, p.z)};
         for (int a = 0; a < 3; ++a) {
             const int b = (a + 1) % 3, c = (a + 2) % 3;
-            Span& s = rows_[a][static_cast<std::size_t>(cell[b]) * cells_[c] + cell[c]];
-            if (!s.set) {
-                s = {p, p, true};
-                continue;
-            }
-            if (p[a] < s.lo[a])
-                s.lo = p;
-            if (p[a] > s.hi[a])
-                s.hi = p;
+            rows_[a][static_cast<std::size_t>(cell[b]) * cells_[c] + cell[c]].add(p, a);
         }
     }
     // Triangles longer than reach (two rows across) also give the points where the rows' centre lines cross
@@ -117,15 +96,7 @@ void HullWitness::crossRows(int a, const Vec3& p0, const Vec3& p1, const Vec3& p
             if (w1 < 0 || w2 < 0 || w1 + w2 > 1)
                 continue;
             const Vec3 q = p0 + (p1 - p0) * w1 + (p2 - p0) * w2; // on the triangle
-            Span& s = rows_[a][static_cast<std::size_t>(i) * cells_[c] + j];
-            if (!s.set) {
-                s = {q, q, true};
-                continue;
-            }
-            if (q[a] < s.lo[a])
-                s.lo = q;
-            if (q[a] > s.hi[a])
-                s.hi = q;
+            rows_[a][static_cast<std::size_t>(i) * cells_[c] + j].add(q, a);
         }
 }
 
@@ -207,7 +178,7 @@ bool HullWitness::near(const Vec3& p) const {
         bucketOf(2, p.z);
     for (std::uint32_t i = bucketStart_[k]; i < bucketStart_[k + 1]; ++i) {
         const auto c = mesh_.corners(large_[i]);
-        if (triangleDistance(p, c[0], c[1], c[2]) <= reach_)
+        if (length(p - closestOnTriangle(p, c[0], c[1], c[2])) <= reach_)
             return true;
     }
     return false;
@@ -220,10 +191,7 @@ namespace {
 Result<ConvexPolytope> hullOfExtremes(const std::vector<Vec3>& points, std::size_t n) {
     std::vector<Vec3> extremes;
     for (std::size_t k = 0; k < n; ++k) {
-        const double z = 1 - (2 * static_cast<double>(k) + 1) / static_cast<double>(n);
-        const double r = std::sqrt(std::max(0.0, 1 - z * z));
-        const double phi = static_cast<double>(k) * std::numbers::pi * (3 - std::sqrt(5.0));
-        const Vec3 d{r * std::cos(phi), r * std::sin(phi), z};
+        const Vec3 d = sphereDirection(k, n);
         std::size_t best = 0;
         for (std::size_t i = 1; i < points.size(); ++i)
             if (dot(d, points[i]) > dot(d, points[best]))

@@ -30,8 +30,15 @@ public:
 
 private:
     struct Span {
-        Vec3 lo, hi; // the row's vertices least and greatest along its axis
+        Vec3 lo, hi; // the row's points least and greatest along its axis
         bool set = false;
+        void add(const Vec3& p, int axis) {
+            if (!set || p[axis] < lo[axis])
+                lo = p;
+            if (!set || p[axis] > hi[axis])
+                hi = p;
+            set = true;
+        }
     };
     const Mesh& mesh_;
     double reach_;
