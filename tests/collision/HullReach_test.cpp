@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "PartOverlap.hpp"
+#include "SurfaceImpact.hpp"
 #include "collision/HullWitness.hpp"
 #include "rubble/collision/CollisionTolerance.hpp"
 #include "rubble/collision/ConvexDecomposition.hpp"
@@ -23,13 +24,10 @@ double worstReachOverChain(Mesh mesh, const DecompositionParams& dp, int hits, s
     double worst = test::reachOutsideHull(mesh, parts);
     Rng rng(seed);
     for (int hit = 0; hit < hits; ++hit) {
-        const auto t = static_cast<std::size_t>(rng.below(mesh.triangles.size()));
-        const auto c = mesh.corners(t);
-        const Vec3 n = normalized(cross(c[1] - c[0], c[2] - c[0]));
         FractureParams fp;
         fp.sizeLaw.base = 0.45;
         fp.sizeLaw.scale = 0;
-        auto fr = fracture(mesh, {(c[0] + c[1] + c[2]) / 3.0 - n * 1e-3, n, 10}, fp, seed + hit);
+        auto fr = fracture(mesh, test::randomSurfaceImpact(mesh, rng, 10), fp, seed + hit);
         if (!fr)
             continue;
         const auto updated = updateDecomposition(parts, *fr, dp);
