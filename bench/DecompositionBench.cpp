@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -214,6 +215,7 @@ struct Method {
     int threads = 1;
     bool hullOnly = false;          // Qhull's hull of the whole mesh
     std::size_t proxyAbove = 20000; // DecompositionParams::proxyAboveTriangles
+    std::size_t maxTriangles = std::numeric_limits<std::size_t>::max(); // larger meshes skip the method
 };
 
 int runOrganic(const BenchArgs& args) {
@@ -224,7 +226,10 @@ int runOrganic(const BenchArgs& args) {
         {"rubble", 1, false, rubble::DecompositionParams{}.proxyAboveTriangles},
         {"rubble_2_threads", 2, false, rubble::DecompositionParams{}.proxyAboveTriangles},
         {"rubble_proxy_always", 1, false, 0},
-        {"qhull_hull", 1, true, 0}};
+        {"qhull_hull", 1, true, 0},
+        // The exact search on a mesh just above the threshold, as on one just under it (e.g. CGAL's camel).
+        {"rubble_exact", 1, false, std::numeric_limits<std::size_t>::max(), 30000},
+        {"rubble_exact_2_threads", 2, false, std::numeric_limits<std::size_t>::max(), 30000}};
     const rubble::bench::CpuMeter cpu;
     rubble::bench::Table table{
         {"mesh", "tris", "method", "parts", "wall med ms", "cpu med ms", "excess", "concavity"}, {}};
@@ -237,6 +242,8 @@ int runOrganic(const BenchArgs& args) {
         for (std::size_t size : sizes) {
             const rubble::Mesh mesh = rubble::bench::megaMesh(kind, size);
             for (const Method& m : methods) {
+                if (mesh.triangles.size() > m.maxTriangles)
+                    continue;
                 std::optional<rubble::ThreadPool> pool;
                 rubble::DecomposeControl control;
                 if (m.threads > 1) {

@@ -15,6 +15,7 @@ extern "C" {
 #include <libqhull_r/qhull_ra.h>
 }
 
+#include "collision/MeshRegion.hpp"
 #include "rubble/collision/CollisionTolerance.hpp"
 #include "rubble/collision/ConvexDecomposition.hpp"
 
@@ -147,10 +148,7 @@ Result<ConvexPolytope> pushedOutHull(const std::vector<Vec3>& points, std::size_
     const Vec3 half = box.size() * 0.5 + Vec3{1, 1, 1} * (1e-12 * (box.diagonal() + 1));
     std::vector<Vec3> extremes;
     for (std::size_t k = 0; k < directions; ++k) {
-        const double z = 1 - (2 * static_cast<double>(k) + 1) / static_cast<double>(directions);
-        const double r = std::sqrt(std::max(0.0, 1 - z * z));
-        const double phi = static_cast<double>(k) * std::numbers::pi * (3 - std::sqrt(5.0));
-        const Vec3 u{r * std::cos(phi), r * std::sin(phi), z};
+        const Vec3 u = detail::sphereDirection(k, directions);
         const Vec3 n{u.x / half.x, u.y / half.y, u.z / half.z};
         std::size_t best = 0;
         double bestDot = -std::numeric_limits<double>::infinity();

@@ -55,6 +55,8 @@ constexpr std::size_t kProxyDepthFaces = 64;
 constexpr std::size_t kDepthChunk = 32;
 /// Share of the progress that the search for cuts takes (the final part shapes take the rest).
 constexpr double kSearchShare = 0.9;
+/// Most points per side in the hull that bounds a candidate split's score from below.
+constexpr std::size_t kBoundPoints = 256;
 /// Concavity below this fraction of the diagonal is rounding: such a part is convex.
 constexpr double kConvexTolerance = 1e-9;
 
@@ -401,6 +403,97 @@ public:
         return s;
     }
 
+    /// A lower bound of trySplit(part, plane)'s score: the volumes of the hulls, on each side, of the part's
+    /// hull vertices there and the points where the surface crosses the plane (all of them points that the
+    /// side's own hull holds; a side with too few or flat points counts 0).
+    double splitBound(const Part& part, const Plane& plane) const {
+        std::vector<Vec3> in, out;
+        const double tol = 1e-12 * std::max(diag_, 1e-300);
+        for (const Vec3& v : part.hull.vertices()) {
+            const double d = plane.signedDistance(v);
+            if (d < -tol)
+                in.push_back(v);
+            else if (d > tol)
+                out.push_back(v);
+        }
+        Polygon a, b;
+        for (const Polygon& poly : part.surface) {
+            bool below = false, above = false;
+            for (const Vec3& p : poly) {
+                const double d = plane.signedDistance(p);
+                below |= d < 0;
+                above |= d > 0;
+            }
+            if (!below || !above)
+                continue;
+            // The corners the split makes on the plane, as trySplit makes them.
+            detail::splitPolygon(poly, plane, a, b);
+            for (const Vec3& p : a)
+                if (std::find(poly.begin(), poly.end(), p) == poly.end())
+                    in.push_back(p);
+            for (const Vec3& p : b)
+                if (std::find(poly.begin(), poly.end(), p) == poly.end())
+                    out.push_back(p);
+        }
+        double volume = 0;
+        for (std::vector<Vec3>* side : {&in, &out}) {
+            // Every k-th point, at most kBoundPoints: a subset's hull is a lower bound too, and far cheaper.
+            const std::size_t stride = (side->size() + kBoundPoints - 1) / kBoundPoints;
+            if (stride > 1) {
+                std::size_t kept = 0;
+                for (std::size_t i = 0; i < side->size(); i += stride)
+                    (*side)[kept++] = (*side)[i];
+                side->resize(kept);
+            }
+            if (side->size() >= 4)
+                if (auto h = convexHull(*side))
+                    volume += h->volume();
+        }
+        return volume;
+    }
+
+    /// The split of part by a plane through its pocket with the least score (the first of equal scores), as
+    /// evaluating every candidate would find it. Candidates are tried in the order of a lower bound of their
+    /// score, a batch at a time on the job system, and those whose bound already loses are skipped.
+    std::optional<Split> bestSplit(const Part& part, const std::vector<Vec3>& normals) {
+        const std::size_t n = normals.size();
+        std::vector<double> bound(n, 0);
+        parallelFor(n, [&](std::size_t i) {
+            if (!stopped())
+                bound[i] = splitBound(part, Plane::fromPointNormal(part.pocket, normals[i]));
+        });
+        std::vector<std::size_t> order(n);
+        for (std::size_t i = 0; i < n; ++i)
+            order[i] = i;
+        std::stable_sort(order.begin(), order.end(),
+                         [&](std::size_t a, std::size_t b) { return bound[a] < bound[b]; });
+        std::optional<Split> chosen;
+        std::size_t chosenIndex = n;
+        // A candidate can still win while its bound does not exceed the best score (with room for the
+        // rounding of two hulls' volumes: a bound may equal a score).
+        auto mayWin = [&](std::size_t i) { return !chosen || bound[i] <= chosen->score * (1 + 1e-9); };
+        const std::size_t batch =
+            control_.jobs ? static_cast<std::size_t>(std::max(1, control_.jobs->workerCount()) + 1) : 1;
+        for (std::size_t next = 0; next < n && !stopped();) {
+            std::vector<std::size_t> take;
+            for (; next < n && take.size() < batch; ++next)
+                if (mayWin(order[next]))
+                    take.push_back(order[next]);
+            std::vector<std::optional<Split>> tries(take.size());
+            parallelFor(take.size(), [&](std::size_t k) {
+                if (!stopped())
+                    tries[k] = trySplit(part, Plane::fromPointNormal(part.pocket, normals[take[k]]));
+            });
+            for (std::size_t k = 0; k < take.size(); ++k)
+                if (tries[k] && (!chosen || tries[k]->score < chosen->score ||
+                                 (tries[k]->score == chosen->score && take[k] < chosenIndex))) {
+                    chosen = std::move(tries[k]);
+                    chosenIndex = take[k];
+                }
+        }
+        return chosen;
+    }
+
     std::vector<Vec3> candidateNormals(const Part& part) const {
         std::vector<Vec3> normals = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
         // Principal axes of the hull's vertices.
@@ -529,15 +622,7 @@ public:
                                            threshold / parts[best].depth));
             const Part& part = parts[best];
             const std::vector<Vec3> normals = candidateNormals(part);
-            std::vector<std::optional<Split>> tries(normals.size());
-            parallelFor(normals.size(), [&](std::size_t i) {
-                if (!stopped())
-                    tries[i] = trySplit(part, Plane::fromPointNormal(part.pocket, normals[i]));
-            });
-            std::optional<Split> chosen;
-            for (std::optional<Split>& s : tries)
-                if (s && (!chosen || s->score < chosen->score))
-                    chosen = std::move(s);
+            std::optional<Split> chosen = bestSplit(part, normals);
             if (!chosen || chosen->score > part.hull.volume() * (1 + 1e-9)) {
                 done[best] = true;
                 continue;

@@ -2,6 +2,9 @@
 // Private helpers of the collision module: polygon clipping, point-in-mesh, and the convex hull of the part
 // of a closed mesh inside a convex region.
 
+#include <algorithm>
+#include <cmath>
+#include <numbers>
 #include <vector>
 
 #include "rubble/core/Result.hpp"
@@ -34,6 +37,14 @@ Result<ConvexPolytope> hullOfMeshInRegion(const Mesh& mesh, const ConvexPolytope
 /// pairs of opposite triangles cancelled. Closed (every edge used as often in both directions) but not
 /// necessarily manifold; its winding number follows the mesh's away from the surface.
 Mesh clusteredProxy(const Mesh& mesh, int cellsPerAxis);
+
+/// The k-th of n directions spread evenly over the unit sphere (a Fibonacci lattice).
+inline Vec3 sphereDirection(std::size_t k, std::size_t n) {
+    const double z = 1 - (2 * static_cast<double>(k) + 1) / static_cast<double>(n);
+    const double r = std::sqrt(std::max(0.0, 1 - z * z));
+    const double phi = static_cast<double>(k) * std::numbers::pi * (3 - std::sqrt(5.0));
+    return {r * std::cos(phi), r * std::sin(phi), z};
+}
 
 /// Most hull planes that keepInsideHull clips one part by.
 constexpr std::size_t kMaxHullClips = 256;

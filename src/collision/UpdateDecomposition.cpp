@@ -7,6 +7,7 @@
 #include <optional>
 #include <unordered_map>
 
+#include "collision/HullWitness.hpp"
 #include "collision/MeshRegion.hpp"
 #include "rubble/collision/CollisionTolerance.hpp"
 #include "rubble/collision/ConvexDecomposition.hpp"
@@ -21,6 +22,10 @@ namespace {
 /// fraction of its parts' volume; a high-poly piece's parts become their hull when it is at most this much
 /// larger than their sum (docs/megamesh.md).
 constexpr double kHighPolyFillTolerance = 0.01;
+
+/// The share of kPartHullTolerance that a part's proven reach out of its piece's hull may take (the rest is
+/// margin for rounding).
+constexpr double kHullReachShare = 0.9;
 
 /// The share of kPartOverlapTolerance that the merges of a remainder may spend (the rest is margin for the
 /// pieces' real surfaces against the cells).
@@ -818,17 +823,30 @@ void fitPiece(std::size_t i, Assignment& a, const PieceSet& pieces,
     mergeToBudget(parts, a.origins[i], params.maxParts, g);
 }
 
-/// Stage 5, bounds: parts kept inside their piece's convex hull (kPartHullTolerance), and to a bounded size,
-/// so that the next hit clips the same few faces (a bounded part reaches at most half the tolerance out of
-/// its hull).
+/// Stage 5, bounds: parts kept to a bounded size, so that the next hit clips the same few faces, and inside
+/// their piece's convex hull (kPartHullTolerance): clipped by its exact hull up to proxyAboveTriangles, and
+/// above, every part with a corner not proven near the hull (detail::HullWitness) replaced by the hull of the
+/// piece's points it holds (docs/collision.md).
 void boundToHull(std::vector<ConvexPolytope>& parts, const Mesh& piece, const DecompositionParams& params) {
-    if (!parts.empty() && piece.triangles.size() <= params.proxyAboveTriangles)
-        if (auto hull = convexHull(piece.positions))
-            detail::keepInsideHull(parts, *hull, 1e-9 * piece.bounds().diagonal());
+    if (parts.empty())
+        return;
+    const double reach = kHullReachShare * partHullTolerance(piece.bounds().diagonal());
+    const bool highPoly = piece.triangles.size() > params.proxyAboveTriangles;
+    std::optional<ConvexPolytope> hull;
+    if (!highPoly)
+        if (auto h = convexHull(piece.positions))
+            hull = std::move(h.value());
+    if (hull)
+        detail::keepInsideHull(parts, *hull, 1e-9 * piece.bounds().diagonal());
+    bool bounded = false;
     for (ConvexPolytope& p : parts)
         if (p.faces().size() > params.maxPartFaces)
-            if (auto b = boundedHull(p.vertices(), params.maxPartFaces))
+            if (auto b = boundedHull(p.vertices(), params.maxPartFaces)) {
                 p = std::move(b.value());
+                bounded = true;
+            }
+    if (highPoly || (hull && bounded))
+        detail::keepNearHull(parts, piece, reach, params.maxPartFaces, hull ? &*hull : nullptr);
 }
 
 /// updateDecomposition on pieces held elsewhere (no copies): the five stages.

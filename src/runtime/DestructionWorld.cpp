@@ -14,6 +14,7 @@
 
 #include "geometry/ClosestPoint.hpp"
 #include "geometry/ShellScratch.hpp"
+#include "rubble/collision/DecomposeControl.hpp"
 #include "rubble/core/Log.hpp"
 #include "rubble/core/ParameterCheck.hpp"
 #include "rubble/core/Random.hpp"
@@ -599,7 +600,9 @@ Result<ObjectId> DestructionWorld::addObject(ObjectDesc desc) {
     s.mass = facts ? massProperties(facts.value().integrals) : computeMassProperties(desc.mesh);
     s.convexParts = std::move(desc.convexParts);
     if (s.convexParts.empty() && report.valid()) {
-        auto d = impl_->cache.get(desc.mesh, impl_->config.decomposition);
+        DecomposeControl control; // on the world's workers beside the calling thread
+        control.jobs = impl_->jobs;
+        auto d = impl_->cache.get(desc.mesh, impl_->config.decomposition, control);
         if (d)
             s.convexParts = d.value().parts;
     }

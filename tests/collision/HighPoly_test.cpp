@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include "SurfaceImpact.hpp"
 #include "rubble/collision/ConvexDecomposition.hpp"
 #include "rubble/core/Random.hpp"
 #include "rubble/fracture/Fracture.hpp"
@@ -92,13 +93,10 @@ std::vector<ChainStep> chainOnTorus(int hits, const DecompositionParams& dp) {
     std::vector<ChainStep> steps;
     Rng rng(7);
     for (int hit = 0; hit < hits; ++hit) {
-        const auto t = static_cast<std::size_t>(rng.below(mesh.triangles.size()));
-        const auto c = mesh.corners(t);
-        const Vec3 n = normalized(cross(c[1] - c[0], c[2] - c[0]));
         FractureParams fp;
         fp.sizeLaw.base = 0.5;
         fp.sizeLaw.scale = 0;
-        auto fr = fracture(mesh, {(c[0] + c[1] + c[2]) / 3.0 - n * 1e-3, n, 10}, fp, 60 + hit, facts);
+        auto fr = fracture(mesh, test::randomSurfaceImpact(mesh, rng, 10), fp, 60 + hit, facts);
         if (!fr)
             continue;
         ChainStep step{std::move(fr).value(), {}};

@@ -1,9 +1,13 @@
 // The in-memory DecompositionCache is bounded (issue #7, soak): DestructionWorld keeps one for the life of
 // the world and adds an entry for every object added without convex parts.
+#include <atomic>
+
 #include <gtest/gtest.h>
 
 #include "TestSupport.hpp"
 #include "rubble/collision/ConvexDecomposition.hpp"
+#include "rubble/core/ThreadPool.hpp"
+#include "rubble/runtime/DestructionWorld.hpp"
 
 namespace rubble {
 namespace {
@@ -11,6 +15,31 @@ namespace {
 Mesh boxOfWidth(int i) {
     const double w = 1.0 + 0.25 * i;
     return makeSubdividedBox({0, 0, 0}, {w, 1, 1}, 1);
+}
+
+/// A job system that counts the jobs it passes on to a pool.
+class CountingJobs final : public JobSystem {
+public:
+    void submit(std::function<void()> job) override {
+        ++submitted;
+        pool.submit(std::move(job));
+    }
+    int workerCount() const override { return pool.workerCount(); }
+    std::atomic<int> submitted{0};
+    ThreadPool pool{1};
+};
+
+TEST(DecompositionCacheBound, AWorldDecomposesAnAddedObjectOnItsOwnWorkers) {
+    CountingJobs jobs;
+    DestructionWorld::Config config;
+    config.jobs = &jobs;
+    DestructionWorld world(config);
+    ObjectDesc desc;
+    desc.mesh = makeTorus({0, 0, 0}, 1.0, 0.3, 24, 10); // concave: the search tries cuts
+    auto id = world.addObject(desc);
+    ASSERT_TRUE(id) << id.error().message;
+    EXPECT_GT(world.object(*id)->convexParts.size(), 1u);
+    EXPECT_GT(jobs.submitted.load(), 0) << "the decomposition ran on the calling thread alone";
 }
 
 TEST(DecompositionCacheBound, EntriesNeverExceedCapacityAfterManyDistinctMeshes) {
