@@ -101,8 +101,9 @@ struct StressSolver::DirectCache {
     std::vector<char> flags;      // each corner's active and slip flags the factorisation holds
     Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
     bool analysed = false;
-    bool factored = false; // the numeric factorisation matches the nodes and bonds (until one changes)
-    double compliance = 0; // the one it was made with
+    bool factored = false;  // the numeric factorisation matches the nodes and bonds (until one changes)
+    double compliance = 0;  // the one it was made with
+    bool polishing = false; // its Gauss-Seidel polish runs: stalls what stops converging (solveGaussSeidel)
 };
 
 StructureNode structureNode(const std::vector<ConvexPolytope>& parts, double density, bool root) {
@@ -725,6 +726,11 @@ void StressSolver::solveGaussSeidel(double tolerance) {
     const double tolerance2 = tolerance * tolerance, quiet2 = tolerance2 * 1e-4;
     std::vector<std::uint32_t> active, touched;
     std::vector<std::size_t> list;
+    // The direct solve's polish: every stallSweeps sweeps, a node on bearings still accelerating by
+    // `unbalanced` whose acceleration changed by at most 1 % since the last check is stalled (the sweeps
+    // no longer move it: it has no equilibrium there), whatever the last solve said.
+    const bool polish = direct_ && direct_->polishing;
+    std::vector<double> seen(polish ? nodes_.size() : 0, 0.0); // each node's residual at the last check
     double max2 = 0;
     for (std::uint32_t i = 0; i < nodes_.size(); ++i)
         if (movable(i)) {
@@ -732,18 +738,27 @@ void StressSolver::solveGaussSeidel(double tolerance) {
             max2 = std::max(max2, e2);
             if (e2 > quiet2)
                 active.push_back(i);
+            if (polish)
+                seen[i] = e2;
         }
     bondStamp_.resize(bonds_.size(), 0);
     nodeStamp_.resize(nodes_.size(), 0);
     auto resting = [&](std::uint32_t i) { return !movable(i) || nodeResidual(nodes_[i]) <= quiet2; };
     const double unbalanced2 = settings_.unbalanced * settings_.unbalanced;
     for (sweeps_ = 0; sweeps_ < settings_.maxSweeps && max2 > tolerance2; ++sweeps_) {
-        if (sweeps_ > 0 && sweeps_ == settings_.stallSweeps) {
+        const int stall = settings_.stallSweeps;
+        if (sweeps_ > 0 && stall > 0 && (sweeps_ == stall || (polish && sweeps_ % stall == 0))) {
             // What bearings did not hold in the last solve and still do not is left out: its bonds keep
             // their forces, it counts as unbalanced again, and the rest converges around it.
             for (std::uint32_t n : active) {
                 NodeState& s = nodes_[n];
-                s.stalled = s.bearings > 0 && s.unbalanced > 0 &&
+                bool stuck = false;
+                if (polish) { // stuck: its acceleration unchanged within 1 % over the last stallSweeps
+                    const double e = std::sqrt(nodeResidual(s)), last = std::sqrt(seen[n]);
+                    stuck = last > 0 && std::abs(e - last) <= 0.01 * last;
+                    seen[n] = e * e;
+                }
+                s.stalled = s.bearings > 0 && (s.unbalanced > 0 || stuck) &&
                             (lengthSquared(s.v) > unbalanced2 || lengthSquared(s.w) > unbalanced2);
             }
             std::erase_if(active, [&](std::uint32_t n) { return nodes_[n].stalled; });
@@ -1194,7 +1209,9 @@ void StressSolver::solveDirect(double tolerance) {
                 release(bonds_[k], c);
             limit(bonds_[k], c);
         }
+    cache.polishing = true;
     solveGaussSeidel(tolerance);
+    cache.polishing = false;
     sweeps_ += directSweeps;
 }
 
