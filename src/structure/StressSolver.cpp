@@ -2,6 +2,10 @@
 
 #include <Eigen/Dense>
 #include <Eigen/SparseCholesky>
+#ifdef RUBBLE_HAVE_CHOLMOD
+#include <Eigen/CholmodSupport>
+#include <dlfcn.h>
+#endif
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -93,13 +97,46 @@ std::vector<Vec2> bearingCorners(const std::vector<Vec2>& corners) {
     return out;
 }
 
+#ifdef RUBBLE_HAVE_CHOLMOD
+// Keeps CHOLMOD's OpenMP regions on the calling thread while alive (Debian's CHOLMOD asks for 4 threads):
+// the solver runs on the caller's thread only. Looked up at run time: OpenMP comes in with CHOLMOD.
+class SerialOpenMp {
+public:
+    SerialOpenMp() {
+        get_ = reinterpret_cast<int (*)()>(dlsym(RTLD_DEFAULT, "omp_get_max_active_levels"));
+        set_ = reinterpret_cast<void (*)(int)>(dlsym(RTLD_DEFAULT, "omp_set_max_active_levels"));
+        if (get_ && set_) {
+            saved_ = get_();
+            set_(0);
+        }
+    }
+    ~SerialOpenMp() {
+        if (get_ && set_)
+            set_(saved_);
+    }
+    SerialOpenMp(const SerialOpenMp&) = delete;
+    SerialOpenMp& operator=(const SerialOpenMp&) = delete;
+
+private:
+    int (*get_)() = nullptr;
+    void (*set_)(int) = nullptr;
+    int saved_ = 0;
+};
+#else
+struct SerialOpenMp {};
+#endif
+
 } // namespace
 
 // The direct solve's factorisation, kept across solves while the structure and the active set stay.
 struct StressSolver::DirectCache {
     std::vector<std::size_t> key; // the movable nodes in unknown order, then each bond's slot and nodes
     std::vector<char> flags;      // each corner's active and slip flags the factorisation holds
+#ifdef RUBBLE_HAVE_CHOLMOD
+    Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>> ldlt; // supernodal: dense kernels on the fill
+#else
     Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
+#endif
     bool analysed = false;
     bool factored = false;  // the numeric factorisation matches the nodes and bonds (until one changes)
     double compliance = 0;  // the one it was made with
@@ -942,6 +979,7 @@ void StressSolver::solveDirect(double tolerance) {
     using Vec6 = Eigen::Matrix<double, 6, 1>;
     using Sparse = Eigen::SparseMatrix<double>;
     const double delta = std::max(settings_.compliance, 1e-12);
+    [[maybe_unused]] const SerialOpenMp serial;
     if (!direct_ || direct_.use_count() > 1)
         direct_ = std::make_shared<DirectCache>();
     DirectCache& cache = *direct_;
