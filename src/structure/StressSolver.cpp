@@ -763,9 +763,9 @@ void StressSolver::solveGaussSeidel(double tolerance) {
     const double tolerance2 = tolerance * tolerance, quiet2 = tolerance2 * 1e-4;
     std::vector<std::uint32_t> active, touched;
     std::vector<std::size_t> list;
-    // The direct solve's polish: every stallSweeps sweeps, a node on bearings still accelerating by
-    // `unbalanced` whose acceleration changed by at most 1 % since the last check is stalled (the sweeps
-    // no longer move it: it has no equilibrium there), whatever the last solve said.
+    // The direct solve's polish: every stallSweeps sweeps, a node on bearings still outside the tolerance
+    // whose acceleration changed by at most 1 % since the last check is stalled (the sweeps no longer move
+    // it), whatever the last solve said and however small its acceleration.
     const bool polish = direct_ && direct_->polishing;
     std::vector<double> seen(polish ? nodes_.size() : 0, 0.0); // each node's residual at the last check
     double max2 = 0;
@@ -792,11 +792,11 @@ void StressSolver::solveGaussSeidel(double tolerance) {
                 bool stuck = false;
                 if (polish) { // stuck: its acceleration unchanged within 1 % over the last stallSweeps
                     const double e = std::sqrt(nodeResidual(s)), last = std::sqrt(seen[n]);
-                    stuck = last > 0 && std::abs(e - last) <= 0.01 * last;
+                    stuck = last > 0 && e * e > tolerance2 && std::abs(e - last) <= 0.01 * last;
                     seen[n] = e * e;
                 }
-                s.stalled = s.bearings > 0 && (s.unbalanced > 0 || stuck) &&
-                            (lengthSquared(s.v) > unbalanced2 || lengthSquared(s.w) > unbalanced2);
+                const bool moving = lengthSquared(s.v) > unbalanced2 || lengthSquared(s.w) > unbalanced2;
+                s.stalled = s.bearings > 0 && ((s.unbalanced > 0 && moving) || stuck);
             }
             std::erase_if(active, [&](std::uint32_t n) { return nodes_[n].stalled; });
             max2 = 0;

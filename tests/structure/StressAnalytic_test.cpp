@@ -509,3 +509,27 @@ TEST(StressAnalytic, TheDirectSolvesPolishStopsOnABodyThatBeginsToSlide) {
     }
     EXPECT_EQ(s.unsupported(), std::vector<std::uint32_t>{blocks[2]});
 }
+
+// The same stack with `unbalanced` above the top block's acceleration (1.8 m/s^2 against 5): the block never
+// counts as unbalanced, so only the polish's own rule (its acceleration stops changing) keeps each solve from
+// sweeping to maxSweeps; it is left out within 256 sweeps every solve, still counts in the residual, and is
+// not dropped (below `unbalanced`).
+TEST(StressAnalytic, TheDirectSolvesPolishStopsBelowTheUnbalancedThreshold) {
+    Lattice l;
+    const double rho = 2400;
+    l.add(box({-2, -1, -2}, {2, 0, 2}), rho, true, 0.6);
+    std::vector<std::uint32_t> blocks;
+    for (int i = 0; i < 3; ++i)
+        blocks.push_back(l.add(box({-0.5, 0.5 * i, -0.5}, {0.5, 0.5 * (i + 1), 0.5}), rho, false, 0.6));
+    StressSettings settings = converged().back();
+    settings.unbalanced = 5;
+    StressSolver s = l.solver(settings);
+    const double top = l.mass(blocks[2]) * kG;
+    for (int frame = 0; frame < 5; ++frame) {
+        s.addLoad(blocks[2], {1.3 * 0.6 * top, 0, 0}, {0, 1.25, 0});
+        s.solve();
+        EXPECT_LT(s.sweeps(), 256) << "frame " << frame;
+        EXPECT_GT(s.residual(), settings.residual) << "frame " << frame;
+    }
+    EXPECT_TRUE(s.unsupported().empty());
+}
