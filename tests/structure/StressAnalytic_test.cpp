@@ -251,6 +251,22 @@ TEST(StressAnalytic, ThreeHingedArchThrustsHorizontallyAsStaticsSays) {
     }
 }
 
+namespace {
+// The lowest `count` joints of a stack of three equal blocks on `ground` each carry the weight above them
+// (`top` a block's) and the horizontal force `shear` on the top block, within 1 %.
+void expectStackCarries(const StressSolver& s, std::uint32_t ground, const std::vector<std::uint32_t>& blocks,
+                        double top, double shear, int count) {
+    for (int i = 0; i < count; ++i) {
+        const std::uint32_t below = i ? blocks[static_cast<std::size_t>(i - 1)] : ground;
+        const Vec3 f = forceOn(s, bondBetween(s, below, blocks[static_cast<std::size_t>(i)]),
+                               blocks[static_cast<std::size_t>(i)]);
+        const double weight = top * (3 - i);
+        EXPECT_NEAR(f.y, weight, 0.01 * weight) << "interface " << i;
+        EXPECT_NEAR(-f.x, shear, 0.01 * shear) << "interface " << i;
+    }
+}
+} // namespace
+
 // Three blocks stacked on bearings, the top one pushed sideways: each interface carries the weight above in
 // compression and the push in friction; a push over mu times the top block's weight slides it off, and the
 // blocks below, pressed harder, hold.
@@ -279,14 +295,7 @@ TEST(StressAnalytic, StackOnBearingsCarriesWeightAndFrictionUpToItsLimit) {
             if (ratio < 1) {
                 EXPECT_LE(s.residual(), settings.residual);
                 EXPECT_TRUE(s.unsupported().empty());
-                for (int i = 0; i < 3; ++i) {
-                    const std::uint32_t below = i ? blocks[static_cast<std::size_t>(i - 1)] : ground;
-                    const Vec3 f = forceOn(s, bondBetween(s, below, blocks[static_cast<std::size_t>(i)]),
-                                           blocks[static_cast<std::size_t>(i)]);
-                    const double weight = top * (3 - i);
-                    EXPECT_NEAR(f.y, weight, 0.01 * weight) << "interface " << i;
-                    EXPECT_NEAR(-f.x, push, 0.01 * push) << "interface " << i;
-                }
+                expectStackCarries(s, ground, blocks, top, push, 3);
             } else {
                 EXPECT_GT(s.residual(), settings.residual) << "no equilibrium to converge to";
                 EXPECT_EQ(s.unsupported(), std::vector<std::uint32_t>{blocks[2]});
@@ -495,14 +504,7 @@ TEST(StressAnalytic, TheDirectSolvesPolishStopsOnABodyThatBeginsToSlide) {
     s.solve();
     EXPECT_LT(s.sweeps(), 256) << "the sliding block is stalled, not swept to maxSweeps";
     EXPECT_GT(s.residual(), settings.residual) << "the sliding block still counts";
-    for (int i = 0; i < 2; ++i) {
-        const std::uint32_t below = i ? blocks[static_cast<std::size_t>(i - 1)] : ground;
-        const Vec3 f = forceOn(s, bondBetween(s, below, blocks[static_cast<std::size_t>(i)]),
-                               blocks[static_cast<std::size_t>(i)]);
-        const double weight = top * (3 - i);
-        EXPECT_NEAR(f.y, weight, 0.01 * weight) << "interface " << i;
-        EXPECT_NEAR(-f.x, 0.6 * top, 0.01 * 0.6 * top) << "interface " << i;
-    }
+    expectStackCarries(s, ground, blocks, top, 0.6 * top, 2);
     for (int frame = 0; frame < settings.unbalancedSolves; ++frame) {
         s.addLoad(blocks[2], {1.3 * 0.6 * top, 0, 0}, {0, 1.25, 0});
         s.solve();
