@@ -7,6 +7,7 @@ set -euo pipefail
 core=(
     build-essential cmake ninja-build pkg-config ccache clang-format lld
     libcgal-dev libgmp-dev libmpfr-dev libboost-dev libeigen3-dev voro++-dev libqhull-dev libtbb-dev
+    libsuitesparse-dev libopenblas0-serial
     libassimp-dev nlohmann-json3-dev libcli11-dev
     libgtest-dev libgmock-dev libbenchmark-dev
     libbullet-dev libenet-dev zlib1g-dev

@@ -112,6 +112,7 @@ struct DestructionRuntime::Impl {
     detail::SupportGraph support;
     detail::StructureMonitor structure;
     std::vector<StructureBreak> breaks;            // the bonds this frame broke
+    std::vector<StructureCollapse> collapses;      // the static bodies this frame let fall
     std::map<ObjectId, const Material*> materials; // of objects (pieces inherit their parent's)
     std::map<ObjectId, std::uint64_t> solids;      // pieces: the scene object they were cut from
     detail::DebrisGovernor governor;
@@ -214,6 +215,23 @@ struct DestructionRuntime::Impl {
     }
 
     // A static or frozen body becomes dynamic (wake rules: docs/architecture.md).
+    // A static body about to fall for want of support, as a collapse record.
+    void recordCollapse(BodyId id, bool byStress) {
+        const BodyRecord* r = bodies.find(id);
+        if (!r || r->motion == BodyMotionState::Dynamic)
+            return;
+        StructureCollapse e;
+        e.frame = counters.frames;
+        e.body = id;
+        e.position = binding.motion(id).transform.translation;
+        e.volume = r->volume;
+        e.mass = r->mass;
+        e.byStress = byStress;
+        if (r->hasObject)
+            e.material = materialOf(r->object).name;
+        collapses.push_back(std::move(e));
+    }
+
     void makeDynamic(BodyId id) {
         BodyRecord* r = bodies.find(id);
         if (!r || r->motion == BodyMotionState::Dynamic)
@@ -345,6 +363,7 @@ struct DestructionRuntime::Impl {
             const std::vector<BodyId> fallen = support.settle(searchesLeft);
             stats.supportSearches += before - searchesLeft;
             for (BodyId id : fallen) {
+                recordCollapse(id, false);
                 makeDynamic(id);
                 ++stats.piecesCollapsed;
                 ++counters.piecesCollapsed;
@@ -385,6 +404,7 @@ struct DestructionRuntime::Impl {
         }
         counters.bondsBroken += broken;
         for (BodyId id : fallen) {
+            recordCollapse(id, true);
             makeDynamic(id);
             ++stats.piecesCollapsed;
             ++counters.piecesCollapsed;
@@ -469,6 +489,7 @@ struct DestructionRuntime::Impl {
         const auto t0 = Clock::now();
         contacts.clear();
         breaks.clear();
+        collapses.clear();
         f.stats.substeps = binding.step(f.dt, contacts);
         f.stats.physicsMs = msSince(t0);
         f.afterPhysics = Clock::now();
@@ -846,6 +867,10 @@ std::vector<StructureBond> DestructionRuntime::structureBonds() const {
 
 const std::vector<StructureBreak>& DestructionRuntime::structureBreaks() const {
     return impl_->breaks;
+}
+
+const std::vector<StructureCollapse>& DestructionRuntime::structureCollapses() const {
+    return impl_->collapses;
 }
 
 std::vector<BodyId> DestructionRuntime::supportNeighbours(BodyId id) const {

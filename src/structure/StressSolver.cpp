@@ -2,6 +2,10 @@
 
 #include <Eigen/Dense>
 #include <Eigen/SparseCholesky>
+#ifdef RUBBLE_HAVE_CHOLMOD
+#include <Eigen/CholmodSupport>
+#include <dlfcn.h>
+#endif
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -93,16 +97,50 @@ std::vector<Vec2> bearingCorners(const std::vector<Vec2>& corners) {
     return out;
 }
 
+#ifdef RUBBLE_HAVE_CHOLMOD
+// Keeps CHOLMOD's OpenMP regions on the calling thread while alive (Debian's CHOLMOD asks for 4 threads):
+// the solver runs on the caller's thread only. Looked up at run time: OpenMP comes in with CHOLMOD.
+class SerialOpenMp {
+public:
+    SerialOpenMp() {
+        get_ = reinterpret_cast<int (*)()>(dlsym(RTLD_DEFAULT, "omp_get_max_active_levels"));
+        set_ = reinterpret_cast<void (*)(int)>(dlsym(RTLD_DEFAULT, "omp_set_max_active_levels"));
+        if (get_ && set_) {
+            saved_ = get_();
+            set_(0);
+        }
+    }
+    ~SerialOpenMp() {
+        if (get_ && set_)
+            set_(saved_);
+    }
+    SerialOpenMp(const SerialOpenMp&) = delete;
+    SerialOpenMp& operator=(const SerialOpenMp&) = delete;
+
+private:
+    int (*get_)() = nullptr;
+    void (*set_)(int) = nullptr;
+    int saved_ = 0;
+};
+#else
+struct SerialOpenMp {};
+#endif
+
 } // namespace
 
 // The direct solve's factorisation, kept across solves while the structure and the active set stay.
 struct StressSolver::DirectCache {
     std::vector<std::size_t> key; // the movable nodes in unknown order, then each bond's slot and nodes
     std::vector<char> flags;      // each corner's active and slip flags the factorisation holds
+#ifdef RUBBLE_HAVE_CHOLMOD
+    Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>> ldlt; // supernodal: dense kernels on the fill
+#else
     Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
+#endif
     bool analysed = false;
-    bool factored = false; // the numeric factorisation matches the nodes and bonds (until one changes)
-    double compliance = 0; // the one it was made with
+    bool factored = false;  // the numeric factorisation matches the nodes and bonds (until one changes)
+    double compliance = 0;  // the one it was made with
+    bool polishing = false; // its Gauss-Seidel polish runs: stalls what stops converging (solveGaussSeidel)
 };
 
 StructureNode structureNode(const std::vector<ConvexPolytope>& parts, double density, bool root) {
@@ -725,6 +763,11 @@ void StressSolver::solveGaussSeidel(double tolerance) {
     const double tolerance2 = tolerance * tolerance, quiet2 = tolerance2 * 1e-4;
     std::vector<std::uint32_t> active, touched;
     std::vector<std::size_t> list;
+    // The direct solve's polish: every stallSweeps sweeps, a node on bearings still outside the tolerance
+    // whose acceleration changed by at most 1 % since the last check is stalled (the sweeps no longer move
+    // it), whatever the last solve said and however small its acceleration.
+    const bool polish = direct_ && direct_->polishing;
+    std::vector<double> seen(polish ? nodes_.size() : 0, 0.0); // each node's residual at the last check
     double max2 = 0;
     for (std::uint32_t i = 0; i < nodes_.size(); ++i)
         if (movable(i)) {
@@ -732,19 +775,28 @@ void StressSolver::solveGaussSeidel(double tolerance) {
             max2 = std::max(max2, e2);
             if (e2 > quiet2)
                 active.push_back(i);
+            if (polish)
+                seen[i] = e2;
         }
     bondStamp_.resize(bonds_.size(), 0);
     nodeStamp_.resize(nodes_.size(), 0);
     auto resting = [&](std::uint32_t i) { return !movable(i) || nodeResidual(nodes_[i]) <= quiet2; };
     const double unbalanced2 = settings_.unbalanced * settings_.unbalanced;
     for (sweeps_ = 0; sweeps_ < settings_.maxSweeps && max2 > tolerance2; ++sweeps_) {
-        if (sweeps_ > 0 && sweeps_ == settings_.stallSweeps) {
+        const int stall = settings_.stallSweeps;
+        if (sweeps_ > 0 && stall > 0 && (sweeps_ == stall || (polish && sweeps_ % stall == 0))) {
             // What bearings did not hold in the last solve and still do not is left out: its bonds keep
             // their forces, it counts as unbalanced again, and the rest converges around it.
             for (std::uint32_t n : active) {
                 NodeState& s = nodes_[n];
-                s.stalled = s.bearings > 0 && s.unbalanced > 0 &&
-                            (lengthSquared(s.v) > unbalanced2 || lengthSquared(s.w) > unbalanced2);
+                bool stuck = false;
+                if (polish) { // stuck: its acceleration unchanged within 1 % over the last stallSweeps
+                    const double e = std::sqrt(nodeResidual(s)), last = std::sqrt(seen[n]);
+                    stuck = last > 0 && e * e > tolerance2 && std::abs(e - last) <= 0.01 * last;
+                    seen[n] = e * e;
+                }
+                const bool moving = lengthSquared(s.v) > unbalanced2 || lengthSquared(s.w) > unbalanced2;
+                s.stalled = s.bearings > 0 && ((s.unbalanced > 0 && moving) || stuck);
             }
             std::erase_if(active, [&](std::uint32_t n) { return nodes_[n].stalled; });
             max2 = 0;
@@ -927,6 +979,7 @@ void StressSolver::solveDirect(double tolerance) {
     using Vec6 = Eigen::Matrix<double, 6, 1>;
     using Sparse = Eigen::SparseMatrix<double>;
     const double delta = std::max(settings_.compliance, 1e-12);
+    [[maybe_unused]] const SerialOpenMp serial;
     if (!direct_ || direct_.use_count() > 1)
         direct_ = std::make_shared<DirectCache>();
     DirectCache& cache = *direct_;
@@ -1194,7 +1247,9 @@ void StressSolver::solveDirect(double tolerance) {
                 release(bonds_[k], c);
             limit(bonds_[k], c);
         }
+    cache.polishing = true;
     solveGaussSeidel(tolerance);
+    cache.polishing = false;
     sweeps_ += directSweeps;
 }
 

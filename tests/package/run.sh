@@ -37,7 +37,8 @@ install)
     needed=$(readelf -d "$prefix/$libdir/librubble.so" | sed -n 's/.*(NEEDED).*\[\(.*\)\]/\1/p')
     for lib in $needed; do
         case "$lib" in
-        libvoro++.so.* | libqhull_r.so.* | libgmp.so.* | libmpfr.so.* | libassimp.so.* | libstdc++.so.* | \
+        libvoro++.so.* | libqhull_r.so.* | libgmp.so.* | libmpfr.so.* | libassimp.so.* | libcholmod.so.* | \
+            libsuitesparseconfig.so.* | libstdc++.so.* | \
             libm.so.* | libgcc_s.so.* | libc.so.* | ld-linux*) ;;
         *) fail "librubble.so needs $lib, which docs/hello.md does not name" ;;
         esac

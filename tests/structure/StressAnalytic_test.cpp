@@ -251,6 +251,22 @@ TEST(StressAnalytic, ThreeHingedArchThrustsHorizontallyAsStaticsSays) {
     }
 }
 
+namespace {
+// The lowest `count` joints of a stack of three equal blocks on `ground` each carry the weight above them
+// (`top` a block's) and the horizontal force `shear` on the top block, within 1 %.
+void expectStackCarries(const StressSolver& s, std::uint32_t ground, const std::vector<std::uint32_t>& blocks,
+                        double top, double shear, int count) {
+    for (int i = 0; i < count; ++i) {
+        const std::uint32_t below = i ? blocks[static_cast<std::size_t>(i - 1)] : ground;
+        const Vec3 f = forceOn(s, bondBetween(s, below, blocks[static_cast<std::size_t>(i)]),
+                               blocks[static_cast<std::size_t>(i)]);
+        const double weight = top * (3 - i);
+        EXPECT_NEAR(f.y, weight, 0.01 * weight) << "interface " << i;
+        EXPECT_NEAR(-f.x, shear, 0.01 * shear) << "interface " << i;
+    }
+}
+} // namespace
+
 // Three blocks stacked on bearings, the top one pushed sideways: each interface carries the weight above in
 // compression and the push in friction; a push over mu times the top block's weight slides it off, and the
 // blocks below, pressed harder, hold.
@@ -279,14 +295,7 @@ TEST(StressAnalytic, StackOnBearingsCarriesWeightAndFrictionUpToItsLimit) {
             if (ratio < 1) {
                 EXPECT_LE(s.residual(), settings.residual);
                 EXPECT_TRUE(s.unsupported().empty());
-                for (int i = 0; i < 3; ++i) {
-                    const std::uint32_t below = i ? blocks[static_cast<std::size_t>(i - 1)] : ground;
-                    const Vec3 f = forceOn(s, bondBetween(s, below, blocks[static_cast<std::size_t>(i)]),
-                                           blocks[static_cast<std::size_t>(i)]);
-                    const double weight = top * (3 - i);
-                    EXPECT_NEAR(f.y, weight, 0.01 * weight) << "interface " << i;
-                    EXPECT_NEAR(-f.x, push, 0.01 * push) << "interface " << i;
-                }
+                expectStackCarries(s, ground, blocks, top, push, 3);
             } else {
                 EXPECT_GT(s.residual(), settings.residual) << "no equilibrium to converge to";
                 EXPECT_EQ(s.unsupported(), std::vector<std::uint32_t>{blocks[2]});
@@ -469,4 +478,60 @@ TEST(StressAnalytic, AFactorisationReusedAfterABreakMatchesAFreshOne) {
         EXPECT_LE(length(reused.bondMoment(k) - fresh.bondMoment(k)), 1e-3 * moment) << "bond " << k;
     }
     EXPECT_TRUE(reused.unsupported().empty());
+}
+
+// A stack of three blocks on bearings whose top block is pushed at 0.9 of its friction limit, then at 1.3:
+// in the direct solve where it first slides (it held in the last one), the Gauss-Seidel polish leaves it out
+// once its acceleration stops changing, instead of sweeping to maxSweeps; the blocks beneath still converge
+// around it (their joints carry the weights and the top's friction within 1 %), and it falls after
+// unbalancedSolves as before.
+TEST(StressAnalytic, TheDirectSolvesPolishStopsOnABodyThatBeginsToSlide) {
+    Lattice l;
+    const double rho = 2400;
+    const std::uint32_t ground = l.add(box({-2, -1, -2}, {2, 0, 2}), rho, true, 0.6);
+    std::vector<std::uint32_t> blocks;
+    for (int i = 0; i < 3; ++i)
+        blocks.push_back(l.add(box({-0.5, 0.5 * i, -0.5}, {0.5, 0.5 * (i + 1), 0.5}), rho, false, 0.6));
+    StressSettings settings = converged().back();
+    StressSolver s = l.solver(settings);
+    const double top = l.mass(blocks[2]) * kG;
+    for (int frame = 0; frame < 3; ++frame) {
+        s.addLoad(blocks[2], {0.9 * 0.6 * top, 0, 0}, {0, 1.25, 0});
+        s.solve();
+    }
+    ASSERT_LE(s.residual(), settings.residual);
+    s.addLoad(blocks[2], {1.3 * 0.6 * top, 0, 0}, {0, 1.25, 0});
+    s.solve();
+    EXPECT_LT(s.sweeps(), 256) << "the sliding block is stalled, not swept to maxSweeps";
+    EXPECT_GT(s.residual(), settings.residual) << "the sliding block still counts";
+    expectStackCarries(s, ground, blocks, top, 0.6 * top, 2);
+    for (int frame = 0; frame < settings.unbalancedSolves; ++frame) {
+        s.addLoad(blocks[2], {1.3 * 0.6 * top, 0, 0}, {0, 1.25, 0});
+        s.solve();
+    }
+    EXPECT_EQ(s.unsupported(), std::vector<std::uint32_t>{blocks[2]});
+}
+
+// The same stack with `unbalanced` above the top block's acceleration (1.8 m/s^2 against 5): the block never
+// counts as unbalanced, so only the polish's own rule (its acceleration stops changing) keeps each solve from
+// sweeping to maxSweeps; it is left out within 256 sweeps every solve, still counts in the residual, and is
+// not dropped (below `unbalanced`).
+TEST(StressAnalytic, TheDirectSolvesPolishStopsBelowTheUnbalancedThreshold) {
+    Lattice l;
+    const double rho = 2400;
+    l.add(box({-2, -1, -2}, {2, 0, 2}), rho, true, 0.6);
+    std::vector<std::uint32_t> blocks;
+    for (int i = 0; i < 3; ++i)
+        blocks.push_back(l.add(box({-0.5, 0.5 * i, -0.5}, {0.5, 0.5 * (i + 1), 0.5}), rho, false, 0.6));
+    StressSettings settings = converged().back();
+    settings.unbalanced = 5;
+    StressSolver s = l.solver(settings);
+    const double top = l.mass(blocks[2]) * kG;
+    for (int frame = 0; frame < 5; ++frame) {
+        s.addLoad(blocks[2], {1.3 * 0.6 * top, 0, 0}, {0, 1.25, 0});
+        s.solve();
+        EXPECT_LT(s.sweeps(), 256) << "frame " << frame;
+        EXPECT_GT(s.residual(), settings.residual) << "frame " << frame;
+    }
+    EXPECT_TRUE(s.unsupported().empty());
 }

@@ -32,6 +32,27 @@ TEST(StructureRuntime, AnOverhangThatConnectivityWouldHoldBreaksUnderItsWeight) 
         // first (converged) solve breaks its top and its foot.
         EXPECT_EQ(rig.runtime.counters().bondsBroken, structure ? 2 : 0);
         EXPECT_EQ(rig.runtime.structureBonds().size(), structure ? 2u : 0u) << "ground-column, column-slab";
+        // Both broken bonds let go: the overhang's column and the slab fall, a collapse record each, in this
+        // frame, the slab's at the slab.
+        const std::vector<StructureCollapse>& fell = rig.runtime.structureCollapses();
+        ASSERT_EQ(fell.size(), structure ? 2u : 0u);
+        if (structure) {
+            const BodyRecord& body = *rig.runtime.bodyOf(slab);
+            const auto it = std::find_if(fell.begin(), fell.end(),
+                                         [&](const StructureCollapse& e) { return e.body == body.id; });
+            ASSERT_NE(it, fell.end());
+            for (const StructureCollapse& e : fell) {
+                EXPECT_EQ(e.frame, rig.runtime.counters().frames);
+                EXPECT_TRUE(e.byStress);
+                EXPECT_EQ(e.material, "concrete");
+            }
+            EXPECT_NEAR(it->position.x, 2.8, 1e-6);
+            EXPECT_NEAR(it->position.y, 3.1, 1e-6);
+            EXPECT_NEAR(it->position.z, 0, 1e-6);
+            EXPECT_NEAR(it->volume, 6 * 0.2 * 1.5, 1e-9);
+            EXPECT_EQ(it->mass, body.mass);
+            EXPECT_GT(it->mass, 0);
+        }
     }
 }
 

@@ -139,6 +139,15 @@ struct RUBBLE_API StructureBreak {
     std::string materialA;   ///< a's material (preset name)
     std::string materialB;   ///< b's material
 };
+/// A static body that lost its support and began to fall (a collapse), for effects: a self-contained record.
+struct RUBBLE_API StructureCollapse {
+    std::uint64_t frame = 0;     ///< the frame it began to fall in (RuntimeCounters::frames)
+    BodyId body = 0;             ///< the body (dynamic from then on)
+    Vec3 position;               ///< its body origin (world) when it let go
+    double volume = 0, mass = 0; ///< m³, kg
+    bool byStress = false;       ///< the stress solver let it go (else the support graph)
+    std::string material;        ///< its object's material (preset name; empty without an object)
+};
 
 /// Budgets of the debris governor (DebrisGovernor): what keeps thousands of pieces affordable. Every resting
 /// moving body that carries an object may be frozen, but only pieces are ever retired (the game's own objects
@@ -381,6 +390,8 @@ public:
     /// The structure bonds the last stepFrame() broke, in the order they broke (empty unless
     /// StructurePolicy::enabled).
     const std::vector<StructureBreak>& structureBreaks() const;
+    /// Static bodies that fell for want of support since the last stepFrame() began (adoptReady() too).
+    const std::vector<StructureCollapse>& structureCollapses() const;
     /// The point distant debris fades from (e.g. the camera).
     void setFocus(const Vec3& point);
 

@@ -49,37 +49,32 @@ struct RUBBLE_API BondStress {
 enum class StressMethod {
     SweepBudget,       ///< Gauss-Seidel over every bond, at most `iterations` sweeps (the default)
     GaussSeidel,       ///< Gauss-Seidel over the bonds of the nodes not at rest, until `residual` is met
-    ConjugateGradient, ///< block-Jacobi preconditioned conjugate gradient on the welds, until `residual` is
-                       ///< met
-    Direct ///< sparse LDLT of the regularised bond system with an active set for bearings, then Gauss-Seidel
-           ///< until `residual` is met (friction limits, what bearings cannot hold)
+    ConjugateGradient, ///< block-Jacobi preconditioned conjugate gradient on the welds, until `residual`
+    Direct ///< sparse Cholesky of the regularised bond system with an active set for bearings, then
+           ///< Gauss-Seidel until `residual` (friction limits, what bearings cannot hold)
 };
 
 /// Settings of the stress solver.
 struct RUBBLE_API StressSettings {
     int iterations = 25;       ///< Gauss-Seidel sweeps over all bonds per solve(), at most
-    double tolerance = 0.01;   ///< m/s^2 (and rad/s^2): fewer sweeps once every bonded node's remaining
-                               ///< acceleration is below it (a warm-started, unchanged structure needs none);
-                               ///< 0: always `iterations`
+    double tolerance = 0.01;   ///< m/s^2 (and rad/s^2), SweepBudget: fewer sweeps once every bonded node's
+                               ///< acceleration is below it; 0: always `iterations`
     Vec3 gravity{0, -9.81, 0}; ///< m/s^2
     double unbalanced = 0.5;   ///< m/s^2 (and rad/s^2): a node left accelerating this much is not held
     int unbalancedSolves = 30; ///< ... after this many solves in a row (the warm-started solve converges)
-    StressMethod method =
-        StressMethod::SweepBudget; ///< how solve() iterates (docs/structure.md, "Convergence")
-    double residual = 1e-3;        ///< GaussSeidel, ConjugateGradient: the relative residual solve() reaches
-    int maxSweeps = 5000; ///< GaussSeidel, ConjugateGradient: sweeps (iterations) at most, for structures
-                          ///< bearings cannot hold (they never converge)
+    StressMethod method = StressMethod::SweepBudget; ///< how solve() iterates (docs/structure.md)
+    double residual = 1e-3; ///< GaussSeidel, ConjugateGradient, Direct: the relative residual solve() reaches
+    int maxSweeps = 5000;   ///< ... sweeps at most (what bearings cannot hold never converges)
     bool deadLoadGuess = false; ///< GaussSeidel, ConjugateGradient: a structure whose bonds carry nothing yet
                                 ///< starts from its dead load passed down (off: it biases which equilibrium
                                 ///< indeterminate contacts reach; docs/structure.md)
-    bool trace = false;     ///< record the relative residual after every sweep (history(); costs a pass over
-                            ///< the nodes per sweep)
-    bool routeLoads = true; ///< GaussSeidel, ConjugateGradient: a change of a node's load since the last
+    bool trace = false;         ///< record the relative residual after every sweep (history())
+    bool routeLoads = true;     ///< GaussSeidel, ConjugateGradient: a change of a node's load since the last
                             ///< solve is first passed down the welds beneath it to the ground (a warm start)
     double compliance = 1e-6; ///< Direct: each constraint's regularisation, relative to its effective mass
-    int stallSweeps = 64; ///< GaussSeidel, Direct: after this many sweeps, nodes on bearings that the last
-                          ///< solve left unbalanced and that still accelerate by `unbalanced` are left out of
-                          ///< the solve (their bonds' forces kept; they count as unbalanced); 0: never
+    int stallSweeps = 64; ///< GaussSeidel, Direct: after this many sweeps, nodes on bearings the last solve
+                          ///< left unbalanced and still accelerating by `unbalanced` are left out (forces
+                          ///< kept); Direct also, every this many, those stuck outside `residual`; 0: never
 };
 
 /// A bond that broke in breakOverstressed() or damage(), with what it carried the moment it broke.
