@@ -304,7 +304,9 @@ int runHost(const Args& a) {
     std::vector<net::ShotRequest> requested; // clients' shots that passed the host's checks
     host.setShotHandler([&](const net::ShotRequest& r) { requested.push_back(r); });
     auto frame = [&](bool firing) {
-        std::this_thread::sleep_until(start + period * f);
+        for (auto due = start + period * f; Clock::now() < due;) // the host serves the network meanwhile
+            host.service(
+                static_cast<int>(std::chrono::ceil<std::chrono::milliseconds>(due - Clock::now()).count()));
         const long due = static_cast<long>(static_cast<double>(f) * a.shotsPerSecond / 60.0);
         for (; firing && shots < due; ++shots)
             fire(runtime, rng);

@@ -17,6 +17,15 @@ namespace rubble::net {
 
 using detail::Message;
 
+namespace {
+constexpr double kChunksPerMs = 8; // snapshot chunks per client per ms (about 8.8 MB/s)
+constexpr double kChunkBurst = 96; // the most sent to a client at once (the relay's buffers hold them)
+constexpr double kPumpEveryMs = 2; // chunks go out at most this often
+constexpr int kServiceSliceMs = 2;
+constexpr std::chrono::seconds kResyncEvery{2}; // the most often a client gets a fresh snapshot // how long
+                                                // service() waits at a time while a snapshot is on its way
+} // namespace
+
 struct NetHost::Impl {
     Impl(DestructionWorld& w, const DestructionWorld::Config& c) : world(w), config(c) {}
     DestructionWorld& world;
@@ -50,17 +59,23 @@ struct NetHost::Impl {
         std::vector<std::chrono::steady_clock::time_point> sent; // last sent (epoch: never)
         std::uint64_t frame = 0;                                 // the snapshot's frame
         std::chrono::steady_clock::time_point started;
+        double credit = kChunkBurst; // chunks it may send now
+        bool resync = false;         // to a client that had joined already
     };
     std::map<ENetPeer*, Transfer> transfers;
     std::chrono::steady_clock::time_point lastPump;
     std::uint32_t nextTransfer = 1;
+    std::map<ENetPeer*, std::chrono::steady_clock::time_point> resynced; // each client's latest resync
+    std::uint64_t placementsFrame = 0;                                   // of the latest publishPlacements
+    std::vector<std::pair<ObjectId, detail::Quantized>> placementsNow;   // what it was given then
 
-    // Sends each transfer's chunks that are new or unacknowledged for longer than a round trip, at most
-    // `budget` per client.
-    void pump(std::size_t budget) {
+    // Sends each transfer's chunks that are new or unacknowledged for longer than a round trip, as many as
+    // the time since the last pump allows (kChunksPerMs per client, at most kChunkBurst at once).
+    void pump() {
         const auto now = std::chrono::steady_clock::now();
-        if (transfers.empty() || now - lastPump < std::chrono::milliseconds(8))
-            return; // paced: at most 64 datagrams per 8 ms per client
+        const double ms = std::chrono::duration<double, std::milli>(now - lastPump).count();
+        if (transfers.empty() || ms < kPumpEveryMs)
+            return;
         lastPump = now;
         for (auto it = transfers.begin();
              it != transfers.end();) { // a client that never has it all is dropped
@@ -74,8 +89,8 @@ struct NetHost::Impl {
         for (auto& [peer, t] : transfers) {
             const auto resend =
                 std::chrono::milliseconds(10 + peer->roundTripTime + peer->roundTripTimeVariance);
-            std::size_t n = 0;
-            for (std::size_t i = 0; i < t.acked.size() && n < budget; ++i) {
+            t.credit = std::min(kChunkBurst, t.credit + ms * kChunksPerMs);
+            for (std::size_t i = 0; i < t.acked.size() && t.credit >= 1; ++i) {
                 if (t.acked[i] || (t.sent[i].time_since_epoch().count() != 0 && now - t.sent[i] < resend))
                     continue;
                 const std::size_t at = i * detail::kSnapshotChunk;
@@ -89,10 +104,30 @@ struct NetHost::Impl {
                            t.bytes.begin() + static_cast<std::ptrdiff_t>(at + len));
                 detail::sendUnreliable(peer, msg);
                 t.sent[i] = now;
-                ++n;
+                t.credit -= 1;
+                ++stats.snapshotChunksSent;
             }
         }
         enet_host_flush(host);
+    }
+
+    // Sends a client the placements that differ from what it acknowledged, within its allowance.
+    void sendPlacements(ENetPeer* peer, long long legacy) {
+        detail::PlacementEncoder& encoder = encoders[peer];
+        const PlacementBudget& b = placementBudget;
+        detail::PlacementAllowance& allowance =
+            allowances.try_emplace(peer, b.mean, b.peak, b.reserve).first->second;
+        std::size_t spent = 0;
+        for (const std::vector<std::uint8_t>& msg :
+             encoder.encode(placementsFrame, placementsNow, allowance.next())) {
+            detail::sendUnreliable(peer, msg);
+            spent += msg.size();
+        }
+        allowance.spent(spent);
+        stats.placementBytes += static_cast<long long>(spent);
+        stats.placementsDeferred += static_cast<long long>(encoder.deferred());
+        stats.placementPublishesFull += encoder.deferred() > 0;
+        stats.legacyPlacementBytes += legacy;
     }
 
     // A sync: everything sent so far, applied up to `frame`, gives `hash`.
@@ -119,12 +154,16 @@ struct NetHost::Impl {
         if (!all)
             return;
         const std::uint64_t frame = t->second.frame;
-        stats.snapshotTransferMs +=
-            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t->second.started)
-                .count();
+        if (!t->second.resync)
+            stats.snapshotTransferMs += std::chrono::duration<double, std::milli>(
+                                            std::chrono::steady_clock::now() - t->second.started)
+                                            .count();
         transfers.erase(t);
         if (lastSync >= frame && hashes.count(lastSync)) // the latest sync, which it was not sent
             sendSync(peer, lastSync, lastSyncPosition, hashes[lastSync]);
+        if (placementsFrame > frame) // the latest placements, newer than its snapshot's
+            sendPlacements(peer, 0);
+        enet_host_flush(host);
     }
 
     // A client's shot: fired through the handler if it passes the rules, else counted as refused.
@@ -148,8 +187,9 @@ struct NetHost::Impl {
         shotHandler(r);
     }
 
-    // A client's Hello: it gets the snapshot, without the objects it has already.
-    void join(ENetPeer* peer, const detail::KnownObjects& known) {
+    // Takes a snapshot for a client, without the objects it has already, and starts sending it; its
+    // placement baselines become the snapshot's. False when it cannot be encoded.
+    bool startTransfer(ENetPeer* peer, const detail::KnownObjects& known, bool isResync) {
         const auto started = std::chrono::steady_clock::now();
         std::vector<ObjectPlacement> placements =
             placementSource ? placementSource() : std::vector<ObjectPlacement>{};
@@ -159,10 +199,8 @@ struct NetHost::Impl {
         detail::JoinSnapshotSize size;
         const std::vector<std::uint8_t> msg =
             detail::encodeJoinSnapshot(takeSnapshot(world, std::move(placements)), known, &size);
-        if (msg.empty()) {
-            enet_peer_disconnect(peer, detail::kGoodbye);
-            return;
-        }
+        if (msg.empty())
+            return false;
         Transfer& t = transfers[peer];
         t.id = nextTransfer++;
         t.bytes = msg;
@@ -171,15 +209,45 @@ struct NetHost::Impl {
         t.sent.assign(chunks, {});
         t.frame = world.frame();
         t.started = std::chrono::steady_clock::now();
-        peers[peer] = world.journalPosition();
-        joinOrder[peer] = static_cast<std::uint64_t>(stats.joins);
-        ++stats.joins;
-        stats.snapshotBuildMs +=
-            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started).count();
+        t.resync = isResync;
+        if (isResync) {
+            stats.resyncBytes += static_cast<long long>(size.wire);
+            return true;
+        }
+        stats.snapshotBuildMs += std::chrono::duration<double, std::milli>(t.started - started).count();
         stats.snapshotBytes += static_cast<long long>(size.wire);
         stats.snapshotRawBytes += static_cast<long long>(size.raw);
         stats.snapshotObjectsByReference += static_cast<long long>(size.referenced);
         enet_host_flush(host);
+        return true;
+    }
+
+    // A client's Hello: it gets the snapshot, without the objects it has already.
+    void join(ENetPeer* peer, const detail::KnownObjects& known) {
+        if (!startTransfer(peer, known, false)) {
+            enet_peer_disconnect(peer, detail::kGoodbye);
+            return;
+        }
+        peers[peer] = world.journalPosition();
+        joinOrder[peer] = static_cast<std::uint64_t>(stats.joins);
+        ++stats.joins;
+    }
+
+    // A joined client's Hello: it is far behind (after an outage) and gets a fresh snapshot instead of the
+    // backlog's work, at most once per kResyncEvery. Its journal stream goes on: it skips what the snapshot
+    // has.
+    void resync(ENetPeer* peer, const detail::KnownObjects& known) {
+        const auto now = std::chrono::steady_clock::now();
+        if (transfers.count(peer))
+            return;
+        if (auto last = resynced.find(peer); last != resynced.end() && now - last->second < kResyncEvery)
+            return;
+        resynced[peer] = now;
+        if (!startTransfer(peer, known, true)) {
+            enet_peer_disconnect(peer, detail::kGoodbye);
+            return;
+        }
+        ++stats.resyncs;
     }
 
     void receive(ENetPeer* peer, const ENetPacket* packet) {
@@ -197,8 +265,8 @@ struct NetHost::Impl {
         }
         if (d[0] == static_cast<std::uint8_t>(Message::Hello)) {
             detail::KnownObjects known;
-            if (!closing && !peers.count(peer) && detail::decodeHello(d, packet->dataLength, known))
-                join(peer, known);
+            if (!closing && detail::decodeHello(d, packet->dataLength, known))
+                peers.count(peer) ? resync(peer, known) : join(peer, known);
             return;
         }
         if (d[0] == static_cast<std::uint8_t>(Message::SnapshotAck))
@@ -285,38 +353,24 @@ void NetHost::publish() {
     im.journal.clear();
     im.base = end;
     enet_host_flush(im.host);
-    im.pump(64);
+    im.pump();
 }
 
 void NetHost::publishPlacements(const std::vector<ObjectPlacement>& placements) {
     Impl& im = *impl_;
-    std::vector<std::pair<ObjectId, detail::Quantized>> now;
-    now.reserve(placements.size());
+    im.placementsNow.clear();
+    im.placementsNow.reserve(placements.size());
     std::size_t dynamic = 0;
     for (const ObjectPlacement& p : placements) {
-        now.emplace_back(p.object, detail::quantize(p.objectToWorld));
+        im.placementsNow.emplace_back(p.object, detail::quantize(p.objectToWorld));
         dynamic += p.motion == BodyMotionState::Dynamic;
     }
+    im.placementsFrame = im.world.frame();
     // The previous protocol: 13 + 32 n bytes per 37 dynamic bodies, every time.
     const auto legacy = static_cast<long long>((dynamic + 36) / 37 * 13 + dynamic * 32);
-    for (auto& [peer, position] : im.peers) {
-        if (!im.acked.count(peer))
-            continue; // still loading its snapshot: nothing to compare against yet
-        detail::PlacementEncoder& encoder = im.encoders[peer];
-        const PlacementBudget& b = im.placementBudget;
-        detail::PlacementAllowance& allowance =
-            im.allowances.try_emplace(peer, b.mean, b.peak, b.reserve).first->second;
-        std::size_t spent = 0;
-        for (const std::vector<std::uint8_t>& msg : encoder.encode(im.world.frame(), now, allowance.next())) {
-            detail::sendUnreliable(peer, msg);
-            spent += msg.size();
-        }
-        allowance.spent(spent);
-        im.stats.placementBytes += static_cast<long long>(spent);
-        im.stats.placementsDeferred += static_cast<long long>(encoder.deferred());
-        im.stats.placementPublishesFull += encoder.deferred() > 0;
-        im.stats.legacyPlacementBytes += legacy;
-    }
+    for (auto& [peer, position] : im.peers)
+        if (!im.transfers.count(peer)) // else it gets them once its snapshot is in
+            im.sendPlacements(peer, legacy);
     enet_host_flush(im.host);
 }
 
@@ -363,34 +417,45 @@ void NetHost::setPlacementSource(std::function<std::vector<ObjectPlacement>()> s
 
 void NetHost::service(int timeoutMs) {
     Impl& im = *impl_;
-    ENetEvent e;
-    for (int r = enet_host_service(im.host, &e, static_cast<enet_uint32>(std::max(0, timeoutMs))); r > 0;
-         r = enet_host_service(im.host, &e, 0)) {
-        switch (e.type) {
-        case ENET_EVENT_TYPE_CONNECT: // it joins with its Hello
-            detail::configurePeer(e.peer);
-            if (im.closing)
-                enet_peer_disconnect(e.peer, detail::kGoodbye);
-            break;
-        case ENET_EVENT_TYPE_RECEIVE:
-            im.receive(e.peer, e.packet);
-            enet_packet_destroy(e.packet);
-            break;
-        case ENET_EVENT_TYPE_DISCONNECT:
-            im.peers.erase(e.peer);
-            im.acked.erase(e.peer);
-            im.encoders.erase(e.peer);
-            im.allowances.erase(e.peer);
-            im.heard.erase(e.peer);
-            im.joinOrder.erase(e.peer);
-            im.transfers.erase(e.peer);
-            im.shotTokens.erase(e.peer);
-            break;
-        default:
-            break;
+    const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(std::max(0, timeoutMs));
+    for (;;) {
+        const auto left =
+            std::chrono::duration_cast<std::chrono::milliseconds>(end - std::chrono::steady_clock::now())
+                .count();
+        // While a snapshot is on its way, wake often enough to pace its chunks.
+        const auto wait = static_cast<enet_uint32>(
+            std::max<long long>(0, im.transfers.empty() ? left : std::min<long long>(left, kServiceSliceMs)));
+        ENetEvent e;
+        for (int r = enet_host_service(im.host, &e, wait); r > 0; r = enet_host_service(im.host, &e, 0)) {
+            switch (e.type) {
+            case ENET_EVENT_TYPE_CONNECT: // it joins with its Hello
+                detail::configurePeer(e.peer);
+                if (im.closing)
+                    enet_peer_disconnect(e.peer, detail::kGoodbye);
+                break;
+            case ENET_EVENT_TYPE_RECEIVE:
+                im.receive(e.peer, e.packet);
+                enet_packet_destroy(e.packet);
+                break;
+            case ENET_EVENT_TYPE_DISCONNECT:
+                im.peers.erase(e.peer);
+                im.acked.erase(e.peer);
+                im.encoders.erase(e.peer);
+                im.allowances.erase(e.peer);
+                im.heard.erase(e.peer);
+                im.joinOrder.erase(e.peer);
+                im.transfers.erase(e.peer);
+                im.shotTokens.erase(e.peer);
+                im.resynced.erase(e.peer);
+                break;
+            default:
+                break;
+            }
         }
+        im.pump();
+        if (std::chrono::steady_clock::now() >= end)
+            break;
     }
-    im.pump(64);
     im.stats.clients = static_cast<int>(im.peers.size());
 }
 
