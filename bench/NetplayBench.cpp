@@ -516,6 +516,7 @@ int runHost(const Args& a) {
     r["snapshot_objects_by_reference"] = hs.snapshotObjectsByReference / std::max<long long>(1, hs.joins);
     r["clients_load_scene"] = !a.noBase;
     r["snapshot_build_ms"] = hs.snapshotBuildMs / static_cast<double>(std::max<long long>(1, hs.joins));
+    r["snapshot_chunks_sent"] = hs.snapshotChunksSent;
     r["snapshot_transfer_ms"] = hs.snapshotTransferMs / static_cast<double>(std::max<long long>(1, hs.joins));
     r["final_hashes_equal"] = allConverged;
     r["converge_ms"] = convergeMs;

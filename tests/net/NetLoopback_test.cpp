@@ -6,10 +6,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
 #include "JournalScene.hpp"
+#include "NetRig.hpp"
 #include "NetWait.hpp"
 #include "TestSupport.hpp"
 #include "rubble/persist/JournalFile.hpp"
@@ -227,6 +229,72 @@ TEST(NetLoopback, AClientWhoseWorldLagsShowsThoseFramesBetweenPlacements) {
         ASSERT_TRUE(f);
         EXPECT_NEAR(f->translation.x, start.x + 0.01 * (last - back - first), 1e-3) << back << " frames back";
     }
+}
+
+TEST(NetLoopback, OneLongServiceCallSendsASnapshotOfMoreThanOneBurst) {
+    test::NetHostRig net;
+    ASSERT_TRUE(net.server);
+    net::NetHost& h = *net.server;
+    net.rig.play(120);
+    DestructionWorld world(net.config); // bare: the whole snapshot travels
+    auto client = net::NetClient::connect(world, net.config, "127.0.0.1", h.port());
+    ASSERT_TRUE(client) << client.error().message;
+    // Until the host took the snapshot (the client goes first, so it has read no chunk yet).
+    ASSERT_TRUE(test::waitFor([&] { return h.stats().joins == 1; },
+                              [&] {
+                                  const bool ok = static_cast<bool>((*client)->service(1));
+                                  h.service(0);
+                                  return ok;
+                              }));
+    ASSERT_GT(h.stats().snapshotBytes, 96 * 1100) << "more chunks than the host sends at once";
+    h.service(300); // the game serves the network once, while it waits for its next frame
+    // Every chunk went out in that call: the client has the snapshot without the host being serviced again.
+    const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while (!(*client)->stats().joined && std::chrono::steady_clock::now() < end)
+        ASSERT_TRUE((*client)->service(1));
+    EXPECT_TRUE((*client)->stats().joined);
+}
+
+TEST(NetLoopback, AJoiningClientGetsTheLatestPlacementsAsSoonAsItHasItsSnapshot) {
+    test::NetHostRig net;
+    ASSERT_TRUE(net.server);
+    net::NetHost& h = *net.server;
+    net.rig.play(20); // the slab falls, pieces fly
+    DestructionWorld world(net.config);
+    auto client = net::NetClient::connect(world, net.config, "127.0.0.1", h.port());
+    ASSERT_TRUE(client) << client.error().message;
+    ASSERT_TRUE(test::waitFor([&] { return h.stats().joins == 1; },
+                              [&] {
+                                  const bool ok = static_cast<bool>((*client)->service(1));
+                                  h.service(0);
+                                  return ok;
+                              }));
+    const std::vector<ObjectPlacement> atSnapshot = net.rig.runtime.placements();
+    net.rig.play(12);
+    h.publish();
+    const std::vector<ObjectPlacement> latest = net.rig.runtime.placements();
+    h.publishPlacements(latest); // its snapshot is still on its way; the game publishes no more
+    const double frame = static_cast<double>(net.rig.runtime.world().frame());
+    std::vector<ObjectPlacement> moved;
+    for (const ObjectPlacement& p : latest)
+        for (const ObjectPlacement& q : atSnapshot)
+            if (p.object == q.object && p.motion == BodyMotionState::Dynamic &&
+                length(p.objectToWorld.translation - q.objectToWorld.translation) > 0.01)
+                moved.push_back(p);
+    ASSERT_FALSE(moved.empty());
+    ASSERT_TRUE(test::waitFor(
+        [&] {
+            return std::all_of(moved.begin(), moved.end(), [&](const ObjectPlacement& p) {
+                return (*client)->placementFrame(p.object) == std::optional(frame);
+            });
+        },
+        [&] {
+            h.service(1);
+            return static_cast<bool>((*client)->service(1));
+        }));
+    for (const ObjectPlacement& p : moved)
+        EXPECT_LT(length((*client)->placement(p.object, frame)->translation - p.objectToWorld.translation),
+                  1e-3);
 }
 
 TEST(NetLoopback, OnlyLoopbackAddressesAndDeterministicWorlds) {

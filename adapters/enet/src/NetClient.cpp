@@ -3,7 +3,6 @@
 #include <chrono>
 #include <deque>
 #include <map>
-#include <vector>
 
 #include <algorithm>
 
@@ -24,10 +23,6 @@ using Clock = std::chrono::steady_clock;
 /// Host frames of placements kept per body: a client whose world lags the placements it receives (it is still
 /// cutting pieces) can show any frame of the last two seconds between two placements.
 constexpr double kTrackFrames = 120;
-/// Host frames a client may lag the syncs it has before it asks for a fresh snapshot (instead of cutting
-/// the backlog's pieces itself), and the least time between two such requests.
-constexpr std::uint64_t kResyncFrames = 60;
-constexpr std::chrono::seconds kResyncEvery{3};
 
 struct NetClient::Impl {
     Impl(DestructionWorld& w, const DestructionWorld::Config& c) : world(w), config(c), player(w) {
@@ -86,11 +81,6 @@ struct NetClient::Impl {
     std::uint64_t seed = 0;             // the host world's seed (from the snapshot)
     std::optional<Snapshot> joinedWith; // the snapshot it joined with (for a replay)
     std::vector<JournalEvent> applied;  // every event applied since
-    std::uint64_t streamPosition = 0;   // journal position of the next event the host sends (once joined)
-    std::uint64_t latestSync = 0;       // frame of the latest sync received
-    bool resyncing = false;             // it asked for a fresh snapshot: keeps events, ignores syncs
-    Clock::time_point resyncAsked;      // when it last asked
-    std::vector<std::pair<std::uint64_t, detail::WireEvent>> pending; // events kept meanwhile, by position
 
     // Applies the held events of the world's current frame, with the fields the host left out.
     Status applyHeld() {
@@ -116,40 +106,6 @@ struct NetClient::Impl {
                 return st;
             applied.push_back(e);
         }
-        return Status::ok();
-    }
-
-    // Leaves resync mode: the kept events from journal position `from` on are the world's next ones.
-    Status resumeAfterResync(std::uint64_t from) {
-        resyncing = false;
-        for (const auto& [position, w] : pending) {
-            if (position < from)
-                continue;
-            const std::uint32_t last = held.empty() ? 0 : held.back().event.tick;
-            if (w.event.tick < world.frame() || w.event.tick < last)
-                return Error{ErrorCode::InvalidInput, "netplay: journal event of tick " +
-                                                          std::to_string(w.event.tick) + " arrived late"};
-            held.push_back(w);
-            ++stats.events;
-        }
-        pending.clear();
-        return applyHeld();
-    }
-
-    // Asks the host for a fresh snapshot when the syncs it has are far ahead of its world; gives up
-    // waiting (and replays what it kept) when none came.
-    Status checkLag() {
-        const Clock::time_point now = Clock::now();
-        if (resyncing && incoming.id == 0 && now - resyncAsked > kResyncEvery)
-            return resumeAfterResync(0);
-        if (!stats.joined || resyncing || !server || latestSync <= world.frame() + kResyncFrames ||
-            now - resyncAsked < kResyncEvery)
-            return Status::ok();
-        if (!detail::sendReliable(server, detail::encodeHello(world)))
-            return Error{ErrorCode::IoError, "netplay: cannot ask for a fresh snapshot"};
-        resyncing = true;
-        resyncAsked = now;
-        enet_host_flush(host);
         return Status::ok();
     }
 
@@ -223,8 +179,7 @@ struct NetClient::Impl {
         const std::uint32_t id = detail::readU32(d + 1), index = detail::readU32(d + 5),
                             total = detail::readU32(d + 9);
         ackDue = true;
-        if (id <= doneTransfer || (stats.joined && !resyncing && id != incoming.id) || total == 0 ||
-            total > (1u << 30))
+        if (id == doneTransfer || (stats.joined && id != incoming.id) || total == 0 || total > (1u << 30))
             return Status::ok();
         const std::size_t count = (total + detail::kSnapshotChunk - 1) / detail::kSnapshotChunk;
         if (incoming.id != id) {
@@ -243,6 +198,7 @@ struct NetClient::Impl {
             return Status::ok();
         doneTransfer = id;
         doneChunks = count;
+        acknowledgeChunks(); // before loading it, so that the host sends no chunk again meanwhile
         const std::vector<std::uint8_t> whole = std::move(incoming.bytes);
         incoming = {};
         if (Status st = receive(whole.data(), whole.size()); !st)
@@ -288,7 +244,7 @@ struct NetClient::Impl {
                 fresh[p.object].add(frame, p.objectToWorld);
                 baselines.setBaseline(p.object, detail::quantize(p.objectToWorld));
             }
-            const std::uint64_t hostSeed = s->world.seed, position = s->world.journalPosition;
+            const std::uint64_t hostSeed = s->world.seed;
             Snapshot kept = *s;
             if (Status st = restoreSnapshot(world, std::move(*s)); !st)
                 return st;
@@ -298,11 +254,6 @@ struct NetClient::Impl {
             decoder = std::move(baselines);
             held.clear();
             seed = hostSeed;
-            if (stats.joined) { // a fresh snapshot: the events it kept meanwhile that are not in it follow
-                ++stats.resyncs;
-                return resumeAfterResync(position);
-            }
-            streamPosition = position; // the host's events go on from there
             stats.joined = true;
             stats.joinMs = std::chrono::duration<double, std::milli>(Clock::now() - connected).count();
             stats.snapshotLoadMs = std::chrono::duration<double, std::milli>(Clock::now() - received).count();
@@ -318,11 +269,6 @@ struct NetClient::Impl {
                 return Error{ErrorCode::ParseError,
                              "netplay: events message of " + std::to_string(n) + " bytes"};
             for (const detail::WireEvent& w : arrived) {
-                if (resyncing) { // kept until the fresh snapshot says which of them it has
-                    pending.emplace_back(streamPosition++, w);
-                    continue;
-                }
-                ++streamPosition;
                 const std::uint32_t last = held.empty() ? 0 : held.back().event.tick;
                 if (w.event.tick < world.frame() || w.event.tick < last)
                     return Error{ErrorCode::InvalidInput, "netplay: journal event of tick " +
@@ -336,11 +282,10 @@ struct NetClient::Impl {
             if (n != 25)
                 return Error{ErrorCode::ParseError,
                              "netplay: sync message of " + std::to_string(n) + " bytes"};
+            if (!stats.joined)
+                return Status::ok();
             const std::uint64_t frame = detail::readU64(d + 1), position = detail::readU64(d + 9),
                                 hash = detail::readU64(d + 17);
-            latestSync = std::max(latestSync, frame);
-            if (!stats.joined || resyncing)
-                return Status::ok();
             if (Status st = advanceTo(frame); !st)
                 return st;
             const std::uint64_t mine = world.geometryHash();
@@ -399,50 +344,33 @@ Result<std::unique_ptr<NetClient>> NetClient::connect(DestructionWorld& world,
 
 Status NetClient::service(int timeoutMs) {
     Impl& im = *impl_;
-    // Everything that arrived, first: how far ahead its syncs are decides whether to replay them.
-    std::vector<ENetEvent> events;
     ENetEvent e;
     int r = enet_host_service(im.host, &e, static_cast<enet_uint32>(std::max(0, timeoutMs)));
     for (; r > 0; r = enet_host_service(im.host, &e, 0)) {
-        events.push_back(e);
-        const ENetPacket* p = e.packet;
-        if (e.type == ENET_EVENT_TYPE_RECEIVE && p->dataLength == 25 &&
-            p->data[0] == static_cast<std::uint8_t>(Message::Sync))
-            im.latestSync = std::max(im.latestSync, detail::readU64(p->data + 1));
-    }
-    Status status = im.checkLag();
-    for (ENetEvent& ev : events) {
-        if (!status) { // the rest is dropped
-            if (ev.type == ENET_EVENT_TYPE_RECEIVE)
-                enet_packet_destroy(ev.packet);
-            continue;
-        }
-        if (ev.type == ENET_EVENT_TYPE_CONNECT) {
+        if (e.type == ENET_EVENT_TYPE_CONNECT) {
             im.stats.connected = true;
             detail::configurePeer(im.server, im.timeoutMs);
             if (!detail::sendReliable(im.server, detail::encodeHello(im.world)))
-                status = Error{ErrorCode::IoError, "netplay: cannot send the hello"};
-        } else if (ev.type == ENET_EVENT_TYPE_RECEIVE) {
+                return Error{ErrorCode::IoError, "netplay: cannot send the hello"};
+        } else if (e.type == ENET_EVENT_TYPE_RECEIVE) {
             const Clock::time_point now = Clock::now();
             if (now - im.heard > std::chrono::milliseconds(300) && im.server)
                 detail::retransmitSoon(im.server); // the host was silent: an outage ended
             im.heard = now;
-            status = im.receive(ev.packet->data, ev.packet->dataLength);
-            enet_packet_destroy(ev.packet);
-        } else if (ev.type == ENET_EVENT_TYPE_DISCONNECT) {
+            Status s = im.receive(e.packet->data, e.packet->dataLength);
+            enet_packet_destroy(e.packet);
+            if (!s)
+                return s;
+        } else if (e.type == ENET_EVENT_TYPE_DISCONNECT) {
             im.server = nullptr;
             if (!im.stats.connected)
-                status = Error{ErrorCode::IoError, "netplay: no host answered"};
-            else
-                status =
-                    Error{ErrorCode::IoError, ev.data == detail::kGoodbye
-                                                  ? "netplay: the host closed the connection"
-                                                  : "netplay: the host stopped answering (no reply for " +
-                                                        std::to_string(im.timeoutMs) + " ms)"};
+                return Error{ErrorCode::IoError, "netplay: no host answered"};
+            return Error{ErrorCode::IoError, e.data == detail::kGoodbye
+                                                 ? "netplay: the host closed the connection"
+                                                 : "netplay: the host stopped answering (no reply for " +
+                                                       std::to_string(im.timeoutMs) + " ms)"};
         }
     }
-    if (!status)
-        return status;
     im.acknowledgeChunks();
     if (r < 0)
         return Error{ErrorCode::IoError, "netplay: ENet service failed"};

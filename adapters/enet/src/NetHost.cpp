@@ -21,9 +21,7 @@ namespace {
 constexpr double kChunksPerMs = 8; // snapshot chunks per client per ms (about 8.8 MB/s)
 constexpr double kChunkBurst = 96; // the most sent to a client at once (the relay's buffers hold them)
 constexpr double kPumpEveryMs = 2; // chunks go out at most this often
-constexpr int kServiceSliceMs = 2;
-constexpr std::chrono::seconds kResyncEvery{2}; // the most often a client gets a fresh snapshot // how long
-                                                // service() waits at a time while a snapshot is on its way
+constexpr int kServiceSliceMs = 2; // how long service() waits at a time while a snapshot is on its way
 } // namespace
 
 struct NetHost::Impl {
@@ -60,17 +58,15 @@ struct NetHost::Impl {
         std::uint64_t frame = 0;                                 // the snapshot's frame
         std::chrono::steady_clock::time_point started;
         double credit = kChunkBurst; // chunks it may send now
-        bool resync = false;         // to a client that had joined already
     };
     std::map<ENetPeer*, Transfer> transfers;
     std::chrono::steady_clock::time_point lastPump;
     std::uint32_t nextTransfer = 1;
-    std::map<ENetPeer*, std::chrono::steady_clock::time_point> resynced; // each client's latest resync
-    std::uint64_t placementsFrame = 0;                                   // of the latest publishPlacements
-    std::vector<std::pair<ObjectId, detail::Quantized>> placementsNow;   // what it was given then
+    std::uint64_t placementsFrame = 0;                                 // of the latest publishPlacements
+    std::vector<std::pair<ObjectId, detail::Quantized>> placementsNow; // what it was given then
 
-    // Sends each transfer's chunks that are new or unacknowledged for longer than a round trip, as many as
-    // the time since the last pump allows (kChunksPerMs per client, at most kChunkBurst at once).
+    // Sends each transfer's chunks that are new or unacknowledged for 1.5 round trips and 4 variances, as
+    // many as the time since the last pump allows (kChunksPerMs per client, at most kChunkBurst at once).
     void pump() {
         const auto now = std::chrono::steady_clock::now();
         const double ms = std::chrono::duration<double, std::milli>(now - lastPump).count();
@@ -88,7 +84,7 @@ struct NetHost::Impl {
         }
         for (auto& [peer, t] : transfers) {
             const auto resend =
-                std::chrono::milliseconds(10 + peer->roundTripTime + peer->roundTripTimeVariance);
+                std::chrono::milliseconds(20 + peer->roundTripTime * 3 / 2 + 4 * peer->roundTripTimeVariance);
             t.credit = std::min(kChunkBurst, t.credit + ms * kChunksPerMs);
             for (std::size_t i = 0; i < t.acked.size() && t.credit >= 1; ++i) {
                 if (t.acked[i] || (t.sent[i].time_since_epoch().count() != 0 && now - t.sent[i] < resend))
@@ -154,10 +150,9 @@ struct NetHost::Impl {
         if (!all)
             return;
         const std::uint64_t frame = t->second.frame;
-        if (!t->second.resync)
-            stats.snapshotTransferMs += std::chrono::duration<double, std::milli>(
-                                            std::chrono::steady_clock::now() - t->second.started)
-                                            .count();
+        stats.snapshotTransferMs +=
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t->second.started)
+                .count();
         transfers.erase(t);
         if (lastSync >= frame && hashes.count(lastSync)) // the latest sync, which it was not sent
             sendSync(peer, lastSync, lastSyncPosition, hashes[lastSync]);
@@ -187,9 +182,8 @@ struct NetHost::Impl {
         shotHandler(r);
     }
 
-    // Takes a snapshot for a client, without the objects it has already, and starts sending it; its
-    // placement baselines become the snapshot's. False when it cannot be encoded.
-    bool startTransfer(ENetPeer* peer, const detail::KnownObjects& known, bool isResync) {
+    // A client's Hello: it gets the snapshot, without the objects it has already.
+    void join(ENetPeer* peer, const detail::KnownObjects& known) {
         const auto started = std::chrono::steady_clock::now();
         std::vector<ObjectPlacement> placements =
             placementSource ? placementSource() : std::vector<ObjectPlacement>{};
@@ -199,8 +193,10 @@ struct NetHost::Impl {
         detail::JoinSnapshotSize size;
         const std::vector<std::uint8_t> msg =
             detail::encodeJoinSnapshot(takeSnapshot(world, std::move(placements)), known, &size);
-        if (msg.empty())
-            return false;
+        if (msg.empty()) {
+            enet_peer_disconnect(peer, detail::kGoodbye);
+            return;
+        }
         Transfer& t = transfers[peer];
         t.id = nextTransfer++;
         t.bytes = msg;
@@ -209,45 +205,15 @@ struct NetHost::Impl {
         t.sent.assign(chunks, {});
         t.frame = world.frame();
         t.started = std::chrono::steady_clock::now();
-        t.resync = isResync;
-        if (isResync) {
-            stats.resyncBytes += static_cast<long long>(size.wire);
-            return true;
-        }
-        stats.snapshotBuildMs += std::chrono::duration<double, std::milli>(t.started - started).count();
+        peers[peer] = world.journalPosition();
+        joinOrder[peer] = static_cast<std::uint64_t>(stats.joins);
+        ++stats.joins;
+        stats.snapshotBuildMs +=
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started).count();
         stats.snapshotBytes += static_cast<long long>(size.wire);
         stats.snapshotRawBytes += static_cast<long long>(size.raw);
         stats.snapshotObjectsByReference += static_cast<long long>(size.referenced);
         enet_host_flush(host);
-        return true;
-    }
-
-    // A client's Hello: it gets the snapshot, without the objects it has already.
-    void join(ENetPeer* peer, const detail::KnownObjects& known) {
-        if (!startTransfer(peer, known, false)) {
-            enet_peer_disconnect(peer, detail::kGoodbye);
-            return;
-        }
-        peers[peer] = world.journalPosition();
-        joinOrder[peer] = static_cast<std::uint64_t>(stats.joins);
-        ++stats.joins;
-    }
-
-    // A joined client's Hello: it is far behind (after an outage) and gets a fresh snapshot instead of the
-    // backlog's work, at most once per kResyncEvery. Its journal stream goes on: it skips what the snapshot
-    // has.
-    void resync(ENetPeer* peer, const detail::KnownObjects& known) {
-        const auto now = std::chrono::steady_clock::now();
-        if (transfers.count(peer))
-            return;
-        if (auto last = resynced.find(peer); last != resynced.end() && now - last->second < kResyncEvery)
-            return;
-        resynced[peer] = now;
-        if (!startTransfer(peer, known, true)) {
-            enet_peer_disconnect(peer, detail::kGoodbye);
-            return;
-        }
-        ++stats.resyncs;
     }
 
     void receive(ENetPeer* peer, const ENetPacket* packet) {
@@ -265,8 +231,8 @@ struct NetHost::Impl {
         }
         if (d[0] == static_cast<std::uint8_t>(Message::Hello)) {
             detail::KnownObjects known;
-            if (!closing && detail::decodeHello(d, packet->dataLength, known))
-                peers.count(peer) ? resync(peer, known) : join(peer, known);
+            if (!closing && !peers.count(peer) && detail::decodeHello(d, packet->dataLength, known))
+                join(peer, known);
             return;
         }
         if (d[0] == static_cast<std::uint8_t>(Message::SnapshotAck))
@@ -446,7 +412,6 @@ void NetHost::service(int timeoutMs) {
                 im.joinOrder.erase(e.peer);
                 im.transfers.erase(e.peer);
                 im.shotTokens.erase(e.peer);
-                im.resynced.erase(e.peer);
                 break;
             default:
                 break;

@@ -22,7 +22,6 @@ struct ClientStats {
     double joinMs = 0;              ///< connect → snapshot loaded (ms)
     double snapshotLoadMs = 0;      ///< of joinMs: inflating, decoding and loading the snapshot (ms)
     long long events = 0;           ///< journal events applied
-    long long resyncs = 0;          ///< fresh snapshots loaded after falling far behind the host
     long long syncs = 0;            ///< frame syncs checked
     long long mismatchedHashes = 0; ///< syncs whose geometry hash differed from the host's
     std::uint64_t frame = 0;        ///< the world's frame after the last sync

@@ -21,8 +21,6 @@ namespace rubble::net {
 struct HostStats {
     int clients = 0;                          ///< clients connected now
     long long joins = 0;                      ///< clients that joined (each got a snapshot)
-    long long resyncs = 0;                    ///< fresh snapshots sent to joined clients that fell far behind
-    long long resyncBytes = 0;                ///< their bytes (deflated; not in snapshotBytes)
     long long eventsSent = 0;                 ///< journal events sent (per client)
     long long eventBytes = 0;                 ///< bytes of journal event messages sent (per client, payload)
     long long snapshotBytes = 0;              ///< bytes of snapshot messages sent (deflated)
