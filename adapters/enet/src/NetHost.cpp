@@ -65,8 +65,8 @@ struct NetHost::Impl {
     std::uint64_t placementsFrame = 0;                                 // of the latest publishPlacements
     std::vector<std::pair<ObjectId, detail::Quantized>> placementsNow; // what it was given then
 
-    // Sends each transfer's chunks that are new or unacknowledged for 1.5 round trips and 4 variances, as
-    // many as the time since the last pump allows (kChunksPerMs per client, at most kChunkBurst at once).
+    // Sends each transfer's chunks that are new or unacknowledged for longer than a round trip, as many as
+    // the time since the last pump allows (kChunksPerMs per client, at most kChunkBurst at once).
     void pump() {
         const auto now = std::chrono::steady_clock::now();
         const double ms = std::chrono::duration<double, std::milli>(now - lastPump).count();
@@ -84,7 +84,7 @@ struct NetHost::Impl {
         }
         for (auto& [peer, t] : transfers) {
             const auto resend =
-                std::chrono::milliseconds(20 + peer->roundTripTime * 3 / 2 + 4 * peer->roundTripTimeVariance);
+                std::chrono::milliseconds(10 + peer->roundTripTime + peer->roundTripTimeVariance);
             t.credit = std::min(kChunkBurst, t.credit + ms * kChunksPerMs);
             for (std::size_t i = 0; i < t.acked.size() && t.credit >= 1; ++i) {
                 if (t.acked[i] || (t.sent[i].time_since_epoch().count() != 0 && now - t.sent[i] < resend))
