@@ -23,13 +23,12 @@ namespace rubble {
 namespace {
 
 TEST(NetLoopback, ClientsConvergeToTheHostsGeometryHash) {
-    test::JournalRig host(1);
-    const DestructionWorld::Config config = test::journalConfig(1).world;
-    auto server = net::NetHost::listen(host.runtime.world(), config, "127.0.0.1", 0);
-    ASSERT_TRUE(server) << server.error().message;
-    net::NetHost& h = **server;
+    test::NetHostRig net;
+    ASSERT_TRUE(net.server);
+    test::JournalRig& host = net.rig;
+    const DestructionWorld::Config& config = net.config;
+    net::NetHost& h = *net.server;
     ASSERT_NE(h.port(), 0);
-    h.setPlacementSource([&] { return host.runtime.placements(); });
 
     DestructionWorld::Config c2 = config;
     c2.workers = 2;
@@ -134,20 +133,21 @@ TEST(NetLoopback, ClientsConvergeToTheHostsGeometryHash) {
 }
 
 TEST(NetLoopback, AClientKeepsAReplayOfTheGameWhenTheHostStops) {
-    test::JournalRig host(1);
-    const DestructionWorld::Config config = test::journalConfig(1).world;
-    auto server = net::NetHost::listen(host.runtime.world(), config, "127.0.0.1", 0);
-    ASSERT_TRUE(server) << server.error().message;
+    test::NetHostRig net;
+    ASSERT_TRUE(net.server);
+    test::JournalRig& host = net.rig;
+    const DestructionWorld::Config& config = net.config;
+    std::unique_ptr<net::NetHost>& server = net.server;
     host.play(30); // some fractures before the client joins, more after
     DestructionWorld world(config);
-    auto client = net::NetClient::connect(world, config, "127.0.0.1", (*server)->port());
+    auto client = net::NetClient::connect(world, config, "127.0.0.1", server->port());
     ASSERT_TRUE(client) << client.error().message;
     EXPECT_FALSE((*client)->writeReplay(test::tempDir("net_replay") / "early.rbsn",
                                         test::tempDir("net_replay") / "early.rbj"));
     Status ending;
     const auto pump = [&] {
-        if (*server)
-            (*server)->service(1);
+        if (server)
+            server->service(1);
         ending = (*client)->service(1);
         return ending.ok();
     };
@@ -155,22 +155,22 @@ TEST(NetLoopback, AClientKeepsAReplayOfTheGameWhenTheHostStops) {
     const std::uint64_t joinedAt = host.runtime.world().frame();
     for (int frame = 0; frame < 120; ++frame) {
         host.play(1);
-        (*server)->publish();
+        server->publish();
         ASSERT_TRUE(pump());
     }
     host.settle();
-    (*server)->publish();
+    server->publish();
     const std::uint64_t last = host.runtime.world().frame(), hash = host.runtime.world().geometryHash();
     ASSERT_TRUE(test::waitFor([&] { return (*client)->stats().frame == last; }, pump));
     bool closed = false; // the host stops: the client hears it at once, not after ENet's timeout
     ASSERT_TRUE(test::waitFor([&] { return closed && !ending; },
                               [&] {
-                                  closed = closed || (*server)->close(10);
+                                  closed = closed || server->close(10);
                                   if (ending)
                                       ending = (*client)->service(1);
                                   return true;
                               }));
-    server->reset();
+    server.reset();
     EXPECT_EQ(ending.error().code, ErrorCode::IoError);
     EXPECT_NE(ending.message().find("closed"), std::string::npos) << ending.message();
     ASSERT_EQ(world.geometryHash(), hash);
@@ -195,12 +195,11 @@ TEST(NetLoopback, AClientKeepsAReplayOfTheGameWhenTheHostStops) {
 }
 
 TEST(NetLoopback, AClientWhoseWorldLagsShowsThoseFramesBetweenPlacements) {
-    test::JournalRig host(1);
-    const DestructionWorld::Config config = test::journalConfig(1).world;
-    auto server = net::NetHost::listen(host.runtime.world(), config, "127.0.0.1", 0);
-    ASSERT_TRUE(server) << server.error().message;
-    net::NetHost& h = **server;
-    h.setPlacementSource([&] { return host.runtime.placements(); });
+    test::NetHostRig net;
+    ASSERT_TRUE(net.server);
+    test::JournalRig& host = net.rig;
+    const DestructionWorld::Config& config = net.config;
+    net::NetHost& h = *net.server;
     h.publish(); // the sync a joining client gets once its snapshot is in
     DestructionWorld world(config);
     auto client = net::NetClient::connect(world, config, "127.0.0.1", h.port());
