@@ -231,29 +231,39 @@ TEST(NetLoopback, AClientWhoseWorldLagsShowsThoseFramesBetweenPlacements) {
     }
 }
 
+// A client of the host on `world`, connected until the host took its snapshot (the client goes first each
+// round, so it has read no chunk yet); null when that failed.
+std::unique_ptr<net::NetClient> joining(test::NetHostRig& net, DestructionWorld& world) {
+    auto client = net::NetClient::connect(world, net.config, "127.0.0.1", net.server->port());
+    EXPECT_TRUE(client) << (client ? std::string() : client.error().message);
+    if (!client)
+        return nullptr;
+    const bool taken = test::waitFor([&] { return net.server->stats().joins == 1; },
+                                     [&] {
+                                         const bool ok = static_cast<bool>((*client)->service(1));
+                                         net.server->service(0);
+                                         return ok;
+                                     });
+    EXPECT_TRUE(taken);
+    return taken ? std::move(*client) : nullptr;
+}
+
 TEST(NetLoopback, OneLongServiceCallSendsASnapshotOfMoreThanOneBurst) {
     test::NetHostRig net;
     ASSERT_TRUE(net.server);
     net::NetHost& h = *net.server;
     net.rig.play(360);
     DestructionWorld world(net.config); // bare: the whole snapshot travels
-    auto client = net::NetClient::connect(world, net.config, "127.0.0.1", h.port());
-    ASSERT_TRUE(client) << client.error().message;
-    // Until the host took the snapshot (the client goes first, so it has read no chunk yet).
-    ASSERT_TRUE(test::waitFor([&] { return h.stats().joins == 1; },
-                              [&] {
-                                  const bool ok = static_cast<bool>((*client)->service(1));
-                                  h.service(0);
-                                  return ok;
-                              }));
+    std::unique_ptr<net::NetClient> client = joining(net, world);
+    ASSERT_TRUE(client);
     ASSERT_GT(h.stats().snapshotBytes, 2 * 96 * 1100) << "more chunks than the host sends in two bursts";
     // The client reads on its own thread while the game serves the network once, as it waits for its next
     // frame; every chunk goes out in that call, so the client gets the snapshot without another.
     bool joined = false;
     std::thread reader([&] {
         const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-        while (!joined && std::chrono::steady_clock::now() < end && (*client)->service(1))
-            joined = (*client)->stats().joined;
+        while (!joined && std::chrono::steady_clock::now() < end && client->service(1))
+            joined = client->stats().joined;
     });
     h.service(300);
     reader.join();
@@ -266,14 +276,8 @@ TEST(NetLoopback, AJoiningClientGetsTheLatestPlacementsAsSoonAsItHasItsSnapshot)
     net::NetHost& h = *net.server;
     net.rig.play(20); // the slab falls, pieces fly
     DestructionWorld world(net.config);
-    auto client = net::NetClient::connect(world, net.config, "127.0.0.1", h.port());
-    ASSERT_TRUE(client) << client.error().message;
-    ASSERT_TRUE(test::waitFor([&] { return h.stats().joins == 1; },
-                              [&] {
-                                  const bool ok = static_cast<bool>((*client)->service(1));
-                                  h.service(0);
-                                  return ok;
-                              }));
+    std::unique_ptr<net::NetClient> client = joining(net, world);
+    ASSERT_TRUE(client);
     const std::vector<ObjectPlacement> atSnapshot = net.rig.runtime.placements();
     net.rig.play(12);
     h.publish();
@@ -290,15 +294,15 @@ TEST(NetLoopback, AJoiningClientGetsTheLatestPlacementsAsSoonAsItHasItsSnapshot)
     ASSERT_TRUE(test::waitFor(
         [&] {
             return std::all_of(moved.begin(), moved.end(), [&](const ObjectPlacement& p) {
-                return (*client)->placementFrame(p.object) == std::optional(frame);
+                return client->placementFrame(p.object) == std::optional(frame);
             });
         },
         [&] {
             h.service(1);
-            return static_cast<bool>((*client)->service(1));
+            return static_cast<bool>(client->service(1));
         }));
     for (const ObjectPlacement& p : moved)
-        EXPECT_LT(length((*client)->placement(p.object, frame)->translation - p.objectToWorld.translation),
+        EXPECT_LT(length(client->placement(p.object, frame)->translation - p.objectToWorld.translation),
                   1e-3);
 }
 
