@@ -304,7 +304,9 @@ int runHost(const Args& a) {
     std::vector<net::ShotRequest> requested; // clients' shots that passed the host's checks
     host.setShotHandler([&](const net::ShotRequest& r) { requested.push_back(r); });
     auto frame = [&](bool firing) {
-        std::this_thread::sleep_until(start + period * f);
+        for (auto due = start + period * f; Clock::now() < due;) // the host serves the network meanwhile
+            host.service(
+                static_cast<int>(std::chrono::ceil<std::chrono::milliseconds>(due - Clock::now()).count()));
         const long due = static_cast<long>(static_cast<double>(f) * a.shotsPerSecond / 60.0);
         for (; firing && shots < due; ++shots)
             fire(runtime, rng);
@@ -514,6 +516,7 @@ int runHost(const Args& a) {
     r["snapshot_objects_by_reference"] = hs.snapshotObjectsByReference / std::max<long long>(1, hs.joins);
     r["clients_load_scene"] = !a.noBase;
     r["snapshot_build_ms"] = hs.snapshotBuildMs / static_cast<double>(std::max<long long>(1, hs.joins));
+    r["snapshot_chunks_sent"] = hs.snapshotChunksSent;
     r["snapshot_transfer_ms"] = hs.snapshotTransferMs / static_cast<double>(std::max<long long>(1, hs.joins));
     r["final_hashes_equal"] = allConverged;
     r["converge_ms"] = convergeMs;

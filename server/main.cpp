@@ -15,7 +15,6 @@
 #include <csignal>
 #include <cstdio>
 #include <iostream>
-#include <thread>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -116,7 +115,9 @@ int main(int argc, char** argv) {
     };
     while (!stopRequested &&
            (seconds <= 0 || Clock::now() - start < std::chrono::duration<double>(seconds))) {
-        std::this_thread::sleep_until(start + period * frame);
+        for (auto due = start + period * frame; Clock::now() < due;) // serving the network meanwhile
+            host.service(
+                static_cast<int>(std::chrono::ceil<std::chrono::milliseconds>(due - Clock::now()).count()));
         step();
     }
     shots.clear(); // no more shots: the jobs in flight finish

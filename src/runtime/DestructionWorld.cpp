@@ -22,6 +22,7 @@
 #include "rubble/geometry/MassProperties.hpp"
 #include "rubble/geometry/MeshCheck.hpp"
 #include "rubble/geometry/MeshRepair.hpp"
+#include "rubble/runtime/JobSeed.hpp"
 #include "rubble/structure/Material.hpp"
 
 namespace rubble {
@@ -349,7 +350,7 @@ struct DestructionWorld::Impl {
         unhashed.clear();
     }
     std::uint64_t jobSeed(const ObjectState& o) const {
-        return mixSeed(mixSeed(config.seed, o.id), o.version);
+        return rubble::jobSeed(config.seed, o.id, o.version);
     }
     void journal(const JournalEvent& e) {
         ++journalLength;

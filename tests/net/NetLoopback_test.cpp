@@ -6,10 +6,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <thread>
 
 #include "JournalScene.hpp"
+#include "NetRig.hpp"
 #include "NetWait.hpp"
 #include "TestSupport.hpp"
 #include "rubble/persist/JournalFile.hpp"
@@ -20,13 +23,12 @@ namespace rubble {
 namespace {
 
 TEST(NetLoopback, ClientsConvergeToTheHostsGeometryHash) {
-    test::JournalRig host(1);
-    const DestructionWorld::Config config = test::journalConfig(1).world;
-    auto server = net::NetHost::listen(host.runtime.world(), config, "127.0.0.1", 0);
-    ASSERT_TRUE(server) << server.error().message;
-    net::NetHost& h = **server;
+    test::NetHostRig net;
+    ASSERT_TRUE(net.server);
+    test::JournalRig& host = net.rig;
+    const DestructionWorld::Config& config = net.config;
+    net::NetHost& h = *net.server;
     ASSERT_NE(h.port(), 0);
-    h.setPlacementSource([&] { return host.runtime.placements(); });
 
     DestructionWorld::Config c2 = config;
     c2.workers = 2;
@@ -131,20 +133,21 @@ TEST(NetLoopback, ClientsConvergeToTheHostsGeometryHash) {
 }
 
 TEST(NetLoopback, AClientKeepsAReplayOfTheGameWhenTheHostStops) {
-    test::JournalRig host(1);
-    const DestructionWorld::Config config = test::journalConfig(1).world;
-    auto server = net::NetHost::listen(host.runtime.world(), config, "127.0.0.1", 0);
-    ASSERT_TRUE(server) << server.error().message;
+    test::NetHostRig net;
+    ASSERT_TRUE(net.server);
+    test::JournalRig& host = net.rig;
+    const DestructionWorld::Config& config = net.config;
+    std::unique_ptr<net::NetHost>& server = net.server;
     host.play(30); // some fractures before the client joins, more after
     DestructionWorld world(config);
-    auto client = net::NetClient::connect(world, config, "127.0.0.1", (*server)->port());
+    auto client = net::NetClient::connect(world, config, "127.0.0.1", server->port());
     ASSERT_TRUE(client) << client.error().message;
     EXPECT_FALSE((*client)->writeReplay(test::tempDir("net_replay") / "early.rbsn",
                                         test::tempDir("net_replay") / "early.rbj"));
     Status ending;
     const auto pump = [&] {
-        if (*server)
-            (*server)->service(1);
+        if (server)
+            server->service(1);
         ending = (*client)->service(1);
         return ending.ok();
     };
@@ -152,22 +155,22 @@ TEST(NetLoopback, AClientKeepsAReplayOfTheGameWhenTheHostStops) {
     const std::uint64_t joinedAt = host.runtime.world().frame();
     for (int frame = 0; frame < 120; ++frame) {
         host.play(1);
-        (*server)->publish();
+        server->publish();
         ASSERT_TRUE(pump());
     }
     host.settle();
-    (*server)->publish();
+    server->publish();
     const std::uint64_t last = host.runtime.world().frame(), hash = host.runtime.world().geometryHash();
     ASSERT_TRUE(test::waitFor([&] { return (*client)->stats().frame == last; }, pump));
     bool closed = false; // the host stops: the client hears it at once, not after ENet's timeout
     ASSERT_TRUE(test::waitFor([&] { return closed && !ending; },
                               [&] {
-                                  closed = closed || (*server)->close(10);
+                                  closed = closed || server->close(10);
                                   if (ending)
                                       ending = (*client)->service(1);
                                   return true;
                               }));
-    server->reset();
+    server.reset();
     EXPECT_EQ(ending.error().code, ErrorCode::IoError);
     EXPECT_NE(ending.message().find("closed"), std::string::npos) << ending.message();
     ASSERT_EQ(world.geometryHash(), hash);
@@ -192,12 +195,11 @@ TEST(NetLoopback, AClientKeepsAReplayOfTheGameWhenTheHostStops) {
 }
 
 TEST(NetLoopback, AClientWhoseWorldLagsShowsThoseFramesBetweenPlacements) {
-    test::JournalRig host(1);
-    const DestructionWorld::Config config = test::journalConfig(1).world;
-    auto server = net::NetHost::listen(host.runtime.world(), config, "127.0.0.1", 0);
-    ASSERT_TRUE(server) << server.error().message;
-    net::NetHost& h = **server;
-    h.setPlacementSource([&] { return host.runtime.placements(); });
+    test::NetHostRig net;
+    ASSERT_TRUE(net.server);
+    test::JournalRig& host = net.rig;
+    const DestructionWorld::Config& config = net.config;
+    net::NetHost& h = *net.server;
     h.publish(); // the sync a joining client gets once its snapshot is in
     DestructionWorld world(config);
     auto client = net::NetClient::connect(world, config, "127.0.0.1", h.port());
@@ -227,6 +229,81 @@ TEST(NetLoopback, AClientWhoseWorldLagsShowsThoseFramesBetweenPlacements) {
         ASSERT_TRUE(f);
         EXPECT_NEAR(f->translation.x, start.x + 0.01 * (last - back - first), 1e-3) << back << " frames back";
     }
+}
+
+// A client of the host on `world`, connected until the host took its snapshot (the client goes first each
+// round, so it has read no chunk yet); null when that failed.
+std::unique_ptr<net::NetClient> joining(test::NetHostRig& net, DestructionWorld& world) {
+    auto client = net::NetClient::connect(world, net.config, "127.0.0.1", net.server->port());
+    EXPECT_TRUE(client) << (client ? std::string() : client.error().message);
+    if (!client)
+        return nullptr;
+    const bool taken = test::waitFor([&] { return net.server->stats().joins == 1; },
+                                     [&] {
+                                         const bool ok = static_cast<bool>((*client)->service(1));
+                                         net.server->service(0);
+                                         return ok;
+                                     });
+    EXPECT_TRUE(taken);
+    return taken ? std::move(*client) : nullptr;
+}
+
+TEST(NetLoopback, OneLongServiceCallSendsASnapshotOfMoreThanOneBurst) {
+    test::NetHostRig net;
+    ASSERT_TRUE(net.server);
+    net::NetHost& h = *net.server;
+    net.rig.play(360);
+    DestructionWorld world(net.config); // bare: the whole snapshot travels
+    std::unique_ptr<net::NetClient> client = joining(net, world);
+    ASSERT_TRUE(client);
+    ASSERT_GT(h.stats().snapshotBytes, 2 * 96 * 1100) << "more chunks than the host sends in two bursts";
+    // The client reads on its own thread while the game serves the network once, as it waits for its next
+    // frame; every chunk goes out in that call, so the client gets the snapshot without another.
+    bool joined = false;
+    std::thread reader([&] {
+        const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+        while (!joined && std::chrono::steady_clock::now() < end && client->service(1))
+            joined = client->stats().joined;
+    });
+    h.service(300);
+    reader.join();
+    EXPECT_TRUE(joined);
+}
+
+TEST(NetLoopback, AJoiningClientGetsTheLatestPlacementsAsSoonAsItHasItsSnapshot) {
+    test::NetHostRig net;
+    ASSERT_TRUE(net.server);
+    net::NetHost& h = *net.server;
+    net.rig.play(20); // the slab falls, pieces fly
+    DestructionWorld world(net.config);
+    std::unique_ptr<net::NetClient> client = joining(net, world);
+    ASSERT_TRUE(client);
+    const std::vector<ObjectPlacement> atSnapshot = net.rig.runtime.placements();
+    net.rig.play(12);
+    h.publish();
+    const std::vector<ObjectPlacement> latest = net.rig.runtime.placements();
+    h.publishPlacements(latest); // its snapshot is still on its way; the game publishes no more
+    const double frame = static_cast<double>(net.rig.runtime.world().frame());
+    std::vector<ObjectPlacement> moved;
+    for (const ObjectPlacement& p : latest)
+        for (const ObjectPlacement& q : atSnapshot)
+            if (p.object == q.object && p.motion == BodyMotionState::Dynamic &&
+                length(p.objectToWorld.translation - q.objectToWorld.translation) > 0.01)
+                moved.push_back(p);
+    ASSERT_FALSE(moved.empty());
+    ASSERT_TRUE(test::waitFor(
+        [&] {
+            return std::all_of(moved.begin(), moved.end(), [&](const ObjectPlacement& p) {
+                return client->placementFrame(p.object) == std::optional(frame);
+            });
+        },
+        [&] {
+            h.service(1);
+            return static_cast<bool>(client->service(1));
+        }));
+    for (const ObjectPlacement& p : moved)
+        EXPECT_LT(length(client->placement(p.object, frame)->translation - p.objectToWorld.translation),
+                  1e-3);
 }
 
 TEST(NetLoopback, OnlyLoopbackAddressesAndDeterministicWorlds) {

@@ -19,6 +19,7 @@
 #include <thread>
 
 #include "JournalScene.hpp"
+#include "NetRig.hpp"
 #include "NetWait.hpp"
 
 namespace rubble {
@@ -54,12 +55,10 @@ struct Follower {
 };
 
 TEST(NetRelay, ClientsThroughMisbehavingLinksConvergeAfterAPartitionAndAReplacement) {
-    test::JournalRig host(1);
-    const DestructionWorld::Config config = test::journalConfig(1).world;
-    auto server = net::NetHost::listen(host.runtime.world(), config, "127.0.0.1", 0);
-    ASSERT_TRUE(server) << server.error().message;
-    net::NetHost& h = **server;
-    h.setPlacementSource([&] { return host.runtime.placements(); });
+    test::NetHostRig net;
+    ASSERT_TRUE(net.server);
+    test::JournalRig& host = net.rig;
+    net::NetHost& h = *net.server;
     std::vector<std::unique_ptr<Follower>> live;
     live.push_back(std::make_unique<Follower>(h.port(), 1));
     live.push_back(std::make_unique<Follower>(h.port(), 2));
@@ -166,11 +165,9 @@ TEST(NetRelay, ClientsThroughMisbehavingLinksConvergeAfterAPartitionAndAReplacem
 }
 
 TEST(NetRelay, AClientNoticesAHostThatStoppedAnsweringAfterItsTimeout) {
-    test::JournalRig host(1);
-    const DestructionWorld::Config config = test::journalConfig(1).world;
-    auto server = net::NetHost::listen(host.runtime.world(), config, "127.0.0.1", 0);
-    ASSERT_TRUE(server) << server.error().message;
-    net::NetHost& h = **server;
+    test::NetHostRig net;
+    ASSERT_TRUE(net.server);
+    net::NetHost& h = *net.server;
     h.publish();
     Follower f(h.port(), 31);
     ASSERT_TRUE(test::waitFor([&] { return h.stats().acks > 0; },
@@ -192,11 +189,11 @@ TEST(NetRelay, AClientNoticesAHostThatStoppedAnsweringAfterItsTimeout) {
 }
 
 TEST(NetRelay, RogueTrafficNeitherCrashesTheHostNorChangesItsWorld) {
-    test::JournalRig host(1), reference(1);
-    const DestructionWorld::Config config = test::journalConfig(1).world;
-    auto server = net::NetHost::listen(host.runtime.world(), config, "127.0.0.1", 0);
-    ASSERT_TRUE(server) << server.error().message;
-    net::NetHost& h = **server;
+    test::NetHostRig net;
+    ASSERT_TRUE(net.server);
+    test::JournalRig &host = net.rig, reference(1);
+    const DestructionWorld::Config& config = net.config;
+    net::NetHost& h = *net.server;
     DestructionWorld world(config);
     auto honest = net::NetClient::connect(world, config, "127.0.0.1", h.port());
     ASSERT_TRUE(honest);

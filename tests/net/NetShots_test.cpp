@@ -10,17 +10,18 @@
 #include <limits>
 
 #include "JournalScene.hpp"
+#include "NetRig.hpp"
 #include "NetWait.hpp"
 
 namespace rubble {
 namespace {
 
 TEST(NetShots, TheHostFiresOnlyTheShotsThatPassItsRules) {
-    test::JournalRig host(1);
-    const DestructionWorld::Config config = test::journalConfig(1).world;
-    auto server = net::NetHost::listen(host.runtime.world(), config, "127.0.0.1", 0);
-    ASSERT_TRUE(server) << server.error().message;
-    net::NetHost& h = **server;
+    test::NetHostRig net;
+    ASSERT_TRUE(net.server);
+    test::JournalRig& host = net.rig;
+    const DestructionWorld::Config& config = net.config;
+    net::NetHost& h = *net.server;
     DestructionWorld world(config);
     auto client = net::NetClient::connect(world, config, "127.0.0.1", h.port());
     ASSERT_TRUE(client);

@@ -10,9 +10,9 @@
 #include "JoinSnapshot.hpp"
 #include "Placements.hpp"
 #include "Protocol.hpp"
-#include "rubble/core/Random.hpp"
 #include "rubble/persist/JournalFile.hpp"
 #include "rubble/persist/Snapshot.hpp"
+#include "rubble/runtime/JobSeed.hpp"
 #include "rubble/runtime/JournalPlayer.hpp"
 
 namespace rubble::net {
@@ -96,7 +96,7 @@ struct NetClient::Impl {
                                                               ", which this world does not have"};
                 e.pattern = patternByte(o->fracture);
                 e.cells = static_cast<std::uint16_t>(std::clamp(o->fracture.cells, 0, 65535));
-                e.seed = mixSeed(mixSeed(seed, o->id), o->version); // the world's next job seed
+                e.seed = jobSeed(seed, o->id, o->version); // the world's next job seed
                 if (detail::eventCheck(e) != check)
                     return Error{ErrorCode::InvalidInput,
                                  "netplay: impact on object " + std::to_string(e.object) +
@@ -198,6 +198,7 @@ struct NetClient::Impl {
             return Status::ok();
         doneTransfer = id;
         doneChunks = count;
+        acknowledgeChunks(); // before loading it, so that the host sends no chunk again meanwhile
         const std::vector<std::uint8_t> whole = std::move(incoming.bytes);
         incoming = {};
         if (Status st = receive(whole.data(), whole.size()); !st)

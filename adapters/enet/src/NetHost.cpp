@@ -17,6 +17,13 @@ namespace rubble::net {
 
 using detail::Message;
 
+namespace {
+constexpr double kChunksPerMs = 8; // snapshot chunks per client per ms (about 8.8 MB/s)
+constexpr double kChunkBurst = 96; // the most sent to a client at once (the relay's buffers hold them)
+constexpr double kPumpEveryMs = 2; // chunks go out at most this often
+constexpr int kServiceSliceMs = 2; // how long service() waits at a time while a snapshot is on its way
+} // namespace
+
 struct NetHost::Impl {
     Impl(DestructionWorld& w, const DestructionWorld::Config& c) : world(w), config(c) {}
     DestructionWorld& world;
@@ -50,17 +57,21 @@ struct NetHost::Impl {
         std::vector<std::chrono::steady_clock::time_point> sent; // last sent (epoch: never)
         std::uint64_t frame = 0;                                 // the snapshot's frame
         std::chrono::steady_clock::time_point started;
+        double credit = kChunkBurst; // chunks it may send now
     };
     std::map<ENetPeer*, Transfer> transfers;
     std::chrono::steady_clock::time_point lastPump;
     std::uint32_t nextTransfer = 1;
+    std::uint64_t placementsFrame = 0;                                 // of the latest publishPlacements
+    std::vector<std::pair<ObjectId, detail::Quantized>> placementsNow; // what it was given then
 
-    // Sends each transfer's chunks that are new or unacknowledged for longer than a round trip, at most
-    // `budget` per client.
-    void pump(std::size_t budget) {
+    // Sends each transfer's chunks that are new or unacknowledged for longer than a round trip, as many as
+    // the time since the last pump allows (kChunksPerMs per client, at most kChunkBurst at once).
+    void pump() {
         const auto now = std::chrono::steady_clock::now();
-        if (transfers.empty() || now - lastPump < std::chrono::milliseconds(8))
-            return; // paced: at most 64 datagrams per 8 ms per client
+        const double ms = std::chrono::duration<double, std::milli>(now - lastPump).count();
+        if (transfers.empty() || ms < kPumpEveryMs)
+            return;
         lastPump = now;
         for (auto it = transfers.begin();
              it != transfers.end();) { // a client that never has it all is dropped
@@ -74,8 +85,8 @@ struct NetHost::Impl {
         for (auto& [peer, t] : transfers) {
             const auto resend =
                 std::chrono::milliseconds(10 + peer->roundTripTime + peer->roundTripTimeVariance);
-            std::size_t n = 0;
-            for (std::size_t i = 0; i < t.acked.size() && n < budget; ++i) {
+            t.credit = std::min(kChunkBurst, t.credit + ms * kChunksPerMs);
+            for (std::size_t i = 0; i < t.acked.size() && t.credit >= 1; ++i) {
                 if (t.acked[i] || (t.sent[i].time_since_epoch().count() != 0 && now - t.sent[i] < resend))
                     continue;
                 const std::size_t at = i * detail::kSnapshotChunk;
@@ -89,10 +100,30 @@ struct NetHost::Impl {
                            t.bytes.begin() + static_cast<std::ptrdiff_t>(at + len));
                 detail::sendUnreliable(peer, msg);
                 t.sent[i] = now;
-                ++n;
+                t.credit -= 1;
+                ++stats.snapshotChunksSent;
             }
         }
         enet_host_flush(host);
+    }
+
+    // Sends a client the placements that differ from what it acknowledged, within its allowance.
+    void sendPlacements(ENetPeer* peer, long long legacy) {
+        detail::PlacementEncoder& encoder = encoders[peer];
+        const PlacementBudget& b = placementBudget;
+        detail::PlacementAllowance& allowance =
+            allowances.try_emplace(peer, b.mean, b.peak, b.reserve).first->second;
+        std::size_t spent = 0;
+        for (const std::vector<std::uint8_t>& msg :
+             encoder.encode(placementsFrame, placementsNow, allowance.next())) {
+            detail::sendUnreliable(peer, msg);
+            spent += msg.size();
+        }
+        allowance.spent(spent);
+        stats.placementBytes += static_cast<long long>(spent);
+        stats.placementsDeferred += static_cast<long long>(encoder.deferred());
+        stats.placementPublishesFull += encoder.deferred() > 0;
+        stats.legacyPlacementBytes += legacy;
     }
 
     // A sync: everything sent so far, applied up to `frame`, gives `hash`.
@@ -125,6 +156,9 @@ struct NetHost::Impl {
         transfers.erase(t);
         if (lastSync >= frame && hashes.count(lastSync)) // the latest sync, which it was not sent
             sendSync(peer, lastSync, lastSyncPosition, hashes[lastSync]);
+        if (placementsFrame > frame) // the latest placements, newer than its snapshot's
+            sendPlacements(peer, 0);
+        enet_host_flush(host);
     }
 
     // A client's shot: fired through the handler if it passes the rules, else counted as refused.
@@ -285,38 +319,24 @@ void NetHost::publish() {
     im.journal.clear();
     im.base = end;
     enet_host_flush(im.host);
-    im.pump(64);
+    im.pump();
 }
 
 void NetHost::publishPlacements(const std::vector<ObjectPlacement>& placements) {
     Impl& im = *impl_;
-    std::vector<std::pair<ObjectId, detail::Quantized>> now;
-    now.reserve(placements.size());
+    im.placementsNow.clear();
+    im.placementsNow.reserve(placements.size());
     std::size_t dynamic = 0;
     for (const ObjectPlacement& p : placements) {
-        now.emplace_back(p.object, detail::quantize(p.objectToWorld));
+        im.placementsNow.emplace_back(p.object, detail::quantize(p.objectToWorld));
         dynamic += p.motion == BodyMotionState::Dynamic;
     }
+    im.placementsFrame = im.world.frame();
     // The previous protocol: 13 + 32 n bytes per 37 dynamic bodies, every time.
     const auto legacy = static_cast<long long>((dynamic + 36) / 37 * 13 + dynamic * 32);
-    for (auto& [peer, position] : im.peers) {
-        if (!im.acked.count(peer))
-            continue; // still loading its snapshot: nothing to compare against yet
-        detail::PlacementEncoder& encoder = im.encoders[peer];
-        const PlacementBudget& b = im.placementBudget;
-        detail::PlacementAllowance& allowance =
-            im.allowances.try_emplace(peer, b.mean, b.peak, b.reserve).first->second;
-        std::size_t spent = 0;
-        for (const std::vector<std::uint8_t>& msg : encoder.encode(im.world.frame(), now, allowance.next())) {
-            detail::sendUnreliable(peer, msg);
-            spent += msg.size();
-        }
-        allowance.spent(spent);
-        im.stats.placementBytes += static_cast<long long>(spent);
-        im.stats.placementsDeferred += static_cast<long long>(encoder.deferred());
-        im.stats.placementPublishesFull += encoder.deferred() > 0;
-        im.stats.legacyPlacementBytes += legacy;
-    }
+    for (auto& [peer, position] : im.peers)
+        if (!im.transfers.count(peer)) // else it gets them once its snapshot is in
+            im.sendPlacements(peer, legacy);
     enet_host_flush(im.host);
 }
 
@@ -363,34 +383,44 @@ void NetHost::setPlacementSource(std::function<std::vector<ObjectPlacement>()> s
 
 void NetHost::service(int timeoutMs) {
     Impl& im = *impl_;
-    ENetEvent e;
-    for (int r = enet_host_service(im.host, &e, static_cast<enet_uint32>(std::max(0, timeoutMs))); r > 0;
-         r = enet_host_service(im.host, &e, 0)) {
-        switch (e.type) {
-        case ENET_EVENT_TYPE_CONNECT: // it joins with its Hello
-            detail::configurePeer(e.peer);
-            if (im.closing)
-                enet_peer_disconnect(e.peer, detail::kGoodbye);
-            break;
-        case ENET_EVENT_TYPE_RECEIVE:
-            im.receive(e.peer, e.packet);
-            enet_packet_destroy(e.packet);
-            break;
-        case ENET_EVENT_TYPE_DISCONNECT:
-            im.peers.erase(e.peer);
-            im.acked.erase(e.peer);
-            im.encoders.erase(e.peer);
-            im.allowances.erase(e.peer);
-            im.heard.erase(e.peer);
-            im.joinOrder.erase(e.peer);
-            im.transfers.erase(e.peer);
-            im.shotTokens.erase(e.peer);
-            break;
-        default:
-            break;
+    const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(std::max(0, timeoutMs));
+    for (;;) {
+        const auto left =
+            std::chrono::duration_cast<std::chrono::milliseconds>(end - std::chrono::steady_clock::now())
+                .count();
+        // While a snapshot is on its way, wake often enough to pace its chunks.
+        const auto wait = static_cast<enet_uint32>(
+            std::max<long long>(0, im.transfers.empty() ? left : std::min<long long>(left, kServiceSliceMs)));
+        ENetEvent e;
+        for (int r = enet_host_service(im.host, &e, wait); r > 0; r = enet_host_service(im.host, &e, 0)) {
+            switch (e.type) {
+            case ENET_EVENT_TYPE_CONNECT: // it joins with its Hello
+                detail::configurePeer(e.peer);
+                if (im.closing)
+                    enet_peer_disconnect(e.peer, detail::kGoodbye);
+                break;
+            case ENET_EVENT_TYPE_RECEIVE:
+                im.receive(e.peer, e.packet);
+                enet_packet_destroy(e.packet);
+                break;
+            case ENET_EVENT_TYPE_DISCONNECT:
+                im.peers.erase(e.peer);
+                im.acked.erase(e.peer);
+                im.encoders.erase(e.peer);
+                im.allowances.erase(e.peer);
+                im.heard.erase(e.peer);
+                im.joinOrder.erase(e.peer);
+                im.transfers.erase(e.peer);
+                im.shotTokens.erase(e.peer);
+                break;
+            default:
+                break;
+            }
         }
+        im.pump();
+        if (std::chrono::steady_clock::now() >= end)
+            break;
     }
-    im.pump(64);
     im.stats.clients = static_cast<int>(im.peers.size());
 }
 

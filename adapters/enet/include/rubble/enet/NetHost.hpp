@@ -27,6 +27,7 @@ struct HostStats {
     long long snapshotRawBytes = 0;           ///< what they inflate to (the objects the clients did not have)
     long long snapshotObjectsByReference = 0; ///< objects sent by id: the client had them in that state
     double snapshotBuildMs = 0;               ///< time spent taking, encoding and deflating snapshots (ms)
+    long long snapshotChunksSent = 0;         ///< snapshot chunks sent, resends included
     double snapshotTransferMs =
         0;               ///< time from sending snapshots' first chunks to their last acknowledgement (ms)
     long long syncs = 0; ///< frame syncs sent (per client)
@@ -89,7 +90,8 @@ public:
     void publish();
     /// Sends every client the placements that differ from what it acknowledged (unreliable, on channel 1;
     /// quantized, delta-coded, the most overdue first within the budget): the host is authoritative for
-    /// motion. Bodies at rest cost nothing. Call at a modest rate (10 Hz).
+    /// motion. Bodies at rest cost nothing. Call at a modest rate (10 Hz). A client whose snapshot is on its
+    /// way gets the latest ones as soon as it has the snapshot.
     void publishPlacements(const std::vector<ObjectPlacement>& placements);
     /// Bytes of placements per client (PlacementBudget: a mean, a peak and a reserve).
     void setPlacementBudget(const PlacementBudget& budget);
@@ -102,7 +104,8 @@ public:
     bool close(int timeoutMs);
     /// Where joining clients' snapshots get the bodies' placements from (e.g. the runtime's placements()).
     void setPlacementSource(std::function<std::vector<ObjectPlacement>()> source);
-    /// Handles the network (joins, leaves, clients' hash reports) for up to timeoutMs.
+    /// Handles the network (joins, leaves, clients' hash reports) for timeoutMs, sending snapshot chunks
+    /// throughout at their own pace: a game that waits for its next frame should wait in here.
     void service(int timeoutMs = 0);
     /// Takes clients' shots: each one that passes `rules` (finite, speed and origin in range, within the
     /// client's rate) goes to `handler`, which fires it in the host's world; everything else is refused and
