@@ -22,7 +22,7 @@ namespace {
 TEST(NetLoopback, ClientsConvergeToTheHostsGeometryHash) {
     test::JournalRig host(1);
     const DestructionWorld::Config config = test::journalConfig(1).world;
-    auto server = net::NetHost::listen(host.runtime.world(), config, "127.0.0.1", 0);
+    auto server = net::NetHost::listen(host.runtime, config, "127.0.0.1", 0);
     ASSERT_TRUE(server) << server.error().message;
     net::NetHost& h = **server;
     ASSERT_NE(h.port(), 0);
@@ -133,7 +133,7 @@ TEST(NetLoopback, ClientsConvergeToTheHostsGeometryHash) {
 TEST(NetLoopback, AClientKeepsAReplayOfTheGameWhenTheHostStops) {
     test::JournalRig host(1);
     const DestructionWorld::Config config = test::journalConfig(1).world;
-    auto server = net::NetHost::listen(host.runtime.world(), config, "127.0.0.1", 0);
+    auto server = net::NetHost::listen(host.runtime, config, "127.0.0.1", 0);
     ASSERT_TRUE(server) << server.error().message;
     host.play(30); // some fractures before the client joins, more after
     DestructionWorld world(config);
@@ -194,7 +194,7 @@ TEST(NetLoopback, AClientKeepsAReplayOfTheGameWhenTheHostStops) {
 TEST(NetLoopback, AClientWhoseWorldLagsShowsThoseFramesBetweenPlacements) {
     test::JournalRig host(1);
     const DestructionWorld::Config config = test::journalConfig(1).world;
-    auto server = net::NetHost::listen(host.runtime.world(), config, "127.0.0.1", 0);
+    auto server = net::NetHost::listen(host.runtime, config, "127.0.0.1", 0);
     ASSERT_TRUE(server) << server.error().message;
     net::NetHost& h = **server;
     h.setPlacementSource([&] { return host.runtime.placements(); });
@@ -231,13 +231,14 @@ TEST(NetLoopback, AClientWhoseWorldLagsShowsThoseFramesBetweenPlacements) {
 
 TEST(NetLoopback, OnlyLoopbackAddressesAndDeterministicWorlds) {
     DestructionWorld::Config config = test::journalConfig(1).world;
+    test::JournalRig host(1);
     DestructionWorld world(config);
-    auto outside = net::NetHost::listen(world, config, "192.0.2.1", 0);
+    auto outside = net::NetHost::listen(host.runtime, config, "192.0.2.1", 0);
     ASSERT_FALSE(outside);
     EXPECT_NE(outside.error().message.find("not a loopback address"), std::string::npos);
     EXPECT_FALSE(net::NetClient::connect(world, config, "192.0.2.1", 7777));
     config.deterministic = false;
-    EXPECT_FALSE(net::NetHost::listen(world, config, "127.0.0.1", 0));
+    EXPECT_FALSE(net::NetHost::listen(host.runtime, config, "127.0.0.1", 0));
 }
 
 } // namespace

@@ -56,7 +56,7 @@ struct Follower {
 TEST(NetRelay, ClientsThroughMisbehavingLinksConvergeAfterAPartitionAndAReplacement) {
     test::JournalRig host(1);
     const DestructionWorld::Config config = test::journalConfig(1).world;
-    auto server = net::NetHost::listen(host.runtime.world(), config, "127.0.0.1", 0);
+    auto server = net::NetHost::listen(host.runtime, config, "127.0.0.1", 0);
     ASSERT_TRUE(server) << server.error().message;
     net::NetHost& h = **server;
     h.setPlacementSource([&] { return host.runtime.placements(); });
@@ -168,7 +168,7 @@ TEST(NetRelay, ClientsThroughMisbehavingLinksConvergeAfterAPartitionAndAReplacem
 TEST(NetRelay, AClientNoticesAHostThatStoppedAnsweringAfterItsTimeout) {
     test::JournalRig host(1);
     const DestructionWorld::Config config = test::journalConfig(1).world;
-    auto server = net::NetHost::listen(host.runtime.world(), config, "127.0.0.1", 0);
+    auto server = net::NetHost::listen(host.runtime, config, "127.0.0.1", 0);
     ASSERT_TRUE(server) << server.error().message;
     net::NetHost& h = **server;
     h.publish();
@@ -194,7 +194,7 @@ TEST(NetRelay, AClientNoticesAHostThatStoppedAnsweringAfterItsTimeout) {
 TEST(NetRelay, RogueTrafficNeitherCrashesTheHostNorChangesItsWorld) {
     test::JournalRig host(1), reference(1);
     const DestructionWorld::Config config = test::journalConfig(1).world;
-    auto server = net::NetHost::listen(host.runtime.world(), config, "127.0.0.1", 0);
+    auto server = net::NetHost::listen(host.runtime, config, "127.0.0.1", 0);
     ASSERT_TRUE(server) << server.error().message;
     net::NetHost& h = **server;
     DestructionWorld world(config);

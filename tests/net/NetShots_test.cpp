@@ -18,7 +18,7 @@ namespace {
 TEST(NetShots, TheHostFiresOnlyTheShotsThatPassItsRules) {
     test::JournalRig host(1);
     const DestructionWorld::Config config = test::journalConfig(1).world;
-    auto server = net::NetHost::listen(host.runtime.world(), config, "127.0.0.1", 0);
+    auto server = net::NetHost::listen(host.runtime, config, "127.0.0.1", 0);
     ASSERT_TRUE(server) << server.error().message;
     net::NetHost& h = **server;
     DestructionWorld world(config);
