@@ -1,5 +1,7 @@
 #include "ConvexCellClipper.hpp"
 
+#include "CellComplex.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -21,10 +23,6 @@ struct Degenerate {
 };
 
 constexpr std::uint32_t kNone = 0xFFFFFFFFu;
-
-std::uint64_t pairKey(std::uint32_t a, std::uint32_t b) {
-    return (std::uint64_t(a) << 32) | b;
-}
 
 /// Key of a created point: which mesh edge / triangle and which cell planes or complex edge it lies on.
 struct PointKey {
@@ -56,139 +54,31 @@ struct Corner {
     Support next;
 };
 
-/// The cells as one complex: welded vertices, and faces shared by two cells stored once. A face's plane is
-/// outward for its `back` cell; `front` is the cell on the other side, or the outside region (index K).
-struct CellComplex {
-    struct Face {
-        std::vector<std::uint32_t> loop; // counter-clockwise seen from the back cell's outside
-        Plane plane;
-        std::uint32_t back = 0, front = 0;
-    };
-    struct Cell {
-        std::vector<std::uint32_t> faces; // complex faces
-        std::vector<bool> flipped;        // true where the cell is the face's front
-        std::unordered_map<std::uint64_t, std::uint64_t> edgeOfFaces; // face pair (f<g) -> complex edge (a<b)
-        Aabb box;
-    };
-    std::vector<Vec3> vertices;
-    std::vector<Face> faces;
-    std::vector<Cell> cells;
-};
-
-/// The loop rotated to start at its smallest id (identifies a face whatever corner it starts from).
-std::vector<std::uint32_t> canonicalLoop(std::vector<std::uint32_t> loop) {
-    std::rotate(loop.begin(), std::min_element(loop.begin(), loop.end()), loop.end());
-    return loop;
-}
-
-CellComplex buildComplex(const std::vector<ConvexPolytope>& polytopes, double eps) {
-    CellComplex cx;
-    const auto outside = static_cast<std::uint32_t>(polytopes.size());
-    std::map<std::tuple<double, double, double>, std::uint32_t> index;
-    std::map<std::vector<std::uint32_t>, std::uint32_t> faceByLoop;
-    for (std::uint32_t c = 0; c < polytopes.size(); ++c) {
-        CellComplex::Cell cell;
-        cell.box = polytopes[c].bounds();
-        std::unordered_map<std::uint64_t, std::uint32_t> localFaceOfEdge;
-        std::vector<std::vector<std::uint32_t>> loops;
-        for (const PolytopeFace& f : polytopes[c].faces()) {
-            std::vector<std::uint32_t> loop;
-            for (const Vec3& p : f.corners) {
-                auto [it, inserted] = index.emplace(std::make_tuple(p.x, p.y, p.z),
-                                                    static_cast<std::uint32_t>(cx.vertices.size()));
-                if (inserted)
-                    cx.vertices.push_back(p);
-                if (loop.empty() || loop.back() != it->second)
-                    loop.push_back(it->second);
-            }
-            while (loop.size() > 1 && loop.front() == loop.back())
-                loop.pop_back();
-            if (loop.size() < 3)
-                continue;
-            const auto local = static_cast<std::uint32_t>(loops.size());
-            for (std::size_t i = 0; i < loop.size(); ++i)
-                if (!localFaceOfEdge.emplace(pairKey(loop[i], loop[(i + 1) % loop.size()]), local).second)
-                    throw Degenerate{"cell edge used twice"};
-            // A face another cell already has, reversed, is shared; the same face with the same orientation
-            // means the cells overlap.
-            std::vector<std::uint32_t> key = canonicalLoop(loop);
-            auto shared =
-                faceByLoop.find(canonicalLoop(std::vector<std::uint32_t>(loop.rbegin(), loop.rend())));
-            if (shared != faceByLoop.end() && cx.faces[shared->second].front == outside) {
-                cx.faces[shared->second].front = c;
-                cell.faces.push_back(shared->second);
-                cell.flipped.push_back(true);
-            } else {
-                const auto id = static_cast<std::uint32_t>(cx.faces.size());
-                if (!faceByLoop.emplace(std::move(key), id).second)
-                    throw Degenerate{"cells overlap"};
-                cx.faces.push_back({loop, f.plane, c, outside});
-                cell.faces.push_back(id);
-                cell.flipped.push_back(false);
-            }
-            loops.push_back(std::move(loop));
-        }
-        for (const auto& [key, face] : localFaceOfEdge) {
-            const auto a = static_cast<std::uint32_t>(key >> 32),
-                       b = static_cast<std::uint32_t>(key & 0xFFFFFFFFu);
-            auto twin = localFaceOfEdge.find(pairKey(b, a));
-            if (twin == localFaceOfEdge.end())
-                throw Degenerate{"cell is not closed"};
-            const std::uint32_t f = cell.faces[face], g = cell.faces[twin->second];
-            cell.edgeOfFaces[pairKey(std::min(f, g), std::max(f, g))] =
-                pairKey(std::min(a, b), std::max(a, b));
-        }
-        if (loops.size() < 4)
-            throw Degenerate{"cell has fewer than 4 faces"};
-        cx.cells.push_back(std::move(cell));
-    }
-    // The union's boundary (faces with the outside in front) must close up: every directed edge once and its
-    // reverse once. Faces of neighbouring cells that overlap without being the same face break this.
-    std::unordered_map<std::uint64_t, int> directed;
-    for (const CellComplex::Face& f : cx.faces)
-        if (f.front == outside)
-            for (std::size_t i = 0; i < f.loop.size(); ++i)
-                if (++directed[pairKey(f.loop[i], f.loop[(i + 1) % f.loop.size()])] > 1)
-                    throw Degenerate{"cells do not form a complex"};
-    for (const auto& [key, count] : directed)
-        if (!directed.count(pairKey(static_cast<std::uint32_t>(key & 0xFFFFFFFFu),
-                                    static_cast<std::uint32_t>(key >> 32))))
-            throw Degenerate{"cells do not form a complex"};
-    // Disjoint interiors: no pair of nearby cells overlaps by more than eps.
-    for (std::uint32_t c = 0; c < polytopes.size(); ++c)
-        for (std::uint32_t d = c + 1; d < polytopes.size(); ++d) {
-            if (!cx.cells[c].box.overlaps(cx.cells[d].box, eps))
-                continue;
-            auto separates = [&](std::uint32_t a, std::uint32_t b) {
-                const std::vector<Vec3> others = polytopes[b].vertices();
-                for (const PolytopeFace& f : polytopes[a].faces())
-                    if (std::all_of(others.begin(), others.end(),
-                                    [&](const Vec3& p) { return f.plane.signedDistance(p) >= -eps; }))
-                        return true;
-                return false;
-            };
-            // Face planes separate most pairs; the full separating-axis test (with edge x edge axes) the
-            // rest.
-            if (!separates(c, d) && !separates(d, c) && withinGap(polytopes[c], polytopes[d], -eps))
-                throw Degenerate{"cells overlap"};
-        }
-    return cx;
-}
-
 /// Splits a mesh by a complex of convex cells in one pass: every point is computed once, from the input
 /// mesh and the complex, and shared by every region that uses it.
 class Clipper {
 public:
-    Clipper(const Mesh& mesh, const std::vector<ConvexPolytope>& cells) : mesh_(mesh) {
-        nV_ = static_cast<std::uint32_t>(mesh.positions.size());
-        k_ = static_cast<std::uint32_t>(cells.size());
+    /// The cells' bounds and the clip's tolerance (relative to their size and distance from the origin).
+    struct Scale {
+        Aabb box;
+        double eps = 0;
+    };
+    static Scale scaleOf(const std::vector<ConvexPolytope>& cells) {
+        Scale s;
         for (const ConvexPolytope& c : cells)
-            box_.extend(c.bounds());
+            s.box.extend(c.bounds());
         double maxAbs = 0;
         for (int a = 0; a < 3; ++a)
-            maxAbs = std::max({maxAbs, std::abs(box_.lo[a]), std::abs(box_.hi[a])});
-        eps_ = std::max(1e-10 * box_.diagonal(), 1e-14 * maxAbs);
-        cx_ = buildComplex(cells, eps_);
+            maxAbs = std::max({maxAbs, std::abs(s.box.lo[a]), std::abs(s.box.hi[a])});
+        s.eps = std::max(1e-10 * s.box.diagonal(), 1e-14 * maxAbs);
+        return s;
+    }
+
+    /// A clipper of mesh by the complex of cells built at scale (buildCellComplex(cells, scale.eps)).
+    Clipper(const Mesh& mesh, const Scale& scale, CellComplex cx)
+        : mesh_(mesh), cx_(std::move(cx)), box_(scale.box), eps_(scale.eps) {
+        nV_ = static_cast<std::uint32_t>(mesh.positions.size());
+        k_ = static_cast<std::uint32_t>(cx_.cells.size());
         nF_ = static_cast<std::uint32_t>(cx_.faces.size());
         cutEdges_.resize(nF_);
         untouched_.resize(k_ + 1);
@@ -221,9 +111,9 @@ public:
 private:
     const Mesh& mesh_;
     CellComplex cx_;
-    std::uint32_t nV_ = 0, k_ = 0, nF_ = 0;
     Aabb box_;
     double eps_ = 0;
+    std::uint32_t nV_ = 0, k_ = 0, nF_ = 0;
 
     std::vector<Vec3> extra_;   // created points, ids nV_ + i
     std::vector<bool> offEdge_; // per created point: kind 4 (may not end up in an output)
@@ -939,7 +829,11 @@ auto guardedClip(const std::vector<ConvexPolytope>& cells, F f) -> decltype(f())
 Result<MultiCellEdit> clipByConvexCellsAsEdit(const Mesh& mesh, const std::vector<ConvexPolytope>& cells,
                                               const VolumeIntegrals& meshIntegrals) {
     return guardedClip(cells, [&]() -> Result<MultiCellEdit> {
-        Clipper clipper(mesh, cells);
+        const Clipper::Scale scale = Clipper::scaleOf(cells);
+        Result<CellComplex> cx = buildCellComplex(cells, scale.eps);
+        if (!cx)
+            return cx.error();
+        Clipper clipper(mesh, scale, std::move(*cx));
         MultiCellEdit out;
         std::optional<VolumeIntegrals> rest;
         std::vector<Mesh> regions = clipper.run(&meshIntegrals, rest, &out.outside);
@@ -955,7 +849,11 @@ Result<MultiCellEdit> clipByConvexCellsAsEdit(const Mesh& mesh, const std::vecto
 Result<MultiCellSplit> clipByConvexCells(const Mesh& mesh, const std::vector<ConvexPolytope>& cells,
                                          const VolumeIntegrals* meshIntegrals) {
     return guardedClip(cells, [&]() -> Result<MultiCellSplit> {
-        Clipper clipper(mesh, cells);
+        const Clipper::Scale scale = Clipper::scaleOf(cells);
+        Result<CellComplex> cx = buildCellComplex(cells, scale.eps);
+        if (!cx)
+            return cx.error();
+        Clipper clipper(mesh, scale, std::move(*cx));
         MultiCellSplit out;
         std::vector<Mesh> regions = clipper.run(meshIntegrals, out.outsideIntegrals);
         out.outside = std::move(regions.back());
