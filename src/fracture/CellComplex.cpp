@@ -7,11 +7,11 @@
 
 namespace rubble::detail {
 
-namespace {
-
-Error declined(const char* why) {
+Error clipDeclined(const char* why) {
     return Error{ErrorCode::GeometryFailure, std::string("fast clip declined: ") + why};
 }
+
+namespace {
 
 /// The loop rotated to start at its smallest id (identifies a face whatever corner it starts from).
 std::vector<std::uint32_t> canonicalLoop(std::vector<std::uint32_t> loop) {
@@ -48,7 +48,7 @@ Result<CellComplex> buildCellComplex(const std::vector<ConvexPolytope>& polytope
             const auto local = static_cast<std::uint32_t>(loops.size());
             for (std::size_t i = 0; i < loop.size(); ++i)
                 if (!localFaceOfEdge.emplace(pairKey(loop[i], loop[(i + 1) % loop.size()]), local).second)
-                    return declined("cell edge used twice");
+                    return clipDeclined("cell edge used twice");
             // A face another cell already has, reversed, is shared; the same face with the same orientation
             // means the cells overlap.
             std::vector<std::uint32_t> key = canonicalLoop(loop);
@@ -61,7 +61,7 @@ Result<CellComplex> buildCellComplex(const std::vector<ConvexPolytope>& polytope
             } else {
                 const auto id = static_cast<std::uint32_t>(cx.faces.size());
                 if (!faceByLoop.emplace(std::move(key), id).second)
-                    return declined("cells overlap");
+                    return clipDeclined("cells overlap");
                 cx.faces.push_back({loop, f.plane, c, outside});
                 cell.faces.push_back(id);
                 cell.flipped.push_back(false);
@@ -73,13 +73,13 @@ Result<CellComplex> buildCellComplex(const std::vector<ConvexPolytope>& polytope
                        b = static_cast<std::uint32_t>(key & 0xFFFFFFFFu);
             auto twin = localFaceOfEdge.find(pairKey(b, a));
             if (twin == localFaceOfEdge.end())
-                return declined("cell is not closed");
+                return clipDeclined("cell is not closed");
             const std::uint32_t f = cell.faces[face], g = cell.faces[twin->second];
             cell.edgeOfFaces[pairKey(std::min(f, g), std::max(f, g))] =
                 pairKey(std::min(a, b), std::max(a, b));
         }
         if (loops.size() < 4)
-            return declined("cell has fewer than 4 faces");
+            return clipDeclined("cell has fewer than 4 faces");
         cx.cells.push_back(std::move(cell));
     }
     // The union's boundary (faces with the outside in front) must close up: every directed edge once and its
@@ -89,11 +89,11 @@ Result<CellComplex> buildCellComplex(const std::vector<ConvexPolytope>& polytope
         if (f.front == outside)
             for (std::size_t i = 0; i < f.loop.size(); ++i)
                 if (++directed[pairKey(f.loop[i], f.loop[(i + 1) % f.loop.size()])] > 1)
-                    return declined("cells do not form a complex");
+                    return clipDeclined("cells do not form a complex");
     for (const auto& [key, count] : directed)
         if (!directed.count(pairKey(static_cast<std::uint32_t>(key & 0xFFFFFFFFu),
                                     static_cast<std::uint32_t>(key >> 32))))
-            return declined("cells do not form a complex");
+            return clipDeclined("cells do not form a complex");
     // Disjoint interiors: no pair of nearby cells overlaps by more than eps.
     for (std::uint32_t c = 0; c < polytopes.size(); ++c)
         for (std::uint32_t d = c + 1; d < polytopes.size(); ++d) {
@@ -110,7 +110,7 @@ Result<CellComplex> buildCellComplex(const std::vector<ConvexPolytope>& polytope
             // Face planes separate most pairs; the full separating-axis test (with edge x edge axes) the
             // rest.
             if (!separates(c, d) && !separates(d, c) && withinGap(polytopes[c], polytopes[d], -eps))
-                return declined("cells overlap");
+                return clipDeclined("cells overlap");
         }
     return cx;
 }

@@ -35,6 +35,10 @@ struct CellComplex {
     std::vector<Cell> cells;
 };
 
+/// The error of a fast clip that leaves a configuration to an exact backend: GeometryFailure, "fast clip
+/// declined: " and why.
+Error clipDeclined(const char* why);
+
 /// The cells (non-empty, convex) as a complex; eps is the overlap tolerance between cells. GeometryFailure
 /// ("fast clip declined: ...") when a cell is not closed or has fewer than 4 faces, cells overlap, or their
 /// union's boundary does not close up: configurations the fast clipper leaves to an exact backend.

@@ -17,11 +17,6 @@ namespace rubble::detail {
 
 namespace {
 
-/// Internal signal: this configuration is not handled robustly here; the caller uses an exact backend.
-struct Degenerate {
-    const char* why;
-};
-
 constexpr std::uint32_t kNone = 0xFFFFFFFFu;
 
 /// Key of a created point: which mesh edge / triangle and which cell planes or complex edge it lies on.
@@ -103,14 +98,24 @@ public:
     /// rest's integrals by difference.
     /// With edit (and known), the rest is not assembled but returned as an edit of the mesh (the last
     /// region of the result is then empty).
-    std::vector<Mesh> run(const VolumeIntegrals* known, std::optional<VolumeIntegrals>& restIntegrals,
-                          RemainderEdit* edit = nullptr);
+    /// GeometryFailure ("fast clip declined: ...") for a configuration it does not handle robustly.
+    Result<std::vector<Mesh>> run(const VolumeIntegrals* known, std::optional<VolumeIntegrals>& restIntegrals,
+                                  RemainderEdit* edit = nullptr);
     /// After run: the triangles region r kept whole (assemble puts them first).
     std::size_t keptWhole(std::uint32_t r) const { return untouched_[r].size(); }
 
 private:
     const Mesh& mesh_;
     CellComplex cx_;
+    const char* declined_ =
+        nullptr; // why run declines, once a stage found a configuration it does not handle
+
+    /// Records why the clip declines (the first reason); kNone for a stage that returns a point.
+    std::uint32_t decline(const char* why) {
+        if (!declined_)
+            declined_ = why;
+        return kNone;
+    }
     Aabb box_;
     double eps_ = 0;
     std::uint32_t nV_ = 0, k_ = 0, nF_ = 0;
@@ -203,7 +208,7 @@ std::uint32_t Clipper::crossing(std::uint32_t tri, std::uint32_t cell, const Sup
         // cells of a shared face: the ratio does not depend on the sign).
         const double da = dist(s.a, face), db = dist(s.b, face);
         if (!((da < 0 && db > 0) || (da > 0 && db < 0)))
-            throw Degenerate{"edge crossing without sign change"};
+            return decline("edge crossing without sign change");
         const Vec3& pa = mesh_.positions[s.a];
         const Vec3& pb = mesh_.positions[s.b];
         return addPoint(key, pa + (pb - pa) * (da / (da - db)));
@@ -228,10 +233,10 @@ std::uint32_t Clipper::crossing(std::uint32_t tri, std::uint32_t cell, const Sup
     const Vec3 &pa = cx_.vertices[a], &pb = cx_.vertices[b];
     const double da = dot(n, pa - c[0]), db = dot(n, pb - c[0]);
     if (!(std::abs(da - db) > 1e-9 * length(n) * length(pb - pa)))
-        throw Degenerate{"triangle parallel to a cell edge"};
+        return decline("triangle parallel to a cell edge");
     const Vec3 x = pa + (pb - pa) * (da / (da - db));
     if (length(x - along) > 10 * eps_)
-        throw Degenerate{"ill-conditioned cell edge crossing"};
+        return decline("ill-conditioned cell edge crossing");
     return addPoint(key, x);
 }
 
@@ -253,7 +258,8 @@ std::vector<Corner> Clipper::clipTriangle(std::uint32_t t, std::uint32_t cell) {
         for (std::size_t c = 0; c < poly.size(); ++c) {
             d[c] = cellDist(poly[c].id, cell, l);
             if (std::abs(d[c]) <= eps_) {
-                throw Degenerate{"point on a cell plane"};
+                decline("point on a cell plane");
+                return {};
             }
             anyOut |= d[c] > 0;
             anyIn |= d[c] < 0;
@@ -275,11 +281,15 @@ std::vector<Corner> Clipper::clipTriangle(std::uint32_t t, std::uint32_t cell) {
                 if (!nxtIn) {
                     const std::uint32_t x =
                         crossing(t, cell, cur.next, faces[l], cur.id, nxt.id, d[c], d[(c + 1) % n]);
+                    if (declined_)
+                        return {};
                     next.push_back({x, {false, faces[l], 0}});
                 }
             } else if (nxtIn) {
                 const std::uint32_t y =
                     crossing(t, cell, cur.next, faces[l], cur.id, nxt.id, d[c], d[(c + 1) % n]);
+                if (declined_)
+                    return {};
                 next.push_back({y, cur.next});
             }
         }
@@ -307,8 +317,10 @@ void Clipper::emitConvex(const std::vector<std::uint32_t>& polyIn, const Vec3& n
                 ear = c;
                 break;
             }
-        if (ear == poly.size())
-            throw Degenerate{"flat polygon"};
+        if (ear == poly.size()) {
+            decline("flat polygon");
+            return;
+        }
         const std::size_t n = poly.size();
         out.push_back({{poly[(ear + n - 1) % n], poly[ear], poly[(ear + 1) % n]}, source, kNone, false});
         poly.erase(poly.begin() + static_cast<std::ptrdiff_t>(ear));
@@ -330,8 +342,10 @@ void Clipper::triangulateRegion(const std::vector<std::pair<std::uint32_t, std::
         region.push_back({edges[e].first, edges[e].second, e < boundaryEdges ? 1u : 2u});
     std::vector<std::array<std::uint32_t, 3>> tris;
     if (const char* why = triangulatePlanarRegion(
-            region, normal, [&](std::uint32_t id) { return pos(id); }, tris))
-        throw Degenerate{why};
+            region, normal, [&](std::uint32_t id) { return pos(id); }, tris)) {
+        decline(why);
+        return;
+    }
     for (const auto& t : tris)
         out.push_back({{t[0], t[1], t[2]}, source, face, false});
 }
@@ -342,13 +356,17 @@ void Clipper::cutTriangle(std::uint32_t t, const std::vector<std::uint32_t>& cel
     std::uint32_t wholeIn = kNone;
     for (std::uint32_t c : cells) {
         std::vector<Corner> poly = clipTriangle(t, c);
+        if (declined_)
+            return;
         if (poly.empty())
             continue;
         bool created = false;
         for (const Corner& k : poly) {
             created |= k.id >= nV_;
-            if (k.id >= nV_ && offEdge_[k.id - nV_])
-                throw Degenerate{"triangle through a cell vertex"};
+            if (k.id >= nV_ && offEdge_[k.id - nV_]) {
+                decline("triangle through a cell vertex");
+                return;
+            }
         }
         if (created)
             polys.emplace_back(c, std::move(poly));
@@ -356,8 +374,10 @@ void Clipper::cutTriangle(std::uint32_t t, const std::vector<std::uint32_t>& cel
             wholeIn = c;
     }
     if (wholeIn != kNone) {
-        if (!polys.empty())
-            throw Degenerate{"triangle inside a cell and cut by another"};
+        if (!polys.empty()) {
+            decline("triangle inside a cell and cut by another");
+            return;
+        }
         untouched_[wholeIn].push_back(t);
         return;
     }
@@ -375,6 +395,8 @@ void Clipper::cutTriangle(std::uint32_t t, const std::vector<std::uint32_t>& cel
         for (const Corner& k : poly)
             ids.push_back(k.id);
         emitConvex(ids, normal, t, tris_[cell]);
+        if (declined_)
+            return;
         for (std::size_t c = 0; c < poly.size(); ++c) {
             const Corner& cur = poly[c];
             const Corner& nxt = poly[(c + 1) % poly.size()];
@@ -456,9 +478,12 @@ void Clipper::buildCaps() {
     const std::size_t nCellVerts = cx_.vertices.size();
     std::vector<int> vertexInside(nCellVerts, -1);
     auto setStatus = [&](std::uint32_t v, int s) {
-        if (vertexInside[v] >= 0 && vertexInside[v] != s)
-            throw Degenerate{"inconsistent cell vertex status"};
+        if (vertexInside[v] >= 0 && vertexInside[v] != s) {
+            decline("inconsistent cell vertex status");
+            return false;
+        }
         vertexInside[v] = s;
+        return true;
     };
     // Per directed edge of face f: sorted pierce points and the inside status of each sub-edge.
     struct EdgeSplit {
@@ -481,20 +506,22 @@ void Clipper::buildCaps() {
             s.inside.assign(s.points.size() + 1, -1);
             for (std::size_t q = 0; q < s.points.size(); ++q) {
                 auto it = leaves[f].find(s.points[q]);
-                if (it == leaves[f].end())
-                    throw Degenerate{"pierce point without cut edge"};
+                if (it == leaves[f].end()) {
+                    decline("pierce point without cut edge");
+                    return;
+                }
                 const int before =
                     it->second ? 1 : 0; // cap edge leaves the point: the sub-edge before is inside
                 for (auto [slot, value] : {std::pair{q, before}, std::pair{q + 1, 1 - before}}) {
-                    if (s.inside[slot] >= 0 && s.inside[slot] != value)
-                        throw Degenerate{"inconsistent cut along a cell edge"};
+                    if (s.inside[slot] >= 0 && s.inside[slot] != value) {
+                        decline("inconsistent cut along a cell edge");
+                        return;
+                    }
                     s.inside[slot] = value;
                 }
             }
-            if (!s.points.empty()) {
-                setStatus(A, s.inside.front());
-                setStatus(B, s.inside.back());
-            }
+            if (!s.points.empty() && (!setStatus(A, s.inside.front()) || !setStatus(B, s.inside.back())))
+                return;
         }
     }
     // Propagate vertex status along unpierced complex edges; with no information at all, cast a ray.
@@ -514,7 +541,8 @@ void Clipper::buildCaps() {
                     vertexInside[A] = vertexInside[B];
                     changed = true;
                 } else if (vertexInside[A] >= 0 && vertexInside[A] != vertexInside[B]) {
-                    throw Degenerate{"inconsistent unpierced cell edge"};
+                    decline("inconsistent unpierced cell edge");
+                    return;
                 }
             }
         }
@@ -553,6 +581,8 @@ void Clipper::buildCaps() {
             continue;
         caps.clear();
         triangulateRegion(edges, edges.size(), cx_.faces[f].plane.normal, kNone, f, caps);
+        if (declined_)
+            return;
         for (const OutTri& c : caps) {
             tris_[cx_.faces[f].back].push_back(c);
             tris_[cx_.faces[f].front].push_back({{c.v[0], c.v[2], c.v[1]}, kNone, f, true});
@@ -658,25 +688,26 @@ RemainderEdit Clipper::assembleEdit(std::vector<std::uint32_t> removed) const {
     return e;
 }
 
-// Every directed edge of the new triangles that touches a created point has its twin among them.
-void checkNewEdgesClosed(const std::vector<std::array<std::uint32_t, 3>>& tris, std::uint32_t firstCreated) {
+// Every directed edge of the new triangles that touches a created point has its twin among them: null, or
+// why not.
+const char* openNewEdges(const std::vector<std::array<std::uint32_t, 3>>& tris, std::uint32_t firstCreated) {
     std::unordered_set<std::uint64_t> directed;
     directed.reserve(tris.size() * 3);
     for (const auto& t : tris)
         for (int c = 0; c < 3; ++c)
-            if (!directed.insert(pairKey(t[c], t[(c + 1) % 3])).second) {
-                throw Degenerate{"edge used twice in one direction"};
-            }
+            if (!directed.insert(pairKey(t[c], t[(c + 1) % 3])).second)
+                return "edge used twice in one direction";
     for (const auto& t : tris)
         for (int c = 0; c < 3; ++c) {
             const std::uint32_t a = t[c], b = t[(c + 1) % 3];
             if ((a >= firstCreated || b >= firstCreated) && !directed.count(pairKey(b, a)))
-                throw Degenerate{"open edge at the cut"};
+                return "open edge at the cut";
         }
+    return nullptr;
 }
 
-std::vector<Mesh> Clipper::run(const VolumeIntegrals* known, std::optional<VolumeIntegrals>& restIntegrals,
-                               RemainderEdit* edit) {
+Result<std::vector<Mesh>> Clipper::run(const VolumeIntegrals* known,
+                                       std::optional<VolumeIntegrals>& restIntegrals, RemainderEdit* edit) {
     const std::size_t nT = mesh_.triangles.size();
     // Per vertex, the sides of the cells' box (with eps) it lies beyond, 2 bits per axis: a triangle misses
     // the box exactly when its three corners share a bit.
@@ -738,9 +769,14 @@ std::vector<Mesh> Clipper::run(const VolumeIntegrals* known, std::optional<Volum
     std::vector<std::size_t> scanned; // per region, the triangles the scan kept whole
     for (const auto& kept : untouched_)
         scanned.push_back(kept.size());
-    for (const auto& [t, cells] : cut)
+    for (const auto& [t, cells] : cut) {
         cutTriangle(t, cells);
+        if (declined_)
+            return clipDeclined(declined_);
+    }
     buildCaps();
+    if (declined_)
+        return clipDeclined(declined_);
 
     std::vector<Mesh> result;
     for (std::uint32_t r = 0; r < k_; ++r)
@@ -777,18 +813,19 @@ std::vector<Mesh> Clipper::run(const VolumeIntegrals* known, std::optional<Volum
         created.reserve(tris_[r].size());
         for (const OutTri& o : tris_[r])
             created.push_back({o.v[0], o.v[1], o.v[2]});
-        checkNewEdgesClosed(created, nV_);
+        if (const char* why = openNewEdges(created, nV_))
+            return clipDeclined(why);
         const bool empty = r == k_ && edit ? lost.size() == nT && tris_[k_].empty() : result[r].empty();
         const double v = empty                        ? 0.0
                          : (r == k_ && restIntegrals) ? restIntegrals->volume
                                                       : signedVolume(result[r]);
         if (v < 0)
-            throw Degenerate{"negative volume"};
+            return clipDeclined("negative volume");
         sum += v;
     }
     const double v0 = known ? known->volume : signedVolume(mesh_);
     if (std::abs(sum - v0) > 1e-9 * std::abs(v0))
-        throw Degenerate{"volume not conserved"};
+        return clipDeclined("volume not conserved");
     if (edit) {
         std::sort(lost.begin(), lost.end());
         *edit = assembleEdit(std::move(lost));
@@ -809,7 +846,7 @@ Result<CellSplit> clipByConvexCell(const Mesh& mesh, const ConvexPolytope& cell)
 
 namespace {
 
-/// f() with the clipper's declines and failures as GeometryFailure errors; empty cells are InvalidInput.
+/// f() with a failure (e.g. out of memory) as a GeometryFailure error; empty cells are InvalidInput.
 template <class F>
 auto guardedClip(const std::vector<ConvexPolytope>& cells, F f) -> decltype(f()) {
     if (cells.empty() ||
@@ -817,8 +854,6 @@ auto guardedClip(const std::vector<ConvexPolytope>& cells, F f) -> decltype(f())
         return makeError(ErrorCode::InvalidInput, "no cells, or an empty cell");
     try {
         return f();
-    } catch (const Degenerate& d) {
-        return makeError(ErrorCode::GeometryFailure, std::string("fast clip declined: ") + d.why);
     } catch (const std::exception& e) {
         return makeError(ErrorCode::GeometryFailure, std::string("fast clip failed: ") + e.what());
     }
@@ -836,7 +871,10 @@ Result<MultiCellEdit> clipByConvexCellsAsEdit(const Mesh& mesh, const std::vecto
         Clipper clipper(mesh, scale, std::move(*cx));
         MultiCellEdit out;
         std::optional<VolumeIntegrals> rest;
-        std::vector<Mesh> regions = clipper.run(&meshIntegrals, rest, &out.outside);
+        Result<std::vector<Mesh>> run = clipper.run(&meshIntegrals, rest, &out.outside);
+        if (!run)
+            return run.error();
+        std::vector<Mesh>& regions = *run;
         regions.pop_back();
         out.inside = std::move(regions);
         for (std::uint32_t r = 0; r < out.inside.size(); ++r)
@@ -855,7 +893,10 @@ Result<MultiCellSplit> clipByConvexCells(const Mesh& mesh, const std::vector<Con
             return cx.error();
         Clipper clipper(mesh, scale, std::move(*cx));
         MultiCellSplit out;
-        std::vector<Mesh> regions = clipper.run(meshIntegrals, out.outsideIntegrals);
+        Result<std::vector<Mesh>> run = clipper.run(meshIntegrals, out.outsideIntegrals);
+        if (!run)
+            return run.error();
+        std::vector<Mesh>& regions = *run;
         out.outside = std::move(regions.back());
         regions.pop_back();
         out.inside = std::move(regions);

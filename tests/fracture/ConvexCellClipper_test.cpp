@@ -334,6 +334,22 @@ TEST(ConvexCellClipper, CellsThatAreNotAComplexAreDeclined) {
     EXPECT_FALSE(detail::clipByConvexCells(sphere, {}).isOk());
 }
 
+// A cell plane through mesh vertices is declined by the triangle clip with its reason (returned, not thrown),
+// and the next clip on the same thread starts clean.
+TEST(ConvexCellClipper, ACellPlaneThroughMeshVerticesIsDeclinedAndTheNextClipWorks) {
+    const Mesh box = makeBox({-1, -1, -1}, {1, 1, 1});
+    const auto declined = detail::clipByConvexCell(box, ConvexPolytope::fromAabb({{1, -2, -2}, {3, 2, 2}}));
+    ASSERT_FALSE(declined);
+    EXPECT_EQ(declined.error().code, ErrorCode::GeometryFailure);
+    EXPECT_EQ(declined.error().message, "fast clip declined: point on a cell plane");
+    const auto cut = detail::clipByConvexCell(box, ConvexPolytope::fromAabb({{0.5, -2, -2}, {3, 2, 2}}));
+    ASSERT_TRUE(cut) << cut.error().message;
+    EXPECT_TRUE(closedAndOriented(cut->inside));
+    EXPECT_TRUE(closedAndOriented(cut->outside));
+    EXPECT_NEAR(signedVolume(cut->inside), 2.0, 1e-9);
+    EXPECT_NEAR(signedVolume(cut->outside), 6.0, 1e-9);
+}
+
 // The complex stage alone: two boxes sharing a face weld into 12 vertices and 11 faces, the shared one stored
 // once with each box on one side; overlapping boxes are declined with the reason, not thrown.
 TEST(ConvexCellClipper, TheComplexStoresASharedFaceOnceAndDeclinesOverlapsAsAnError) {
