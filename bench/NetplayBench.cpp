@@ -253,7 +253,7 @@ int runHost(const Args& a) {
     DestructionRuntime runtime(binding, rc);
     if (!loadObjects(a.file, runtime))
         return 2;
-    auto server = net::NetHost::listen(runtime.world(), rc.world, "127.0.0.1", 0, a.clients);
+    auto server = net::NetHost::listen(runtime, rc.world, "127.0.0.1", 0, a.clients);
     if (!server) {
         std::cerr << "rubble-bench netplay: " << server.error().message << "\n";
         return 1;

@@ -208,7 +208,7 @@ int runScene(const SceneArgs& a, SceneSummary* summary = nullptr) {
     PhysicsWorld physics;
     BulletBinding binding(physics);
     DestructionRuntime runtime(binding, rc);
-    DestructionWorld& destruction = runtime.world();
+    const DestructionWorld& destruction = runtime.world();
     SceneLoadOptions lo;
     lo.loadVehicle = false;
     lo.materialRoughness = a.materialRoughness;

@@ -157,7 +157,7 @@ bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const Game
     runtime_ = std::make_unique<rubble::DestructionRuntime>(*binding_, rc);
     worldConfig_ = rc.world;
     journal_.clear();
-    runtime_->world().setJournalSink([this](const rubble::JournalEvent& e) { journaled(e); });
+    runtime_->setJournalSink([this](const rubble::JournalEvent& e) { journaled(e); });
     runtime_->setOnRemoved([this, &renderer](const BodyRecord& b) {
         if (auto shell = shells_.find(b.id); shell != shells_.end()) { // a shell's hit is known when it goes
             if (b.spent)
@@ -870,7 +870,13 @@ bool Game::replayJournal(const std::string& path, std::uint64_t& hash, std::stri
         message = s.message() + " (replay with the recording's options, e.g. --deterministic)";
         return false;
     }
-    rubble::JournalPlayer player(runtime_->world());
+    // The replay runs on a copy of the loaded world: the runtime's own changes only as the game plays.
+    rubble::DestructionWorld replayed(worldConfig_);
+    if (rubble::Status s = replayed.loadState(runtime_->world().saveState()); !s) {
+        message = s.message();
+        return false;
+    }
+    rubble::JournalPlayer player(replayed);
     for (const rubble::JournalEvent& e : journal->events)
         if (rubble::Status s = player.receive(e); !s) {
             message = s.message();
@@ -880,7 +886,7 @@ bool Game::replayJournal(const std::string& path, std::uint64_t& hash, std::stri
         message = s.message();
         return false;
     }
-    hash = runtime_->world().geometryHash();
+    hash = replayed.geometryHash();
     message = std::to_string(journal->events.size()) + " events";
     return true;
 }
@@ -890,7 +896,7 @@ bool Game::host(std::uint16_t port, std::string& message) {
         message = "no scene loaded";
         return false;
     }
-    auto server = rubble::net::NetHost::listen(runtime_->world(), worldConfig_, "127.0.0.1", port);
+    auto server = rubble::net::NetHost::listen(*runtime_, worldConfig_, "127.0.0.1", port);
     if (!server) {
         message = server.error().message;
         return false;
@@ -898,7 +904,7 @@ bool Game::host(std::uint16_t port, std::string& message) {
     net_ = std::move(*server);
     net_->setPlacementSource([this] { return runtime_->placements(); });
     // One journal sink: the recording and the clients both get every event.
-    runtime_->world().setJournalSink([this](const rubble::JournalEvent& e) { journaled(e); });
+    runtime_->setJournalSink([this](const rubble::JournalEvent& e) { journaled(e); });
     message = "127.0.0.1:" + std::to_string(net_->port());
     return true;
 }

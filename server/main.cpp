@@ -79,8 +79,8 @@ int main(int argc, char** argv) {
     const LoadedScene loaded = loadScene(*scene, runtime, lo);
     for (const std::string& w : loaded.warnings)
         std::cerr << "rubble-server: " << w << "\n";
-    auto server = net::NetHost::listen(runtime.world(), rc.world, "127.0.0.1",
-                                       static_cast<std::uint16_t>(port), clients);
+    auto server =
+        net::NetHost::listen(runtime, rc.world, "127.0.0.1", static_cast<std::uint16_t>(port), clients);
     if (!server) {
         std::cerr << "rubble-server: " << server.error().message << "\n";
         return 1;

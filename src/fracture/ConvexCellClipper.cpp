@@ -1,792 +1,13 @@
 #include "ConvexCellClipper.hpp"
 
-#include <algorithm>
-#include <cmath>
-#include <map>
-#include <ranges>
-#include <unordered_map>
-#include <unordered_set>
-
-#include "geometry/PlanarTriangulation.hpp"
-#include "geometry/RayParity.hpp"
-#include "rubble/geometry/MassProperties.hpp"
+#include "Clipper.hpp"
 
 namespace rubble::detail {
 
-namespace {
+namespace clip {
 
-/// Internal signal: this configuration is not handled robustly here; the caller uses an exact backend.
-struct Degenerate {
-    const char* why;
-};
-
-constexpr std::uint32_t kNone = 0xFFFFFFFFu;
-
-std::uint64_t pairKey(std::uint32_t a, std::uint32_t b) {
-    return (std::uint64_t(a) << 32) | b;
-}
-
-/// Key of a created point: which mesh edge / triangle and which cell planes or complex edge it lies on.
-struct PointKey {
-    // 1: mesh edge (a<b) ∩ face c; 2: triangle a ∩ complex edge (b<c); 3: complex vertex a;
-    // 4: triangle a ∩ faces b<c that share no edge (never a corner of an output)
-    std::uint32_t kind;
-    std::uint32_t a, b, c;
-    bool operator==(const PointKey&) const = default;
-};
-struct PointKeyHash {
-    std::size_t operator()(const PointKey& k) const {
-        std::uint64_t h = k.kind * 0x9E3779B97F4A7C15ull;
-        h ^= (std::uint64_t(k.a) + 0x632BE59BD9B4E019ull) * 0xBF58476D1CE4E5B9ull;
-        h = (h << 17) | (h >> 47);
-        h ^= (std::uint64_t(k.b) << 32 | k.c) * 0x94D049BB133111EBull;
-        return static_cast<std::size_t>(h ^ (h >> 29));
-    }
-};
-
-/// What an edge of a clipped polygon lies on.
-struct Support {
-    bool onMeshEdge; // true: the mesh edge (a,b) with a<b; false: the cut line of complex face a
-    std::uint32_t a, b;
-};
-
-/// A polygon corner and the support of the edge to the next corner.
-struct Corner {
-    std::uint32_t id;
-    Support next;
-};
-
-/// The cells as one complex: welded vertices, and faces shared by two cells stored once. A face's plane is
-/// outward for its `back` cell; `front` is the cell on the other side, or the outside region (index K).
-struct CellComplex {
-    struct Face {
-        std::vector<std::uint32_t> loop; // counter-clockwise seen from the back cell's outside
-        Plane plane;
-        std::uint32_t back = 0, front = 0;
-    };
-    struct Cell {
-        std::vector<std::uint32_t> faces; // complex faces
-        std::vector<bool> flipped;        // true where the cell is the face's front
-        std::unordered_map<std::uint64_t, std::uint64_t> edgeOfFaces; // face pair (f<g) -> complex edge (a<b)
-        Aabb box;
-    };
-    std::vector<Vec3> vertices;
-    std::vector<Face> faces;
-    std::vector<Cell> cells;
-};
-
-/// The loop rotated to start at its smallest id (identifies a face whatever corner it starts from).
-std::vector<std::uint32_t> canonicalLoop(std::vector<std::uint32_t> loop) {
-    std::rotate(loop.begin(), std::min_element(loop.begin(), loop.end()), loop.end());
-    return loop;
-}
-
-CellComplex buildComplex(const std::vector<ConvexPolytope>& polytopes, double eps) {
-    CellComplex cx;
-    const auto outside = static_cast<std::uint32_t>(polytopes.size());
-    std::map<std::tuple<double, double, double>, std::uint32_t> index;
-    std::map<std::vector<std::uint32_t>, std::uint32_t> faceByLoop;
-    for (std::uint32_t c = 0; c < polytopes.size(); ++c) {
-        CellComplex::Cell cell;
-        cell.box = polytopes[c].bounds();
-        std::unordered_map<std::uint64_t, std::uint32_t> localFaceOfEdge;
-        std::vector<std::vector<std::uint32_t>> loops;
-        for (const PolytopeFace& f : polytopes[c].faces()) {
-            std::vector<std::uint32_t> loop;
-            for (const Vec3& p : f.corners) {
-                auto [it, inserted] = index.emplace(std::make_tuple(p.x, p.y, p.z),
-                                                    static_cast<std::uint32_t>(cx.vertices.size()));
-                if (inserted)
-                    cx.vertices.push_back(p);
-                if (loop.empty() || loop.back() != it->second)
-                    loop.push_back(it->second);
-            }
-            while (loop.size() > 1 && loop.front() == loop.back())
-                loop.pop_back();
-            if (loop.size() < 3)
-                continue;
-            const auto local = static_cast<std::uint32_t>(loops.size());
-            for (std::size_t i = 0; i < loop.size(); ++i)
-                if (!localFaceOfEdge.emplace(pairKey(loop[i], loop[(i + 1) % loop.size()]), local).second)
-                    throw Degenerate{"cell edge used twice"};
-            // A face another cell already has, reversed, is shared; the same face with the same orientation
-            // means the cells overlap.
-            std::vector<std::uint32_t> key = canonicalLoop(loop);
-            auto shared =
-                faceByLoop.find(canonicalLoop(std::vector<std::uint32_t>(loop.rbegin(), loop.rend())));
-            if (shared != faceByLoop.end() && cx.faces[shared->second].front == outside) {
-                cx.faces[shared->second].front = c;
-                cell.faces.push_back(shared->second);
-                cell.flipped.push_back(true);
-            } else {
-                const auto id = static_cast<std::uint32_t>(cx.faces.size());
-                if (!faceByLoop.emplace(std::move(key), id).second)
-                    throw Degenerate{"cells overlap"};
-                cx.faces.push_back({loop, f.plane, c, outside});
-                cell.faces.push_back(id);
-                cell.flipped.push_back(false);
-            }
-            loops.push_back(std::move(loop));
-        }
-        for (const auto& [key, face] : localFaceOfEdge) {
-            const auto a = static_cast<std::uint32_t>(key >> 32),
-                       b = static_cast<std::uint32_t>(key & 0xFFFFFFFFu);
-            auto twin = localFaceOfEdge.find(pairKey(b, a));
-            if (twin == localFaceOfEdge.end())
-                throw Degenerate{"cell is not closed"};
-            const std::uint32_t f = cell.faces[face], g = cell.faces[twin->second];
-            cell.edgeOfFaces[pairKey(std::min(f, g), std::max(f, g))] =
-                pairKey(std::min(a, b), std::max(a, b));
-        }
-        if (loops.size() < 4)
-            throw Degenerate{"cell has fewer than 4 faces"};
-        cx.cells.push_back(std::move(cell));
-    }
-    // The union's boundary (faces with the outside in front) must close up: every directed edge once and its
-    // reverse once. Faces of neighbouring cells that overlap without being the same face break this.
-    std::unordered_map<std::uint64_t, int> directed;
-    for (const CellComplex::Face& f : cx.faces)
-        if (f.front == outside)
-            for (std::size_t i = 0; i < f.loop.size(); ++i)
-                if (++directed[pairKey(f.loop[i], f.loop[(i + 1) % f.loop.size()])] > 1)
-                    throw Degenerate{"cells do not form a complex"};
-    for (const auto& [key, count] : directed)
-        if (!directed.count(pairKey(static_cast<std::uint32_t>(key & 0xFFFFFFFFu),
-                                    static_cast<std::uint32_t>(key >> 32))))
-            throw Degenerate{"cells do not form a complex"};
-    // Disjoint interiors: no pair of nearby cells overlaps by more than eps.
-    for (std::uint32_t c = 0; c < polytopes.size(); ++c)
-        for (std::uint32_t d = c + 1; d < polytopes.size(); ++d) {
-            if (!cx.cells[c].box.overlaps(cx.cells[d].box, eps))
-                continue;
-            auto separates = [&](std::uint32_t a, std::uint32_t b) {
-                const std::vector<Vec3> others = polytopes[b].vertices();
-                for (const PolytopeFace& f : polytopes[a].faces())
-                    if (std::all_of(others.begin(), others.end(),
-                                    [&](const Vec3& p) { return f.plane.signedDistance(p) >= -eps; }))
-                        return true;
-                return false;
-            };
-            // Face planes separate most pairs; the full separating-axis test (with edge x edge axes) the
-            // rest.
-            if (!separates(c, d) && !separates(d, c) && withinGap(polytopes[c], polytopes[d], -eps))
-                throw Degenerate{"cells overlap"};
-        }
-    return cx;
-}
-
-/// Splits a mesh by a complex of convex cells in one pass: every point is computed once, from the input
-/// mesh and the complex, and shared by every region that uses it.
-class Clipper {
-public:
-    Clipper(const Mesh& mesh, const std::vector<ConvexPolytope>& cells) : mesh_(mesh) {
-        nV_ = static_cast<std::uint32_t>(mesh.positions.size());
-        k_ = static_cast<std::uint32_t>(cells.size());
-        for (const ConvexPolytope& c : cells)
-            box_.extend(c.bounds());
-        double maxAbs = 0;
-        for (int a = 0; a < 3; ++a)
-            maxAbs = std::max({maxAbs, std::abs(box_.lo[a]), std::abs(box_.hi[a])});
-        eps_ = std::max(1e-10 * box_.diagonal(), 1e-14 * maxAbs);
-        cx_ = buildComplex(cells, eps_);
-        nF_ = static_cast<std::uint32_t>(cx_.faces.size());
-        cutEdges_.resize(nF_);
-        untouched_.resize(k_ + 1);
-        tris_.resize(k_ + 1);
-        thread_local SlotArray threadSlots;
-        slots_ = threadSlots.busy ? &ownSlots_ : &threadSlots;
-        slots_->busy = true;
-        if (slots_->slot.size() < nV_)
-            slots_->slot.resize(nV_, -1);
-        distSlot_ = slots_->slot.data();
-    }
-    ~Clipper() {
-        for (std::uint32_t v : slots_->set)
-            distSlot_[v] = -1;
-        slots_->set.clear();
-        slots_->busy = false;
-    }
-    Clipper(const Clipper&) = delete;
-    Clipper& operator=(const Clipper&) = delete;
-
-    /// Region k < K: mesh ∩ cell k; region K: the rest. With known (the mesh's integrals), outside gets the
-    /// rest's integrals by difference.
-    /// With edit (and known), the rest is not assembled but returned as an edit of the mesh (the last
-    /// region of the result is then empty).
-    std::vector<Mesh> run(const VolumeIntegrals* known, std::optional<VolumeIntegrals>& restIntegrals,
-                          RemainderEdit* edit = nullptr);
-    /// After run: the triangles region r kept whole (assemble puts them first).
-    std::size_t keptWhole(std::uint32_t r) const { return untouched_[r].size(); }
-
-private:
-    const Mesh& mesh_;
-    CellComplex cx_;
-    std::uint32_t nV_ = 0, k_ = 0, nF_ = 0;
-    Aabb box_;
-    double eps_ = 0;
-
-    std::vector<Vec3> extra_;   // created points, ids nV_ + i
-    std::vector<bool> offEdge_; // per created point: kind 4 (may not end up in an output)
-    std::unordered_map<PointKey, std::uint32_t, PointKeyHash> keyed_;
-    // Per mesh vertex: offset into dist_ or -1; a per-thread array, reset only at the vertices it set.
-    struct SlotArray {
-        std::vector<std::int32_t> slot;
-        std::vector<std::uint32_t> set; // the vertices whose slot is not -1
-        bool busy = false;
-    };
-    SlotArray ownSlots_; // used when the thread's array is taken (a clip inside a clip)
-    SlotArray* slots_ = nullptr;
-    std::int32_t* distSlot_ = nullptr;
-    std::vector<double> dist_; // distances to every complex face plane
-
-    // Per complex face: the directed cut edges of its back cell's polygons on that face.
-    std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>> cutEdges_;
-    // Per complex edge (a<b): points where it pierces the mesh surface.
-    std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> pierce_;
-
-    // Output triangles by point id, with the source triangle (kNone for cap faces) and cap face.
-    struct OutTri {
-        std::uint32_t v[3];
-        std::uint32_t source; // mesh triangle it lies in, or kNone for a cap
-        std::uint32_t face;   // complex face of a cap
-        bool flipped;         // cap seen from the face's front
-    };
-    std::vector<std::vector<OutTri>> tris_;             // per region
-    std::vector<std::vector<std::uint32_t>> untouched_; // per region: input triangles kept whole
-
-    const Vec3& pos(std::uint32_t id) const { return id < nV_ ? mesh_.positions[id] : extra_[id - nV_]; }
-
-    /// Signed distance to complex face f's plane (positive in front).
-    double dist(std::uint32_t id, std::uint32_t f) const {
-        if (id < nV_)
-            return dist_[static_cast<std::size_t>(distSlot_[id]) + f];
-        return cx_.faces[f].plane.signedDistance(extra_[id - nV_]);
-    }
-    /// Signed distance to the l-th plane of cell c (positive outside the cell).
-    double cellDist(std::uint32_t id, std::uint32_t c, std::size_t l) const {
-        const double d = dist(id, cx_.cells[c].faces[l]);
-        return cx_.cells[c].flipped[l] ? -d : d;
-    }
-
-    void ensureDistances(std::uint32_t v) {
-        if (distSlot_[v] >= 0)
-            return;
-        distSlot_[v] = static_cast<std::int32_t>(dist_.size());
-        slots_->set.push_back(v);
-        for (const CellComplex::Face& f : cx_.faces)
-            dist_.push_back(f.plane.signedDistance(mesh_.positions[v]));
-    }
-
-    std::uint32_t addPoint(const PointKey& key, const Vec3& p, bool offEdge = false) {
-        auto [it, inserted] = keyed_.emplace(key, nV_ + static_cast<std::uint32_t>(extra_.size()));
-        if (inserted) {
-            extra_.push_back(p);
-            offEdge_.push_back(offEdge);
-        }
-        return it->second;
-    }
-
-    std::uint32_t crossing(std::uint32_t tri, std::uint32_t cell, const Support& s, std::uint32_t face,
-                           std::uint32_t from, std::uint32_t to, double dFrom, double dTo);
-    std::vector<Corner> clipTriangle(std::uint32_t t, std::uint32_t cell);
-    void cutTriangle(std::uint32_t t, const std::vector<std::uint32_t>& cells);
-    void emitConvex(const std::vector<std::uint32_t>& poly, const Vec3& normal, std::uint32_t source,
-                    std::vector<OutTri>& out);
-    void triangulateRegion(const std::vector<std::pair<std::uint32_t, std::uint32_t>>& edges,
-                           std::size_t boundaryEdges, const Vec3& normal, std::uint32_t source,
-                           std::uint32_t face, std::vector<OutTri>& out);
-    void buildCaps();
-    bool pointInsideMesh(const Vec3& p) const;
-    void emitAttributes(const OutTri& o, std::vector<Vec3>* normals, std::vector<Vec2>& uvs,
-                        std::vector<std::uint32_t>& materials) const;
-    Mesh assemble(std::uint32_t region) const;
-    RemainderEdit assembleEdit(std::vector<std::uint32_t> removed) const;
-};
-
-std::uint32_t Clipper::crossing(std::uint32_t tri, std::uint32_t cell, const Support& s, std::uint32_t face,
-                                std::uint32_t from, std::uint32_t to, double dFrom, double dTo) {
-    if (s.onMeshEdge) {
-        const PointKey key{1, s.a, s.b, face};
-        if (auto it = keyed_.find(key); it != keyed_.end())
-            return it->second;
-        // Canonical: from the lower vertex index to the higher, with their own distances (the same for both
-        // cells of a shared face: the ratio does not depend on the sign).
-        const double da = dist(s.a, face), db = dist(s.b, face);
-        if (!((da < 0 && db > 0) || (da > 0 && db < 0)))
-            throw Degenerate{"edge crossing without sign change"};
-        const Vec3& pa = mesh_.positions[s.a];
-        const Vec3& pb = mesh_.positions[s.b];
-        return addPoint(key, pa + (pb - pa) * (da / (da - db)));
-    }
-    const std::uint32_t f = std::min(s.a, face), g = std::max(s.a, face);
-    const Vec3& p = pos(from);
-    const Vec3& q = pos(to);
-    const Vec3 along = p + (q - p) * (dFrom / (dFrom - dTo));
-    const auto& edges = cx_.cells[cell].edgeOfFaces;
-    const auto edge = edges.find(pairKey(f, g));
-    if (edge == edges.end()) // the faces meet at most in a vertex: this point cannot survive clipping
-        return addPoint({4, tri, f, g}, along, true);
-    // Where the triangle meets a complex edge: every cell around the edge gets the same point, computed
-    // from the edge's (welded) end points and the triangle's plane.
-    const auto a = static_cast<std::uint32_t>(edge->second >> 32);
-    const auto b = static_cast<std::uint32_t>(edge->second & 0xFFFFFFFFu);
-    const PointKey key{2, tri, a, b};
-    if (auto it = keyed_.find(key); it != keyed_.end())
-        return it->second;
-    const auto c = mesh_.corners(tri);
-    const Vec3 n = cross(c[1] - c[0], c[2] - c[0]);
-    const Vec3 &pa = cx_.vertices[a], &pb = cx_.vertices[b];
-    const double da = dot(n, pa - c[0]), db = dot(n, pb - c[0]);
-    if (!(std::abs(da - db) > 1e-9 * length(n) * length(pb - pa)))
-        throw Degenerate{"triangle parallel to a cell edge"};
-    const Vec3 x = pa + (pb - pa) * (da / (da - db));
-    if (length(x - along) > 10 * eps_)
-        throw Degenerate{"ill-conditioned cell edge crossing"};
-    return addPoint(key, x);
-}
-
-// Sutherland–Hodgman clipping of triangle t by all planes of a cell; corners carry the support of their
-// next edge.
-std::vector<Corner> Clipper::clipTriangle(std::uint32_t t, std::uint32_t cell) {
-    const Triangle& tri = mesh_.triangles[t];
-    std::vector<Corner> poly;
-    for (int c = 0; c < 3; ++c) {
-        const std::uint32_t a = tri[c], b = tri[(c + 1) % 3];
-        poly.push_back({a, {true, std::min(a, b), std::max(a, b)}});
-    }
-    std::vector<Corner> next;
-    std::vector<double> d;
-    const std::vector<std::uint32_t>& faces = cx_.cells[cell].faces;
-    for (std::size_t l = 0; l < faces.size() && !poly.empty(); ++l) {
-        d.resize(poly.size());
-        bool anyOut = false, anyIn = false;
-        for (std::size_t c = 0; c < poly.size(); ++c) {
-            d[c] = cellDist(poly[c].id, cell, l);
-            if (std::abs(d[c]) <= eps_) {
-                throw Degenerate{"point on a cell plane"};
-            }
-            anyOut |= d[c] > 0;
-            anyIn |= d[c] < 0;
-        }
-        if (!anyOut)
-            continue;
-        if (!anyIn) {
-            poly.clear();
-            break;
-        }
-        next.clear();
-        const std::size_t n = poly.size();
-        for (std::size_t c = 0; c < n; ++c) {
-            const Corner& cur = poly[c];
-            const Corner& nxt = poly[(c + 1) % n];
-            const bool curIn = d[c] < 0, nxtIn = d[(c + 1) % n] < 0;
-            if (curIn) {
-                next.push_back(cur);
-                if (!nxtIn) {
-                    const std::uint32_t x =
-                        crossing(t, cell, cur.next, faces[l], cur.id, nxt.id, d[c], d[(c + 1) % n]);
-                    next.push_back({x, {false, faces[l], 0}});
-                }
-            } else if (nxtIn) {
-                const std::uint32_t y =
-                    crossing(t, cell, cur.next, faces[l], cur.id, nxt.id, d[c], d[(c + 1) % n]);
-                next.push_back({y, cur.next});
-            }
-        }
-        poly.swap(next);
-    }
-    return poly;
-}
-
-// Triangulates a convex polygon (possibly with collinear corners) by clipping strictly convex ears.
-void Clipper::emitConvex(const std::vector<std::uint32_t>& polyIn, const Vec3& normal, std::uint32_t source,
-                         std::vector<OutTri>& out) {
-    std::vector<std::uint32_t> poly = polyIn;
-    auto strictlyConvex = [&](std::size_t c) {
-        const std::size_t n = poly.size();
-        const Vec3& a = pos(poly[(c + n - 1) % n]);
-        const Vec3& b = pos(poly[c]);
-        const Vec3& e = pos(poly[(c + 1) % n]);
-        const Vec3 cr = cross(b - a, e - b);
-        return dot(cr, normal) > 1e-12 * length(b - a) * length(e - b);
-    };
-    while (poly.size() > 3) {
-        std::size_t ear = poly.size();
-        for (std::size_t c = 0; c < poly.size(); ++c)
-            if (strictlyConvex(c)) {
-                ear = c;
-                break;
-            }
-        if (ear == poly.size())
-            throw Degenerate{"flat polygon"};
-        const std::size_t n = poly.size();
-        out.push_back({{poly[(ear + n - 1) % n], poly[ear], poly[(ear + 1) % n]}, source, kNone, false});
-        poly.erase(poly.begin() + static_cast<std::ptrdiff_t>(ear));
-    }
-    out.push_back({{poly[0], poly[1], poly[2]}, source, kNone, false});
-}
-
-// Triangulates (with a constrained Delaunay triangulation) the planar region bounded by the first
-// `boundaryEdges` directed edges (counter-clockwise seen along normal), minus the polygons whose edges are
-// the remaining ones (the holes). Inside and outside are found topologically: walking from the unbounded
-// face, every crossed boundary edge toggles "inside the region" and every crossed hole edge toggles "inside
-// the hole".
-void Clipper::triangulateRegion(const std::vector<std::pair<std::uint32_t, std::uint32_t>>& edges,
-                                std::size_t boundaryEdges, const Vec3& normal, std::uint32_t source,
-                                std::uint32_t face, std::vector<OutTri>& out) {
-    std::vector<RegionEdge> region;
-    region.reserve(edges.size());
-    for (std::size_t e = 0; e < edges.size(); ++e)
-        region.push_back({edges[e].first, edges[e].second, e < boundaryEdges ? 1u : 2u});
-    std::vector<std::array<std::uint32_t, 3>> tris;
-    if (const char* why = triangulatePlanarRegion(
-            region, normal, [&](std::uint32_t id) { return pos(id); }, tris))
-        throw Degenerate{why};
-    for (const auto& t : tris)
-        out.push_back({{t[0], t[1], t[2]}, source, face, false});
-}
-
-void Clipper::cutTriangle(std::uint32_t t, const std::vector<std::uint32_t>& cells) {
-    const Triangle& tri = mesh_.triangles[t];
-    std::vector<std::pair<std::uint32_t, std::vector<Corner>>> polys;
-    std::uint32_t wholeIn = kNone;
-    for (std::uint32_t c : cells) {
-        std::vector<Corner> poly = clipTriangle(t, c);
-        if (poly.empty())
-            continue;
-        bool created = false;
-        for (const Corner& k : poly) {
-            created |= k.id >= nV_;
-            if (k.id >= nV_ && offEdge_[k.id - nV_])
-                throw Degenerate{"triangle through a cell vertex"};
-        }
-        if (created)
-            polys.emplace_back(c, std::move(poly));
-        else // wholly inside this cell (its distances said otherwise only within rounding)
-            wholeIn = c;
-    }
-    if (wholeIn != kNone) {
-        if (!polys.empty())
-            throw Degenerate{"triangle inside a cell and cut by another"};
-        untouched_[wholeIn].push_back(t);
-        return;
-    }
-    if (polys.empty()) {
-        untouched_[k_].push_back(t);
-        return;
-    }
-    const Vec3 normal = mesh_.triangleNormal(t);
-    // Each cell's part; cut edges (on faces whose back is that cell) and pierce points for the caps; contact
-    // points on the triangle's edges.
-    std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> contacts; // by mesh edge (a<b)
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> holes;
-    for (const auto& [cell, poly] : polys) {
-        std::vector<std::uint32_t> ids;
-        for (const Corner& k : poly)
-            ids.push_back(k.id);
-        emitConvex(ids, normal, t, tris_[cell]);
-        for (std::size_t c = 0; c < poly.size(); ++c) {
-            const Corner& cur = poly[c];
-            const Corner& nxt = poly[(c + 1) % poly.size()];
-            holes.emplace_back(cur.id, nxt.id);
-            if (!cur.next.onMeshEdge && cx_.faces[cur.next.a].back == cell)
-                cutEdges_[cur.next.a].emplace_back(cur.id, nxt.id);
-            if (cur.id < nV_)
-                continue;
-            // Which key made it: look at its supports.
-            const Support& in = poly[(c + poly.size() - 1) % poly.size()].next;
-            const Support& out = cur.next;
-            if (!in.onMeshEdge && !out.onMeshEdge) {
-                const std::uint32_t f = std::min(in.a, out.a), g = std::max(in.a, out.a);
-                pierce_[cx_.cells[cell].edgeOfFaces.at(pairKey(f, g))].push_back(cur.id);
-            } else {
-                const Support& edge = in.onMeshEdge ? in : out;
-                contacts[pairKey(edge.a, edge.b)].push_back(cur.id);
-            }
-        }
-    }
-    // The rest: the triangle minus the cells' convex polygons (edges two neighbouring polygons share cancel),
-    // as a constrained triangulation.
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
-    for (int c = 0; c < 3; ++c) {
-        const std::uint32_t a = tri[c], b = tri[(c + 1) % 3];
-        std::vector<std::uint32_t> onEdge;
-        if (auto it = contacts.find(pairKey(std::min(a, b), std::max(a, b))); it != contacts.end())
-            onEdge = it->second;
-        const Vec3 pa = pos(a), dir = pos(b) - pa;
-        std::sort(onEdge.begin(), onEdge.end(), [&](std::uint32_t x, std::uint32_t y) {
-            return dot(pos(x) - pa, dir) < dot(pos(y) - pa, dir);
-        });
-        onEdge.erase(std::unique(onEdge.begin(), onEdge.end()), onEdge.end());
-        std::uint32_t prev = a;
-        for (std::uint32_t x : onEdge) {
-            edges.emplace_back(prev, x);
-            prev = x;
-        }
-        edges.emplace_back(prev, b);
-    }
-    const std::size_t boundary = edges.size();
-    edges.insert(edges.end(), holes.begin(), holes.end());
-    triangulateRegion(edges, boundary, normal, t, kNone, tris_[k_]);
-}
-
-bool Clipper::pointInsideMesh(const Vec3& p) const {
-    // All triangle indices; not std::views::iota, which clang 14 cannot compile with libstdc++ 12 (the
-    // sanitizer and fuzzer builds use clang).
-    struct AllTriangles {
-        struct It {
-            std::size_t i;
-            std::size_t operator*() const { return i; }
-            It& operator++() {
-                ++i;
-                return *this;
-            }
-            bool operator!=(const It& o) const { return i != o.i; }
-        };
-        std::size_t n;
-        It begin() const { return {0}; }
-        It end() const { return {n}; }
-    };
-    return insideByRayParity(mesh_, AllTriangles{mesh_.triangles.size()}, p);
-}
-
-void Clipper::buildCaps() {
-    // Map: per face, point -> whether the back cell's polygon cut edge leaves it (true) or arrives at it
-    // (false).
-    std::vector<std::unordered_map<std::uint32_t, bool>> leaves(nF_);
-    for (std::uint32_t f = 0; f < nF_; ++f)
-        for (const auto& [a, b] : cutEdges_[f]) {
-            leaves[f][b] = true;
-            leaves[f][a] = false;
-        }
-    for (auto& [edge, points] : pierce_) { // every cell around a complex edge reports its pierce points
-        std::sort(points.begin(), points.end());
-        points.erase(std::unique(points.begin(), points.end()), points.end());
-    }
-    const std::size_t nCellVerts = cx_.vertices.size();
-    std::vector<int> vertexInside(nCellVerts, -1);
-    auto setStatus = [&](std::uint32_t v, int s) {
-        if (vertexInside[v] >= 0 && vertexInside[v] != s)
-            throw Degenerate{"inconsistent cell vertex status"};
-        vertexInside[v] = s;
-    };
-    // Per directed edge of face f: sorted pierce points and the inside status of each sub-edge.
-    struct EdgeSplit {
-        std::vector<std::uint32_t> points;
-        std::vector<int> inside; // points.size() + 1 entries
-    };
-    std::vector<std::vector<EdgeSplit>> splits(nF_);
-    for (std::uint32_t f = 0; f < nF_; ++f) {
-        const auto& loop = cx_.faces[f].loop;
-        splits[f].resize(loop.size());
-        for (std::size_t e = 0; e < loop.size(); ++e) {
-            const std::uint32_t A = loop[e], B = loop[(e + 1) % loop.size()];
-            EdgeSplit& s = splits[f][e];
-            if (auto it = pierce_.find(pairKey(std::min(A, B), std::max(A, B))); it != pierce_.end())
-                s.points = it->second;
-            const Vec3 pa = cx_.vertices[A], dir = cx_.vertices[B] - pa;
-            std::sort(s.points.begin(), s.points.end(), [&](std::uint32_t x, std::uint32_t y) {
-                return dot(pos(x) - pa, dir) < dot(pos(y) - pa, dir);
-            });
-            s.inside.assign(s.points.size() + 1, -1);
-            for (std::size_t q = 0; q < s.points.size(); ++q) {
-                auto it = leaves[f].find(s.points[q]);
-                if (it == leaves[f].end())
-                    throw Degenerate{"pierce point without cut edge"};
-                const int before =
-                    it->second ? 1 : 0; // cap edge leaves the point: the sub-edge before is inside
-                for (auto [slot, value] : {std::pair{q, before}, std::pair{q + 1, 1 - before}}) {
-                    if (s.inside[slot] >= 0 && s.inside[slot] != value)
-                        throw Degenerate{"inconsistent cut along a cell edge"};
-                    s.inside[slot] = value;
-                }
-            }
-            if (!s.points.empty()) {
-                setStatus(A, s.inside.front());
-                setStatus(B, s.inside.back());
-            }
-        }
-    }
-    // Propagate vertex status along unpierced complex edges; with no information at all, cast a ray.
-    bool changed = true;
-    while (changed) {
-        changed = false;
-        for (std::uint32_t f = 0; f < nF_; ++f) {
-            const auto& loop = cx_.faces[f].loop;
-            for (std::size_t e = 0; e < loop.size(); ++e) {
-                if (!splits[f][e].points.empty())
-                    continue;
-                const std::uint32_t A = loop[e], B = loop[(e + 1) % loop.size()];
-                if (vertexInside[A] >= 0 && vertexInside[B] < 0) {
-                    vertexInside[B] = vertexInside[A];
-                    changed = true;
-                } else if (vertexInside[B] >= 0 && vertexInside[A] < 0) {
-                    vertexInside[A] = vertexInside[B];
-                    changed = true;
-                } else if (vertexInside[A] >= 0 && vertexInside[A] != vertexInside[B]) {
-                    throw Degenerate{"inconsistent unpierced cell edge"};
-                }
-            }
-        }
-        if (!changed && std::find(vertexInside.begin(), vertexInside.end(), -1) != vertexInside.end()) {
-            const auto it = std::find(vertexInside.begin(), vertexInside.end(), -1);
-            *it = pointInsideMesh(cx_.vertices[static_cast<std::size_t>(it - vertexInside.begin())]) ? 1 : 0;
-            changed = true;
-        }
-    }
-    // Complex vertices become points (created lazily when a cap uses them). A cap goes to the face's back
-    // cell as it is and to the region in front reversed.
-    auto cellPoint = [&](std::uint32_t v) { return addPoint({3, v, 0, 0}, cx_.vertices[v]); };
-    std::vector<OutTri> caps;
-    for (std::uint32_t f = 0; f < nF_; ++f) {
-        std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
-        for (const auto& [a, b] : cutEdges_[f])
-            edges.emplace_back(b, a);
-        const auto& loop = cx_.faces[f].loop;
-        for (std::size_t e = 0; e < loop.size(); ++e) {
-            const std::uint32_t A = loop[e], B = loop[(e + 1) % loop.size()];
-            const EdgeSplit& s = splits[f][e];
-            if (s.points.empty()) {
-                if (vertexInside[A] == 1)
-                    edges.emplace_back(cellPoint(A), cellPoint(B));
-                continue;
-            }
-            for (std::size_t q = 0; q <= s.points.size(); ++q) {
-                if (s.inside[q] != 1)
-                    continue;
-                const std::uint32_t from = q == 0 ? cellPoint(A) : s.points[q - 1];
-                const std::uint32_t to = q == s.points.size() ? cellPoint(B) : s.points[q];
-                edges.emplace_back(from, to);
-            }
-        }
-        if (edges.empty())
-            continue;
-        caps.clear();
-        triangulateRegion(edges, edges.size(), cx_.faces[f].plane.normal, kNone, f, caps);
-        for (const OutTri& c : caps) {
-            tris_[cx_.faces[f].back].push_back(c);
-            tris_[cx_.faces[f].front].push_back({{c.v[0], c.v[2], c.v[1]}, kNone, f, true});
-        }
-    }
-}
-
-void Clipper::emitAttributes(const OutTri& o, std::vector<Vec3>* normals, std::vector<Vec2>& uvs,
-                             std::vector<std::uint32_t>& materials) const {
-    const bool hasUv = mesh_.hasUvs();
-    if (o.source == kNone) {
-        const Vec3& normal = cx_.faces[o.face].plane.normal;
-        if (normals)
-            normals->insert(normals->end(), 3, o.flipped ? -normal : normal);
-        uvs.insert(uvs.end(), 3, Vec2{}); // interior UVs are generated by the fracture pipeline
-        materials.push_back(kInteriorMaterial);
-        return;
-    }
-    // Barycentric interpolation of the source triangle's corner attributes.
-    const auto c = mesh_.corners(o.source);
-    const Vec3 n = cross(c[1] - c[0], c[2] - c[0]);
-    const double inv = 1.0 / dot(n, n);
-    for (std::uint32_t v : o.v) {
-        const Vec3 p = pos(v);
-        const double w0 = dot(cross(c[1] - p, c[2] - p), n) * inv;
-        const double w1 = dot(cross(c[2] - p, c[0] - p), n) * inv;
-        const double w2 = 1 - w0 - w1;
-        const std::size_t b = 3 * static_cast<std::size_t>(o.source);
-        if (normals)
-            normals->push_back(
-                normalized(mesh_.normals[b] * w0 + mesh_.normals[b + 1] * w1 + mesh_.normals[b + 2] * w2));
-        if (hasUv) {
-            const Vec2 &u0 = mesh_.uvs[b], &u1 = mesh_.uvs[b + 1], &u2 = mesh_.uvs[b + 2];
-            uvs.push_back({u0.x * w0 + u1.x * w1 + u2.x * w2, u0.y * w0 + u1.y * w1 + u2.y * w2});
-        } else {
-            uvs.push_back({});
-        }
-    }
-    materials.push_back(mesh_.material(o.source));
-}
-
-Mesh Clipper::assemble(std::uint32_t region) const {
-    const std::vector<std::uint32_t>& untouched = untouched_[region];
-    const std::vector<OutTri>& tris = tris_[region];
-    Mesh m;
-    m.materialNames = mesh_.materialNames;
-    std::vector<std::uint32_t> local(nV_ + extra_.size(), kNone);
-    auto id = [&](std::uint32_t g) {
-        if (local[g] == kNone) {
-            local[g] = static_cast<std::uint32_t>(m.positions.size());
-            m.positions.push_back(pos(g));
-        }
-        return local[g];
-    };
-    const bool hasN = mesh_.hasNormals(), hasUv = mesh_.hasUvs();
-    const std::size_t total = untouched.size() + tris.size();
-    m.positions.reserve(std::min<std::size_t>(nV_ + extra_.size(), 3 * total));
-    m.triangles.reserve(total);
-    m.materials.reserve(total);
-    m.uvs.reserve(3 * total);
-    if (hasN)
-        m.normals.reserve(3 * total);
-    for (std::uint32_t t : untouched) {
-        const Triangle& tri = mesh_.triangles[t];
-        m.triangles.push_back({id(tri[0]), id(tri[1]), id(tri[2])});
-        if (hasN)
-            m.normals.insert(m.normals.end(), mesh_.normals.begin() + 3 * t,
-                             mesh_.normals.begin() + 3 * t + 3);
-        if (hasUv)
-            m.uvs.insert(m.uvs.end(), mesh_.uvs.begin() + 3 * t, mesh_.uvs.begin() + 3 * t + 3);
-        m.materials.push_back(mesh_.material(t));
-    }
-    if (!hasUv)
-        m.uvs.resize(3 * m.triangles.size()); // zeros, in one go
-    for (const OutTri& o : tris) {
-        m.triangles.push_back({id(o.v[0]), id(o.v[1]), id(o.v[2])});
-        emitAttributes(o, hasN ? &m.normals : nullptr, m.uvs, m.materials);
-    }
-    return m;
-}
-
-RemainderEdit Clipper::assembleEdit(std::vector<std::uint32_t> removed) const {
-    RemainderEdit e;
-    e.removed = std::move(removed);
-    std::unordered_map<std::uint32_t, std::uint32_t> local; // created point -> its new vertex
-    const bool hasN = mesh_.hasNormals();
-    for (const OutTri& o : tris_[k_]) {
-        Triangle t;
-        for (int c = 0; c < 3; ++c) {
-            const std::uint32_t g = o.v[c];
-            if (g < nV_) {
-                t[static_cast<std::size_t>(c)] = g;
-                continue;
-            }
-            auto [it, fresh] = local.emplace(g, nV_ + static_cast<std::uint32_t>(e.newPositions.size()));
-            if (fresh)
-                e.newPositions.push_back(pos(g));
-            t[static_cast<std::size_t>(c)] = it->second;
-        }
-        e.added.triangles.push_back(t);
-        emitAttributes(o, hasN ? &e.added.normals : nullptr, e.added.uvs, e.added.materials);
-    }
-    return e;
-}
-
-// Every directed edge of the new triangles that touches a created point has its twin among them.
-void checkNewEdgesClosed(const std::vector<std::array<std::uint32_t, 3>>& tris, std::uint32_t firstCreated) {
-    std::unordered_set<std::uint64_t> directed;
-    directed.reserve(tris.size() * 3);
-    for (const auto& t : tris)
-        for (int c = 0; c < 3; ++c)
-            if (!directed.insert(pairKey(t[c], t[(c + 1) % 3])).second) {
-                throw Degenerate{"edge used twice in one direction"};
-            }
-    for (const auto& t : tris)
-        for (int c = 0; c < 3; ++c) {
-            const std::uint32_t a = t[c], b = t[(c + 1) % 3];
-            if ((a >= firstCreated || b >= firstCreated) && !directed.count(pairKey(b, a)))
-                throw Degenerate{"open edge at the cut"};
-        }
-}
-
-std::vector<Mesh> Clipper::run(const VolumeIntegrals* known, std::optional<VolumeIntegrals>& restIntegrals,
-                               RemainderEdit* edit) {
+Result<std::vector<Mesh>> Clipper::run(const VolumeIntegrals* known,
+                                       std::optional<VolumeIntegrals>& restIntegrals, RemainderEdit* edit) {
     const std::size_t nT = mesh_.triangles.size();
     // Per vertex, the sides of the cells' box (with eps) it lies beyond, 2 bits per axis: a triangle misses
     // the box exactly when its three corners share a bit.
@@ -848,9 +69,14 @@ std::vector<Mesh> Clipper::run(const VolumeIntegrals* known, std::optional<Volum
     std::vector<std::size_t> scanned; // per region, the triangles the scan kept whole
     for (const auto& kept : untouched_)
         scanned.push_back(kept.size());
-    for (const auto& [t, cells] : cut)
+    for (const auto& [t, cells] : cut) {
         cutTriangle(t, cells);
+        if (declined_)
+            return clipDeclined(declined_);
+    }
     buildCaps();
+    if (declined_)
+        return clipDeclined(declined_);
 
     std::vector<Mesh> result;
     for (std::uint32_t r = 0; r < k_; ++r)
@@ -887,18 +113,19 @@ std::vector<Mesh> Clipper::run(const VolumeIntegrals* known, std::optional<Volum
         created.reserve(tris_[r].size());
         for (const OutTri& o : tris_[r])
             created.push_back({o.v[0], o.v[1], o.v[2]});
-        checkNewEdgesClosed(created, nV_);
+        if (const char* why = openNewEdges(created, nV_))
+            return clipDeclined(why);
         const bool empty = r == k_ && edit ? lost.size() == nT && tris_[k_].empty() : result[r].empty();
         const double v = empty                        ? 0.0
                          : (r == k_ && restIntegrals) ? restIntegrals->volume
                                                       : signedVolume(result[r]);
         if (v < 0)
-            throw Degenerate{"negative volume"};
+            return clipDeclined("negative volume");
         sum += v;
     }
     const double v0 = known ? known->volume : signedVolume(mesh_);
     if (std::abs(sum - v0) > 1e-9 * std::abs(v0))
-        throw Degenerate{"volume not conserved"};
+        return clipDeclined("volume not conserved");
     if (edit) {
         std::sort(lost.begin(), lost.end());
         *edit = assembleEdit(std::move(lost));
@@ -906,7 +133,9 @@ std::vector<Mesh> Clipper::run(const VolumeIntegrals* known, std::optional<Volum
     return result;
 }
 
-} // namespace
+} // namespace clip
+
+using clip::Clipper;
 
 Result<CellSplit> clipByConvexCell(const Mesh& mesh, const ConvexPolytope& cell) {
     if (cell.empty())
@@ -919,7 +148,7 @@ Result<CellSplit> clipByConvexCell(const Mesh& mesh, const ConvexPolytope& cell)
 
 namespace {
 
-/// f() with the clipper's declines and failures as GeometryFailure errors; empty cells are InvalidInput.
+/// f() with a failure (e.g. out of memory) as a GeometryFailure error; empty cells are InvalidInput.
 template <class F>
 auto guardedClip(const std::vector<ConvexPolytope>& cells, F f) -> decltype(f()) {
     if (cells.empty() ||
@@ -927,8 +156,6 @@ auto guardedClip(const std::vector<ConvexPolytope>& cells, F f) -> decltype(f())
         return makeError(ErrorCode::InvalidInput, "no cells, or an empty cell");
     try {
         return f();
-    } catch (const Degenerate& d) {
-        return makeError(ErrorCode::GeometryFailure, std::string("fast clip declined: ") + d.why);
     } catch (const std::exception& e) {
         return makeError(ErrorCode::GeometryFailure, std::string("fast clip failed: ") + e.what());
     }
@@ -939,10 +166,17 @@ auto guardedClip(const std::vector<ConvexPolytope>& cells, F f) -> decltype(f())
 Result<MultiCellEdit> clipByConvexCellsAsEdit(const Mesh& mesh, const std::vector<ConvexPolytope>& cells,
                                               const VolumeIntegrals& meshIntegrals) {
     return guardedClip(cells, [&]() -> Result<MultiCellEdit> {
-        Clipper clipper(mesh, cells);
+        const Clipper::Scale scale = Clipper::scaleOf(cells);
+        Result<CellComplex> cx = buildCellComplex(cells, scale.eps);
+        if (!cx)
+            return cx.error();
+        Clipper clipper(mesh, scale, std::move(*cx));
         MultiCellEdit out;
         std::optional<VolumeIntegrals> rest;
-        std::vector<Mesh> regions = clipper.run(&meshIntegrals, rest, &out.outside);
+        Result<std::vector<Mesh>> run = clipper.run(&meshIntegrals, rest, &out.outside);
+        if (!run)
+            return run.error();
+        std::vector<Mesh>& regions = *run;
         regions.pop_back();
         out.inside = std::move(regions);
         for (std::uint32_t r = 0; r < out.inside.size(); ++r)
@@ -955,9 +189,16 @@ Result<MultiCellEdit> clipByConvexCellsAsEdit(const Mesh& mesh, const std::vecto
 Result<MultiCellSplit> clipByConvexCells(const Mesh& mesh, const std::vector<ConvexPolytope>& cells,
                                          const VolumeIntegrals* meshIntegrals) {
     return guardedClip(cells, [&]() -> Result<MultiCellSplit> {
-        Clipper clipper(mesh, cells);
+        const Clipper::Scale scale = Clipper::scaleOf(cells);
+        Result<CellComplex> cx = buildCellComplex(cells, scale.eps);
+        if (!cx)
+            return cx.error();
+        Clipper clipper(mesh, scale, std::move(*cx));
         MultiCellSplit out;
-        std::vector<Mesh> regions = clipper.run(meshIntegrals, out.outsideIntegrals);
+        Result<std::vector<Mesh>> run = clipper.run(meshIntegrals, out.outsideIntegrals);
+        if (!run)
+            return run.error();
+        std::vector<Mesh>& regions = *run;
         out.outside = std::move(regions.back());
         regions.pop_back();
         out.inside = std::move(regions);

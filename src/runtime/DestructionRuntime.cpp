@@ -601,10 +601,6 @@ DestructionRuntime::~DestructionRuntime() {
         impl_->binding.removeBody(id);
 }
 
-DestructionWorld& DestructionRuntime::world() {
-    return impl_->world;
-}
-
 const DestructionWorld& DestructionRuntime::world() const {
     return impl_->world;
 }
@@ -750,6 +746,26 @@ bool DestructionRuntime::submitImpact(BodyId id, const Vec3& worldPoint, const V
     p.worldNormal = worldNormal;
     FrameStats ignored;
     return im.submit(p, ignored);
+}
+
+bool DestructionRuntime::submitLocalImpact(ObjectId object, const Impact& impact) {
+    Impl& im = *impl_;
+    const BodyRecord* r = im.bodies.findObject(object);
+    if (!r)
+        return false;
+    const Frame f = im.binding.motion(r->id).transform * r->objectToBody.inverse();
+    detail::PendingImpact p;
+    p.body = r->id;
+    p.object = object;
+    p.impact = impact;
+    p.worldPoint = f.apply(impact.point);
+    p.worldNormal = f.rotation * impact.normal;
+    FrameStats ignored;
+    return im.submit(p, ignored);
+}
+
+void DestructionRuntime::setJournalSink(std::function<void(const JournalEvent&)> sink) {
+    impl_->world.setJournalSink(std::move(sink));
 }
 
 int DestructionRuntime::blast(const Vec3& center, double radius, double impulse, double edgeShare) {

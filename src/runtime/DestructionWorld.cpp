@@ -960,7 +960,7 @@ void DestructionWorld::commit(const FractureOutcome& split) {
     }
 }
 
-bool DestructionWorld::waitForResult(Clock::time_point deadline) {
+bool DestructionWorld::waitForResult(Clock::time_point deadline) const {
     Impl& im = *impl_;
     if (im.config.deterministic || im.inflight.empty())
         return false;
@@ -972,7 +972,7 @@ bool DestructionWorld::waitForResult(Clock::time_point deadline) {
     });
 }
 
-void DestructionWorld::waitIdle() {
+void DestructionWorld::waitIdle() const {
     std::unique_lock lock(impl_->sync->mutex);
     impl_->sync->done.wait(lock, [&] { return impl_->sync->outstanding == 0; });
 }

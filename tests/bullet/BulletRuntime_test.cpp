@@ -45,7 +45,7 @@ struct Rig {
         binding.reset();
         physics.reset();
     }
-    DestructionWorld& world() { return runtime->world(); }
+    const DestructionWorld& world() const { return runtime->world(); }
     ObjectId addBox(const Vec3& half, const Frame& placement, double density, bool isStatic = false,
                     const FractureParams& fracture = {}) {
         ObjectDesc d;
@@ -141,7 +141,7 @@ TEST(BulletRuntime, PieceBodiesHaveTrueMassAndCentreOfMass) {
             ++checked;
         }
     });
-    ASSERT_TRUE(rig.world().submitImpact(id, Impact{{1, 0.1, 0.2}, {1, 0, 0}, 100}));
+    ASSERT_TRUE(rig.runtime->submitLocalImpact(id, Impact{{1, 0.1, 0.2}, {1, 0, 0}, 100}));
     ASSERT_TRUE(rig.runUntilFracture());
     EXPECT_GE(checked, 2);
 }
@@ -190,7 +190,7 @@ TEST(BulletRuntime, PiecesFollowTheParentsVelocityFieldAndConserveMomentum) {
         EXPECT_NEAR(momentum.z, p0.z, 1e-4 * snap->mass);
         checked = true;
     });
-    ASSERT_TRUE(rig.world().submitImpact(id, Impact{{1, 0, 0}, {1, 0, 0}, 100}));
+    ASSERT_TRUE(rig.runtime->submitLocalImpact(id, Impact{{1, 0, 0}, {1, 0, 0}, 100}));
     ASSERT_TRUE(rig.runUntilFracture());
     EXPECT_TRUE(checked);
     rig.runtime->setOnRemoved({});
@@ -443,7 +443,8 @@ TEST(BulletRuntime, ShutdownWithJobsInFlightNeitherHangsNorLeaks) {
             for (int i = 0; i < 6; ++i)
                 ids.push_back(rig.addBox({1, 1, 1}, Frame{Mat3::identity(), {4.0 * i, 0, 0}}, 100));
             for (ObjectId id : ids)
-                submitted += rig.world().submitImpact(id, Impact{{1, 0.1, 0.2}, {1, 0, 0}, 100}) ? 1 : 0;
+                submitted +=
+                    rig.runtime->submitLocalImpact(id, Impact{{1, 0.1, 0.2}, {1, 0, 0}, 100}) ? 1 : 0;
             rig.runtime->stepFrame();
         }
         return submitted;
@@ -509,7 +510,7 @@ struct CollapseRig : Rig {
                                    b->volume});
             }
         });
-        EXPECT_TRUE(world().submitImpact(id, impact));
+        EXPECT_TRUE(runtime->submitLocalImpact(id, impact));
         EXPECT_TRUE(runUntilFracture());
         runtime->setOnAdopted({});
         return out;
@@ -699,7 +700,7 @@ TEST(BulletRuntimeCollapse, DebrisOfAStaticWallIsThrownOutward) {
                     if (const BodyRecord* b = rig.bodyOf(p.id); b && !isStatic(*b))
                         velocities.push_back(rig.runtime->motion(b->id).linearVelocity);
         });
-        ASSERT_TRUE(rig.world().submitImpact(wall, Impact{{0, 0, 0.25}, {0, 0, 1}, 200}));
+        ASSERT_TRUE(rig.runtime->submitLocalImpact(wall, Impact{{0, 0, 0.25}, {0, 0, 1}, 200}));
         ASSERT_TRUE(rig.runUntilFracture());
         ASSERT_FALSE(velocities.empty());
         for (const Vec3& v : velocities) {

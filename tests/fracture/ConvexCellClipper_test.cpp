@@ -3,6 +3,7 @@
 #include <map>
 
 #include "TestSupport.hpp"
+#include "fracture/CellComplex.hpp"
 #include "fracture/ConvexCellClipper.hpp"
 #include "rubble/core/Random.hpp"
 #include "rubble/fracture/Fracture.hpp"
@@ -331,4 +332,44 @@ TEST(ConvexCellClipper, CellsThatAreNotAComplexAreDeclined) {
         EXPECT_EQ(r.error().code, ErrorCode::GeometryFailure);
     }
     EXPECT_FALSE(detail::clipByConvexCells(sphere, {}).isOk());
+}
+
+// A cell plane through mesh vertices is declined by the triangle clip with its reason (returned, not thrown),
+// and the next clip on the same thread starts clean.
+TEST(ConvexCellClipper, ACellPlaneThroughMeshVerticesIsDeclinedAndTheNextClipWorks) {
+    const Mesh box = makeBox({-1, -1, -1}, {1, 1, 1});
+    const auto declined = detail::clipByConvexCell(box, ConvexPolytope::fromAabb({{1, -2, -2}, {3, 2, 2}}));
+    ASSERT_FALSE(declined);
+    EXPECT_EQ(declined.error().code, ErrorCode::GeometryFailure);
+    EXPECT_EQ(declined.error().message, "fast clip declined: point on a cell plane");
+    const auto cut = detail::clipByConvexCell(box, ConvexPolytope::fromAabb({{0.5, -2, -2}, {3, 2, 2}}));
+    ASSERT_TRUE(cut) << cut.error().message;
+    EXPECT_TRUE(closedAndOriented(cut->inside));
+    EXPECT_TRUE(closedAndOriented(cut->outside));
+    EXPECT_NEAR(signedVolume(cut->inside), 2.0, 1e-9);
+    EXPECT_NEAR(signedVolume(cut->outside), 6.0, 1e-9);
+}
+
+// The complex stage alone: two boxes sharing a face weld into 12 vertices and 11 faces, the shared one stored
+// once with each box on one side; overlapping boxes are declined with the reason, not thrown.
+TEST(ConvexCellClipper, TheComplexStoresASharedFaceOnceAndDeclinesOverlapsAsAnError) {
+    const ConvexPolytope a = ConvexPolytope::fromAabb({{0, 0, 0}, {1, 1, 1}});
+    const ConvexPolytope b = ConvexPolytope::fromAabb({{1, 0, 0}, {2, 1, 1}});
+    const Result<detail::CellComplex> cx = detail::buildCellComplex({a, b}, 1e-10);
+    ASSERT_TRUE(cx) << cx.error().message;
+    EXPECT_EQ(cx->vertices.size(), 12u);
+    EXPECT_EQ(cx->faces.size(), 11u);
+    ASSERT_EQ(cx->cells.size(), 2u);
+    int shared = 0;
+    for (const detail::CellComplex::Face& f : cx->faces)
+        shared += f.back == 0 && f.front == 1 ? 1 : 0;
+    EXPECT_EQ(shared, 1);
+    EXPECT_EQ(cx->cells[0].faces.size(), 6u);
+    EXPECT_EQ(cx->cells[1].faces.size(), 6u);
+
+    const ConvexPolytope overlapping = ConvexPolytope::fromAabb({{0.5, 0, 0}, {1.5, 1, 1}});
+    const Result<detail::CellComplex> refused = detail::buildCellComplex({a, overlapping}, 1e-10);
+    ASSERT_FALSE(refused);
+    EXPECT_EQ(refused.error().code, ErrorCode::GeometryFailure);
+    EXPECT_EQ(refused.error().message, "fast clip declined: cells overlap");
 }

@@ -308,13 +308,14 @@ TEST(NetLoopback, AJoiningClientGetsTheLatestPlacementsAsSoonAsItHasItsSnapshot)
 
 TEST(NetLoopback, OnlyLoopbackAddressesAndDeterministicWorlds) {
     DestructionWorld::Config config = test::journalConfig(1).world;
+    test::JournalRig host(1);
     DestructionWorld world(config);
-    auto outside = net::NetHost::listen(world, config, "192.0.2.1", 0);
+    auto outside = net::NetHost::listen(host.runtime, config, "192.0.2.1", 0);
     ASSERT_FALSE(outside);
     EXPECT_NE(outside.error().message.find("not a loopback address"), std::string::npos);
     EXPECT_FALSE(net::NetClient::connect(world, config, "192.0.2.1", 7777));
     config.deterministic = false;
-    EXPECT_FALSE(net::NetHost::listen(world, config, "127.0.0.1", 0));
+    EXPECT_FALSE(net::NetHost::listen(host.runtime, config, "127.0.0.1", 0));
 }
 
 } // namespace

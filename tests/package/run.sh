@@ -43,11 +43,14 @@ install)
         *) fail "librubble.so needs $lib, which docs/hello.md does not name" ;;
         esac
     done
-    # librubble.so exports Rubble's API only: no CGAL, Boost or standard-library instance.
-    exported=$(nm -D --defined-only "$prefix/$libdir/librubble.so" | awk '{print $3}' | c++filt)
-    foreign=$(echo "$exported" | grep -vE '^(rubble::|rubble_|typeinfo for rubble::|typeinfo name for rubble::|vtable for rubble::|non-virtual thunk to rubble::)' || true)
-    [ -z "$foreign" ] || fail "librubble.so exports $(echo "$foreign" | wc -l) symbols that are not Rubble's, e.g. $(echo "$foreign" | head -3)"
-    echo "librubble.so exports $(echo "$exported" | wc -l) symbols"
+    # librubble.so and librubble_bullet.so export Rubble's API only: no CGAL, Bullet, Boost or standard-library
+    # instance.
+    for so in librubble.so librubble_bullet.so; do
+        exported=$(nm -D --defined-only "$prefix/$libdir/$so" | awk '{print $3}' | c++filt)
+        foreign=$(echo "$exported" | grep -vE '^(rubble::|rubble_|typeinfo for rubble::|typeinfo name for rubble::|vtable for rubble::|non-virtual thunk to rubble::)' || true)
+        [ -z "$foreign" ] || fail "$so exports $(echo "$foreign" | wc -l) symbols that are not Rubble's, e.g. $(echo "$foreign" | head -3)"
+        echo "$so exports $(echo "$exported" | wc -l) symbols"
+    done
     # The install is lean: stripped, and the CLI and the Python module share librubble.so (558 MB before).
     size_mb=$(du -sm "$prefix" | cut -f1)
     [ "$size_mb" -le 50 ] || fail "the installed tree takes $size_mb MB, over 50"

@@ -25,7 +25,7 @@ struct Recording {
 Recording record(int workers, int frames) {
     test::JournalRig rig(workers);
     Recording r;
-    rig.runtime.world().setJournalSink([&](const JournalEvent& e) { r.events.push_back(e); });
+    rig.runtime.setJournalSink([&](const JournalEvent& e) { r.events.push_back(e); });
     rig.play(frames);
     rig.settle();
     r.frame = rig.runtime.world().frame();

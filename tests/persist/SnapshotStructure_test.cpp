@@ -175,7 +175,7 @@ TEST(SnapshotStructure, ARestoredWeldStaysAWeldAndABearingABearing) {
     chip.sizeLaw.scale = 0;
     const ObjectId beam = rig.addBox({-0.2, 3, -0.5}, {6.2, 3.4, 0.5}, "steel", true, chip);
     rig.runtime.stepFrame();
-    ASSERT_TRUE(rig.runtime.world().submitImpact(beam, Impact{{0, -0.2, 0}, {0, -1, 0}, 100}));
+    ASSERT_TRUE(rig.runtime.submitLocalImpact(beam, Impact{{0, -0.2, 0}, {0, -1, 0}, 100}));
     for (int i = 0; i < 60; ++i)
         rig.runtime.stepFrame();
     ASSERT_EQ(rig.runtime.counters().fractures, 1);

@@ -275,7 +275,7 @@ TEST(Snapshot, AnOlderVersionIsRefusedWithAClearError) {
 TEST(Snapshot, SnapshotPlusJournalTailConvergesWithTheHost) {
     MidFire m;
     std::vector<JournalEvent> tail;
-    m.rig.runtime.world().setJournalSink([&](const JournalEvent& e) { tail.push_back(e); });
+    m.rig.runtime.setJournalSink([&](const JournalEvent& e) { tail.push_back(e); });
     m.rig.play(120);
     m.rig.settle();
     ASSERT_GT(tail.size(), 3u);

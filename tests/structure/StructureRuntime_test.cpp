@@ -239,7 +239,7 @@ TEST(StructureRuntime, ChipsStayBondedAcrossTheirCutFacesByPolicyAndTheStructure
         rig.runtime.stepFrame();
         EXPECT_EQ(rig.runtime.structureBonds().size(), 2u);
         // A hit chips the column: the remainder and one chip (the cell's piece).
-        EXPECT_TRUE(rig.runtime.world().submitImpact(column, Impact{{0.5, 0, 0}, {1, 0, 0}, 100}));
+        EXPECT_TRUE(rig.runtime.submitLocalImpact(column, Impact{{0.5, 0, 0}, {1, 0, 0}, 100}));
         for (int i = 0; i < 30; ++i)
             rig.runtime.stepFrame();
         EXPECT_EQ(rig.runtime.counters().fractures, 1);

@@ -14,7 +14,7 @@ namespace rubble::test {
 /// A JournalRig (one worker) with a NetHost listening on it; `server` is null when listening failed.
 struct NetHostRig {
     NetHostRig() : rig(1), config(journalConfig(1).world) {
-        auto listened = net::NetHost::listen(rig.runtime.world(), config, "127.0.0.1", 0);
+        auto listened = net::NetHost::listen(rig.runtime, config, "127.0.0.1", 0);
         EXPECT_TRUE(listened) << (listened ? std::string() : listened.error().message);
         if (!listened)
             return;

@@ -25,8 +25,10 @@ constexpr int kServiceSliceMs = 2; // how long service() waits at a time while a
 } // namespace
 
 struct NetHost::Impl {
-    Impl(DestructionWorld& w, const DestructionWorld::Config& c) : world(w), config(c) {}
-    DestructionWorld& world;
+    Impl(DestructionRuntime& r, const DestructionWorld::Config& c)
+        : runtime(r), world(r.world()), config(c) {}
+    DestructionRuntime& runtime;
+    const DestructionWorld& world;
     DestructionWorld::Config config;
     ENetHost* host = nullptr;
     std::vector<JournalEvent> journal;             // events since base
@@ -252,7 +254,7 @@ struct NetHost::Impl {
 NetHost::NetHost(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 
 NetHost::~NetHost() {
-    impl_->world.setJournalSink({});
+    impl_->runtime.setJournalSink({});
     if (impl_->host) {
         for (auto& [peer, position] : impl_->peers)
             enet_peer_disconnect_now(peer, detail::kGoodbye);
@@ -260,7 +262,7 @@ NetHost::~NetHost() {
     }
 }
 
-Result<std::unique_ptr<NetHost>> NetHost::listen(DestructionWorld& world,
+Result<std::unique_ptr<NetHost>> NetHost::listen(DestructionRuntime& runtime,
                                                  const DestructionWorld::Config& config,
                                                  const std::string& address, std::uint16_t port,
                                                  int maxClients) {
@@ -271,13 +273,13 @@ Result<std::unique_ptr<NetHost>> NetHost::listen(DestructionWorld& world,
     Result<ENetAddress> a = detail::loopbackAddress(address, port);
     if (!a)
         return a.error();
-    auto impl = std::make_unique<Impl>(world, config);
+    auto impl = std::make_unique<Impl>(runtime, config);
     impl->host = enet_host_create(&*a, static_cast<std::size_t>(maxClients), 2, 0, 0);
     if (!impl->host)
         return Error{ErrorCode::IoError, "cannot listen on " + address + ":" + std::to_string(port)};
-    impl->base = world.journalPosition();
+    impl->base = runtime.world().journalPosition();
     Impl* raw = impl.get();
-    world.setJournalSink([raw](const JournalEvent& e) { raw->journal.push_back(e); });
+    runtime.setJournalSink([raw](const JournalEvent& e) { raw->journal.push_back(e); });
     return std::unique_ptr<NetHost>(new NetHost(std::move(impl)));
 }
 

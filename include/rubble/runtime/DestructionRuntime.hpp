@@ -314,9 +314,7 @@ public:
     DestructionRuntime(const DestructionRuntime&) = delete;
     DestructionRuntime& operator=(const DestructionRuntime&) = delete;
 
-    /// The fracture jobs and object states.
-    DestructionWorld& world();
-    /// The fracture jobs and object states.
+    /// The fracture jobs and object states (read-only: the runtime alone changes them).
     const DestructionWorld& world() const;
     /// The engine.
     PhysicsBinding& binding();
@@ -339,6 +337,12 @@ public:
     /// Submits an impact on a body's object at a world point with a world normal (out of the object) and an
     /// impulse, e.g. for a blast. False when ignored (no destructible object, below its threshold).
     bool submitImpact(BodyId id, const Vec3& worldPoint, const Vec3& worldNormal, double impulse);
+    /// Submits an impact in an object's local coordinates (as DestructionWorld::submitImpact takes it) on the
+    /// object a body carries, as a contact's impact is submitted. False when ignored (no body carries the
+    /// object, or the world's filter refuses it).
+    bool submitLocalImpact(ObjectId object, const Impact& impact);
+    /// Called with every journal event of the world (DestructionWorld::setJournalSink).
+    void setJournalSink(std::function<void(const JournalEvent&)> sink);
     /// A blast: an impact on every destructible object whose bounding sphere meets the sphere of `radius`
     /// around `center`, at the point of its bounding sphere nearest the centre (pushed in), its normal toward
     /// the centre, the impulse falling off linearly from `impulse` to `edgeShare` of it across the radius.

@@ -237,9 +237,9 @@ public:
     /// adopting results in the main thread's idle time between frames (collect() may be called again in
     /// the same frame). Returns false at once when no job is in flight, and always in deterministic mode,
     /// where adoption stays bound to frames so that replays are identical. A deadline in the past polls.
-    bool waitForResult(std::chrono::steady_clock::time_point deadline);
+    bool waitForResult(std::chrono::steady_clock::time_point deadline) const;
     /// Blocks until no job is in flight or queued (for tools, tests and shutdown).
-    void waitIdle();
+    void waitIdle() const;
 
     /// Jobs running or waiting.
     int jobsInFlight() const;

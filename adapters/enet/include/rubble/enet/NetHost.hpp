@@ -70,9 +70,10 @@ struct ShotRequest {
 /// must be deterministic (Config::deterministic), since clients replay its journal.
 class NetHost {
 public:
-    /// Listens on address:port (port 0 = any free port) for at most maxClients. Fails for a non-loopback
-    /// address, a world that is not deterministic, or when ENet cannot bind.
-    static Result<std::unique_ptr<NetHost>> listen(DestructionWorld& world,
+    /// Listens on address:port (port 0 = any free port) for at most maxClients, replicating the runtime's
+    /// world (config: its DestructionWorld::Config). Fails for a non-loopback address, a world that is not
+    /// deterministic, or when ENet cannot bind.
+    static Result<std::unique_ptr<NetHost>> listen(DestructionRuntime& runtime,
                                                    const DestructionWorld::Config& config,
                                                    const std::string& address, std::uint16_t port,
                                                    int maxClients = 8);
@@ -80,7 +81,7 @@ public:
     NetHost(const NetHost&) = delete;
     NetHost& operator=(const NetHost&) = delete;
 
-    /// Takes a journal event. listen() makes this the world's journal sink; a game that has its own sink
+    /// Takes a journal event. listen() makes this the runtime's journal sink; a game that has its own sink
     /// forwards the events here instead.
     void journaled(const JournalEvent& event);
     /// The port it listens on.
