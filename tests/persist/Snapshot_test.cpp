@@ -240,8 +240,7 @@ TEST(Snapshot, KeepsDecompositionSettingsMeshHashesAndTheVolumeLedger) {
 // A snapshot saved by the previous format (version 1, tests/data/snapshot/v1-box.rsnap: a box shattered into
 // 4 pieces) is refused naming the version and what to do; the world stays as it was.
 TEST(Snapshot, AnOlderVersionIsRefusedWithAClearError) {
-    const std::filesystem::path v1 =
-        test::sourceDir() / "tests/data/snapshot/v1-box.rsnap";
+    const std::filesystem::path v1 = test::sourceDir() / "tests/data/snapshot/v1-box.rsnap";
     Result<Snapshot> r = loadSnapshot(v1);
     ASSERT_FALSE(r);
     EXPECT_NE(r.error().message.find("v1-box.rsnap: offset 4, field version: version 1 is not supported"),

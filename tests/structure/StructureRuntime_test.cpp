@@ -333,8 +333,7 @@ namespace rubble {
 // with it: the load brings the tower down, where connectivity alone (the slab still touches two pillars)
 // leaves it standing.
 TEST(StructureRuntime, ATowerStandsUnshotAndFallsWhenOneSideOfItsBaseIsRemoved) {
-    const Result<SceneConfig> scene =
-        parseSceneConfig(test::sourceDir() / "assets/scenes/tower.cfg");
+    const Result<SceneConfig> scene = parseSceneConfig(test::sourceDir() / "assets/scenes/tower.cfg");
     ASSERT_TRUE(scene) << scene.error().message;
     for (const int mode : {0, 1, 2}) { // Gauss-Seidel, direct, connectivity
         const bool structure = mode < 2;
