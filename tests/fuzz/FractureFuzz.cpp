@@ -13,6 +13,7 @@
 #include "rubble/core/ParameterCheck.hpp"
 #include "rubble/fracture/Fracture.hpp"
 #include "rubble/geometry/MassProperties.hpp"
+#include "rubble/geometry/MeshCheck.hpp"
 
 namespace {
 
@@ -132,7 +133,8 @@ bool acceptableInput(const Mesh& m) {
             if (v >= m.positions.size())
                 return false;
     for (const Vec3& p : m.positions)
-        if (!isFinite(p))
+        if (!isFinite(p) || std::abs(p.x) > kMaxCoordinate || std::abs(p.y) > kMaxCoordinate ||
+            std::abs(p.z) > kMaxCoordinate)
             return false;
     return fuzz::closedAndOriented(m) && signedVolume(m) > 0;
 }
@@ -190,8 +192,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
             // A valid input may miss or defeat the kernel (it then stays whole), never be called invalid.
             const ErrorCode code = r.error().code;
             if ((code != ErrorCode::NoIntersection && code != ErrorCode::GeometryFailure) ||
-                r.error().message.empty())
+                r.error().message.empty()) {
+                std::fprintf(stderr, "FractureFuzz: error %d: %s\n", static_cast<int>(code),
+                             r.error().message.c_str());
                 fail("a valid input gave an error other than NoIntersection or GeometryFailure");
+            }
             return 0;
         }
         const double v0 = signedVolume(mesh);
