@@ -133,10 +133,9 @@ bool acceptableInput(const Mesh& m) {
             if (v >= m.positions.size())
                 return false;
     for (const Vec3& p : m.positions)
-        if (!isFinite(p) || std::abs(p.x) > kMaxCoordinate || std::abs(p.y) > kMaxCoordinate ||
-            std::abs(p.z) > kMaxCoordinate)
+        if (!isFinite(p))
             return false;
-    return fuzz::closedAndOriented(m) && signedVolume(m) > 0;
+    return checkCoordinateRange(m, "fuzz").isOk() && fuzz::closedAndOriented(m) && signedVolume(m) > 0;
 }
 
 std::uint64_t hashPieces(const FractureResult& r) {
