@@ -57,6 +57,8 @@ function(rubble_tests folder)
         add_executable(${exe} ${src})
         target_link_libraries(${exe} PRIVATE ${ARGN} rubble_test_support GTest::gtest_main rubble_warnings)
         set_target_properties(${exe} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
+        # Test code at -O1: the library under test keeps its build type's flags (docs/robustness.md, section 7).
+        target_compile_options(${exe} PRIVATE $<$<NOT:$<CONFIG:Debug>>:-O1>)
         gtest_discover_tests(${exe} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR} DISCOVERY_TIMEOUT 60
             PROPERTIES LABELS ${folder})
     endforeach()
