@@ -165,6 +165,31 @@ double cutArea(const FractureResult& r, std::int32_t cell = kAnyCell) {
     return a;
 }
 
+/// The vertices of cut triangles (interior material) of r's pieces that are not vertices of the mesh it cut
+/// and lie on none of its cells' face planes: new cut vertices moved off their flat cut.
+std::size_t displacedNewCutVertices(const Mesh& before, const FractureResult& r) {
+    std::set<std::tuple<double, double, double>> old;
+    for (const Vec3& v : before.positions)
+        old.emplace(v.x, v.y, v.z);
+    std::set<std::tuple<double, double, double>> moved;
+    for (const Piece& p : r.pieces)
+        for (std::size_t t = 0; t < p.mesh.triangles.size(); ++t) {
+            if (p.mesh.materials[t] != kInteriorMaterial)
+                continue;
+            for (const Vec3& c : p.mesh.corners(t)) {
+                if (old.count({c.x, c.y, c.z}))
+                    continue;
+                double nearest = 1e300;
+                for (const ConvexPolytope& cell : r.cells)
+                    for (const PolytopeFace& f : cell.faces())
+                        nearest = std::min(nearest, std::abs(f.plane.signedDistance(c)));
+                if (nearest > 1e-6)
+                    moved.emplace(c.x, c.y, c.z);
+            }
+        }
+    return moved.size();
+}
+
 } // namespace
 
 TEST(RoughFracture, RandomHitsAndPiecesOfPiecesKeepTheInvariants) {
@@ -340,6 +365,46 @@ TEST(RoughFracture, SmallPiecesFollowTheBudget) {
         EXPECT_LE(cut, 500u);
         EXPECT_GT(cut, 100u);
     }
+}
+
+namespace {
+
+/// The most cut triangles (interior material) of one piece.
+std::size_t mostCutTriangles(const FractureResult& r) {
+    std::size_t most = 0;
+    for (const Piece& p : r.pieces)
+        most = std::max(most, static_cast<std::size_t>(std::count(
+                                  p.mesh.materials.begin(), p.mesh.materials.end(), kInteriorMaterial)));
+    return most;
+}
+
+} // namespace
+
+// A cut through a fine mesh: its outline has many short segments, whose slivers an estimate from the cut's
+// area misses. The bisection's triangles are counted, so no piece's cut faces exceed the budget, copied or
+// edited in place, and the cut is still rough.
+TEST(RoughFracture, TheBudgetHoldsOnAFineOutline) {
+    Mesh sphere = makeSphere({0, 0, 0}, 1, 160, 80);
+    const Mesh input = sphere;
+    auto facts = analyzeMesh(sphere);
+    ASSERT_TRUE(facts);
+    FractureParams p = roughParams();
+    p.sizeLaw.base = 0.8;
+    p.roughness.maxTrianglesPerPiece = 600;
+    const Impact impact{{1 - 1e-3, 0.01, 0.02}, {1, 0, 0}, 10};
+    auto copied = fracture(input, impact, p, 5);
+    auto inPlace = fracture(std::move(sphere), impact, p, 5, std::move(*facts));
+    ASSERT_TRUE(copied && inPlace);
+    for (const FractureResult* r : {&*copied, &*inPlace}) {
+        const std::string what = r->editedInPlace ? "in place" : "copied";
+        ASSERT_TRUE(r->rough) << what;
+        EXPECT_LE(mostCutTriangles(*r), 600u) << what;
+        EXPECT_GT(mostCutTriangles(*r), 300u) << what;
+        expectSoundPieces(input, *r, what);
+        expectCutsCoincide(*r, what);
+    }
+    EXPECT_TRUE(inPlace->editedInPlace);
+    EXPECT_GT(displacedNewCutVertices(input, *copied), 10u);
 }
 
 TEST(RoughFracture, ParametersAreValidated) {
