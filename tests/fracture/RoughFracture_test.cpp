@@ -390,7 +390,7 @@ std::size_t mostCutTriangles(const FractureResult& r) {
 
 // A cut through a fine mesh: its outline has many short segments, whose slivers an estimate from the cut's
 // area misses. The bisection's triangles are counted, so no piece's cut faces exceed the budget, copied or
-// edited in place, and the cut is still rough.
+// edited in place, and the cut is still rough, with no self-intersection.
 TEST(RoughFracture, TheBudgetHoldsOnAFineOutline) {
     Mesh sphere = makeSphere({0, 0, 0}, 1, 160, 80);
     const Mesh input = sphere;
@@ -413,6 +413,11 @@ TEST(RoughFracture, TheBudgetHoldsOnAFineOutline) {
     }
     EXPECT_TRUE(inPlace->editedInPlace);
     EXPECT_GT(displacedNewCutVertices(input, *copied), 10u);
+    for (const Piece& piece : copied->pieces) {
+        const MeshReport report = checkMesh(piece.mesh);
+        EXPECT_TRUE(report.selfIntersectionsChecked) << report.selfIntersectionNote;
+        EXPECT_TRUE(report.valid()) << test::joinLines(report.problems);
+    }
 }
 
 // The UVs of a rough face are the planar projection of its flat position in the face's basis, the same
