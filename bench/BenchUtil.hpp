@@ -28,6 +28,9 @@ Stats stats(std::vector<double> samples);
 /// Milliseconds since t0 on the steady clock.
 double msSince(std::chrono::steady_clock::time_point t0);
 
+/// This thread's CPU time in ms (the machine is shared: wall time includes waiting for a core).
+double threadCpuMs();
+
 /// Runs f `runs` times and returns the statistics of its wall-clock durations in milliseconds.
 template <class F>
 Stats timeIt(int runs, F&& f) {

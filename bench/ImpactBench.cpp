@@ -66,6 +66,7 @@ struct Samples {
     std::vector<double> excess;    // (Σ part volume − Σ piece volume) / Σ piece volume
     int fallbacks = 0, failures = 0;
     std::size_t pieceCount = 0, partCount = 0; // of the last run
+    std::size_t mostCut = 0;                   // the most cut triangles of one piece, every run
     std::string error;
 };
 
@@ -144,6 +145,10 @@ void runOnce(Case& c, rubble::BooleanKind kind, std::uint64_t seed) {
     s.decomposition.push_back(partsMs);
     s.fallbacks += r->exactFallback ? 1 : 0;
     s.pieceCount = r->pieces.size();
+    for (const rubble::Piece& p : r->pieces)
+        s.mostCut = std::max(
+            s.mostCut, static_cast<std::size_t>(std::count(p.mesh.materials.begin(), p.mesh.materials.end(),
+                                                           rubble::kInteriorMaterial)));
     s.partCount = 0;
     double partVolume = 0, pieceVolume = 0;
     for (std::size_t i = 0; i < parts.size(); ++i) {
@@ -379,6 +384,7 @@ int runBench(const BenchArgs& args) {
                     "thesis_s",
                     "speedup_vs_thesis",
                     "pieces_cpu_median_ms",
+                    "cut_triangles_max",
                     "other_cpu_cores"};
     std::string failures;
     for (const Case& c : cases)
@@ -410,6 +416,7 @@ int runBench(const BenchArgs& args) {
                                   reference ? fixed(c.thesisS) : "",
                                   reference ? fixed(c.thesisS * 1000 / withParts.median, 0) : "",
                                   fixed(stats(s.piecesCpu).median),
+                                  std::to_string(s.mostCut),
                                   fixed(otherCpu, 2)});
             if (s.failures > 0)
                 failures += c.name + " " + backendName(kind) + ": " + std::to_string(s.failures) + " of " +

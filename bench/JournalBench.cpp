@@ -38,6 +38,7 @@ namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 using rubble::bench::fixed;
 using rubble::bench::msSince;
+using rubble::bench::threadCpuMs;
 
 struct BenchArgs {
     bool quick = false;
@@ -72,13 +73,6 @@ struct SnapshotTiming {
     double loadCpuMs = 0; // CPU time of the loading thread: what the load costs when other processes compete
     bool same = false;    // the loaded world has the saved one's geometry hash
 };
-
-// CPU time of the calling thread (ms).
-double threadCpuMs() {
-    timespec ts{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) / 1e6;
-}
 
 // Encodes, saves atomically to the file scratch, reads, decodes and restores into a fresh world.
 SnapshotTiming timeSnapshot(const rubble::DestructionWorld& world,

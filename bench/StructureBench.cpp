@@ -30,6 +30,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using rubble::bench::fixed;
+using rubble::bench::threadCpuMs;
 
 struct BenchArgs {
     bool quick = false;
@@ -53,12 +54,6 @@ struct Row {
     double updateP50 = 0, updateP99 = 0, rebuildMs = 0; // one fracture's structure update, thread CPU
     double pieces = 0;                                  // pieces per fracture (mean)
 };
-
-double threadCpuMs() {
-    timespec t{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-    return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
-}
 
 double percentile(std::vector<double> v, double q) {
     if (v.empty())

@@ -260,8 +260,50 @@ struct RoughSettings {
     double uvScale = 1;
 };
 
-/// Splits the working triangles' marked edges (edge key -> midpoint vertex) by the templates of red-green
-/// refinement; the two-edge template takes the shorter diagonal (ties by the diagonals' corners).
+/// The passes of tessellate's bisection at most.
+constexpr int kBisectionPasses = 40;
+
+/// The red-green template of a triangle whose edges (k, k + 1) marked in split are bisected: calls
+/// emit(a, b, c) for each child, its corners numbered 0..2 and the midpoint of edge k 3 + k; p holds those
+/// six points (the midpoints of edges not split unused). The two-edge template takes the shorter diagonal
+/// (ties by the diagonals' corners).
+template <class Emit>
+void bisectionTemplate(const std::array<bool, 3>& split, const std::array<Vec3, 6>& p, Emit emit) {
+    const int count = int{split[0]} + int{split[1]} + int{split[2]};
+    if (count == 3) {
+        emit(0, 3, 5);
+        emit(3, 1, 4);
+        emit(5, 4, 2);
+        emit(3, 4, 5);
+    } else if (count == 1) {
+        const int k = split[0] ? 0 : split[1] ? 1 : 2; // split edge (k, k+1)
+        const int j = (k + 1) % 3, l = (k + 2) % 3;
+        emit(k, 3 + k, l);
+        emit(3 + k, j, l);
+    } else if (count == 2) {
+        const int z = !split[0] ? 0 : !split[1] ? 1 : 2;   // the edge (z, z+1) is whole
+        const int a = (z + 1) % 3, b = (z + 2) % 3, c = z; // split edges (a, b) and (b, c)
+        const int m1 = 3 + a, m2 = 3 + b;
+        emit(m1, b, m2);
+        // Quad (a, m1, m2, c): diagonal a-m2 or m1-c, the shorter; ties by the diagonals' corners.
+        const Vec3 &pa = p[a], &pc = p[c], &p1 = p[m1], &p2 = p[m2];
+        const double d1 = dot(pa - p2, pa - p2), d2 = dot(p1 - pc, p1 - pc);
+        bool first = d1 < d2;
+        if (d1 == d2) {
+            const Vec3 k1 = lexLess(pa, p2) ? pa : p2, k2 = lexLess(p1, pc) ? p1 : pc;
+            first = lexLess(k1, k2);
+        }
+        if (first) {
+            emit(a, m1, m2);
+            emit(a, m2, c);
+        } else {
+            emit(a, m1, c);
+            emit(m1, m2, c);
+        }
+    }
+}
+
+/// Splits the working triangles' marked edges (edge key -> midpoint vertex) by bisectionTemplate.
 void splitTriangles(std::vector<WorkTriangle>& work,
                     const std::unordered_map<std::uint64_t, std::uint32_t>& mid, const std::vector<Vec3>& pos,
                     bool normals) {
@@ -269,13 +311,13 @@ void splitTriangles(std::vector<WorkTriangle>& work,
     out.reserve(work.size() * 2);
     for (const WorkTriangle& t : work) {
         std::array<std::int64_t, 3> m{-1, -1, -1}; // midpoint of edge (k, k+1)
-        int count = 0;
+        std::array<bool, 3> split{};
         for (int k = 0; k < 3; ++k)
             if (auto it = mid.find(edgeKey(t.v[k], t.v[(k + 1) % 3])); it != mid.end()) {
                 m[k] = it->second;
-                ++count;
+                split[k] = true;
             }
-        if (count == 0) {
+        if (!split[0] && !split[1] && !split[2]) {
             out.push_back(t);
             continue;
         }
@@ -283,58 +325,97 @@ void splitTriangles(std::vector<WorkTriangle>& work,
         std::array<std::uint32_t, 6> vid{};
         std::array<Vec3, 6> nn{};
         std::array<Vec2, 6> uu{};
+        std::array<Vec3, 6> pp{};
         for (int k = 0; k < 3; ++k) {
             vid[k] = t.v[k];
             nn[k] = t.n[k];
             uu[k] = t.uv[k];
+            pp[k] = pos[t.v[k]];
             const int j = (k + 1) % 3;
             if (m[k] >= 0) {
                 vid[3 + k] = static_cast<std::uint32_t>(m[k]);
                 if (normals)
                     nn[3 + k] = normalized(t.n[k] + t.n[j]);
                 uu[3 + k] = {(t.uv[k].x + t.uv[j].x) * 0.5, (t.uv[k].y + t.uv[j].y) * 0.5};
+                pp[3 + k] = pos[vid[3 + k]];
             }
         }
-        auto emit = [&](int a, int b, int c) {
+        bisectionTemplate(split, pp, [&](int a, int b, int c) {
             WorkTriangle s = t;
             s.v = {vid[a], vid[b], vid[c]};
             s.n = {nn[a], nn[b], nn[c]};
             s.uv = {uu[a], uu[b], uu[c]};
             out.push_back(s);
-        };
-        if (count == 3) {
-            emit(0, 3, 5);
-            emit(3, 1, 4);
-            emit(5, 4, 2);
-            emit(3, 4, 5);
-        } else if (count == 1) {
-            const int k = m[0] >= 0 ? 0 : m[1] >= 0 ? 1 : 2; // split edge (k, k+1)
-            const int j = (k + 1) % 3, l = (k + 2) % 3;
-            emit(k, 3 + k, l);
-            emit(3 + k, j, l);
-        } else {
-            const int z = m[0] < 0 ? 0 : m[1] < 0 ? 1 : 2;     // the edge (z, z+1) is whole
-            const int a = (z + 1) % 3, b = (z + 2) % 3, c = z; // split edges (a, b) and (b, c)
-            const int m1 = 3 + a, m2 = 3 + b;
-            emit(m1, b, m2);
-            // Quad (a, m1, m2, c): diagonal a-m2 or m1-c, the shorter; ties by the diagonals' corners.
-            const Vec3 &pa = pos[vid[a]], &pc = pos[vid[c]], &p1 = pos[vid[m1]], &p2 = pos[vid[m2]];
-            const double d1 = dot(pa - p2, pa - p2), d2 = dot(p1 - pc, p1 - pc);
-            bool first = d1 < d2;
-            if (d1 == d2) {
-                const Vec3 k1 = lexLess(pa, p2) ? pa : p2, k2 = lexLess(p1, pc) ? p1 : pc;
-                first = lexLess(k1, k2);
-            }
-            if (first) {
-                emit(a, m1, m2);
-                emit(a, m2, c);
-            } else {
-                emit(a, m1, c);
-                emit(m1, m2, c);
-            }
-        }
+        });
     }
     work = std::move(out);
+}
+
+/// Adds to count the triangles that tessellate's bisection to edges of squared length at most edge2 makes
+/// of the cut triangle p from this pass on (an edge splits by its length alone, so a cut triangle's share is
+/// its own); stops once count exceeds limit.
+void countBisected(const std::array<Vec3, 3>& p, double edge2, int pass, std::size_t limit,
+                   std::size_t& count) {
+    if (count > limit)
+        return;
+    std::array<bool, 3> split{};
+    std::array<Vec3, 6> q{p[0], p[1], p[2]};
+    for (int k = 0; k < 3 && pass < kBisectionPasses; ++k) {
+        const Vec3& a = p[k];
+        const Vec3& b = p[(k + 1) % 3];
+        const Vec3 d = a - b;
+        split[k] = dot(d, d) > edge2;
+        if (split[k])
+            q[3 + k] = (a + b) * 0.5;
+    }
+    if (!split[0] && !split[1] && !split[2]) {
+        ++count;
+        return;
+    }
+    bisectionTemplate(split, q, [&](int a, int b, int c) {
+        countBisected({q[a], q[b], q[c]}, edge2, pass + 1, limit, count);
+    });
+}
+
+/// The target edge: the estimate (from the cut area), or the least longer edge at which the bisection gives
+/// no output more than budget cut triangles, counted (a fine outline adds slivers the estimate misses); the
+/// longest cut edge (no bisection) when even that does not fit. cut: each output's cut triangles.
+double edgeWithinBudget(const std::vector<std::vector<std::array<Vec3, 3>>>& cut, double estimate,
+                        std::size_t budget) {
+    const auto fits = [&](double e) {
+        for (const auto& triangles : cut) {
+            std::size_t count = 0;
+            for (const auto& t : triangles)
+                countBisected(t, e * e, 0, budget, count);
+            if (count > budget)
+                return false;
+        }
+        return true;
+    };
+    if (fits(estimate))
+        return estimate;
+    double longest = 0;
+    for (const auto& triangles : cut)
+        for (const auto& t : triangles)
+            for (int k = 0; k < 3; ++k)
+                longest = std::max(longest, length(t[k] - t[(k + 1) % 3]));
+    double over = estimate, fit = estimate;
+    bool ok = false;
+    do {
+        over = fit;
+        fit = std::min(longest, fit * 1.25);
+        ok = fits(fit);
+    } while (!ok && fit < longest);
+    if (!ok) // the cut as it is: no edge is longer than the longest
+        return fit;
+    for (int step = 0; step < 4; ++step) {
+        const double e = 0.5 * (over + fit);
+        if (fits(e))
+            fit = e;
+        else
+            over = e;
+    }
+    return fit;
 }
 
 /// A face's edges in an output's sorted edge list.
@@ -409,7 +490,7 @@ void tessellate(RoughOutput& o, Mesh& m, const std::vector<std::int32_t>& faceOf
     std::vector<WorkTriangle>& work = o.work;
     // Bisect every cut-face edge longer than the target until none is.
     const double edge2 = s.edge * s.edge;
-    for (int pass = 0; pass < 40; ++pass) {
+    for (int pass = 0; pass < kBisectionPasses; ++pass) {
         std::unordered_map<std::uint64_t, std::uint32_t> mid;
         for (const WorkTriangle& t : work) {
             if (t.face < 0)
@@ -650,6 +731,7 @@ RoughCutReport roughenOutputs(const std::vector<Mesh*>& outputs, VolumeIntegrals
 
     const CutFaces faces(cells, onPlane);
     std::vector<std::vector<std::int32_t>> faceOf(outputs.size());
+    std::vector<std::vector<std::array<Vec3, 3>>> cut(outputs.size()); // each output's cut triangles
     Aabb focus;
     for (const ConvexPolytope& c : cells)
         focus.extend(c.bounds());
@@ -668,15 +750,19 @@ RoughCutReport roughenOutputs(const std::vector<Mesh*>& outputs, VolumeIntegrals
             if (!focus.contains(c[0]) || !focus.contains(c[1]) || !focus.contains(c[2]))
                 continue;
             faceOf[o][t] = faces.find(c);
-            if (faceOf[o][t] >= 0)
-                area += 0.5 * length(cross(c[1] - c[0], c[2] - c[0]));
+            if (faceOf[o][t] < 0)
+                continue;
+            area += 0.5 * length(cross(c[1] - c[0], c[2] - c[0]));
+            cut[o].push_back(c);
         }
         largestCut = std::max(largestCut, area);
     }
-    // Edges resolve the finest octave by three; the budget coarsens them and drops the octaves they miss.
+    // Edges resolve the finest octave by three; the budget coarsens them (estimated from the cut area, then
+    // counted) and drops the octaves they miss.
     const double finest = report.featureSize / std::ldexp(1.0, r.octaves - 1);
     const double budgetEdge = std::sqrt(largestCut / (0.07 * r.maxTrianglesPerPiece));
-    report.edge = std::max(finest / 3, budgetEdge);
+    report.edge = edgeWithinBudget(cut, std::max(finest / 3, budgetEdge),
+                                   static_cast<std::size_t>(r.maxTrianglesPerPiece));
     report.octaves = 1;
     while (report.octaves < r.octaves &&
            report.featureSize / std::ldexp(1.0, report.octaves) >= 3 * report.edge)

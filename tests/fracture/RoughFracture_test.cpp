@@ -165,12 +165,37 @@ double cutArea(const FractureResult& r, std::int32_t cell = kAnyCell) {
     return a;
 }
 
+/// The vertices of cut triangles (interior material) of r's pieces that are not vertices of the mesh it cut
+/// and lie on none of its cells' face planes: new cut vertices moved off their flat cut.
+std::size_t displacedNewCutVertices(const Mesh& before, const FractureResult& r) {
+    std::set<std::tuple<double, double, double>> old;
+    for (const Vec3& v : before.positions)
+        old.emplace(v.x, v.y, v.z);
+    std::set<std::tuple<double, double, double>> moved;
+    for (const Piece& p : r.pieces)
+        for (std::size_t t = 0; t < p.mesh.triangles.size(); ++t) {
+            if (p.mesh.materials[t] != kInteriorMaterial)
+                continue;
+            for (const Vec3& c : p.mesh.corners(t)) {
+                if (old.count({c.x, c.y, c.z}))
+                    continue;
+                double nearest = 1e300;
+                for (const ConvexPolytope& cell : r.cells)
+                    for (const PolytopeFace& f : cell.faces())
+                        nearest = std::min(nearest, std::abs(f.plane.signedDistance(c)));
+                if (nearest > 1e-6)
+                    moved.emplace(c.x, c.y, c.z);
+            }
+        }
+    return moved.size();
+}
+
 } // namespace
 
 TEST(RoughFracture, RandomHitsAndPiecesOfPiecesKeepTheInvariants) {
     const Mesh input = cube();
     Rng rng(7);
-    int rough = 0, total = 0;
+    int rough = 0, total = 0, roughAgain = 0;
     for (int i = 0; i < 6; ++i) {
         Impact impact;
         impact.point = surfacePoint(input, rng);
@@ -196,8 +221,16 @@ TEST(RoughFracture, RandomHitsAndPiecesOfPiecesKeepTheInvariants) {
         ++total;
         rough += r2->rough ? 1 : 0;
         expectSoundPieces(largest->mesh, *r2, what + " again");
+        EXPECT_LT(offCube(*r2), 1e-12) << what << " again";
+        roughAgain += displacedNewCutVertices(largest->mesh, *r2) > 0 ? 1 : 0;
+        for (const Piece& p : r2->pieces) {
+            const MeshReport report = checkMesh(p.mesh);
+            EXPECT_TRUE(report.selfIntersectionsChecked) << report.selfIntersectionNote;
+            EXPECT_TRUE(report.valid()) << what << " again: " << test::joinLines(report.problems);
+        }
     }
     EXPECT_GE(rough, total - 2); // the exact fallback (flat) is rare
+    EXPECT_GE(roughAgain, 4);    // the second cuts are rough too
 }
 
 TEST(RoughFracture, PiecesDoNotSelfIntersect) {
@@ -340,6 +373,117 @@ TEST(RoughFracture, SmallPiecesFollowTheBudget) {
         EXPECT_LE(cut, 500u);
         EXPECT_GT(cut, 100u);
     }
+}
+
+namespace {
+
+/// The most cut triangles (interior material) of one piece.
+std::size_t mostCutTriangles(const FractureResult& r) {
+    std::size_t most = 0;
+    for (const Piece& p : r.pieces)
+        most = std::max(most, static_cast<std::size_t>(std::count(
+                                  p.mesh.materials.begin(), p.mesh.materials.end(), kInteriorMaterial)));
+    return most;
+}
+
+} // namespace
+
+// A cut through a fine mesh: its outline has many short segments, whose slivers an estimate from the cut's
+// area misses. The bisection's triangles are counted, so no piece's cut faces exceed the budget, copied or
+// edited in place, and the cut is still rough, with no self-intersection.
+TEST(RoughFracture, TheBudgetHoldsOnAFineOutline) {
+    Mesh sphere = makeSphere({0, 0, 0}, 1, 160, 80);
+    const Mesh input = sphere;
+    auto facts = analyzeMesh(sphere);
+    ASSERT_TRUE(facts);
+    FractureParams p = roughParams();
+    p.sizeLaw.base = 0.8;
+    p.roughness.maxTrianglesPerPiece = 600;
+    const Impact impact{{1 - 1e-3, 0.01, 0.02}, {1, 0, 0}, 10};
+    auto copied = fracture(input, impact, p, 5);
+    auto inPlace = fracture(std::move(sphere), impact, p, 5, std::move(*facts));
+    ASSERT_TRUE(copied && inPlace);
+    for (const FractureResult* r : {&*copied, &*inPlace}) {
+        const std::string what = r->editedInPlace ? "in place" : "copied";
+        ASSERT_TRUE(r->rough) << what;
+        EXPECT_LE(mostCutTriangles(*r), 600u) << what;
+        EXPECT_GT(mostCutTriangles(*r), 300u) << what;
+        expectSoundPieces(input, *r, what);
+        expectCutsCoincide(*r, what);
+    }
+    EXPECT_TRUE(inPlace->editedInPlace);
+    EXPECT_GT(displacedNewCutVertices(input, *copied), 10u);
+    for (const Piece& piece : copied->pieces) {
+        const MeshReport report = checkMesh(piece.mesh);
+        EXPECT_TRUE(report.selfIntersectionsChecked) << report.selfIntersectionNote;
+        EXPECT_TRUE(report.valid()) << test::joinLines(report.problems);
+    }
+}
+
+// The UVs of a rough face are the planar projection of its flat position in the face's basis, the same
+// basis for both sides: every cut corner at a point has the same UV in both pieces, and the UVs span the flat
+// cut (the square x = 0.01, |y|, |z| <= 1, at uvScale 2).
+TEST(RoughFracture, UvsAreContinuousAcrossTheRoughFace) {
+    FractureParams p;
+    p.roughness = absoluteRoughness(0.12, 0.5, 2, 20000);
+    p.simplifyPieces = false;
+    p.uvScale = 2;
+    std::vector<ConvexPolytope> cells{ConvexPolytope::fromAabb({{0.01, -3, -3}, {3, 3, 3}})};
+    auto r = fractureWithCells(cube(), cells, p);
+    ASSERT_TRUE(r) << r.error().message;
+    ASSERT_TRUE(r->rough);
+    std::map<std::tuple<double, double, double>, Vec2> uvAt;
+    std::size_t corners = 0, mismatched = 0;
+    Vec2 lo{1e300, 1e300}, hi{-1e300, -1e300};
+    for (const Piece& piece : r->pieces) {
+        const Mesh& m = piece.mesh;
+        for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+            if (m.materials[t] != kInteriorMaterial)
+                continue;
+            const auto c = m.corners(t);
+            for (std::size_t k = 0; k < 3; ++k) {
+                const Vec2 uv = m.uvs[3 * t + k];
+                const auto [it, fresh] = uvAt.emplace(std::tuple{c[k].x, c[k].y, c[k].z}, uv);
+                mismatched += !fresh && (it->second.x != uv.x || it->second.y != uv.y) ? 1 : 0;
+                ++corners;
+                lo = {std::min(lo.x, uv.x), std::min(lo.y, uv.y)};
+                hi = {std::max(hi.x, uv.x), std::max(hi.y, uv.y)};
+            }
+        }
+    }
+    EXPECT_GT(corners, 1000u);
+    EXPECT_EQ(mismatched, 0u) << "of " << corners << " cut corners";
+    EXPECT_NEAR(hi.x - lo.x, 4.0, 1e-9);
+    EXPECT_NEAR(hi.y - lo.y, 4.0, 1e-9);
+}
+
+// Wood (the preset's grainStretch 6): wavelengths along the grain six times the ones across it, so the
+// height field changes far less along the grain at the same distance.
+TEST(RoughFracture, WoodIsSmootherAlongTheGrain) {
+    Roughness wood = roughnessPreset("wood");
+    wood.seed = 5;
+    const Vec3 grain{0, 0, 1};
+    const detail::RoughField field(wood, 1.0, wood.octaves, grain);
+    Rng rng(3);
+    double along = 0, across = 0;
+    for (int i = 0; i < 2000; ++i) {
+        const Vec3 p{rng.uniform(-5, 5), rng.uniform(-5, 5), rng.uniform(-5, 5)};
+        const double h = field(p);
+        along += std::pow(field(p + grain * 0.1) - h, 2);
+        across += std::pow(field(p + Vec3{0.1, 0, 0}) - h, 2);
+    }
+    EXPECT_LT(along, 0.3 * across);
+    EXPECT_GT(along, 0);
+    Roughness isotropic = wood;
+    isotropic.grainStretch = 1;
+    const detail::RoughField plain(isotropic, 1.0, wood.octaves, grain);
+    double plainAlong = 0, plainAcross = 0;
+    for (int i = 0; i < 2000; ++i) {
+        const Vec3 p{rng.uniform(-5, 5), rng.uniform(-5, 5), rng.uniform(-5, 5)};
+        plainAlong += std::pow(plain(p + grain * 0.1) - plain(p), 2);
+        plainAcross += std::pow(plain(p + Vec3{0.1, 0, 0}) - plain(p), 2);
+    }
+    EXPECT_GT(plainAlong, 0.6 * plainAcross);
 }
 
 TEST(RoughFracture, ParametersAreValidated) {

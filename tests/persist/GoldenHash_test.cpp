@@ -14,6 +14,8 @@ namespace {
 
 constexpr std::uint64_t kExpectedGeometryHash = 0x17667C3DD2AEA439ull;
 constexpr std::uint32_t kExpectedJournalCrc = 0x2144DF1Cu;
+/// The same scene and journal with rough cut faces (the concrete preset; docs/roughness.md).
+constexpr std::uint64_t kExpectedRoughGeometryHash = 0xBC5F67EED18EEC77ull;
 
 DestructionWorld::Config goldenConfig(int workers) {
     DestructionWorld::Config c;
@@ -24,8 +26,9 @@ DestructionWorld::Config goldenConfig(int workers) {
     return c;
 }
 
-// A subdivided wall (shatter), a sphere (single cell) and a torus (shatter, crumbles once detailed enough).
-void addScene(DestructionWorld& world) {
+// A subdivided wall (shatter), a sphere (single cell) and a torus (shatter, crumbles once detailed enough),
+// their cuts flat unless roughness says otherwise.
+void addScene(DestructionWorld& world, const Roughness& roughness = {}) {
     ObjectDesc wall;
     wall.mesh = makeSubdividedBox({-2, 0, -0.2}, {2, 3, 0.2}, 6);
     wall.fracture.pattern = CellPattern::Shatter;
@@ -36,16 +39,18 @@ void addScene(DestructionWorld& world) {
     ring.mesh = makeTorus({0, 0, 0}, 1.5, 0.4, 32, 12);
     ring.fracture.pattern = CellPattern::Shatter;
     ring.fracture.cells = 4;
-    for (ObjectDesc* d : {&wall, &ball, &ring})
+    for (ObjectDesc* d : {&wall, &ball, &ring}) {
+        d->fracture.roughness = roughness;
         ASSERT_TRUE(world.addObject(std::move(*d)));
+    }
 }
 
 // The journal: impacts on the three objects, some in the same frame (merged into one job), and hits on the
 // pieces of earlier fractures (ids 4 and up), derived from the world as it plays so that the test also
 // records them; the recorded journal is then replayed on a fresh world.
-std::vector<JournalEvent> recordGoldenJournal() {
+std::vector<JournalEvent> recordGoldenJournal(const Roughness& roughness = {}) {
     DestructionWorld world(goldenConfig(1));
-    addScene(world);
+    addScene(world, roughness);
     std::vector<JournalEvent> events;
     world.setJournalSink([&](const JournalEvent& e) { events.push_back(e); });
     for (int frame = 0; frame < 40; ++frame) {
@@ -68,10 +73,10 @@ std::vector<JournalEvent> recordGoldenJournal() {
     return events;
 }
 
-std::uint64_t replay(const JournalFile& journal, int workers) {
+std::uint64_t replay(const JournalFile& journal, int workers, const Roughness& roughness = {}) {
     DestructionWorld world(goldenConfig(workers));
     EXPECT_TRUE(checkJournalHeader(journal.header, goldenConfig(workers)));
-    addScene(world);
+    addScene(world, roughness);
     JournalPlayer player(world);
     for (const JournalEvent& e : journal.events)
         EXPECT_TRUE(player.receive(e));
@@ -93,6 +98,20 @@ TEST(GoldenHash, FixedJournalOnFixedSceneGivesThePinnedGeometry) {
                 static_cast<unsigned long long>(one));
     EXPECT_EQ(crc, kExpectedJournalCrc) << "the journal's encoding or its recorded values changed";
     EXPECT_EQ(one, kExpectedGeometryHash) << "the geometry differs from the pinned one";
+}
+
+// Rough scenes have a pinned geometry of their own, the same on 1 and 2 workers; the flat one above is not
+// touched by rough cuts.
+TEST(GoldenHash, RoughScenesHaveTheirOwnPinnedGeometry) {
+    const Roughness concrete = roughnessPreset("concrete");
+    const JournalFile journal{journalHeaderOf(goldenConfig(1), "golden rough"),
+                              recordGoldenJournal(concrete)};
+    ASSERT_EQ(journal.events.size(), 7u);
+    const std::uint64_t one = replay(journal, 1, concrete);
+    EXPECT_EQ(one, replay(journal, 2, concrete));
+    std::printf("golden rough: geometry hash 0x%016llX\n", static_cast<unsigned long long>(one));
+    EXPECT_NE(one, kExpectedGeometryHash);
+    EXPECT_EQ(one, kExpectedRoughGeometryHash) << "the rough geometry differs from the pinned one";
 }
 
 } // namespace
