@@ -298,7 +298,7 @@ int runOrganic(const BenchArgs& args, const std::string& heldOutDir) {
             c.name = kind + "_" + std::to_string(c.mesh.triangles.size());
             cases.push_back(std::move(c));
         }
-    if (!args.quick) {
+    if (!args.quick || !heldOutDir.empty()) {
         const std::vector<fs::path> heldOut = heldOutMeshes(heldOutDir);
         if (heldOut.empty())
             std::cout << "(no held-out meshes (CGAL's armadillo, camel, ...) found"

@@ -94,6 +94,25 @@ double subsetVolume(const std::vector<Vec3>& points, std::size_t most) {
     return h ? h->volume() : 0;
 }
 
+/// Calls f(polygon, inner part, outer part) for each polygon with corners strictly on both sides of the
+/// plane.
+template <class F>
+void forEachCrossed(const std::vector<Polygon>& polygons, const Plane& plane, F&& f) {
+    Polygon a, b;
+    for (const Polygon& poly : polygons) {
+        bool below = false, above = false;
+        for (const Vec3& p : poly) {
+            const double d = plane.signedDistance(p);
+            below |= d < 0;
+            above |= d > 0;
+        }
+        if (!below || !above)
+            continue;
+        detail::splitPolygon(poly, plane, a, b);
+        f(poly, a, b);
+    }
+}
+
 /// The polygons' corners, each once, sorted.
 std::vector<Vec3> cornersOf(const std::vector<Polygon>& polygons) {
     std::vector<Vec3> points;
@@ -493,20 +512,10 @@ public:
             return made;
         }
         const std::size_t sortedIn = pin.size(), sortedOut = pout.size();
-        Polygon a, b;
-        for (const Polygon& poly : part.surface) {
-            bool below = false, above = false;
-            for (const Vec3& p : poly) {
-                const double d = plane.signedDistance(p);
-                below |= d < 0;
-                above |= d > 0;
-            }
-            if (!below || !above)
-                continue;
-            detail::splitPolygon(poly, plane, a, b);
+        forEachCrossed(part.surface, plane, [&](const Polygon&, const Polygon& a, const Polygon& b) {
             pin.insert(pin.end(), a.begin(), a.end());
             pout.insert(pout.end(), b.begin(), b.end());
-        }
+        });
         mergeUnique(pin, sortedIn);
         mergeUnique(pout, sortedOut);
         return makeSplit(part, plane, std::move(rin), std::move(rout), std::move(pin), std::move(pout),
@@ -527,25 +536,15 @@ public:
             else if (d > tol)
                 out.push_back(v);
         }
-        Polygon a, b;
-        for (const Polygon& poly : part.surface) {
-            bool below = false, above = false;
-            for (const Vec3& p : poly) {
-                const double d = plane.signedDistance(p);
-                below |= d < 0;
-                above |= d > 0;
-            }
-            if (!below || !above)
-                continue;
-            // The corners the split makes on the plane, as trySplit makes them.
-            detail::splitPolygon(poly, plane, a, b);
+        // The corners the split makes on the plane, as trySplit makes them.
+        forEachCrossed(part.surface, plane, [&](const Polygon& poly, const Polygon& a, const Polygon& b) {
             for (const Vec3& p : a)
                 if (std::find(poly.begin(), poly.end(), p) == poly.end())
                     in.push_back(p);
             for (const Vec3& p : b)
                 if (std::find(poly.begin(), poly.end(), p) == poly.end())
                     out.push_back(p);
-        }
+        });
         // Every k-th point, at most kBoundPoints: a subset's hull is a lower bound too, and far cheaper.
         return {subsetVolume(in, kBoundPoints), subsetVolume(out, kBoundPoints)};
     }
