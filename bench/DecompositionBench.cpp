@@ -10,11 +10,14 @@
 // --organic: organic meshes generated here (a body with seven limbs, a bumpy potato; bench/MegaMeshes.hpp) at
 // 5k, 20k and 100k triangles, each decomposed side by side in the same run by: Rubble on one thread, on two,
 // Rubble searching through its bounded proxy at every size (the cheaper first pass), and Qhull's hull of the
-// whole (the floor: one part). Columns: wall and CPU time, parts, volume excess, Hausdorff concavity
-// (rubble/collision/PartConcavity.hpp); DIR/decomposition_organic.csv and .png.
+// whole (the floor: one part); the exact search at 20k and 100k, and up to 32 parts. Held-out meshes (CGAL's
+// armadillo, camel...) are added when found (--held-out DIR, else ../shared and /usr/share/doc/libcgal*).
+// Columns: wall and CPU time, parts, volume excess, Hausdorff concavity (rubble/collision/PartConcavity.hpp);
+// DIR/decomposition_organic.csv and .png.
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <iostream>
 #include <limits>
@@ -216,9 +219,63 @@ struct Method {
     bool hullOnly = false;          // Qhull's hull of the whole mesh
     std::size_t proxyAbove = 20000; // DecompositionParams::proxyAboveTriangles
     std::size_t maxTriangles = std::numeric_limits<std::size_t>::max(); // larger meshes skip the method
+    int maxParts = 24;                                                  // DecompositionParams::maxParts
 };
 
-int runOrganic(const BenchArgs& args) {
+/// An organic row's mesh: generated here, or a held-out file.
+struct OrganicCase {
+    std::string name, series;
+    rubble::Mesh mesh;
+};
+
+/// Held-out meshes (CGAL's data set: armadillo, camel, elephant...) under dir, or when dir is empty under
+/// ../shared and /usr/share/doc/libcgal*; the first file of each name, in path order. Never committed.
+std::vector<fs::path> heldOutMeshes(const std::string& dir) {
+    std::vector<fs::path> roots;
+    std::error_code ec;
+    if (!dir.empty()) {
+        roots.push_back(dir);
+    } else {
+        roots.push_back(rubble::bench::sourceDir() / ".." / "shared");
+        for (const auto& e : fs::directory_iterator("/usr/share/doc", ec))
+            if (e.path().filename().string().rfind("libcgal", 0) == 0)
+                roots.push_back(e.path());
+    }
+    const std::vector<std::string> names = {"armadillo", "camel", "elephant", "dragon",
+                                            "bunny",     "cow",   "homer"};
+    const std::vector<std::string>& extensions = rubble::supportedMeshExtensions();
+    std::map<std::string, fs::path> found;
+    for (const fs::path& root : roots) {
+        std::vector<fs::path> files;
+        for (auto it =
+                 fs::recursive_directory_iterator(root, fs::directory_options::skip_permission_denied, ec);
+             !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
+            if (it.depth() > 6)
+                it.disable_recursion_pending();
+            if (it->is_regular_file(ec))
+                files.push_back(it->path());
+        }
+        std::sort(files.begin(), files.end());
+        for (const fs::path& f : files) {
+            std::string stem = f.stem().string(), ext = f.extension().string();
+            std::transform(stem.begin(), stem.end(), stem.begin(),
+                           [](unsigned char c) { return std::tolower(c); });
+            std::transform(ext.begin(), ext.end(), ext.begin(),
+                           [](unsigned char c) { return std::tolower(c); });
+            if (std::find(extensions.begin(), extensions.end(), ext) == extensions.end())
+                continue;
+            for (const std::string& n : names)
+                if (stem.rfind(n, 0) == 0 && !found.count(n))
+                    found[n] = f;
+        }
+    }
+    std::vector<fs::path> out;
+    for (const auto& [n, f] : found)
+        out.push_back(f);
+    return out;
+}
+
+int runOrganic(const BenchArgs& args, const std::string& heldOutDir) {
     const int runs = args.quick ? 1 : std::max(1, std::min(args.runs, 5));
     const std::vector<std::size_t> sizes =
         args.quick ? std::vector<std::size_t>{2000} : std::vector<std::size_t>{5000, 20000, 100000};
@@ -229,7 +286,34 @@ int runOrganic(const BenchArgs& args) {
         {"qhull_hull", 1, true, 0},
         // The exact search on a mesh just above the threshold, as on one just under it (e.g. CGAL's camel).
         {"rubble_exact", 1, false, std::numeric_limits<std::size_t>::max(), 30000},
-        {"rubble_exact_2_threads", 2, false, std::numeric_limits<std::size_t>::max(), 30000}};
+        {"rubble_exact_2_threads", 2, false, std::numeric_limits<std::size_t>::max(), 30000},
+        // The budget: at most 32 parts.
+        {"rubble_32_parts", 1, false, rubble::DecompositionParams{}.proxyAboveTriangles,
+         std::numeric_limits<std::size_t>::max(), 32},
+        {"rubble_exact_32_parts", 1, false, std::numeric_limits<std::size_t>::max(), 30000, 32}};
+    std::vector<OrganicCase> cases;
+    for (const std::string& kind : rubble::bench::kOrganicKinds)
+        for (std::size_t size : sizes) {
+            OrganicCase c{"", kind, rubble::bench::megaMesh(kind, size)};
+            c.name = kind + "_" + std::to_string(c.mesh.triangles.size());
+            cases.push_back(std::move(c));
+        }
+    if (!args.quick || !heldOutDir.empty()) {
+        const std::vector<fs::path> heldOut = heldOutMeshes(heldOutDir);
+        if (heldOut.empty())
+            std::cout << "(no held-out meshes (CGAL's armadillo, camel, ...) found"
+                      << (heldOutDir.empty() ? " under ../shared or /usr/share/doc/libcgal*"
+                                             : " in " + heldOutDir)
+                      << ": held-out rows skipped)\n";
+        for (const fs::path& f : heldOut) {
+            auto mesh = rubble::readMesh(f);
+            if (!mesh) {
+                std::cout << "(held-out " << f.string() << " skipped: " << mesh.error().message << ")\n";
+                continue;
+            }
+            cases.push_back({"held_out_" + f.stem().string(), "held-out", std::move(mesh.value())});
+        }
+    }
     const rubble::bench::CpuMeter cpu;
     rubble::bench::Table table{
         {"mesh", "tris", "method", "parts", "wall med ms", "cpu med ms", "excess", "concavity"}, {}};
@@ -238,50 +322,55 @@ int runOrganic(const BenchArgs& args) {
                               "other_cpu_cores"},
                              {}};
     std::map<std::string, std::ostringstream> series; // kind + method -> "triangles cpu_ms concavity" lines
-    for (const std::string& kind : rubble::bench::kOrganicKinds)
-        for (std::size_t size : sizes) {
-            const rubble::Mesh mesh = rubble::bench::megaMesh(kind, size);
-            for (const Method& m : methods) {
-                if (mesh.triangles.size() > m.maxTriangles)
-                    continue;
-                std::optional<rubble::ThreadPool> pool;
-                rubble::DecomposeControl control;
-                if (m.threads > 1) {
-                    pool.emplace(m.threads - 1);
-                    control.jobs = &*pool;
-                }
-                rubble::DecompositionParams params;
-                params.proxyAboveTriangles = m.proxyAbove;
-                std::vector<double> wall, cpuTime;
-                rubble::Decomposition d;
-                for (int r = 0; r < runs; ++r) {
-                    const auto t0 = std::chrono::steady_clock::now();
-                    const double c0 = cpuMs();
-                    if (m.hullOnly) {
-                        d = {};
-                        d.parts.push_back(rubble::convexHull(mesh.positions).value());
-                        d.meshVolume = rubble::signedVolume(mesh);
-                        d.hullVolume = d.parts[0].volume();
-                    } else {
-                        d = rubble::decompose(mesh, params, control).value();
-                    }
-                    cpuTime.push_back(cpuMs() - c0);
-                    wall.push_back(rubble::bench::msSince(t0));
-                }
-                const Stats w = rubble::bench::stats(wall), c = rubble::bench::stats(cpuTime);
-                const double concavity = rubble::partConcavity(mesh, d.parts);
-                const std::string name = kind + "_" + std::to_string(mesh.triangles.size());
-                table.rows.push_back({name, std::to_string(mesh.triangles.size()), m.name,
-                                      std::to_string(d.parts.size()), fixed(w.median), fixed(c.median),
-                                      fixed(d.excess(), 4), fixed(concavity, 4)});
-                csv.rows.push_back(
-                    {name, std::to_string(mesh.triangles.size()), m.name, std::to_string(m.threads),
-                     std::to_string(runs), std::to_string(d.parts.size()), fixed(w.median), fixed(w.min),
-                     fixed(w.max), fixed(c.median), fixed(d.excess(), 5), fixed(concavity, 5), ""});
-                series[kind + " " + m.name] << mesh.triangles.size() << " " << c.median << " " << concavity
-                                            << "\n";
+    for (const OrganicCase& oc : cases) {
+        const rubble::Mesh& mesh = oc.mesh;
+        for (const Method& m : methods) {
+            if (mesh.triangles.size() > m.maxTriangles)
+                continue;
+            std::optional<rubble::ThreadPool> pool;
+            rubble::DecomposeControl control;
+            if (m.threads > 1) {
+                pool.emplace(m.threads - 1);
+                control.jobs = &*pool;
             }
+            rubble::DecompositionParams params;
+            params.proxyAboveTriangles = m.proxyAbove;
+            params.maxParts = m.maxParts;
+            std::vector<double> wall, cpuTime;
+            rubble::Decomposition d;
+            bool failed = false;
+            for (int r = 0; r < runs && !failed; ++r) {
+                const auto t0 = std::chrono::steady_clock::now();
+                const double c0 = cpuMs();
+                if (m.hullOnly) {
+                    d = {};
+                    d.parts.push_back(rubble::convexHull(mesh.positions).value());
+                    d.meshVolume = rubble::signedVolume(mesh);
+                    d.hullVolume = d.parts[0].volume();
+                } else if (auto got = rubble::decompose(mesh, params, control)) {
+                    d = std::move(got.value());
+                } else {
+                    std::cout << "(" << oc.name << ", " << m.name << ": " << got.error().message << ")\n";
+                    failed = true;
+                }
+                cpuTime.push_back(cpuMs() - c0);
+                wall.push_back(rubble::bench::msSince(t0));
+            }
+            if (failed)
+                continue;
+            const Stats w = rubble::bench::stats(wall), c = rubble::bench::stats(cpuTime);
+            const double concavity = rubble::partConcavity(mesh, d.parts);
+            table.rows.push_back({oc.name, std::to_string(mesh.triangles.size()), m.name,
+                                  std::to_string(d.parts.size()), fixed(w.median), fixed(c.median),
+                                  fixed(d.excess(), 4), fixed(concavity, 4)});
+            csv.rows.push_back({oc.name, std::to_string(mesh.triangles.size()), m.name,
+                                std::to_string(m.threads), std::to_string(runs),
+                                std::to_string(d.parts.size()), fixed(w.median), fixed(w.min), fixed(w.max),
+                                fixed(c.median), fixed(d.excess(), 5), fixed(concavity, 5), ""});
+            series[oc.series + " " + m.name] << mesh.triangles.size() << " " << c.median << " " << concavity
+                                             << "\n";
         }
+    }
     const std::string other = fixed(cpu.read().other, 2);
     for (auto& row : csv.rows)
         row.back() = other;
@@ -313,6 +402,11 @@ const rubble::tools::Registrar registrar{
          app.add_option("--runs", args->runs, "repetitions per case")->check(CLI::Range(1, 10000));
          app.add_option("--out", args->out, "folder for decomposition.csv and decomposition.png");
          auto organic = std::make_shared<bool>(false);
+         auto heldOut = std::make_shared<std::string>();
+         app.add_option(
+             "--held-out", *heldOut,
+             "folder of held-out meshes for the --organic rows (CGAL's armadillo, camel, elephant, "
+             "dragon, bunny, cow, homer; default: ../shared and /usr/share/doc/libcgal*)");
          app.add_flag("--organic", *organic,
                       "only the organic rows (limbed blob and bumpy potato at 5k, 20k, 100k triangles; "
                       "decomposition_organic.csv/.png), Rubble beside the hull of the whole");
@@ -329,11 +423,11 @@ const rubble::tools::Registrar registrar{
          auto writeDir = std::make_shared<std::string>();
          app.add_option("--write-mega", *writeDir,
                         "write the --mega meshes as OBJ into this folder (kind_triangles.obj) and stop");
-         return [args, mega, megaOn, writeDir, organic] {
+         return [args, mega, megaOn, writeDir, organic, heldOut] {
              if (!writeDir->empty())
                  return rubble::bench::writeMegaMeshes(*mega, *writeDir);
              if (*organic)
-                 return runOrganic(*args);
+                 return runOrganic(*args, *heldOut);
              if (!*megaOn)
                  return runBench(*args);
              mega->out = args->out;

@@ -12,16 +12,22 @@
 // its region, so the cost of the search does not grow with the triangle count and parts still cover the
 // solid (docs/megamesh.md).
 #include <algorithm>
+#include <array>
+#include <atomic>
 #include <cmath>
 #include <condition_variable>
 #include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <tuple>
 
+#include "collision/HullPlaneTree.hpp"
+#include "collision/HullWitness.hpp"
 #include "collision/MeshRegion.hpp"
 #include "collision/PolygonBvh.hpp"
 #include "geometry/OrientedShells.hpp"
+#include "rubble/collision/CollisionTolerance.hpp"
 #include "rubble/collision/ConvexDecomposition.hpp"
 #include "rubble/collision/DecomposeControl.hpp"
 #include "rubble/geometry/MassProperties.hpp"
@@ -36,6 +42,7 @@ using detail::Polygon;
 struct Part {
     ConvexPolytope region;
     std::vector<Polygon> surface; // mesh triangles clipped to region
+    std::vector<Vec3> points;     // the surface's corners, each once, sorted as pointLess orders them
     ConvexPolytope hull;
     double depth = 0; // deepest pocket between hull and mesh
     Vec3 pocket;      // where that pocket's bottom is
@@ -59,6 +66,61 @@ constexpr double kSearchShare = 0.9;
 constexpr std::size_t kBoundPoints = 256;
 /// Concavity below this fraction of the diagonal is rounding: such a part is convex.
 constexpr double kConvexTolerance = 1e-9;
+
+/// The order in which hullOfPolygons sorts a hull's input points.
+bool pointLess(const Vec3& a, const Vec3& b) {
+    return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
+}
+
+/// Sorts points[sorted, end) and merges them into the sorted points[0, sorted); each point kept once.
+void mergeUnique(std::vector<Vec3>& points, std::size_t sorted) {
+    std::sort(points.begin() + static_cast<std::ptrdiff_t>(sorted), points.end(), pointLess);
+    std::inplace_merge(points.begin(), points.begin() + static_cast<std::ptrdiff_t>(sorted), points.end(),
+                       pointLess);
+    points.erase(std::unique(points.begin(), points.end()), points.end());
+}
+
+/// The volume of the hull of every k-th point, at most `most` of them (0 when flat or too few): a lower bound
+/// of the volume of the points' hull.
+double subsetVolume(const std::vector<Vec3>& points, std::size_t most) {
+    const std::size_t stride = (points.size() + most - 1) / most;
+    std::vector<Vec3> subset;
+    subset.reserve(most);
+    for (std::size_t i = 0; i < points.size(); i += stride)
+        subset.push_back(points[i]);
+    if (subset.size() < 4)
+        return 0;
+    auto h = convexHull(subset);
+    return h ? h->volume() : 0;
+}
+
+/// Calls f(polygon, inner part, outer part) for each polygon with corners strictly on both sides of the
+/// plane.
+template <class F>
+void forEachCrossed(const std::vector<Polygon>& polygons, const Plane& plane, F&& f) {
+    Polygon a, b;
+    for (const Polygon& poly : polygons) {
+        bool below = false, above = false;
+        for (const Vec3& p : poly) {
+            const double d = plane.signedDistance(p);
+            below |= d < 0;
+            above |= d > 0;
+        }
+        if (!below || !above)
+            continue;
+        detail::splitPolygon(poly, plane, a, b);
+        f(poly, a, b);
+    }
+}
+
+/// The polygons' corners, each once, sorted.
+std::vector<Vec3> cornersOf(const std::vector<Polygon>& polygons) {
+    std::vector<Vec3> points;
+    for (const Polygon& poly : polygons)
+        points.insert(points.end(), poly.begin(), poly.end());
+    mergeUnique(points, 0);
+    return points;
+}
 
 class Decomposer {
 public:
@@ -211,14 +273,18 @@ public:
         return in;
     }
 
-    std::optional<ConvexPolytope> hullOf(const std::vector<Polygon>& surface, const ConvexPolytope& region) {
-        std::vector<Vec3> extra;
+    /// The hull of a part: of its surface's corners (sorted, each once) and its region's corners inside the
+    /// solid, the input hullOfPolygons would give Qhull; nullopt without a surface and 4 such corners.
+    std::optional<ConvexPolytope> hullOf(const std::vector<Vec3>& surfacePoints,
+                                         const ConvexPolytope& region) {
+        std::vector<Vec3> points = surfacePoints;
         for (const Vec3& v : region.vertices())
             if (inside(v))
-                extra.push_back(v);
-        if (surface.empty() && extra.size() < 4)
+                points.push_back(v);
+        if (surfacePoints.empty() && points.size() < 4)
             return std::nullopt;
-        auto h = detail::hullOfPolygons(surface, extra);
+        mergeUnique(points, surfacePoints.size());
+        auto h = convexHull(points);
         if (!h)
             return std::nullopt;
         return std::move(h.value());
@@ -257,6 +323,7 @@ public:
         planes.reserve(hullFaces.size());
         for (const PolytopeFace& f : hullFaces)
             planes.push_back(f.plane);
+        const detail::HullPlaneTree exitTree(hullFaces, planes);
         // The hull's box, padded: a ray leaves it no earlier than it leaves the hull.
         Aabb hullBox = part.hull.bounds();
         const double boxPad = 1e-6 * (hullBox.diagonal() + diag_) + 1e-300;
@@ -267,7 +334,7 @@ public:
         parallelFor(chunks, [&](std::size_t chunk) {
             const std::size_t end = std::min(order.size(), (chunk + 1) * kDepthChunk);
             for (std::size_t k = chunk * kDepthChunk; k < end; ++k)
-                faceDepth(hullFaces[order[k]], planes, cuts, bvh, hullBox, deepest[chunk]);
+                faceDepth(hullFaces[order[k]], planes, exitTree, cuts, bvh, hullBox, deepest[chunk]);
         });
         for (const Deepest& d : deepest)
             if (d.depth > part.depth) {
@@ -285,8 +352,8 @@ public:
 
     /// The deepest pocket under the samples of one hull face, where deeper than `best` so far.
     void faceDepth(const PolytopeFace& hf, const std::vector<Plane>& planes,
-                   const std::vector<const PolytopeFace*>& cuts, const detail::PolygonBvh& bvh,
-                   const Aabb& box, Deepest& best) const {
+                   const detail::HullPlaneTree& exitTree, const std::vector<const PolytopeFace*>& cuts,
+                   const detail::PolygonBvh& bvh, const Aabb& box, Deepest& best) const {
         const double delta = 1e-9 * std::max(diag_, 1.0);
         const double planeTol = 1e-7 * std::max(diag_, 1.0);
         bool onCut = false;
@@ -310,15 +377,10 @@ public:
             samples.push_back(g + ((a + b) * 0.5 - g) * 0.6);
         }
         const Vec3 dir = -hf.plane.normal;
-        // The hull faces the ray can leave through, with the cosine of each (the same for every sample).
-        std::vector<std::pair<const Plane*, double>> exits;
-        for (const Plane& plane : planes)
-            if (const double nd = dot(plane.normal, dir); nd > 1e-12)
-                exits.emplace_back(&plane, nd);
         const double stop = delta * 2;
         for (const Vec3& s : samples) {
             const Vec3 o = s + hf.plane.normal * delta;
-            const double t = depthAlong(o, dir, exits, box, stop, bvh);
+            const double t = depthAlong(o, dir, planes, exitTree, box, stop, bvh);
             const double depth = t - delta;
             if (depth > best.depth) {
                 best.depth = depth;
@@ -329,16 +391,17 @@ public:
     }
 
     /// min(first surface hit, exit from the hull) along o + t·dir, as bvh.nearest(o, dir, exit, stop) gives
-    /// it; exits are the hull planes the ray can leave through, with their cosines. The hit is found first,
-    /// bounded by the exit from box (which holds the hull), so that only the planes the ray may leave through
-    /// before it are divided out.
-    static double depthAlong(const Vec3& o, const Vec3& dir,
-                             const std::vector<std::pair<const Plane*, double>>& exits, const Aabb& box,
-                             double stop, const detail::PolygonBvh& bvh) {
+    /// it; planes are the hull's. The hit is found first, bounded by the exit from box (which holds the
+    /// hull), so that only the planes the ray may leave through before it are divided out (found through
+    /// exitTree).
+    static double depthAlong(const Vec3& o, const Vec3& dir, const std::vector<Plane>& planes,
+                             const detail::HullPlaneTree& exitTree, const Aabb& box, double stop,
+                             const detail::PolygonBvh& bvh) {
         auto exactExit = [&] {
             double tExit = std::numeric_limits<double>::infinity();
-            for (const auto& [plane, nd] : exits)
-                tExit = std::min(tExit, (plane->offset - dot(plane->normal, o)) / nd);
+            for (const Plane& plane : planes)
+                if (const double nd = dot(plane.normal, dir); nd > 1e-12)
+                    tExit = std::min(tExit, (plane.offset - dot(plane.normal, o)) / nd);
             return tExit;
         };
         double boxExit = std::numeric_limits<double>::infinity();
@@ -349,38 +412,55 @@ public:
             return bvh.nearest(o, dir, exactExit(), stop);
         const double hit = bvh.nearest(o, dir, boxExit, stop);
         // Planes left through before max(hit, stop) (with room for rounding); the others exit later.
-        const double reach = std::max(hit, stop) * (1 + 1e-9);
-        double tExit = std::numeric_limits<double>::infinity();
-        for (const auto& [plane, nd] : exits)
-            if (const double a = plane->offset - dot(plane->normal, o); a <= reach * nd)
-                tExit = std::min(tExit, a / nd);
+        const double tExit = exitTree.exitBefore(o, dir, std::max(hit, stop) * (1 + 1e-9));
         if (!(tExit > stop)) // leaves at once: the search stops at its first leaf, as before
             return bvh.nearest(o, dir, exactExit(), stop);
         return std::min(hit, tExit);
     }
 
+    /// Two parts and their score; the parts' surfaces are filled in by surfaceSplit, for the chosen split.
     struct Split {
         double score = std::numeric_limits<double>::infinity();
+        Plane plane;
         Part left, right;
+        bool surfaced = false; // left.surface and right.surface are filled in
     };
 
-    std::optional<Part> makePart(ConvexPolytope region, std::vector<Polygon> surface) {
-        auto h = hullOf(surface, region);
-        if (!h)
+    /// Split's parts from their regions and surface points; nullopt when a side has no hull or too little
+    /// volume, or when the score exceeds cutoff (the side with fewer points is made first: with the other
+    /// side's lower bound, bounds[1] for the outer side and bounds[0] for the inner, it may lose already).
+    std::optional<Split> makeSplit(const Part& part, const Plane& plane, ConvexPolytope rin,
+                                   ConvexPolytope rout, std::vector<Vec3> pin, std::vector<Vec3> pout,
+                                   double cutoff, const std::array<double, 2>& bounds) {
+        const bool inFirst = pin.size() <= pout.size();
+        std::optional<ConvexPolytope> l, r;
+        for (int k = 0; k < 2; ++k) {
+            const bool in = (k == 0) == inFirst;
+            std::optional<ConvexPolytope>& h = in ? l : r;
+            h = in ? hullOf(pin, rin) : hullOf(pout, rout);
+            if (!h)
+                return std::nullopt;
+            if (k == 0 && h->volume() + bounds[in ? 1 : 0] > cutoff)
+                return std::nullopt;
+        }
+        const double minVol = std::max(1e-9 * part.hull.volume(), minPartVolume_);
+        if (l->volume() < minVol || r->volume() < minVol)
             return std::nullopt;
-        Part p;
-        p.region = std::move(region);
-        p.surface = std::move(surface);
-        p.hull = std::move(*h);
-        return p;
+        Split s;
+        s.score = l->volume() + r->volume();
+        s.plane = plane;
+        s.left.region = std::move(rin);
+        s.left.points = std::move(pin);
+        s.left.hull = std::move(*l);
+        s.right.region = std::move(rout);
+        s.right.points = std::move(pout);
+        s.right.hull = std::move(*r);
+        return s;
     }
 
-    std::optional<Split> trySplit(const Part& part, const Plane& plane) {
-        ConvexPolytope rin = part.region.clipped(plane, nextTag_);
-        ConvexPolytope rout = part.region.clippedOutside(plane, nextTag_);
-        if (rin.empty() || rout.empty())
-            return std::nullopt;
-        std::vector<Polygon> sin, sout;
+    /// The part's surface split by the plane, into the inner and the outer polygons.
+    static void splitSurface(const Part& part, const Plane& plane, std::vector<Polygon>& sin,
+                             std::vector<Polygon>& sout) {
         Polygon a, b;
         for (const Polygon& poly : part.surface) {
             detail::splitPolygon(poly, plane, a, b);
@@ -389,24 +469,64 @@ public:
             if (b.size() >= 3)
                 sout.push_back(b);
         }
-        auto l = makePart(std::move(rin), std::move(sin));
-        auto r = makePart(std::move(rout), std::move(sout));
-        if (!l || !r)
-            return std::nullopt;
-        const double minVol = std::max(1e-9 * part.hull.volume(), minPartVolume_);
-        if (l->hull.volume() < minVol || r->hull.volume() < minVol)
-            return std::nullopt;
-        Split s;
-        s.score = l->hull.volume() + r->hull.volume();
-        s.left = std::move(*l);
-        s.right = std::move(*r);
-        return s;
     }
 
-    /// A lower bound of trySplit(part, plane)'s score: the volumes of the hulls, on each side, of the part's
-    /// hull vertices there and the points where the surface crosses the plane (all of them points that the
-    /// side's own hull holds; a side with too few or flat points counts 0).
-    double splitBound(const Part& part, const Plane& plane) const {
+    /// Fills in the surfaces of a split of part.
+    static void surfaceSplit(const Part& part, Split& s) {
+        if (!s.surfaced)
+            splitSurface(part, s.plane, s.left.surface, s.right.surface);
+        s.surfaced = true;
+    }
+
+    /// The split of a part by a plane: its two sides' hulls and score (nullopt past cutoff, see makeSplit).
+    /// Each side's points are the part's points on that side and the corners the plane makes on the polygons
+    /// it crosses, which are the corners of the side's polygons; where a point lies on the plane, the
+    /// polygons are split to decide.
+    std::optional<Split> trySplit(const Part& part, const Plane& plane, double cutoff,
+                                  const std::array<double, 2>& bounds) {
+        ConvexPolytope rin = part.region.clipped(plane, nextTag_);
+        ConvexPolytope rout = part.region.clippedOutside(plane, nextTag_);
+        if (rin.empty() || rout.empty())
+            return std::nullopt;
+        std::vector<Vec3> pin, pout;
+        bool onPlane = false;
+        for (const Vec3& p : part.points) {
+            const double d = plane.signedDistance(p);
+            if (d < 0)
+                pin.push_back(p);
+            else if (d > 0)
+                pout.push_back(p);
+            else
+                onPlane = true;
+        }
+        if (onPlane) {
+            Split s;
+            splitSurface(part, plane, s.left.surface, s.right.surface);
+            auto made = makeSplit(part, plane, std::move(rin), std::move(rout), cornersOf(s.left.surface),
+                                  cornersOf(s.right.surface), cutoff, bounds);
+            if (made) {
+                made->left.surface = std::move(s.left.surface);
+                made->right.surface = std::move(s.right.surface);
+                made->surfaced = true;
+            }
+            return made;
+        }
+        const std::size_t sortedIn = pin.size(), sortedOut = pout.size();
+        forEachCrossed(part.surface, plane, [&](const Polygon&, const Polygon& a, const Polygon& b) {
+            pin.insert(pin.end(), a.begin(), a.end());
+            pout.insert(pout.end(), b.begin(), b.end());
+        });
+        mergeUnique(pin, sortedIn);
+        mergeUnique(pout, sortedOut);
+        return makeSplit(part, plane, std::move(rin), std::move(rout), std::move(pin), std::move(pout),
+                         cutoff, bounds);
+    }
+
+    /// Lower bounds of the volumes of trySplit(part, plane)'s inner and outer sides, whose sum bounds its
+    /// score: the volumes of the hulls, on each side, of the part's hull vertices there and the points where
+    /// the surface crosses the plane (all of them points that the side's own hull holds; a side with too few
+    /// or flat points counts 0).
+    std::array<double, 2> splitBound(const Part& part, const Plane& plane) const {
         std::vector<Vec3> in, out;
         const double tol = 1e-12 * std::max(diag_, 1e-300);
         for (const Vec3& v : part.hull.vertices()) {
@@ -416,40 +536,17 @@ public:
             else if (d > tol)
                 out.push_back(v);
         }
-        Polygon a, b;
-        for (const Polygon& poly : part.surface) {
-            bool below = false, above = false;
-            for (const Vec3& p : poly) {
-                const double d = plane.signedDistance(p);
-                below |= d < 0;
-                above |= d > 0;
-            }
-            if (!below || !above)
-                continue;
-            // The corners the split makes on the plane, as trySplit makes them.
-            detail::splitPolygon(poly, plane, a, b);
+        // The corners the split makes on the plane, as trySplit makes them.
+        forEachCrossed(part.surface, plane, [&](const Polygon& poly, const Polygon& a, const Polygon& b) {
             for (const Vec3& p : a)
                 if (std::find(poly.begin(), poly.end(), p) == poly.end())
                     in.push_back(p);
             for (const Vec3& p : b)
                 if (std::find(poly.begin(), poly.end(), p) == poly.end())
                     out.push_back(p);
-        }
-        double volume = 0;
-        for (std::vector<Vec3>* side : {&in, &out}) {
-            // Every k-th point, at most kBoundPoints: a subset's hull is a lower bound too, and far cheaper.
-            const std::size_t stride = (side->size() + kBoundPoints - 1) / kBoundPoints;
-            if (stride > 1) {
-                std::size_t kept = 0;
-                for (std::size_t i = 0; i < side->size(); i += stride)
-                    (*side)[kept++] = (*side)[i];
-                side->resize(kept);
-            }
-            if (side->size() >= 4)
-                if (auto h = convexHull(*side))
-                    volume += h->volume();
-        }
-        return volume;
+        });
+        // Every k-th point, at most kBoundPoints: a subset's hull is a lower bound too, and far cheaper.
+        return {subsetVolume(in, kBoundPoints), subsetVolume(out, kBoundPoints)};
     }
 
     /// The split of part by a plane through its pocket with the least score (the first of equal scores), as
@@ -458,9 +555,12 @@ public:
     std::optional<Split> bestSplit(const Part& part, const std::vector<Vec3>& normals) {
         const std::size_t n = normals.size();
         std::vector<double> bound(n, 0);
+        std::vector<std::array<double, 2>> sides(n, {0, 0});
         parallelFor(n, [&](std::size_t i) {
-            if (!stopped())
-                bound[i] = splitBound(part, Plane::fromPointNormal(part.pocket, normals[i]));
+            if (!stopped()) {
+                sides[i] = splitBound(part, Plane::fromPointNormal(part.pocket, normals[i]));
+                bound[i] = sides[i][0] + sides[i][1];
+            }
         });
         std::vector<std::size_t> order(n);
         for (std::size_t i = 0; i < n; ++i)
@@ -480,9 +580,12 @@ public:
                 if (mayWin(order[next]))
                     take.push_back(order[next]);
             std::vector<std::optional<Split>> tries(take.size());
+            const double cutoff =
+                chosen ? chosen->score * (1 + 1e-9) : std::numeric_limits<double>::infinity();
             parallelFor(take.size(), [&](std::size_t k) {
                 if (!stopped())
-                    tries[k] = trySplit(part, Plane::fromPointNormal(part.pocket, normals[take[k]]));
+                    tries[k] = trySplit(part, Plane::fromPointNormal(part.pocket, normals[take[k]]), cutoff,
+                                        sides[take[k]]);
             });
             for (std::size_t k = 0; k < take.size(); ++k)
                 if (tries[k] && (!chosen || tries[k]->score < chosen->score ||
@@ -602,6 +705,7 @@ public:
             Part root;
             root.region = ConvexPolytope::fromAabb(box);
             root.surface = std::move(surface);
+            root.points = cornersOf(root.surface);
             root.hull = std::move(hull.value());
             measureDepth(root);
             parts.push_back(std::move(root));
@@ -628,6 +732,7 @@ public:
                 continue;
             }
             ++nextTag_;
+            surfaceSplit(part, *chosen);
             measureDepth(chosen->left);
             measureDepth(chosen->right);
             parts[best] = std::move(chosen->left);
@@ -644,12 +749,17 @@ public:
         });
         if (stopped())
             return out;
-        for (std::optional<ConvexPolytope>& shape : shapes) {
-            if (!shape)
-                continue;
-            out.hullVolume += shape->volume();
-            out.parts.push_back(std::move(*shape));
-        }
+        for (std::optional<ConvexPolytope>& shape : shapes)
+            if (shape)
+                out.parts.push_back(std::move(*shape));
+        // Through a proxy, each part's corners are proven near the exact mesh's hull, as a high-poly piece's
+        // are after a fracture (bounded hulls of many points reach out by their pushed-out planes).
+        if (proxied())
+            detail::keepNearHull(out.parts, exact_,
+                                 detail::kHullReachShare * partHullTolerance(exact_.bounds().diagonal()),
+                                 params_.maxPartFaces);
+        for (const ConvexPolytope& part : out.parts)
+            out.hullVolume += part.volume();
         if (out.parts.empty())
             return makeError(ErrorCode::GeometryFailure, "decompose: no part holds any of the mesh");
         return out;

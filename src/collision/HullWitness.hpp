@@ -11,6 +11,10 @@
 
 namespace rubble::detail {
 
+/// The share of kPartHullTolerance that a part's proven reach out of its piece's hull may take (the rest is
+/// margin for rounding).
+inline constexpr double kHullReachShare = 0.9;
+
 /// Which vertices the mesh's triangles use.
 std::vector<bool> usedVertices(const Mesh& mesh);
 

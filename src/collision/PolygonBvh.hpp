@@ -115,8 +115,12 @@ private:
             for (const Vec3& p : t)
                 all.extend(p);
         pad_ = 1e-9 * (all.diagonal() + 1);
+        centres_.reserve(tris_.size());
+        for (const Tri& t : tris_)
+            centres_.push_back(centroid(t));
         if (!tris_.empty())
             build(0, static_cast<std::uint32_t>(tris_.size()));
+        centres_ = {};
     }
 
 public:
@@ -171,7 +175,7 @@ private:
         for (std::uint32_t i = begin; i < end; ++i) {
             for (const Vec3& p : tris_[order_[i]])
                 box.extend(p);
-            centers.extend(centroid(tris_[order_[i]]));
+            centers.extend(centres_[order_[i]]);
         }
         box.lo -= Vec3{pad_, pad_, pad_};
         box.hi += Vec3{pad_, pad_, pad_};
@@ -186,7 +190,7 @@ private:
         const std::uint32_t mid = begin + (end - begin) / 2;
         std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end,
                          [&](std::uint32_t a, std::uint32_t b) {
-                             const double ca = centroid(tris_[a])[axis], cb = centroid(tris_[b])[axis];
+                             const double ca = centres_[a][axis], cb = centres_[b][axis];
                              return ca < cb || (ca == cb && a < b);
                          });
         const std::uint32_t left = build(begin, mid);
@@ -216,6 +220,7 @@ private:
     }
 
     std::vector<Tri> tris_;
+    std::vector<Vec3> centres_; // the triangles' centroids, while building
     std::vector<std::uint32_t> order_;
     std::vector<Node> nodes_;
     double pad_ = 0;

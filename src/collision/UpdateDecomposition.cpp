@@ -23,10 +23,6 @@ namespace {
 /// larger than their sum (docs/megamesh.md).
 constexpr double kHighPolyFillTolerance = 0.01;
 
-/// The share of kPartHullTolerance that a part's proven reach out of its piece's hull may take (the rest is
-/// margin for rounding).
-constexpr double kHullReachShare = 0.9;
-
 /// The share of kPartOverlapTolerance that the merges of a remainder may spend (the rest is margin for the
 /// pieces' real surfaces against the cells).
 constexpr double kOverlapShare = 0.5;
@@ -830,7 +826,7 @@ void fitPiece(std::size_t i, Assignment& a, const PieceSet& pieces,
 void boundToHull(std::vector<ConvexPolytope>& parts, const Mesh& piece, const DecompositionParams& params) {
     if (parts.empty())
         return;
-    const double reach = kHullReachShare * partHullTolerance(piece.bounds().diagonal());
+    const double reach = detail::kHullReachShare * partHullTolerance(piece.bounds().diagonal());
     const bool highPoly = piece.triangles.size() > params.proxyAboveTriangles;
     std::optional<ConvexPolytope> hull;
     if (!highPoly)

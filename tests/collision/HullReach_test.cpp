@@ -98,6 +98,21 @@ TEST(HullReach, ChainedHitsAboveTheHighPolyThresholdKeepPartsNearTheirPiecesHull
     EXPECT_LE(worstReachOverChain(mesh, dp, 4, 3), kPartHullTolerance);
 }
 
+TEST(HullReach, AFirstDecompositionThroughAProxyKeepsItsPartsNearTheHull) {
+    // Few faces per part make the proxy path's bounded hulls reach far out (the pushed-out planes of a few
+    // extremes: 4.3 % of the diagonal here); the witness keeps every part near the torus's hull.
+    DecompositionParams dp;
+    dp.proxyAboveTriangles = 1000;
+    dp.maxPartFaces = 16;
+    dp.concavity = 0.005;
+    const Mesh mesh = makeTorus({0, 0, 0}, 1.0, 0.35, 48, 24);
+    ASSERT_GT(mesh.triangles.size(), dp.proxyAboveTriangles);
+    auto d = decompose(mesh, dp);
+    ASSERT_TRUE(d) << d.error().message;
+    EXPECT_GT(d->parts.size(), 4u);
+    EXPECT_LE(test::reachOutsideHull(mesh, d->parts), kPartHullTolerance);
+}
+
 TEST(HullReach, AWallCutFromAChannelLeavesNoPartOverTheOpenedSide) {
     // A channel (a box with a slot along y) decomposed into one part, its hull (the whole box); a cut then
     // takes one wall. The remainder's hull no longer covers the slot, which the part minus the cut still

@@ -1,10 +1,14 @@
-// PolygonBvh::winding: the signed ray crossings that decompose() uses as its inside test.
+// PolygonBvh::winding: the signed ray crossings that decompose() uses as its inside test; HullPlaneTree: the
+// hull planes its pocket rays leave through.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <optional>
 
+#include "collision/HullPlaneTree.hpp"
 #include "collision/PolygonBvh.hpp"
+#include "rubble/collision/ConvexDecomposition.hpp"
 #include "rubble/core/Random.hpp"
 
 namespace rubble {
@@ -58,6 +62,60 @@ TEST(PolygonBvh, WindingDeclinesOnTheSurfaceAndThroughEdges) {
     for (Triangle& t : flipped.triangles)
         std::swap(t[1], t[2]);
     EXPECT_EQ(detail::PolygonBvh(flipped).winding({0.3, 0.4, 0.2}, kRay, 1e-9), -1);
+}
+
+// The plane-by-plane scan that HullPlaneTree::exitBefore replaces.
+double scanExit(const std::vector<Plane>& planes, const Vec3& o, const Vec3& dir, double reach) {
+    double t = std::numeric_limits<double>::infinity();
+    for (const Plane& plane : planes)
+        if (const double nd = dot(plane.normal, dir); nd > 1e-12)
+            if (const double a = plane.offset - dot(plane.normal, o); a <= reach * nd)
+                t = std::min(t, a / nd);
+    return t;
+}
+
+TEST(HullPlaneTree, FindsTheSameExitAsAScanOfEveryPlane) {
+    // A lumpy hull of many faces, far from the origin; rays from just inside its faces (as pocket rays
+    // start), from deep inside and from outside, with reaches from zero to past the far side.
+    Rng rng(7);
+    std::vector<Vec3> points;
+    const Vec3 centre{40, -25, 10};
+    for (int i = 0; i < 3000; ++i) {
+        const Vec3 u = rng.unitVector();
+        points.push_back(centre + Vec3{3 * u.x, 1.5 * u.y, u.z} * (1 + 0.05 * std::sin(7 * u.x + 5 * u.y)));
+    }
+    const ConvexPolytope hull = convexHull(points).value();
+    ASSERT_GT(hull.faces().size(), 1000u);
+    std::vector<Plane> planes;
+    for (const PolytopeFace& f : hull.faces())
+        planes.push_back(f.plane);
+    const detail::HullPlaneTree tree(hull.faces(), planes);
+    int exits = 0, none = 0;
+    for (int i = 0; i < 4000; ++i) {
+        const PolytopeFace& f = hull.faces()[rng.below(hull.faces().size())];
+        Vec3 o;
+        Vec3 dir = -f.plane.normal;
+        switch (i % 3) {
+        case 0: // just inside a face, inward
+            for (const Vec3& c : f.corners)
+                o += c;
+            o = o / static_cast<double>(f.corners.size()) - f.plane.normal * 1e-9;
+            break;
+        case 1: // anywhere in the hull's box, any direction
+            o = rng.inBox(hull.bounds().lo, hull.bounds().hi);
+            dir = rng.unitVector();
+            break;
+        default: // outside, towards the hull
+            o = centre + rng.unitVector() * 5;
+            dir = normalized(centre - o + rng.unitVector());
+        }
+        const double reach = rng.uniform(0.0, 7.0) * (i % 7 == 0 ? 1e-6 : 1.0);
+        const double expected = scanExit(planes, o, dir, reach);
+        EXPECT_EQ(tree.exitBefore(o, dir, reach), expected) << i;
+        (std::isfinite(expected) ? exits : none)++;
+    }
+    EXPECT_GT(exits, 500);
+    EXPECT_GT(none, 500);
 }
 
 } // namespace
