@@ -381,6 +381,7 @@ int runHost(const Args& a) {
     double lateJoinMs = -1;
     bool allConverged = true;
     std::vector<double> allErrors, allSafeErrors, means, p99s;
+    std::map<long, std::vector<double>> allAhead; // lag → errors of samples past the newest placement
     for (std::size_t c = 0; c < children.size(); ++c) {
         Child& child = children[c];
         const std::string out = readAll(child.out);
@@ -405,6 +406,7 @@ int runHost(const Args& a) {
         }
         // Placement error against the host, for bodies dynamic at the sampled frame.
         std::map<std::uint32_t, std::vector<double>> errorsAt; // lag → errors
+        std::map<std::uint32_t, std::vector<double>> aheadAt;  // of those: the view past the newest placement
         nlohmann::json worst = nlohmann::json::array();        // samples off by more than 50 cm
         long long missing = 0;
         {
@@ -429,6 +431,8 @@ int runHost(const Args& a) {
                             continue;
                         }
                         errorsAt[lag].push_back(length(v->second - at) * 100);
+                        if (newest[{fr, id}] < static_cast<float>(fr))
+                            aheadAt[lag].push_back(errorsAt[lag].back());
                         if (errorsAt[lag].back() > 50)
                             worst.push_back({{"cm", errorsAt[lag].back()},
                                              {"object", id},
@@ -478,6 +482,16 @@ int runHost(const Args& a) {
         }
         j["placement_error_cm_lag12"] = {{"p50", percentile(errorsAt[kSafeViewLag], 0.5)},
                                          {"p99", percentile(errorsAt[kSafeViewLag], 0.99)}};
+        for (const long lag : {kViewLag, kSafeViewLag}) { // samples shown past the body's newest placement
+            const std::vector<double>& ahead = aheadAt[static_cast<std::uint32_t>(lag)];
+            j["placement_error_cm_past_newest"]["lag" + std::to_string(lag)] = {
+                {"samples", ahead.size()}, {"p50", percentile(ahead, 0.5)}, {"p99", percentile(ahead, 0.99)}};
+            allAhead[lag].insert(allAhead[lag].end(), ahead.begin(), ahead.end());
+        }
+        nlohmann::json seconds = nlohmann::json::array(); // kbps per second, with when each second ended
+        for (std::size_t k = 0; k < kbps[c].size(); ++k)
+            seconds.push_back({std::round(secondEnds[c][k] * 10) / 10, std::round(kbps[c][k])});
+        j["kbps_seconds"] = seconds;
         j["link"] = {{"down_lost", relays[c]->down().lost},
                      {"down_partition_drops", relays[c]->down().partitionDrops},
                      {"up_lost", relays[c]->up().lost}};
@@ -515,7 +529,9 @@ int runHost(const Args& a) {
     r["snapshot_raw_bytes"] = hs.snapshotRawBytes / std::max<long long>(1, hs.joins);
     r["snapshot_objects_by_reference"] = hs.snapshotObjectsByReference / std::max<long long>(1, hs.joins);
     r["clients_load_scene"] = !a.noBase;
-    r["snapshot_build_ms"] = hs.snapshotBuildMs / static_cast<double>(std::max<long long>(1, hs.joins));
+    r["snapshot_builds"] = hs.snapshotBuilds;
+    r["snapshot_build_ms"] =
+        hs.snapshotBuildMs / static_cast<double>(std::max<long long>(1, hs.snapshotBuilds));
     r["snapshot_chunks_sent"] = hs.snapshotChunksSent;
     r["snapshot_transfer_ms"] = hs.snapshotTransferMs / static_cast<double>(std::max<long long>(1, hs.joins));
     r["final_hashes_equal"] = allConverged;
@@ -525,6 +541,9 @@ int runHost(const Args& a) {
     r["placement_error_cm"] = {{"p50", percentile(allErrors, 0.5)}, {"p99", percentile(allErrors, 0.99)}};
     r["placement_error_cm_lag12"] = {{"p50", percentile(allSafeErrors, 0.5)},
                                      {"p99", percentile(allSafeErrors, 0.99)}};
+    for (const auto& [lag, ahead] : allAhead)
+        r["placement_error_cm_past_newest"]["lag" + std::to_string(lag)] = {
+            {"samples", ahead.size()}, {"p50", percentile(ahead, 0.5)}, {"p99", percentile(ahead, 0.99)}};
     r["host_geometry_hash"] = std::to_string(hostHash);
     r["clients"] = clients;
     const auto use = cpu.read();

@@ -23,6 +23,7 @@ struct HostStats {
     long long joins = 0;                      ///< clients that joined (each got a snapshot)
     long long eventsSent = 0;                 ///< journal events sent (per client)
     long long eventBytes = 0;                 ///< bytes of journal event messages sent (per client, payload)
+    long long snapshotBuilds = 0;             ///< snapshots built (joins within 30 frames share one)
     long long snapshotBytes = 0;              ///< bytes of snapshot messages sent (deflated)
     long long snapshotRawBytes = 0;           ///< what they inflate to (the objects the clients did not have)
     long long snapshotObjectsByReference = 0; ///< objects sent by id: the client had them in that state
