@@ -220,8 +220,8 @@ struct NetClient::Impl {
             applied.clear();
             tracks = std::move(fresh);
             decoder = std::move(baselines);
-            publishes = {};
-            publishes.received(0, frame); // the baselines, seq 0
+            publishes =
+                {}; // its datagrams start at seq 1; the snapshot's placements are no publish it had whole
             held.clear();
             seed = hostSeed;
             stats.joined = true;
