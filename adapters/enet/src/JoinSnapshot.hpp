@@ -1,6 +1,6 @@
 #pragma once
 // Private: what a joining client announces (Hello) and the snapshot it gets back (docs/netplay.md, 'Late
-// join'): objects the client has already, in the same state, go by id; the rest is the snapshot, deflated.
+// join'): objects the client has already, in the same state, go by id; the rest is the snapshot, compressed.
 
 #include <cstddef>
 #include <cstdint>
