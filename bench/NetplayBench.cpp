@@ -1,6 +1,8 @@
 // `rubble-bench netplay SCENE.cfg [--seconds T] [--clients N] [--shots-per-second R] [--workers W] [--seed S]
 //  [--late-join F] [--delay-ms D] [--jitter-ms J] [--loss L] [--burst B] [--partition-at A --partition-s P]
-//  [--placement-budget BYTES] [--placement-peak BYTES] [--placement-reserve BYTES] [--json] [--out DIR]`
+//  [--placement-budget BYTES] [--placement-peak BYTES] [--placement-reserve BYTES] [--placement-hz H]
+//  [--json]
+//  [--out DIR]`
 //
 // Multiplayer as separate processes over a network that misbehaves: this process hosts the scene on the
 // Bullet binding in deterministic mode (fixed 1/60 s frames paced at 60 Hz, seeded projectiles at
@@ -10,10 +12,10 @@
 // joins at fraction F of the run (default 1/3: snapshot + journal tail), the others at once. Each client
 // loads the scene itself first, so the host sends its unbroken objects by id (--no-base: the snapshot brings
 // all). Each frame the host publishes the journal events and a sync with its geometry hash; every 6th frame
-// the placements (10 Hz, BYTES per client at most). After T seconds the host stops firing, lets the fracture
-// jobs finish, waits (at most 10 s) for every client to confirm the last sync, closes the connections; the
-// clients print their figures and exit (a client still running 15 s later is killed). Bounded in time and
-// packets; loopback addresses only.
+// the placements (10 Hz; H a second with --placement-hz, the budget scaled to the same bytes a second). After
+// T seconds the host stops firing, lets the fracture jobs finish, waits (at most 10 s) for every client to
+// confirm the last sync, closes the connections; the clients print their figures and exit (a client still
+// running 15 s later is killed). Bounded in time and packets; loopback addresses only.
 //
 // Reports per client the kbps the host offered its link (UDP payload: ENet headers included, IP/UDP headers
 // not), mean and 99th-percentile second, its mismatched hashes and placement error (the client's interpolated
@@ -82,11 +84,12 @@ struct Args {
     double delayMs = 0, jitterMs = 0, loss = 0, burst = 1;
     double partitionAt = -1, partitionS = 0;
     rubble::net::PlacementBudget budget;
-    std::string out;     // folder for netplay.csv and netplay.png ("" = none)
-    int port = 0;        // client: the host's port
-    std::string samples; // client: where it writes its placement samples
-    bool noBase = false; // clients do not load the scene first (the snapshot brings every object)
-    std::string replay;  // client: folder where it keeps the game when the host stops
+    double placementHz = 10; // placements publishes a second
+    std::string out;         // folder for netplay.csv and netplay.png ("" = none)
+    int port = 0;            // client: the host's port
+    std::string samples;     // client: where it writes its placement samples
+    bool noBase = false;     // clients do not load the scene first (the snapshot brings every object)
+    std::string replay;      // client: folder where it keeps the game when the host stops
 };
 
 // Frames between placement samples, and how far behind its latest sync a client shows placements.
@@ -260,7 +263,11 @@ int runHost(const Args& a) {
     }
     net::NetHost& host = **server;
     host.setPlacementSource([&] { return runtime.placements(); });
-    host.setPlacementBudget(a.budget);
+    const long placementEvery = std::max(1L, std::lround(60.0 / a.placementHz)); // frames between publishes
+    net::PlacementBudget budget = a.budget; // per publish: the same bytes per second at any rate
+    budget.mean = budget.mean * static_cast<std::size_t>(placementEvery) / 6;
+    budget.peak = budget.peak * static_cast<std::size_t>(placementEvery) / 6;
+    host.setPlacementBudget(budget);
     const std::string tmp =
         (std::filesystem::temp_directory_path() / ("rubble-netplay-" + std::to_string(getpid()) + "-"))
             .string();
@@ -316,9 +323,9 @@ int runHost(const Args& a) {
         runtime.stepFrame();
         host.publish();
         const std::uint64_t now = runtime.world().frame();
-        if (f % 6 == 0 || now % kSampleEvery == 0) {
+        if (f % placementEvery == 0 || now % kSampleEvery == 0) {
             const std::vector<ObjectPlacement> placements = runtime.placements();
-            if (f % 6 == 0)
+            if (f % placementEvery == 0)
                 host.publishPlacements(placements);
             if (now % kSampleEvery == 0)
                 for (const ObjectPlacement& p : placements)
@@ -508,10 +515,11 @@ int runHost(const Args& a) {
     r["link"] = {{"delay_ms", a.delayMs}, {"jitter_ms", a.jitterMs},       {"loss", a.loss},
                  {"burst", a.burst},      {"partition_at", a.partitionAt}, {"partition_s", a.partitionS}};
     r["placement_budget"] = {{"mean", a.budget.mean}, {"peak", a.budget.peak}, {"reserve", a.budget.reserve}};
+    r["placement_hz"] = a.placementHz;
     r["placements_deferred_per_publish"] =
-        static_cast<double>(hs.placementsDeferred) / perClient / (runSeconds * 10);
+        static_cast<double>(hs.placementsDeferred) / perClient / (runSeconds * 60.0 / placementEvery);
     r["placement_publishes_full_share"] =
-        static_cast<double>(hs.placementPublishesFull) / perClient / (runSeconds * 10);
+        static_cast<double>(hs.placementPublishesFull) / perClient / (runSeconds * 60.0 / placementEvery);
     r["impacts"] = runtime.counters().impacts;
     r["fractures"] = runtime.counters().fractures;
     r["geometry_bytes_per_impact"] = impacts > 0 ? perClientEventBytes / impacts : 0;
@@ -797,8 +805,11 @@ const rubble::tools::Registrar host{
          app.add_option("--partition-s", a->partitionS, "how long the links stay dead")
              ->check(CLI::Range(0.0, 60.0));
          app.add_option("--placement-budget", a->budget.mean,
-                        "placement bytes per client per 10 Hz publish, mean")
+                        "placement bytes per client per 10 Hz publish, mean (scaled at other rates)")
              ->check(CLI::Range(100, 1000000));
+         app.add_option("--placement-hz", a->placementHz,
+                        "placements publishes a second (the budget's bytes per publish scale with it)")
+             ->check(CLI::Range(1.0, 60.0));
          app.add_option("--placement-peak", a->budget.peak, "placement bytes per client in one publish")
              ->check(CLI::Range(100, 1000000));
          app.add_option("--placement-reserve", a->budget.reserve, "placement bytes a client may save up")
