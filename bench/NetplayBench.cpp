@@ -453,11 +453,16 @@ int runHost(const Args& a) {
         allErrors.insert(allErrors.end(), errors.begin(), errors.end());
         allSafeErrors.insert(allSafeErrors.end(), errorsAt[kSafeViewLag].begin(),
                              errorsAt[kSafeViewLag].end());
-        // In play: the seconds after its snapshot arrived (the join's burst is reported apart).
-        const double joined = // it connects once it loaded the scene
-            spawned[c] +
-            (report.is_object() ? report.value("scene_load_ms", 0.0) + report.value("join_ms", 0.0) : 0.0) /
-                1000;
+        // In play: the seconds that began 0.25 s (a round trip, and the host's slack before it sends a chunk
+        // again) or more after its snapshot arrived, by the client's clock (the same monotonic clock); the
+        // join's burst, with the chunks sent again meanwhile, is reported apart.
+        const double joined = report.is_object() && report.value("joined_s", -1.0) >= 0
+                                  ? report.value("joined_s", -1.0) -
+                                        std::chrono::duration<double>(start.time_since_epoch()).count() + 0.25
+                                  : spawned[c] + (report.is_object() ? report.value("scene_load_ms", 0.0) +
+                                                                           report.value("join_ms", 0.0)
+                                                                     : 0.0) /
+                                                     1000;
         std::vector<double> play, joining;
         for (std::size_t k = 0; k < kbps[c].size(); ++k)
             (secondEnds[c][k] - 1 > joined ? play : joining).push_back(kbps[c][k]);
@@ -648,6 +653,7 @@ int runClient(const Args& a) {
         }
         baseMs = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
     }
+    const auto connectAt = Clock::now();
     auto client = net::NetClient::connect(world, rc.world, "127.0.0.1", static_cast<std::uint16_t>(a.port));
     if (!client) {
         std::cout << nlohmann::json{{"error", client.error().message}}.dump() << "\n";
@@ -754,6 +760,7 @@ int runClient(const Args& a) {
     const net::ClientStats& st = (*client)->stats();
     nlohmann::json j{{"joined", st.joined},
                      {"join_ms", st.joinMs},
+                     {"joined_s", st.joined ? monotonic(connectAt) + st.joinMs / 1000 : -1.0},
                      {"scene_load_ms", baseMs},
                      {"snapshot_load_ms", st.snapshotLoadMs},
                      {"events", st.events},
