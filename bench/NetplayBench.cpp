@@ -1,6 +1,8 @@
 // `rubble-bench netplay SCENE.cfg [--seconds T] [--clients N] [--shots-per-second R] [--workers W] [--seed S]
 //  [--late-join F] [--delay-ms D] [--jitter-ms J] [--loss L] [--burst B] [--partition-at A --partition-s P]
-//  [--placement-budget BYTES] [--placement-peak BYTES] [--placement-reserve BYTES] [--json] [--out DIR]`
+//  [--placement-budget BYTES] [--placement-peak BYTES] [--placement-reserve BYTES] [--placement-hz H]
+//  [--json]
+//  [--out DIR]`
 //
 // Multiplayer as separate processes over a network that misbehaves: this process hosts the scene on the
 // Bullet binding in deterministic mode (fixed 1/60 s frames paced at 60 Hz, seeded projectiles at
@@ -10,10 +12,10 @@
 // joins at fraction F of the run (default 1/3: snapshot + journal tail), the others at once. Each client
 // loads the scene itself first, so the host sends its unbroken objects by id (--no-base: the snapshot brings
 // all). Each frame the host publishes the journal events and a sync with its geometry hash; every 6th frame
-// the placements (10 Hz, BYTES per client at most). After T seconds the host stops firing, lets the fracture
-// jobs finish, waits (at most 10 s) for every client to confirm the last sync, closes the connections; the
-// clients print their figures and exit (a client still running 15 s later is killed). Bounded in time and
-// packets; loopback addresses only.
+// the placements (10 Hz; H a second with --placement-hz, the budget scaled to the same bytes a second). After
+// T seconds the host stops firing, lets the fracture jobs finish, waits (at most 10 s) for every client to
+// confirm the last sync, closes the connections; the clients print their figures and exit (a client still
+// running 15 s later is killed). Bounded in time and packets; loopback addresses only.
 //
 // Reports per client the kbps the host offered its link (UDP payload: ENet headers included, IP/UDP headers
 // not), mean and 99th-percentile second, its mismatched hashes and placement error (the client's interpolated
@@ -82,11 +84,12 @@ struct Args {
     double delayMs = 0, jitterMs = 0, loss = 0, burst = 1;
     double partitionAt = -1, partitionS = 0;
     rubble::net::PlacementBudget budget;
-    std::string out;     // folder for netplay.csv and netplay.png ("" = none)
-    int port = 0;        // client: the host's port
-    std::string samples; // client: where it writes its placement samples
-    bool noBase = false; // clients do not load the scene first (the snapshot brings every object)
-    std::string replay;  // client: folder where it keeps the game when the host stops
+    double placementHz = 10; // placements publishes a second
+    std::string out;         // folder for netplay.csv and netplay.png ("" = none)
+    int port = 0;            // client: the host's port
+    std::string samples;     // client: where it writes its placement samples
+    bool noBase = false;     // clients do not load the scene first (the snapshot brings every object)
+    std::string replay;      // client: folder where it keeps the game when the host stops
 };
 
 // Frames between placement samples, and how far behind its latest sync a client shows placements.
@@ -260,7 +263,11 @@ int runHost(const Args& a) {
     }
     net::NetHost& host = **server;
     host.setPlacementSource([&] { return runtime.placements(); });
-    host.setPlacementBudget(a.budget);
+    const long placementEvery = std::max(1L, std::lround(60.0 / a.placementHz)); // frames between publishes
+    net::PlacementBudget budget = a.budget; // per publish: the same bytes per second at any rate
+    budget.mean = budget.mean * static_cast<std::size_t>(placementEvery) / 6;
+    budget.peak = budget.peak * static_cast<std::size_t>(placementEvery) / 6;
+    host.setPlacementBudget(budget);
     const std::string tmp =
         (std::filesystem::temp_directory_path() / ("rubble-netplay-" + std::to_string(getpid()) + "-"))
             .string();
@@ -316,9 +323,9 @@ int runHost(const Args& a) {
         runtime.stepFrame();
         host.publish();
         const std::uint64_t now = runtime.world().frame();
-        if (f % 6 == 0 || now % kSampleEvery == 0) {
+        if (f % placementEvery == 0 || now % kSampleEvery == 0) {
             const std::vector<ObjectPlacement> placements = runtime.placements();
-            if (f % 6 == 0)
+            if (f % placementEvery == 0)
                 host.publishPlacements(placements);
             if (now % kSampleEvery == 0)
                 for (const ObjectPlacement& p : placements)
@@ -381,6 +388,7 @@ int runHost(const Args& a) {
     double lateJoinMs = -1;
     bool allConverged = true;
     std::vector<double> allErrors, allSafeErrors, means, p99s;
+    std::map<long, std::vector<double>> allAhead; // lag → errors of samples past the newest placement
     for (std::size_t c = 0; c < children.size(); ++c) {
         Child& child = children[c];
         const std::string out = readAll(child.out);
@@ -405,6 +413,7 @@ int runHost(const Args& a) {
         }
         // Placement error against the host, for bodies dynamic at the sampled frame.
         std::map<std::uint32_t, std::vector<double>> errorsAt; // lag → errors
+        std::map<std::uint32_t, std::vector<double>> aheadAt;  // of those: the view past the newest placement
         nlohmann::json worst = nlohmann::json::array();        // samples off by more than 50 cm
         long long missing = 0;
         {
@@ -429,6 +438,8 @@ int runHost(const Args& a) {
                             continue;
                         }
                         errorsAt[lag].push_back(length(v->second - at) * 100);
+                        if (newest[{fr, id}] < static_cast<float>(fr))
+                            aheadAt[lag].push_back(errorsAt[lag].back());
                         if (errorsAt[lag].back() > 50)
                             worst.push_back({{"cm", errorsAt[lag].back()},
                                              {"object", id},
@@ -442,11 +453,16 @@ int runHost(const Args& a) {
         allErrors.insert(allErrors.end(), errors.begin(), errors.end());
         allSafeErrors.insert(allSafeErrors.end(), errorsAt[kSafeViewLag].begin(),
                              errorsAt[kSafeViewLag].end());
-        // In play: the seconds after its snapshot arrived (the join's burst is reported apart).
-        const double joined = // it connects once it loaded the scene
-            spawned[c] +
-            (report.is_object() ? report.value("scene_load_ms", 0.0) + report.value("join_ms", 0.0) : 0.0) /
-                1000;
+        // In play: the seconds that began 0.25 s (a round trip, and the host's slack before it sends a chunk
+        // again) or more after its snapshot arrived, by the client's clock (the same monotonic clock); the
+        // join's burst, with the chunks sent again meanwhile, is reported apart.
+        const double joined = report.is_object() && report.value("joined_s", -1.0) >= 0
+                                  ? report.value("joined_s", -1.0) -
+                                        std::chrono::duration<double>(start.time_since_epoch()).count() + 0.25
+                                  : spawned[c] + (report.is_object() ? report.value("scene_load_ms", 0.0) +
+                                                                           report.value("join_ms", 0.0)
+                                                                     : 0.0) /
+                                                     1000;
         std::vector<double> play, joining;
         for (std::size_t k = 0; k < kbps[c].size(); ++k)
             (secondEnds[c][k] - 1 > joined ? play : joining).push_back(kbps[c][k]);
@@ -478,6 +494,16 @@ int runHost(const Args& a) {
         }
         j["placement_error_cm_lag12"] = {{"p50", percentile(errorsAt[kSafeViewLag], 0.5)},
                                          {"p99", percentile(errorsAt[kSafeViewLag], 0.99)}};
+        for (const long lag : {kViewLag, kSafeViewLag}) { // samples shown past the body's newest placement
+            const std::vector<double>& ahead = aheadAt[static_cast<std::uint32_t>(lag)];
+            j["placement_error_cm_past_newest"]["lag" + std::to_string(lag)] = {
+                {"samples", ahead.size()}, {"p50", percentile(ahead, 0.5)}, {"p99", percentile(ahead, 0.99)}};
+            allAhead[lag].insert(allAhead[lag].end(), ahead.begin(), ahead.end());
+        }
+        nlohmann::json seconds = nlohmann::json::array(); // kbps per second, with when each second ended
+        for (std::size_t k = 0; k < kbps[c].size(); ++k)
+            seconds.push_back({std::round(secondEnds[c][k] * 10) / 10, std::round(kbps[c][k])});
+        j["kbps_seconds"] = seconds;
         j["link"] = {{"down_lost", relays[c]->down().lost},
                      {"down_partition_drops", relays[c]->down().partitionDrops},
                      {"up_lost", relays[c]->up().lost}};
@@ -494,10 +520,11 @@ int runHost(const Args& a) {
     r["link"] = {{"delay_ms", a.delayMs}, {"jitter_ms", a.jitterMs},       {"loss", a.loss},
                  {"burst", a.burst},      {"partition_at", a.partitionAt}, {"partition_s", a.partitionS}};
     r["placement_budget"] = {{"mean", a.budget.mean}, {"peak", a.budget.peak}, {"reserve", a.budget.reserve}};
+    r["placement_hz"] = a.placementHz;
     r["placements_deferred_per_publish"] =
-        static_cast<double>(hs.placementsDeferred) / perClient / (runSeconds * 10);
+        static_cast<double>(hs.placementsDeferred) / perClient / (runSeconds * 60.0 / placementEvery);
     r["placement_publishes_full_share"] =
-        static_cast<double>(hs.placementPublishesFull) / perClient / (runSeconds * 10);
+        static_cast<double>(hs.placementPublishesFull) / perClient / (runSeconds * 60.0 / placementEvery);
     r["impacts"] = runtime.counters().impacts;
     r["fractures"] = runtime.counters().fractures;
     r["geometry_bytes_per_impact"] = impacts > 0 ? perClientEventBytes / impacts : 0;
@@ -515,7 +542,9 @@ int runHost(const Args& a) {
     r["snapshot_raw_bytes"] = hs.snapshotRawBytes / std::max<long long>(1, hs.joins);
     r["snapshot_objects_by_reference"] = hs.snapshotObjectsByReference / std::max<long long>(1, hs.joins);
     r["clients_load_scene"] = !a.noBase;
-    r["snapshot_build_ms"] = hs.snapshotBuildMs / static_cast<double>(std::max<long long>(1, hs.joins));
+    r["snapshot_builds"] = hs.snapshotBuilds;
+    r["snapshot_build_ms"] =
+        hs.snapshotBuildMs / static_cast<double>(std::max<long long>(1, hs.snapshotBuilds));
     r["snapshot_chunks_sent"] = hs.snapshotChunksSent;
     r["snapshot_transfer_ms"] = hs.snapshotTransferMs / static_cast<double>(std::max<long long>(1, hs.joins));
     r["final_hashes_equal"] = allConverged;
@@ -525,6 +554,9 @@ int runHost(const Args& a) {
     r["placement_error_cm"] = {{"p50", percentile(allErrors, 0.5)}, {"p99", percentile(allErrors, 0.99)}};
     r["placement_error_cm_lag12"] = {{"p50", percentile(allSafeErrors, 0.5)},
                                      {"p99", percentile(allSafeErrors, 0.99)}};
+    for (const auto& [lag, ahead] : allAhead)
+        r["placement_error_cm_past_newest"]["lag" + std::to_string(lag)] = {
+            {"samples", ahead.size()}, {"p50", percentile(ahead, 0.5)}, {"p99", percentile(ahead, 0.99)}};
     r["host_geometry_hash"] = std::to_string(hostHash);
     r["clients"] = clients;
     const auto use = cpu.read();
@@ -621,6 +653,7 @@ int runClient(const Args& a) {
         }
         baseMs = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
     }
+    const auto connectAt = Clock::now();
     auto client = net::NetClient::connect(world, rc.world, "127.0.0.1", static_cast<std::uint16_t>(a.port));
     if (!client) {
         std::cout << nlohmann::json{{"error", client.error().message}}.dump() << "\n";
@@ -727,6 +760,7 @@ int runClient(const Args& a) {
     const net::ClientStats& st = (*client)->stats();
     nlohmann::json j{{"joined", st.joined},
                      {"join_ms", st.joinMs},
+                     {"joined_s", st.joined ? monotonic(connectAt) + st.joinMs / 1000 : -1.0},
                      {"scene_load_ms", baseMs},
                      {"snapshot_load_ms", st.snapshotLoadMs},
                      {"events", st.events},
@@ -778,8 +812,11 @@ const rubble::tools::Registrar host{
          app.add_option("--partition-s", a->partitionS, "how long the links stay dead")
              ->check(CLI::Range(0.0, 60.0));
          app.add_option("--placement-budget", a->budget.mean,
-                        "placement bytes per client per 10 Hz publish, mean")
+                        "placement bytes per client per 10 Hz publish, mean (scaled at other rates)")
              ->check(CLI::Range(100, 1000000));
+         app.add_option("--placement-hz", a->placementHz,
+                        "placements publishes a second (the budget's bytes per publish scale with it)")
+             ->check(CLI::Range(1.0, 60.0));
          app.add_option("--placement-peak", a->budget.peak, "placement bytes per client in one publish")
              ->check(CLI::Range(100, 1000000));
          app.add_option("--placement-reserve", a->budget.reserve, "placement bytes a client may save up")

@@ -10,7 +10,7 @@ core=(
     libsuitesparse-dev libopenblas0-serial
     libassimp-dev nlohmann-json3-dev libcli11-dev
     libgtest-dev libgmock-dev libbenchmark-dev
-    libbullet-dev libenet-dev zlib1g-dev
+    libbullet-dev libenet-dev zlib1g-dev libzstd-dev
     pybind11-dev python3-dev python3-numpy python3-pytest
     libglfw3-dev libimgui-dev libepoxy-dev libstb-dev libegl-dev libgl-dev libgl1-mesa-dri libopenal-dev
     xvfb xauth xdotool gnuplot-nox

@@ -1,17 +1,19 @@
 // `rubble-server SCENE.cfg [--port P] [--clients N] [--seconds T] [--workers W] [--seed S] [--shot-rate R]
-//  [--placement-budget BYTES] [--placement-peak BYTES] [--placement-reserve BYTES]`
+//  [--placement-budget BYTES] [--placement-peak BYTES] [--placement-reserve BYTES] [--placement-hz H]`
 //
 // A dedicated, headless netplay server (docs/netplay.md, 'Dedicated server'): it loads a world.cfg scene on
 // the Bullet binding in deterministic mode, listens on 127.0.0.1:P (0 = any free port) and runs the
 // authoritative world at 60 Hz. The world changes only through clients' shots that pass the host's checks
-// (NetHost::setShotHandler: rate, speed, origin); every frame it publishes the journal and a sync, every 6th
-// the placements. After T seconds (0 = until SIGINT or SIGTERM) it lets the fracture jobs finish, waits for
-// the clients to confirm the last sync, tells them it stops (NetHost::close) and prints one JSON line of
-// totals with its final geometry hash. Prints "rubble-server: listening on 127.0.0.1:PORT" once it serves.
+// (NetHost::setShotHandler: rate, speed, origin); every frame it publishes the journal and a sync, every 3rd
+// the placements (H = 20 a second; the budget's bytes per publish scaled to the same bytes a second). After T
+// seconds (0 = until SIGINT or SIGTERM) it lets the fracture jobs finish, waits for the clients to confirm
+// the last sync, tells them it stops (NetHost::close) and prints one JSON line of totals with its final
+// geometry hash. Prints "rubble-server: listening on 127.0.0.1:PORT" once it serves.
 #include <CLI/CLI.hpp>
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <iostream>
@@ -60,6 +62,9 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(100, 1000000));
     app.add_option("--placement-reserve", budget.reserve, "placement bytes a client may have saved up")
         ->check(CLI::Range(100, 10000000));
+    double placementHz = 20;
+    app.add_option("--placement-hz", placementHz, "placements publishes a second")
+        ->check(CLI::Range(1.0, 60.0));
     CLI11_PARSE(app, argc, argv);
 
     Result<SceneConfig> scene = parseSceneConfig(file);
@@ -87,6 +92,10 @@ int main(int argc, char** argv) {
     }
     net::NetHost& host = **server;
     host.setPlacementSource([&] { return runtime.placements(); });
+    const long placementEvery = std::max(1L, std::lround(60.0 / placementHz)); // frames between publishes
+    budget.mean =
+        budget.mean * static_cast<std::size_t>(placementEvery) / 6; // per 10 Hz publish → per publish
+    budget.peak = budget.peak * static_cast<std::size_t>(placementEvery) / 6;
     host.setPlacementBudget(budget);
     std::vector<net::ShotRequest> shots;
     net::ShotRules rules;
@@ -108,7 +117,7 @@ int main(int argc, char** argv) {
         shots.clear();
         runtime.stepFrame();
         host.publish();
-        if (frame % 6 == 0)
+        if (frame % placementEvery == 0)
             host.publishPlacements(runtime.placements());
         host.service(0);
         ++frame;

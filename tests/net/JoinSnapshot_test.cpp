@@ -4,7 +4,11 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <utility>
+
 #include "JournalScene.hpp"
+#include "rubble/runtime/JournalPlayer.hpp"
 
 namespace rubble {
 namespace {
@@ -15,6 +19,7 @@ using net::detail::encodeHello;
 using net::detail::encodeJoinSnapshot;
 using net::detail::JoinSnapshotSize;
 using net::detail::KnownObjects;
+using net::detail::SnapshotCodec;
 
 // A host whose first shot broke the wall (the column and the slab are as loaded).
 struct Fired {
@@ -61,6 +66,48 @@ TEST(JoinSnapshot, AClientWithTheSceneGetsItsUnbrokenObjectsByIdAndEndsInTheHost
     ASSERT_TRUE(t) << t.error().message;
     ASSERT_TRUE(restoreSnapshot(empty, std::move(*t)));
     EXPECT_EQ(empty.geometryHash(), world.geometryHash());
+}
+
+TEST(JoinSnapshot, ZstdPacksASnapshotTighterThanDeflateAndDecodesToTheSameState) {
+    Fired fired;
+    DestructionWorld deflated(test::journalConfig(1).world), zstd(test::journalConfig(1).world);
+    JoinSnapshotSize a, b;
+    const std::vector<std::uint8_t> deflateMsg =
+        encodeJoinSnapshot(fired.snapshot(), {}, &a, SnapshotCodec::Deflate);
+    const std::vector<std::uint8_t> zstdMsg =
+        encodeJoinSnapshot(fired.snapshot(), {}, &b, SnapshotCodec::Zstd);
+    EXPECT_EQ(a.raw, b.raw);
+    EXPECT_LT(b.wire, a.wire) << "on the demolition scene a third smaller; here less (docs/netplay.md)";
+    for (auto [msg, world] : {std::pair{&deflateMsg, &deflated}, std::pair{&zstdMsg, &zstd}}) {
+        Result<Snapshot> s = decodeJoinSnapshot(msg->data(), msg->size(), *world);
+        ASSERT_TRUE(s) << s.error().message;
+        ASSERT_TRUE(restoreSnapshot(*world, std::move(*s)));
+        EXPECT_EQ(world->geometryHash(), fired.host.runtime.world().geometryHash());
+    }
+    std::printf("join snapshot: %zu raw bytes, %zu deflated, %zu with zstd\n", a.raw, a.wire, b.wire);
+}
+
+TEST(JoinSnapshot, AClientThatReplayedTheJournalHasEveryPieceById) {
+    test::JournalRig host(1);
+    std::vector<JournalEvent> events;
+    host.runtime.setJournalSink([&](const JournalEvent& e) { events.push_back(e); });
+    host.play(40);
+    host.settle();
+    const DestructionWorld& world = host.runtime.world();
+    auto client = test::journalWorld(1);
+    JournalPlayer player(*client);
+    for (const JournalEvent& e : events)
+        ASSERT_TRUE(player.receive(e));
+    ASSERT_TRUE(player.advanceTo(world.frame()));
+    ASSERT_EQ(client->geometryHash(), world.geometryHash());
+    KnownObjects known;
+    const std::vector<std::uint8_t> hello = encodeHello(*client);
+    ASSERT_TRUE(decodeHello(hello.data(), hello.size(), known));
+    JoinSnapshotSize size;
+    (void)encodeJoinSnapshot(takeSnapshot(host.runtime), known, &size);
+    EXPECT_GT(host.runtime.counters().fractures, 3);
+    EXPECT_EQ(size.referenced, world.objects().size())
+        << "the pieces it cut itself are the host's, byte for byte";
 }
 
 TEST(JoinSnapshot, ObjectsInAnotherStateAreSentAndMalformedMessagesRefused) {

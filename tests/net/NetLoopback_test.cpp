@@ -306,6 +306,42 @@ TEST(NetLoopback, AJoiningClientGetsTheLatestPlacementsAsSoonAsItHasItsSnapshot)
                   1e-3);
 }
 
+TEST(NetLoopback, ClientsJoiningWithinHalfASecondShareOneSnapshotAndGetTheJournalSinceIt) {
+    test::NetHostRig net;
+    ASSERT_TRUE(net.server);
+    net::NetHost& h = *net.server;
+    net.rig.play(20);
+    h.publish();
+    DestructionWorld first(net.config), second(net.config);
+    std::unique_ptr<net::NetClient> a = joining(net, first);
+    ASSERT_TRUE(a);
+    net.rig.play(15, 3); // shots between the two joins: journal events the second needs
+    h.publish();
+    auto b = net::NetClient::connect(second, net.config, "127.0.0.1", h.port());
+    ASSERT_TRUE(b);
+    const auto pump = [&] {
+        h.service(1);
+        return a->service(1) && (*b)->service(1);
+    };
+    ASSERT_TRUE(test::waitFor([&] { return h.stats().joins == 2; }, pump));
+    EXPECT_EQ(h.stats().snapshotBuilds, 1) << "the second is given the first one's snapshot, 15 frames old";
+    for (int frame = 0; frame < 30; ++frame) {
+        net.rig.play(1, 3);
+        h.publish();
+        (void)pump();
+    }
+    net.rig.settle();
+    h.publish();
+    const std::uint64_t last = net.rig.runtime.world().frame();
+    ASSERT_TRUE(test::waitFor([&] { return a->stats().frame == last && (*b)->stats().frame == last; }, pump));
+    EXPECT_EQ(first.geometryHash(), net.rig.runtime.world().geometryHash());
+    EXPECT_EQ(second.geometryHash(), net.rig.runtime.world().geometryHash());
+    EXPECT_EQ(a->stats().mismatchedHashes, 0);
+    EXPECT_EQ((*b)->stats().mismatchedHashes, 0);
+    EXPECT_EQ(h.stats().mismatchedHashes, 0);
+    EXPECT_GT((*b)->stats().events, 0);
+}
+
 TEST(NetLoopback, OnlyLoopbackAddressesAndDeterministicWorlds) {
     DestructionWorld::Config config = test::journalConfig(1).world;
     test::JournalRig host(1);

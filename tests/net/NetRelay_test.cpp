@@ -164,6 +164,41 @@ TEST(NetRelay, ClientsThroughMisbehavingLinksConvergeAfterAPartitionAndAReplacem
     EXPECT_GT(duplicated, 0);
 }
 
+TEST(NetRelay, AClientCutOffIsSentASyncOnlyNowAndThenAndTheLatestWhenHeardAgain) {
+    test::NetHostRig net;
+    ASSERT_TRUE(net.server);
+    test::JournalRig& host = net.rig;
+    net::NetHost& h = *net.server;
+    Follower f(h.port(), 41);
+    const auto pump = [&] {
+        h.service(1);
+        return static_cast<bool>(f.client->service(1));
+    };
+    ASSERT_TRUE(test::waitFor([&] { return f.client->stats().joined; }, pump));
+    host.play(1);
+    h.publish();
+    ASSERT_TRUE(test::waitFor([&] { return h.stats().acks > 0; }, pump)) << "its snapshot is in, syncs flow";
+    f.relay->setPartitioned(true);
+    const auto quiet = Clock::now() + std::chrono::milliseconds(400); // longer than the host's 300 ms
+    ASSERT_TRUE(test::waitFor([&] { return Clock::now() >= quiet; }, pump));
+    const long long before = h.stats().syncs;
+    for (int frame = 0; frame < 120; ++frame) { // 2 s of frames, published at once
+        host.play(1);
+        h.publish();
+        h.service(0);
+    }
+    EXPECT_GE(h.stats().syncs - before, 120 / 30);
+    EXPECT_LE(h.stats().syncs - before, 120 / 30 + 1) << "a sync every 30 frames while it is cut off";
+    f.relay->setPartitioned(false);
+    const std::uint64_t last = host.runtime.world().frame();
+    ASSERT_TRUE(test::waitFor([&] { return f.client->stats().frame == last; }, pump))
+        << "it is sent the latest sync once heard again; at frame " << f.client->stats().frame << " of "
+        << last;
+    EXPECT_EQ(f.world->geometryHash(), host.runtime.world().geometryHash());
+    EXPECT_EQ(f.client->stats().mismatchedHashes, 0);
+    EXPECT_EQ(h.stats().mismatchedHashes, 0);
+}
+
 TEST(NetRelay, AClientNoticesAHostThatStoppedAnsweringAfterItsTimeout) {
     test::NetHostRig net;
     ASSERT_TRUE(net.server);

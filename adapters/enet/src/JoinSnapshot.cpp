@@ -1,6 +1,7 @@
 #include "JoinSnapshot.hpp"
 
 #include <zlib.h>
+#include <zstd.h>
 
 #include <algorithm>
 #include <string>
@@ -58,7 +59,7 @@ bool decodeHello(const std::uint8_t* data, std::size_t size, KnownObjects& out) 
 }
 
 std::vector<std::uint8_t> encodeJoinSnapshot(Snapshot snapshot, const KnownObjects& known,
-                                             JoinSnapshotSize* size) {
+                                             JoinSnapshotSize* size, SnapshotCodec codec) {
     std::vector<ObjectId> referenced;
     std::vector<ObjectState> sent;
     for (ObjectState& o : snapshot.world.objects) {
@@ -77,13 +78,22 @@ std::vector<std::uint8_t> encodeJoinSnapshot(Snapshot snapshot, const KnownObjec
         putVarint(out, id - previous);
         previous = id;
     }
+    out.push_back(static_cast<std::uint8_t>(codec));
     putVarint(out, raw.size());
-    uLongf packed = compressBound(static_cast<uLong>(raw.size()));
     const std::size_t at = out.size();
-    out.resize(at + packed);
-    if (compress2(out.data() + at, &packed, raw.data(), static_cast<uLong>(raw.size()), 1) != Z_OK)
-        return {}; // only when out of memory
-    out.resize(at + packed);
+    if (codec == SnapshotCodec::Zstd) {
+        out.resize(at + ZSTD_compressBound(raw.size()));
+        const std::size_t packed = ZSTD_compress(out.data() + at, out.size() - at, raw.data(), raw.size(), 3);
+        if (ZSTD_isError(packed))
+            return {}; // only when out of memory
+        out.resize(at + packed);
+    } else {
+        uLongf packed = compressBound(static_cast<uLong>(raw.size()));
+        out.resize(at + packed);
+        if (compress2(out.data() + at, &packed, raw.data(), static_cast<uLong>(raw.size()), 1) != Z_OK)
+            return {}; // only when out of memory
+        out.resize(at + packed);
+    }
     if (size)
         *size = {raw.size(), out.size(), referenced.size()};
     return out;
@@ -110,14 +120,26 @@ Result<Snapshot> decodeJoinSnapshot(const std::uint8_t* data, std::size_t size,
                              " is sent by id, and this world does not have it");
         referenced.push_back(*o);
     }
+    if (p == end || *p > static_cast<std::uint8_t>(SnapshotCodec::Zstd))
+        return malformed("unknown codec");
+    const auto codec = static_cast<SnapshotCodec>(*p++);
     std::uint64_t rawSize = 0;
     if (!getVarint(p, end, rawSize) || rawSize > kMaxRaw ||
-        rawSize > 1032 * static_cast<std::uint64_t>(end - p) + 64) // deflate's largest ratio
+        rawSize > 1032 * static_cast<std::uint64_t>(end - p) +
+                      64) // deflate's largest ratio (snapshots pack < 20:1)
         return malformed("bad or too large inflated size");
     std::vector<std::uint8_t> raw(static_cast<std::size_t>(rawSize));
-    uLongf got = static_cast<uLongf>(rawSize);
-    if (uncompress(raw.data(), &got, p, static_cast<uLong>(end - p)) != Z_OK || got != rawSize)
-        return malformed("the deflated snapshot is corrupted or not " + std::to_string(rawSize) + " bytes");
+    const auto packed = static_cast<std::size_t>(end - p);
+    bool whole = false;
+    if (codec == SnapshotCodec::Zstd) {
+        const std::size_t got = ZSTD_decompress(raw.data(), raw.size(), p, packed);
+        whole = !ZSTD_isError(got) && got == rawSize;
+    } else {
+        uLongf got = static_cast<uLongf>(rawSize);
+        whole = uncompress(raw.data(), &got, p, static_cast<uLong>(packed)) == Z_OK && got == rawSize;
+    }
+    if (!whole)
+        return malformed("the compressed snapshot is corrupted or not " + std::to_string(rawSize) + " bytes");
     Result<Snapshot> s = decodeSnapshot(raw.data(), raw.size(), "host snapshot");
     if (!s)
         return s;

@@ -10,6 +10,7 @@
 #include "JoinSnapshot.hpp"
 #include "Placements.hpp"
 #include "Protocol.hpp"
+#include "Track.hpp"
 #include "rubble/persist/JournalFile.hpp"
 #include "rubble/persist/Snapshot.hpp"
 #include "rubble/runtime/JobSeed.hpp"
@@ -20,9 +21,8 @@ namespace rubble::net {
 using detail::Message;
 using Clock = std::chrono::steady_clock;
 
-/// Host frames of placements kept per body: a client whose world lags the placements it receives (it is still
-/// cutting pieces) can show any frame of the last two seconds between two placements.
-constexpr double kTrackFrames = 120;
+using detail::PublishLog;
+using detail::Track;
 
 struct NetClient::Impl {
     Impl(DestructionWorld& w, const DestructionWorld::Config& c) : world(w), config(c), player(w) {
@@ -37,44 +37,8 @@ struct NetClient::Impl {
     Clock::time_point heard; // when the host was last heard
     enet_uint32 timeoutMs = detail::kPeerTimeoutMs;
     ClientStats stats;
-    /// The latest placements of a body, by host frame (ascending, within kTrackFrames of the newest).
-    struct Track {
-        std::vector<std::pair<double, Frame>> points;
-        void add(double frame, const Frame& f) {
-            if (!points.empty() && frame < points.back().first - kTrackFrames)
-                return; // older than all it keeps
-            auto at = std::lower_bound(points.begin(), points.end(), frame,
-                                       [](const auto& p, double x) { return p.first < x; });
-            if (at != points.end() && at->first == frame)
-                return; // a duplicate
-            points.insert(at, {frame, f});
-            while (points.size() > 2 && points.front().first < points.back().first - kTrackFrames)
-                points.erase(points.begin());
-        }
-        /// Where it is at `frame`: interpolated between two points, held at the ends (not empty).
-        Frame at(double frame) const {
-            if (frame <= points.front().first)
-                return points.front().second;
-            if (frame >= points.back().first)
-                return points.back().second;
-            std::size_t k = 0;
-            while (points[k + 1].first < frame)
-                ++k;
-            const Frame &a = points[k].second, &b = points[k + 1].second;
-            const double s = (frame - points[k].first) / (points[k + 1].first - points[k].first);
-            Frame f;
-            f.translation = a.translation * (1 - s) + b.translation * s;
-            auto qa = detail::toQuaternion(a.rotation), qb = detail::toQuaternion(b.rotation);
-            const double dot = qa[0] * qb[0] + qa[1] * qb[1] + qa[2] * qb[2] + qa[3] * qb[3];
-            const double sign = dot < 0 ? -1 : 1; // the shorter way round
-            std::array<double, 4> q{};
-            for (int i = 0; i < 4; ++i)
-                q[i] = qa[i] * (1 - s) + sign * qb[i] * s;
-            f.rotation = detail::fromQuaternion(q);
-            return f;
-        }
-    };
     std::map<ObjectId, Track> tracks; // also of pieces the world does not have yet
+    PublishLog publishes;             // the placements datagrams received
     detail::PlacementDecoder decoder;
     std::deque<detail::WireEvent> held; // events received, applied when the world reaches their tick
     std::vector<detail::WireEvent> arrived;
@@ -147,9 +111,13 @@ struct NetClient::Impl {
             return; // unreliable channel: a malformed packet is dropped
         stats.placementBytes += static_cast<long long>(n);
         const double frame = static_cast<double>(frameNumber);
+        const std::uint32_t seq = detail::readU32(d + 1), latest = decoder.latest();
+        if (seq == latest ||
+            (seq < latest && latest - seq <= 32 && (decoder.mask() >> (latest - seq - 1)) & 1))
+            publishes.received(seq, frame); // decoded whole (a record without its baseline is left out)
         for (const detail::DecodedPlacement& r : decoded) {
             const Frame f = detail::dequantize(r.q);
-            tracks[r.id].add(frame, f);
+            tracks[r.id].add(frame, f, &publishes);
             ++stats.placements;
         }
         std::vector<std::uint8_t> ack{static_cast<std::uint8_t>(Message::PlacementAck)};
@@ -252,6 +220,8 @@ struct NetClient::Impl {
             applied.clear();
             tracks = std::move(fresh);
             decoder = std::move(baselines);
+            publishes =
+                {}; // its datagrams start at seq 1; the snapshot's placements are no publish it had whole
             held.clear();
             seed = hostSeed;
             stats.joined = true;
@@ -391,7 +361,7 @@ std::optional<Frame> NetClient::placement(ObjectId object, double frame) const {
     auto it = impl_->tracks.find(object);
     if (it == impl_->tracks.end() || it->second.points.empty())
         return std::nullopt;
-    return it->second.at(frame);
+    return it->second.at(frame, &impl_->publishes);
 }
 
 Status NetClient::shoot(const Vec3& origin, const Vec3& velocity) {

@@ -22,6 +22,9 @@ constexpr double kChunksPerMs = 8; // snapshot chunks per client per ms (about 8
 constexpr double kChunkBurst = 96; // the most sent to a client at once (the relay's buffers hold them)
 constexpr double kPumpEveryMs = 2; // chunks go out at most this often
 constexpr int kServiceSliceMs = 2; // how long service() waits at a time while a snapshot is on its way
+constexpr std::uint64_t kReuseFrames = 30; // how old a snapshot a joining client may be given (frames)
+constexpr auto kSilence = std::chrono::milliseconds(300); // a client not heard for this long is cut off
+constexpr std::uint64_t kSilentSyncEvery = 30;            // frames between syncs to a client cut off
 } // namespace
 
 struct NetHost::Impl {
@@ -64,6 +67,16 @@ struct NetHost::Impl {
     std::map<ENetPeer*, Transfer> transfers;
     std::chrono::steady_clock::time_point lastPump;
     std::uint32_t nextTransfer = 1;
+    // The latest snapshot built: a client that joins within kReuseFrames, announcing the same objects, gets
+    // it too, and the journal since it is kept for that client.
+    struct Built {
+        bool valid = false;
+        std::uint64_t frame = 0, position = 0;
+        detail::KnownObjects known;
+        std::vector<std::uint8_t> msg;
+        std::vector<ObjectPlacement> placements;
+        detail::JoinSnapshotSize size;
+    } built;
     std::uint64_t placementsFrame = 0;                                 // of the latest publishPlacements
     std::vector<std::pair<ObjectId, detail::Quantized>> placementsNow; // what it was given then
 
@@ -128,6 +141,21 @@ struct NetHost::Impl {
         stats.legacyPlacementBytes += legacy;
     }
 
+    // The journal events from `position` to `end` (recorded by `frame`), if any; position becomes end.
+    void sendEvents(ENetPeer* peer, std::uint64_t& position, std::uint64_t end, std::uint64_t frame) {
+        if (position >= end)
+            return;
+        const auto n = static_cast<std::size_t>(end - position);
+        const JournalEvent* first = journal.data() + (position - base);
+        for (std::size_t k = 0; k < n; ++k)
+            stats.impactEvents += first[k].kind == JournalEventKind::Impact;
+        const std::vector<std::uint8_t> msg = detail::encodeEvents(frame, first, n);
+        detail::sendReliable(peer, msg);
+        stats.eventsSent += static_cast<long long>(n);
+        stats.eventBytes += static_cast<long long>(msg.size());
+        position = end;
+    }
+
     // A sync: everything sent so far, applied up to `frame`, gives `hash`.
     void sendSync(ENetPeer* peer, std::uint64_t frame, std::uint64_t position, std::uint64_t hash) {
         std::vector<std::uint8_t> sync{static_cast<std::uint8_t>(Message::Sync)};
@@ -184,44 +212,56 @@ struct NetHost::Impl {
         shotHandler(r);
     }
 
-    // A client's Hello: it gets the snapshot, without the objects it has already.
+    // A client's Hello: it gets the snapshot, without the objects it has already (the latest one built, if
+    // it is recent and for the same objects).
     void join(ENetPeer* peer, const detail::KnownObjects& known) {
         const auto started = std::chrono::steady_clock::now();
-        std::vector<ObjectPlacement> placements =
-            placementSource ? placementSource() : std::vector<ObjectPlacement>{};
-        detail::PlacementEncoder& encoder = encoders[peer] = {};
-        for (const ObjectPlacement& p : placements) // the client has these from its snapshot
-            encoder.setBaseline(p.object, detail::quantize(p.objectToWorld));
-        detail::JoinSnapshotSize size;
-        const std::vector<std::uint8_t> msg =
-            detail::encodeJoinSnapshot(takeSnapshot(world, std::move(placements)), known, &size);
-        if (msg.empty()) {
-            enet_peer_disconnect(peer, detail::kGoodbye);
-            return;
+        if (!built.valid || world.frame() > built.frame + kReuseFrames || built.known != known) {
+            built = {};
+            built.placements = placementSource ? placementSource() : std::vector<ObjectPlacement>{};
+            built.msg = detail::encodeJoinSnapshot(takeSnapshot(world, built.placements), known, &built.size);
+            if (built.msg.empty()) {
+                built = {};
+                enet_peer_disconnect(peer, detail::kGoodbye);
+                return;
+            }
+            built.valid = true;
+            built.frame = world.frame();
+            built.position = world.journalPosition();
+            built.known = known;
+            ++stats.snapshotBuilds;
+            stats.snapshotBuildMs +=
+                std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started).count();
         }
+        detail::PlacementEncoder& encoder = encoders[peer] = {};
+        for (const ObjectPlacement& p : built.placements) // the client has these from its snapshot
+            encoder.setBaseline(p.object, detail::quantize(p.objectToWorld));
         Transfer& t = transfers[peer];
         t.id = nextTransfer++;
-        t.bytes = msg;
-        const std::size_t chunks = (msg.size() + detail::kSnapshotChunk - 1) / detail::kSnapshotChunk;
+        t.bytes = built.msg;
+        const std::size_t chunks = (t.bytes.size() + detail::kSnapshotChunk - 1) / detail::kSnapshotChunk;
         t.acked.assign(chunks, false);
         t.sent.assign(chunks, {});
-        t.frame = world.frame();
+        t.frame = built.frame;
         t.started = std::chrono::steady_clock::now();
-        peers[peer] = world.journalPosition();
+        std::uint64_t& position = peers[peer] = built.position; // it is sent the journal since its snapshot
+        if (lastSync >= built.frame) // what the others were sent since, before any sync reaches it
+            sendEvents(peer, position, lastSyncPosition, lastSync);
         joinOrder[peer] = static_cast<std::uint64_t>(stats.joins);
         ++stats.joins;
-        stats.snapshotBuildMs +=
-            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started).count();
-        stats.snapshotBytes += static_cast<long long>(size.wire);
-        stats.snapshotRawBytes += static_cast<long long>(size.raw);
-        stats.snapshotObjectsByReference += static_cast<long long>(size.referenced);
+        stats.snapshotBytes += static_cast<long long>(built.size.wire);
+        stats.snapshotRawBytes += static_cast<long long>(built.size.raw);
+        stats.snapshotObjectsByReference += static_cast<long long>(built.size.referenced);
         enet_host_flush(host);
     }
 
     void receive(ENetPeer* peer, const ENetPacket* packet) {
         const auto now = std::chrono::steady_clock::now();
-        if (auto h = heard.find(peer); h != heard.end() && now - h->second > std::chrono::milliseconds(300))
+        if (auto h = heard.find(peer); h != heard.end() && now - h->second > kSilence) {
             detail::retransmitSoon(peer); // it was silent: an outage ended
+            if (peers.count(peer) && !transfers.count(peer) && hashes.count(lastSync)) // the latest sync
+                sendSync(peer, lastSync, lastSyncPosition, hashes[lastSync]);
+        }
         heard[peer] = now;
         if (packet->dataLength == 0)
             return;
@@ -303,23 +343,21 @@ void NetHost::publish() {
     while (im.hashes.size() > 4096)
         im.hashes.erase(im.hashes.begin());
     for (auto& [peer, position] : im.peers) {
-        if (position < end) {
-            const auto n = static_cast<std::size_t>(end - position);
-            const JournalEvent* first = im.journal.data() + (position - im.base);
-            for (std::size_t k = 0; k < n; ++k)
-                im.stats.impactEvents += first[k].kind == JournalEventKind::Impact;
-            const std::vector<std::uint8_t> msg = detail::encodeEvents(frame, first, n);
-            detail::sendReliable(peer, msg);
-            im.stats.eventsSent += static_cast<long long>(n);
-            im.stats.eventBytes += static_cast<long long>(msg.size());
-            position = end;
-        }
-        if (!im.transfers.count(peer)) // else its snapshot is on its way: it keeps the events meanwhile
+        im.sendEvents(peer, position, end, frame);
+        // Not while its snapshot is on its way (it keeps the events meanwhile); to a client not heard
+        // lately (an outage), only every kSilentSyncEvery frames: the latest sync is all it needs.
+        const auto h = im.heard.find(peer);
+        const bool silent = h != im.heard.end() && std::chrono::steady_clock::now() - h->second > kSilence;
+        if (!im.transfers.count(peer) && (!silent || frame % kSilentSyncEvery == 0))
             im.sendSync(peer, frame, end, hash);
     }
-    // Every client has been sent everything, and a client that joins later gets a snapshot: nothing to keep.
-    im.journal.clear();
-    im.base = end;
+    // Every client has been sent everything; a client that joins later gets a snapshot, and the events
+    // since the latest one are kept while it may be reused.
+    if (im.built.valid && frame > im.built.frame + kReuseFrames)
+        im.built = {};
+    const std::uint64_t keep = im.built.valid ? std::min(im.built.position, end) : end;
+    im.journal.erase(im.journal.begin(), im.journal.begin() + static_cast<std::ptrdiff_t>(keep - im.base));
+    im.base = keep;
     enet_host_flush(im.host);
     im.pump();
 }

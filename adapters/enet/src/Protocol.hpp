@@ -18,7 +18,7 @@ namespace rubble::net::detail {
 
 /// Message types (first byte of every packet; on channel 0, reliable and ordered, unless said).
 enum class Message : std::uint8_t {
-    Snapshot = 1,     ///< objects sent by id, then the deflated snapshot (JoinSnapshot.hpp)
+    Snapshot = 1,     ///< objects sent by id, then the compressed snapshot (JoinSnapshot.hpp)
     Events = 2,       ///< u32 count, then count × 48-byte journal events
     Sync = 3,         ///< u64 frame, u64 journal position, u64 geometry hash
     Ack = 4,          ///< client → host: u64 frame, u64 its geometry hash after that sync

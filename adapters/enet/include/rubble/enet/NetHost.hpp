@@ -1,6 +1,6 @@
 #pragma once
 /// \file NetHost.hpp
-/// The authoritative side of loopback multiplayer: sends a joining client a snapshot (deflated, without the
+/// The authoritative side of loopback multiplayer: sends a joining client a snapshot (compressed, without the
 /// objects it announced it has in the same state), then every journal event and, once per frame, the frame
 /// number with the geometry hash it must match (docs/netplay.md).
 
@@ -23,10 +23,11 @@ struct HostStats {
     long long joins = 0;                      ///< clients that joined (each got a snapshot)
     long long eventsSent = 0;                 ///< journal events sent (per client)
     long long eventBytes = 0;                 ///< bytes of journal event messages sent (per client, payload)
-    long long snapshotBytes = 0;              ///< bytes of snapshot messages sent (deflated)
+    long long snapshotBuilds = 0;             ///< snapshots built (joins within 30 frames share one)
+    long long snapshotBytes = 0;              ///< bytes of snapshot messages sent (compressed)
     long long snapshotRawBytes = 0;           ///< what they inflate to (the objects the clients did not have)
     long long snapshotObjectsByReference = 0; ///< objects sent by id: the client had them in that state
-    double snapshotBuildMs = 0;               ///< time spent taking, encoding and deflating snapshots (ms)
+    double snapshotBuildMs = 0;               ///< time spent taking, encoding and compressing snapshots (ms)
     long long snapshotChunksSent = 0;         ///< snapshot chunks sent, resends included
     double snapshotTransferMs =
         0;               ///< time from sending snapshots' first chunks to their last acknowledgement (ms)
