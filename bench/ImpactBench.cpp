@@ -378,7 +378,7 @@ int writePartsComparison(const BenchArgs& args, const std::vector<Case>& cases, 
         if (!c.roughness.active() || it == c.samples.end() || it->second.flatCut.ms.empty())
             continue;
         const Samples& s = it->second;
-        data += "\"" + c.name + "\"";
+        data += "\"" + c.name.substr(0, c.name.size() - 6) + "\""; // without _rough
         for (const auto& [from, q] : {std::pair<const char*, const PartsQuality*>{"flat_cut", &s.flatCut},
                                       {"rough_piece", &s.ownParts}}) {
             table.rows.push_back(
@@ -386,7 +386,8 @@ int writePartsComparison(const BenchArgs& args, const std::vector<Case>& cases, 
                  std::to_string(s.pieceCount), fixed(stats(q->ms).median), fixed(stats(q->ms).min),
                  std::to_string(q->count), fixed(q->vertexOverA, 3), fixed(stats(q->ratio).median, 4),
                  fixed(q->concavity, 4), fixed(q->concavityOverA, 3), fixed(otherCpu, 2)});
-            data += " " + fixed(stats(q->ms).median) + " " + fixed(q->vertexOverA, 3);
+            data += " " + fixed(stats(q->ms).median) + " " + fixed(q->vertexOverA, 3) + " " +
+                    fixed(q->concavityOverA, 3);
         }
         data += "\n";
     }
@@ -405,17 +406,19 @@ int writePartsComparison(const BenchArgs& args, const std::vector<Case>& cases, 
                           << " A outside the flat cut's parts\n";
                 bound = false;
             }
-    rubble::bench::plotPng(args.out, "impact_rough_parts", data,
-                           "set termoption noenhanced\nset multiplot layout 1,2 title 'Convex parts of rough "
-                           "pieces: flat cut parts vs each rough piece decomposed, one run'\n"
-                           "set style data histograms\nset style fill solid 0.6\nset xtics rotate by -20\n"
-                           "set grid ytics\nset key top left\nset logscale y\n"
-                           "set ylabel 'time to parts, ms (median)'\n"
-                           "plot $DATA u 2:xtic(1) t 'flat cut parts', '' u 4 t 'rough piece parts'\n"
-                           "unset logscale y\nset yrange [0:*]\n"
-                           "set ylabel 'largest rough vertex outside the parts / A'\n"
-                           "plot $DATA u 3:xtic(1) t 'flat cut parts', '' u 5 t 'rough piece parts', 1 w l "
-                           "dt 2 t 'A'\nunset multiplot");
+    rubble::bench::plotPng(
+        args.out, "impact_rough_parts", data,
+        "set termoption noenhanced\nset multiplot layout 1,3 title 'Convex parts of rough pieces: flat cut "
+        "parts (as shipped) vs each rough piece decomposed, one run'\n"
+        "set style data histograms\nset style fill solid 0.6\nset xtics rotate by -30 font ',8'\n"
+        "set grid ytics\nset key top left font ',8'\nset logscale y\n"
+        "set title 'ms to parts (median)' font ',9'\n"
+        "plot $DATA u 2:xtic(1) t 'flat cut', '' u 5 t 'rough piece'\n"
+        "unset logscale y\nset yrange [0:1.3]\n"
+        "set title 'rough vertex outside parts / A' font ',9'\n"
+        "plot $DATA u 3:xtic(1) t 'flat cut', '' u 6 t 'rough piece', 1 w l dt 2 lc 'black' t 'A'\n"
+        "set yrange [0:*]\nset title 'Hausdorff concavity / A' font ',9'\n"
+        "plot $DATA u 4:xtic(1) t 'flat cut', '' u 7 t 'rough piece'\nunset multiplot");
     return bound ? 0 : 1;
 }
 
