@@ -18,6 +18,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -26,6 +27,7 @@
 #include "MegaMeshes.hpp"
 #include "Subcommand.hpp"
 #include "rubble/collision/ConvexDecomposition.hpp"
+#include "rubble/collision/PartConcavity.hpp"
 #include "rubble/core/Random.hpp"
 #include "rubble/fracture/Fracture.hpp"
 #include "rubble/io/MeshIO.hpp"
@@ -42,6 +44,7 @@ struct BenchArgs {
     std::vector<std::string> backends{"corefine", "fast", "nef"}; // which backends run
     std::string out = rubble::bench::resultsDir();
     bool rough = false; // only the rough rows beside their flat twins (impact_rough.csv)
+    bool parts = false; // with rough: the flat cut's parts vs each rough piece's own (impact_rough_parts.csv)
 };
 
 using rubble::bench::msSince;
@@ -59,6 +62,16 @@ const char* backendName(rubble::BooleanKind k) {
     return "corefine";
 }
 
+/// How well one choice of convex parts covers the rough pieces of one fracture.
+struct PartsQuality {
+    std::vector<double> ms;    // time to the parts
+    std::size_t count = 0;     // parts of every piece, last run
+    double vertexOverA = 0;    // largest distance of a rough-surface vertex outside every part, over A
+    std::vector<double> ratio; // Σ part volume / Σ piece volume
+    double concavity = 0;      // largest partConcavity of a piece (fraction of its diagonal)
+    double concavityOverA = 0; // the same, in units of A
+};
+
 /// Samples of one backend on one case.
 struct Samples {
     std::vector<double> pieces, withParts, cell, boolean, islands, mass, decomposition;
@@ -68,6 +81,7 @@ struct Samples {
     std::size_t pieceCount = 0, partCount = 0; // of the last run
     std::size_t mostCut = 0;                   // the most cut triangles of one piece, every run
     std::string error;
+    PartsQuality flatCut, ownParts; // with --parts, on rough cases: the runtime's parts and the alternative
 };
 
 struct Case {
@@ -93,7 +107,72 @@ void assignWithRoom(std::vector<T>& to, const std::vector<T>& from) {
     to = from;
 }
 
-void runOnce(Case& c, rubble::BooleanKind kind, std::uint64_t seed) {
+/// Segment distance, for polygonDistance.
+double segmentDistance(const rubble::Vec3& p, const rubble::Vec3& a, const rubble::Vec3& b) {
+    const rubble::Vec3 ab = b - a;
+    const double len2 = dot(ab, ab);
+    const double t = len2 > 0 ? std::clamp(dot(p - a, ab) / len2, 0.0, 1.0) : 0.0;
+    return length(p - (a + ab * t));
+}
+
+/// Distance from p to the solid union of parts (0 inside one): exact, face polygon by face polygon.
+double outsideParts(const rubble::Vec3& p, const std::vector<rubble::ConvexPolytope>& parts) {
+    double best = std::numeric_limits<double>::infinity();
+    for (const rubble::ConvexPolytope& part : parts) {
+        if (part.contains(p))
+            return 0;
+        for (const rubble::PolytopeFace& f : part.faces()) {
+            const std::size_t n = f.corners.size();
+            bool inside = n >= 3;
+            double edges = std::numeric_limits<double>::infinity();
+            for (std::size_t i = 0; i < n; ++i) {
+                const rubble::Vec3 &a = f.corners[i], &b = f.corners[(i + 1) % n];
+                inside = inside && dot(cross(b - a, p - a), f.plane.normal) >= 0;
+                edges = std::min(edges, segmentDistance(p, a, b));
+            }
+            best = std::min(best, inside ? std::abs(f.plane.signedDistance(p)) : edges);
+        }
+    }
+    return best;
+}
+
+/// The quality of parts[i] for the pieces of r, whose roughness amplitude is amplitude.
+void measureParts(PartsQuality& q, const rubble::FractureResult& r,
+                  const std::vector<std::vector<rubble::ConvexPolytope>>& parts, double amplitude,
+                  double ms) {
+    q.ms.push_back(ms);
+    q.count = 0;
+    double partVolume = 0, pieceVolume = 0;
+    const std::vector<double> concavity = rubble::pieceConcavity(r, parts);
+    for (std::size_t i = 0; i < parts.size() && i < r.pieces.size(); ++i) {
+        q.count += parts[i].size();
+        for (const rubble::ConvexPolytope& p : parts[i])
+            partVolume += p.volume();
+        const rubble::Mesh& m = r.pieces[i].mesh;
+        pieceVolume += r.pieces[i].mass.volume;
+        q.concavity = std::max(q.concavity, concavity[i]);
+        q.concavityOverA = std::max(q.concavityOverA, concavity[i] * m.bounds().diagonal() / amplitude);
+        for (std::size_t t = 0; t < m.triangles.size(); ++t)
+            if (m.materials[t] == rubble::kInteriorMaterial)
+                for (const rubble::Vec3& v : m.corners(t))
+                    q.vertexOverA = std::max(q.vertexOverA, outsideParts(v, parts[i]) / amplitude);
+    }
+    q.ratio.push_back(pieceVolume > 0 ? partVolume / pieceVolume : 0.0);
+}
+
+/// The amplitude of a rough cut in mesh units: relative to the cube root of the cells' mean volume.
+double cutAmplitude(const rubble::Roughness& r, const std::vector<rubble::ConvexPolytope>& cells) {
+    double volume = 0;
+    int count = 0;
+    for (const rubble::ConvexPolytope& c : cells)
+        if (!c.empty()) {
+            volume += c.volume();
+            ++count;
+        }
+    return r.relative && count > 0 ? r.amplitude * std::cbrt(volume / count) : r.amplitude;
+}
+
+void runOnce(Case& c, rubble::BooleanKind kind, std::uint64_t seed, bool compareParts) {
     rubble::FractureParams params;
     params.backend = kind;
     params.sizeLaw.base = c.domain;
@@ -158,6 +237,20 @@ void runOnce(Case& c, rubble::BooleanKind kind, std::uint64_t seed) {
         pieceVolume += r->pieces[i].mass.volume;
     }
     s.excess.push_back(pieceVolume > 0 ? partVolume / pieceVolume - 1 : 0.0);
+    if (!compareParts || !r->rough)
+        return;
+    // The alternative: each rough piece decomposed on its own, with the default settings.
+    const auto t4 = Clock::now();
+    std::vector<std::vector<rubble::ConvexPolytope>> own;
+    own.reserve(meshes.size());
+    for (const rubble::Mesh& m : meshes) {
+        auto d = rubble::decompose(m);
+        own.push_back(d ? std::move(d->parts) : std::vector<rubble::ConvexPolytope>{});
+    }
+    const double ownMs = msSince(t4);
+    const double amplitude = cutAmplitude(c.roughness, r->cells);
+    measureParts(s.flatCut, *r, parts, amplitude, partsMs);
+    measureParts(s.ownParts, *r, own, amplitude, ownMs);
 }
 
 /// The centroid of the triangle furthest along +x: a point on the surface of any closed mesh.
@@ -262,6 +355,73 @@ std::vector<Case> roughCases(bool quick) {
     return cases;
 }
 
+/// --rough --parts: the flat cut's parts beside each rough piece's own, per rough case (Fast backend).
+int writePartsComparison(const BenchArgs& args, const std::vector<Case>& cases, int runs, double otherCpu) {
+    using rubble::bench::fixed;
+    rubble::bench::Table table;
+    table.header = {"model",
+                    "triangles",
+                    "parts_from",
+                    "runs",
+                    "pieces",
+                    "parts_ms_median",
+                    "parts_ms_min",
+                    "convex_parts",
+                    "rough_vertex_outside_over_A_max",
+                    "parts_over_piece_volume_median",
+                    "hausdorff_concavity_max",
+                    "hausdorff_over_A_max",
+                    "other_cpu_cores"};
+    std::string data;
+    for (const Case& c : cases) {
+        auto it = c.samples.find(rubble::BooleanKind::Fast);
+        if (!c.roughness.active() || it == c.samples.end() || it->second.flatCut.ms.empty())
+            continue;
+        const Samples& s = it->second;
+        data += "\"" + c.name.substr(0, c.name.size() - 6) + "\""; // without _rough
+        for (const auto& [from, q] : {std::pair<const char*, const PartsQuality*>{"flat_cut", &s.flatCut},
+                                      {"rough_piece", &s.ownParts}}) {
+            table.rows.push_back(
+                {c.name, std::to_string(c.mesh.triangleCount()), from, std::to_string(q->ms.size()),
+                 std::to_string(s.pieceCount), fixed(stats(q->ms).median), fixed(stats(q->ms).min),
+                 std::to_string(q->count), fixed(q->vertexOverA, 3), fixed(stats(q->ratio).median, 4),
+                 fixed(q->concavity, 4), fixed(q->concavityOverA, 3), fixed(otherCpu, 2)});
+            data += " " + fixed(stats(q->ms).median) + " " + fixed(q->vertexOverA, 3) + " " +
+                    fixed(q->concavityOverA, 3);
+        }
+        data += "\n";
+    }
+    rubble::bench::printTable(table);
+    std::printf(
+        "runs per case: %d (seeds 1000+i), both choices on the same fracture; A = the cut's amplitude; "
+        "other processes used %.2f cores meanwhile\n",
+        runs, otherCpu);
+    if (!rubble::bench::writeCsv(fs::path(args.out) / "impact_rough_parts.csv", table))
+        return 1;
+    bool bound = true; // the flat cut's parts stay within A of every rough vertex (docs/roughness.md)
+    for (const Case& c : cases)
+        for (const auto& [kind, s] : c.samples)
+            if (s.flatCut.vertexOverA > 1 + 1e-9) {
+                std::cerr << "impact: " << c.name << ": a rough vertex lies " << s.flatCut.vertexOverA
+                          << " A outside the flat cut's parts\n";
+                bound = false;
+            }
+    rubble::bench::plotPng(
+        args.out, "impact_rough_parts", data,
+        "set termoption noenhanced\nset multiplot layout 1,3 title 'Convex parts of rough pieces: flat cut "
+        "parts (as shipped) vs each rough piece decomposed, one run'\n"
+        "set style data histograms\nset style fill solid 0.6\nset xtics rotate by -30 font ',8'\n"
+        "set grid ytics\nset key top left font ',8'\nset logscale y\n"
+        "set title 'ms to parts (median)' font ',9'\n"
+        "plot $DATA u 2:xtic(1) t 'flat cut', '' u 5 t 'rough piece'\n"
+        "unset logscale y\nset yrange [0:1.3]\n"
+        "set title 'rough vertex outside parts / A' font ',9'\n"
+        "plot $DATA u 3:xtic(1) t 'flat cut', '' u 6 t 'rough piece', 1 w l dt 2 lc 'black' t 'A'\n"
+        "set yrange [0:*]\nset title 'Hausdorff concavity / A' font ',9'\n"
+        "plot $DATA u 4:xtic(1) t 'flat cut', '' u 7 t 'rough piece'\nunset multiplot");
+    return bound ? 0 : 1;
+}
+
 int runBench(const BenchArgs& args) {
     const int runs = args.quick ? 2 : std::max(1, args.runs);
     // The thesis's program measured here: impact → final collision shape (seconds, MEASUREMENTS.md).
@@ -273,6 +433,10 @@ int runBench(const BenchArgs& args) {
                                                : std::vector<int>{1, 3, 7, 15, 29};
     if (args.rough)
         cases = roughCases(args.quick);
+    if (args.parts) // the rough cases only, once each (the in-place copy makes the same pieces)
+        cases.erase(std::remove_if(cases.begin(), cases.end(),
+                                   [](const Case& c) { return !c.roughness.active() || c.known; }),
+                    cases.end());
     for (int n : grid) {
         Case c;
         c.mesh = rubble::makeSubdividedBox({-1, -1, -1}, {1, 1, 1}, n);
@@ -352,7 +516,7 @@ int runBench(const BenchArgs& args) {
                 const bool wanted = std::find(args.backends.begin(), args.backends.end(), backendName(k)) !=
                                     args.backends.end();
                 if (wanted && (k != rubble::BooleanKind::Nef || c.mesh.triangleCount() <= 2700))
-                    runOnce(c, k, 1000 + static_cast<std::uint64_t>(run));
+                    runOnce(c, k, 1000 + static_cast<std::uint64_t>(run), args.parts);
             }
         }
 
@@ -429,6 +593,8 @@ int runBench(const BenchArgs& args) {
         "decomposition is cached before the impact (initial_decomposition_ms); other processes used %.2f "
         "cores meanwhile\n",
         failures.c_str(), runs, otherCpu);
+    if (args.parts)
+        return writePartsComparison(args, cases, runs, otherCpu);
     if (!rubble::bench::writeCsv(fs::path(args.out) / (args.rough ? "impact_rough.csv" : "impact.csv"),
                                  table))
         return 1;
@@ -497,6 +663,9 @@ const rubble::tools::Registrar registrar{
              "--rough", args->rough,
              "only flat and rough (concrete) twins: the 10k cube with one cell and a 16-cell shatter, "
              "a 250k geodesic sphere copied and edited in place (impact_rough.csv/.png)");
+         app.add_flag("--parts", args->parts,
+                      "with --rough: also decompose every rough piece on its own and compare its parts with "
+                      "the flat cut's (impact_rough_parts.csv/.png)");
          auto mega = std::make_shared<rubble::bench::MegaArgs>();
          auto megaOn = std::make_shared<bool>(false);
          app.add_flag("--mega", *megaOn,
@@ -518,6 +687,7 @@ const rubble::tools::Registrar registrar{
                         "chained hits on the 250k UV sphere and geodesic sphere in --mega (0: none)")
              ->check(CLI::Range(0, 100000));
          return [args, mega, megaOn] {
+             args->rough = args->rough || args->parts;
              if (!*megaOn)
                  return runBench(*args);
              mega->out = args->out;
