@@ -9,6 +9,7 @@
 #include <string>
 #include <tuple>
 
+#include "geometry/MeshTopology.hpp"
 #include "runtime/BodyTable.hpp"
 #include "runtime/DebrisGovernor.hpp"
 #include "runtime/DebrisPool.hpp"

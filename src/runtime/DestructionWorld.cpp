@@ -13,6 +13,7 @@
 #include <utility>
 
 #include "geometry/ClosestPoint.hpp"
+#include "geometry/MeshTopology.hpp"
 #include "geometry/ShellScratch.hpp"
 #include "rubble/collision/DecomposeControl.hpp"
 #include "rubble/core/Log.hpp"
@@ -140,8 +141,9 @@ std::pair<Mesh, MeshFacts> editableCopy(const Mesh& m, const MeshFacts& f) {
     c.uvs = withRoom(m.uvs);
     c.materials = withRoom(m.materials);
     c.materialNames = m.materialNames;
-    MeshFacts cf = f;
-    cf.topology.twin = withRoom(f.topology.twin);
+    MeshFacts cf{f.known, f.triangles, f.vertices, f.integrals};
+    if (const MeshTopology* t = f.topology.get())
+        cf.topology = MeshTopology{withRoom(t->twin)};
     return {std::move(c), std::move(cf)};
 }
 
@@ -225,8 +227,8 @@ void runJob(Job& job) {
         return;
     }
     job.result = std::move(r).value();
-    job.prepareMs += job.result.timings.validateMs;
-    job.cellMs += job.result.timings.cellMs;
+    job.prepareMs += job.result.stats.timings.validateMs;
+    job.cellMs += job.result.stats.timings.cellMs;
     const auto t1 = Clock::now();
     std::vector<Mesh> meshes;
     std::vector<std::int32_t> pieceCells;
@@ -262,7 +264,7 @@ void runJob(Job& job) {
                         volumeIntegrals(meshes[i]), std::move(piece.facts.topology)};
         // The topology analyzeMesh finds (so that a loaded world, which finds it again, cuts the same bits).
         if (meshes[i].triangles.size() <= kTopologyAboveTriangles)
-            facts.topology = {};
+            facts.topology = HeldTopology{};
         else if (!facts.topology.fits(meshes[i]))
             facts.topology = buildTopology(meshes[i]).value_or(MeshTopology{});
         job.localMass.push_back(massProperties(facts.integrals));
@@ -861,8 +863,8 @@ std::vector<FractureOutcome> DestructionWorld::collect() {
         rec.queueMs = job->queueMs;
         rec.prepareMs = job->prepareMs;
         rec.cellMs = job->cellMs;
-        rec.booleanMs = job->result.timings.booleanMs;
-        rec.islandsMs = job->result.timings.islandsMs;
+        rec.booleanMs = job->result.stats.timings.booleanMs;
+        rec.islandsMs = job->result.stats.timings.islandsMs;
         rec.decompositionMs = job->decompositionMs;
         rec.finishMs = job->finishMs;
         rec.handoffMs = msBetween(job->finishedAt, a0);

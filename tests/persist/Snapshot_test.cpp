@@ -20,6 +20,7 @@
 #include "JournalScene.hpp"
 #include "TestSupport.hpp"
 #include "WorldSteps.hpp"
+#include "geometry/MeshTopology.hpp"
 #include "persist/Bytes.hpp"
 #include "rubble/fracture/Roughness.hpp"
 #include "rubble/persist/JournalFile.hpp"
@@ -361,7 +362,7 @@ TEST(Snapshot, ALoadedWorldFracturesPiecesOfPiecesBitForBitAsTheOriginal) {
 TEST(Snapshot, ALoadedWorldFracturesALargeMeshInPlaceBitForBitAsTheOriginal) {
     Mesh large = makeSphere({0, 1.5, 0}, 1.5, 250, 121); // 60k: its remainders stay above the threshold
     ASSERT_GT(large.triangles.size(), kTopologyAboveTriangles);
-    ASSERT_FALSE(analyzeMesh(large)->topology.twin.empty());
+    ASSERT_FALSE(analyzeMesh(large)->topology.empty());
     expectALoadedWorldContinuesBitForBit(std::move(large));
 }
 

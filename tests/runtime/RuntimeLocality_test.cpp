@@ -5,9 +5,9 @@
 #include "TestSupport.hpp"
 #include "ToyPhysics.hpp"
 #include "WorldSteps.hpp"
+#include "geometry/MeshTopology.hpp"
 #include "rubble/core/ThreadPool.hpp"
 #include "rubble/geometry/MassProperties.hpp"
-#include "rubble/geometry/MeshTopology.hpp"
 #include "rubble/runtime/DestructionRuntime.hpp"
 #include "rubble/runtime/DestructionWorld.hpp"
 

@@ -41,7 +41,7 @@ struct RUBBLE_API ObjectState {
     ObjectId id = 0;           ///< its id
     std::uint32_t version = 0; ///< bumped whenever its shape is replaced
     Mesh mesh; ///< local mesh: a piece's is in its principal frame (origin at the centre of mass), but for
-               ///< a remainder above kTopologyAboveTriangles cut in place, which keeps its parent's frame
+               ///< a remainder above 20k triangles cut in place, which keeps its parent's frame
     MassProperties mass;         ///< mass properties of mesh, density 1
     double density = 1;          ///< density
     bool destructible = true;    ///< false when never fractured (also: mesh could not be made valid)
