@@ -209,7 +209,7 @@ TEST(Snapshot, KeepsDecompositionSettingsMeshHashesAndTheVolumeLedger) {
     other.play(30);
     ASSERT_TRUE(restoreSnapshot(other.runtime, std::move(*decoded)));
     EXPECT_EQ(other.runtime.world().geometryHash(), m.rig.runtime.world().geometryHash());
-    const WorldState loaded = other.runtime.world().saveState();
+    const WorldState loaded = captureState(other.runtime.world());
     EXPECT_EQ(loaded.decomposition.maxParts, 7);
     EXPECT_EQ(loaded.decomposition.concavity, 0.125);
     EXPECT_EQ(loaded.decomposition.maxPartFaces, 96u);
