@@ -21,6 +21,7 @@
 
 #include "BenchUtil.hpp"
 #include "Subcommand.hpp"
+#include "fracture/BooleanBackend.hpp"
 #include "rubble/core/Random.hpp"
 #include "rubble/fracture/Fracture.hpp"
 #include "rubble/geometry/MassProperties.hpp"

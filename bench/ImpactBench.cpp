@@ -26,6 +26,7 @@
 #include "BenchUtil.hpp"
 #include "MegaMeshes.hpp"
 #include "Subcommand.hpp"
+#include "geometry/MeshTopology.hpp"
 #include "rubble/collision/ConvexDecomposition.hpp"
 #include "rubble/collision/PartConcavity.hpp"
 #include "rubble/core/Random.hpp"
@@ -190,7 +191,8 @@ void runOnce(Case& c, rubble::BooleanKind kind, std::uint64_t seed, bool compare
         assignWithRoom(work.uvs, c.mesh.uvs);
         assignWithRoom(work.materials, c.mesh.materials);
         work.materialNames = c.mesh.materialNames;
-        assignWithRoom(facts.topology.twin, c.known->topology.twin);
+        if (rubble::MeshTopology* t = facts.topology.get())
+            assignWithRoom(t->twin, c.known->topology.get()->twin);
     }
     const auto t0 = Clock::now();
     auto r = c.known ? rubble::fracture(std::move(work), c.impact, params, seed, std::move(facts))
@@ -215,14 +217,14 @@ void runOnce(Case& c, rubble::BooleanKind kind, std::uint64_t seed, bool compare
     const double piecesMs = std::chrono::duration<double, std::milli>(t1 - t0).count();
     const double partsMs = std::chrono::duration<double, std::milli>(t3 - t2).count();
     s.pieces.push_back(piecesMs);
-    s.piecesCpu.push_back(r->cpuTimings.totalMs);
+    s.piecesCpu.push_back(r->stats.cpuTimings.totalMs);
     s.withParts.push_back(piecesMs + partsMs);
-    s.cell.push_back(r->timings.cellMs);
-    s.boolean.push_back(r->timings.booleanMs);
-    s.islands.push_back(r->timings.islandsMs - r->timings.massMs);
-    s.mass.push_back(r->timings.massMs);
+    s.cell.push_back(r->stats.timings.cellMs);
+    s.boolean.push_back(r->stats.timings.booleanMs);
+    s.islands.push_back(r->stats.timings.islandsMs - r->stats.timings.massMs);
+    s.mass.push_back(r->stats.timings.massMs);
     s.decomposition.push_back(partsMs);
-    s.fallbacks += r->exactFallback ? 1 : 0;
+    s.fallbacks += r->stats.exactFallback ? 1 : 0;
     s.pieceCount = r->pieces.size();
     for (const rubble::Piece& p : r->pieces)
         s.mostCut = std::max(

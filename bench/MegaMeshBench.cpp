@@ -18,6 +18,7 @@
 
 #include "BenchUtil.hpp"
 #include "MegaMeshes.hpp"
+#include "geometry/MeshTopology.hpp"
 #include "rubble/collision/ConvexDecomposition.hpp"
 #include "rubble/core/Random.hpp"
 #include "rubble/fracture/Fracture.hpp"
@@ -135,7 +136,8 @@ Mesh roomyCopy(const Mesh& m) {
 }
 MeshFacts roomyCopy(const MeshFacts& f) {
     MeshFacts c = f;
-    c.topology.twin = roomy(f.topology.twin);
+    if (const MeshTopology* t = f.topology.get())
+        c.topology = MeshTopology{roomy(t->twin)};
     return c;
 }
 
@@ -159,7 +161,7 @@ std::optional<FractureResult> hitOnce(const Mesh& mesh, Mesh&& work, MeshFacts&&
     auto parts = updateDecomposition(parentParts, *r);
     const double partsMs = msSince(t1);
     s.cpuParts.push_back(threadCpuMs() - c1);
-    const FractureTimings& ct = r->cpuTimings;
+    const FractureTimings& ct = r->stats.cpuTimings;
     s.cpuValidate.push_back(ct.validateMs);
     s.cpuBoolean.push_back(ct.booleanMs - ct.verifyMs);
     s.cpuVerify.push_back(ct.verifyMs);
@@ -169,21 +171,21 @@ std::optional<FractureResult> hitOnce(const Mesh& mesh, Mesh&& work, MeshFacts&&
     s.withPartsCpu.push_back(threadCpuMs() - c0);
     s.withParts.push_back(piecesMs + partsMs);
     s.pieces.push_back(piecesMs);
-    s.validate.push_back(r->timings.validateMs);
-    s.cell.push_back(r->timings.cellMs);
-    s.boolean.push_back(r->timings.booleanMs);
-    s.islands.push_back(r->timings.islandsMs - r->timings.massMs - r->timings.simplifyMs);
-    s.mass.push_back(r->timings.massMs);
-    s.simplify.push_back(r->timings.simplifyMs);
+    s.validate.push_back(r->stats.timings.validateMs);
+    s.cell.push_back(r->stats.timings.cellMs);
+    s.boolean.push_back(r->stats.timings.booleanMs);
+    s.islands.push_back(r->stats.timings.islandsMs - r->stats.timings.massMs - r->stats.timings.simplifyMs);
+    s.mass.push_back(r->stats.timings.massMs);
+    s.simplify.push_back(r->stats.timings.simplifyMs);
     s.parts.push_back(partsMs);
-    s.fallbacks += r->exactFallback ? 1 : 0;
-    s.inPlace += r->editedInPlace ? 1 : 0;
-    s.fullLabels += r->islandsLabelledFully ? 1 : 0;
-    s.raced += r->islandsByRace ? 1 : 0;
-    s.path.push_back(r->islandsLabelledFully ? "full"
-                     : r->islandsByRace      ? "race"
-                     : r->editedInPlace      ? "walk"
-                                             : "copy");
+    s.fallbacks += r->stats.exactFallback ? 1 : 0;
+    s.inPlace += r->stats.editedInPlace ? 1 : 0;
+    s.fullLabels += r->stats.islandsLabelledFully ? 1 : 0;
+    s.raced += r->stats.islandsByRace ? 1 : 0;
+    s.path.push_back(r->stats.islandsLabelledFully ? "full"
+                     : r->stats.islandsByRace      ? "race"
+                     : r->stats.editedInPlace      ? "walk"
+                                                   : "copy");
     std::size_t touched = 0;
     s.clip.push_back(clipOnly(mesh, r->cells, touched));
     s.touched.push_back(static_cast<double>(touched));

@@ -872,7 +872,7 @@ bool Game::replayJournal(const std::string& path, std::uint64_t& hash, std::stri
     }
     // The replay runs on a copy of the loaded world: the runtime's own changes only as the game plays.
     rubble::DestructionWorld replayed(worldConfig_);
-    if (rubble::Status s = replayed.loadState(runtime_->world().saveState()); !s) {
+    if (rubble::Status s = rubble::restoreState(replayed, rubble::captureState(runtime_->world())); !s) {
         message = s.message();
         return false;
     }

@@ -28,7 +28,7 @@ int main() {
         total += piece.mass.volume;
     }
     std::printf("volume before %.6f, after %.6f, in %.2f ms\n", broken->inputVolume, total,
-                broken->timings.totalMs);
+                broken->stats.timings.totalMs);
 
     // 3. The runtime: what a game links. It decomposes the object into convex parts once, fractures on a
     //    worker thread, and hands out pieces (with their convex parts and frames) for adoption.

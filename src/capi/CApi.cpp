@@ -490,8 +490,8 @@ rubble_status rubble_fracture_get_info(const rubble_fracture* fracture, rubble_f
         out->piece_count = r.pieces.size();
         out->input_volume = r.inputVolume;
         out->dropped_volume = r.droppedVolume;
-        out->exact_fallback = r.exactFallback;
-        out->total_ms = r.timings.totalMs;
+        out->exact_fallback = r.stats.exactFallback;
+        out->total_ms = r.stats.timings.totalMs;
         return ok();
     });
 }

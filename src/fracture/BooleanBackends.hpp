@@ -5,6 +5,7 @@
 #include <memory>
 #include <vector>
 
+#include "BooleanBackend.hpp"
 #include "ConvexCellClipper.hpp"
 #include "rubble/fracture/Fracture.hpp"
 #include "rubble/geometry/ConvexPolytope.hpp"

@@ -14,6 +14,7 @@
 #include "FracturePipeline.hpp"
 #include "RoughCut.hpp"
 #include "geometry/Islands.hpp"
+#include "geometry/MeshTopology.hpp"
 #include "geometry/OrientedShells.hpp"
 #include "geometry/TopologyEdit.hpp"
 #include "rubble/core/ParameterCheck.hpp"
@@ -36,7 +37,7 @@ double threadCpuMs() {
 }
 
 /// A start on the wall clock and on this thread's CPU clock; a stage's time goes into both timings of a
-/// result (FractureResult::timings and cpuTimings).
+/// result (FractureStats::timings and cpuTimings).
 struct Stopwatch {
     Clock::time_point wall = Clock::now();
     double cpu = threadCpuMs();
@@ -44,13 +45,13 @@ struct Stopwatch {
     double wallMs() const { return std::chrono::duration<double, std::milli>(Clock::now() - wall).count(); }
     /// Sets the stage to the time since the start.
     void set(FractureResult& r, double FractureTimings::*stage) const {
-        r.timings.*stage = wallMs();
-        r.cpuTimings.*stage = threadCpuMs() - cpu;
+        r.stats.timings.*stage = wallMs();
+        r.stats.cpuTimings.*stage = threadCpuMs() - cpu;
     }
     /// Adds the time since the start to the stage.
     void add(FractureResult& r, double FractureTimings::*stage) const {
-        r.timings.*stage += wallMs();
-        r.cpuTimings.*stage += threadCpuMs() - cpu;
+        r.stats.timings.*stage += wallMs();
+        r.stats.cpuTimings.*stage += threadCpuMs() - cpu;
     }
 };
 
@@ -358,8 +359,8 @@ Result<FractureResult> runPipeline(const Mesh& mesh, std::vector<ConvexPolytope>
     auto split = backend.split(mesh, cells);
     const double onPlane = 1e-7 * meshBox.diagonal();
     // Rough cut faces need the clipper's split: each cut triangle in both outputs it separates.
-    res.rough = split && params.roughness.active() && !split->exactFallback && backend.name() == "fast";
-    if (res.rough)
+    res.stats.rough = split && params.roughness.active() && !split->exactFallback && backend.name() == "fast";
+    if (res.stats.rough)
         detail::roughenSplit(*split, cells, params.roughness, params.uvScale, meshBox, onPlane);
     // The result must close up and conserve volume; a failed fast split is redone exactly (flat). The check
     // labels the shells of every output on the way; the islands below reuse them.
@@ -371,7 +372,7 @@ Result<FractureResult> runPipeline(const Mesh& mesh, std::vector<ConvexPolytope>
         split = detail::makeCorefineBackend()->split(mesh, cells);
         if (split)
             split->exactFallback = true;
-        res.rough = false;
+        res.stats.rough = false;
         sound = split && detail::splitIsSound(*split, inputVolume, &shells);
     }
     if (!split)
@@ -386,12 +387,12 @@ Result<FractureResult> runPipeline(const Mesh& mesh, std::vector<ConvexPolytope>
         hit |= !m.empty();
     if (!hit)
         return cellsCutNothing();
-    res.exactFallback = split->exactFallback;
+    res.stats.exactFallback = split->exactFallback;
     t0.set(res, &FractureTimings::booleanMs);
 
     const Stopwatch t1;
     const Aabb focus = cutFocus(cells, meshBox);
-    if (!res.rough) { // roughenSplit gave the rough faces theirs
+    if (!res.stats.rough) { // roughenSplit gave the rough faces theirs
         finishCutFaces(split->remainder, cells, params.uvScale, focus, onPlane);
         finishInsideCutFaces(split->inside, cells, params, focus, onPlane);
     }
@@ -400,7 +401,7 @@ Result<FractureResult> runPipeline(const Mesh& mesh, std::vector<ConvexPolytope>
     const VolumeIntegrals* whole = split->remainderIntegrals ? &*split->remainderIntegrals : nullptr;
     // Rough pieces are not simplified: its plane tolerance would treat the two sides of a cut differently.
     FractureParams finish = params;
-    finish.simplifyPieces = params.simplifyPieces && !res.rough;
+    finish.simplifyPieces = params.simplifyPieces && !res.stats.rough;
     addPieces(std::move(split->remainder), shells[0], -1, minVolume, finish.simplifyPieces, focus, whole, res,
               nullptr, wantTopology);
     return finishPieces(std::move(split->inside), shells, std::move(cells), finish, minVolume, focus,
@@ -467,12 +468,13 @@ void simplifyAroundCut(Mesh& mesh, MeshTopology& topology, std::span<const std::
 /// edit, checked around the cut and then applied; its islands are found by a walk around the cut, with the
 /// full labelling as the fallback. A split that fails leaves mesh and topology as they were (a failed edit
 /// is redone by Corefine on the intact mesh when exactRedo is set); on success the mesh is consumed.
-Result<FractureResult> runInPlace(Mesh& mesh, MeshTopology& topology, std::vector<ConvexPolytope> cells,
+Result<FractureResult> runInPlace(Mesh& mesh, HeldTopology& held, std::vector<ConvexPolytope> cells,
                                   const FractureParams& params, const BooleanBackend& backend, bool exactRedo,
                                   double inputVolume) {
     const auto* editing = dynamic_cast<const detail::EditingBackend*>(&backend);
-    if (!editing || !topology.fits(mesh))
+    if (!editing || !held.fits(mesh))
         return runPipeline(mesh, std::move(cells), params, backend, exactRedo, inputVolume, true);
+    MeshTopology& topology = *held.get();
     const Stopwatch t0;
     FractureResult res;
     Aabb meshBox;
@@ -483,12 +485,12 @@ Result<FractureResult> runInPlace(Mesh& mesh, MeshTopology& topology, std::vecto
     auto split = editing->splitAsEdit(mesh, cells, meshBox);
     const double onPlane = 1e-7 * meshBox.diagonal();
     // Rough cut faces: the edit's new triangles and the cells' pieces, before the checks.
-    res.rough = split && params.roughness.active();
-    if (res.rough)
+    res.stats.rough = split && params.roughness.active();
+    if (res.stats.rough)
         detail::roughenEdit(*split, mesh, cells, params.roughness, params.uvScale, meshBox, onPlane);
     // Rough pieces are not simplified (as in runPipeline).
     FractureParams finish = params;
-    finish.simplifyPieces = params.simplifyPieces && !res.rough;
+    finish.simplifyPieces = params.simplifyPieces && !res.stats.rough;
     const Stopwatch tv;
     std::vector<detail::OutputShells> shells;
     std::optional<std::vector<std::uint32_t>> slots;
@@ -536,18 +538,18 @@ Result<FractureResult> runInPlace(Mesh& mesh, MeshTopology& topology, std::vecto
         auto r = runPipeline(mesh, std::move(cells), params, *detail::makeCorefineBackend(), false,
                              inputVolume, true);
         if (r) {
-            r->exactFallback = true;
-            r->timings.verifyMs += res.timings.verifyMs;
-            r->cpuTimings.verifyMs += res.cpuTimings.verifyMs;
+            r->stats.exactFallback = true;
+            r->stats.timings.verifyMs += res.stats.timings.verifyMs;
+            r->stats.cpuTimings.verifyMs += res.stats.cpuTimings.verifyMs;
         }
         return r;
     }
-    res.editedInPlace = true;
+    res.stats.editedInPlace = true;
     t0.set(res, &FractureTimings::booleanMs);
 
     const Stopwatch t1;
     const Aabb focus = cutFocus(cells, meshBox);
-    if (!res.rough) { // roughenEdit gave the rough faces theirs
+    if (!res.stats.rough) { // roughenEdit gave the rough faces theirs
         finishCutFaces(mesh, cells, params.uvScale, focus, onPlane, &*slots);
         finishInsideCutFaces(split->inside, cells, params, focus, onPlane);
     }
@@ -560,7 +562,7 @@ Result<FractureResult> runInPlace(Mesh& mesh, MeshTopology& topology, std::vecto
                (removed.empty() ? slots->empty() : detail::stillOneShell(mesh, topology, *slots, focus));
     std::vector<Mesh> chips; // shells that broke off the remainder, found by racing walks
     if (!one && !mesh.empty() && !removed.empty()) {
-        res.islandsByRace = true;
+        res.stats.islandsByRace = true;
         const auto broken = detail::racingIslands(topology, *slots);
         std::vector<std::uint32_t> gone;
         for (const auto& shell : broken)
@@ -584,7 +586,7 @@ Result<FractureResult> runInPlace(Mesh& mesh, MeshTopology& topology, std::vecto
     if (one) {
         rest.count = 1;
     } else if (!mesh.empty()) {
-        res.islandsLabelledFully = true;
+        res.stats.islandsLabelledFully = true;
         const std::int64_t count = detail::closedOrientedShells(mesh, &rest.triangleShell);
         if (count < 1)
             return makeError(ErrorCode::GeometryFailure,
@@ -624,8 +626,8 @@ Result<FractureResult> withValidation(const Mesh& mesh, const MeshFacts& known, 
     t0.set(pre, &FractureTimings::validateMs);
     auto r = run(volume);
     if (r) {
-        r->timings.validateMs = pre.timings.validateMs;
-        r->cpuTimings.validateMs = pre.cpuTimings.validateMs;
+        r->stats.timings.validateMs = pre.stats.timings.validateMs;
+        r->stats.cpuTimings.validateMs = pre.stats.cpuTimings.validateMs;
         t0.set(*r, &FractureTimings::totalMs);
     }
     return r;
@@ -709,9 +711,9 @@ Result<FractureResult> fractureBy(const Mesh& mesh, const Impact& impact, const 
     };
     auto finish = [&](Result<FractureResult> r, int redraws) {
         if (r) {
-            r->redraws = redraws;
-            for (auto [to, from] :
-                 {std::pair{&r->timings, &pre.timings}, {&r->cpuTimings, &pre.cpuTimings}}) {
+            r->stats.redraws = redraws;
+            for (auto [to, from] : {std::pair{&r->stats.timings, &pre.stats.timings},
+                                    {&r->stats.cpuTimings, &pre.stats.cpuTimings}}) {
                 to->validateMs = from->validateMs;
                 to->cellMs = from->cellMs;
             }

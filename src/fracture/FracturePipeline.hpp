@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "BooleanBackend.hpp"
 #include "rubble/fracture/Fracture.hpp"
 #include "rubble/geometry/ConvexPolytope.hpp"
 #include "rubble/geometry/Mesh.hpp"
@@ -25,7 +26,7 @@ bool splitIsSound(const SplitResult& split, double inputVolume, std::vector<Outp
                   double otherVolume = 0);
 
 /// fractureWithCells with an explicit backend (tests inject faulty ones). A split that fails splitIsSound
-/// is redone by Corefine when exactRedo is set (then FractureResult::exactFallback), else it is an error.
+/// is redone by Corefine when exactRedo is set (then FractureStats::exactFallback), else it is an error.
 /// known: as for fracture (the backend is given the integrals by the caller).
 Result<FractureResult> fractureWithBackend(const Mesh& mesh, std::vector<ConvexPolytope> cells,
                                            const FractureParams& params, const BooleanBackend& backend,

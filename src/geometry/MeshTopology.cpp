@@ -1,4 +1,4 @@
-#include "rubble/geometry/MeshTopology.hpp"
+#include "geometry/MeshTopology.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -7,9 +7,9 @@
 #include <span>
 #include <vector>
 
+#include "geometry/MeshTopology.hpp"
 #include "rubble/core/Aabb.hpp"
 #include "rubble/geometry/Mesh.hpp"
-#include "rubble/geometry/MeshTopology.hpp"
 
 namespace rubble::detail {
 

@@ -428,26 +428,26 @@ StructureState readStructure(ByteReader& r, const std::vector<ObjectPlacement>& 
 
 Snapshot takeSnapshot(const DestructionWorld& world, std::vector<ObjectPlacement> placements) {
     Snapshot s;
-    s.world = world.saveState();
+    s.world = captureState(world);
     s.placements = std::move(placements);
     return s;
 }
 
 Status restoreSnapshot(DestructionWorld& world, Snapshot snapshot) {
-    return world.loadState(std::move(snapshot.world));
+    return restoreState(world, std::move(snapshot.world));
 }
 
 Snapshot takeSnapshot(const DestructionRuntime& runtime) {
     Snapshot s = takeSnapshot(runtime.world(), runtime.placements());
     s.volumes = runtime.volumes();
     s.volumes.live = 0;
-    s.structure = runtime.structureState();
+    s.structure = captureStructure(runtime);
     return s;
 }
 
 Status restoreSnapshot(DestructionRuntime& runtime, Snapshot snapshot) {
-    return runtime.restore(std::move(snapshot.world), snapshot.placements, snapshot.volumes,
-                           snapshot.structure);
+    return restoreState(runtime, std::move(snapshot.world), snapshot.placements, snapshot.volumes,
+                        snapshot.structure);
 }
 
 std::uint64_t objectStateHash(const ObjectState& object) {

@@ -9,11 +9,13 @@
 #include <string>
 #include <tuple>
 
+#include "geometry/MeshTopology.hpp"
 #include "runtime/BodyTable.hpp"
 #include "runtime/DebrisGovernor.hpp"
 #include "runtime/DebrisPool.hpp"
 #include "runtime/ImpactCollector.hpp"
 #include "runtime/PieceAdopter.hpp"
+#include "runtime/StateAccess.hpp"
 #include "runtime/StructureMonitor.hpp"
 #include "runtime/SupportGraph.hpp"
 
@@ -412,54 +414,17 @@ struct DestructionRuntime::Impl {
         stats.structureMs += msSince(t0); // what rested on the fallen is checked at the next support stage
     }
 
-    // A saved structure names static objects (nodes once each) and, in bonds, nodes or this runtime's
-    // ground and scenery bodies in the structure; `nodes` gets the records by object.
-    Status checkStructure(const StructureState& saved,
-                          const std::map<ObjectId, const ObjectPlacement*>& where,
-                          std::map<ObjectId, const StructureNodeState*>& nodes) const {
-        if (!saved.saved && !(saved.nodes.empty() && saved.bonds.empty()))
-            return Error{ErrorCode::InvalidInput, "structure: nodes or bonds but not saved"};
-        for (const StructureNodeState& n : saved.nodes) {
-            const std::string which = "structure node of object " + std::to_string(n.object);
-            const auto it = where.find(n.object);
-            if (it == where.end() || it->second->motion != BodyMotionState::Static)
-                return Error{ErrorCode::InvalidInput, which + ": no static object"};
-            if (n.material >= materialPresets().size())
-                return Error{ErrorCode::InvalidInput,
-                             which + ": unknown material " + std::to_string(n.material)};
-            if ((n.anchor && !n.root) || (n.pending && n.root))
-                return Error{ErrorCode::InvalidInput, which + ": an anchor is a root, a pending node is not"};
-            if (!nodes.emplace(n.object, &n).second)
-                return Error{ErrorCode::InvalidInput, which + ": listed twice"};
-        }
-        for (const StructureBondState& b : saved.bonds)
-            for (std::uint64_t key : {b.a, b.b}) {
-                const std::string which = "structure bond " + std::to_string(b.a) + "-" + std::to_string(b.b);
-                if (!(key & kSceneryNodeKey)) {
-                    if (key > 0xFFFFFFFFull || !nodes.count(static_cast<ObjectId>(key)))
-                        return Error{ErrorCode::InvalidInput, which + ": names no structure node"};
-                    continue;
-                }
-                const BodyRecord* r = bodies.find(static_cast<BodyId>(key));
-                if (config.structure.enabled &&
-                    (key >> 32 != kSceneryNodeKey >> 32 || !r || r->hasObject || !structure.contains(r->id)))
-                    return Error{ErrorCode::InvalidInput, which + ": names no ground or scenery body"};
-            }
-        return Status::ok();
-    }
-
     // A restored static object joins the structure: as saved, or (nothing saved) as a scene object at load.
     void restoreNode(BodyId body, ObjectId object, const std::vector<ConvexPolytope>& parts, bool saved,
-                     const std::map<ObjectId, const StructureNodeState*>& nodes) {
+                     const detail::StructureMonitor::SavedNode* node) {
         if (!saved) {
             addStructure(body, parts, defaultMaterial(), false, object, true);
             return;
         }
-        const auto it = nodes.find(object);
-        if (it == nodes.end())
+        if (!node)
             return;
-        const StructureNodeState& n = *it->second;
-        const Material& m = materialPresets()[n.material];
+        const detail::StructureMonitor::SavedNode& n = *node;
+        const Material& m = *n.material;
         if (&m != &defaultMaterial())
             materials[object] = &m;
         if (n.solid != object)
@@ -467,21 +432,6 @@ struct DestructionRuntime::Impl {
         addStructure(body, parts, m, n.root, n.solid, n.pending);
         if (n.anchor && config.structure.enabled)
             structure.markAnchor(body);
-    }
-
-    // The bonds rebuilt from geometry take their saved health and broken state; the next solve settles.
-    void restoreBonds(const StructureState& saved) {
-        if (!config.structure.enabled)
-            return;
-        auto bodyOfKey = [&](std::uint64_t key) -> BodyId {
-            if (key & kSceneryNodeKey)
-                return static_cast<BodyId>(key);
-            const BodyRecord* r = bodies.findObject(static_cast<ObjectId>(key));
-            return r ? r->id : 0;
-        };
-        for (const StructureBondState& b : saved.bonds)
-            (void)structure.restoreBond(bodyOfKey(b.a), bodyOfKey(b.b), b.health, b.broken);
-        structure.settleNext();
     }
 
     // The stages of a frame (stepFrame) and of an adoption between frames (adoptReady), over a FrameContext.
@@ -909,103 +859,63 @@ std::vector<ObjectPlacement> DestructionRuntime::placements() const {
     return out;
 }
 
-Status DestructionRuntime::restore(WorldState state, const std::vector<ObjectPlacement>& placements,
-                                   const VolumeLedger& volumes, const StructureState& structure) {
-    Impl& im = *impl_;
-    for (double v : {volumes.retired, volumes.dust, volumes.dropped})
-        if (!(v >= 0 && v < 1e300))
-            return Error{ErrorCode::InvalidInput,
-                         "volume ledger: " + std::to_string(v) + " is negative or not finite"};
-    std::map<ObjectId, const ObjectPlacement*> where;
-    for (const ObjectPlacement& p : placements) {
-        const std::string which = "placement of object " + std::to_string(p.object);
-        if (p.role != BodyRole::Object && p.role != BodyRole::Piece)
-            return Error{ErrorCode::InvalidInput, which + ": role is neither object nor piece"};
-        if (!where.emplace(p.object, &p).second)
-            return Error{ErrorCode::InvalidInput, which + ": listed twice"};
-    }
-    if (where.size() != state.objects.size())
-        return Error{ErrorCode::InvalidInput, std::to_string(state.objects.size()) + " objects but " +
-                                                  std::to_string(where.size()) + " placements"};
-    for (const ObjectState& o : state.objects)
-        if (!where.count(o.id))
-            return Error{ErrorCode::InvalidInput, "object " + std::to_string(o.id) + " has no placement"};
-    std::map<ObjectId, const StructureNodeState*> nodes;
-    if (Status s = im.checkStructure(structure, where, nodes); !s)
-        return s;
-    // The old objects' bodies go (the world's objects are replaced below); nothing is journaled.
-    std::vector<BodyId> old;
-    for (const auto& [id, r] : im.bodies.all())
-        if (r.hasObject)
-            old.push_back(id);
-    if (Status s = im.world.loadState(std::move(state)); !s)
-        return s;
-    for (BodyId id : old)
-        im.dropBody(id);
-    im.ledger = VolumeLedger{0, volumes.retired, volumes.dust, volumes.dropped};
-    for (ObjectId id : im.world.objects()) {
-        const ObjectState& st = *im.world.object(id);
-        const ObjectPlacement& p = *where.at(id);
-        const bool isStatic = p.motion != BodyMotionState::Dynamic;
-        detail::PieceSpawn s = detail::describeObjectBody(
-            st, isStatic, p.role == BodyRole::Piece ? im.config.adoption.singleHullVolume : 0);
-        s.desc.transform = p.objectToWorld * s.objectToBody;
-        s.desc.linearVelocity = p.linearVelocity;
-        s.desc.angularVelocity = p.angularVelocity;
-        if (p.role == BodyRole::Piece) {
-            s.desc.friction = im.config.adoption.friction;
-            s.desc.restitution = im.config.adoption.restitution;
-        }
-        BodyRecord rec = objectRecord(id, p.role, p.motion, s, st);
-        rec.structural = p.motion == BodyMotionState::Static;
-        const BodyId body = im.insert(rec, s.desc).id;
-        if (p.motion == BodyMotionState::Static) {
-            const auto parts = worldParts(st, p.objectToWorld);
-            im.restoreNode(body, id, parts, structure.saved, nodes);
-            im.support.add(body, parts, false, true);
-        } else if (p.motion == BodyMotionState::Frozen) {
-            im.governor.frozen(body, s.desc.transform.translation, rec.radius);
-        }
-    }
-    im.restoreBonds(structure);
-    return Status::ok();
+namespace detail {
+
+const DestructionRuntime::Config& StateAccess::config(const DestructionRuntime& runtime) {
+    return runtime.impl_->config;
 }
 
-StructureState DestructionRuntime::structureState() const {
-    const Impl& im = *impl_;
-    StructureState out;
-    if (!im.config.structure.enabled)
-        return out;
-    out.saved = true;
-    for (const auto& [id, r] : im.bodies.all()) {
-        if (!r.hasObject || !im.structure.contains(id))
-            continue;
-        const detail::StructureMonitor::SavedNode n = im.structure.saved(id);
-        StructureNodeState v;
-        v.object = r.object;
-        v.solid = static_cast<ObjectId>(n.solid);
-        v.material = static_cast<std::uint8_t>(n.material - materialPresets().data());
-        v.root = n.root;
-        v.anchor = n.anchor;
-        v.pending = n.pending;
-        out.nodes.push_back(v);
-    }
-    std::sort(out.nodes.begin(), out.nodes.end(),
-              [](const StructureNodeState& x, const StructureNodeState& y) { return x.object < y.object; });
-    auto key = [&](BodyId id) -> std::uint64_t {
-        const BodyRecord* r = im.bodies.find(id);
-        return r && r->hasObject ? r->object : kSceneryNodeKey | id;
-    };
-    for (const detail::StructureMonitor::SavedBond& b : im.structure.savedBonds()) {
-        const std::uint64_t ka = key(b.a), kb = key(b.b);
-        out.bonds.push_back({std::min(ka, kb), std::max(ka, kb), b.health, b.broken});
-    }
-    std::sort(out.bonds.begin(), out.bonds.end(),
-              [](const StructureBondState& x, const StructureBondState& y) {
-                  return x.a < y.a || (x.a == y.a && x.b < y.b);
-              });
-    return out;
+DestructionWorld& StateAccess::world(DestructionRuntime& runtime) {
+    return runtime.impl_->world;
 }
+
+const BodyTable& StateAccess::bodies(const DestructionRuntime& runtime) {
+    return runtime.impl_->bodies;
+}
+
+const StructureMonitor& StateAccess::structure(const DestructionRuntime& runtime) {
+    return runtime.impl_->structure;
+}
+
+StructureMonitor& StateAccess::structure(DestructionRuntime& runtime) {
+    return runtime.impl_->structure;
+}
+
+void StateAccess::dropBody(DestructionRuntime& runtime, BodyId id) {
+    runtime.impl_->dropBody(id);
+}
+
+void StateAccess::continueLedger(DestructionRuntime& runtime, const VolumeLedger& volumes) {
+    runtime.impl_->ledger = VolumeLedger{0, volumes.retired, volumes.dust, volumes.dropped};
+}
+
+void StateAccess::placeObject(DestructionRuntime& runtime, ObjectId id, const ObjectPlacement& p,
+                              bool savedStructure, const StructureMonitor::SavedNode* node) {
+    DestructionRuntime::Impl& im = *runtime.impl_;
+    const ObjectState& st = *im.world.object(id);
+    const bool isStatic = p.motion != BodyMotionState::Dynamic;
+    PieceSpawn s =
+        describeObjectBody(st, isStatic, p.role == BodyRole::Piece ? im.config.adoption.singleHullVolume : 0);
+    s.desc.transform = p.objectToWorld * s.objectToBody;
+    s.desc.linearVelocity = p.linearVelocity;
+    s.desc.angularVelocity = p.angularVelocity;
+    if (p.role == BodyRole::Piece) {
+        s.desc.friction = im.config.adoption.friction;
+        s.desc.restitution = im.config.adoption.restitution;
+    }
+    BodyRecord rec = objectRecord(id, p.role, p.motion, s, st);
+    rec.structural = p.motion == BodyMotionState::Static;
+    const BodyId body = im.insert(rec, s.desc).id;
+    if (p.motion == BodyMotionState::Static) {
+        const auto parts = worldParts(st, p.objectToWorld);
+        im.restoreNode(body, id, parts, savedStructure, node);
+        im.support.add(body, parts, false, true);
+    } else if (p.motion == BodyMotionState::Frozen) {
+        im.governor.frozen(body, s.desc.transform.translation, rec.radius);
+    }
+}
+
+} // namespace detail
 
 std::uint64_t DestructionRuntime::stateHash() const {
     std::uint64_t h = 0xCBF29CE484222325ull;

@@ -13,6 +13,7 @@
 #include <utility>
 
 #include "geometry/ClosestPoint.hpp"
+#include "geometry/MeshTopology.hpp"
 #include "geometry/ShellScratch.hpp"
 #include "rubble/collision/DecomposeControl.hpp"
 #include "rubble/core/Log.hpp"
@@ -24,6 +25,7 @@
 #include "rubble/geometry/MeshRepair.hpp"
 #include "rubble/runtime/JobSeed.hpp"
 #include "rubble/structure/Material.hpp"
+#include "runtime/StateAccess.hpp"
 
 namespace rubble {
 namespace {
@@ -140,8 +142,9 @@ std::pair<Mesh, MeshFacts> editableCopy(const Mesh& m, const MeshFacts& f) {
     c.uvs = withRoom(m.uvs);
     c.materials = withRoom(m.materials);
     c.materialNames = m.materialNames;
-    MeshFacts cf = f;
-    cf.topology.twin = withRoom(f.topology.twin);
+    MeshFacts cf{f.known, f.triangles, f.vertices, f.integrals};
+    if (const MeshTopology* t = f.topology.get())
+        cf.topology = MeshTopology{withRoom(t->twin)};
     return {std::move(c), std::move(cf)};
 }
 
@@ -225,8 +228,8 @@ void runJob(Job& job) {
         return;
     }
     job.result = std::move(r).value();
-    job.prepareMs += job.result.timings.validateMs;
-    job.cellMs += job.result.timings.cellMs;
+    job.prepareMs += job.result.stats.timings.validateMs;
+    job.cellMs += job.result.stats.timings.cellMs;
     const auto t1 = Clock::now();
     std::vector<Mesh> meshes;
     std::vector<std::int32_t> pieceCells;
@@ -262,7 +265,7 @@ void runJob(Job& job) {
                         volumeIntegrals(meshes[i]), std::move(piece.facts.topology)};
         // The topology analyzeMesh finds (so that a loaded world, which finds it again, cuts the same bits).
         if (meshes[i].triangles.size() <= kTopologyAboveTriangles)
-            facts.topology = {};
+            facts.topology = HeldTopology{};
         else if (!facts.topology.fits(meshes[i]))
             facts.topology = buildTopology(meshes[i]).value_or(MeshTopology{});
         job.localMass.push_back(massProperties(facts.integrals));
@@ -718,73 +721,51 @@ Status DestructionWorld::applyJournalEvent(const JournalEvent& e) {
     return Status::ok();
 }
 
-WorldState DestructionWorld::saveState() const {
-    const Impl& im = *impl_;
-    impl_->hashPending();
-    WorldState w;
-    w.seed = im.config.seed;
-    w.delayFrames = im.config.delayFrames;
-    w.crumbleTriangles = im.config.crumbleTriangles;
-    w.crumbleCells = im.config.crumbleCells;
-    w.minPieceVolume = im.config.minPieceVolume;
-    w.decomposition = im.config.decomposition;
-    w.frame = im.frame;
-    w.nextId = im.nextId;
-    w.journalPosition = im.journalLength;
+namespace detail {
+
+DestructionWorld::Config& StateAccess::config(DestructionWorld& world) {
+    return world.impl_->config;
+}
+
+const DestructionWorld::Config& StateAccess::config(const DestructionWorld& world) {
+    return world.impl_->config;
+}
+
+ObjectId StateAccess::nextId(const DestructionWorld& world) {
+    return world.impl_->nextId;
+}
+
+std::vector<ObjectState> StateAccess::objects(const DestructionWorld& world) {
+    DestructionWorld::Impl& im = *world.impl_;
+    im.hashPending();
+    std::vector<ObjectState> out;
     for (const auto& [id, o] : im.objects)
-        w.objects.push_back(*o);
+        out.push_back(*o);
+    return out;
+}
+
+std::vector<WorldWork> StateAccess::work(const DestructionWorld& world) {
+    const DestructionWorld::Impl& im = *world.impl_;
+    std::vector<WorldWork> out;
     for (const auto& job : im.inflight) {
-        PendingWork p{job->id, job->version, true, job->readyFrame, job->submitted, {}};
-        for (const PendingImpact& q : job->impacts)
-            p.ticks.push_back(q.frame);
-        w.work.push_back(std::move(p));
+        WorldWork w{job->id, job->version, true, job->readyFrame, {}};
+        for (std::size_t i = 0; i < job->impacts.size(); ++i)
+            w.impacts.push_back({job->submitted[i], job->impacts[i].frame});
+        out.push_back(std::move(w));
     }
     for (const auto& [id, impacts] : im.waiting) {
         auto o = im.objects.find(id);
-        PendingWork p{id, o == im.objects.end() ? 0u : o->second->version, false, 0, {}, {}};
-        for (const PendingImpact& q : impacts) {
-            p.impacts.push_back(q.impact);
-            p.ticks.push_back(q.frame);
-        }
-        w.work.push_back(std::move(p));
+        WorldWork w{id, o == im.objects.end() ? 0u : o->second->version, false, 0, {}};
+        for (const PendingImpact& q : impacts)
+            w.impacts.push_back({q.impact, q.frame});
+        out.push_back(std::move(w));
     }
-    return w;
+    return out;
 }
 
-Status DestructionWorld::loadState(WorldState w) {
-    Impl& im = *impl_;
-    auto bad = [](const std::string& what) { return Error{ErrorCode::InvalidInput, "world state: " + what}; };
-    if (w.delayFrames < 0 || w.crumbleCells < 0 || !(w.minPieceVolume >= 0 && w.minPieceVolume < 1e300))
-        return bad("settings out of range (delayFrames " + std::to_string(w.delayFrames) + ", crumbleCells " +
-                   std::to_string(w.crumbleCells) + ", minPieceVolume " + std::to_string(w.minPieceVolume) +
-                   ")");
-    if (const Status s = checkDecompositionParams(w.decomposition); !s)
-        return bad("decomposition settings out of range: " + s.message());
-    ObjectId last = 0;
-    std::map<ObjectId, std::uint32_t> versions;
-    for (const ObjectState& o : w.objects) {
-        if (o.id <= last || o.id >= w.nextId)
-            return bad("object id " + std::to_string(o.id) + " is not ascending or not below nextId " +
-                       std::to_string(w.nextId));
-        if (o.mesh.triangles.empty() || o.mesh.positions.empty())
-            return bad("object " + std::to_string(o.id) + " has an empty mesh");
-        last = o.id;
-        versions[o.id] = o.version;
-    }
-    std::set<ObjectId> busy, waiting;
-    for (const PendingWork& p : w.work) {
-        auto v = versions.find(p.object);
-        const std::string which = "work on object " + std::to_string(p.object);
-        if (v == versions.end() || v->second != p.version)
-            return bad(which + ": no such object or version");
-        if (p.impacts.empty() || p.ticks.size() != p.impacts.size())
-            return bad(which + ": no impacts, or not one tick per impact");
-        if (!(p.inFlight ? busy : waiting).insert(p.object).second)
-            return bad(which + ": listed twice");
-        if (!p.inFlight && !busy.count(p.object))
-            return bad(which + ": impacts wait for a job that is not in flight");
-    }
-    // Consistent: replace everything. Jobs of the old state finish on their own; their results are dropped.
+void StateAccess::replace(DestructionWorld& world, std::vector<ObjectState> objects, std::uint64_t frame,
+                          ObjectId nextId, std::uint64_t journalPosition) {
+    DestructionWorld::Impl& im = *world.impl_;
     im.inflight.clear();
     im.waiting.clear();
     im.open.clear();
@@ -792,32 +773,29 @@ Status DestructionWorld::loadState(WorldState w) {
     im.facts.clear();
     im.geometrySum = 0;
     im.unhashed.clear();
-    for (ObjectState& o : w.objects) {
+    for (ObjectState& o : objects) {
         if (o.meshHash == 0) // a saved state brings its hashes: hashing every mesh again is most of a load
             o.meshHash = o.mesh.hash();
         im.insertObject(std::make_shared<const ObjectState>(std::move(o)));
     }
-    im.config.seed = w.seed;
-    im.config.delayFrames = w.delayFrames;
-    im.config.crumbleTriangles = static_cast<std::size_t>(w.crumbleTriangles);
-    im.config.crumbleCells = w.crumbleCells;
-    im.config.minPieceVolume = w.minPieceVolume;
-    im.config.decomposition = w.decomposition;
-    im.frame = w.frame;
-    im.nextId = w.nextId;
-    im.journalLength = w.journalPosition;
-    const auto now = Clock::now();
-    for (const PendingWork& p : w.work) {
-        std::vector<PendingImpact> impacts;
-        for (std::size_t i = 0; i < p.impacts.size(); ++i)
-            impacts.push_back({p.impacts[i], p.ticks[i], now});
-        if (p.inFlight)
-            im.launch(p.object, std::move(impacts))->readyFrame = p.readyFrame;
-        else
-            im.waiting[p.object] = std::move(impacts);
-    }
-    return Status::ok();
+    im.frame = frame;
+    im.nextId = nextId;
+    im.journalLength = journalPosition;
 }
+
+void StateAccess::resume(DestructionWorld& world, const WorldWork& work) {
+    DestructionWorld::Impl& im = *world.impl_;
+    const auto now = Clock::now();
+    std::vector<PendingImpact> impacts;
+    for (const TickedImpact& t : work.impacts)
+        impacts.push_back({t.impact, t.tick, now});
+    if (work.inFlight)
+        im.launch(work.object, std::move(impacts))->readyFrame = work.readyFrame;
+    else
+        im.waiting[work.object] = std::move(impacts);
+}
+
+} // namespace detail
 
 std::uint64_t DestructionWorld::geometryHash() const {
     impl_->hashPending();
@@ -861,8 +839,8 @@ std::vector<FractureOutcome> DestructionWorld::collect() {
         rec.queueMs = job->queueMs;
         rec.prepareMs = job->prepareMs;
         rec.cellMs = job->cellMs;
-        rec.booleanMs = job->result.timings.booleanMs;
-        rec.islandsMs = job->result.timings.islandsMs;
+        rec.booleanMs = job->result.stats.timings.booleanMs;
+        rec.islandsMs = job->result.stats.timings.islandsMs;
         rec.decompositionMs = job->decompositionMs;
         rec.finishMs = job->finishMs;
         rec.handoffMs = msBetween(job->finishedAt, a0);

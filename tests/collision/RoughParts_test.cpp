@@ -81,7 +81,7 @@ TEST(RoughParts, PartsAndRoughSurfaceStayWithinTheAmplitudeOfEachOther) {
         fp.roughness.featureSize = 0.3;
         auto fr = fracture(cube, {test::surfacePoint(cube, rng), {1, 0, 0}, 1}, fp, rng.next());
         ASSERT_TRUE(fr) << fr.error().message;
-        ASSERT_TRUE(fr->rough);
+        ASSERT_TRUE(fr->stats.rough);
         const auto parts = updateDecomposition(d->parts, *fr, DecompositionParams{});
         ASSERT_EQ(parts.size(), fr->pieces.size());
         const double amplitude = fp.roughness.amplitude, eps = 1e-9;

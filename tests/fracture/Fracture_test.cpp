@@ -9,6 +9,7 @@
 
 #include "PieceHash.hpp"
 #include "TestSupport.hpp"
+#include "fracture/BooleanBackend.hpp"
 #include "fracture/ConvexCellClipper.hpp"
 #include "rubble/core/Random.hpp"
 #include "rubble/fracture/Fracture.hpp"
@@ -92,7 +93,7 @@ void checkResult(const Mesh& input, const FractureResult& r, const std::string& 
     }
     EXPECT_NEAR(sum, v0, 1e-6 * v0) << what;
     EXPECT_NEAR(r.inputVolume, v0, 1e-12 * v0) << what;
-    EXPECT_GE(r.timings.totalMs, r.timings.booleanMs) << what;
+    EXPECT_GE(r.stats.timings.totalMs, r.stats.timings.booleanMs) << what;
 }
 
 /// Fallbacks to the exact backend, by cell pattern.
@@ -124,7 +125,7 @@ int runImpacts(const Mesh& mesh, const std::string& name, int count, BooleanKind
         if (fallbacks) {
             const bool shatter = params.pattern == CellPattern::Shatter;
             (shatter ? fallbacks->shatterImpacts : fallbacks->singleImpacts)++;
-            if (r->exactFallback)
+            if (r->stats.exactFallback)
                 (shatter ? fallbacks->shatter : fallbacks->single)++;
         }
         checkResult(mesh, *r, what);
@@ -419,8 +420,8 @@ TEST(Fracture, ManyCellShattersOfTheUnitCubeSucceed) {
                                          ", backend " + std::to_string(static_cast<int>(backend));
                 auto r = fracture(cube, {{0.5, 0.5, 1}, {0, 0, 1}, 1}, params, seed);
                 ASSERT_TRUE(r.isOk()) << what << ": " << r.error().message;
-                fallbacks += r->exactFallback;
-                redraws += r->redraws;
+                fallbacks += r->stats.exactFallback;
+                redraws += r->stats.redraws;
                 checkResult(cube, *r, what);
             }
         }
@@ -447,8 +448,8 @@ TEST(Fracture, FastRedrawsADeclinedPattern) {
         << "the seed's own pattern is no longer declined";
     auto r = fracture(*arch, impact, params, 3);
     ASSERT_TRUE(r.isOk()) << r.error().message;
-    EXPECT_GE(r->redraws, 1);
-    EXPECT_FALSE(r->exactFallback);
+    EXPECT_GE(r->stats.redraws, 1);
+    EXPECT_FALSE(r->stats.exactFallback);
     checkResult(*arch, *r, "redrawn pattern");
     auto again = fracture(*arch, impact, params, 3);
     ASSERT_TRUE(again.isOk());

@@ -61,8 +61,8 @@ std::optional<FractureResult> checkedHit(const Mesh& mesh, const MeshFacts& fact
     EXPECT_EQ(bool(with), bool(without));
     if (!with || !without)
         return std::nullopt;
-    EXPECT_EQ(with->exactFallback, without->exactFallback);
-    EXPECT_EQ(with->redraws, without->redraws);
+    EXPECT_EQ(with->stats.exactFallback, without->stats.exactFallback);
+    EXPECT_EQ(with->stats.redraws, without->stats.redraws);
     EXPECT_EQ(with->pieces.size(), without->pieces.size());
     double volume = 0;
     for (std::size_t i = 0; i < std::min(with->pieces.size(), without->pieces.size()); ++i) {

@@ -205,9 +205,9 @@ TEST(RoughFracture, RandomHitsAndPiecesOfPiecesKeepTheInvariants) {
         auto r = fracture(input, impact, params, rng.next());
         ASSERT_TRUE(r) << what << ": " << r.error().message;
         ++total;
-        rough += r->rough ? 1 : 0;
+        rough += r->stats.rough ? 1 : 0;
         expectSoundPieces(input, *r, what);
-        if (r->rough) // a flat cut (exact fallback) is simplified: its sides may differ in flat regions
+        if (r->stats.rough) // a flat cut (exact fallback) is simplified: its sides may differ in flat regions
             expectCutsCoincide(*r, what);
         EXPECT_LT(offCube(*r), 1e-12) << what;
         // Pieces of pieces: the largest piece hit again is roughened again where it is cut.
@@ -219,7 +219,7 @@ TEST(RoughFracture, RandomHitsAndPiecesOfPiecesKeepTheInvariants) {
         auto r2 = fracture(largest->mesh, again, params, rng.next(), largest->facts);
         ASSERT_TRUE(r2) << what << " again: " << r2.error().message;
         ++total;
-        rough += r2->rough ? 1 : 0;
+        rough += r2->stats.rough ? 1 : 0;
         expectSoundPieces(largest->mesh, *r2, what + " again");
         EXPECT_LT(offCube(*r2), 1e-12) << what << " again";
         roughAgain += displacedNewCutVertices(largest->mesh, *r2) > 0 ? 1 : 0;
@@ -246,7 +246,7 @@ TEST(RoughFracture, PiecesDoNotSelfIntersect) {
         }
         auto r = fracture(input, impact, params, rng.next());
         ASSERT_TRUE(r);
-        EXPECT_TRUE(r->rough);
+        EXPECT_TRUE(r->stats.rough);
         for (const Piece& p : r->pieces) {
             const MeshReport report = checkMesh(p.mesh);
             EXPECT_TRUE(report.selfIntersectionsChecked) << report.selfIntersectionNote;
@@ -262,7 +262,7 @@ TEST(RoughFracture, TheCutIsRough) {
     const Roughness rough = absoluteRoughness(0.12, 0.15, 2, 100000);
     auto r = halfCut(rough);
     ASSERT_TRUE(r) << r.error().message;
-    ASSERT_TRUE(r->rough);
+    ASSERT_TRUE(r->stats.rough);
     ASSERT_EQ(r->pieces.size(), 2u);
     expectCutsCoincide(*r, "half cut");
     // The flat cut is the square x = 0 of area 4.
@@ -288,7 +288,7 @@ TEST(RoughFracture, StructureFunctionFollowsTheHurstExponent) {
         rough.seed = 3;
         auto r = halfCut(rough);
         ASSERT_TRUE(r) << r.error().message;
-        ASSERT_TRUE(r->rough);
+        ASSERT_TRUE(r->stats.rough);
         // Heights (x) of vertices away from the outline (where the envelope does not bind), binned by
         // distance.
         std::vector<Vec3> v;
@@ -335,7 +335,7 @@ TEST(RoughFracture, SameSeedSameBytesOtherSeedOtherSurface) {
     auto a = fracture(input, impact, params, 42);
     auto b = fracture(input, impact, params, 42);
     ASSERT_TRUE(a && b);
-    EXPECT_TRUE(a->rough);
+    EXPECT_TRUE(a->stats.rough);
     EXPECT_EQ(test::hashPieces(*a), test::hashPieces(*b));
     // Pinned, as the flat scenes' golden hash (tests/persist/GoldenHash_test.cpp): a change of the rough
     // surface's bytes must be deliberate.
@@ -352,7 +352,7 @@ TEST(RoughFracture, SameSeedSameBytesOtherSeedOtherSurface) {
     flat.roughness.hurst = 0.5;
     auto g = fracture(input, impact, flat, 42);
     ASSERT_TRUE(f && g);
-    EXPECT_FALSE(f->rough);
+    EXPECT_FALSE(f->stats.rough);
     EXPECT_EQ(test::hashPieces(*f), test::hashPieces(*g));
     EXPECT_NE(test::hashPieces(*f), test::hashPieces(*a));
 }
@@ -365,7 +365,7 @@ TEST(RoughFracture, SmallPiecesFollowTheBudget) {
     rough.octaves = 8; // finer than any budget allows
     rough.maxTrianglesPerPiece = 500;
     auto r = halfCut(rough);
-    ASSERT_TRUE(r && r->rough);
+    ASSERT_TRUE(r && r->stats.rough);
     for (const Piece& p : r->pieces) {
         std::size_t cut = 0;
         for (std::uint32_t m : p.mesh.materials)
@@ -533,7 +533,7 @@ TEST(RoughFracture, EdgeEnvelopesFollowTheDihedralAngle) {
         params.roughness.amplitude = 0;
         auto f = fracture(input, impact, params, seed);
         ASSERT_TRUE(r && f);
-        ASSERT_TRUE(r->rough);
+        ASSERT_TRUE(r->stats.rough);
         rough += cutArea(*r);
         flat += cutArea(*f);
     }
@@ -553,7 +553,7 @@ TEST(RoughFracture, NormalsAreSmoothOnTheRoughFaceAndSharpAtItsOutline) {
             input.normals.push_back(normalized(input.triangleNormal(t)));
     auto r = halfCut(absoluteRoughness(0.12, 0.5, 2, 20000), input);
     ASSERT_TRUE(r) << r.error().message;
-    ASSERT_TRUE(r->rough);
+    ASSERT_TRUE(r->stats.rough);
     std::size_t cutCorners = 0, outlineCorners = 0;
     double worstExcess = -1; // angle to the triangle's normal beyond the widest neighbour's, radians
     for (const Piece& piece : r->pieces) {
@@ -614,7 +614,7 @@ TEST(RoughFracture, ACutGrazingTheOuterSurfaceDoesNotCrossIt) {
     p.simplifyPieces = false;
     auto r = fractureWithCells(cube(), cells, p);
     ASSERT_TRUE(r) << r.error().message;
-    ASSERT_TRUE(r->rough);
+    ASSERT_TRUE(r->stats.rough);
     ASSERT_EQ(r->pieces.size(), 2u);
     expectCutsCoincide(*r, "grazing cut");
     EXPECT_LT(offCube(*r), 1e-12);
@@ -656,9 +656,10 @@ RoughHit roughHitInPlace(int radius, bool inPlace) {
     if (!r)
         return h;
     const std::string what = "sphere " + std::to_string(radius) + (inPlace ? " in place" : " copied");
-    EXPECT_TRUE(r->rough) << what;
-    EXPECT_EQ(r->editedInPlace, inPlace) << what;
-    EXPECT_FALSE(r->islandsLabelledFully) << what; // the walk around the cut proved the remainder one shell
+    EXPECT_TRUE(r->stats.rough) << what;
+    EXPECT_EQ(r->stats.editedInPlace, inPlace) << what;
+    // the walk around the cut proved the remainder one shell
+    EXPECT_FALSE(r->stats.islandsLabelledFully) << what;
     expectSoundPieces(input, *r, what);
     expectCutsCoincide(*r, what);
     h.hash = test::hashPieces(*r);

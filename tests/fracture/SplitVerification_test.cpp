@@ -113,7 +113,7 @@ TEST(SplitVerification, EveryInjectedCorruptionIsCaught) {
     const FaultyBackend harmless([](SplitResult&) {});
     auto ok = detail::fractureWithBackend(box, cells, params, harmless, false);
     ASSERT_TRUE(ok.isOk()) << ok.error().message;
-    EXPECT_FALSE(ok->exactFallback);
+    EXPECT_FALSE(ok->stats.exactFallback);
 
     for (const Corruption& c : corruptions()) {
         SplitResult bad = *good;
@@ -127,7 +127,7 @@ TEST(SplitVerification, EveryInjectedCorruptionIsCaught) {
         // ... with one it redoes the split exactly and says so.
         auto redone = detail::fractureWithBackend(box, cells, params, faulty, true);
         ASSERT_TRUE(redone.isOk()) << c.name << ": " << redone.error().message;
-        EXPECT_TRUE(redone->exactFallback) << c.name;
+        EXPECT_TRUE(redone->stats.exactFallback) << c.name;
         double sum = redone->droppedVolume;
         for (const Piece& p : redone->pieces) {
             EXPECT_TRUE(referenceClosedOriented(p.mesh)) << c.name;

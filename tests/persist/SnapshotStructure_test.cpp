@@ -106,7 +106,7 @@ Snapshot decoded(const std::vector<std::uint8_t>& bytes) {
 // restored runtime, hit alike, break the same bonds and drop the same bodies frame by frame.
 TEST(SnapshotStructure, ARestoredStructureHasTheSameBondsAndContinuesAsTheOriginal) {
     Colonnade original;
-    const StructureState before = original.rig.runtime.structureState();
+    const StructureState before = captureStructure(original.rig.runtime);
     ASSERT_TRUE(before.saved);
     ASSERT_EQ(before.nodes.size(), 4u);
     int damaged = 0, broken = 0;
@@ -121,8 +121,8 @@ TEST(SnapshotStructure, ARestoredStructureHasTheSameBondsAndContinuesAsTheOrigin
 
     test::StructureRig restored{true, 1, false, 0.6};
     ASSERT_TRUE(restoreSnapshot(restored.runtime, decoded(bytes)));
-    expectSameBonds(restored.runtime.structureState(), before);
-    expectSameNodes(restored.runtime.structureState(), before);
+    expectSameBonds(captureStructure(restored.runtime), before);
+    expectSameNodes(captureStructure(restored.runtime), before);
 
     // The same hits on both: the third column's bearing weakens to 0.3, the middle one's breaks at the second
     // hit, and the slab, left on the third column only, tips off it.
@@ -144,7 +144,7 @@ TEST(SnapshotStructure, ARestoredStructureHasTheSameBondsAndContinuesAsTheOrigin
     }
     EXPECT_EQ(fallen(restored.runtime).count(original.slab), 1u) << "it tipped off the third column";
     EXPECT_GE(restored.runtime.counters().bondsBroken - brokenBefore[1], 1) << "the middle column's bearing";
-    expectSameBonds(restored.runtime.structureState(), original.rig.runtime.structureState());
+    expectSameBonds(captureStructure(restored.runtime), captureStructure(original.rig.runtime));
 }
 
 // (d) Load then save gives the same bytes, structure section included.
@@ -193,11 +193,11 @@ TEST(SnapshotStructure, ARestoredWeldStaysAWeldAndABearingABearing) {
 
     test::StructureRig restored{true, 1, true, 0.6};
     ASSERT_TRUE(restoreSnapshot(restored.runtime, saved));
-    expectSameNodes(restored.runtime.structureState(), saved.structure);
+    expectSameNodes(captureStructure(restored.runtime), saved.structure);
     for (int i = 0; i < 60; ++i)
         restored.runtime.stepFrame();
     EXPECT_TRUE(fallen(restored.runtime).empty()) << "still a weld";
-    expectSameBonds(restored.runtime.structureState(), saved.structure);
+    expectSameBonds(captureStructure(restored.runtime), saved.structure);
 
     Snapshot forgotten = saved;
     forgotten.structure = {};
@@ -226,7 +226,7 @@ TEST(SnapshotStructure, AVersion2SnapshotLoadsWithFreshBonds) {
     EXPECT_FALSE(old.structure.saved);
     test::StructureRig restored{true, 1, false, 0.6};
     ASSERT_TRUE(restoreSnapshot(restored.runtime, std::move(old)));
-    const StructureState now = restored.runtime.structureState();
+    const StructureState now = captureStructure(restored.runtime);
     ASSERT_EQ(now.bonds.size(), s.structure.bonds.size()) << "the same pairs, from geometry";
     for (std::size_t i = 0; i < now.bonds.size(); ++i) {
         EXPECT_EQ(now.bonds[i].a, s.structure.bonds[i].a);
@@ -278,7 +278,7 @@ TEST(SnapshotStructure, DamagedStructureRecordsAreRefusedAndTheRuntimeStaysAsItW
     other.addBox({20, 0, 20}, {21, 1, 21});
     other.runtime.stepFrame();
     const std::uint64_t hash = other.runtime.stateHash();
-    const std::size_t bondCount = other.runtime.structureState().bonds.size();
+    const std::size_t bondCount = captureStructure(other.runtime).bonds.size();
     Snapshot bad = s;
     bad.structure.bonds.back().b = kSceneryNodeKey | 99;
     Status st = restoreSnapshot(other.runtime, bad);
@@ -290,7 +290,7 @@ TEST(SnapshotStructure, DamagedStructureRecordsAreRefusedAndTheRuntimeStaysAsItW
     ASSERT_FALSE(st);
     EXPECT_NE(st.message().find("names no structure node"), std::string::npos) << st.message();
     EXPECT_EQ(other.runtime.stateHash(), hash);
-    EXPECT_EQ(other.runtime.structureState().bonds.size(), bondCount);
+    EXPECT_EQ(captureStructure(other.runtime).bonds.size(), bondCount);
 }
 
 } // namespace rubble

@@ -5,9 +5,10 @@
 #include "TestSupport.hpp"
 #include "ToyPhysics.hpp"
 #include "WorldSteps.hpp"
+#include "geometry/MeshTopology.hpp"
 #include "rubble/core/ThreadPool.hpp"
 #include "rubble/geometry/MassProperties.hpp"
-#include "rubble/geometry/MeshTopology.hpp"
+#include "rubble/persist/WorldState.hpp"
 #include "rubble/runtime/DestructionRuntime.hpp"
 #include "rubble/runtime/DestructionWorld.hpp"
 
@@ -64,7 +65,7 @@ Hit hitSphere(int r) {
     for (ObjectId o : w.objects())
         EXPECT_EQ(w.object(o)->meshHash, w.object(o)->mesh.hash());
     DestructionWorld loaded(c);
-    EXPECT_TRUE(loaded.loadState(w.saveState()));
+    EXPECT_TRUE(restoreState(loaded, captureState(w)));
     EXPECT_EQ(loaded.geometryHash(), geometry);
     return h;
 }

@@ -82,8 +82,8 @@ Sweep runSweep(BooleanKind backend, int count, std::uint64_t seed) {
             ADD_FAILURE() << what << ": " << r.error().message;
             continue;
         }
-        s.fallbacks += r->exactFallback;
-        s.redraws += r->redraws;
+        s.fallbacks += r->stats.exactFallback;
+        s.redraws += r->stats.redraws;
         const double v0 = signedVolume(shape.mesh);
         double sum = r->droppedVolume;
         for (const Piece& p : r->pieces) {

@@ -225,7 +225,7 @@ struct Fractured {
 Fractured piecesOf(rubble::FractureResult& fr, const std::vector<rubble::ConvexPolytope>& parentParts,
                    const std::string& prefix, int parent, int level) {
     Fractured out;
-    out.timings = fr.timings;
+    out.timings = fr.stats.timings;
     out.droppedVolume = fr.droppedVolume;
     for (const rubble::Piece& piece : fr.pieces)
         out.cut = out.cut || std::find(piece.mesh.materials.begin(), piece.mesh.materials.end(),

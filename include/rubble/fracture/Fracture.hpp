@@ -5,8 +5,6 @@
 
 #include <cstdint>
 #include <memory>
-#include <optional>
-#include <string>
 #include <vector>
 
 #include "rubble/core/Export.hpp"
@@ -16,9 +14,10 @@
 #include "rubble/geometry/ConvexPolytope.hpp"
 #include "rubble/geometry/MassProperties.hpp"
 #include "rubble/geometry/Mesh.hpp"
-#include "rubble/geometry/MeshTopology.hpp"
 
 namespace rubble {
+
+struct MeshTopology; // a large mesh's half-edge twins (internal: src/geometry/MeshTopology.hpp)
 
 /// An impact on an object, in the object's mesh coordinates.
 struct RUBBLE_API Impact {
@@ -56,8 +55,8 @@ enum class BooleanKind {
           ///< detail::clipByConvexCells (src/fracture/ConvexCellClipper.hpp), all cells in one pass as a
           ///< complex (adjacent shatter cells share their faces exactly); when it
           ///< declines a near-degenerate configuration, or its split fails verification, the whole split is
-          ///< redone by Corefine (FractureResult::exactFallback). fracture() first redraws a declined
-          ///< pattern up to twice (FractureResult::redraws). Same seed, same bytes, like the others.
+          ///< redone by Corefine (FractureStats::exactFallback). fracture() first redraws a declined
+          ///< pattern up to twice (FractureStats::redraws). Same seed, same bytes, like the others.
 };
 
 /// Where a Shatter pattern's cells lie around the impact (a material's fracture pattern, Material.hpp).
@@ -99,6 +98,31 @@ struct RUBBLE_API FractureParams {
     Roughness roughness;
 };
 
+/// A MeshTopology held by value: copied and compared with the facts that hold it; empty when unknown.
+class RUBBLE_API HeldTopology {
+public:
+    HeldTopology() noexcept;
+    HeldTopology(MeshTopology&& topology); ///< holds topology (nothing when it is empty)
+    HeldTopology(const HeldTopology& other);
+    HeldTopology(HeldTopology&& other) noexcept;
+    HeldTopology& operator=(const HeldTopology& other);
+    HeldTopology& operator=(HeldTopology&& other) noexcept;
+    ~HeldTopology();
+    /// True when no topology, or an empty one, is held.
+    bool empty() const;
+    /// The topology, or null.
+    const MeshTopology* get() const { return held_.get(); }
+    /// The topology, or null.
+    MeshTopology* get() { return held_.get(); }
+    /// True when a topology is held and sized for mesh (it must also belong to mesh, as MeshFacts do).
+    bool fits(const Mesh& mesh) const;
+    /// Both empty, or the same twins.
+    bool operator==(const HeldTopology& other) const;
+
+private:
+    std::unique_ptr<MeshTopology> held_;
+};
+
 /// What is known of a mesh, so that fracturing it skips the passes over the whole mesh that would find it
 /// again: that it is a valid closed, consistently oriented solid, and its volume integrals. analyzeMesh finds
 /// them once (e.g. when an object is added); every Piece carries them for its own mesh, so a piece that is
@@ -109,10 +133,9 @@ struct RUBBLE_API MeshFacts {
     std::size_t triangles = 0; ///< the mesh's triangle count
     std::size_t vertices = 0;  ///< the mesh's vertex count
     VolumeIntegrals integrals; ///< of the mesh (its mass properties are massProperties(integrals))
-    /// Of a mesh above kTopologyAboveTriangles that is one shell (analyzeMesh; pieces of a fracture given
-    /// it), else empty: with it, the consuming fracture edits the mesh in place and checks only around the
-    /// cut.
-    MeshTopology topology{};
+    /// Of a mesh above 20k triangles that is one shell (analyzeMesh; pieces of a fracture given it), else
+    /// empty: with it, the consuming fracture edits the mesh in place and checks only around the cut.
+    HeldTopology topology{};
     /// True when these are facts of a mesh with mesh's counts.
     bool fit(const Mesh& mesh) const {
         return known && triangles == mesh.triangles.size() && vertices == mesh.positions.size();
@@ -143,24 +166,28 @@ struct RUBBLE_API FractureTimings {
     double totalMs = 0;    ///< everything
 };
 
-/// Everything one fracture produced.
-struct RUBBLE_API FractureResult {
-    std::vector<Piece> pieces;         ///< remainder islands first, then debris islands by cell
-    std::vector<ConvexPolytope> cells; ///< the cells that were cut (faces tagged with their plane index)
-    double inputVolume = 0;            ///< volume of the input mesh
-    double droppedVolume = 0;          ///< volume of pieces dropped as too small
-    bool exactFallback = false;        ///< Fast declined or failed verification; Corefine made the split
+/// How one fracture went: the path it took and its stage durations (diagnostics; not part of the pieces).
+struct RUBBLE_API FractureStats {
+    bool exactFallback = false; ///< Fast declined or failed verification; Corefine made the split
     int redraws = 0; ///< fracture() with Fast: cell patterns redrawn (from derived seeds) because the clipper
                      ///< declined a near-degenerate one; 0 = the seed's own pattern
     bool editedInPlace = false; ///< the remainder is the input edited in place (MeshFacts::topology)
-    bool rough =
-        false; ///< the cut faces were roughened (params.roughness active and the clipper's split kept)
+    bool rough = false;         ///< the cut faces were roughened (roughness active, the clipper's split kept)
     bool islandsLabelledFully = false; ///< edited in place, but the walk around the cut did not prove the
                                        ///< remainder one shell: it was labelled in full (a cavity)
     bool islandsByRace = false; ///< edited in place, and the remainder's islands were found by walks racing
                                 ///< from the cut (docs/megamesh.md), not by labelling it in full
     FractureTimings timings;    ///< stage durations, wall clock
     FractureTimings cpuTimings; ///< the same stages in the calling thread's CPU time (on a shared machine)
+};
+
+/// Everything one fracture produced.
+struct RUBBLE_API FractureResult {
+    std::vector<Piece> pieces;         ///< remainder islands first, then debris islands by cell
+    std::vector<ConvexPolytope> cells; ///< the cells that were cut (faces tagged with their plane index)
+    double inputVolume = 0;            ///< volume of the input mesh
+    double droppedVolume = 0;          ///< volume of pieces dropped as too small
+    FractureStats stats;               ///< how it went
 };
 
 /// The cut of one impact on a mesh with the given bounds. SingleCell and Shatter: the params' pattern and
@@ -172,30 +199,6 @@ RUBBLE_API ImpactCut impactCut(const FractureParams& params, const Aabb& meshBou
 /// Builds the cutting cells of an impact on a mesh with these bounds (clamps cells); deterministic in seed.
 RUBBLE_API std::vector<ConvexPolytope> generateCells(const Aabb& meshBounds, const Impact& impact,
                                                      const FractureParams& params, std::uint64_t seed);
-
-/// Result of splitting a mesh by disjoint convex cells.
-struct RUBBLE_API SplitResult {
-    Mesh remainder;             ///< mesh − ∪ cells (may be empty)
-    std::vector<Mesh> inside;   ///< inside[i] = mesh ∩ cells[i] (may be empty)
-    bool exactFallback = false; ///< a fast backend declined and an exact backend made this split
-    /// The remainder's volume integrals when the backend derived them from the input's (Fast, given known
-    /// facts): the input's minus the triangles the cut removed plus those it created.
-    std::optional<VolumeIntegrals> remainderIntegrals;
-};
-
-/// A boolean implementation: splits a closed mesh by disjoint convex cells.
-class RUBBLE_API BooleanBackend {
-public:
-    virtual ~BooleanBackend() = default;
-    /// Short name ("corefine", "nef").
-    virtual std::string name() const = 0;
-    /// remainder = mesh − ∪cells and inside[i] = mesh ∩ cells[i]. Faces created by cell faces carry
-    /// kInteriorMaterial; other faces keep the input's attributes. Errors leave nothing half-done.
-    virtual Result<SplitResult> split(const Mesh& mesh, const std::vector<ConvexPolytope>& cells) const = 0;
-};
-
-/// The backend of the given kind.
-RUBBLE_API std::unique_ptr<BooleanBackend> makeBooleanBackend(BooleanKind kind);
 
 /// The checks of the parameter table (rubble/core/ParameterCheck.hpp) on an impact's point, normal and
 /// impulse and on params' cells: what fracture() refuses.

@@ -13,8 +13,7 @@
 
 #include "rubble/core/Export.hpp"
 #include "rubble/core/Result.hpp"
-#include "rubble/runtime/DestructionRuntime.hpp"
-#include "rubble/runtime/DestructionWorld.hpp"
+#include "rubble/persist/WorldState.hpp"
 
 namespace rubble {
 
@@ -31,9 +30,9 @@ RUBBLE_API Snapshot takeSnapshot(const DestructionWorld& world, std::vector<Obje
 /// The snapshot of a runtime: its world, its bodies' placements, its volume ledger and its structure.
 RUBBLE_API Snapshot takeSnapshot(const DestructionRuntime& runtime);
 /// Loads a snapshot into a world (any worker count; the world adopts the snapshot's settings); fails,
-/// changing nothing, when the state is inconsistent (DestructionWorld::loadState).
+/// changing nothing, when the state is inconsistent (restoreState).
 RUBBLE_API Status restoreSnapshot(DestructionWorld& world, Snapshot snapshot);
-/// Loads a snapshot into a runtime (DestructionRuntime::restore): its world and the bodies of its objects;
+/// Loads a snapshot into a runtime (restoreState of the runtime): its world and the bodies of its objects;
 /// fails, changing nothing, like restoreSnapshot(world, ...) or when the placements do not match the objects.
 RUBBLE_API Status restoreSnapshot(DestructionRuntime& runtime, Snapshot snapshot);
 

@@ -266,31 +266,6 @@ struct RUBBLE_API ObjectPlacement {
 /// Structure keys of bodies without objects (ground, scenery) in StructureBondState: this bit | the body id.
 constexpr std::uint64_t kSceneryNodeKey = 1ull << 63;
 
-/// What a snapshot keeps of a structure node (a static object or piece in the stress solver).
-struct RUBBLE_API StructureNodeState {
-    ObjectId object = 0;       ///< the object
-    ObjectId solid = 0;        ///< the scene object it was cut from (its own id for a scene object)
-    std::uint8_t material = 0; ///< its material: an index into materialPresets()
-    bool root = false;         ///< held in place (an anchor, or the piece an anchor kept)
-    bool anchor = false;       ///< made a root by the anchor rule (its pieces are classified again)
-    bool pending = false;      ///< placed since the last step: the anchor rule decides at the next one
-};
-
-/// What a snapshot keeps of a bond: what geometry cannot give back. Its nodes are object ids, or
-/// kSceneryNodeKey | body id for ground and scenery (the same bodies in the same order as in the saver).
-struct RUBBLE_API StructureBondState {
-    std::uint64_t a = 0, b = 0; ///< its nodes, a < b
-    double health = 1;          ///< remaining fraction of the section
-    bool broken = false;        ///< broken (it stays broken while both nodes stay)
-};
-
-/// The structure's saved state (docs/journal.md, Snapshots).
-struct RUBBLE_API StructureState {
-    bool saved = false; ///< false: not saved (no structure, a world-only or a version 2 snapshot)
-    std::vector<StructureNodeState> nodes; ///< ascending object
-    std::vector<StructureBondState> bonds; ///< every bond, broken ones included, ascending (a, b)
-};
-
 /// The runtime. Call everything from one (main) thread; fracture jobs run on the DestructionWorld's workers.
 class RUBBLE_API DestructionRuntime {
 public:
@@ -401,21 +376,6 @@ public:
 
     /// The placement of every body that carries an object, ascending body id.
     std::vector<ObjectPlacement> placements() const;
-    /// The structure's nodes and bonds for a snapshot (saved false unless StructurePolicy::enabled).
-    StructureState structureState() const;
-    /// Replaces the world's state and every body that carries an object by a saved world (a snapshot): each
-    /// object gets a body at its placement with its velocities and motion state (static ones join the support
-    /// graph and the structure, frozen ones the governor's grid). Bodies without objects (ground, scenery,
-    /// projectiles) stay. With a saved structure, its nodes join with their solid, material and root state,
-    /// and the bonds rebuilt from geometry take the saved health and broken state; without, every static
-    /// object joins as a scene object does at load (fresh bonds). The volume ledger continues from volumes'
-    /// retired, dust and dropped (live is the objects'). Fails, changing nothing, when the state is
-    /// inconsistent (DestructionWorld::loadState), an object has no placement or a placement no object, a
-    /// placement's role is neither Object nor Piece, a volume is negative or not finite, or a structure node
-    /// or bond names no static object (or a bond no ground or scenery body of this runtime).
-    Status restore(WorldState state, const std::vector<ObjectPlacement>& placements,
-                   const VolumeLedger& volumes = {}, const StructureState& structure = {});
-
     /// Hash of the live body set (id, role, motion, object version and mesh hash, transform bits) and of the
     /// volume ledger: equal runs give equal hashes.
     std::uint64_t stateHash() const;
@@ -427,6 +387,7 @@ public:
     void setOnRemoved(std::function<void(const BodyRecord&)> callback);
 
 private:
+    friend class detail::StateAccess; // saving and loading (rubble/persist/WorldState.hpp)
     struct Impl;
     std::unique_ptr<Impl> impl_;
 };

@@ -21,6 +21,10 @@
 
 namespace rubble {
 
+namespace detail {
+class StateAccess; // src/runtime/StateAccess.hpp
+} // namespace detail
+
 /// Identifies a destructible object in a DestructionWorld (never reused).
 using ObjectId = std::uint32_t;
 
@@ -41,7 +45,7 @@ struct RUBBLE_API ObjectState {
     ObjectId id = 0;           ///< its id
     std::uint32_t version = 0; ///< bumped whenever its shape is replaced
     Mesh mesh; ///< local mesh: a piece's is in its principal frame (origin at the centre of mass), but for
-               ///< a remainder above kTopologyAboveTriangles cut in place, which keeps its parent's frame
+               ///< a remainder above 20k triangles cut in place, which keeps its parent's frame
     MassProperties mass;         ///< mass properties of mesh, density 1
     double density = 1;          ///< density
     bool destructible = true;    ///< false when never fractured (also: mesh could not be made valid)
@@ -51,9 +55,9 @@ struct RUBBLE_API ObjectState {
     std::string warning;                     ///< why it is indestructible, when it had to be made so
     std::size_t crumbleAbove = 0; ///< a hit on it crumbles it once its mesh has more triangles than this
                                   ///< (see Config::crumbleTriangles; pieces inherit their parent's)
-    std::uint64_t meshHash = 0;   ///< mesh.hash(), computed once when the object is made (loadState takes
+    std::uint64_t meshHash = 0;   ///< mesh.hash(), computed once when the object is made (restoreState takes
                                   ///< a saved one as it is; 0 there: computed), or for a remainder cut in
-                                  ///< place when first read (0 until geometryHash() or saveState())
+                                  ///< place when first read (0 until geometryHash() or captureState())
 };
 
 /// Wall-clock timing of one impact from submission to adoption, in milliseconds. For an adopted job the
@@ -120,32 +124,6 @@ struct RUBBLE_API FractureOutcome {
     double dustVolume() const;
 };
 
-/// Fracture work not yet adopted: a job in flight (to be relaunched on load) or impacts waiting for one.
-struct RUBBLE_API PendingWork {
-    ObjectId object = 0;              ///< the object hit
-    std::uint32_t version = 0;        ///< its version when the job started
-    bool inFlight = false;            ///< a launched job (true) or impacts waiting for the object's job
-    std::uint64_t readyFrame = 0;     ///< in flight: the frame it is adopted in (deterministic mode)
-    std::vector<Impact> impacts;      ///< as submitted (journal precision), in order
-    std::vector<std::uint64_t> ticks; ///< frame of each impact's submission
-};
-
-/// Everything a DestructionWorld holds besides its threads and timings: what a snapshot saves. The settings
-/// that decide the geometry travel with it, so that a world loading it cuts the same pieces.
-struct RUBBLE_API WorldState {
-    std::uint64_t seed = 1;             ///< Config::seed
-    std::int32_t delayFrames = 2;       ///< Config::delayFrames
-    std::uint64_t crumbleTriangles = 0; ///< Config::crumbleTriangles
-    std::int32_t crumbleCells = 0;      ///< Config::crumbleCells
-    double minPieceVolume = 0;          ///< Config::minPieceVolume
-    DecompositionParams decomposition;  ///< Config::decomposition (convex parts of new pieces)
-    std::uint64_t frame = 0;            ///< DestructionWorld::frame()
-    ObjectId nextId = 1;                ///< the id the next new object gets
-    std::uint64_t journalPosition = 0;  ///< journal events so far
-    std::vector<ObjectState> objects;   ///< live objects, ascending id
-    std::vector<PendingWork> work;      ///< jobs in flight (launch order), then waiting impacts (by object)
-};
-
 /// The runtime. All member functions are called from one (main) thread; work runs on the JobSystem.
 class RUBBLE_API DestructionWorld {
 public:
@@ -209,13 +187,6 @@ public:
     /// the object does not exist, refuses the impact, or its fracture pattern or next job seed differ from
     /// the event's (a journal of another scene or world seed).
     Status applyJournalEvent(const JournalEvent& event);
-    /// The world's state (objects, frame, id counter, journal position, unadopted work).
-    WorldState saveState() const;
-    /// Replaces the world's state by state, its settings included (pending results of the current state are
-    /// discarded; work in the state is relaunched as it was). Fails, changing nothing, when the state is
-    /// inconsistent (ids not ascending or not below nextId, work on a missing object or version, an empty
-    /// mesh, a negative delay or cell count, a minimum piece volume that is negative or not finite).
-    Status loadState(WorldState state);
 
     /// Order-independent hash of the geometry: every live object's id, version and mesh hash. Equal worlds
     /// give equal hashes on any worker count and compiler (docs/journal.md). O(1): kept up to date.
@@ -253,6 +224,7 @@ public:
     Status writeTimingsCsv(const std::filesystem::path& path) const;
 
 private:
+    friend class detail::StateAccess; // saving and loading (rubble/persist/WorldState.hpp)
     struct Impl;
     std::unique_ptr<Impl> impl_;
 };
