@@ -239,7 +239,7 @@ void runOnce(Case& c, rubble::BooleanKind kind, std::uint64_t seed, bool compare
         pieceVolume += r->pieces[i].mass.volume;
     }
     s.excess.push_back(pieceVolume > 0 ? partVolume / pieceVolume - 1 : 0.0);
-    if (!compareParts || !r->rough)
+    if (!compareParts || !r->stats.rough)
         return;
     // The alternative: each rough piece decomposed on its own, with the default settings.
     const auto t4 = Clock::now();

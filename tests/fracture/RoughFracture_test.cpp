@@ -404,14 +404,14 @@ TEST(RoughFracture, TheBudgetHoldsOnAFineOutline) {
     auto inPlace = fracture(std::move(sphere), impact, p, 5, std::move(*facts));
     ASSERT_TRUE(copied && inPlace);
     for (const FractureResult* r : {&*copied, &*inPlace}) {
-        const std::string what = r->editedInPlace ? "in place" : "copied";
-        ASSERT_TRUE(r->rough) << what;
+        const std::string what = r->stats.editedInPlace ? "in place" : "copied";
+        ASSERT_TRUE(r->stats.rough) << what;
         EXPECT_LE(mostCutTriangles(*r), 600u) << what;
         EXPECT_GT(mostCutTriangles(*r), 300u) << what;
         expectSoundPieces(input, *r, what);
         expectCutsCoincide(*r, what);
     }
-    EXPECT_TRUE(inPlace->editedInPlace);
+    EXPECT_TRUE(inPlace->stats.editedInPlace);
     EXPECT_GT(displacedNewCutVertices(input, *copied), 10u);
     for (const Piece& piece : copied->pieces) {
         const MeshReport report = checkMesh(piece.mesh);
@@ -431,7 +431,7 @@ TEST(RoughFracture, UvsAreContinuousAcrossTheRoughFace) {
     std::vector<ConvexPolytope> cells{ConvexPolytope::fromAabb({{0.01, -3, -3}, {3, 3, 3}})};
     auto r = fractureWithCells(cube(), cells, p);
     ASSERT_TRUE(r) << r.error().message;
-    ASSERT_TRUE(r->rough);
+    ASSERT_TRUE(r->stats.rough);
     std::map<std::tuple<double, double, double>, Vec2> uvAt;
     std::size_t corners = 0, mismatched = 0;
     Vec2 lo{1e300, 1e300}, hi{-1e300, -1e300};
