@@ -30,13 +30,11 @@ csv="$results/latency.csv"
 [ -f "$csv" ] || echo "date_utc,label,options,scene,seconds,frames,fps_p50,fps_p99,frame_ms_p50,frame_ms_p99,shots,fractures,latency_count,latency_p50_ms,latency_p99_ms,latency_max_ms,worker_nice,workers_at_nice,raster_threads,demo_cpu_ms_per_frame,own_cpu_cores,other_cpu_cores,command" >"$csv"
 work=$(mktemp -d /tmp/rubble-latency.XXXXXX)
 trap 'rm -rf "$work"' EXIT
-busy() { awk '/^cpu /{print $2 + $3 + $4 + $7 + $8 + $9; exit}' /proc/stat; }
-hz=$(getconf CLK_TCK)
+. "$root/scripts/bench-configs.sh"
 
 for ((r = 1; r <= rounds; ++r)); do
     for config in "${configs[@]}"; do
-        label=${config%%=*}
-        read -r -a opts <<<"${config#*=}"
+        split_config "$config"
         args=(--scene "$scene" --autopilot "$seconds" --fire-rate 5 --adopt-ready --headless --width 1280
             --height 720 --out "$work/run" "${opts[@]}")
         rm -rf "$work/run"
