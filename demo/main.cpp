@@ -51,7 +51,7 @@ const char* kFallbackScene =
     "tower.obj;;0;-5;-120;4;5;4;300\n";
 
 /// The fracture workers' default niceness: above llvmpipe's rasteriser threads (docs/rendering.md).
-constexpr int kWorkerNice = -10;
+constexpr int kWorkerNice = -5;
 /// How long a frame waits, before drawing, for a fracture job in flight (ms).
 constexpr double kAdoptWaitMs = 0;
 
