@@ -61,3 +61,7 @@ print("showcase-bench:", ",".join(str(x) for x in row))
 PY
     done
 done
+if command -v gnuplot >/dev/null; then
+    (cd "$results" && gnuplot -e "csv='showcase.csv'; png='showcase.png'" "$root/bench/results/showcase.gp")
+    echo "wrote $csv and ${csv%.csv}.png"
+fi
