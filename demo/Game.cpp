@@ -141,6 +141,9 @@ bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const Game
     renderer.shadows = settings.shadows;
     particles_.dustDensity = renderer.quality().software ? 0.35f : 1.0f;
     rubble::DestructionRuntime::Config rc;
+    jobs_.reset();
+    jobs_ = std::make_unique<PriorityJobs>(settings.workers, settings.workerNice);
+    rc.world.jobs = jobs_.get();
     rc.world.workers = settings.workers;
     rc.world.deterministic = settings.deterministic;
     rc.world.seed = 20260522;
@@ -551,18 +554,34 @@ void Game::fire() {
     const btTransform& vt = vehicle->getWorldTransform();
     const btVector3 fwd = vt.getBasis() * btVector3(0, 0, -1);
     const btVector3 from = vt.getOrigin() + fwd * noseOffset_;
-    const WeaponSpec& w = weaponSpec(weapon_);
-    const bool cannon = weapon_ == Weapon::Cannon;
     const V3 v = shotVelocity();
-    const btVector3 vel(v.x, v.y, v.z);
-    const BodyId p = runtime_->fireProjectile(rubble::bullet::fromBt(from), rubble::bullet::fromBt(vel),
-                                              cannon ? settings_.projectileMass : w.mass, w.radius);
+    launch(from, btVector3(v.x, v.y, v.z), weapon_);
+}
+
+void Game::launch(const btVector3& from, const btVector3& velocity, Weapon weapon) {
+    const WeaponSpec& w = weaponSpec(weapon);
+    const BodyId p =
+        runtime_->fireProjectile(rubble::bullet::fromBt(from), rubble::bullet::fromBt(velocity),
+                                 weapon == Weapon::Cannon ? settings_.projectileMass : w.mass, w.radius);
     btRigidBody* rb = binding_->rigid(p);
     rb->setFlags(rb->getFlags() | BT_DISABLE_WORLD_GRAVITY);
     rb->setGravity(btVector3(0, -2.0f, 0));
-    shells_[p] = {weapon_, {}, false};
+    shells_[p] = {weapon, {}, false};
     ++counters_.shots;
-    ++counters_.weaponShots[static_cast<std::size_t>(weapon_)];
+    ++counters_.weaponShots[static_cast<std::size_t>(weapon)];
+}
+
+bool Game::shootNextTarget(const V3& from) {
+    const std::vector<V3> standing = targets();
+    if (standing.empty())
+        return false;
+    const V3 target = standing[nextShot_++ % standing.size()];
+    const V3 toward = from - target;
+    const V3 dir = len(toward) > 1e-3f ? norm(toward) : V3{0, 0, 1};
+    const V3 muzzle = target + dir * 40.0f;
+    const V3 v = dir * -settings_.projectileSpeed;
+    launch(btVector3(muzzle.x, muzzle.y, muzzle.z), btVector3(v.x, v.y, v.z), Weapon::Cannon);
+    return true;
 }
 
 void Game::journaled(const rubble::JournalEvent& e) {
@@ -687,9 +706,13 @@ void Game::step(const ControlInput& input, float dt, Renderer& renderer) {
     updateCounters();
 }
 
-void Game::adoptReady() {
+void Game::adoptReady(double waitMs) {
     if (!runtime_)
         return;
+    if (waitMs > 0) // returns at once when nothing is in flight, and in deterministic mode
+        (void)runtime_->world().waitForResult(std::chrono::steady_clock::now() +
+                                              std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                  std::chrono::duration<double, std::milli>(waitMs)));
     const long long impacts = runtime_->counters().impacts;
     const long long retiredBefore = runtime_->counters().piecesRetired;
     if (runtime_->adoptReady().piecesRetired > 0)

@@ -16,6 +16,7 @@
 #include "ChaseCamera.hpp"
 #include "Math.hpp"
 #include "ParticleSystem.hpp"
+#include "PriorityJobs.hpp"
 #include "Renderer.hpp"
 #include "Sound.hpp"
 #include "Weapons.hpp"
@@ -42,6 +43,7 @@ struct GameSettings {
     double impulseThreshold = 50;    ///< impacts below this impulse do not fracture
     double collisionImpulse = 2500;  ///< non-projectile contacts above this impulse fracture too
     int workers = -1;                ///< fracture worker threads (-1 automatic), applied on restart
+    int workerNice = 0;              ///< niceness of the fracture workers (0: unchanged), applied on restart
     bool deterministic = false;      ///< adopt results a fixed number of frames after the impact
     float timeScale = 1;             ///< slow motion factor
     float projectileSpeed = 170;     ///< m/s
@@ -108,8 +110,9 @@ public:
     /// One fixed step of dt seconds (already scaled by slow motion).
     void step(const ControlInput& input, float dt, Renderer& renderer);
     /// Adopts the fracture results that are ready now (call after the steps, right before drawing, so that
-    /// pieces appear in the frame in which their job finished); does nothing in deterministic mode.
-    void adoptReady();
+    /// pieces appear in the frame in which their job finished), first waiting up to waitMs for a job in
+    /// flight to finish; does nothing in deterministic mode.
+    void adoptReady(double waitMs = 0);
     /// Queues the frame's draws (meshes, particles, debug lines) and updates the camera.
     void draw(Renderer& renderer, float dt);
 
@@ -145,6 +148,9 @@ public:
     /// A demolition charge's blast on the next standing target (round robin over targets()), for --demolish;
     /// false when nothing stands.
     bool blastNextTarget();
+    /// A cannon shell at the next standing target (round robin over targets()), fired from 40 m off on the
+    /// side of `from` (the camera), for --fire-rate; false when nothing stands.
+    bool shootNextTarget(const V3& from);
     /// One impact at a world point on the objects whose bounds reach it (no sparks); false when none took it.
     bool hitAt(const V3& point, float impulse);
     /// Places the showcase camera (GameSettings::showcase) at eye, looking at target.
@@ -158,6 +164,8 @@ public:
     std::vector<double> takeNewLatencies();
     /// All adopted latencies so far (ms).
     const std::vector<double>& latencies() const { return latencies_; }
+    /// The fracture workers (null before a scene is loaded).
+    const PriorityJobs* jobs() const { return jobs_.get(); }
     /// Centres of destructible objects still standing (for the autopilot).
     std::vector<V3> targets() const;
     /// Height of the ground surface.
@@ -208,6 +216,7 @@ private:
         Timbre timbre = Timbre::Stone; ///< how the object's material sounds
     };
     void fire();
+    void launch(const btVector3& from, const btVector3& velocity, Weapon weapon);
     void journaled(const rubble::JournalEvent& e);
     void creditHits();
     void onAdopted(const rubble::FractureOutcome& outcome, Renderer& renderer);
@@ -224,7 +233,8 @@ private:
     GameCounters counters_;
     ChaseCamera camera_;
     ParticleSystem particles_;
-    // destroyed in reverse order: the runtime before the binding before the physics world
+    // destroyed in reverse order: the runtime before the binding before the physics world before the workers
+    std::unique_ptr<PriorityJobs> jobs_;
     std::unique_ptr<rubble::bullet::PhysicsWorld> physics_;
     std::unique_ptr<rubble::bullet::BulletBinding> binding_;
     std::unique_ptr<rubble::DestructionRuntime> runtime_;
@@ -262,6 +272,7 @@ private:
     std::vector<rubble::JournalEvent> stepImpacts_;    // impacts journaled this step, credited after it
     int blastBy_ = -1;                                 // weapon whose blast is submitting impacts
     std::size_t nextTarget_ = 0;                       // --demolish: the target blasted next
+    std::size_t nextShot_ = 0;                         // --fire-rate: the target shot next
     std::map<rubble::ObjectId, int> hitBy_;            // object -> weapon whose impact will fracture it
     std::vector<SoundEvent> sounds_;                   // made since the last takeSounds()
     std::unordered_map<rubble::BodyId, std::uint64_t> lastKnock_; // body -> frame it last hit the ground

@@ -103,6 +103,10 @@ bool RunReport::write(const std::filesystem::path& dir, const std::string& scene
                   {"max_voices", maxVoices_},
                   {"peak_voices", audio_.peakVoices},
                   {"peak_level", audio_.peakLevel}};
+    j["threads"] = {{"fracture_workers", threads_.workers},      {"worker_nice", threads_.workerNice},
+                    {"workers_at_nice", threads_.workersAtNice}, {"workers_refused", threads_.workersRefused},
+                    {"raster_threads", threads_.rasterThreads},  {"adopt_ready", threads_.adoptReady},
+                    {"adopt_wait_ms", threads_.adoptWaitMs}};
     j["screenshots"] = screenshots;
     j["fracture_runtime"] = Game::fractureAvailable();
     std::ofstream js(dir / "report.json");

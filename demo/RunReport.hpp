@@ -41,6 +41,17 @@ public:
         maxVoices_ = maxVoices;
         audioDevice_ = device;
     }
+    /// Who ran the fracture jobs and who rasterised.
+    struct Threads {
+        int workers = 0;        ///< fracture worker threads
+        int workerNice = 0;     ///< their niceness asked for
+        int workersAtNice = 0;  ///< workers that got it
+        int workersRefused = 0; ///< workers the system refused it
+        int rasterThreads = 0;  ///< llvmpipe's rasteriser threads
+        bool adoptReady = true; ///< results adopted when ready (false: deterministic, 2 frames after)
+        double adoptWaitMs = 0; ///< how long a frame waited before drawing for a job in flight, at most
+    };
+    void setThreads(const Threads& t) { threads_ = t; }
     /// Number of frames recorded.
     std::size_t size() const { return frames_.size(); }
     /// Writes frames.csv and report.json into dir; latencies are impact → adopted in ms.
@@ -52,6 +63,7 @@ private:
     MixerStats audio_;
     int maxVoices_ = 0;
     bool audioDevice_ = false;
+    Threads threads_;
 };
 
 /// Writes tightly packed RGB rows (top first) as PNG.

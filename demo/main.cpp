@@ -50,6 +50,11 @@ const char* kFallbackScene =
     "tower.obj;;60;5;-300;12;15;12;0\n"
     "tower.obj;;0;-5;-120;4;5;4;300\n";
 
+/// The fracture workers' default niceness: above llvmpipe's rasteriser threads (docs/rendering.md).
+constexpr int kWorkerNice = -5;
+/// How long a frame waits, before drawing, for a fracture job in flight (ms).
+constexpr double kAdoptWaitMs = 0;
+
 struct Options {
     std::string scene;
     bool debug = false;
@@ -70,31 +75,36 @@ struct Options {
     bool noShadows = false;
     bool bilinear = false;
     bool showcase = false;
-    std::vector<std::string> hits; // "X,Y,Z,IMPULSE": impacts in the first frame
-    bool holdFire = false;         // the autopilot flies without shooting
-    std::string camera;            // "EX,EY,EZ,TX,TY,TZ": a fixed showcase camera
-    std::string record;            // journal file written at exit
-    std::string replay;            // journal file replayed on the loaded scene instead of playing
-    int host = 0;                  // port to host loopback multiplayer on
-    double hostWait = 0;           // game seconds at which the host holds until a client joins
-    std::string join;              // HOST:PORT of a host to follow
-    double joinFire = 0;           // with --join: seconds between automatic shots
-    bool structure = true;         // the stress solver (with bearings)
-    bool rough = true;             // rough cuts by material (docs/roughness.md)
-    bool bonds = false;            // draw its bonds by stress
-    std::string quality = "auto";  // auto (from GL_RENDERER), software or gpu
-    float targetFps = 60;          // dynamic resolution holds this rate (software quality)
-    float minScale = -1;           // smallest internal resolution scale (-1: the quality's)
-    std::string renderBench;       // "N,N,...": the render bench's resting piece counts
-    int benchFrames = 60;          // measured frames per render bench row
-    bool json = false;             // the render bench prints JSON
-    int rasterNice = 0;            // niceness of llvmpipe's rasteriser threads (0: unchanged)
-    double demolish = 0;           // seconds between demolition charges on standing targets (0: none)
-    int maxAwake = 0;              // awake debris budget (0: the game's default)
-    double lightPerAwake = -1;     // light pieces per budgeted awake body (< 0: the game's default)
-    bool mute = false;             // no sound
-    std::string audioWav;          // the run's sound captured to this WAV file (no device)
-    bool structureFlag = false;    // --structure given (its bonds are drawn)
+    std::vector<std::string> hits;     // "X,Y,Z,IMPULSE": impacts in the first frame
+    bool holdFire = false;             // the autopilot flies without shooting
+    std::string camera;                // "EX,EY,EZ,TX,TY,TZ": a fixed showcase camera
+    std::string record;                // journal file written at exit
+    std::string replay;                // journal file replayed on the loaded scene instead of playing
+    int host = 0;                      // port to host loopback multiplayer on
+    double hostWait = 0;               // game seconds at which the host holds until a client joins
+    std::string join;                  // HOST:PORT of a host to follow
+    double joinFire = 0;               // with --join: seconds between automatic shots
+    bool structure = true;             // the stress solver (with bearings)
+    bool rough = true;                 // rough cuts by material (docs/roughness.md)
+    bool bonds = false;                // draw its bonds by stress
+    std::string quality = "auto";      // auto (from GL_RENDERER), software or gpu
+    float targetFps = 60;              // dynamic resolution holds this rate (software quality)
+    float minScale = -1;               // smallest internal resolution scale (-1: the quality's)
+    std::string renderBench;           // "N,N,...": the render bench's resting piece counts
+    int benchFrames = 60;              // measured frames per render bench row
+    bool json = false;                 // the render bench prints JSON
+    int rasterNice = 0;                // niceness of llvmpipe's rasteriser threads (0: unchanged)
+    int rasterThreads = -1;            // LP_NUM_THREADS for llvmpipe (-1: unchanged)
+    int workerNice = kWorkerNice;      // niceness of the fracture workers (0: unchanged)
+    double fireRate = 0;               // cannon shots per game second at the standing targets (0: none)
+    bool adoptReady = false;           // the autopilot adopts results when ready, not a fixed 2 frames later
+    double adoptWaitMs = kAdoptWaitMs; // before drawing, wait this long for a fracture job in flight
+    double demolish = 0;               // seconds between demolition charges on standing targets (0: none)
+    int maxAwake = 0;                  // awake debris budget (0: the game's default)
+    double lightPerAwake = -1;         // light pieces per budgeted awake body (< 0: the game's default)
+    bool mute = false;                 // no sound
+    std::string audioWav;              // the run's sound captured to this WAV file (no device)
+    bool structureFlag = false;        // --structure given (its bonds are drawn)
 };
 
 /// Sounds at once, at most.
@@ -244,20 +254,28 @@ bool loadScene(App& a, std::string& error) {
     return true;
 }
 
-/// Lowers the scheduling priority of llvmpipe's rasteriser threads (named llvmpipe-N) to `niceness`, so that
-/// on a small machine the fracture workers run first; returns how many threads it changed.
-int lowerRasterizerPriority(int niceness) {
-    int changed = 0;
+/// Thread ids of llvmpipe's rasteriser threads (named llvmpipe-N) in this process.
+std::vector<int> rasterizerThreads() {
+    std::vector<int> out;
     std::error_code ec;
     for (const auto& task : std::filesystem::directory_iterator("/proc/self/task", ec)) {
         std::ifstream comm(task.path() / "comm");
         std::string name;
         if (!std::getline(comm, name) || name.rfind("llvmpipe", 0) != 0)
             continue;
-        const int tid = std::atoi(task.path().filename().c_str());
-        if (tid > 0 && setpriority(PRIO_PROCESS, static_cast<id_t>(tid), niceness) == 0)
-            ++changed;
+        if (const int tid = std::atoi(task.path().filename().c_str()); tid > 0)
+            out.push_back(tid);
     }
+    return out;
+}
+
+/// Lowers the scheduling priority of llvmpipe's rasteriser threads to `niceness`, so that on a small
+/// machine the fracture workers run first; returns how many threads it changed.
+int lowerRasterizerPriority(int niceness) {
+    int changed = 0;
+    for (const int tid : rasterizerThreads())
+        if (setpriority(PRIO_PROCESS, static_cast<id_t>(tid), niceness) == 0)
+            ++changed;
     return changed;
 }
 
@@ -395,6 +413,29 @@ int parseOptions(int argc, char** argv, Options& o) {
            "niceness of llvmpipe's rasteriser threads (default 0: unchanged): above 0, fracture workers run "
            "before them (on a machine shared with other work they also lose to it; docs/rendering.md)")
         ->check(CLI::Range(0, 19));
+    cli.add_option("--raster-threads", o.rasterThreads,
+                   "llvmpipe's rasteriser threads (sets LP_NUM_THREADS before the GL context; 0: the main "
+                   "thread rasterises; default: Mesa's, one per core)")
+        ->check(CLI::Range(0, 64));
+    cli.add_option("--worker-nice", o.workerNice,
+                   "niceness of the fracture worker threads (default " + std::to_string(kWorkerNice) +
+                       "; below 0 they run before software GL's rasteriser threads, which needs "
+                       "CAP_SYS_NICE; report.json says what the system granted)")
+        ->check(CLI::Range(-20, 19));
+    cli.add_option("--fire-rate", o.fireRate,
+                   "cannon shots per game second at the standing objects, round robin, from 40 m on the "
+                   "camera's side (a latency run's steady fractures; also with --hold-fire)")
+        ->check(CLI::Range(0.0, 60.0));
+    cli.add_option(
+           "--adopt-wait", o.adoptWaitMs,
+           "ms a frame waits before drawing for a fracture job in flight to finish, so that its pieces "
+           "appear in this frame rather than the next (default " +
+               CLI::detail::to_string(kAdoptWaitMs) + "; not in deterministic runs)")
+        ->check(CLI::Range(0.0, 100.0));
+    cli.add_flag("--adopt-ready", o.adoptReady,
+                 "with --autopilot: adopt fracture results as soon as their job finished, right before "
+                 "drawing (as play does), not exactly 2 frames after the impact; impact -> adopted latency "
+                 "then measures the workers, but runs are no longer deterministic");
     CLI11_PARSE(cli, argc, argv);
     o.structureFlag = cli.count("--structure") > 0;
     return -1;
@@ -498,7 +539,8 @@ int setUp(App& app, RunMode& mode) {
     }
 
     app.pending.workers = o.workers;
-    app.pending.deterministic = o.deterministic || autopilot;
+    app.pending.workerNice = o.workerNice;
+    app.pending.deterministic = o.deterministic || (autopilot && !o.adoptReady);
     app.pending.fracture.pattern = o.pattern == "shatter"  ? rubble::CellPattern::Shatter
                                    : o.pattern == "single" ? rubble::CellPattern::SingleCell
                                                            : rubble::CellPattern::Adaptive;
@@ -516,6 +558,8 @@ int setUp(App& app, RunMode& mode) {
         app.pending.lightPerAwake = o.lightPerAwake;
 
     std::string error;
+    if (o.rasterThreads >= 0) // Mesa reads it when the context's screen is made
+        setenv("LP_NUM_THREADS", std::to_string(o.rasterThreads).c_str(), 1);
     app.gl = demo::GlContext::create(o.width, o.height, headless, error);
     if (!app.gl) {
         std::fprintf(stderr, "error: %s\n", error.c_str());
@@ -643,6 +687,7 @@ int frameLoop(App& app, const RunMode& mode) {
     const long shotEvery = o.screenshotEvery > 0 ? std::max(1L, std::lround(o.screenshotEvery * 60.0)) : 0;
     long renderFrame = 0;
     long nextDemolish = 60; // --demolish: game frame of the next charge (the first after a second)
+    long nextShot = 60;     // --fire-rate: game frame of the next shell
     double accumulator = 0;
     auto last = Clock::now();
 
@@ -669,6 +714,11 @@ int frameLoop(App& app, const RunMode& mode) {
             app.game.blastNextTarget(); // --demolish: the next charge, on the next standing target
             nextDemolish = static_cast<long>(app.game.counters().frame) + std::lround(o.demolish * 60.0);
         }
+        if (o.fireRate > 0 && static_cast<long>(app.game.counters().frame) >= nextShot) {
+            app.game.shootNextTarget(app.game.camera().eye); // --fire-rate: the next shell
+            nextShot =
+                static_cast<long>(app.game.counters().frame) + std::max(1L, std::lround(60.0 / o.fireRate));
+        }
         if (autopilot) {
             demo::ControlInput in = pilot.update(app.game, fixedDt);
             in.fire = in.fire && !app.opt.holdFire;
@@ -694,7 +744,7 @@ int frameLoop(App& app, const RunMode& mode) {
         // pieces appear in this frame rather than after the next step (no-op in deterministic mode, which the
         // autopilot uses; nothing changes while paused).
         if (!app.paused || autopilot)
-            app.game.adoptReady();
+            app.game.adoptReady(o.adoptWaitMs);
         const double stepMs = std::chrono::duration<double, std::milli>(Clock::now() - stepStart).count();
         { // Sound: heard from the camera, the capture in step with game time.
             const demo::M4 view = app.game.camera().view();
@@ -828,6 +878,10 @@ int frameLoop(App& app, const RunMode& mode) {
         return 1;
     }
     report.setAudio(audio.stats(), kVoices, audio.hasDevice());
+    if (const demo::PriorityJobs* jobs = app.game.jobs())
+        report.setThreads({jobs->workerCount(), jobs->nice(), jobs->raised(), jobs->refused(),
+                           static_cast<int>(rasterizerThreads().size()), !app.pending.deterministic,
+                           o.adoptWaitMs});
     if (!o.out.empty()) {
         std::string summary;
         const auto outDir = std::filesystem::path(o.out);

@@ -45,6 +45,20 @@ events=$(sed -n 's/^journal: .* (\([0-9]*\) events, [0-9]* bytes).*$/\1/p' "$wor
 [ -n "$events" ] && [ "$events" -gt 0 ] || fail "the deterministic session journaled nothing"
 echo "ok: --record and --replay ($events events, geometry hash $recorded)"
 
+# A latency run: --fire-rate shells (the autopilot holding its own fire), results adopted when ready, the
+# fracture workers at the asked niceness (1: any user may lower a thread's priority).
+run latency --scene "$here/e2e.cfg" --autopilot 2 --hold-fire --fire-rate 4 --adopt-ready --worker-nice 1
+python3 - "$work/latency/report.json" <<'PY' || fail "the latency run's report: $(cat "$work/latency/report.json")"
+import json, sys
+r = json.load(open(sys.argv[1]))
+t = r["threads"]
+assert r["weapons"]["cannon"]["shots"] == 4 and r["shots"] == 4, r["weapons"]  # game frames 60, 75, 90, 105
+assert r["fractures"] > 0 and r["latency_ms"]["count"] > 0, (r["fractures"], r["latency_ms"])
+assert t["adopt_ready"] and t["worker_nice"] == 1, t
+assert 1 <= t["workers_at_nice"] <= t["fracture_workers"] and t["workers_refused"] == 0, t  # those that ran jobs
+PY
+echo "ok: --fire-rate, --adopt-ready and --worker-nice"
+
 # --host: a client process (rubble-bench netplay-client) follows the demo over ENet on 127.0.0.1.
 if [ -n "$bench" ]; then
     port=$(python3 -c "import socket; s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM); s.bind(('127.0.0.1', 0)); print(s.getsockname()[1])")
