@@ -96,10 +96,11 @@ struct Track {
             const auto& [t1, b] = points.back();
             const auto& [t0, a] = points[points.size() - 2];
             const double period = log->period();
-            const bool atRest = log->newest() > t1 && log->arrivedAll(t1, log->newest());
             const double ahead = frame - t1;
-            if (atRest || t1 - t0 > 1.5 * period || ahead > kExtrapolatePeriods * period)
+            if (t1 - t0 > 1.5 * period || ahead > kExtrapolatePeriods * period)
                 return f;
+            if (log->newest() > t1 && log->arrivedAll(t1, log->newest()))
+                return f; // shown at rest by a later publish
             f.translation = b.translation + (b.translation - a.translation) * (ahead / (t1 - t0));
             return f;
         }
