@@ -127,8 +127,7 @@ TEST(NetRelay, ClientsThroughMisbehavingLinksConvergeAfterAPartitionAndAReplacem
     // Placements: what the host last published reaches everyone through the loss (delta-coded, sent again
     // until acknowledged).
     const std::vector<ObjectPlacement> placements = host.runtime.placements();
-    // Asked a second past the last frame: a client carries a body on for up to two publish periods when a
-    // lost datagram leaves it unsure that the body stopped, and holds it at its newest placement after that.
+    // A second past the last frame, where a client holds every body at its newest placement.
     const double settled = static_cast<double>(last) + 60;
     // The first placement not yet where the host put it; empty once every one is.
     const auto missing = [&] {
