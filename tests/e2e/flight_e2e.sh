@@ -61,9 +61,7 @@ again() { [ "$(field respawns)" -gt "$r0" ]; }
 wait_for 20 again || fail "R did not respawn"
 echo "ok: R respawned the jet"
 xdotool key --clearmodifiers Escape
-wait_for 20 bash -c "! kill -0 $demo_pid 2>/dev/null" || true
-wait "$demo_pid" 2>/dev/null
-demo_pid=""
+wait_exit 20 || fail "Escape did not quit the demo"
 
 # Crash into an object: the jet flies into a cube 70 m ahead; the crash's blast fractures it.
 "$demo" --scene "$here/crash.cfg" --stats --stats-every 5 --no-panel --width 640 --height 360 >"$work/log" 2>&1 &

@@ -59,3 +59,14 @@ wait_for() {
 }
 
 have_stats() { grep -q '^stats ' "$work/log"; }
+
+# wait_exit SECONDS: waits for rubble-demo to quit and reaps it; 1 when it is still running after SECONDS.
+wait_exit() {
+    for _ in $(seq 1 $(($1 * 10))); do
+        kill -0 "$demo_pid" 2>/dev/null || break
+        sleep 0.1
+    done
+    kill -0 "$demo_pid" 2>/dev/null && return 1
+    wait "$demo_pid" 2>/dev/null
+    demo_pid=""
+}
