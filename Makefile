@@ -8,7 +8,7 @@
 #   make sanitize    clang ASan+UBSan build of the whole test suite (build-asan/) and TSan build of the runtime
 #                    and Bullet tests (build-tsan/), both run by CTest (scripts/sanitize.sh)
 #   make sanitize-ci what CI runs after make test: make sanitize, then every libFuzzer target for a fixed seed and
-#                    input count (5-40 s each; scripts/fuzz.sh ci), so CI findings reproduce
+#                    input count (3-25 s each; scripts/fuzz.sh ci), so CI findings reproduce
 #   make fuzz-smoke  every libFuzzer target for FUZZ_SECONDS (default 45) each with fresh seeds, in build-asan/
 #   make stress      the chained-fracture stress test with STRESS_IMPACTS (default 10000) impacts
 #   make soak        rubble-bench scene with continuous fire for SOAK_FRAMES (default 100000) frames

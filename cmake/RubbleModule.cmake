@@ -48,6 +48,14 @@ function(rubble_shared_library target)
         LINKER_LANGUAGE CXX)
 endfunction()
 
+# rubble_test_code_uninstrumented(TARGET): under ASan, test code itself is compiled without sanitizers (the library
+# under test keeps them; the executable still links their runtime). TSan keeps them: its atomics must be seen.
+function(rubble_test_code_uninstrumented target)
+    if(RUBBLE_SANITIZE MATCHES "address")
+        target_compile_options(${target} PRIVATE -fno-sanitize=all)
+    endif()
+endfunction()
+
 # rubble_tests(FOLDER LIBS...): one GoogleTest executable per *_test.cpp in FOLDER, registered with CTest.
 function(rubble_tests folder)
     file(GLOB tests CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/${folder}/*_test.cpp)
@@ -59,6 +67,7 @@ function(rubble_tests folder)
         set_target_properties(${exe} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
         # Test code at -O1: the library under test keeps its build type's flags (docs/robustness.md, section 7).
         target_compile_options(${exe} PRIVATE $<$<NOT:$<CONFIG:Debug>>:-O1>)
+        rubble_test_code_uninstrumented(${exe})
         gtest_discover_tests(${exe} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR} DISCOVERY_TIMEOUT 60
             PROPERTIES LABELS ${folder})
     endforeach()

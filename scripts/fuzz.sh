@@ -9,7 +9,7 @@
 # Exploration keeps the inputs that grew the coverage in <tree>/corpus/<target>/ for the next run (the repository's
 # corpus is only read). RUBBLE_FUZZ_SEED and RUBBLE_FUZZ_RUNS (libFuzzer's -seed and -runs; the time limit still
 # caps the run) make it reproducible.
-# CI mode runs each target from seed 1 for the input count in ci_runs below (sized to 5-40 s each on the
+# CI mode runs each target from seed 1 for the input count in ci_runs below (sized to 3-25 s each on the
 # 2-core CI machine), starting from the repository's corpus and an empty work corpus (<tree>/corpus-ci/), with
 # ASLR off, a fixed environment and libFuzzer's timed corpus reload off: otherwise two runs of the same seed
 # diverge after a few hundred inputs (the targets' coverage depends on addresses, heap and stack, and reloads
@@ -19,12 +19,15 @@
 # input is also printed in base64, so it can be taken from the CI log.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-declare -A ci_runs=([obj]=500000 [json]=500000 [off]=250000 [ply_stl]=300000 [scene]=400000 [mesh_repair]=40000 [convex_clip]=14000 [fracture]=800 [snapshot]=60000 [net_protocol]=150000 [mtl]=300000 [gltf]=60000)
+declare -A ci_runs=([obj]=300000 [json]=300000 [off]=150000 [ply_stl]=180000 [scene]=250000 [mesh_repair]=25000 [convex_clip]=9000 [fracture]=500 [snapshot]=40000 [net_protocol]=100000 [mtl]=200000 [gltf]=40000)
 ci_cap=150
+# Seconds one input may run before it counts as a hang (CI: generous, for a loaded machine).
+input_timeout=10
 ci=0
 if [ "${1:-}" = ci ]; then
     ci=1
     seconds=$ci_cap
+    input_timeout=60
 else
     seconds=${1:-60}
 fi
@@ -69,7 +72,7 @@ run_one() { # target; prints its summary, returns non-zero on a finding
     fi
     mkdir -p "$dir/crashes/$t" "$work"
     t0=$(date +%s)
-    if ! "${norand[@]}" "$dir/fuzz/fuzz_$t" "$work" "tests/corpus/$t" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+    if ! "${norand[@]}" "$dir/fuzz/fuzz_$t" "$work" "tests/corpus/$t" -max_total_time="$seconds" -timeout=$input_timeout -rss_limit_mb=2048 \
         -max_len=4096 "${repro[@]}" -artifact_prefix="$dir/crashes/$t/" -print_final_stats=1 2>"$dir/fuzz_$t.log"; then
         echo "fuzz: $t FAILED; see $dir/fuzz_$t.log and $dir/crashes/$t/"
         tail -40 "$dir/fuzz_$t.log"
