@@ -311,7 +311,9 @@ TEST(DestructionRuntime, TriangleBudgetAndFadingRetireDebris) {
     ASSERT_TRUE(rig.runtime.submitLocalImpact(box, Impact{{0, 1, 0}, {0, 1, 0}, 50}));
     ASSERT_GE(rig.breakAndWait(box).size(), 4u);
     const std::size_t before = rig.runtime.debrisTriangles();
-    rig.runtime.config().debris.maxTriangles = before / 2;
+    DebrisBudget budget = rig.runtime.config().debris;
+    budget.maxTriangles = before / 2;
+    rig.runtime.setDebrisBudget(budget);
     rig.step(1);
     EXPECT_LE(rig.runtime.debrisTriangles(), before / 2);
     EXPECT_GT(rig.runtime.debrisTriangles(), 0u);
