@@ -464,16 +464,15 @@ void simplifyAroundCut(Mesh& mesh, MeshTopology& topology, std::span<const std::
         rest.accumulate(report.integralsChange, 1.0);
 }
 
-/// runPipeline on a mesh with its topology, edited in place (docs/megamesh.md): the split's remainder is an
-/// edit, checked around the cut and then applied; its islands are found by a walk around the cut, with the
-/// full labelling as the fallback. A split that fails leaves mesh and topology as they were (a failed edit
-/// is redone by Corefine on the intact mesh when exactRedo is set); on success the mesh is consumed.
+/// runPipeline on a mesh with its topology (held fits mesh; backend is an EditingBackend), edited in place
+/// (docs/megamesh.md): the split's remainder is an edit, checked around the cut and then applied; its islands
+/// are found by a walk around the cut, with the full labelling as the fallback. A split that fails leaves
+/// mesh and topology as they were (a failed edit is redone by Corefine on the intact mesh when exactRedo is
+/// set); on success the mesh is consumed.
 Result<FractureResult> runInPlace(Mesh& mesh, HeldTopology& held, std::vector<ConvexPolytope> cells,
                                   const FractureParams& params, const BooleanBackend& backend, bool exactRedo,
                                   double inputVolume) {
-    const auto* editing = dynamic_cast<const detail::EditingBackend*>(&backend);
-    if (!editing || !held.fits(mesh))
-        return runPipeline(mesh, std::move(cells), params, backend, exactRedo, inputVolume, true);
+    const auto* editing = &dynamic_cast<const detail::EditingBackend&>(backend);
     MeshTopology& topology = *held.get();
     const Stopwatch t0;
     FractureResult res;
@@ -611,20 +610,70 @@ Result<FractureResult> runInPlace(Mesh& mesh, HeldTopology& held, std::vector<Co
                         t0, t1, std::move(res), &debris);
 }
 
-/// Runs a pipeline (runPipeline or runInPlace) after the input's validation, with its timings.
-template <class Run>
-Result<FractureResult> withValidation(const Mesh& mesh, const MeshFacts& known, const FractureParams& params,
-                                      Run run) {
+/// Where one fracture cuts, decided once when it starts: the mesh as given, or, when the backend edits and
+/// the known facts hold the mesh's topology, the mesh edited in place: the caller's when it handed the mesh
+/// and its facts over, else a copy.
+class Place {
+public:
+    /// A fracture of mesh: copied to be edited in place.
+    Place(const Mesh& mesh, const MeshFacts& known, bool editing) : mesh_(&mesh), known_(&known) {
+        if (!editable(mesh, known, editing))
+            return;
+        copy_ = mesh;
+        copyFacts_ = known;
+        mesh_ = edit_ = &copy_;
+        known_ = &copyFacts_;
+        topology_ = &copyFacts_.topology;
+    }
+    /// A fracture of a mesh handed over with its facts: edited in place itself.
+    Place(Mesh& mesh, MeshFacts& known, bool editing) : mesh_(&mesh), known_(&known) {
+        if (editable(mesh, known, editing)) {
+            edit_ = &mesh;
+            topology_ = &known.topology;
+        }
+    }
+    Place(const Place&) = delete;
+    Place& operator=(const Place&) = delete;
+
+    /// The mesh cut.
+    const Mesh& mesh() const { return *mesh_; }
+    /// Its facts.
+    const MeshFacts& known() const { return *known_; }
+    /// Cuts the validated mesh by cells: runInPlace or runPipeline.
+    Result<FractureResult> cut(std::vector<ConvexPolytope> cells, const FractureParams& params,
+                               const BooleanBackend& backend, bool exactRedo, double volume) const {
+        if (edit_)
+            return runInPlace(*edit_, *topology_, std::move(cells), params, backend, exactRedo, volume);
+        return runPipeline(*mesh_, std::move(cells), params, backend, exactRedo, volume);
+    }
+
+private:
+    static bool editable(const Mesh& mesh, const MeshFacts& known, bool editing) {
+        return editing && known.fit(mesh) && known.topology.fits(mesh);
+    }
+
+    const Mesh* mesh_;
+    const MeshFacts* known_;
+    Mesh* edit_ = nullptr;
+    HeldTopology* topology_ = nullptr;
+    Mesh copy_;
+    MeshFacts copyFacts_;
+};
+
+/// Cuts place by given cells after the input's validation, with its timings.
+Result<FractureResult> cutWithCells(const Place& place, std::vector<ConvexPolytope> cells,
+                                    const FractureParams& params, const BooleanBackend& backend,
+                                    bool exactRedo) {
     const Stopwatch t0;
     if (Status s = validateRoughness(params.roughness); !s)
         return makeError(ErrorCode::InvalidInput, "fracture: " + s.message());
     double volume = 0;
     const VolumeIntegrals* integrals = nullptr;
-    if (Status s = prepareInput(mesh, known, volume, integrals); !s)
+    if (Status s = prepareInput(place.mesh(), place.known(), volume, integrals); !s)
         return s.error();
     FractureResult pre; // the stages before the pipeline
     t0.set(pre, &FractureTimings::validateMs);
-    auto r = run(volume);
+    auto r = place.cut(std::move(cells), params, backend, exactRedo, volume);
     if (r) {
         r->stats.timings.validateMs = pre.stats.timings.validateMs;
         r->stats.cpuTimings.validateMs = pre.stats.cpuTimings.validateMs;
@@ -632,52 +681,6 @@ Result<FractureResult> withValidation(const Mesh& mesh, const MeshFacts& known, 
     }
     return r;
 }
-
-/// True when mesh is fractured in place: known facts with a topology, the Fast backend.
-bool inPlace(const Mesh& mesh, const MeshFacts& known, const FractureParams& params) {
-    return params.backend == BooleanKind::Fast && known.fit(mesh) && known.topology.fits(mesh);
-}
-
-} // namespace
-
-namespace detail {
-
-Result<FractureResult> fractureWithBackend(const Mesh& mesh, std::vector<ConvexPolytope> cells,
-                                           const FractureParams& params, const BooleanBackend& backend,
-                                           bool exactRedo, const MeshFacts& known) {
-    if (known.fit(mesh) && known.topology.fits(mesh) && dynamic_cast<const EditingBackend*>(&backend)) {
-        Mesh copy = mesh;
-        MeshFacts facts = known;
-        return fractureInPlaceWithBackend(copy, facts, std::move(cells), params, backend, exactRedo);
-    }
-    return withValidation(mesh, known, params, [&](double volume) {
-        return runPipeline(mesh, std::move(cells), params, backend, exactRedo, volume);
-    });
-}
-
-Result<FractureResult> fractureInPlaceWithBackend(Mesh& mesh, MeshFacts& known,
-                                                  std::vector<ConvexPolytope> cells,
-                                                  const FractureParams& params, const BooleanBackend& backend,
-                                                  bool exactRedo) {
-    return withValidation(mesh, known, params, [&](double volume) {
-        return runInPlace(mesh, known.topology, std::move(cells), params, backend, exactRedo, volume);
-    });
-}
-
-} // namespace detail
-
-Result<MeshFacts> analyzeMesh(const Mesh& mesh) {
-    if (Status s = checkSolid(mesh); !s)
-        return s.error();
-    MeshFacts facts{true, mesh.triangles.size(), mesh.positions.size(), volumeIntegrals(mesh)};
-    if (Status s = positiveVolume(facts.integrals.volume); !s)
-        return s.error();
-    if (mesh.triangles.size() > kTopologyAboveTriangles)
-        facts.topology = buildTopology(mesh).value_or(MeshTopology{});
-    return facts;
-}
-
-namespace {
 
 /// The backend of params, given the input's integrals when they are known (Fast uses them).
 std::unique_ptr<BooleanBackend> backendFor(BooleanKind kind, bool exactFallback,
@@ -687,11 +690,26 @@ std::unique_ptr<BooleanBackend> backendFor(BooleanKind kind, bool exactFallback,
     return makeBooleanBackend(kind);
 }
 
-/// fracture: cells from the seed (redrawn when Fast declines them), then run(cells, backend, exactRedo,
-/// volume), which is runPipeline or runInPlace.
-template <class Run>
-Result<FractureResult> fractureBy(const Mesh& mesh, const Impact& impact, const FractureParams& params,
-                                  std::uint64_t seed, const MeshFacts& known, Run run) {
+/// fractureWithCells with params' backend.
+Result<FractureResult> cutWithCells(const Place& place, std::vector<ConvexPolytope> cells,
+                                    const FractureParams& params) {
+    const VolumeIntegrals* integrals = place.known().fit(place.mesh()) ? &place.known().integrals : nullptr;
+    return cutWithCells(place, std::move(cells), params, *backendFor(params.backend, true, integrals),
+                        params.backend == BooleanKind::Fast);
+}
+
+/// params with the fracture's seed mixed into the roughness seed (a rough surface per fracture).
+FractureParams seeded(const FractureParams& params, std::uint64_t seed) {
+    FractureParams p = params;
+    if (p.roughness.active())
+        p.roughness.seed = mixSeed(seed, p.roughness.seed);
+    return p;
+}
+
+/// fracture: cells from the seed (redrawn when Fast declines them), cut where place says.
+Result<FractureResult> cutAtImpact(const Place& place, const Impact& impact, const FractureParams& original,
+                                   std::uint64_t seed) {
+    const FractureParams params = seeded(original, seed);
     const Stopwatch t0;
     if (Status s = validateRoughness(params.roughness); !s)
         return makeError(ErrorCode::InvalidInput, "fracture: " + s.message());
@@ -699,13 +717,13 @@ Result<FractureResult> fractureBy(const Mesh& mesh, const Impact& impact, const 
     const VolumeIntegrals* integrals = nullptr;
     if (Status s = checkFractureParams(impact, params); !s)
         return makeError(ErrorCode::InvalidInput, "fracture: " + s.message());
-    if (Status s = prepareInput(mesh, known, volume, integrals); !s)
+    if (Status s = prepareInput(place.mesh(), place.known(), volume, integrals); !s)
         return s.error();
     FractureResult pre; // the stages before the pipeline
     t0.set(pre, &FractureTimings::validateMs);
     auto cellsFor = [&](std::uint64_t s) {
         const Stopwatch tc;
-        std::vector<ConvexPolytope> cells = generateCells(mesh.bounds(), impact, params, s);
+        std::vector<ConvexPolytope> cells = generateCells(place.mesh().bounds(), impact, params, s);
         tc.add(pre, &FractureTimings::cellMs);
         return cells;
     };
@@ -729,72 +747,69 @@ Result<FractureResult> fractureBy(const Mesh& mesh, const Impact& impact, const 
             std::vector<ConvexPolytope> cells = cellsFor(redraw == 0 ? seed : mixSeed(seed, 0xDA7A + redraw));
             if (cells.empty())
                 break;
-            auto r = run(std::move(cells), *detail::makeFastBackend(false, integrals), false, volume);
+            auto r = place.cut(std::move(cells), params, *detail::makeFastBackend(false, integrals), false,
+                               volume);
             if (r || r.error().code != ErrorCode::GeometryFailure)
                 return finish(std::move(r), redraw);
         }
     std::vector<ConvexPolytope> cells = cellsFor(seed);
     if (cells.empty())
         return makeError(ErrorCode::NoIntersection, "fracture: no cell could be built around the impact");
-    return finish(run(std::move(cells), *backendFor(params.backend, true, integrals),
-                      params.backend == BooleanKind::Fast, volume),
+    return finish(place.cut(std::move(cells), params, *backendFor(params.backend, true, integrals),
+                            params.backend == BooleanKind::Fast, volume),
                   0);
 }
 
 } // namespace
 
+namespace detail {
+
+Result<FractureResult> fractureWithBackend(const Mesh& mesh, std::vector<ConvexPolytope> cells,
+                                           const FractureParams& params, const BooleanBackend& backend,
+                                           bool exactRedo, const MeshFacts& known) {
+    const Place place(mesh, known, dynamic_cast<const EditingBackend*>(&backend) != nullptr);
+    return cutWithCells(place, std::move(cells), params, backend, exactRedo);
+}
+
+Result<FractureResult> fractureInPlaceWithBackend(Mesh& mesh, MeshFacts& known,
+                                                  std::vector<ConvexPolytope> cells,
+                                                  const FractureParams& params, const BooleanBackend& backend,
+                                                  bool exactRedo) {
+    const Place place(mesh, known, dynamic_cast<const EditingBackend*>(&backend) != nullptr);
+    return cutWithCells(place, std::move(cells), params, backend, exactRedo);
+}
+
+} // namespace detail
+
+Result<MeshFacts> analyzeMesh(const Mesh& mesh) {
+    if (Status s = checkSolid(mesh); !s)
+        return s.error();
+    MeshFacts facts{true, mesh.triangles.size(), mesh.positions.size(), volumeIntegrals(mesh)};
+    if (Status s = positiveVolume(facts.integrals.volume); !s)
+        return s.error();
+    if (mesh.triangles.size() > kTopologyAboveTriangles)
+        facts.topology = buildTopology(mesh).value_or(MeshTopology{});
+    return facts;
+}
+
 Result<FractureResult> fractureWithCells(const Mesh& mesh, std::vector<ConvexPolytope> cells,
                                          const FractureParams& params, const MeshFacts& known) {
-    if (inPlace(mesh, known, params))
-        return fractureWithCells(Mesh(mesh), std::move(cells), params, MeshFacts(known));
-    const VolumeIntegrals* integrals = known.fit(mesh) ? &known.integrals : nullptr;
-    return detail::fractureWithBackend(mesh, std::move(cells), params,
-                                       *backendFor(params.backend, true, integrals),
-                                       params.backend == BooleanKind::Fast, known);
+    return cutWithCells(Place(mesh, known, params.backend == BooleanKind::Fast), std::move(cells), params);
 }
 
 Result<FractureResult> fractureWithCells(Mesh&& mesh, std::vector<ConvexPolytope> cells,
                                          const FractureParams& params, MeshFacts known) {
-    if (!inPlace(mesh, known, params))
-        return fractureWithCells(std::as_const(mesh), std::move(cells), params, known);
-    const auto backend = detail::makeFastBackend(true, &known.integrals);
-    return detail::fractureInPlaceWithBackend(mesh, known, std::move(cells), params, *backend, true);
+    return cutWithCells(Place(mesh, known, params.backend == BooleanKind::Fast), std::move(cells), params);
 }
-
-namespace {
-
-/// params with the fracture's seed mixed into the roughness seed (a rough surface per fracture).
-FractureParams seeded(const FractureParams& params, std::uint64_t seed) {
-    FractureParams p = params;
-    if (p.roughness.active())
-        p.roughness.seed = mixSeed(seed, p.roughness.seed);
-    return p;
-}
-
-} // namespace
 
 Result<FractureResult> fracture(const Mesh& mesh, const Impact& impact, const FractureParams& params,
                                 std::uint64_t seed, const MeshFacts& known) {
-    if (inPlace(mesh, known, params))
-        return fracture(Mesh(mesh), impact, params, seed, MeshFacts(known));
-    const FractureParams p = seeded(params, seed);
-    return fractureBy(
-        mesh, impact, p, seed, known,
-        [&](std::vector<ConvexPolytope> cells, const BooleanBackend& backend, bool exactRedo, double volume) {
-            return runPipeline(mesh, std::move(cells), p, backend, exactRedo, volume);
-        });
+    return cutAtImpact(Place(mesh, known, params.backend == BooleanKind::Fast), impact, params, seed);
 }
 
 Result<FractureResult> fracture(Mesh&& mesh, const Impact& impact, const FractureParams& params,
                                 std::uint64_t seed, MeshFacts known) {
-    if (!inPlace(mesh, known, params))
-        return fracture(std::as_const(mesh), impact, params, seed, known);
-    const FractureParams p = seeded(params, seed);
-    return fractureBy(
-        mesh, impact, p, seed, known,
-        [&](std::vector<ConvexPolytope> cells, const BooleanBackend& backend, bool exactRedo, double volume) {
-            return runInPlace(mesh, known.topology, std::move(cells), p, backend, exactRedo, volume);
-        });
+    return cutAtImpact(Place(mesh, known, params.backend == BooleanKind::Fast), impact, params, seed);
 }
 
 } // namespace rubble
