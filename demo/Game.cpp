@@ -211,7 +211,9 @@ bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const Game
         boundsMinZ_ = static_cast<float>(g.position.z - half.z);
         boundsMaxZ_ = static_cast<float>(g.position.z + half.z);
     }
-    runtime_->config().debris.killBelowY = groundTop_ - 60.0;
+    rubble::DebrisBudget debris = runtime_->config().debris;
+    debris.killBelowY = groundTop_ - 60.0;
+    runtime_->setDebrisBudget(debris);
 
     // Vehicle: the scene's model, or the built-in jet; an indestructible convex body steered by
     // controlVehicle.
@@ -676,10 +678,16 @@ void Game::step(const ControlInput& input, float dt, Renderer& renderer) {
     fireWasDown_ = input.fire;
 
     // live-tunable runtime settings
-    auto& rc = runtime_->config();
-    rc.debris.maxAwakeBodies = settings_.maxAwake;
-    rc.impacts.collisionImpulseThreshold = settings_.collisionImpulse;
-    rc.support.collapseUnsupported = settings_.collapseUnsupported;
+    const auto& rc = runtime_->config();
+    rubble::DebrisBudget debris = rc.debris;
+    debris.maxAwakeBodies = settings_.maxAwake;
+    runtime_->setDebrisBudget(debris);
+    rubble::ImpactPolicy impacts = rc.impacts;
+    impacts.collisionImpulseThreshold = settings_.collisionImpulse;
+    runtime_->setImpactPolicy(impacts);
+    rubble::SupportPolicy support = rc.support;
+    support.collapseUnsupported = settings_.collapseUnsupported;
+    runtime_->setSupportPolicy(support);
 
     const long long impactsBefore = runtime_->counters().impacts;
     const long long retiredBefore = runtime_->counters().piecesRetired;

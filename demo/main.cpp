@@ -641,13 +641,8 @@ int replayMode(App& app) {
 }
 
 /// Play (and host): the frame loop until quit or the end of the autopilot, then the report and the journal.
-int frameLoop(App& app, const RunMode& mode) {
-    const Options& o = app.opt;
-    const bool headless = mode.headless;
-    const bool autopilot = mode.autopilot;
-    const std::string& rendererName = mode.rendererName;
-    const int reniced = mode.reniced;
-    std::string error;
+// Dear ImGui over the window (or offscreen), the keys bound; returns its IO.
+ImGuiIO& startUi(App& app, bool autopilot) {
     IMGUI_CHECKVERSION();
     ImGui::CreateContext();
     ImGuiIO& io = ImGui::GetIO();
@@ -663,7 +658,78 @@ int frameLoop(App& app, const RunMode& mode) {
         app.imguiGlfw = true;
     }
     ImGui_ImplOpenGL3_Init("#version 330 core");
-    app.panel.visible = !o.noPanel;
+    app.panel.visible = !app.opt.noPanel;
+    return io;
+}
+
+// The end of a run: the audio capture, report.json, the host's and the journal's summaries; then the UI, the
+// game and the window closed. Returns the exit status.
+int finishRun(App& app, demo::Audio& audio, demo::RunReport& report, const std::string& rendererName) {
+    const Options& o = app.opt;
+    if (std::string message; !audio.finish(message)) {
+        std::fprintf(stderr, "error: %s\n", message.c_str());
+        return 1;
+    }
+    report.setAudio(audio.stats(), kVoices, audio.hasDevice());
+    if (const demo::PriorityJobs* jobs = app.game.jobs())
+        report.setThreads({jobs->workerCount(), jobs->nice(), jobs->raised(), jobs->refused(),
+                           static_cast<int>(rasterizerThreads().size()), !app.pending.deterministic,
+                           o.adoptWaitMs});
+    if (!o.out.empty()) {
+        std::string summary;
+        const auto outDir = std::filesystem::path(o.out);
+        if (report.write(
+                outDir, app.scene.baseDir.string() + "/" + app.sceneName,
+                {rendererName, app.quality.name(), app.pending.shadows, app.gl->width(), app.gl->height()},
+                app.game.latencies(), app.screenshots, summary)) {
+            app.game.writeTimings((outDir / "latency.csv").string());
+            std::printf("report: %s\n", summary.c_str());
+            std::printf("wrote %s/report.json, %s/frames.csv and %d screenshots\n", o.out.c_str(),
+                        o.out.c_str(), app.screenshots);
+        } else {
+            std::fprintf(stderr, "error: cannot write the report into %s\n", o.out.c_str());
+        }
+    }
+    int status = 0;
+    app.game.finishHosting(); // the clients confirm the last sync before the connections close
+    if (const rubble::net::HostStats* h = app.game.hostStats())
+        std::printf("host: %lld clients joined, %lld syncs sent, %lld acknowledged, %lld mismatched hashes, "
+                    "geometry hash %016llx\n",
+                    h->joins, h->syncs, h->acks, h->mismatchedHashes,
+                    static_cast<unsigned long long>(app.game.geometryHash()));
+    if (!o.record.empty()) {
+        std::string message;
+        const std::uint64_t hash = app.game.finishRecording();
+        if (app.game.writeJournal(o.record, app.scene.baseDir.string() + "/" + app.sceneName, message)) {
+            std::printf("journal: %s (%s), geometry hash %016llx\n", o.record.c_str(), message.c_str(),
+                        static_cast<unsigned long long>(hash));
+        } else {
+            std::fprintf(stderr, "error: cannot write the journal %s: %s\n", o.record.c_str(),
+                         message.c_str());
+            status = 1;
+        }
+    }
+    std::fflush(stdout);
+
+    ImGui_ImplOpenGL3_Shutdown();
+    if (app.imguiGlfw)
+        ImGui_ImplGlfw_Shutdown();
+    ImGui::DestroyContext();
+    app.game.clear(app.renderer);
+    app.renderer.shutdown();
+    app.sceneTarget.release();
+    app.gl.reset();
+    return status;
+}
+
+int frameLoop(App& app, const RunMode& mode) {
+    const Options& o = app.opt;
+    const bool headless = mode.headless;
+    const bool autopilot = mode.autopilot;
+    const std::string& rendererName = mode.rendererName;
+    const int reniced = mode.reniced;
+    std::string error;
+    ImGuiIO& io = startUi(app, autopilot);
 
     if (!o.out.empty()) {
         std::error_code ec;
@@ -873,60 +939,7 @@ int frameLoop(App& app, const RunMode& mode) {
             break;
     }
 
-    if (std::string message; !audio.finish(message)) {
-        std::fprintf(stderr, "error: %s\n", message.c_str());
-        return 1;
-    }
-    report.setAudio(audio.stats(), kVoices, audio.hasDevice());
-    if (const demo::PriorityJobs* jobs = app.game.jobs())
-        report.setThreads({jobs->workerCount(), jobs->nice(), jobs->raised(), jobs->refused(),
-                           static_cast<int>(rasterizerThreads().size()), !app.pending.deterministic,
-                           o.adoptWaitMs});
-    if (!o.out.empty()) {
-        std::string summary;
-        const auto outDir = std::filesystem::path(o.out);
-        if (report.write(
-                outDir, app.scene.baseDir.string() + "/" + app.sceneName,
-                {rendererName, app.quality.name(), app.pending.shadows, app.gl->width(), app.gl->height()},
-                app.game.latencies(), app.screenshots, summary)) {
-            app.game.writeTimings((outDir / "latency.csv").string());
-            std::printf("report: %s\n", summary.c_str());
-            std::printf("wrote %s/report.json, %s/frames.csv and %d screenshots\n", o.out.c_str(),
-                        o.out.c_str(), app.screenshots);
-        } else {
-            std::fprintf(stderr, "error: cannot write the report into %s\n", o.out.c_str());
-        }
-    }
-    int status = 0;
-    app.game.finishHosting(); // the clients confirm the last sync before the connections close
-    if (const rubble::net::HostStats* h = app.game.hostStats())
-        std::printf("host: %lld clients joined, %lld syncs sent, %lld acknowledged, %lld mismatched hashes, "
-                    "geometry hash %016llx\n",
-                    h->joins, h->syncs, h->acks, h->mismatchedHashes,
-                    static_cast<unsigned long long>(app.game.geometryHash()));
-    if (!o.record.empty()) {
-        std::string message;
-        const std::uint64_t hash = app.game.finishRecording();
-        if (app.game.writeJournal(o.record, app.scene.baseDir.string() + "/" + app.sceneName, message)) {
-            std::printf("journal: %s (%s), geometry hash %016llx\n", o.record.c_str(), message.c_str(),
-                        static_cast<unsigned long long>(hash));
-        } else {
-            std::fprintf(stderr, "error: cannot write the journal %s: %s\n", o.record.c_str(),
-                         message.c_str());
-            status = 1;
-        }
-    }
-    std::fflush(stdout);
-
-    ImGui_ImplOpenGL3_Shutdown();
-    if (app.imguiGlfw)
-        ImGui_ImplGlfw_Shutdown();
-    ImGui::DestroyContext();
-    app.game.clear(app.renderer);
-    app.renderer.shutdown();
-    app.sceneTarget.release();
-    app.gl.reset();
-    return status;
+    return finishRun(app, audio, report, rendererName);
 }
 
 } // namespace

@@ -55,6 +55,43 @@ struct Stopwatch {
     }
 };
 
+/// What the stages of one fracture share: the result they build and the clocks that time them. Validation
+/// and cells are timed once; each attempt at the split restarts the rest.
+class Stages {
+public:
+    FractureResult res; ///< what the stages made so far
+
+    /// A new attempt at the split: a fresh result that keeps the validation and cell times.
+    void restart() {
+        FractureResult fresh;
+        for (auto [to, from] : {std::pair{&fresh.stats.timings, &res.stats.timings},
+                                {&fresh.stats.cpuTimings, &res.stats.cpuTimings}}) {
+            to->validateMs = from->validateMs;
+            to->cellMs = from->cellMs;
+        }
+        res = std::move(fresh);
+        split_ = {};
+    }
+    /// Starts the clock of the pieces (after the split).
+    void startPieces() { pieces_ = {}; }
+    /// Sets stage to the time since the fracture began.
+    void sinceStart(double FractureTimings::*stage) { start_.set(res, stage); }
+    /// Sets stage to the time since the attempt's split began.
+    void sinceSplit(double FractureTimings::*stage) { split_.set(res, stage); }
+    /// Sets stage to the time since the pieces began.
+    void sincePieces(double FractureTimings::*stage) { pieces_.set(res, stage); }
+    /// Runs step and adds its time to stage.
+    template <class Step>
+    void time(double FractureTimings::*stage, Step&& step) {
+        const Stopwatch clock;
+        step();
+        clock.add(res, stage);
+    }
+
+private:
+    Stopwatch start_, split_, pieces_;
+};
+
 /// Checks that mesh is a valid closed, oriented solid.
 Status checkSolid(const Mesh& mesh) {
     if (mesh.empty())
@@ -161,61 +198,61 @@ void finishCutFaces(Mesh& m, std::span<const ConvexPolytope> cells, double uvSca
 /// one island (kept, or found again when simplification changed it); with wantTopology, islands above
 /// kTopologyAboveTriangles get theirs.
 void addPieces(Mesh&& m, const detail::OutputShells& shells, std::int32_t cell, double minVolume,
-               bool simplify, const Aabb& focus, const VolumeIntegrals* whole, FractureResult& out,
+               bool simplify, const Aabb& focus, const VolumeIntegrals* whole, Stages& st,
                MeshTopology* topology = nullptr, bool wantTopology = false) {
     if (m.empty())
         return;
     std::vector<Mesh> islands = splitIntoIslands(std::move(m), shells.triangleShell, shells.count);
     std::size_t largest = islands.size();
     VolumeIntegrals rest;
-    if (whole) {
-        const Stopwatch tm;
-        largest = 0;
-        for (std::size_t i = 1; i < islands.size(); ++i)
-            if (islands[i].triangles.size() > islands[largest].triangles.size())
-                largest = i;
-        rest = *whole;
-        for (std::size_t i = 0; i < islands.size(); ++i)
-            if (i != largest)
-                rest.accumulate(volumeIntegrals(islands[i], whole->reference), -1.0);
-        tm.add(out, &FractureTimings::massMs);
-    }
+    if (whole)
+        st.time(&FractureTimings::massMs, [&] {
+            largest = 0;
+            for (std::size_t i = 1; i < islands.size(); ++i)
+                if (islands[i].triangles.size() > islands[largest].triangles.size())
+                    largest = i;
+            rest = *whole;
+            for (std::size_t i = 0; i < islands.size(); ++i)
+                if (i != largest)
+                    rest.accumulate(volumeIntegrals(islands[i], whole->reference), -1.0);
+        });
     for (std::size_t i = 0; i < islands.size(); ++i) {
         Mesh& island = islands[i];
         const bool byDifference = i == largest;
-        if (simplify) {
-            const Stopwatch ts;
-            PlanarSimplifyParams sp;
-            sp.focus = focus;
-            sp.integralsReference = rest.reference;
-            PlanarSimplifyReport report;
-            island = simplifyPlanarRegions(std::move(island), sp, &report);
-            if (byDifference && !report.unchanged)
-                rest.accumulate(report.integralsChange, 1.0);
-            if (topology && !report.unchanged)
-                topology = nullptr; // found again below
-            ts.add(out, &FractureTimings::simplifyMs);
-        }
-        const Stopwatch tm;
-        MeshTopology topo;
-        const bool large = island.triangles.size() > kTopologyAboveTriangles;
-        if (topology && islands.size() == 1 && large) {
-            topo = std::move(*topology);
-            detail::compactVerticesIfSparse(island);
-        } else if (topology && islands.size() == 1) {
-            island.removeUnreferencedVertices(); // small: the copying path's layout from now on
-        } else if (wantTopology && large) {
-            topo = buildTopology(island).value_or(MeshTopology{});
-        }
-        MeshFacts facts{true, island.triangles.size(), island.positions.size(),
-                        byDifference ? rest : volumeIntegrals(island), std::move(topo)};
-        MassProperties mp = massProperties(facts.integrals);
-        tm.add(out, &FractureTimings::massMs);
+        if (simplify)
+            st.time(&FractureTimings::simplifyMs, [&] {
+                PlanarSimplifyParams sp;
+                sp.focus = focus;
+                sp.integralsReference = rest.reference;
+                PlanarSimplifyReport report;
+                island = simplifyPlanarRegions(std::move(island), sp, &report);
+                if (byDifference && !report.unchanged)
+                    rest.accumulate(report.integralsChange, 1.0);
+                if (topology && !report.unchanged)
+                    topology = nullptr; // found again below
+            });
+        MeshFacts facts;
+        MassProperties mp;
+        st.time(&FractureTimings::massMs, [&] {
+            MeshTopology topo;
+            const bool large = island.triangles.size() > kTopologyAboveTriangles;
+            if (topology && islands.size() == 1 && large) {
+                topo = std::move(*topology);
+                detail::compactVerticesIfSparse(island);
+            } else if (topology && islands.size() == 1) {
+                island.removeUnreferencedVertices(); // small: the copying path's layout from now on
+            } else if (wantTopology && large) {
+                topo = buildTopology(island).value_or(MeshTopology{});
+            }
+            facts = MeshFacts{true, island.triangles.size(), island.positions.size(),
+                              byDifference ? rest : volumeIntegrals(island), std::move(topo)};
+            mp = massProperties(facts.integrals);
+        });
         if (!(mp.volume > minVolume)) {
-            out.droppedVolume += mp.volume;
+            st.res.droppedVolume += mp.volume;
             continue;
         }
-        out.pieces.push_back({std::move(island), mp, cell, std::move(facts)});
+        st.res.pieces.push_back({std::move(island), mp, cell, std::move(facts)});
     }
 }
 
@@ -281,8 +318,9 @@ Aabb cutFocus(const std::vector<ConvexPolytope>& cells, const Aabb& meshBox) {
 /// The start of a pipeline: the result knows the input volume, meshBox is the mesh's bounds; an error when
 /// no cell reaches them.
 Status startPipeline(const Mesh& mesh, const std::vector<ConvexPolytope>& cells, double inputVolume,
-                     FractureResult& res, Aabb& meshBox) {
-    res.inputVolume = inputVolume;
+                     Stages& st, Aabb& meshBox) {
+    st.restart();
+    st.res.inputVolume = inputVolume;
     meshBox = mesh.bounds();
     bool any = false;
     for (const ConvexPolytope& c : cells)
@@ -314,47 +352,44 @@ struct InsideInPlace {
     double meshDiagonal;
 };
 
-/// After the remainder's pieces: the cells' pieces (shells[i + 1] for inside[i]), the cells and the times.
-FractureResult finishPieces(std::vector<Mesh>&& inside, const std::vector<detail::OutputShells>& shells,
-                            std::vector<ConvexPolytope>&& cells, const FractureParams& params,
-                            double minVolume, const Aabb& focus, bool wantTopology, const Stopwatch& t0,
-                            const Stopwatch& t1, FractureResult&& res,
-                            const InsideInPlace* inPlace = nullptr) {
+/// After the remainder's pieces: the cells' pieces (shells[i + 1] for inside[i]) and the cells.
+Status finishPieces(std::vector<Mesh>&& inside, const std::vector<detail::OutputShells>& shells,
+                    std::vector<ConvexPolytope>&& cells, const FractureParams& params, double minVolume,
+                    const Aabb& focus, bool wantTopology, Stages& st,
+                    const InsideInPlace* inPlace = nullptr) {
     for (std::size_t i = 0; i < inside.size(); ++i) {
         Mesh& m = inside[i];
         std::optional<MeshTopology> topology;
         if (inPlace && params.simplifyPieces && shells[i + 1].count == 1 && i < inPlace->insideKept.size() &&
-            inPlace->insideKept[i] < m.triangles.size()) {
-            const Stopwatch ts;
-            topology = buildTopology(m);
-            if (topology) {
+            inPlace->insideKept[i] < m.triangles.size())
+            st.time(&FractureTimings::simplifyMs, [&] {
+                topology = buildTopology(m);
+                if (!topology)
+                    return;
                 std::vector<std::uint32_t> added(m.triangles.size() - inPlace->insideKept[i]);
                 for (std::size_t k = 0; k < added.size(); ++k)
                     added[k] = static_cast<std::uint32_t>(inPlace->insideKept[i] + k);
                 VolumeIntegrals unused; // the piece is measured in full
                 simplifyAroundCut(m, *topology, added, focus, inPlace->meshDiagonal, unused);
-            }
-            ts.add(res, &FractureTimings::simplifyMs);
-        }
+            });
         addPieces(std::move(m), shells[i + 1], static_cast<std::int32_t>(i), minVolume,
-                  params.simplifyPieces && !topology, focus, nullptr, res, topology ? &*topology : nullptr,
+                  params.simplifyPieces && !topology, focus, nullptr, st, topology ? &*topology : nullptr,
                   wantTopology);
     }
-    t1.set(res, &FractureTimings::islandsMs);
-    res.cells = std::move(cells);
-    t0.set(res, &FractureTimings::totalMs);
-    return std::move(res);
+    st.sincePieces(&FractureTimings::islandsMs);
+    st.res.cells = std::move(cells);
+    return {};
 }
 
-/// The pipeline after input validation. wantTopology: pieces above kTopologyAboveTriangles get theirs.
-Result<FractureResult> runPipeline(const Mesh& mesh, std::vector<ConvexPolytope> cells,
-                                   const FractureParams& params, const BooleanBackend& backend,
-                                   bool exactRedo, double inputVolume, bool wantTopology = false) {
-    const Stopwatch t0;
-    FractureResult res;
+/// The pipeline after input validation, an attempt of its own in st. wantTopology: pieces above
+/// kTopologyAboveTriangles get theirs.
+Status runPipeline(Stages& st, const Mesh& mesh, std::vector<ConvexPolytope> cells,
+                   const FractureParams& params, const BooleanBackend& backend, bool exactRedo,
+                   double inputVolume, bool wantTopology = false) {
+    FractureResult& res = st.res;
     Aabb meshBox;
-    if (Status s = startPipeline(mesh, cells, inputVolume, res, meshBox); !s)
-        return s.error();
+    if (Status s = startPipeline(mesh, cells, inputVolume, st, meshBox); !s)
+        return s;
 
     auto split = backend.split(mesh, cells);
     const double onPlane = 1e-7 * meshBox.diagonal();
@@ -365,9 +400,9 @@ Result<FractureResult> runPipeline(const Mesh& mesh, std::vector<ConvexPolytope>
     // The result must close up and conserve volume; a failed fast split is redone exactly (flat). The check
     // labels the shells of every output on the way; the islands below reuse them.
     std::vector<detail::OutputShells> shells;
-    const Stopwatch tv;
-    bool sound = split && detail::splitIsSound(*split, inputVolume, &shells);
-    tv.set(res, &FractureTimings::verifyMs);
+    bool sound = false;
+    st.time(&FractureTimings::verifyMs,
+            [&] { sound = split && detail::splitIsSound(*split, inputVolume, &shells); });
     if (split && !sound && exactRedo) {
         split = detail::makeCorefineBackend()->split(mesh, cells);
         if (split)
@@ -388,24 +423,24 @@ Result<FractureResult> runPipeline(const Mesh& mesh, std::vector<ConvexPolytope>
     if (!hit)
         return cellsCutNothing();
     res.stats.exactFallback = split->exactFallback;
-    t0.set(res, &FractureTimings::booleanMs);
+    st.sinceSplit(&FractureTimings::booleanMs);
 
-    const Stopwatch t1;
+    st.startPieces();
     const Aabb focus = cutFocus(cells, meshBox);
     if (!res.stats.rough) { // roughenSplit gave the rough faces theirs
         finishCutFaces(split->remainder, cells, params.uvScale, focus, onPlane);
         finishInsideCutFaces(split->inside, cells, params, focus, onPlane);
     }
-    t1.set(res, &FractureTimings::massMs);
+    st.sincePieces(&FractureTimings::massMs);
     const double minVolume = std::max(0.0, params.minPieceVolumeFraction) * inputVolume;
     const VolumeIntegrals* whole = split->remainderIntegrals ? &*split->remainderIntegrals : nullptr;
     // Rough pieces are not simplified: its plane tolerance would treat the two sides of a cut differently.
     FractureParams finish = params;
     finish.simplifyPieces = params.simplifyPieces && !res.stats.rough;
-    addPieces(std::move(split->remainder), shells[0], -1, minVolume, finish.simplifyPieces, focus, whole, res,
+    addPieces(std::move(split->remainder), shells[0], -1, minVolume, finish.simplifyPieces, focus, whole, st,
               nullptr, wantTopology);
     return finishPieces(std::move(split->inside), shells, std::move(cells), finish, minVolume, focus,
-                        wantTopology, t0, t1, std::move(res));
+                        wantTopology, st);
 }
 
 /// simplifyPlanarRegions on the triangles around the cut only (the added ones and those sharing a corner
@@ -464,22 +499,20 @@ void simplifyAroundCut(Mesh& mesh, MeshTopology& topology, std::span<const std::
         rest.accumulate(report.integralsChange, 1.0);
 }
 
-/// runPipeline on a mesh with its topology, edited in place (docs/megamesh.md): the split's remainder is an
-/// edit, checked around the cut and then applied; its islands are found by a walk around the cut, with the
-/// full labelling as the fallback. A split that fails leaves mesh and topology as they were (a failed edit
-/// is redone by Corefine on the intact mesh when exactRedo is set); on success the mesh is consumed.
-Result<FractureResult> runInPlace(Mesh& mesh, HeldTopology& held, std::vector<ConvexPolytope> cells,
-                                  const FractureParams& params, const BooleanBackend& backend, bool exactRedo,
-                                  double inputVolume) {
-    const auto* editing = dynamic_cast<const detail::EditingBackend*>(&backend);
-    if (!editing || !held.fits(mesh))
-        return runPipeline(mesh, std::move(cells), params, backend, exactRedo, inputVolume, true);
+/// runPipeline on a mesh with its topology (held fits mesh; backend is an EditingBackend), edited in place
+/// (docs/megamesh.md): the split's remainder is an edit, checked around the cut and then applied; its islands
+/// are found by a walk around the cut, with the full labelling as the fallback. A split that fails leaves
+/// mesh and topology as they were (a failed edit is redone by Corefine on the intact mesh when exactRedo is
+/// set); on success the mesh is consumed.
+Status runInPlace(Stages& st, Mesh& mesh, HeldTopology& held, std::vector<ConvexPolytope> cells,
+                  const FractureParams& params, const BooleanBackend& backend, bool exactRedo,
+                  double inputVolume) {
+    const auto* editing = &dynamic_cast<const detail::EditingBackend&>(backend);
     MeshTopology& topology = *held.get();
-    const Stopwatch t0;
-    FractureResult res;
+    FractureResult& res = st.res;
     Aabb meshBox;
-    if (Status s = startPipeline(mesh, cells, inputVolume, res, meshBox); !s)
-        return s.error();
+    if (Status s = startPipeline(mesh, cells, inputVolume, st, meshBox); !s)
+        return s;
     const std::size_t nT = mesh.triangles.size();
 
     auto split = editing->splitAsEdit(mesh, cells, meshBox);
@@ -491,13 +524,14 @@ Result<FractureResult> runInPlace(Mesh& mesh, HeldTopology& held, std::vector<Co
     // Rough pieces are not simplified (as in runPipeline).
     FractureParams finish = params;
     finish.simplifyPieces = params.simplifyPieces && !res.stats.rough;
-    const Stopwatch tv;
     std::vector<detail::OutputShells> shells;
     std::optional<std::vector<std::uint32_t>> slots;
-    bool remainderEmpty = false;
-    if (split) {
+    bool cutNothing = false;
+    st.time(&FractureTimings::verifyMs, [&] {
+        if (!split)
+            return;
         detail::RemainderEdit& edit = split->remainder;
-        remainderEmpty = edit.removed.size() == nT && edit.added.triangles.empty();
+        const bool remainderEmpty = edit.removed.size() == nT && edit.added.triangles.empty();
         const double rest = remainderEmpty ? 0.0 : split->remainderIntegrals.volume;
         SplitResult debris;
         debris.inside = std::move(split->inside);
@@ -505,8 +539,10 @@ Result<FractureResult> runInPlace(Mesh& mesh, HeldTopology& held, std::vector<Co
             bool hit = false;
             for (const Mesh& m : debris.inside)
                 hit |= !m.empty();
-            if (!hit)
-                return cellsCutNothing();
+            if (!hit) {
+                cutNothing = true;
+                return;
+            }
             const bool noUvs = mesh.uvs.empty(), noMaterials = mesh.materials.empty();
             // The layout every split output has, with room for the edit (as the caller's copy has).
             const std::size_t room = std::max(nT, mesh.triangles.capacity());
@@ -526,8 +562,9 @@ Result<FractureResult> runInPlace(Mesh& mesh, HeldTopology& held, std::vector<Co
                 mesh.materials.clear();
         }
         split->inside = std::move(debris.inside);
-    }
-    tv.set(res, &FractureTimings::verifyMs);
+    });
+    if (cutNothing)
+        return cellsCutNothing();
     if (!slots) {
         if (!exactRedo)
             return split ? makeError(ErrorCode::GeometryFailure,
@@ -535,19 +572,20 @@ Result<FractureResult> runInPlace(Mesh& mesh, HeldTopology& held, std::vector<Co
                                          " backend's split is not closed around the cut or does not conserve "
                                          "volume")
                          : split.error();
-        auto r = runPipeline(mesh, std::move(cells), params, *detail::makeCorefineBackend(), false,
-                             inputVolume, true);
-        if (r) {
-            r->stats.exactFallback = true;
-            r->stats.timings.verifyMs += res.stats.timings.verifyMs;
-            r->stats.cpuTimings.verifyMs += res.stats.cpuTimings.verifyMs;
-        }
-        return r;
+        const double verifyMs = res.stats.timings.verifyMs, verifyCpuMs = res.stats.cpuTimings.verifyMs;
+        if (Status s = runPipeline(st, mesh, std::move(cells), params, *detail::makeCorefineBackend(), false,
+                                   inputVolume, true);
+            !s)
+            return s;
+        res.stats.exactFallback = true;
+        res.stats.timings.verifyMs += verifyMs;
+        res.stats.cpuTimings.verifyMs += verifyCpuMs;
+        return {};
     }
     res.stats.editedInPlace = true;
-    t0.set(res, &FractureTimings::booleanMs);
+    st.sinceSplit(&FractureTimings::booleanMs);
 
-    const Stopwatch t1;
+    st.startPieces();
     const Aabb focus = cutFocus(cells, meshBox);
     if (!res.stats.rough) { // roughenEdit gave the rough faces theirs
         finishCutFaces(mesh, cells, params.uvScale, focus, onPlane, &*slots);
@@ -594,48 +632,159 @@ Result<FractureResult> runInPlace(Mesh& mesh, HeldTopology& held, std::vector<Co
         rest.count = static_cast<std::size_t>(count);
         one = count == 1;
     }
-    t1.set(res, &FractureTimings::massMs);
-    if (one && finish.simplifyPieces) {
-        const Stopwatch ts;
-        simplifyAroundCut(mesh, topology, *slots, focus, meshBox.diagonal(), restIntegrals);
-        ts.add(res, &FractureTimings::simplifyMs);
-    }
+    st.sincePieces(&FractureTimings::massMs);
+    if (one && finish.simplifyPieces)
+        st.time(&FractureTimings::simplifyMs,
+                [&] { simplifyAroundCut(mesh, topology, *slots, focus, meshBox.diagonal(), restIntegrals); });
     const double minVolume = std::max(0.0, params.minPieceVolumeFraction) * inputVolume;
-    addPieces(std::move(mesh), rest, -1, minVolume, finish.simplifyPieces && !one, focus, &restIntegrals, res,
+    addPieces(std::move(mesh), rest, -1, minVolume, finish.simplifyPieces && !one, focus, &restIntegrals, st,
               one ? &topology : nullptr, true);
     for (Mesh& chip : chips) // measured: they are small
         addPieces(std::move(chip), detail::OutputShells{{}, 1}, -1, minVolume, finish.simplifyPieces, focus,
-                  nullptr, res, nullptr, true);
+                  nullptr, st, nullptr, true);
     const InsideInPlace debris{split->insideKept, meshBox.diagonal()};
     return finishPieces(std::move(split->inside), shells, std::move(cells), finish, minVolume, focus, true,
-                        t0, t1, std::move(res), &debris);
+                        st, &debris);
 }
 
-/// Runs a pipeline (runPipeline or runInPlace) after the input's validation, with its timings.
-template <class Run>
-Result<FractureResult> withValidation(const Mesh& mesh, const MeshFacts& known, const FractureParams& params,
-                                      Run run) {
-    const Stopwatch t0;
+/// Where one fracture cuts, decided once when it starts: the mesh as given, or, when the backend edits and
+/// the known facts hold the mesh's topology, the mesh edited in place: the caller's when it handed the mesh
+/// and its facts over, else a copy.
+class Place {
+public:
+    /// A fracture of mesh: copied to be edited in place.
+    Place(const Mesh& mesh, const MeshFacts& known, bool editing) : mesh_(&mesh), known_(&known) {
+        if (!editable(mesh, known, editing))
+            return;
+        copy_ = mesh;
+        copyFacts_ = known;
+        mesh_ = edit_ = &copy_;
+        known_ = &copyFacts_;
+        topology_ = &copyFacts_.topology;
+    }
+    /// A fracture of a mesh handed over with its facts: edited in place itself.
+    Place(Mesh& mesh, MeshFacts& known, bool editing) : mesh_(&mesh), known_(&known) {
+        if (editable(mesh, known, editing)) {
+            edit_ = &mesh;
+            topology_ = &known.topology;
+        }
+    }
+    Place(const Place&) = delete;
+    Place& operator=(const Place&) = delete;
+
+    /// The mesh cut.
+    const Mesh& mesh() const { return *mesh_; }
+    /// Its facts.
+    const MeshFacts& known() const { return *known_; }
+    /// Cuts the validated mesh by cells into st: runInPlace or runPipeline.
+    Status cut(Stages& st, std::vector<ConvexPolytope> cells, const FractureParams& params,
+               const BooleanBackend& backend, bool exactRedo, double volume) const {
+        if (edit_)
+            return runInPlace(st, *edit_, *topology_, std::move(cells), params, backend, exactRedo, volume);
+        return runPipeline(st, *mesh_, std::move(cells), params, backend, exactRedo, volume);
+    }
+
+private:
+    static bool editable(const Mesh& mesh, const MeshFacts& known, bool editing) {
+        return editing && known.fit(mesh) && known.topology.fits(mesh);
+    }
+
+    const Mesh* mesh_;
+    const MeshFacts* known_;
+    Mesh* edit_ = nullptr;
+    HeldTopology* topology_ = nullptr;
+    Mesh copy_;
+    MeshFacts copyFacts_;
+};
+
+/// Cuts place by given cells after the input's validation, with its timings.
+Result<FractureResult> cutWithCells(const Place& place, std::vector<ConvexPolytope> cells,
+                                    const FractureParams& params, const BooleanBackend& backend,
+                                    bool exactRedo) {
+    Stages st;
     if (Status s = validateRoughness(params.roughness); !s)
         return makeError(ErrorCode::InvalidInput, "fracture: " + s.message());
     double volume = 0;
     const VolumeIntegrals* integrals = nullptr;
-    if (Status s = prepareInput(mesh, known, volume, integrals); !s)
+    if (Status s = prepareInput(place.mesh(), place.known(), volume, integrals); !s)
         return s.error();
-    FractureResult pre; // the stages before the pipeline
-    t0.set(pre, &FractureTimings::validateMs);
-    auto r = run(volume);
-    if (r) {
-        r->stats.timings.validateMs = pre.stats.timings.validateMs;
-        r->stats.cpuTimings.validateMs = pre.stats.cpuTimings.validateMs;
-        t0.set(*r, &FractureTimings::totalMs);
-    }
-    return r;
+    st.sinceStart(&FractureTimings::validateMs);
+    if (Status s = place.cut(st, std::move(cells), params, backend, exactRedo, volume); !s)
+        return s.error();
+    st.sinceStart(&FractureTimings::totalMs);
+    return std::move(st.res);
 }
 
-/// True when mesh is fractured in place: known facts with a topology, the Fast backend.
-bool inPlace(const Mesh& mesh, const MeshFacts& known, const FractureParams& params) {
-    return params.backend == BooleanKind::Fast && known.fit(mesh) && known.topology.fits(mesh);
+/// The backend of params, given the input's integrals when they are known (Fast uses them).
+std::unique_ptr<BooleanBackend> backendFor(BooleanKind kind, bool exactFallback,
+                                           const VolumeIntegrals* integrals) {
+    if (kind == BooleanKind::Fast)
+        return detail::makeFastBackend(exactFallback, integrals);
+    return makeBooleanBackend(kind);
+}
+
+/// fractureWithCells with params' backend.
+Result<FractureResult> cutWithCells(const Place& place, std::vector<ConvexPolytope> cells,
+                                    const FractureParams& params) {
+    const VolumeIntegrals* integrals = place.known().fit(place.mesh()) ? &place.known().integrals : nullptr;
+    return cutWithCells(place, std::move(cells), params, *backendFor(params.backend, true, integrals),
+                        params.backend == BooleanKind::Fast);
+}
+
+/// params with the fracture's seed mixed into the roughness seed (a rough surface per fracture).
+FractureParams seeded(const FractureParams& params, std::uint64_t seed) {
+    FractureParams p = params;
+    if (p.roughness.active())
+        p.roughness.seed = mixSeed(seed, p.roughness.seed);
+    return p;
+}
+
+/// fracture: cells from the seed (redrawn when Fast declines them), cut where place says.
+Result<FractureResult> cutAtImpact(const Place& place, const Impact& impact, const FractureParams& original,
+                                   std::uint64_t seed) {
+    const FractureParams params = seeded(original, seed);
+    Stages st;
+    if (Status s = validateRoughness(params.roughness); !s)
+        return makeError(ErrorCode::InvalidInput, "fracture: " + s.message());
+    double volume = 0;
+    const VolumeIntegrals* integrals = nullptr;
+    if (Status s = checkFractureParams(impact, params); !s)
+        return makeError(ErrorCode::InvalidInput, "fracture: " + s.message());
+    if (Status s = prepareInput(place.mesh(), place.known(), volume, integrals); !s)
+        return s.error();
+    st.sinceStart(&FractureTimings::validateMs);
+    auto cellsFor = [&](std::uint64_t s) {
+        std::vector<ConvexPolytope> cells;
+        st.time(&FractureTimings::cellMs,
+                [&] { cells = generateCells(place.mesh().bounds(), impact, params, s); });
+        return cells;
+    };
+    auto finish = [&](const Status& s, int redraws) -> Result<FractureResult> {
+        if (!s)
+            return s.error();
+        st.res.stats.redraws = redraws;
+        st.sinceStart(&FractureTimings::totalMs);
+        return std::move(st.res);
+    };
+    // The pattern is random: one the clipper declines as near-degenerate is redrawn (from derived seeds)
+    // before the exact fallback cuts the seed's own pattern.
+    constexpr int kRedraws = 2;
+    if (params.backend == BooleanKind::Fast)
+        for (int redraw = 0; redraw <= kRedraws; ++redraw) {
+            std::vector<ConvexPolytope> cells = cellsFor(redraw == 0 ? seed : mixSeed(seed, 0xDA7A + redraw));
+            if (cells.empty())
+                break;
+            const Status s = place.cut(st, std::move(cells), params,
+                                       *detail::makeFastBackend(false, integrals), false, volume);
+            if (s || s.error().code != ErrorCode::GeometryFailure)
+                return finish(s, redraw);
+        }
+    std::vector<ConvexPolytope> cells = cellsFor(seed);
+    if (cells.empty())
+        return makeError(ErrorCode::NoIntersection, "fracture: no cell could be built around the impact");
+    return finish(place.cut(st, std::move(cells), params, *backendFor(params.backend, true, integrals),
+                            params.backend == BooleanKind::Fast, volume),
+                  0);
 }
 
 } // namespace
@@ -645,23 +794,16 @@ namespace detail {
 Result<FractureResult> fractureWithBackend(const Mesh& mesh, std::vector<ConvexPolytope> cells,
                                            const FractureParams& params, const BooleanBackend& backend,
                                            bool exactRedo, const MeshFacts& known) {
-    if (known.fit(mesh) && known.topology.fits(mesh) && dynamic_cast<const EditingBackend*>(&backend)) {
-        Mesh copy = mesh;
-        MeshFacts facts = known;
-        return fractureInPlaceWithBackend(copy, facts, std::move(cells), params, backend, exactRedo);
-    }
-    return withValidation(mesh, known, params, [&](double volume) {
-        return runPipeline(mesh, std::move(cells), params, backend, exactRedo, volume);
-    });
+    const Place place(mesh, known, dynamic_cast<const EditingBackend*>(&backend) != nullptr);
+    return cutWithCells(place, std::move(cells), params, backend, exactRedo);
 }
 
 Result<FractureResult> fractureInPlaceWithBackend(Mesh& mesh, MeshFacts& known,
                                                   std::vector<ConvexPolytope> cells,
                                                   const FractureParams& params, const BooleanBackend& backend,
                                                   bool exactRedo) {
-    return withValidation(mesh, known, params, [&](double volume) {
-        return runInPlace(mesh, known.topology, std::move(cells), params, backend, exactRedo, volume);
-    });
+    const Place place(mesh, known, dynamic_cast<const EditingBackend*>(&backend) != nullptr);
+    return cutWithCells(place, std::move(cells), params, backend, exactRedo);
 }
 
 } // namespace detail
@@ -677,124 +819,24 @@ Result<MeshFacts> analyzeMesh(const Mesh& mesh) {
     return facts;
 }
 
-namespace {
-
-/// The backend of params, given the input's integrals when they are known (Fast uses them).
-std::unique_ptr<BooleanBackend> backendFor(BooleanKind kind, bool exactFallback,
-                                           const VolumeIntegrals* integrals) {
-    if (kind == BooleanKind::Fast)
-        return detail::makeFastBackend(exactFallback, integrals);
-    return makeBooleanBackend(kind);
-}
-
-/// fracture: cells from the seed (redrawn when Fast declines them), then run(cells, backend, exactRedo,
-/// volume), which is runPipeline or runInPlace.
-template <class Run>
-Result<FractureResult> fractureBy(const Mesh& mesh, const Impact& impact, const FractureParams& params,
-                                  std::uint64_t seed, const MeshFacts& known, Run run) {
-    const Stopwatch t0;
-    if (Status s = validateRoughness(params.roughness); !s)
-        return makeError(ErrorCode::InvalidInput, "fracture: " + s.message());
-    double volume = 0;
-    const VolumeIntegrals* integrals = nullptr;
-    if (Status s = checkFractureParams(impact, params); !s)
-        return makeError(ErrorCode::InvalidInput, "fracture: " + s.message());
-    if (Status s = prepareInput(mesh, known, volume, integrals); !s)
-        return s.error();
-    FractureResult pre; // the stages before the pipeline
-    t0.set(pre, &FractureTimings::validateMs);
-    auto cellsFor = [&](std::uint64_t s) {
-        const Stopwatch tc;
-        std::vector<ConvexPolytope> cells = generateCells(mesh.bounds(), impact, params, s);
-        tc.add(pre, &FractureTimings::cellMs);
-        return cells;
-    };
-    auto finish = [&](Result<FractureResult> r, int redraws) {
-        if (r) {
-            r->stats.redraws = redraws;
-            for (auto [to, from] : {std::pair{&r->stats.timings, &pre.stats.timings},
-                                    {&r->stats.cpuTimings, &pre.stats.cpuTimings}}) {
-                to->validateMs = from->validateMs;
-                to->cellMs = from->cellMs;
-            }
-            t0.set(*r, &FractureTimings::totalMs);
-        }
-        return r;
-    };
-    // The pattern is random: one the clipper declines as near-degenerate is redrawn (from derived seeds)
-    // before the exact fallback cuts the seed's own pattern.
-    constexpr int kRedraws = 2;
-    if (params.backend == BooleanKind::Fast)
-        for (int redraw = 0; redraw <= kRedraws; ++redraw) {
-            std::vector<ConvexPolytope> cells = cellsFor(redraw == 0 ? seed : mixSeed(seed, 0xDA7A + redraw));
-            if (cells.empty())
-                break;
-            auto r = run(std::move(cells), *detail::makeFastBackend(false, integrals), false, volume);
-            if (r || r.error().code != ErrorCode::GeometryFailure)
-                return finish(std::move(r), redraw);
-        }
-    std::vector<ConvexPolytope> cells = cellsFor(seed);
-    if (cells.empty())
-        return makeError(ErrorCode::NoIntersection, "fracture: no cell could be built around the impact");
-    return finish(run(std::move(cells), *backendFor(params.backend, true, integrals),
-                      params.backend == BooleanKind::Fast, volume),
-                  0);
-}
-
-} // namespace
-
 Result<FractureResult> fractureWithCells(const Mesh& mesh, std::vector<ConvexPolytope> cells,
                                          const FractureParams& params, const MeshFacts& known) {
-    if (inPlace(mesh, known, params))
-        return fractureWithCells(Mesh(mesh), std::move(cells), params, MeshFacts(known));
-    const VolumeIntegrals* integrals = known.fit(mesh) ? &known.integrals : nullptr;
-    return detail::fractureWithBackend(mesh, std::move(cells), params,
-                                       *backendFor(params.backend, true, integrals),
-                                       params.backend == BooleanKind::Fast, known);
+    return cutWithCells(Place(mesh, known, params.backend == BooleanKind::Fast), std::move(cells), params);
 }
 
 Result<FractureResult> fractureWithCells(Mesh&& mesh, std::vector<ConvexPolytope> cells,
                                          const FractureParams& params, MeshFacts known) {
-    if (!inPlace(mesh, known, params))
-        return fractureWithCells(std::as_const(mesh), std::move(cells), params, known);
-    const auto backend = detail::makeFastBackend(true, &known.integrals);
-    return detail::fractureInPlaceWithBackend(mesh, known, std::move(cells), params, *backend, true);
+    return cutWithCells(Place(mesh, known, params.backend == BooleanKind::Fast), std::move(cells), params);
 }
-
-namespace {
-
-/// params with the fracture's seed mixed into the roughness seed (a rough surface per fracture).
-FractureParams seeded(const FractureParams& params, std::uint64_t seed) {
-    FractureParams p = params;
-    if (p.roughness.active())
-        p.roughness.seed = mixSeed(seed, p.roughness.seed);
-    return p;
-}
-
-} // namespace
 
 Result<FractureResult> fracture(const Mesh& mesh, const Impact& impact, const FractureParams& params,
                                 std::uint64_t seed, const MeshFacts& known) {
-    if (inPlace(mesh, known, params))
-        return fracture(Mesh(mesh), impact, params, seed, MeshFacts(known));
-    const FractureParams p = seeded(params, seed);
-    return fractureBy(
-        mesh, impact, p, seed, known,
-        [&](std::vector<ConvexPolytope> cells, const BooleanBackend& backend, bool exactRedo, double volume) {
-            return runPipeline(mesh, std::move(cells), p, backend, exactRedo, volume);
-        });
+    return cutAtImpact(Place(mesh, known, params.backend == BooleanKind::Fast), impact, params, seed);
 }
 
 Result<FractureResult> fracture(Mesh&& mesh, const Impact& impact, const FractureParams& params,
                                 std::uint64_t seed, MeshFacts known) {
-    if (!inPlace(mesh, known, params))
-        return fracture(std::as_const(mesh), impact, params, seed, known);
-    const FractureParams p = seeded(params, seed);
-    return fractureBy(
-        mesh, impact, p, seed, known,
-        [&](std::vector<ConvexPolytope> cells, const BooleanBackend& backend, bool exactRedo, double volume) {
-            return runInPlace(mesh, known.topology, std::move(cells), p, backend, exactRedo, volume);
-        });
+    return cutAtImpact(Place(mesh, known, params.backend == BooleanKind::Fast), impact, params, seed);
 }
 
 } // namespace rubble

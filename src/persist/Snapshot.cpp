@@ -14,6 +14,7 @@
 #include "persist/RoughnessRecord.hpp"
 #include "rubble/fracture/Roughness.hpp"
 #include "rubble/persist/JournalFile.hpp"
+#include "rubble/structure/Material.hpp"
 
 namespace rubble {
 namespace {

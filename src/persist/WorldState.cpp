@@ -39,14 +39,26 @@ WorldState captureState(const DestructionWorld& world) {
     return w;
 }
 
+namespace {
+
+// The world settings a state carries, written into c.
+void applySettings(const WorldState& w, DestructionWorld::Config& c) {
+    c.seed = w.seed;
+    c.delayFrames = w.delayFrames;
+    c.crumbleTriangles = static_cast<std::size_t>(w.crumbleTriangles);
+    c.crumbleCells = w.crumbleCells;
+    c.minPieceVolume = w.minPieceVolume;
+    c.decomposition = w.decomposition;
+}
+
+} // namespace
+
 Status restoreState(DestructionWorld& world, WorldState w) {
     auto bad = [](const std::string& what) { return Error{ErrorCode::InvalidInput, "world state: " + what}; };
-    if (w.delayFrames < 0 || w.crumbleCells < 0 || !(w.minPieceVolume >= 0 && w.minPieceVolume < 1e300))
-        return bad("settings out of range (delayFrames " + std::to_string(w.delayFrames) + ", crumbleCells " +
-                   std::to_string(w.crumbleCells) + ", minPieceVolume " + std::to_string(w.minPieceVolume) +
-                   ")");
-    if (const Status s = checkDecompositionParams(w.decomposition); !s)
-        return bad("decomposition settings out of range: " + s.message());
+    DestructionWorld::Config settings = StateAccess::config(world);
+    applySettings(w, settings);
+    if (const Status s = DestructionWorld::checkConfig(settings); !s)
+        return bad("settings out of range: " + s.message());
     ObjectId last = 0;
     std::map<ObjectId, std::uint32_t> versions;
     for (const ObjectState& o : w.objects) {
@@ -73,13 +85,7 @@ Status restoreState(DestructionWorld& world, WorldState w) {
     }
     // Consistent: replace everything. Jobs of the old state finish on their own; their results are dropped.
     StateAccess::replace(world, std::move(w.objects), w.frame, w.nextId, w.journalPosition);
-    DestructionWorld::Config& c = StateAccess::config(world);
-    c.seed = w.seed;
-    c.delayFrames = w.delayFrames;
-    c.crumbleTriangles = static_cast<std::size_t>(w.crumbleTriangles);
-    c.crumbleCells = w.crumbleCells;
-    c.minPieceVolume = w.minPieceVolume;
-    c.decomposition = w.decomposition;
+    StateAccess::config(world) = settings;
     for (const PendingWork& p : w.work) {
         detail::WorldWork work{p.object, p.version, p.inFlight, p.readyFrame, {}};
         for (std::size_t i = 0; i < p.impacts.size(); ++i)

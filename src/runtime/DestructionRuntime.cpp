@@ -10,6 +10,7 @@
 #include <tuple>
 
 #include "geometry/MeshTopology.hpp"
+#include "rubble/structure/Material.hpp"
 #include "runtime/BodyTable.hpp"
 #include "runtime/DebrisGovernor.hpp"
 #include "runtime/DebrisPool.hpp"
@@ -559,8 +560,24 @@ PhysicsBinding& DestructionRuntime::binding() {
     return impl_->binding;
 }
 
-DestructionRuntime::Config& DestructionRuntime::config() {
+const DestructionRuntime::Config& DestructionRuntime::config() const {
     return impl_->config;
+}
+
+void DestructionRuntime::setImpactPolicy(const ImpactPolicy& policy) {
+    impl_->config.impacts = policy;
+}
+
+void DestructionRuntime::setAdoptionPolicy(const AdoptionPolicy& policy) {
+    impl_->config.adoption = policy;
+}
+
+void DestructionRuntime::setSupportPolicy(const SupportPolicy& policy) {
+    impl_->config.support = policy;
+}
+
+void DestructionRuntime::setDebrisBudget(const DebrisBudget& budget) {
+    impl_->config.debris = budget;
 }
 
 BodyId DestructionRuntime::addGround(const Vec3& center, const Vec3& halfExtents) {

@@ -310,12 +310,11 @@ struct DestructionWorld::Impl {
     std::uint64_t recordsErased = 0; // records dropped from the front of `timings` (sequence numbers stay)
     // A split handed out by collect() and not committed yet: its parent stays until commit() replaces it.
     struct OpenSplit {
-        std::uint32_t version = 0;                        // the parent's version
-        std::vector<AdoptedPiece> pieces;                 // as handed out
-        std::vector<std::shared_ptr<ObjectState>> states; // the pieces' states (hashed when read)
-        std::vector<MeshFacts> facts;                     // analyzeMesh of each piece's mesh
-        std::uint64_t record = 0;                         // sequence number of its TimingRecord
-        Clock::time_point recordEnd;                      // where that record's adoption ends so far
+        std::uint32_t version = 0;        // the parent's version
+        std::vector<AdoptedPiece> pieces; // as handed out (their states become the objects)
+        std::vector<MeshFacts> facts;     // analyzeMesh of each piece's mesh
+        std::uint64_t record = 0;         // sequence number of its TimingRecord
+        Clock::time_point recordEnd;      // where that record's adoption ends so far
     };
     std::map<ObjectId, OpenSplit> open; // by parent
     std::function<void(const JournalEvent&)> journalSink;
@@ -485,8 +484,7 @@ struct DestructionWorld::Impl {
             st->crumbleAbove = parent.crumbleAbove;
             st->convexParts = std::move(job.localParts[i]);
             st->meshHash = job.meshHashes[i];
-            o.pieces.push_back({st->id, job.frames[i], cell, st});
-            s.states.push_back(std::move(st));
+            o.pieces.push_back({st->id, job.frames[i], cell, std::move(st)});
             s.facts.push_back(std::move(job.localFacts[i]));
         }
         s.pieces = o.pieces;
@@ -895,9 +893,9 @@ void DestructionWorld::commit(const FractureOutcome& split) {
     Impl::OpenSplit s = std::move(o->second);
     im.open.erase(o);
     im.eraseObject(im.objects.find(split.parent));
-    for (std::size_t i = 0; i < s.states.size(); ++i) {
-        im.facts[s.states[i]->id] = std::move(s.facts[i]);
-        im.insertObject(std::move(s.states[i]));
+    for (std::size_t i = 0; i < s.pieces.size(); ++i) {
+        im.facts[s.pieces[i].id] = std::move(s.facts[i]);
+        im.insertObject(s.pieces[i].state);
     }
     std::vector<PendingImpact> later;
     if (auto w = im.waiting.find(split.parent); w != im.waiting.end()) {

@@ -6,6 +6,9 @@
 #include <vector>
 
 #include "rubble/runtime/DestructionRuntime.hpp"
+#include "rubble/structure/BondGraph.hpp"
+#include "rubble/structure/Material.hpp"
+#include "rubble/structure/StressSolver.hpp"
 
 namespace rubble::detail {
 

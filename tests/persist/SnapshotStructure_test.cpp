@@ -13,6 +13,7 @@
 #include "persist/Bytes.hpp"
 #include "persist/RoughnessRecord.hpp"
 #include "rubble/persist/Snapshot.hpp"
+#include "rubble/structure/Material.hpp"
 
 namespace rubble {
 namespace {

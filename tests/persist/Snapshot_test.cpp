@@ -229,7 +229,9 @@ TEST(Snapshot, KeepsDecompositionSettingsMeshHashesAndTheVolumeLedger) {
     broken.world.decomposition.maxParts = 0;
     Status st = restoreSnapshot(other.runtime, broken);
     EXPECT_FALSE(st);
-    EXPECT_NE(st.message().find("decomposition settings out of range"), std::string::npos) << st.message();
+    EXPECT_NE(st.message().find("settings out of range: world config: decomposition: maxParts 0"),
+              std::string::npos)
+        << st.message();
     broken = s;
     broken.volumes.dust = -1;
     st = restoreSnapshot(other.runtime, broken);
@@ -425,7 +427,8 @@ TEST(Snapshot, DamagedFilesAreRefusedNamingOffsetAndFieldAndTheWorldStaysAsItWas
     broken.world.delayFrames = -1;
     Status s = restoreSnapshot(world, broken);
     EXPECT_FALSE(s);
-    EXPECT_NE(s.message().find("settings out of range"), std::string::npos) << s.message();
+    EXPECT_NE(s.message().find("settings out of range: world config: delayFrames -1"), std::string::npos)
+        << s.message();
     broken = m.snapshot;
     broken.world.work.push_back({12345, 0, true, 0, {Impact{}}, {0}});
     s = restoreSnapshot(world, broken);

@@ -311,7 +311,9 @@ TEST(DestructionRuntime, TriangleBudgetAndFadingRetireDebris) {
     ASSERT_TRUE(rig.runtime.submitLocalImpact(box, Impact{{0, 1, 0}, {0, 1, 0}, 50}));
     ASSERT_GE(rig.breakAndWait(box).size(), 4u);
     const std::size_t before = rig.runtime.debrisTriangles();
-    rig.runtime.config().debris.maxTriangles = before / 2;
+    DebrisBudget budget = rig.runtime.config().debris;
+    budget.maxTriangles = before / 2;
+    rig.runtime.setDebrisBudget(budget);
     rig.step(1);
     EXPECT_LE(rig.runtime.debrisTriangles(), before / 2);
     EXPECT_GT(rig.runtime.debrisTriangles(), 0u);
@@ -338,6 +340,28 @@ TEST(DestructionRuntime, TriangleBudgetAndFadingRetireDebris) {
     EXPECT_NE(far.runtime.bodyOf(farObject), nullptr) << "the game's own objects never fade";
     EXPECT_GT(far.runtime.counters().retired.faded, 0);
     EXPECT_EQ(far.runtime.counters().retired.faded, far.runtime.counters().piecesRetired);
+}
+
+// Policies set between frames govern what follows: impact marks kept, and a static object's remainder.
+TEST(DestructionRuntime, PoliciesSetBetweenFramesGovernWhatFollows) {
+    ToyRig rig;
+    const ObjectId box = rig.addBox({1, 1, 1}, {0, 1, 0}, true, cubeCell(1.2));
+    const ObjectId other = rig.addBox({1, 1, 1}, {5, 1, 0}, true, cubeCell(1.2));
+    rig.step(1);
+    ImpactPolicy impacts = rig.runtime.config().impacts;
+    impacts.maxImpactMarks = 1;
+    rig.runtime.setImpactPolicy(impacts);
+    AdoptionPolicy adoption = rig.runtime.config().adoption;
+    adoption.keepStaticRemainder = false;
+    rig.runtime.setAdoptionPolicy(adoption);
+    EXPECT_EQ(rig.runtime.config().impacts.maxImpactMarks, 1);
+    ASSERT_TRUE(rig.runtime.submitLocalImpact(other, Impact{{1, 0, 0}, {1, 0, 0}, 50}));
+    ASSERT_TRUE(rig.runtime.submitLocalImpact(box, Impact{{1, 0, 0}, {1, 0, 0}, 50}));
+    EXPECT_EQ(rig.runtime.recentImpacts().size(), 1u);
+    const std::vector<AdoptedPiece> pieces = rig.breakAndWait(box);
+    ASSERT_GE(pieces.size(), 2u);
+    for (const AdoptedPiece& p : pieces)
+        EXPECT_EQ(rig.motionOf(p.id), BodyMotionState::Dynamic) << "piece " << p.id << " of cell " << p.cell;
 }
 
 TEST(DestructionRuntime, VolumeAccountingIsExactWithDustParticlesAndRetirement) {

@@ -14,8 +14,7 @@
 #include "rubble/core/Export.hpp"
 #include "rubble/runtime/DestructionWorld.hpp"
 #include "rubble/runtime/PhysicsBinding.hpp"
-#include "rubble/structure/BondGraph.hpp"
-#include "rubble/structure/StressSolver.hpp"
+#include "rubble/structure/StructureSettings.hpp"
 
 namespace rubble {
 
@@ -293,8 +292,17 @@ public:
     const DestructionWorld& world() const;
     /// The engine.
     PhysicsBinding& binding();
-    /// The settings (may be changed between frames; Config::world only at construction).
-    Config& config();
+    /// The settings: Config::world, Config::structure and the projectile lifetimes as constructed, the rest
+    /// as last set.
+    const Config& config() const;
+    /// Contacts → impacts from the next frame on.
+    void setImpactPolicy(const ImpactPolicy& policy);
+    /// Outcomes → piece bodies from the next adoption on.
+    void setAdoptionPolicy(const AdoptionPolicy& policy);
+    /// Support and collapse from the next frame on.
+    void setSupportPolicy(const SupportPolicy& policy);
+    /// The debris governor's budgets from the next frame on.
+    void setDebrisBudget(const DebrisBudget& budget);
 
     /// A static ground box centred at center (a root of support).
     BodyId addGround(const Vec3& center, const Vec3& halfExtents);

@@ -9,9 +9,9 @@
 
 #include "rubble/core/Aabb.hpp"
 #include "rubble/core/Export.hpp"
-
 #include "rubble/core/Vec3.hpp"
 #include "rubble/geometry/ConvexPolytope.hpp"
+#include "rubble/structure/StructureSettings.hpp"
 
 namespace rubble {
 
@@ -36,13 +36,6 @@ struct RUBBLE_API Bond {
     BondInterface section; ///< the shared interface, normal from a to b
     /// The node at the other end from node (one of a and b).
     std::uint32_t other(std::uint32_t node) const { return node == a ? b : a; }
-};
-
-/// How touching is decided.
-struct RUBBLE_API BondSettings {
-    double gap = 1e-3;         ///< faces at most this far apart (m) count as touching
-    double angleTolerance = 1; ///< faces within this angle (degrees) of anti-parallel count as coplanar
-    double minArea = 1e-6;     ///< patches below this area (m^2) make no bond
 };
 
 /// The interface between two solids given as convex parts (same coordinates): the overlap of their

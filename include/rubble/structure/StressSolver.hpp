@@ -13,6 +13,7 @@
 #include "rubble/geometry/ConvexPolytope.hpp"
 #include "rubble/structure/BondGraph.hpp"
 #include "rubble/structure/Material.hpp"
+#include "rubble/structure/StructureSettings.hpp"
 
 namespace rubble {
 
@@ -43,38 +44,6 @@ struct RUBBLE_API BondStress {
     double compression = 0; ///< largest compressive normal stress (axial plus bending)
     double tension = 0;     ///< largest tensile normal stress (axial plus bending)
     double shear = 0;       ///< mean transverse shear plus the largest torsional shear
-};
-
-/// How StressSolver::solve() iterates (docs/structure.md, "Convergence").
-enum class StressMethod {
-    SweepBudget,       ///< Gauss-Seidel over every bond, at most `iterations` sweeps (the default)
-    GaussSeidel,       ///< Gauss-Seidel over the bonds of the nodes not at rest, until `residual` is met
-    ConjugateGradient, ///< block-Jacobi preconditioned conjugate gradient on the welds, until `residual`
-    Direct ///< sparse Cholesky of the regularised bond system with an active set for bearings, then
-           ///< Gauss-Seidel until `residual` (friction limits, what bearings cannot hold)
-};
-
-/// Settings of the stress solver.
-struct RUBBLE_API StressSettings {
-    int iterations = 25;       ///< Gauss-Seidel sweeps over all bonds per solve(), at most
-    double tolerance = 0.01;   ///< m/s^2 (and rad/s^2), SweepBudget: fewer sweeps once every bonded node's
-                               ///< acceleration is below it; 0: always `iterations`
-    Vec3 gravity{0, -9.81, 0}; ///< m/s^2
-    double unbalanced = 0.5;   ///< m/s^2 (and rad/s^2): a node left accelerating this much is not held
-    int unbalancedSolves = 30; ///< ... after this many solves in a row (the warm-started solve converges)
-    StressMethod method = StressMethod::SweepBudget; ///< how solve() iterates (docs/structure.md)
-    double residual = 1e-3; ///< GaussSeidel, ConjugateGradient, Direct: the relative residual solve() reaches
-    int maxSweeps = 5000;   ///< ... sweeps at most (what bearings cannot hold never converges)
-    bool deadLoadGuess = false; ///< GaussSeidel, ConjugateGradient: a structure whose bonds carry nothing yet
-                                ///< starts from its dead load passed down (off: it biases which equilibrium
-                                ///< indeterminate contacts reach; docs/structure.md)
-    bool trace = false;         ///< record the relative residual after every sweep (history())
-    bool routeLoads = true;     ///< GaussSeidel, ConjugateGradient: a change of a node's load since the last
-                            ///< solve is first passed down the welds beneath it to the ground (a warm start)
-    double compliance = 1e-6; ///< Direct: each constraint's regularisation, relative to its effective mass
-    int stallSweeps = 64; ///< GaussSeidel, Direct: after this many sweeps, nodes on bearings the last solve
-                          ///< left unbalanced and still accelerating by `unbalanced` are left out (forces
-                          ///< kept); Direct also, every this many, those stuck outside `residual`; 0: never
 };
 
 /// A bond that broke in breakOverstressed() or damage(), with what it carried the moment it broke.
