@@ -88,10 +88,7 @@ double subsetVolume(const std::vector<Vec3>& points, std::size_t most) {
     subset.reserve(most);
     for (std::size_t i = 0; i < points.size(); i += stride)
         subset.push_back(points[i]);
-    if (subset.size() < 4)
-        return 0;
-    auto h = convexHull(subset);
-    return h ? h->volume() : 0;
+    return detail::hullVolume(subset);
 }
 
 /// Calls f(polygon, inner part, outer part) for each polygon with corners strictly on both sides of the

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <map>
 
+#include "geometry/PseudoAngle.hpp"
+
 namespace rubble {
 
 namespace {
@@ -161,7 +163,7 @@ ConvexPolytope ConvexPolytope::clipped(const Plane& plane, std::int32_t tag, dou
         const Vec3 v = cross(n, u);
         std::vector<std::pair<double, Vec3>> ordered;
         for (const Vec3& p : capPoints)
-            ordered.emplace_back(std::atan2(dot(p - center, v), dot(p - center, u)), p);
+            ordered.emplace_back(detail::pseudoAngle(dot(p - center, u), dot(p - center, v)), p);
         std::sort(ordered.begin(), ordered.end(),
                   [](const auto& x, const auto& y) { return x.first < y.first; });
         PolytopeFace cap;
