@@ -29,6 +29,7 @@
 #include "BenchUtil.hpp"
 #include "MegaMeshes.hpp"
 #include "Subcommand.hpp"
+#include "VoxelDecomposition.hpp"
 #include "rubble/collision/ConvexDecomposition.hpp"
 #include "rubble/collision/DecomposeControl.hpp"
 #include "rubble/collision/PartConcavity.hpp"
@@ -56,6 +57,7 @@ struct BenchArgs {
     bool quick = false;
     int runs = 15;
     std::string out = rubble::bench::resultsDir();
+    std::vector<std::string> methods; // --organic: only these methods (all when empty)
 };
 
 /// The Voronoi cell of `site` among 15 random sites in a cube of edge `size` around it.
@@ -220,6 +222,7 @@ struct Method {
     std::size_t proxyAbove = 20000; // DecompositionParams::proxyAboveTriangles
     std::size_t maxTriangles = std::numeric_limits<std::size_t>::max(); // larger meshes skip the method
     int maxParts = 24;                                                  // DecompositionParams::maxParts
+    bool voxel = false; // the voxel baseline (VoxelDecomposition.hpp)
 };
 
 /// An organic row's mesh: generated here, or a held-out file.
@@ -244,7 +247,7 @@ std::vector<fs::path> heldOutMeshes(const std::string& dir) {
     const std::vector<std::string> names = {"armadillo", "camel", "elephant", "dragon",
                                             "bunny",     "cow",   "homer"};
     const std::vector<std::string>& extensions = rubble::supportedMeshExtensions();
-    std::map<std::string, fs::path> found;
+    std::map<std::string, std::pair<std::string, fs::path>> found; // name -> (stem, file)
     for (const fs::path& root : roots) {
         std::vector<fs::path> files;
         for (auto it =
@@ -264,15 +267,35 @@ std::vector<fs::path> heldOutMeshes(const std::string& dir) {
                            [](unsigned char c) { return std::tolower(c); });
             if (std::find(extensions.begin(), extensions.end(), ext) == extensions.end())
                 continue;
+            // Per name, the file whose stem is the name, else the shortest stem holding it (CGAL's
+            // ChineseDragon-10kv; elephant before elephant-with-holes).
             for (const std::string& n : names)
-                if (stem.rfind(n, 0) == 0 && !found.count(n))
-                    found[n] = f;
+                if (stem.find(n) != std::string::npos) {
+                    auto it = found.find(n);
+                    if (it == found.end() || (it->second.first != n && stem.size() < it->second.first.size()))
+                        found[n] = {stem, f};
+                }
         }
     }
     std::vector<fs::path> out;
     for (const auto& [n, f] : found)
-        out.push_back(f);
+        out.push_back(f.second);
     return out;
+}
+
+/// The share of the mesh's vertices (every k-th, at most 2000) that lie in no part, beyond 1e-9 of the
+/// diagonal.
+double uncoveredShare(const rubble::Mesh& mesh, const std::vector<rubble::ConvexPolytope>& parts) {
+    const std::size_t stride = std::max<std::size_t>(1, mesh.positions.size() / 2000);
+    const double eps = 1e-9 * mesh.bounds().diagonal();
+    std::size_t sampled = 0, out = 0;
+    for (std::size_t v = 0; v < mesh.positions.size(); v += stride) {
+        ++sampled;
+        out += std::none_of(parts.begin(), parts.end(), [&](const rubble::ConvexPolytope& p) {
+            return p.contains(mesh.positions[v], eps);
+        });
+    }
+    return sampled ? static_cast<double>(out) / static_cast<double>(sampled) : 0;
 }
 
 int runOrganic(const BenchArgs& args, const std::string& heldOutDir) {
@@ -290,7 +313,9 @@ int runOrganic(const BenchArgs& args, const std::string& heldOutDir) {
         // The budget: at most 32 parts.
         {"rubble_32_parts", 1, false, rubble::DecompositionParams{}.proxyAboveTriangles,
          std::numeric_limits<std::size_t>::max(), 32},
-        {"rubble_exact_32_parts", 1, false, std::numeric_limits<std::size_t>::max(), 30000, 32}};
+        {"rubble_exact_32_parts", 1, false, std::numeric_limits<std::size_t>::max(), 30000, 32},
+        // A V-HACD-style voxel method written here, at the same budget (VoxelDecomposition.hpp).
+        {"voxel_32_parts", 1, false, 0, std::numeric_limits<std::size_t>::max(), 32, true}};
     std::vector<OrganicCase> cases;
     for (const std::string& kind : rubble::bench::kOrganicKinds)
         for (std::size_t size : sizes) {
@@ -315,17 +340,21 @@ int runOrganic(const BenchArgs& args, const std::string& heldOutDir) {
         }
     }
     const rubble::bench::CpuMeter cpu;
+    int status = 0;
     rubble::bench::Table table{
-        {"mesh", "tris", "method", "parts", "wall med ms", "cpu med ms", "excess", "concavity"}, {}};
+        {"mesh", "tris", "method", "parts", "wall med ms", "cpu med ms", "excess", "concavity", "uncovered"},
+        {}};
     rubble::bench::Table csv{{"mesh", "triangles", "method", "threads", "runs", "parts", "wall_median_ms",
                               "wall_min_ms", "wall_max_ms", "cpu_median_ms", "excess", "concavity",
-                              "other_cpu_cores"},
+                              "uncovered_vertices", "other_cpu_cores"},
                              {}};
     std::map<std::string, std::ostringstream> series; // kind + method -> "triangles cpu_ms concavity" lines
     for (const OrganicCase& oc : cases) {
         const rubble::Mesh& mesh = oc.mesh;
         for (const Method& m : methods) {
-            if (mesh.triangles.size() > m.maxTriangles)
+            if (mesh.triangles.size() > m.maxTriangles ||
+                (!args.methods.empty() &&
+                 std::find(args.methods.begin(), args.methods.end(), m.name) == args.methods.end()))
                 continue;
             std::optional<rubble::ThreadPool> pool;
             rubble::DecomposeControl control;
@@ -342,7 +371,18 @@ int runOrganic(const BenchArgs& args, const std::string& heldOutDir) {
             for (int r = 0; r < runs && !failed; ++r) {
                 const auto t0 = std::chrono::steady_clock::now();
                 const double c0 = cpuMs();
-                if (m.hullOnly) {
+                if (m.voxel) {
+                    rubble::bench::VoxelParams vp;
+                    vp.maxParts = m.maxParts;
+                    if (args.quick)
+                        vp.cells = 24; // the smoke run checks the method, not its resolution
+                    if (auto got = rubble::bench::voxelDecompose(mesh, vp)) {
+                        d = std::move(got.value());
+                    } else {
+                        std::cout << "(" << oc.name << ", " << m.name << ": " << got.error().message << ")\n";
+                        failed = true;
+                    }
+                } else if (m.hullOnly) {
                     d = {};
                     d.parts.push_back(rubble::convexHull(mesh.positions).value());
                     d.meshVolume = rubble::signedVolume(mesh);
@@ -360,13 +400,21 @@ int runOrganic(const BenchArgs& args, const std::string& heldOutDir) {
                 continue;
             const Stats w = rubble::bench::stats(wall), c = rubble::bench::stats(cpuTime);
             const double concavity = rubble::partConcavity(mesh, d.parts);
+            const double uncovered = uncoveredShare(mesh, d.parts);
+            // The voxel parts hold every solid voxel, and each vertex lies in one (a check of the baseline).
+            if (m.voxel && uncovered > 0) {
+                std::cout << "(" << oc.name << ", " << m.name << ": " << uncovered
+                          << " of the sampled vertices lie in no part)\n";
+                status = 1;
+            }
             table.rows.push_back({oc.name, std::to_string(mesh.triangles.size()), m.name,
                                   std::to_string(d.parts.size()), fixed(w.median), fixed(c.median),
-                                  fixed(d.excess(), 4), fixed(concavity, 4)});
+                                  fixed(d.excess(), 4), fixed(concavity, 4), fixed(uncovered, 4)});
             csv.rows.push_back({oc.name, std::to_string(mesh.triangles.size()), m.name,
                                 std::to_string(m.threads), std::to_string(runs),
                                 std::to_string(d.parts.size()), fixed(w.median), fixed(w.min), fixed(w.max),
-                                fixed(c.median), fixed(d.excess(), 5), fixed(concavity, 5), ""});
+                                fixed(c.median), fixed(d.excess(), 5), fixed(concavity, 5),
+                                fixed(uncovered, 5), ""});
             series[oc.series + " " + m.name] << mesh.triangles.size() << " " << c.median << " " << concavity
                                              << "\n";
         }
@@ -379,19 +427,28 @@ int runOrganic(const BenchArgs& args, const std::string& heldOutDir) {
               << " (the rest of the machine's busy cores during the run)\n";
     if (!rubble::bench::writeCsv(fs::path(args.out) / "decomposition_organic.csv", csv))
         return 1;
-    std::ostringstream data, plot;
-    plot << "set logscale xy\nset xlabel 'triangles'\nset ylabel 'CPU time, all threads (ms)'\nset grid\nset "
-            "key bottom right font ',8' noenhanced\nset title 'Organic meshes: decomposition time per method "
-            "(other cores busy: "
-         << other << ")'\nplot ";
+    // Two panels: CPU time and concavity against triangles, one line per mesh series and method.
+    std::ostringstream data, plot, lines;
     int block = 0;
-    for (auto& [label, lines] : series) {
-        data << lines.str() << "\n\n";
-        plot << (block ? ", " : "") << "$DATA index " << block << " u 1:2 w lp t '" << label << "'";
+    for (auto& [label, rows] : series) {
+        data << rows.str() << "\n\n";
+        lines << (block ? ", " : "") << "$DATA index " << block << " u 1:COLUMN w lp t '" << label << "'";
         ++block;
     }
+    auto panel = [&](int column) {
+        std::string s = lines.str();
+        for (std::size_t at; (at = s.find("COLUMN")) != std::string::npos;)
+            s.replace(at, 6, std::to_string(column));
+        return s;
+    };
+    plot << "set multiplot layout 1,2 title 'Organic meshes per method (other cores busy: " << other
+         << ")' noenhanced\nset logscale x\nset xlabel 'triangles'\nset grid\nset key bottom right font ',6' "
+            "noenhanced\nset logscale y\nset ylabel 'CPU time, all threads (ms)'\nplot "
+         << panel(2)
+         << "\nunset logscale y\nset ylabel 'concavity (Hausdorff, of the diagonal)'\nset key top "
+         << "right font ',6' noenhanced\nplot " << panel(3) << "\nunset multiplot\n";
     rubble::bench::plotPng(args.out, "decomposition_organic", data.str(), plot.str());
-    return 0;
+    return status;
 }
 
 const rubble::tools::Registrar registrar{
@@ -407,6 +464,8 @@ const rubble::tools::Registrar registrar{
              "--held-out", *heldOut,
              "folder of held-out meshes for the --organic rows (CGAL's armadillo, camel, elephant, "
              "dragon, bunny, cow, homer; default: ../shared and /usr/share/doc/libcgal*)");
+         app.add_option("--methods", args->methods,
+                        "--organic: only these methods (rubble, rubble_exact, voxel_32_parts, ...)");
          app.add_flag("--organic", *organic,
                       "only the organic rows (limbed blob and bumpy potato at 5k, 20k, 100k triangles; "
                       "decomposition_organic.csv/.png), Rubble beside the hull of the whole");

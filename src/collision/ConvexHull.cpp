@@ -16,6 +16,7 @@ extern "C" {
 }
 
 #include "collision/MeshRegion.hpp"
+#include "geometry/PseudoAngle.hpp"
 #include "rubble/collision/CollisionTolerance.hpp"
 #include "rubble/collision/ConvexDecomposition.hpp"
 
@@ -51,14 +52,39 @@ private:
     char* buffer_ = nullptr;
     std::size_t size_ = 0;
 };
-/// A number increasing with atan2(y, x) over (−π, π], in (−2, 2]: the corners sort as by angle, without
-/// atan2.
-double pseudoAngle(double x, double y) {
-    if (y == 0 && x <= 0)
-        return x == 0 ? 0 : (std::signbit(y) ? -2 : 2); // atan2 gives −π for −0 and π for +0
-    const double d = y / (std::abs(x) + std::abs(y)); // in [−1, 1], increasing with the angle on each side
-    return x >= 0 ? d : (y > 0 ? 2 - d : -2 - d);
-}
+
+/// One Qhull run over finite points, freed when destroyed. The options skip the final pass over every point
+/// for the outer planes (Q5) and the tracking of near-inside points (Q8): neither changes the facets.
+class QhullRun {
+public:
+    explicit QhullRun(const std::vector<Vec3>& points) {
+        coords_.reserve(points.size() * 3);
+        for (const Vec3& p : points)
+            coords_.insert(coords_.end(), {p.x, p.y, p.z});
+        FILE* err = errors_.file() ? errors_.file() : stderr;
+        qh_zero(&qh_, err);
+        char command[] = "qhull Pp Q5 Q8";
+        exitCode_ = qh_new_qhull(&qh_, 3, static_cast<int>(points.size()), coords_.data(), False, command,
+                                 nullptr, err);
+    }
+    ~QhullRun() {
+        qh_freeqhull(&qh_, !qh_ALL);
+        int curlong = 0, totlong = 0;
+        qh_memfreeshort(&qh_, &curlong, &totlong);
+    }
+    QhullRun(const QhullRun&) = delete;
+    QhullRun& operator=(const QhullRun&) = delete;
+
+    bool ok() const { return exitCode_ == 0; }
+    qhT* qh() { return &qh_; }
+    std::string errorText() { return errors_.text(); }
+
+private:
+    MessageStream errors_; // declared first: Qhull may write to it until the destructor's body ends
+    std::vector<coordT> coords_;
+    qhT qh_;
+    int exitCode_ = 0;
+};
 
 } // namespace
 
@@ -66,72 +92,67 @@ Result<ConvexPolytope> convexHull(const std::vector<Vec3>& points) {
     if (points.size() < 4)
         return makeError(ErrorCode::InvalidInput,
                          "convex hull needs at least 4 points, got " + std::to_string(points.size()));
-    std::vector<coordT> coords;
-    coords.reserve(points.size() * 3);
-    for (const Vec3& p : points) {
+    for (const Vec3& p : points)
         if (!isFinite(p))
             return makeError(ErrorCode::InvalidInput, "convex hull: non-finite point");
-        coords.insert(coords.end(), {p.x, p.y, p.z});
-    }
-    MessageStream errors;
-    FILE* err = errors.file() ? errors.file() : stderr;
-    qhT qhStorage;
-    qhT* qh = &qhStorage;
-    qh_zero(qh, err);
-    char command[] = "qhull Pp";
-    const int exitCode =
-        qh_new_qhull(qh, 3, static_cast<int>(points.size()), coords.data(), False, command, nullptr, err);
-    Result<ConvexPolytope> result = makeError(ErrorCode::GeometryFailure, "convex hull failed");
-    if (exitCode != 0) {
-        std::string msg = errors.text();
+    QhullRun run(points);
+    if (!run.ok()) {
+        std::string msg = run.errorText();
         const bool flat = msg.find("QH6154") != std::string::npos || msg.find("flat") != std::string::npos ||
                           msg.find("QH6214") != std::string::npos || msg.find("QH6271") != std::string::npos;
-        result = makeError(flat ? ErrorCode::InvalidInput : ErrorCode::GeometryFailure,
-                           std::string("convex hull: ") +
-                               (flat ? "points are coplanar or degenerate" : "Qhull failed") +
-                               (msg.empty() ? "" : " (" + msg + ")"));
-    } else {
-        std::vector<PolytopeFace> faces;
-        facetT* facet;
-        vertexT* vertex;
-        vertexT** vertexp;
-        FORALLfacets {
-            PolytopeFace f;
-            f.plane.normal = {facet->normal[0], facet->normal[1], facet->normal[2]};
-            f.plane.offset = -facet->offset;
-            Vec3 center;
-            FOREACHvertex_(facet->vertices) {
-                const Vec3 p{vertex->point[0], vertex->point[1], vertex->point[2]};
-                f.corners.push_back(p);
-                center += p;
-            }
-            if (f.corners.size() < 3)
-                continue;
-            center = center / static_cast<double>(f.corners.size());
-            const Vec3 n = f.plane.normal;
-            const Vec3 u =
-                normalized(std::abs(n.x) < 0.9 ? cross(n, Vec3{1, 0, 0}) : cross(n, Vec3{0, 1, 0}));
-            const Vec3 v = cross(n, u);
-            std::vector<std::pair<double, Vec3>> ordered;
-            ordered.reserve(f.corners.size());
-            for (const Vec3& p : f.corners)
-                ordered.emplace_back(pseudoAngle(dot(p - center, u), dot(p - center, v)), p);
-            std::sort(ordered.begin(), ordered.end(),
-                      [](const auto& a, const auto& b) { return a.first < b.first; });
-            for (std::size_t i = 0; i < ordered.size(); ++i)
-                f.corners[i] = ordered[i].second;
-            faces.push_back(std::move(f));
-        }
-        ConvexPolytope hull = ConvexPolytope::fromFaces(std::move(faces));
-        if (hull.empty() || !(hull.volume() > 0))
-            result = makeError(ErrorCode::InvalidInput, "convex hull: points are coplanar or degenerate");
-        else
-            result = std::move(hull);
+        return makeError(flat ? ErrorCode::InvalidInput : ErrorCode::GeometryFailure,
+                         std::string("convex hull: ") +
+                             (flat ? "points are coplanar or degenerate" : "Qhull failed") +
+                             (msg.empty() ? "" : " (" + msg + ")"));
     }
-    qh_freeqhull(qh, !qh_ALL);
-    int curlong = 0, totlong = 0;
-    qh_memfreeshort(qh, &curlong, &totlong);
-    return result;
+    qhT* qh = run.qh();
+    std::vector<PolytopeFace> faces;
+    facetT* facet;
+    vertexT* vertex;
+    vertexT** vertexp;
+    FORALLfacets {
+        PolytopeFace f;
+        f.plane.normal = {facet->normal[0], facet->normal[1], facet->normal[2]};
+        f.plane.offset = -facet->offset;
+        Vec3 center;
+        FOREACHvertex_(facet->vertices) {
+            const Vec3 p{vertex->point[0], vertex->point[1], vertex->point[2]};
+            f.corners.push_back(p);
+            center += p;
+        }
+        if (f.corners.size() < 3)
+            continue;
+        center = center / static_cast<double>(f.corners.size());
+        const Vec3 n = f.plane.normal;
+        const Vec3 u = normalized(std::abs(n.x) < 0.9 ? cross(n, Vec3{1, 0, 0}) : cross(n, Vec3{0, 1, 0}));
+        const Vec3 v = cross(n, u);
+        std::vector<std::pair<double, Vec3>> ordered;
+        ordered.reserve(f.corners.size());
+        for (const Vec3& p : f.corners)
+            ordered.emplace_back(detail::pseudoAngle(dot(p - center, u), dot(p - center, v)), p);
+        std::sort(ordered.begin(), ordered.end(),
+                  [](const auto& a, const auto& b) { return a.first < b.first; });
+        for (std::size_t i = 0; i < ordered.size(); ++i)
+            f.corners[i] = ordered[i].second;
+        faces.push_back(std::move(f));
+    }
+    ConvexPolytope hull = ConvexPolytope::fromFaces(std::move(faces));
+    if (hull.empty() || !(hull.volume() > 0))
+        return makeError(ErrorCode::InvalidInput, "convex hull: points are coplanar or degenerate");
+    return hull;
+}
+
+double detail::hullVolume(const std::vector<Vec3>& points) {
+    if (points.size() < 4)
+        return 0;
+    for (const Vec3& p : points)
+        if (!isFinite(p))
+            return 0;
+    QhullRun run(points);
+    if (!run.ok())
+        return 0;
+    qh_getarea(run.qh(), run.qh()->facet_list);
+    return run.qh()->totvol > 0 ? run.qh()->totvol : 0;
 }
 
 namespace {

@@ -88,10 +88,7 @@ double subsetVolume(const std::vector<Vec3>& points, std::size_t most) {
     subset.reserve(most);
     for (std::size_t i = 0; i < points.size(); i += stride)
         subset.push_back(points[i]);
-    if (subset.size() < 4)
-        return 0;
-    auto h = convexHull(subset);
-    return h ? h->volume() : 0;
+    return detail::hullVolume(subset);
 }
 
 /// Calls f(polygon, inner part, outer part) for each polygon with corners strictly on both sides of the
@@ -526,10 +523,11 @@ public:
     /// score: the volumes of the hulls, on each side, of the part's hull vertices there and the points where
     /// the surface crosses the plane (all of them points that the side's own hull holds; a side with too few
     /// or flat points counts 0).
-    std::array<double, 2> splitBound(const Part& part, const Plane& plane) const {
+    std::array<double, 2> splitBound(const Part& part, const std::vector<Vec3>& hullVertices,
+                                     const Plane& plane) const {
         std::vector<Vec3> in, out;
         const double tol = 1e-12 * std::max(diag_, 1e-300);
-        for (const Vec3& v : part.hull.vertices()) {
+        for (const Vec3& v : hullVertices) {
             const double d = plane.signedDistance(v);
             if (d < -tol)
                 in.push_back(v);
@@ -551,14 +549,16 @@ public:
 
     /// The split of part by a plane through its pocket with the least score (the first of equal scores), as
     /// evaluating every candidate would find it. Candidates are tried in the order of a lower bound of their
-    /// score, a batch at a time on the job system, and those whose bound already loses are skipped.
-    std::optional<Split> bestSplit(const Part& part, const std::vector<Vec3>& normals) {
+    /// score, a batch at a time on the job system, and those whose bound already loses are skipped
+    /// (hullVertices: part.hull.vertices()).
+    std::optional<Split> bestSplit(const Part& part, const std::vector<Vec3>& hullVertices,
+                                   const std::vector<Vec3>& normals) {
         const std::size_t n = normals.size();
         std::vector<double> bound(n, 0);
         std::vector<std::array<double, 2>> sides(n, {0, 0});
         parallelFor(n, [&](std::size_t i) {
             if (!stopped()) {
-                sides[i] = splitBound(part, Plane::fromPointNormal(part.pocket, normals[i]));
+                sides[i] = splitBound(part, hullVertices, Plane::fromPointNormal(part.pocket, normals[i]));
                 bound[i] = sides[i][0] + sides[i][1];
             }
         });
@@ -597,10 +597,9 @@ public:
         return chosen;
     }
 
-    std::vector<Vec3> candidateNormals(const Part& part) const {
+    std::vector<Vec3> candidateNormals(const Part& part, const std::vector<Vec3>& v) const {
         std::vector<Vec3> normals = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
         // Principal axes of the hull's vertices.
-        const std::vector<Vec3> v = part.hull.vertices();
         Vec3 mean;
         for (const Vec3& p : v)
             mean += p;
@@ -725,8 +724,9 @@ public:
             report(kSearchShare * std::max(static_cast<double>(parts.size()) / params_.maxParts,
                                            threshold / parts[best].depth));
             const Part& part = parts[best];
-            const std::vector<Vec3> normals = candidateNormals(part);
-            std::optional<Split> chosen = bestSplit(part, normals);
+            const std::vector<Vec3> hullVertices = part.hull.vertices();
+            const std::vector<Vec3> normals = candidateNormals(part, hullVertices);
+            std::optional<Split> chosen = bestSplit(part, hullVertices, normals);
             if (!chosen || chosen->score > part.hull.volume() * (1 + 1e-9)) {
                 done[best] = true;
                 continue;

@@ -53,6 +53,10 @@ constexpr std::size_t kMaxHullClips = 256;
 /// outside hull (or after kMaxHullClips planes); parts left empty are removed.
 void keepInsideHull(std::vector<ConvexPolytope>& parts, const ConvexPolytope& hull, double margin);
 
+/// The volume of the points' convex hull, computed by Qhull without building a polytope; 0 for fewer than 4,
+/// non-finite or flat points.
+double hullVolume(const std::vector<Vec3>& points);
+
 /// Hull of polygons' corners plus extra points.
 Result<ConvexPolytope> hullOfPolygons(const std::vector<Polygon>& polys, const std::vector<Vec3>& extra);
 

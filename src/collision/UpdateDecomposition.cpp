@@ -222,7 +222,8 @@ public:
         Overlaps out;
         const Aabb b = shape.bounds();
         for (std::size_t c = 0; c < cells_.size(); ++c) {
-            if (!(left_[c] < std::numeric_limits<double>::infinity()) || !b.overlaps(bounds_[c]))
+            if (!(left_[c] < std::numeric_limits<double>::infinity()) || !b.overlaps(bounds_[c]) ||
+                separated(shape, b, cells_[c], bounds_[c]))
                 continue;
             const double v = intersectCell(shape, cells_[c]).volume();
             if (v > 0)
@@ -256,6 +257,34 @@ public:
     }
 
 private:
+    /// True when a face plane of either polytope has the other's corners all beyond it by far more than the
+    /// clipping's tolerance: their intersection is empty, without clipping.
+    static bool separated(const ConvexPolytope& a, const Aabb& ab, const ConvexPolytope& b, const Aabb& bb) {
+        double scale = 1;
+        for (const Aabb* box : {&ab, &bb})
+            for (const Vec3& p : {box->lo, box->hi})
+                scale = std::max({scale, std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+        const double margin = 1e-6 * scale;
+        auto beyond = [margin](const ConvexPolytope& planes, const ConvexPolytope& points) {
+            for (const PolytopeFace& f : planes.faces()) {
+                bool all = true;
+                for (const PolytopeFace& g : points.faces()) {
+                    for (const Vec3& p : g.corners)
+                        if (!(f.plane.signedDistance(p) > margin)) {
+                            all = false;
+                            break;
+                        }
+                    if (!all)
+                        break;
+                }
+                if (all)
+                    return true;
+            }
+            return false;
+        };
+        return beyond(b, a) || beyond(a, b);
+    }
+
     const std::vector<ConvexPolytope>& cells_;
     const std::vector<Aabb>& bounds_;
     std::vector<double> left_;

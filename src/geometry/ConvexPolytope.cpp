@@ -4,6 +4,8 @@
 #include <cmath>
 #include <map>
 
+#include "geometry/PseudoAngle.hpp"
+
 namespace rubble {
 
 namespace {
@@ -120,12 +122,14 @@ ConvexPolytope ConvexPolytope::clipped(const Plane& plane, std::int32_t tag, dou
         return {};
 
     ConvexPolytope out;
+    out.faces_.reserve(faces_.size() + 1);
     std::vector<Vec3> capPoints;
     for (const auto& f : faces_) {
         PolytopeFace nf;
         nf.plane = f.plane;
         nf.tag = f.tag;
         const std::size_t n = f.corners.size();
+        nf.corners.reserve(n + 1);
         for (std::size_t i = 0; i < n; ++i) {
             const Vec3& a = f.corners[i];
             const Vec3& c = f.corners[(i + 1) % n];
@@ -160,13 +164,15 @@ ConvexPolytope ConvexPolytope::clipped(const Plane& plane, std::int32_t tag, dou
         const Vec3 u = normalized(std::abs(n.x) < 0.9 ? cross(n, Vec3{1, 0, 0}) : cross(n, Vec3{0, 1, 0}));
         const Vec3 v = cross(n, u);
         std::vector<std::pair<double, Vec3>> ordered;
+        ordered.reserve(capPoints.size());
         for (const Vec3& p : capPoints)
-            ordered.emplace_back(std::atan2(dot(p - center, v), dot(p - center, u)), p);
+            ordered.emplace_back(detail::pseudoAngle(dot(p - center, u), dot(p - center, v)), p);
         std::sort(ordered.begin(), ordered.end(),
                   [](const auto& x, const auto& y) { return x.first < y.first; });
         PolytopeFace cap;
         cap.plane = plane;
         cap.tag = tag;
+        cap.corners.reserve(ordered.size());
         for (const auto& [angle, p] : ordered)
             cap.corners.push_back(p);
         out.faces_.push_back(std::move(cap));

@@ -8,6 +8,7 @@
 #include <numeric>
 
 #include "TestSupport.hpp"
+#include "collision/MeshRegion.hpp"
 #include "rubble/collision/CollisionTolerance.hpp"
 #include "rubble/collision/ConvexDecomposition.hpp"
 #include "rubble/core/Random.hpp"
@@ -118,6 +119,29 @@ TEST(ConvexHull, DegenerateInputIsAnErrorNotACrash) {
     EXPECT_FALSE(convexHull(same));
     std::vector<Vec3> nan{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, std::nan("")}};
     EXPECT_FALSE(convexHull(nan));
+}
+
+// The volume the decomposition's lower bounds take from Qhull without a polytope: the hull's own.
+TEST(ConvexHull, VolumeWithoutAPolytopeIsTheHullsVolume) {
+    std::vector<Vec3> cube;
+    for (int i = 0; i < 8; ++i)
+        cube.push_back({double(i & 1) * 2, double((i >> 1) & 1) * 2, double((i >> 2) & 1) * 2});
+    cube.push_back({1, 1, 1}); // inside
+    cube.push_back({1, 1, 2}); // on a face
+    EXPECT_NEAR(detail::hullVolume(cube), 8.0, 1e-12);
+    Rng rng(11);
+    std::vector<Vec3> pts;
+    for (int i = 0; i < 300; ++i)
+        pts.push_back(rng.unitVector() * rng.uniform(0.5, 2.0) + Vec3{-3, 4, 1});
+    auto h = convexHull(pts);
+    ASSERT_TRUE(h) << h.error().message;
+    EXPECT_NEAR(detail::hullVolume(pts), h->volume(), 1e-12 * h->volume());
+    std::vector<Vec3> flat;
+    for (int i = 0; i < 20; ++i)
+        flat.push_back({double(i % 5), double(i / 5), 2.0});
+    EXPECT_EQ(detail::hullVolume(flat), 0.0);
+    EXPECT_EQ(detail::hullVolume({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}), 0.0);
+    EXPECT_EQ(detail::hullVolume({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, std::nan("")}}), 0.0);
 }
 
 TEST(Decompose, ConvexInputGivesExactlyOnePart) {
