@@ -1,17 +1,18 @@
-// `rubble-bench structure [--quick] [--frames N] [--iterations N] [--solvers A,B] [--sizes K,..] [--json]
-// [--convergence] [--out DIR]`
+// `rubble-bench structure [--quick] [--frames N] [--iterations N] [--solvers A,B] [--sizes K,..]
+// [--islands N] [--json] [--convergence] [--out DIR]`
 //
 // Stress-solver cost per frame under fire against bond count, one row per solver: a block of stacked bricks
 // (k x h x k, 1 x 0.5 x 1 m each) on a ground root, each brick welded to its face neighbours; every frame one
 // brick is replaced by its Voronoi pieces and debris loads land on random bricks, then one solve (thread CPU
-// time) with its relative residual. Solvers: the converged Gauss-Seidel, conjugate gradient and direct
-// (sparse LDLT with an active set), and the old sweep budget at 12 sweeps (and at --iterations, default 25,
-// as Blast). Also the first solve's cost, and what one fracture costs the structure: a brick replaced by its
-// pieces, updated incrementally (BondGraph and the solver's add/remove, as StructureMonitor does) against a
-// from-scratch rebuild (buildBonds and reset). Table on stdout (or with --json one row per graph size and
-// solver: {"bonds", "solver", "solve_ms": {"p50", "p99"}, "residual": {"p50", "max"}, ...}), CSV in
-// DIR/structure.csv, plots in DIR/structure.png and DIR/structure_convergence.png (residual against time of a
-// first solve from zero forces, per solver).
+// time) with its relative residual; with --islands N, N such blocks side by side, bonded only to the ground
+// (separate islands of the direct solve); with --breaks, one bond breaks a frame instead. Solvers: the
+// converged Gauss-Seidel, conjugate gradient and direct (sparse LDLT with an active set), and the old sweep
+// budget at 12 sweeps (and at --iterations, default 25, as Blast). Also the first solve's cost, and what one
+// fracture costs the structure: a brick replaced by its pieces, updated incrementally (BondGraph and the
+// solver's add/remove, as StructureMonitor does) against a from-scratch rebuild (buildBonds and reset). Table
+// on stdout (or with --json one row per graph size and solver: {"bonds", "solver", "solve_ms": {"p50",
+// "p99"}, "residual": {"p50", "max"}, ...}), CSV in DIR/structure.csv, plots in DIR/structure.png and
+// DIR/structure_convergence.png (residual against time of a first solve from zero forces, per solver).
 #include <algorithm>
 #include <chrono>
 #include <ctime>
@@ -38,6 +39,8 @@ struct BenchArgs {
     bool convergenceOnly = false;
     int frames = 60;
     int iterations = 25;
+    int islands = 1;                  // blocks side by side
+    bool breaks = false;              // a bond breaks each frame instead of a brick fracturing
     std::vector<std::string> solvers; // only these rows (empty: all)
     std::vector<int> sizes;           // block sizes k (k x h x k, h as in the default list; empty: all)
     std::string out = rubble::bench::resultsDir();
@@ -53,6 +56,8 @@ struct Row {
     double buildMs = 0, p50 = 0, p99 = 0, max = 0;
     double updateP50 = 0, updateP99 = 0, rebuildMs = 0; // one fracture's structure update, thread CPU
     double pieces = 0;                                  // pieces per fracture (mean)
+    int islands = 1;
+    double factorizations = 0; // direct: numeric factorisations a frame (mean)
 };
 
 double percentile(std::vector<double> v, double q) {
@@ -62,15 +67,16 @@ double percentile(std::vector<double> v, double q) {
     return v[std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size())))];
 }
 
-// Solids of a k x h x k block of bricks on a ground slab (solid 0).
-std::vector<std::vector<rubble::ConvexPolytope>> bricks(int k, int h) {
+// Solids of `islands` k x h x k blocks of bricks, 1 m apart along x, on a ground slab (solid 0).
+std::vector<std::vector<rubble::ConvexPolytope>> bricks(int k, int h, int islands = 1) {
     std::vector<std::vector<rubble::ConvexPolytope>> out;
-    out.push_back({rubble::ConvexPolytope::fromAabb({{-1, -1, -1}, {k + 1.0, 0, k + 1.0}})});
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < k; ++x)
-            for (int z = 0; z < k; ++z)
-                out.push_back({rubble::ConvexPolytope::fromAabb(
-                    {{double(x), 0.5 * y, double(z)}, {x + 1.0, 0.5 * (y + 1), z + 1.0}})});
+    out.push_back({rubble::ConvexPolytope::fromAabb({{-1, -1, -1}, {(k + 1.0) * islands, 0, k + 1.0}})});
+    for (int i = 0; i < islands; ++i)
+        for (int y = 0; y < h; ++y)
+            for (int x = i * (k + 1); x < i * (k + 1) + k; ++x)
+                for (int z = 0; z < k; ++z)
+                    out.push_back({rubble::ConvexPolytope::fromAabb(
+                        {{double(x), 0.5 * y, double(z)}, {x + 1.0, 0.5 * (y + 1), z + 1.0}})});
     return out;
 }
 
@@ -220,8 +226,9 @@ void debris(Structure& s, int frame) {
     }
 }
 
-std::vector<Row> measure(int k, int h, const std::vector<Solver>& list, int frames, int fractures) {
-    const auto solids = bricks(k, h);
+std::vector<Row> measure(int k, int h, int islands, bool breaks, const std::vector<Solver>& list, int frames,
+                         int fractures) {
+    const auto solids = bricks(k, h, islands);
     const auto t0 = std::chrono::steady_clock::now();
     const std::size_t bondCount = rubble::buildBonds(solids, {}).size();
     const double buildMs = rubble::bench::msSince(t0);
@@ -237,6 +244,7 @@ std::vector<Row> measure(int k, int h, const std::vector<Solver>& list, int fram
         r.nodes = nodes.size();
         r.bonds = bondCount;
         r.iterations = solver.sweeps;
+        r.islands = islands;
         r.buildMs = buildMs;
         // The first solve, from zero forces.
         s.solver.settings() = settingsOf(solver);
@@ -253,13 +261,21 @@ std::vector<Row> measure(int k, int h, const std::vector<Solver>& list, int fram
         s.solver.settings() = settingsOf(solver);
         std::vector<double> ms, residual, sweeps;
         for (int f = 0; f < frames; ++f) {
-            s.fracture(fire[static_cast<std::size_t>(f)].victim, fire[static_cast<std::size_t>(f)].parts);
+            if (breaks) { // an intact bond, spread through the block
+                std::size_t bond = (static_cast<std::size_t>(f) * 7919) % s.solver.bondCount();
+                while (s.solver.broken(bond))
+                    bond = (bond + 1) % s.solver.bondCount();
+                s.solver.breakBond(bond);
+            } else {
+                s.fracture(fire[static_cast<std::size_t>(f)].victim, fire[static_cast<std::size_t>(f)].parts);
+            }
             debris(s, f);
             const double s0 = threadCpuMs();
             s.solver.solve();
             ms.push_back(threadCpuMs() - s0);
             residual.push_back(s.solver.residual());
             sweeps.push_back(s.solver.sweeps());
+            r.factorizations += s.solver.factorizations() / static_cast<double>(frames);
         }
         r.bondsAtEnd = 0;
         for (std::size_t i = 0; i < s.solver.bondCount(); ++i)
@@ -338,8 +354,9 @@ int runBench(const BenchArgs& args) {
     const rubble::bench::CpuMeter cpu;
     std::vector<Row> rows;
     for (const auto& [k, h] : sizes)
-        for (const Row& r :
-             args.convergenceOnly ? std::vector<Row>{} : measure(k, h, list, frames, args.quick ? 3 : 20))
+        for (const Row& r : args.convergenceOnly
+                                ? std::vector<Row>{}
+                                : measure(k, h, args.islands, args.breaks, list, frames, args.quick ? 3 : 20))
             rows.push_back(r);
     std::vector<std::string> titles;
     const std::string history = convergence(args.quick ? 8 : 16, args.quick ? 8 : 26, list, titles);
@@ -353,6 +370,8 @@ int runBench(const BenchArgs& args) {
             j["solve_ms"] = {{"p50", r.p50}, {"p99", r.p99}};
             j["residual"] = {{"p50", r.residualP50}, {"max", r.residualMax}};
             j["sweeps_p50"] = r.sweepsP50;
+            j["islands"] = r.islands;
+            j["factorizations"] = r.factorizations;
             j["cold"] = {{"ms", r.coldMs}, {"residual", r.coldResidual}, {"sweeps", r.coldSweeps}};
             j["update_ms"] = {{"p50", r.updateP50}, {"p99", r.updateP99}};
             j["rebuild_ms"] = r.rebuildMs;
@@ -362,10 +381,13 @@ int runBench(const BenchArgs& args) {
     rubble::bench::Table table{{"bonds", "solver", "solve p50 ms", "p99", "max", "residual p50", "max",
                                 "sweeps p50", "cold ms", "cold residual", "update p50 ms", "rebuild ms"},
                                {}};
-    rubble::bench::Table csv{{"bonds", "nodes", "solver", "frames", "build_ms", "solve_p50_ms",
-                              "solve_p99_ms", "solve_max_ms", "residual_p50", "residual_max", "sweeps_p50",
-                              "cold_ms", "cold_residual", "cold_sweeps", "update_p50_ms", "update_p99_ms",
-                              "rebuild_ms", "pieces_per_fracture", "other_cpu_cores"},
+    rubble::bench::Table csv{{"bonds",         "nodes",          "solver",
+                              "frames",        "build_ms",       "solve_p50_ms",
+                              "solve_p99_ms",  "solve_max_ms",   "residual_p50",
+                              "residual_max",  "sweeps_p50",     "cold_ms",
+                              "cold_residual", "cold_sweeps",    "update_p50_ms",
+                              "update_p99_ms", "rebuild_ms",     "pieces_per_fracture",
+                              "islands",       "factorizations", "other_cpu_cores"},
                              {}};
     auto sci = [](double v) {
         std::ostringstream o;
@@ -377,12 +399,27 @@ int runBench(const BenchArgs& args) {
         table.rows.push_back({std::to_string(r.bonds), r.solver, fixed(r.p50), fixed(r.p99), fixed(r.max),
                               sci(r.residualP50), sci(r.residualMax), fixed(r.sweepsP50, 0), fixed(r.coldMs),
                               sci(r.coldResidual), fixed(r.updateP50), fixed(r.rebuildMs)});
-        csv.rows.push_back({std::to_string(r.bonds), std::to_string(r.nodes), r.solver,
-                            std::to_string(frames), fixed(r.buildMs), fixed(r.p50, 4), fixed(r.p99, 4),
-                            fixed(r.max, 4), sci(r.residualP50), sci(r.residualMax), fixed(r.sweepsP50, 0),
-                            fixed(r.coldMs, 3), sci(r.coldResidual), std::to_string(r.coldSweeps),
-                            fixed(r.updateP50, 4), fixed(r.updateP99, 4), fixed(r.rebuildMs, 2),
-                            fixed(r.pieces, 1), fixed(otherCpu, 2)});
+        csv.rows.push_back({std::to_string(r.bonds),
+                            std::to_string(r.nodes),
+                            r.solver,
+                            std::to_string(frames),
+                            fixed(r.buildMs),
+                            fixed(r.p50, 4),
+                            fixed(r.p99, 4),
+                            fixed(r.max, 4),
+                            sci(r.residualP50),
+                            sci(r.residualMax),
+                            fixed(r.sweepsP50, 0),
+                            fixed(r.coldMs, 3),
+                            sci(r.coldResidual),
+                            std::to_string(r.coldSweeps),
+                            fixed(r.updateP50, 4),
+                            fixed(r.updateP99, 4),
+                            fixed(r.rebuildMs, 2),
+                            fixed(r.pieces, 1),
+                            std::to_string(r.islands),
+                            fixed(r.factorizations, 2),
+                            fixed(otherCpu, 2)});
     }
     if (!args.json)
         rubble::bench::printTable(table);
@@ -439,6 +476,9 @@ const rubble::tools::Registrar registrar{
                         "only these block sizes k (4, 8, 12, 16, 20; 16: 19,136 bonds)")
              ->delimiter(',')
              ->check(CLI::IsMember({4, 8, 12, 16, 20}));
+         app.add_flag("--breaks", args->breaks, "a bond breaks each frame instead of a brick fracturing");
+         app.add_option("--islands", args->islands, "blocks side by side, each its own island (default 1)")
+             ->check(CLI::Range(1, 64));
          app.add_option("--out", args->out, "folder for structure.csv and structure.png");
          return [args] { return runBench(*args); };
      }}};

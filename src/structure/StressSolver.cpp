@@ -22,6 +22,11 @@ namespace {
 
 using Mat6 = Eigen::Matrix<double, 6, 6>;
 
+// Direct: conjugate-gradient iterations a solve against changed numbers may take before a refactorisation.
+constexpr int kUpdateIterations = 16;
+// Direct: the fewest unknowns an island needs for such solves (below, refactorising costs less).
+constexpr Eigen::Index kUpdateUnknowns = 2400;
+
 Eigen::Matrix3d toEigen(const Mat3& m) {
     Eigen::Matrix3d r;
     for (int i = 0; i < 3; ++i)
@@ -128,9 +133,10 @@ struct SerialOpenMp {};
 
 } // namespace
 
-// The direct solve's factorisation, kept across solves while the structure and the active set stay.
-struct StressSolver::DirectCache {
-    std::vector<std::size_t> key; // the movable nodes in unknown order, then each bond's slot and nodes
+// One island's factorisation (the movable nodes that bonds join; a bond to a held node belongs to its movable
+// end's island), kept across solves while the island's nodes, bonds and active set stay.
+struct DirectIsland {
+    std::vector<std::size_t> key; // its nodes in unknown order, then each bond's slot and nodes
     std::vector<char> flags;      // each corner's active and slip flags the factorisation holds
 #ifdef RUBBLE_HAVE_CHOLMOD
     Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>> ldlt; // supernodal: dense kernels on the fill
@@ -138,9 +144,26 @@ struct StressSolver::DirectCache {
     Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
 #endif
     bool analysed = false;
-    bool factored = false;  // the numeric factorisation matches the nodes and bonds (until one changes)
-    double compliance = 0;  // the one it was made with
+    bool numeric = false;  // ldlt holds a numeric factorisation of this key's pattern
+    bool factored = false; // ... of the nodes' and bonds' numbers, or `matrix` holds them (until one changes)
+    bool drift = false;    // `matrix` holds them: bonds broke or corners changed since ldlt was made
+    double compliance = 0; // the one it was made with
+    Eigen::SparseMatrix<double> matrix;
+    Eigen::SparseMatrix<double> assembled; // the last matrix assembled, of the nodes and bonds in slotKey
+    std::vector<std::size_t> slotKey;
+    std::vector<int> slots; // each triplet's place among assembled's values
+};
+
+// The direct solve's factorisations, one per island, and the nodes changed since the last solve.
+struct StressSolver::DirectCache {
+    std::map<std::uint32_t, std::unique_ptr<DirectIsland>> islands; // by the island's lowest node
+    std::vector<char> touched; // a node whose island's numbers changed (its bonds, its mass, its root)
     bool polishing = false; // its Gauss-Seidel polish runs: stalls what stops converging (solveGaussSeidel)
+    void touch(std::uint32_t node) {
+        if (node >= touched.size())
+            touched.resize(node + 1, 0);
+        touched[node] = 1;
+    }
 };
 
 StructureNode structureNode(const std::vector<ConvexPolytope>& parts, double density, bool root) {
@@ -186,6 +209,7 @@ void StressSolver::reset(std::vector<StructureNode> nodes, std::vector<Bond> bon
     orphans_.clear();
     fresh_.clear();
     breaks_.clear();
+    direct_.reset();
     allDirty_ = true;
     reachValid_ = false;
     for (const StructureNode& n : nodes)
@@ -195,8 +219,6 @@ void StressSolver::reset(std::vector<StructureNode> nodes, std::vector<Bond> bon
 }
 
 std::uint32_t StressSolver::addNode(const StructureNode& node) {
-    if (direct_)
-        direct_->factored = false;
     NodeState s;
     s.node = node;
     if (!node.root && node.mass > 0) {
@@ -204,19 +226,20 @@ std::uint32_t StressSolver::addNode(const StructureNode& node) {
         s.invInertia = inverse(node.inertia);
     }
     reachValid_ = false;
+    std::uint32_t i = static_cast<std::uint32_t>(nodes_.size());
     if (freeNodes_.empty()) {
         nodes_.push_back(std::move(s));
-        return static_cast<std::uint32_t>(nodes_.size() - 1);
+    } else {
+        i = freeNodes_.back();
+        freeNodes_.pop_back();
+        nodes_[i] = std::move(s);
     }
-    const std::uint32_t i = freeNodes_.back();
-    freeNodes_.pop_back();
-    nodes_[i] = std::move(s);
+    if (direct_)
+        direct_->touch(i);
     return i;
 }
 
 void StressSolver::removeNode(std::uint32_t node) {
-    if (direct_)
-        direct_->factored = false;
     NodeState& n = nodes_[node];
     if (n.removed)
         return;
@@ -239,8 +262,6 @@ void StressSolver::removeNode(std::uint32_t node) {
 }
 
 std::size_t StressSolver::addBond(Bond bond, StrengthLimits limits) {
-    if (direct_)
-        direct_->factored = false;
     BondState s;
     s.bond = std::move(bond);
     s.limits = limits;
@@ -257,6 +278,8 @@ std::size_t StressSolver::addBond(Bond bond, StrengthLimits limits) {
         std::vector<std::size_t>& list = nodes_[n].bonds;
         list.insert(std::upper_bound(list.begin(), list.end(), i), i);
         nodes_[n].bearings += limits.friction > 0;
+        if (direct_)
+            direct_->touch(n);
     }
     reachValid_ = false;
     if (!orphans_.empty())
@@ -265,13 +288,13 @@ std::size_t StressSolver::addBond(Bond bond, StrengthLimits limits) {
 }
 
 void StressSolver::removeBond(std::size_t i) {
-    if (direct_)
-        direct_->factored = false;
     BondState& b = bonds_[i];
     for (std::uint32_t n : {b.bond.a, b.bond.b}) {
         std::erase(nodes_[n].bonds, i);
         nodes_[n].bearings -= b.limits.friction > 0;
         markDirty(n);
+        if (direct_)
+            direct_->touch(n);
     }
     reachValid_ = false;
     b = BondState{};
@@ -280,8 +303,6 @@ void StressSolver::removeBond(std::size_t i) {
 }
 
 void StressSolver::setRoot(std::uint32_t node, bool root) {
-    if (direct_)
-        direct_->factored = false;
     NodeState& n = nodes_[node];
     n.node.root = root;
     n.invMass = 0;
@@ -291,9 +312,13 @@ void StressSolver::setRoot(std::uint32_t node, bool root) {
         n.invInertia = inverse(n.node.inertia);
     }
     markDirty(node);
+    if (direct_)
+        direct_->touch(node);
     for (std::size_t i : n.bonds) {
         prepare(bonds_[i]);
         markDirty(bonds_[i].bond.other(node));
+        if (direct_)
+            direct_->touch(bonds_[i].bond.other(node));
     }
     reachValid_ = false;
 }
@@ -982,31 +1007,81 @@ void StressSolver::solveDirect(double tolerance) {
     [[maybe_unused]] const SerialOpenMp serial;
     if (!direct_ || direct_.use_count() > 1)
         direct_ = std::make_shared<DirectCache>();
-    DirectCache& cache = *direct_;
-    std::vector<std::uint32_t> order;
-    std::vector<int> index(nodes_.size(), -1);
-    for (std::uint32_t i = 0; i < nodes_.size(); ++i)
-        if (movable(i)) {
-            index[i] = static_cast<int>(order.size());
-            order.push_back(i);
-        }
-    std::vector<std::size_t> pattern;
-    for (std::size_t k = 0; k < bonds_.size(); ++k) {
-        const BondState& b = bonds_[k];
-        if (!b.removed && b.solvable && (index[b.bond.a] >= 0 || index[b.bond.b] >= 0))
-            pattern.push_back(k); // broken ones too (zero blocks): a break keeps the symbolic factorisation
-    }
-    std::vector<std::size_t> held;
-    for (std::size_t k : pattern)
-        if (!bonds_[k].broken)
-            held.push_back(k);
+    DirectCache& caches = *direct_;
     double start = 0;
-    for (std::uint32_t i : order)
-        start = std::max(start, nodeResidual(nodes_[i]));
-    if (order.empty() || start <= tolerance * tolerance) { // nothing to solve (an unchanged structure)
+    for (std::uint32_t i = 0; i < nodes_.size(); ++i)
+        if (movable(i))
+            start = std::max(start, nodeResidual(nodes_[i]));
+    if (start <= tolerance * tolerance) { // nothing to solve (an unchanged structure)
         solveGaussSeidel(tolerance);
         return;
     }
+    // Islands: the movable nodes that bonds join (broken ones too, as they stay in the pattern), each with
+    // its own factorisation; a change in one leaves the others' untouched.
+    std::vector<int> index(nodes_.size(), -1); // a movable node's place in its island's unknowns
+    std::vector<std::vector<std::uint32_t>> islands;
+    for (std::uint32_t i = 0; i < nodes_.size(); ++i) {
+        if (!movable(i) || index[i] >= 0)
+            continue;
+        std::vector<std::uint32_t> members{i};
+        index[i] = 0;
+        for (std::size_t open = 0; open < members.size(); ++open)
+            for (std::size_t k : nodes_[members[open]].bonds) {
+                const BondState& b = bonds_[k];
+                const std::uint32_t m = b.bond.other(members[open]);
+                if (!b.removed && b.solvable && movable(m) && index[m] < 0) {
+                    index[m] = 0;
+                    members.push_back(m);
+                }
+            }
+        std::sort(members.begin(), members.end());
+        for (std::size_t j = 0; j < members.size(); ++j)
+            index[members[j]] = static_cast<int>(j);
+        islands.push_back(std::move(members));
+    }
+    std::vector<std::vector<std::size_t>> keys(islands.size()), patterns(islands.size());
+    std::vector<std::unique_ptr<DirectIsland>> found(islands.size());
+    for (std::size_t c = 0; c < islands.size(); ++c) {
+        const std::vector<std::uint32_t>& members = islands[c];
+        std::vector<std::size_t>& bonds = patterns[c];
+        for (std::uint32_t i : members)
+            for (std::size_t k : nodes_[i].bonds)
+                if (!bonds_[k].removed && bonds_[k].solvable &&
+                    (bonds_[k].bond.a == i || index[bonds_[k].bond.a] < 0))
+                    bonds.push_back(k); // once: at its lower movable end
+        std::sort(bonds.begin(), bonds.end());
+        std::vector<std::size_t>& key = keys[c];
+        key.assign(members.begin(), members.end());
+        key.push_back(std::numeric_limits<std::size_t>::max());
+        for (std::size_t k : bonds)
+            key.insert(key.end(), {k, bonds_[k].bond.a, bonds_[k].bond.b});
+        const auto it = caches.islands.find(members.front());
+        if (it != caches.islands.end() && it->second->key == key)
+            found[c] = std::move(it->second);
+    }
+    // An island whose nodes or bonds changed takes a factorisation left over (its workspace), analysed anew.
+    std::vector<std::unique_ptr<DirectIsland>> spare;
+    for (auto& [node, island] : caches.islands)
+        if (island)
+            spare.push_back(std::move(island));
+    std::map<std::uint32_t, std::unique_ptr<DirectIsland>> kept;
+    for (std::size_t c = 0; c < islands.size(); ++c) {
+        if (!found[c] && !spare.empty()) {
+            found[c] = std::move(spare.back());
+            spare.pop_back();
+        } else if (!found[c]) {
+            found[c] = std::make_unique<DirectIsland>();
+        }
+        for (std::uint32_t i : islands[c])
+            if (i < caches.touched.size() && caches.touched[i])
+                found[c]->factored = false;
+        kept[islands[c].front()] = std::move(found[c]);
+    }
+    caches.islands = std::move(kept);
+    caches.touched.clear();
+    DirectIsland* cache = nullptr;
+    std::vector<std::uint32_t> order;
+    std::vector<std::size_t> pattern, held, key;
     // A node's Jacobian for a weld: relative (linear, angular) acceleration from the node's (v, w).
     auto weldJ = [](const Vec3& r, double sign) {
         Mat6 j = Mat6::Identity();
@@ -1027,8 +1102,8 @@ void StressSolver::solveDirect(double tolerance) {
         w = {x[o + 3], x[o + 4], x[o + 5]};
     };
     // A bond's 12 x 12 block of J^T E^-1 J over its two nodes (its held constraints).
-    std::vector<Eigen::Matrix<double, 12, 12>> blocks(pattern.size());
-    std::vector<char> stale(pattern.size(), 1);
+    std::vector<Eigen::Matrix<double, 12, 12>> blocks;
+    std::vector<char> stale;
     auto blockOf = [&](const BondState& b, Eigen::Matrix<double, 12, 12>& block) {
         block.setZero();
         if (!b.broken && b.corners.empty()) {
@@ -1053,17 +1128,32 @@ void StressSolver::solveDirect(double tolerance) {
             }
         }
     };
-    const Eigen::Index n = static_cast<Eigen::Index>(6 * order.size());
+    Eigen::Index n = 0;
     std::vector<Eigen::Triplet<double>> triplets;
-    auto assemble = [&] {
+    // The island's matrix: built from triplets when its nodes or bonds changed (each triplet's place in it
+    // kept), else its values rewritten in place.
+    auto assemble = [&]() -> const Sparse& {
+        const bool known = cache->slotKey == key;
+        double* values = cache->assembled.valuePtr();
+        if (known)
+            std::fill(values, values + cache->assembled.nonZeros(), 0.0);
         triplets.clear();
+        if (!known)
+            triplets.reserve(12 * order.size() + 4 * 36 * pattern.size());
+        std::size_t t = 0;
+        auto emit = [&](int r, int c, double v) {
+            if (known)
+                values[cache->slots[t++]] += v;
+            else
+                triplets.emplace_back(r, c, v);
+        };
         for (std::uint32_t i : order) {
             const NodeState& s = nodes_[i];
             const int o = 6 * index[i];
             for (int r = 0; r < 3; ++r) {
-                triplets.emplace_back(o + r, o + r, s.node.mass);
+                emit(o + r, o + r, s.node.mass);
                 for (int c = 0; c < 3; ++c)
-                    triplets.emplace_back(o + 3 + r, o + 3 + c, s.node.inertia.m[r][c]);
+                    emit(o + 3 + r, o + 3 + c, s.node.inertia.m[r][c]);
             }
         }
         for (std::size_t p = 0; p < pattern.size(); ++p) {
@@ -1078,38 +1168,76 @@ void StressSolver::solveDirect(double tolerance) {
                     if (ends[e] >= 0 && ends[f] >= 0)
                         for (int r = 0; r < 6; ++r)
                             for (int c = 0; c < 6; ++c)
-                                triplets.emplace_back(6 * ends[e] + r, 6 * ends[f] + c,
-                                                      block(6 * e + r, 6 * f + c));
+                                emit(6 * ends[e] + r, 6 * ends[f] + c, block(6 * e + r, 6 * f + c));
         }
-        Sparse m(n, n);
-        m.setFromTriplets(triplets.begin(), triplets.end());
-        return m;
+        if (known)
+            return cache->assembled;
+        cache->assembled.resize(n, n);
+        cache->assembled.setFromTriplets(triplets.begin(), triplets.end());
+        const int* outer = cache->assembled.outerIndexPtr();
+        const int* inner = cache->assembled.innerIndexPtr();
+        cache->slots.resize(triplets.size());
+        for (std::size_t j = 0; j < triplets.size(); ++j) {
+            const Eigen::Triplet<double>& x = triplets[j];
+            cache->slots[j] = static_cast<int>(
+                std::lower_bound(inner + outer[x.col()], inner + outer[x.col() + 1], x.row()) - inner);
+        }
+        cache->slotKey = key;
+        return cache->assembled;
     };
-    std::vector<std::size_t> key(order.begin(), order.end());
-    key.push_back(nodes_.size());
-    for (std::size_t k : pattern)
-        key.insert(key.end(), {k, bonds_[k].bond.a, bonds_[k].bond.b});
     auto factorize = [&] {
         std::vector<char> flags;
         for (std::size_t k : pattern)
             for (const BearingCorner& c : bonds_[k].corners)
                 flags.push_back(static_cast<char>(c.active + 2 * c.slip));
-        if (cache.factored && cache.key == key && cache.flags == flags && cache.compliance == delta)
+        if (cache->factored && cache->key == key && cache->flags == flags && cache->compliance == delta)
             return true; // the structure and the active set are the last factorisation's
-        const Sparse m = assemble();
-        cache.factored = false;
-        if (!cache.analysed || cache.key != key) {
-            cache.ldlt.analyzePattern(m);
-            cache.key = key;
-            cache.analysed = true;
+        const Sparse& m = assemble();
+        cache->flags = std::move(flags);
+        if (cache->numeric && cache->key == key && cache->compliance == delta && n >= kUpdateUnknowns) {
+            cache->matrix = m; // solved against, with the factorisation as preconditioner
+            cache->drift = cache->factored = true;
+            return true;
+        }
+        cache->factored = cache->numeric = cache->drift = false;
+        cache->matrix = Sparse();
+        if (!cache->analysed || cache->key != key) {
+            cache->ldlt.analyzePattern(m);
+            cache->key = key;
+            cache->analysed = true;
             ++analyses_;
         }
-        cache.ldlt.factorize(m);
+        cache->ldlt.factorize(m);
         ++factorizations_;
-        cache.flags = std::move(flags);
-        cache.compliance = delta;
-        cache.factored = cache.ldlt.info() == Eigen::Success;
-        return cache.factored;
+        cache->compliance = delta;
+        cache->factored = cache->numeric = cache->ldlt.info() == Eigen::Success;
+        return cache->factored;
+    };
+    // Conjugate gradient on `matrix`, preconditioned by the factorisation of the numbers before its bonds
+    // broke or corners changed: a change of low rank takes a few iterations. False when it does not converge.
+    Eigen::VectorXd rhs, x, res, pre, way, aWay;
+    auto update = [&] {
+        const Sparse& a = cache->matrix;
+        x = cache->ldlt.solve(rhs);
+        res = rhs - a * x;
+        const double goal = 1e-10 * rhs.norm();
+        pre = cache->ldlt.solve(res);
+        way = pre;
+        double rz = res.dot(pre);
+        for (int it = 0; it < kUpdateIterations && res.norm() > goal; ++it) {
+            aWay = a * way;
+            const double pq = way.dot(aWay);
+            if (!(pq > 0))
+                return false;
+            const double alpha = rz / pq;
+            x += alpha * way;
+            res -= alpha * aWay;
+            pre = cache->ldlt.solve(res);
+            const double next = res.dot(pre);
+            way = pre + (next / rz) * way;
+            rz = next;
+        }
+        return res.norm() <= goal;
     };
     auto worst = [&] {
         double m = 0;
@@ -1118,14 +1246,21 @@ void StressSolver::solveDirect(double tolerance) {
         return m;
     };
     // One augmented-Lagrangian step: solve for a', move every held constraint's force by -E^-1 J a'.
-    Eigen::VectorXd rhs(n), x(n);
     auto step = [&] {
         for (std::uint32_t i : order) {
             const NodeState& s = nodes_[i];
             const Vec3 lw = s.node.inertia * s.w;
             rhs.segment<6>(6 * index[i]) = vec6(s.v * s.node.mass, lw);
         }
-        x = cache.ldlt.solve(rhs);
+        if (cache->drift && !update()) { // too far from the factorisation: a fresh one
+            cache->ldlt.factorize(cache->matrix);
+            ++factorizations_;
+            cache->matrix = Sparse();
+            cache->drift = false;
+            cache->factored = cache->numeric = cache->ldlt.info() == Eigen::Success;
+        }
+        if (!cache->drift)
+            x = cache->numeric ? Eigen::VectorXd(cache->ldlt.solve(rhs)) : Eigen::VectorXd::Zero(n);
         for (std::size_t k : held) {
             BondState& b = bonds_[k];
             Vec3 va, wa, vb, wb;
@@ -1199,57 +1334,74 @@ void StressSolver::solveDirect(double tolerance) {
     };
     const double target2 = tolerance * tolerance / 4;
     sweeps_ = 0;
-    for (int round = 0; round < 3 && factorize(); ++round) {
-        double last = worst();
-        for (int i = 0; i < 12 && last > target2; ++i) {
-            step();
-            const double now = worst();
-            if (now > 0.9 * last && i >= 2)
-                break;
-            last = now;
-        }
-        const bool settled = last <= target2; // then only corners that pull or slip change the set
-        bool changed = false;
-        for (std::size_t p = 0; p < pattern.size(); ++p) {
-            BondState& b = bonds_[pattern[p]];
-            if (b.broken)
-                continue;
-            double total = 0;
-            for (const BearingCorner& c : b.corners)
-                total += std::abs(c.press);
-            for (BearingCorner& c : b.corners) {
-                bool moved = false;
-                if (c.active && c.press < -1e-6 * total) {
-                    release(b, c);
-                    moved = true;
-                } else if (c.active) { // sticking past the friction limit: it slips (its friction a force)
-                    const bool cut = limit(b, c);
-                    moved = cut && !c.slip;
-                    c.slip = c.slip || cut;
-                } else if (!settled) {
-                    const NodeState& na = nodes_[b.bond.a];
-                    const NodeState& nb = nodes_[b.bond.b];
-                    const double rel =
-                        dot(na.v - nb.v, b.bond.section.normal) + dot(na.w, c.ca[0]) - dot(nb.w, c.cb[0]);
-                    c.active = moved = rel > tolerance;
-                }
-                stale[p] = stale[p] || moved;
-                changed = changed || moved;
+    for (std::size_t island = 0; island < islands.size(); ++island) {
+        order = islands[island];
+        if (worst() <= tolerance * tolerance)
+            continue; // at rest: its factorisation waits
+        cache = caches.islands[order.front()].get();
+        key = keys[island];
+        pattern = patterns[island];
+        held.clear();
+        for (std::size_t k : pattern)
+            if (!bonds_[k].broken)
+                held.push_back(k);
+        n = static_cast<Eigen::Index>(6 * order.size());
+        rhs.resize(n);
+        blocks.assign(pattern.size(), Eigen::Matrix<double, 12, 12>::Zero());
+        stale.assign(pattern.size(), 1);
+        for (int round = 0; round < 3 && factorize(); ++round) {
+            double last = worst();
+            for (int i = 0; i < 12 && last > target2; ++i) {
+                step();
+                const double now = worst();
+                if (now > 0.9 * last && i >= 2)
+                    break;
+                last = now;
             }
+            const bool settled = last <= target2; // then only corners that pull or slip change the set
+            bool changed = false;
+            for (std::size_t p = 0; p < pattern.size(); ++p) {
+                BondState& b = bonds_[pattern[p]];
+                if (b.broken)
+                    continue;
+                double total = 0;
+                for (const BearingCorner& c : b.corners)
+                    total += std::abs(c.press);
+                for (BearingCorner& c : b.corners) {
+                    bool moved = false;
+                    if (c.active && c.press < -1e-6 * total) {
+                        release(b, c);
+                        moved = true;
+                    } else if (c.active) { // sticking past the friction limit: it slips (its friction a
+                                           // force)
+                        const bool cut = limit(b, c);
+                        moved = cut && !c.slip;
+                        c.slip = c.slip || cut;
+                    } else if (!settled) {
+                        const NodeState& na = nodes_[b.bond.a];
+                        const NodeState& nb = nodes_[b.bond.b];
+                        const double rel =
+                            dot(na.v - nb.v, b.bond.section.normal) + dot(na.w, c.ca[0]) - dot(nb.w, c.cb[0]);
+                        c.active = moved = rel > tolerance;
+                    }
+                    stale[p] = stale[p] || moved;
+                    changed = changed || moved;
+                }
+            }
+            if (!changed)
+                break;
         }
-        if (!changed)
-            break;
+        for (std::size_t k : held) // what still pulls lets go; Gauss-Seidel takes it from here
+            for (BearingCorner& c : bonds_[k].corners) {
+                if (c.press < 0)
+                    release(bonds_[k], c);
+                limit(bonds_[k], c);
+            }
     }
     const int directSweeps = sweeps_;
-    for (std::size_t k : held) // what still pulls lets go; Gauss-Seidel takes it from here
-        for (BearingCorner& c : bonds_[k].corners) {
-            if (c.press < 0)
-                release(bonds_[k], c);
-            limit(bonds_[k], c);
-        }
-    cache.polishing = true;
+    caches.polishing = true;
     solveGaussSeidel(tolerance);
-    cache.polishing = false;
+    caches.polishing = false;
     sweeps_ += directSweeps;
 }
 
@@ -1437,8 +1589,10 @@ void StressSolver::setHealth(std::size_t i, double health) {
 }
 
 void StressSolver::breakBond(std::size_t i) {
-    if (direct_)
-        direct_->factored = false;
+    if (direct_) {
+        direct_->touch(bonds_[i].bond.a);
+        direct_->touch(bonds_[i].bond.b);
+    }
     if (!bonds_[i].broken) {
         markDirty(bonds_[i].bond.a);
         markDirty(bonds_[i].bond.b);

@@ -91,8 +91,8 @@ public:
     /// Sweeps (or conjugate-gradient iterations; Direct: solves with the factorisation plus Gauss-Seidel
     /// sweeps) the last solve() ran.
     int sweeps() const { return sweeps_; }
-    /// Direct: numeric factorisations the last solve() ran (one per active set of bearing corners; 0 when
-    /// the last solve's still holds).
+    /// Direct: numeric factorisations the last solve() ran (one per changed island and active set; 0 when
+    /// the kept ones hold or, on a large island, a change is solved against them).
     int factorizations() const { return factorizations_; }
     /// Direct: symbolic analyses so far (a new one only when the nodes or the bonds present change).
     int analyses() const { return analyses_; }
