@@ -115,6 +115,7 @@ void Game::clear(Renderer& renderer) {
     counters_ = {};
     latencies_.clear();
     latencyCursor_ = 0;
+    visible_.clear();
     nextTiming_ = 0;
     shells_.clear();
     landed_.clear();
@@ -727,8 +728,10 @@ void Game::updateCounters() {
     const std::uint64_t first = runtime_->world().firstTimingRecord();
     for (nextTiming_ = std::max(nextTiming_, first); nextTiming_ < first + timings.size(); ++nextTiming_) {
         const rubble::TimingRecord& r = timings[static_cast<std::size_t>(nextTiming_ - first)];
-        if (!r.stale && !r.missed && !r.failed)
+        if (!r.stale && !r.missed && !r.failed) {
             latencies_.push_back(r.totalMs);
+            visible_.adopted(r.object, r.frame, r.totalMs, VisibleLatency::Clock::now());
+        }
     }
     const auto& c = runtime_->counters();
     counters_.impacts = static_cast<int>(c.projectileHits);

@@ -19,6 +19,7 @@
 #include "PriorityJobs.hpp"
 #include "Renderer.hpp"
 #include "Sound.hpp"
+#include "VisibleLatency.hpp"
 #include "Weapons.hpp"
 #include "rubble/bullet/BulletBinding.hpp"
 #include "rubble/bullet/PhysicsWorld.hpp"
@@ -164,6 +165,10 @@ public:
     std::vector<double> takeNewLatencies();
     /// All adopted latencies so far (ms).
     const std::vector<double>& latencies() const { return latencies_; }
+    /// A frame was presented now: fractures adopted before it are visible (impact → visible times).
+    void presented() { visible_.presented(VisibleLatency::Clock::now()); }
+    /// Impact → visible times of the fractures shown so far.
+    const VisibleLatency& visibleLatency() const { return visible_; }
     /// The fracture workers (null before a scene is loaded).
     const PriorityJobs* jobs() const { return jobs_.get(); }
     /// Centres of destructible objects still standing (for the autopilot).
@@ -250,6 +255,7 @@ private:
     float groundTop_ = -10;
     std::vector<double> latencies_;
     size_t latencyCursor_ = 0;
+    VisibleLatency visible_;       // adopted fractures until the frame that draws them is presented
     std::uint64_t nextTiming_ = 0; // sequence number of the next timing record to read
     std::uint32_t burstSeed_ = 1;
     float noseOffset_ = 3;

@@ -46,7 +46,8 @@ events=$(sed -n 's/^journal: .* (\([0-9]*\) events, [0-9]* bytes).*$/\1/p' "$wor
 echo "ok: --record and --replay ($events events, geometry hash $recorded)"
 
 # A latency run: --fire-rate shells (the autopilot holding its own fire), results adopted when ready, the
-# fracture workers at the asked niceness (1: any user may lower a thread's priority).
+# fracture workers at the asked niceness (1: any user may lower a thread's priority); each fracture is
+# visible on the first frame presented after its adoption.
 run latency --scene "$here/e2e.cfg" --autopilot 2 --hold-fire --fire-rate 4 --adopt-ready --worker-nice 1
 python3 - "$work/latency/report.json" <<'PY' || fail "the latency run's report: $(cat "$work/latency/report.json")"
 import json, sys
@@ -56,6 +57,13 @@ assert r["weapons"]["cannon"]["shots"] == 4 and r["shots"] == 4, r["weapons"]  #
 assert r["fractures"] > 0 and r["latency_ms"]["count"] > 0, (r["fractures"], r["latency_ms"])
 assert t["adopt_ready"] and t["worker_nice"] == 1, t
 assert 1 <= t["workers_at_nice"] <= t["fracture_workers"] and t["workers_refused"] == 0, t  # those that ran jobs
+assert 0 < t["jobs_cpu_ms"] and 0 < t["jobs_busy_ms"], t
+# impact -> visible: every adopted fracture is on a presented frame, later than its adoption
+v, a = r["visible_ms"], r["latency_ms"]
+assert v["count"] == a["count"] and v["p50"] >= a["p50"] and v["p99"] >= a["p99"], (v, a)
+rows = [l.split(",") for l in open(sys.argv[1].replace("report.json", "visible.csv")).read().split()[1:]]
+assert len(rows) == a["count"], len(rows)
+assert all(float(s) > 0 and abs(float(ad) + float(s) - float(vis)) < 0.01 for _, _, ad, s, vis in rows), rows
 PY
 echo "ok: --fire-rate, --adopt-ready and --worker-nice"
 
