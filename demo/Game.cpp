@@ -123,6 +123,7 @@ void Game::clear(Renderer& renderer) {
     hitBy_.clear();
     sounds_.clear();
     lastKnock_.clear();
+    collapsesHeard_ = 0;
     blastBy_ = -1;
 }
 
@@ -340,6 +341,33 @@ void Game::onAdopted(const rubble::FractureOutcome& o, Renderer& renderer) {
         e.size = static_cast<float>(std::cbrt(volume));
         sound(e);
     }
+}
+
+void Game::soundCollapses() {
+    // one rumble for the bodies that began to fall since the last call, at their centre of mass, as loud as
+    // their weight falling at 3 m/s, as low as their total volume is big
+    const auto& falls = runtime_->structureCollapses();
+    if (collapsesHeard_ >= falls.size())
+        return;
+    SoundEvent e{SoundKind::Collapse, Timbre::Stone};
+    double mass = 0, volume = 0;
+    rubble::Vec3 centre{};
+    for (std::size_t i = collapsesHeard_; i < falls.size(); ++i) {
+        mass += falls[i].mass;
+        volume += falls[i].volume;
+        centre = centre + falls[i].position * falls[i].mass;
+    }
+    const rubble::StructureCollapse& first = falls[collapsesHeard_];
+    if (const BodyRecord* b = runtime_->body(first.body); b && b->hasObject)
+        if (auto look = looks_.find(b->object); look != looks_.end())
+            e.timbre = look->second.timbre;
+    collapsesHeard_ = falls.size();
+    if (!(mass > 0))
+        return;
+    e.position = toV3(centre * (1.0 / mass));
+    e.impulse = static_cast<float>(3.0 * mass);
+    e.size = static_cast<float>(std::cbrt(volume));
+    sound(e);
 }
 
 void Game::sound(const SoundEvent& e) {
@@ -685,7 +713,9 @@ void Game::step(const ControlInput& input, float dt, Renderer& renderer) {
     const long long impactsBefore = runtime_->counters().impacts;
     const long long retiredBefore = runtime_->counters().piecesRetired;
     runtime_->setFocus({camera_.eye.x, camera_.eye.y, camera_.eye.z}); // distant tiny debris fades
+    collapsesHeard_ = 0; // the runtime's list restarts with the frame
     runtime_->stepFrame(dt);
+    soundCollapses();
     creditHits();
     checkCrash();
     emitEffects(impactsBefore, retiredBefore);
@@ -718,6 +748,7 @@ void Game::adoptReady(double waitMs) {
     const long long retiredBefore = runtime_->counters().piecesRetired;
     if (runtime_->adoptReady().piecesRetired > 0)
         emitEffects(impacts, retiredBefore); // dust for pieces retired while adopting (no new impacts)
+    soundCollapses();
     updateCounters();
 }
 

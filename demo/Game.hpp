@@ -231,6 +231,7 @@ private:
     void checkCrash();
     void emitEffects(long long impactsBefore, long long retiredBefore);
     void listenForDebris();
+    void soundCollapses();
     void sound(const SoundEvent& e);
     void updateCounters();
 
@@ -282,6 +283,7 @@ private:
     std::map<rubble::ObjectId, int> hitBy_;            // object -> weapon whose impact will fracture it
     std::vector<SoundEvent> sounds_;                   // made since the last takeSounds()
     std::unordered_map<rubble::BodyId, std::uint64_t> lastKnock_; // body -> frame it last hit the ground
+    std::size_t collapsesHeard_ = 0; // of the runtime's structureCollapses(), those already sounded
 };
 
 } // namespace demo

@@ -99,6 +99,7 @@ bool RunReport::write(const std::filesystem::path& dir, const std::string& scene
                   {"impacts", last.sounds[static_cast<std::size_t>(SoundKind::Impact)]},
                   {"breaks", last.sounds[static_cast<std::size_t>(SoundKind::Break)]},
                   {"debris", last.sounds[static_cast<std::size_t>(SoundKind::Debris)]},
+                  {"collapses", last.sounds[static_cast<std::size_t>(SoundKind::Collapse)]},
                   {"events", audio_.events},
                   {"played", audio_.played},
                   {"quiet", audio_.quiet},

@@ -38,7 +38,7 @@ live, awake, frozen = map(int, sys.argv[2:5])
 a = r["audio"]
 assert not a["device"], "a headless run opened an audio device"
 assert a["impacts"] > 0 and a["breaks"] > 0 and a["debris"] > 0, a
-assert a["events"] == a["impacts"] + a["breaks"] + a["debris"], a
+assert a["events"] == a["impacts"] + a["breaks"] + a["debris"] + a["collapses"], a
 assert a["played"] + a["quiet"] + a["refused"] == a["events"], a
 assert 0 < a["peak_voices"] <= a["max_voices"], a
 with wave.open(sys.argv[5]) as w:
