@@ -15,8 +15,8 @@ namespace demo {
 
 /// What made a sound.
 enum class SoundKind : int {
-    Impact, ///< a shell or blast hit an object
-    Break,  ///< an object broke into pieces
+    Impact,   ///< a shell or blast hit an object
+    Break,    ///< an object broke into pieces
     Debris,   ///< a falling piece hit the ground
     Collapse, ///< standing bodies lost their support and fell (one rumble a frame)
 };

@@ -3,14 +3,14 @@
 # 1280x720, headless EGL (llvmpipe), with --fire-rate cannon shells at the standing objects and results adopted
 # as soon as they are ready (--adopt-ready), so that report.json's latency_ms (impact -> adopted) measures the
 # workers, not the deterministic 2-frame delay; visible_ms adds the wait for the frame that shows the pieces.
-# Configurations alternate within each round: the demo's defaults (one worker on 2 cores, at niceness -5),
-# two workers (a blast's objects split across them), llvmpipe's rasteriser threads yielding (niceness 10)
-# while a job is in flight, and both. One row per run in bench/results/latency.csv (then latency.png), and
+# Configurations alternate within each round: the demo's defaults (workers at niceness -5, hardware threads
+# - 1 of them: one on 2 cores), two workers (a blast's objects cut two at a time), and two workers with
+# llvmpipe's rasteriser threads yielding (niceness 10) while a job is in flight. One row per run in bench/results/latency.csv (then latency.png), and
 # one row per stage and run in latency_stages.csv: queue, the worker's stages, handoff, adoption and the
 # frame that shows the pieces (shown), with p50, p99, the mean over the slowest tenth of the jobs (impact ->
 # visible) and the stage's value in the job at the visible p99.
 # Usage: scripts/latency-bench.sh BUILD_DIR [SECONDS] [ROUNDS] [CONFIG...]
-#   CONFIG is LABEL=OPTIONS (e.g. 'nice-10=--worker-nice -10'); without any, the four above.
+#   CONFIG is LABEL=OPTIONS (e.g. 'nice-10=--worker-nice -10'); without any, the three above.
 # RUBBLE_SEED_MEDIA overrides ../shared/seed/media; RUBBLE_BENCH_RESULTS the output folder.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
@@ -20,8 +20,7 @@ rounds="${3:-2}"
 shift $(($# < 3 ? $# : 3))
 configs=("$@")
 [ ${#configs[@]} -gt 0 ] ||
-    configs=("default=--workers -1" "workers-2=--workers 2" "yield-10=--raster-yield 10"
-        "workers-2+yield-10=--workers 2 --raster-yield 10")
+    configs=("default=--workers -1" "workers-2=--workers 2" "workers-2+yield-10=--workers 2 --raster-yield 10")
 demo="$build/bin/rubble-demo"
 [ -x "$demo" ] || { echo "latency-bench: $demo not found (build rubble-demo first)" >&2; exit 1; }
 media="${RUBBLE_SEED_MEDIA:-$root/../shared/seed/media}"
