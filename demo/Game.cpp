@@ -344,8 +344,7 @@ void Game::onAdopted(const rubble::FractureOutcome& o, Renderer& renderer) {
 }
 
 void Game::soundCollapses() {
-    // one rumble for the bodies that began to fall since the last call, at their centre of mass, as loud as
-    // their weight falling at 3 m/s, as low as their total volume is big
+    // one rumble for the bodies that began to fall since the last call: their mass at 3 m/s, their volume
     const auto& falls = runtime_->structureCollapses();
     if (collapsesHeard_ >= falls.size())
         return;
