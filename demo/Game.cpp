@@ -115,6 +115,7 @@ void Game::clear(Renderer& renderer) {
     counters_ = {};
     latencies_.clear();
     latencyCursor_ = 0;
+    visible_.clear();
     nextTiming_ = 0;
     shells_.clear();
     landed_.clear();
@@ -122,6 +123,7 @@ void Game::clear(Renderer& renderer) {
     hitBy_.clear();
     sounds_.clear();
     lastKnock_.clear();
+    collapsesHeard_ = 0;
     blastBy_ = -1;
 }
 
@@ -341,6 +343,32 @@ void Game::onAdopted(const rubble::FractureOutcome& o, Renderer& renderer) {
         e.size = static_cast<float>(std::cbrt(volume));
         sound(e);
     }
+}
+
+void Game::soundCollapses() {
+    // one rumble for the bodies that began to fall since the last call: their mass at 3 m/s, their volume
+    const auto& falls = runtime_->structureCollapses();
+    if (collapsesHeard_ >= falls.size())
+        return;
+    SoundEvent e{SoundKind::Collapse, Timbre::Stone};
+    double mass = 0, volume = 0;
+    rubble::Vec3 centre{};
+    for (std::size_t i = collapsesHeard_; i < falls.size(); ++i) {
+        mass += falls[i].mass;
+        volume += falls[i].volume;
+        centre = centre + falls[i].position * falls[i].mass;
+    }
+    const rubble::StructureCollapse& first = falls[collapsesHeard_];
+    if (const BodyRecord* b = runtime_->body(first.body); b && b->hasObject)
+        if (auto look = looks_.find(b->object); look != looks_.end())
+            e.timbre = look->second.timbre;
+    collapsesHeard_ = falls.size();
+    if (!(mass > 0))
+        return;
+    e.position = toV3(centre * (1.0 / mass));
+    e.impulse = static_cast<float>(3.0 * mass);
+    e.size = static_cast<float>(std::cbrt(volume));
+    sound(e);
 }
 
 void Game::sound(const SoundEvent& e) {
@@ -692,7 +720,9 @@ void Game::step(const ControlInput& input, float dt, Renderer& renderer) {
     const long long impactsBefore = runtime_->counters().impacts;
     const long long retiredBefore = runtime_->counters().piecesRetired;
     runtime_->setFocus({camera_.eye.x, camera_.eye.y, camera_.eye.z}); // distant tiny debris fades
+    collapsesHeard_ = 0; // the runtime's list restarts with the frame
     runtime_->stepFrame(dt);
+    soundCollapses();
     creditHits();
     checkCrash();
     emitEffects(impactsBefore, retiredBefore);
@@ -725,6 +755,7 @@ void Game::adoptReady(double waitMs) {
     const long long retiredBefore = runtime_->counters().piecesRetired;
     if (runtime_->adoptReady().piecesRetired > 0)
         emitEffects(impacts, retiredBefore); // dust for pieces retired while adopting (no new impacts)
+    soundCollapses();
     updateCounters();
 }
 
@@ -735,8 +766,10 @@ void Game::updateCounters() {
     const std::uint64_t first = runtime_->world().firstTimingRecord();
     for (nextTiming_ = std::max(nextTiming_, first); nextTiming_ < first + timings.size(); ++nextTiming_) {
         const rubble::TimingRecord& r = timings[static_cast<std::size_t>(nextTiming_ - first)];
-        if (!r.stale && !r.missed && !r.failed)
+        if (!r.stale && !r.missed && !r.failed) {
             latencies_.push_back(r.totalMs);
+            visible_.adopted(r.object, r.frame, r.totalMs, VisibleLatency::Clock::now());
+        }
     }
     const auto& c = runtime_->counters();
     counters_.impacts = static_cast<int>(c.projectileHits);

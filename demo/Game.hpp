@@ -19,6 +19,7 @@
 #include "PriorityJobs.hpp"
 #include "Renderer.hpp"
 #include "Sound.hpp"
+#include "VisibleLatency.hpp"
 #include "Weapons.hpp"
 #include "rubble/bullet/BulletBinding.hpp"
 #include "rubble/bullet/PhysicsWorld.hpp"
@@ -164,6 +165,10 @@ public:
     std::vector<double> takeNewLatencies();
     /// All adopted latencies so far (ms).
     const std::vector<double>& latencies() const { return latencies_; }
+    /// A frame was presented now: fractures adopted before it are visible (impact → visible times).
+    void presented() { visible_.presented(VisibleLatency::Clock::now()); }
+    /// Impact → visible times of the fractures shown so far.
+    const VisibleLatency& visibleLatency() const { return visible_; }
     /// The fracture workers (null before a scene is loaded).
     const PriorityJobs* jobs() const { return jobs_.get(); }
     /// Centres of destructible objects still standing (for the autopilot).
@@ -226,6 +231,7 @@ private:
     void checkCrash();
     void emitEffects(long long impactsBefore, long long retiredBefore);
     void listenForDebris();
+    void soundCollapses();
     void sound(const SoundEvent& e);
     void updateCounters();
 
@@ -250,6 +256,7 @@ private:
     float groundTop_ = -10;
     std::vector<double> latencies_;
     size_t latencyCursor_ = 0;
+    VisibleLatency visible_;       // adopted fractures until the frame that draws them is presented
     std::uint64_t nextTiming_ = 0; // sequence number of the next timing record to read
     std::uint32_t burstSeed_ = 1;
     float noseOffset_ = 3;
@@ -276,6 +283,7 @@ private:
     std::map<rubble::ObjectId, int> hitBy_;            // object -> weapon whose impact will fracture it
     std::vector<SoundEvent> sounds_;                   // made since the last takeSounds()
     std::unordered_map<rubble::BodyId, std::uint64_t> lastKnock_; // body -> frame it last hit the ground
+    std::size_t collapsesHeard_ = 0; // of the runtime's structureCollapses(), those already sounded
 };
 
 } // namespace demo

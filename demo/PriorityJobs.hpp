@@ -23,6 +23,10 @@ public:
     /// Workers that run at the asked niceness so far, and workers the system refused it.
     int raised() const { return raised_.load(); }
     int refused() const { return refused_.load(); }
+    /// Wall-clock and thread CPU time the workers spent in jobs so far (ms): their ratio is the share of a
+    /// core a running job got.
+    double busyMs() const { return static_cast<double>(busyUs_.load()) / 1000.0; }
+    double cpuMs() const { return static_cast<double>(cpuUs_.load()) / 1000.0; }
 
 private:
     void prepareThread();
@@ -30,6 +34,8 @@ private:
     int nice_;
     std::atomic<int> raised_{0};
     std::atomic<int> refused_{0};
+    std::atomic<long long> busyUs_{0};
+    std::atomic<long long> cpuUs_{0};
     rubble::ThreadPool pool_; // last: its workers stop before the counters go
 };
 

@@ -87,6 +87,10 @@ bool RunReport::write(const std::filesystem::path& dir, const std::string& scene
                        {"p50", quantile(latencies, 0.5)},
                        {"p99", quantile(latencies, 0.99)},
                        {"max", quantile(latencies, 1.0)}};
+    j["visible_ms"] = {{"count", visible_.size()},
+                       {"p50", quantile(visible_, 0.5)},
+                       {"p99", quantile(visible_, 0.99)},
+                       {"max", quantile(visible_, 1.0)}};
     for (int w = 0; w < kWeaponCount; ++w) // fractures credited to the weapon whose impact caused them
         j["weapons"][weaponSpec(static_cast<Weapon>(w)).name] = {
             {"shots", last.weaponShots[static_cast<std::size_t>(w)]},
@@ -95,6 +99,7 @@ bool RunReport::write(const std::filesystem::path& dir, const std::string& scene
                   {"impacts", last.sounds[static_cast<std::size_t>(SoundKind::Impact)]},
                   {"breaks", last.sounds[static_cast<std::size_t>(SoundKind::Break)]},
                   {"debris", last.sounds[static_cast<std::size_t>(SoundKind::Debris)]},
+                  {"collapses", last.sounds[static_cast<std::size_t>(SoundKind::Collapse)]},
                   {"events", audio_.events},
                   {"played", audio_.played},
                   {"quiet", audio_.quiet},
@@ -106,7 +111,8 @@ bool RunReport::write(const std::filesystem::path& dir, const std::string& scene
     j["threads"] = {{"fracture_workers", threads_.workers},      {"worker_nice", threads_.workerNice},
                     {"workers_at_nice", threads_.workersAtNice}, {"workers_refused", threads_.workersRefused},
                     {"raster_threads", threads_.rasterThreads},  {"adopt_ready", threads_.adoptReady},
-                    {"adopt_wait_ms", threads_.adoptWaitMs}};
+                    {"adopt_wait_ms", threads_.adoptWaitMs},     {"jobs_busy_ms", threads_.jobsBusyMs},
+                    {"jobs_cpu_ms", threads_.jobsCpuMs},         {"yielded_frames", threads_.yieldedFrames}};
     j["screenshots"] = screenshots;
     j["fracture_runtime"] = Game::fractureAvailable();
     std::ofstream js(dir / "report.json");
@@ -116,7 +122,8 @@ bool RunReport::write(const std::filesystem::path& dir, const std::string& scene
     s << "frames " << frames_.size() << ", fps p50 " << (p50 > 0 ? 1000.0 / p50 : 0.0) << " / p99 "
       << (p99 > 0 ? 1000.0 / p99 : 0.0) << " (frame ms p50 " << p50 << ", p99 " << p99 << "), shots "
       << last.shots << ", impacts " << last.impacts << ", fractures " << last.fractures << ", latency ms p50 "
-      << quantile(latencies, 0.5) << " p99 " << quantile(latencies, 0.99) << ", internal resolution p50 "
+      << quantile(latencies, 0.5) << " p99 " << quantile(latencies, 0.99) << " (visible p50 "
+      << quantile(visible_, 0.5) << " p99 " << quantile(visible_, 0.99) << "), internal resolution p50 "
       << quantile(widths, 0.5) << 'x' << quantile(heights, 0.5) << " (min " << minW << 'x' << minH << ")";
     summary = s.str();
     return static_cast<bool>(js);

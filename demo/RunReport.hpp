@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "Game.hpp"
@@ -50,8 +51,14 @@ public:
         int rasterThreads = 0;  ///< llvmpipe's rasteriser threads
         bool adoptReady = true; ///< results adopted when ready (false: deterministic, 2 frames after)
         double adoptWaitMs = 0; ///< how long a frame waited before drawing for a job in flight, at most
+        double jobsBusyMs = 0;  ///< wall-clock time the workers spent in jobs
+        double jobsCpuMs = 0;   ///< CPU time they got meanwhile
+        long yieldedFrames =
+            0; ///< frames drawn with the rasteriser threads yielding to jobs (--raster-yield)
     };
     void setThreads(const Threads& t) { threads_ = t; }
+    /// Impact → visible times (ms): impact → adopted plus the wait for the frame that draws the pieces.
+    void setVisibleLatencies(std::vector<double> ms) { visible_ = std::move(ms); }
     /// Number of frames recorded.
     std::size_t size() const { return frames_.size(); }
     /// Writes frames.csv and report.json into dir; latencies are impact → adopted in ms.
@@ -64,6 +71,7 @@ private:
     int maxVoices_ = 0;
     bool audioDevice_ = false;
     Threads threads_;
+    std::vector<double> visible_;
 };
 
 /// Writes tightly packed RGB rows (top first) as PNG.

@@ -138,14 +138,25 @@ Recipe recipe(SoundKind kind, Timbre timbre) {
         for (Partial& p : r.partials)
             p.decay *= 0.4f;
         break;
+    case SoundKind::Collapse: // a rumble: an octave down, dark noise, strikes over more than a second
+        r.seconds = 2.4f;
+        r.grains = 40;
+        r.grainSpread = 1.6f;
+        r.noiseDecay *= 4;
+        r.lowpass *= 0.4f;
+        for (Partial& p : r.partials) {
+            p.hz *= 0.5f;
+            p.decay *= 2;
+        }
+        break;
     }
     return r;
 }
 
 /// Reference impulse (N·s) of each kind: at it, loudness is the kind's base level.
-constexpr std::array<float, kSoundKinds> kReferenceImpulse{680.0f, 1000.0f, 2000.0f};
+constexpr std::array<float, kSoundKinds> kReferenceImpulse{680.0f, 1000.0f, 2000.0f, 20000.0f};
 /// Base level of each kind.
-constexpr std::array<float, kSoundKinds> kBaseLevel{0.8f, 1.0f, 0.45f};
+constexpr std::array<float, kSoundKinds> kBaseLevel{0.8f, 1.0f, 0.45f, 1.0f};
 /// Within this distance (m) a sound is not attenuated; beyond, it falls as 1/d.
 constexpr float kNearDistance = 15.0f;
 /// Master gain of the mix (several loud voices sum to more than 1 before the clamp).

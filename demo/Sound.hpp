@@ -15,11 +15,12 @@ namespace demo {
 
 /// What made a sound.
 enum class SoundKind : int {
-    Impact, ///< a shell or blast hit an object
-    Break,  ///< an object broke into pieces
-    Debris, ///< a falling piece hit the ground
+    Impact,   ///< a shell or blast hit an object
+    Break,    ///< an object broke into pieces
+    Debris,   ///< a falling piece hit the ground
+    Collapse, ///< standing bodies lost their support and fell (one rumble a frame)
 };
-inline constexpr int kSoundKinds = 3;
+inline constexpr int kSoundKinds = 4;
 
 /// How a material sounds.
 enum class Timbre : int { Stone, Glass, Wood, Metal };

@@ -11,15 +11,12 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include <CLI/CLI.hpp>
-
-#include <sys/resource.h>
 
 #include "Audio.hpp"
 #include "Autopilot.hpp"
@@ -28,6 +25,7 @@
 #include "GlContext.hpp"
 #include "JoinSession.hpp"
 #include "Panel.hpp"
+#include "RasterThreads.hpp"
 #include "RenderBench.hpp"
 #include "Renderer.hpp"
 #include "RunReport.hpp"
@@ -99,6 +97,7 @@ struct Options {
     double fireRate = 0;               // cannon shots per game second at the standing targets (0: none)
     bool adoptReady = false;           // the autopilot adopts results when ready, not a fixed 2 frames later
     double adoptWaitMs = kAdoptWaitMs; // before drawing, wait this long for a fracture job in flight
+    int rasterYield = 0;               // llvmpipe's niceness while fracture jobs run (0: unchanged)
     double demolish = 0;               // seconds between demolition charges on standing targets (0: none)
     int maxAwake = 0;                  // awake debris budget (0: the game's default)
     double lightPerAwake = -1;         // light pieces per budgeted awake body (< 0: the game's default)
@@ -254,31 +253,6 @@ bool loadScene(App& a, std::string& error) {
     return true;
 }
 
-/// Thread ids of llvmpipe's rasteriser threads (named llvmpipe-N) in this process.
-std::vector<int> rasterizerThreads() {
-    std::vector<int> out;
-    std::error_code ec;
-    for (const auto& task : std::filesystem::directory_iterator("/proc/self/task", ec)) {
-        std::ifstream comm(task.path() / "comm");
-        std::string name;
-        if (!std::getline(comm, name) || name.rfind("llvmpipe", 0) != 0)
-            continue;
-        if (const int tid = std::atoi(task.path().filename().c_str()); tid > 0)
-            out.push_back(tid);
-    }
-    return out;
-}
-
-/// Lowers the scheduling priority of llvmpipe's rasteriser threads to `niceness`, so that on a small
-/// machine the fracture workers run first; returns how many threads it changed.
-int lowerRasterizerPriority(int niceness) {
-    int changed = 0;
-    for (const int tid : rasterizerThreads())
-        if (setpriority(PRIO_PROCESS, static_cast<id_t>(tid), niceness) == 0)
-            ++changed;
-    return changed;
-}
-
 /// Exactly n comma-separated numbers from text into out.
 bool parseNumbers(const std::string& text, std::size_t n, float* out) {
     const char* p = text.c_str();
@@ -417,6 +391,11 @@ int parseOptions(int argc, char** argv, Options& o) {
                    "llvmpipe's rasteriser threads (sets LP_NUM_THREADS before the GL context; 0: the main "
                    "thread rasterises; default: Mesa's, one per core)")
         ->check(CLI::Range(0, 64));
+    cli.add_option("--raster-yield", o.rasterYield,
+                   "niceness of llvmpipe's rasteriser threads while a fracture job is queued or running, "
+                   "back to --raster-nice when none is (default 0: unchanged), so that the workers get the "
+                   "cores; report.json's threads.yielded_frames counts the frames drawn so")
+        ->check(CLI::Range(0, 19));
     cli.add_option("--worker-nice", o.workerNice,
                    "niceness of the fracture worker threads (default " + std::to_string(kWorkerNice) +
                        "; below 0 they run before software GL's rasteriser threads, which needs "
@@ -574,7 +553,7 @@ int setUp(App& app, RunMode& mode) {
     if (o.bilinear)
         app.quality.nearestTexels = false;
     app.pending.shadows = !o.noShadows && app.quality.shadows;
-    const int reniced = o.rasterNice > 0 ? lowerRasterizerPriority(o.rasterNice) : 0;
+    const int reniced = o.rasterNice > 0 ? demo::setRasterizerNice(o.rasterNice) : 0;
     mode.headless = headless;
     mode.autopilot = autopilot;
     mode.rendererName = rendererName;
@@ -664,7 +643,8 @@ ImGuiIO& startUi(App& app, bool autopilot) {
 
 // The end of a run: the audio capture, report.json, the host's and the journal's summaries; then the UI, the
 // game and the window closed. Returns the exit status.
-int finishRun(App& app, demo::Audio& audio, demo::RunReport& report, const std::string& rendererName) {
+int finishRun(App& app, demo::Audio& audio, demo::RunReport& report, const std::string& rendererName,
+              int yieldedFrames) {
     const Options& o = app.opt;
     if (std::string message; !audio.finish(message)) {
         std::fprintf(stderr, "error: %s\n", message.c_str());
@@ -673,8 +653,9 @@ int finishRun(App& app, demo::Audio& audio, demo::RunReport& report, const std::
     report.setAudio(audio.stats(), kVoices, audio.hasDevice());
     if (const demo::PriorityJobs* jobs = app.game.jobs())
         report.setThreads({jobs->workerCount(), jobs->nice(), jobs->raised(), jobs->refused(),
-                           static_cast<int>(rasterizerThreads().size()), !app.pending.deterministic,
-                           o.adoptWaitMs});
+                           static_cast<int>(demo::rasterizerThreads().size()), !app.pending.deterministic,
+                           o.adoptWaitMs, jobs->busyMs(), jobs->cpuMs(), yieldedFrames});
+    report.setVisibleLatencies(app.game.visibleLatency().visibleMs());
     if (!o.out.empty()) {
         std::string summary;
         const auto outDir = std::filesystem::path(o.out);
@@ -683,6 +664,7 @@ int finishRun(App& app, demo::Audio& audio, demo::RunReport& report, const std::
                 {rendererName, app.quality.name(), app.pending.shadows, app.gl->width(), app.gl->height()},
                 app.game.latencies(), app.screenshots, summary)) {
             app.game.writeTimings((outDir / "latency.csv").string());
+            (void)app.game.visibleLatency().writeCsv(outDir / "visible.csv");
             std::printf("report: %s\n", summary.c_str());
             std::printf("wrote %s/report.json, %s/frames.csv and %d screenshots\n", o.out.c_str(),
                         o.out.c_str(), app.screenshots);
@@ -744,6 +726,7 @@ int frameLoop(App& app, const RunMode& mode) {
                  o.rasterNice);
     demo::Audio audio({!headless, o.mute, o.audioWav, kVoices}); // silently no device when none opens
     demo::DynamicResolution resolution(1000.0f / o.targetFps, app.quality.minScale);
+    demo::RasterYield rasterYield(o.rasterYield, o.rasterNice);
     float lastFrameMs = 0;
 
     demo::Autopilot pilot;
@@ -811,6 +794,7 @@ int frameLoop(App& app, const RunMode& mode) {
         // autopilot uses; nothing changes while paused).
         if (!app.paused || autopilot)
             app.game.adoptReady(o.adoptWaitMs);
+        rasterYield.update(app.game.counters().jobs > 0);
         const double stepMs = std::chrono::duration<double, std::milli>(Clock::now() - stepStart).count();
         { // Sound: heard from the camera, the capture in step with game time.
             const demo::M4 view = app.game.camera().view();
@@ -915,6 +899,7 @@ int frameLoop(App& app, const RunMode& mode) {
             shotMs = std::chrono::duration<double, std::milli>(Clock::now() - shotStart).count();
         }
         app.gl->present();
+        app.game.presented(); // fractures adopted before this frame are on screen now
 
         // Frame time without the PNG encoding of screenshots.
         const double frameMs =
@@ -939,7 +924,7 @@ int frameLoop(App& app, const RunMode& mode) {
             break;
     }
 
-    return finishRun(app, audio, report, rendererName);
+    return finishRun(app, audio, report, rendererName, rasterYield.yieldedFrames());
 }
 
 } // namespace

@@ -47,6 +47,24 @@ TEST(Sound, ClipsArePeakNormalisedAndBreaksOutlastKnocks) {
     }
 }
 
+/// Sign changes per second of a clip: lower for a lower sound.
+double crossingsPerSecond(const std::vector<float>& c) {
+    int n = 0;
+    for (std::size_t i = 1; i < c.size(); ++i)
+        n += (c[i - 1] < 0) != (c[i] < 0) ? 1 : 0;
+    return n * static_cast<double>(Mixer::kSampleRate) / static_cast<double>(c.size());
+}
+
+TEST(Sound, CollapsesRumbleLongerAndLowerThanBreaks) {
+    const SoundBank bank(Mixer::kSampleRate);
+    for (int t = 0; t < kTimbres; ++t) {
+        const auto& collapse = bank.clip(SoundKind::Collapse, static_cast<Timbre>(t));
+        const auto& crumble = bank.clip(SoundKind::Break, static_cast<Timbre>(t));
+        EXPECT_GT(collapse.size(), crumble.size()) << "timbre " << t;
+        EXPECT_LT(crossingsPerSecond(collapse), crossingsPerSecond(crumble)) << "timbre " << t;
+    }
+}
+
 TEST(Sound, LoudnessGrowsWithImpulseAndFallsAsOneOverDistance) {
     Mixer m;
     m.setListener({0, 0, 0}, {1, 0, 0});

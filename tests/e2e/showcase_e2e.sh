@@ -2,7 +2,7 @@
 # Headless showcase run of rubble-demo (EGL surfaceless): --demolish keeps blasting demolition_block.cfg and
 # the stats lines (the HUD's numbers) carry the live, awake and frozen piece counts; pieces appear and grow,
 # and resting ones freeze. report.json ends with the same counts. The run's sound, captured to a WAV file
-# without a device, holds impacts, breaks and debris hitting the ground within the voice limit.
+# without a device, holds impacts, breaks, debris hitting the ground and collapses within the voice limit.
 # Usage: showcase_e2e.sh PATH/TO/rubble-demo SCENE
 set -uo pipefail
 demo=${1:?usage: showcase_e2e.sh PATH/TO/rubble-demo SCENE}
@@ -37,8 +37,8 @@ r = json.load(open(sys.argv[1]))
 live, awake, frozen = map(int, sys.argv[2:5])
 a = r["audio"]
 assert not a["device"], "a headless run opened an audio device"
-assert a["impacts"] > 0 and a["breaks"] > 0 and a["debris"] > 0, a
-assert a["events"] == a["impacts"] + a["breaks"] + a["debris"], a
+assert a["impacts"] > 0 and a["breaks"] > 0 and a["debris"] > 0 and a["collapses"] > 0, a
+assert a["events"] == a["impacts"] + a["breaks"] + a["debris"] + a["collapses"], a
 assert a["played"] + a["quiet"] + a["refused"] == a["events"], a
 assert 0 < a["peak_voices"] <= a["max_voices"], a
 with wave.open(sys.argv[5]) as w:
