@@ -206,6 +206,75 @@ TEST(NetRelay, AClientCutOffIsSentASyncOnlyNowAndThenAndTheLatestWhenHeardAgain)
     EXPECT_EQ(h.stats().mismatchedHashes, 0);
 }
 
+TEST(NetRelay, AClientFarBehindAfterAnOutageGetsTheWorldWithItsOwnObjectsByIdInsteadOfCuttingTheBacklog) {
+    test::NetHostRig net;
+    ASSERT_TRUE(net.server);
+    test::JournalRig& host = net.rig;
+    net::NetHost& h = *net.server;
+    Follower f(h.port(), 51);
+    long long cut = 0; // fractures the client adopted itself
+    f.client->setOnOutcome([&](const FractureOutcome&) { ++cut; });
+    const auto pump = [&] {
+        h.service(1);
+        return static_cast<bool>(f.client->service(1));
+    };
+    ASSERT_TRUE(test::waitFor([&] { return f.client->stats().joined; }, pump));
+    for (int frame = 0; frame < 30; ++frame) { // a few breaks before the outage, which it cuts itself
+        host.play(1);
+        h.publish();
+        h.service(0);
+    }
+    host.settle();
+    h.publish();
+    const std::uint64_t before = host.runtime.world().frame();
+    ASSERT_TRUE(test::waitFor([&] { return f.client->stats().frame == before; }, pump));
+    f.relay->setPartitioned(true);
+    const auto healAt = Clock::now() + std::chrono::milliseconds(1300); // longer than the client's 1 s
+    const long long fractured = host.runtime.counters().fractures, cutBefore = cut;
+    const auto step = [&](bool fire) { // the host goes on at its pace
+        if (fire)
+            host.play(1);
+        else
+            host.runtime.stepFrame();
+        h.publish();
+        if (host.runtime.world().frame() % 6 == 0)
+            h.publishPlacements(host.runtime.placements());
+        return pump();
+    };
+    for (int frame = 0; frame < 150; ++frame) // 2.5 s of fire while it hears nothing
+        ASSERT_TRUE(step(true));
+    ASSERT_TRUE(test::waitFor([&] { return Clock::now() >= healAt; }, [&] { return step(false); }));
+    const long long missed = host.runtime.counters().fractures - fractured;
+    ASSERT_GT(missed, 3);
+    f.relay->setPartitioned(false);
+    const std::uint64_t healed = host.runtime.world().frame();
+    ASSERT_TRUE(test::waitFor([&] { return f.client->stats().frame >= healed; }, [&] { return step(false); }))
+        << "at frame " << f.client->stats().frame << " of " << healed;
+    host.settle();
+    h.publish();
+    const std::uint64_t last = host.runtime.world().frame();
+    ASSERT_TRUE(test::waitFor([&] { return f.client->stats().frame == last; }, pump));
+    EXPECT_EQ(f.client->stats().resyncs, 1);
+    EXPECT_EQ(h.stats().resyncs, 1);
+    EXPECT_LT(cut - cutBefore, missed) << "the outage's pieces came by the resync, not cut by the client";
+    EXPECT_GT(h.stats().resyncObjectsSent, 0);
+    EXPECT_LT(h.stats().resyncObjectsSent, static_cast<long long>(host.runtime.world().objects().size()))
+        << "what it had unchanged went by id";
+    EXPECT_EQ(f.world->geometryHash(), host.runtime.world().geometryHash());
+    for (int frame = 0; frame < 60; ++frame) { // and it follows the journal from there
+        host.play(1);
+        h.publish();
+        h.service(0);
+    }
+    host.settle();
+    h.publish();
+    const std::uint64_t end = host.runtime.world().frame();
+    ASSERT_TRUE(test::waitFor([&] { return f.client->stats().frame == end; }, pump));
+    EXPECT_EQ(f.world->geometryHash(), host.runtime.world().geometryHash());
+    EXPECT_EQ(f.client->stats().mismatchedHashes, 0);
+    EXPECT_EQ(h.stats().mismatchedHashes, 0);
+}
+
 TEST(NetRelay, AClientNoticesAHostThatStoppedAnsweringAfterItsTimeout) {
     test::NetHostRig net;
     ASSERT_TRUE(net.server);
