@@ -696,6 +696,7 @@ int runClient(const Args& a) {
         return 1;
     }
     (*client)->setResyncFrames(a.resyncFrames);
+    (*client)->setKeepReplay(!a.replay.empty());
     Rng aim(mixSeed(a.seed, static_cast<std::uint64_t>(getpid())));
     long long shotsSent = 0;
     const auto shootAt = [&](double view) { // a shot from 30 m at a random destructible object it can see

@@ -87,6 +87,8 @@ std::uint64_t stateHash(const ObjectState& object, StateHashes* cache) {
 
 std::vector<std::uint8_t> encodeHello(const DestructionWorld& world, bool resync, StateHashes* cache) {
     std::vector<std::uint8_t> out{static_cast<std::uint8_t>(resync ? Message::Resync : Message::Hello)};
+    if (resync)
+        putVarint(out, world.journalPosition());
     const std::vector<ObjectId> ids = world.objects();
     putVarint(out, ids.size());
     ObjectId previous = 0;
@@ -98,11 +100,14 @@ std::vector<std::uint8_t> encodeHello(const DestructionWorld& world, bool resync
     return out;
 }
 
-bool decodeHello(const std::uint8_t* data, std::size_t size, KnownObjects& out, bool resync) {
+bool decodeHello(const std::uint8_t* data, std::size_t size, KnownObjects& out, bool resync,
+                 std::uint64_t* position) {
     if (size == 0 || data[0] != static_cast<std::uint8_t>(resync ? Message::Resync : Message::Hello))
         return false;
     const std::uint8_t *p = data + 1, *end = data + size;
-    std::uint64_t n = 0;
+    std::uint64_t at = 0, n = 0;
+    if (resync && !getVarint(p, end, at))
+        return false;
     if (!getVarint(p, end, n) || n > size)
         return false;
     KnownObjects known;
@@ -118,6 +123,8 @@ bool decodeHello(const std::uint8_t* data, std::size_t size, KnownObjects& out, 
     if (p != end)
         return false;
     out = std::move(known);
+    if (position)
+        *position = at;
     return true;
 }
 

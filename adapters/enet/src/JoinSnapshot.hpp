@@ -33,12 +33,14 @@ using PackedObjects = std::map<ObjectId, PackedObject>;
 /// Packs an object into `cache` unless it holds its version; false when compression failed.
 bool packObject(const ObjectState& object, PackedObjects& cache);
 
-/// A Hello message (type byte first): the world's objects and their state hashes; with `resync`, the same
-/// as a Resync message (a joined client far behind).
+/// A Hello message (type byte first): the world's objects and their state hashes; with `resync`, a Resync
+/// message (a joined client far behind): its journal position first, then the same.
 std::vector<std::uint8_t> encodeHello(const DestructionWorld& world, bool resync = false,
                                       StateHashes* cache = nullptr);
-/// Decodes a Hello (with `resync`, a Resync) message; false (out unchanged) for a malformed one.
-bool decodeHello(const std::uint8_t* data, std::size_t size, KnownObjects& out, bool resync = false);
+/// Decodes a Hello (with `resync`, a Resync, whose journal position goes to `position`) message; false (out
+/// unchanged) for a malformed one.
+bool decodeHello(const std::uint8_t* data, std::size_t size, KnownObjects& out, bool resync = false,
+                 std::uint64_t* position = nullptr);
 
 /// Sizes of a join snapshot.
 struct JoinSnapshotSize {

@@ -66,6 +66,8 @@ struct NetClient::Impl {
         std::uint64_t frame = 0, position = 0, hash = 0;
     };
     std::optional<SyncMsg> keptSync; // the latest sync received while resyncing
+    std::uint64_t resyncFrom = 0;    // its journal position when it asked
+    bool keepReplay = true;          // keeps the snapshot it joined (or resynced) with, for writeReplay
     detail::StateHashes stateHashes; // its objects' state hashes, by version (Hello, Resync)
 
     // Applies the held events of the world's current frame, with the fields the host left out.
@@ -169,6 +171,7 @@ struct NetClient::Impl {
             return Error{ErrorCode::IoError, "netplay: cannot ask for a resync"};
         resyncing = true;
         resyncAsked = now;
+        resyncFrom = world.journalPosition();
         std::uint64_t position = streamPosition - held.size();
         for (const detail::WireEvent& w : held)
             pending.emplace_back(position++, w);
@@ -329,14 +332,15 @@ struct NetClient::Impl {
         if (!ackDue || !server)
             return;
         ackDue = false;
-        const std::uint32_t id = doneTransfer ? doneTransfer : incoming.id;
-        const std::size_t count = doneTransfer ? doneChunks : incoming.got.size();
+        const bool whole = incoming.id == 0; // else a transfer on its way (a resync's, after the join's)
+        const std::uint32_t id = whole ? doneTransfer : incoming.id;
+        const std::size_t count = whole ? doneChunks : incoming.got.size();
         std::vector<std::uint8_t> ack{static_cast<std::uint8_t>(Message::SnapshotAck)};
         for (int b = 0; b < 4; ++b)
             ack.push_back(static_cast<std::uint8_t>(id >> (8 * b)));
         ack.resize(5 + (count + 7) / 8, 0);
         for (std::size_t i = 0; i < count; ++i)
-            if (doneTransfer || incoming.got[i])
+            if (whole || incoming.got[i])
                 ack[5 + i / 8] |= static_cast<std::uint8_t>(1u << (i % 8));
         detail::sendUnreliable(server, ack);
         enet_host_flush(host);
@@ -347,7 +351,13 @@ struct NetClient::Impl {
     Status resynced(Snapshot s, Clock::time_point received) {
         const std::uint64_t position = s.world.journalPosition;
         const double frame = static_cast<double>(s.world.frame);
-        Snapshot kept = s;
+        if (position < resyncFrom)
+            return Error{ErrorCode::InvalidInput,
+                         "netplay: the resync's snapshot (journal position " + std::to_string(position) +
+                             ") is older than this world (" + std::to_string(resyncFrom) + ")"};
+        std::optional<Snapshot> kept;
+        if (keepReplay)
+            kept = s;
         if (Status st = restoreSnapshot(world, std::move(s)); !st)
             return st;
         joinedWith = std::move(kept); // a replay starts here now
@@ -380,8 +390,10 @@ struct NetClient::Impl {
                 fresh[p.object].add(frame, p.objectToWorld);
                 baselines.setBaseline(p.object, detail::quantize(p.objectToWorld));
             }
-            const std::uint64_t hostSeed = s->world.seed;
-            Snapshot kept = *s;
+            const std::uint64_t hostSeed = s->world.seed, position = s->world.journalPosition;
+            std::optional<Snapshot> kept;
+            if (keepReplay)
+                kept = *s;
             if (Status st = restoreSnapshot(world, std::move(*s)); !st)
                 return st;
             joinedWith = std::move(kept);
@@ -392,8 +404,7 @@ struct NetClient::Impl {
                 {}; // its datagrams start at seq 1; the snapshot's placements are no publish it had whole
             held.clear();
             seed = hostSeed;
-            streamPosition = skipUntil =
-                joinedWith->world.journalPosition; // the host's events go on from there
+            streamPosition = skipUntil = position; // the host's events go on from there
             stats.joined = true;
             stats.joinMs = std::chrono::duration<double, std::milli>(Clock::now() - connected).count();
             stats.snapshotLoadMs = std::chrono::duration<double, std::milli>(Clock::now() - received).count();
@@ -478,7 +489,7 @@ Status NetClient::service(int timeoutMs) {
     std::vector<ENetEvent> events;
     ENetEvent e;
     int r = enet_host_service(im.host, &e, static_cast<enet_uint32>(std::max(0, timeoutMs)));
-    im.pumped = Clock::now();
+    const Clock::time_point started = im.pumped = Clock::now();
     for (; r > 0; r = enet_host_service(im.host, &e, 0)) {
         events.push_back(e);
         if (e.type != ENET_EVENT_TYPE_RECEIVE)
@@ -520,6 +531,8 @@ Status NetClient::service(int timeoutMs) {
         return status;
     im.acknowledgeChunks();
     enet_host_flush(im.host); // its acks, without waiting for the next call
+    if (const Clock::time_point now = Clock::now(); now - started > std::chrono::milliseconds(300))
+        im.heard = std::max(im.heard, now); // it was not listening: what comes next is no outage
     if (r < 0)
         return Error{ErrorCode::IoError, "netplay: ENet service failed"};
     return Status::ok();
@@ -529,6 +542,12 @@ void NetClient::setTimeout(int ms) {
     impl_->timeoutMs = static_cast<enet_uint32>(std::max(1, ms));
     if (impl_->server && impl_->stats.connected)
         detail::configurePeer(impl_->server, impl_->timeoutMs);
+}
+
+void NetClient::setKeepReplay(bool keep) {
+    impl_->keepReplay = keep;
+    if (!keep)
+        impl_->joinedWith.reset();
 }
 
 void NetClient::setResyncFrames(int frames) {
@@ -562,6 +581,8 @@ Status NetClient::shoot(const Vec3& origin, const Vec3& velocity) {
 Status NetClient::writeReplay(const std::filesystem::path& snapshot,
                               const std::filesystem::path& journal) const {
     const Impl& im = *impl_;
+    if (!im.keepReplay)
+        return Error{ErrorCode::InvalidInput, "netplay: this client keeps no replay (setKeepReplay)"};
     if (!im.joinedWith)
         return Error{ErrorCode::InvalidInput, "netplay: no replay before the join"};
     if (Status st = saveSnapshot(snapshot, *im.joinedWith); !st)

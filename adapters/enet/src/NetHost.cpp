@@ -250,9 +250,9 @@ struct NetHost::Impl {
 
     // The latest snapshot for a client that has `known` (for a resync: without placements), built unless
     // the latest one built is recent and for the same objects; false when it cannot be built.
-    bool build(const detail::KnownObjects& known, bool resync) {
+    bool build(const detail::KnownObjects& known, bool resync, std::uint64_t since = 0) {
         if (built.valid && world.frame() <= built.frame + kReuseFrames && built.known == known &&
-            built.resync == resync)
+            built.resync == resync && built.position >= since)
             return true;
         const auto started = std::chrono::steady_clock::now();
         built = {};
@@ -319,9 +319,9 @@ struct NetHost::Impl {
     // A joined client's Resync: far behind, it gets the world as it is now without the objects it has in
     // the same state (the pieces of what it missed), keeps the events it was sent meanwhile by their
     // journal positions, and is sent no sync until it has it. Its placements go on as they were.
-    void resync(ENetPeer* peer, const detail::KnownObjects& known) {
-        if (!build(known, true))
-            return; // it goes on cutting the backlog itself
+    void resync(ENetPeer* peer, const detail::KnownObjects& known, std::uint64_t position) {
+        if (!build(known, true, position)) // not older than the client: it applied the events up to there
+            return;                        // it goes on cutting the backlog itself
         startTransfer(peer, true);
         ++stats.resyncs;
         stats.resyncBytes += static_cast<long long>(built.size.wire);
@@ -353,13 +353,14 @@ struct NetHost::Impl {
         }
         if (d[0] == static_cast<std::uint8_t>(Message::Resync)) {
             detail::KnownObjects known;
+            std::uint64_t position = 0;
             auto last = lastResync.find(peer);
             if (closing || !peers.count(peer) || transfers.count(peer) ||
                 (last != lastResync.end() && now - last->second < kResyncEvery) ||
-                !detail::decodeHello(d, packet->dataLength, known, true))
+                !detail::decodeHello(d, packet->dataLength, known, true, &position))
                 return;
             lastResync[peer] = now;
-            return resync(peer, known);
+            return resync(peer, known, position);
         }
         if (d[0] == static_cast<std::uint8_t>(Message::SnapshotAck))
             return snapshotAck(peer, d, packet->dataLength);

@@ -67,6 +67,9 @@ public:
     /// How long the host may be silent before service() fails with an IoError saying it stopped answering
     /// (default 10 s: a partition shorter than that is survived, a host killed without closing is noticed).
     void setTimeout(int ms);
+    /// Whether it keeps what writeReplay needs (default true): a copy of the world it joined (or resynced)
+    /// with, which costs a copy of every object at each load.
+    void setKeepReplay(bool keep);
     /// After an outage (the host silent for 1 s), a client more than `frames` behind the host asks for the
     /// world as it is, its own unchanged objects by id, instead of cutting the pieces of what it missed
     /// (default 60; 0: never, it cuts them all).
