@@ -1,7 +1,7 @@
 // `rubble-bench netplay SCENE.cfg [--seconds T] [--clients N] [--shots-per-second R] [--workers W] [--seed S]
 //  [--late-join F] [--delay-ms D] [--jitter-ms J] [--loss L] [--burst B] [--partition-at A --partition-s P]
 //  [--placement-budget BYTES] [--placement-peak BYTES] [--placement-reserve BYTES] [--placement-hz H]
-//  [--resync-frames N] [--no-snapshot-cache] [--json] [--out DIR]`
+//  [--resync-frames N] [--snapshot-cache] [--json] [--out DIR]`
 //
 // Multiplayer as separate processes over a network that misbehaves: this process hosts the scene on the
 // Bullet binding in deterministic mode (fixed 1/60 s frames paced at 60 Hz, seeded projectiles at
@@ -83,14 +83,14 @@ struct Args {
     double delayMs = 0, jitterMs = 0, loss = 0, burst = 1;
     double partitionAt = -1, partitionS = 0;
     rubble::net::PlacementBudget budget;
-    double placementHz = 10;      // placements publishes a second
-    std::string out;              // folder for netplay.csv and netplay.png ("" = none)
-    int port = 0;                 // client: the host's port
-    std::string samples;          // client: where it writes its placement samples
-    bool noBase = false;          // clients do not load the scene first (the snapshot brings every object)
-    std::string replay;           // client: folder where it keeps the game when the host stops
-    int resyncFrames = 60;        // clients: frames behind after an outage that ask for a resync (0: never)
-    bool noSnapshotCache = false; // the host compresses every snapshot whole
+    double placementHz = 10;    // placements publishes a second
+    std::string out;            // folder for netplay.csv and netplay.png ("" = none)
+    int port = 0;               // client: the host's port
+    std::string samples;        // client: where it writes its placement samples
+    bool noBase = false;        // clients do not load the scene first (the snapshot brings every object)
+    std::string replay;         // client: folder where it keeps the game when the host stops
+    int resyncFrames = 60;      // clients: frames behind after an outage that ask for a resync (0: never)
+    bool snapshotCache = false; // the host keeps objects compressed one by one (NetHost::setSnapshotCache)
 };
 
 // Frames between placement samples, and how far behind its latest sync a client shows placements.
@@ -275,7 +275,7 @@ int runHost(const Args& a) {
     budget.mean = budget.mean * static_cast<std::size_t>(placementEvery) / 6;
     budget.peak = budget.peak * static_cast<std::size_t>(placementEvery) / 6;
     host.setPlacementBudget(budget);
-    host.setSnapshotCache(!a.noSnapshotCache);
+    host.setSnapshotCache(a.snapshotCache);
     const std::string tmp =
         (std::filesystem::temp_directory_path() / ("rubble-netplay-" + std::to_string(getpid()) + "-"))
             .string();
@@ -563,7 +563,7 @@ int runHost(const Args& a) {
     r["snapshot_build_ms"] =
         hs.snapshotBuildMs / static_cast<double>(std::max<long long>(1, hs.snapshotBuilds));
     r["snapshot_chunks_sent"] = hs.snapshotChunksSent;
-    r["snapshot_cache"] = !a.noSnapshotCache;
+    r["snapshot_cache"] = a.snapshotCache;
     r["snapshot_objects_packed"] = hs.snapshotObjectsPacked;
     r["objects_warmed"] = hs.objectsWarmed;
     r["snapshot_transfer_ms"] = hs.snapshotTransferMs / static_cast<double>(std::max<long long>(1, hs.joins));
@@ -864,8 +864,8 @@ const rubble::tools::Registrar host{
          app.add_option("--out", a->out, "folder: add a row to netplay.csv, draw netplay.png");
          app.add_flag("--no-base", a->noBase,
                       "clients do not load the scene first: the snapshot brings every object");
-         app.add_flag("--no-snapshot-cache", a->noSnapshotCache,
-                      "the host compresses each snapshot whole (no per-object cache, nothing packed ahead)");
+         app.add_flag("--snapshot-cache", a->snapshotCache,
+                      "the host keeps each object compressed on its own and packs new ones ahead");
          app.add_option("--resync-frames", a->resyncFrames,
                         "frames behind the host after an outage at which a client asks for a resync (0: "
                         "never; it cuts the backlog itself)")

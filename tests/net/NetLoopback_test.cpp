@@ -347,6 +347,7 @@ TEST(NetLoopback, AJoinAfterTheHostWaitedCompressesNoObjectItHadCompressedAhead)
     test::NetHostRig net;
     ASSERT_TRUE(net.server);
     net::NetHost& h = *net.server;
+    h.setSnapshotCache(true);
     net.rig.play(40);
     net.rig.settle();
     h.publish();

@@ -50,7 +50,7 @@ struct NetHost::Impl {
 
     std::map<ENetPeer*, std::chrono::steady_clock::time_point> heard;      // when each client was last heard
     std::map<ENetPeer*, std::chrono::steady_clock::time_point> lastResync; // its latest resync
-    bool packSnapshots = true; // objects compressed one by one and kept (setSnapshotCache)
+    bool packSnapshots = false; // objects compressed one by one and kept (setSnapshotCache)
     enet_uint32 timeoutMs = detail::kPeerTimeoutMs; // a client silent this long is dropped
     std::map<ENetPeer*, std::uint64_t> joinOrder;   // 0 for the first to join
     std::function<void(const ShotRequest&)> shotHandler;
@@ -107,7 +107,8 @@ struct NetHost::Impl {
         bool valid = false;
         bool resync = false; // without placements, for a joined client
         std::uint64_t frame = 0, position = 0;
-        detail::KnownObjects known;
+        detail::KnownObjects referenced; // the objects it sends by id, with their state hashes
+        bool reusable = false;           // referenced is all of them
         std::vector<std::uint8_t> msg;
         std::vector<ObjectPlacement> placements;
         detail::JoinSnapshotSize size;
@@ -249,10 +250,16 @@ struct NetHost::Impl {
     }
 
     // The latest snapshot for a client that has `known` (for a resync: without placements), built unless
-    // the latest one built is recent and for the same objects; false when it cannot be built.
+    // the latest one built is recent, of the same kind, not older than journal position `since`, and names
+    // by id only objects the client has in that state; false when it cannot be built.
     bool build(const detail::KnownObjects& known, bool resync, std::uint64_t since = 0) {
-        if (built.valid && world.frame() <= built.frame + kReuseFrames && built.known == known &&
-            built.resync == resync && built.position >= since)
+        const auto has = [&known](const std::pair<const ObjectId, std::uint64_t>& r) {
+            const auto k = known.find(r.first);
+            return k != known.end() && k->second == r.second;
+        };
+        if (built.valid && built.reusable && world.frame() <= built.frame + kReuseFrames &&
+            built.resync == resync && built.position >= since &&
+            std::all_of(built.referenced.begin(), built.referenced.end(), has))
             return true;
         const auto started = std::chrono::steady_clock::now();
         built = {};
@@ -273,7 +280,12 @@ struct NetHost::Impl {
         built.resync = resync;
         built.frame = world.frame();
         built.position = world.journalPosition();
-        built.known = known;
+        for (const auto& [id, hash] : known) // what it sent by id
+            if (const auto h = stateHashes.find(id); h != stateHashes.end() && h->second.second == hash &&
+                                                     world.object(id) &&
+                                                     world.object(id)->version == h->second.first)
+                built.referenced.emplace(id, hash);
+        built.reusable = built.referenced.size() == built.size.referenced;
         ++stats.snapshotBuilds;
         stats.snapshotObjectsPacked += static_cast<long long>(built.size.packed);
         stats.snapshotBuildMs +=
