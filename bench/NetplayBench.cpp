@@ -810,6 +810,7 @@ int runClient(const Args& a) {
                      {"placement_bytes", st.placementBytes},
                      {"shots_sent", shotsSent},
                      {"resyncs", st.resyncs},
+                     {"first_mismatch", st.firstMismatch},
                      {"resync_load_ms", st.resyncLoadMs},
                      {"outage",
                       {{"heard_again_s", monotonic(heardAgain)},

@@ -88,12 +88,18 @@ TEST(JoinSnapshot, ZstdPacksASnapshotTighterThanDeflateAndDecodesToTheSameState)
     std::printf("join snapshot: %zu raw bytes, %zu deflated, %zu with zstd\n", a.raw, a.wire, b.wire);
 }
 
+// What a world announces in its Hello, as the host decodes it.
+KnownObjects announced(const DestructionWorld& world) {
+    KnownObjects known;
+    const std::vector<std::uint8_t> hello = encodeHello(world);
+    EXPECT_TRUE(decodeHello(hello.data(), hello.size(), known));
+    return known;
+}
+
 TEST(JoinSnapshot, ObjectsPackedOneByOneAreCompressedOnceAndDecodeToTheSameState) {
     Fired fired;
     auto client = test::journalWorld(1);
-    KnownObjects known;
-    const std::vector<std::uint8_t> hello = encodeHello(*client);
-    ASSERT_TRUE(decodeHello(hello.data(), hello.size(), known));
+    const KnownObjects known = announced(*client);
     PackedObjects cache;
     JoinSnapshotSize first, again, whole, later;
     const std::vector<std::uint8_t> msg =

@@ -378,17 +378,17 @@ TEST(NetLoopback, AClientLongInOneServiceCallCuttingPiecesStillAnswersTheHost) {
     test::NetHostRig net;
     ASSERT_TRUE(net.server);
     net::NetHost& h = *net.server;
-    h.setTimeout(1000); // a client silent for 1 s is dropped
+    h.setTimeout(2000); // a client silent for 2 s is dropped
     DestructionWorld world(net.config);
     std::unique_ptr<net::NetClient> client = joining(net, world);
     ASSERT_TRUE(client);
     client->setResyncFrames(0); // it cuts everything itself
-    // Each piece it cuts takes 250 ms, as on a machine with little CPU to spare.
+    // Each piece it cuts takes 300 ms, as on a machine with little CPU to spare.
     client->setOnOutcome(
-        [](const FractureOutcome&) { std::this_thread::sleep_for(std::chrono::milliseconds(250)); });
+        [](const FractureOutcome&) { std::this_thread::sleep_for(std::chrono::milliseconds(300)); });
     std::atomic<bool> firing{true}, done{false};
     std::atomic<std::uint64_t> hostFrame{0};
-    std::thread host([&] { // the host at 60 Hz in real time, firing for 1 s
+    std::thread host([&] { // the host at 60 Hz in real time, firing for 1.5 s
         for (int frame = 0; !done; ++frame) {
             if (firing)
                 net.rig.play(1, 6);
@@ -397,7 +397,7 @@ TEST(NetLoopback, AClientLongInOneServiceCallCuttingPiecesStillAnswersTheHost) {
             h.publish();
             hostFrame = net.rig.runtime.world().frame();
             h.service(16);
-            if (frame == 60)
+            if (frame == 90)
                 firing = false;
         }
     });

@@ -218,16 +218,19 @@ TEST(NetRelay, AClientFarBehindAfterAnOutageGetsTheWorldWithItsOwnObjectsByIdIns
         h.service(1);
         return static_cast<bool>(f.client->service(1));
     };
-    ASSERT_TRUE(test::waitFor([&] { return f.client->stats().joined; }, pump));
-    for (int frame = 0; frame < 30; ++frame) { // a few breaks before the outage, which it cuts itself
-        host.play(1);
+    const auto fireAndFollow = [&](int frames) { // the host fires, and the client reaches its last frame
+        for (int frame = 0; frame < frames; ++frame) {
+            host.play(1);
+            h.publish();
+            h.service(0);
+        }
+        host.settle();
         h.publish();
-        h.service(0);
-    }
-    host.settle();
-    h.publish();
-    const std::uint64_t before = host.runtime.world().frame();
-    ASSERT_TRUE(test::waitFor([&] { return f.client->stats().frame == before; }, pump));
+        const std::uint64_t last = host.runtime.world().frame();
+        return test::waitFor([&] { return f.client->stats().frame == last; }, pump);
+    };
+    ASSERT_TRUE(test::waitFor([&] { return f.client->stats().joined; }, pump));
+    ASSERT_TRUE(fireAndFollow(30)); // a few breaks before the outage, which it cuts itself
     f.relay->setPartitioned(true);
     const auto healAt = Clock::now() + std::chrono::milliseconds(1300); // longer than the client's 1 s
     const long long fractured = host.runtime.counters().fractures, cutBefore = cut;
@@ -261,15 +264,7 @@ TEST(NetRelay, AClientFarBehindAfterAnOutageGetsTheWorldWithItsOwnObjectsByIdIns
     EXPECT_LT(h.stats().resyncObjectsSent, static_cast<long long>(host.runtime.world().objects().size()))
         << "what it had unchanged went by id";
     EXPECT_EQ(f.world->geometryHash(), host.runtime.world().geometryHash());
-    for (int frame = 0; frame < 60; ++frame) { // and it follows the journal from there
-        host.play(1);
-        h.publish();
-        h.service(0);
-    }
-    host.settle();
-    h.publish();
-    const std::uint64_t end = host.runtime.world().frame();
-    ASSERT_TRUE(test::waitFor([&] { return f.client->stats().frame == end; }, pump));
+    ASSERT_TRUE(fireAndFollow(60)); // and it follows the journal from there
     EXPECT_EQ(f.world->geometryHash(), host.runtime.world().geometryHash());
     EXPECT_EQ(f.client->stats().mismatchedHashes, 0);
     EXPECT_EQ(h.stats().mismatchedHashes, 0);

@@ -67,6 +67,7 @@ struct NetClient::Impl {
     };
     std::optional<SyncMsg> keptSync; // the latest sync received while resyncing
     std::uint64_t resyncFrom = 0;    // its journal position when it asked
+    std::uint64_t resyncedAt = 0;    // the frame of the latest resync's snapshot
     bool keepReplay = true;          // keeps the snapshot it joined (or resynced) with, for writeReplay
     detail::StateHashes stateHashes; // its objects' state hashes, by version (Hello, Resync)
 
@@ -107,8 +108,19 @@ struct NetClient::Impl {
         const std::uint64_t mine = world.geometryHash();
         ++stats.syncs;
         stats.frame = world.frame();
-        if (mine != m.hash || world.journalPosition() != m.position)
-            ++stats.mismatchedHashes;
+        if (mine != m.hash || world.journalPosition() != m.position) {
+            if (stats.mismatchedHashes++ == 0) // what differed, the first time
+                stats.firstMismatch =
+                    "frame " + std::to_string(m.frame) + ": geometry hash " + std::to_string(mine) +
+                    (mine == m.hash ? " (the host's)" : " against the host's " + std::to_string(m.hash)) +
+                    ", journal position " + std::to_string(world.journalPosition()) +
+                    (world.journalPosition() == m.position
+                         ? " (the host's)"
+                         : " against the host's " + std::to_string(m.position)) +
+                    (stats.resyncs > 0
+                         ? ", " + std::to_string(m.frame - resyncedAt) + " frames after its resync"
+                         : "");
+        }
         if (afterOutage && hostFrame <= world.frame() + resyncFrames)
             afterOutage = false; // caught up
         std::vector<std::uint8_t> ack{static_cast<std::uint8_t>(Message::Ack)};
@@ -368,6 +380,7 @@ struct NetClient::Impl {
                     : std::next(t);
         held.clear();
         ++stats.resyncs;
+        resyncedAt = static_cast<std::uint64_t>(frame);
         stats.resyncLoadMs += std::chrono::duration<double, std::milli>(Clock::now() - received).count();
         return endResync(position);
     }

@@ -30,6 +30,7 @@ struct ClientStats {
     long long resyncs = 0;          ///< snapshots loaded after an outage instead of cutting the backlog
     double resyncLoadMs = 0;        ///< time spent decoding and loading them (ms)
     long long keepAlives = 0;       ///< times ENet was served from within a long catch-up
+    std::string firstMismatch;      ///< what differed at the first mismatched sync (empty: none)
 };
 
 /// A client of a NetHost on a loopback address. Its world must be built with the host's settings (any
