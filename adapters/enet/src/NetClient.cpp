@@ -66,8 +66,10 @@ struct NetClient::Impl {
         std::uint64_t frame = 0, position = 0, hash = 0;
     };
     std::optional<SyncMsg> keptSync; // the latest sync received while resyncing
+    std::uint64_t keptSyncAt = 0;    // the journal position of the event after it in the stream
     std::uint64_t resyncFrom = 0;    // its journal position when it asked
     std::uint64_t resyncedAt = 0;    // the frame of the latest resync's snapshot
+    std::string resyncNote;          // what it was (for a mismatch after it)
     bool keepReplay = true;          // keeps the snapshot it joined (or resynced) with, for writeReplay
     detail::StateHashes stateHashes; // its objects' state hashes, by version (Hello, Resync)
 
@@ -117,9 +119,9 @@ struct NetClient::Impl {
                     (world.journalPosition() == m.position
                          ? " (the host's)"
                          : " against the host's " + std::to_string(m.position)) +
-                    (stats.resyncs > 0
-                         ? ", " + std::to_string(m.frame - resyncedAt) + " frames after its resync"
-                         : "");
+                    (stats.resyncs > 0 ? ", " + std::to_string(m.frame - resyncedAt) +
+                                             " frames after its resync (" + resyncNote + ")"
+                                       : "");
         }
         if (afterOutage && hostFrame <= world.frame() + resyncFrames)
             afterOutage = false; // caught up
@@ -192,28 +194,36 @@ struct NetClient::Impl {
         return Status::ok();
     }
 
-    // Leaves resync mode: the kept events from journal position `from` on follow in order, then the latest
-    // sync kept.
+    // Leaves resync mode: the kept events from journal position `from` on follow in the order they came,
+    // the latest sync kept among them: the events that came before it, then it, then the rest (an event the
+    // host recorded after a sync of the same frame must not be applied before that sync is checked).
     Status endResync(std::uint64_t from) {
         resyncing = false;
         skipUntil = std::max(skipUntil, from);
-        for (const auto& [position, w] : pending) {
-            if (position < skipUntil) {
-                --stats.events; // in the snapshot
-                continue;
-            }
-            const std::uint32_t last = held.empty() ? 0 : held.back().event.tick;
-            if (w.event.tick < world.frame() || w.event.tick < last)
-                return Error{ErrorCode::InvalidInput, "netplay: journal event of tick " +
-                                                          std::to_string(w.event.tick) + " arrived late"};
-            held.push_back(w);
-        }
-        pending.clear();
-        if (Status st = applyHeld(); !st)
-            return st;
         const std::optional<SyncMsg> m = keptSync;
         keptSync.reset();
-        return m ? sync(*m) : Status::ok();
+        const std::vector<std::pair<std::uint64_t, detail::WireEvent>> kept = std::move(pending);
+        pending.clear();
+        const auto hold = [&](bool beforeSync) -> Status {
+            for (const auto& [position, w] : kept) {
+                if (position < skipUntil || (m && (position < keptSyncAt) != beforeSync))
+                    continue;
+                const std::uint32_t last = held.empty() ? 0 : held.back().event.tick;
+                if (w.event.tick < world.frame() || w.event.tick < last)
+                    return Error{ErrorCode::InvalidInput, "netplay: journal event of tick " +
+                                                              std::to_string(w.event.tick) + " arrived late"};
+                held.push_back(w);
+            }
+            return applyHeld();
+        };
+        for (const auto& [position, w] : kept)
+            stats.events -= position < skipUntil; // in the snapshot
+        if (Status st = hold(true); !st)
+            return st;
+        if (m)
+            if (Status st = sync(*m); !st)
+                return st;
+        return m ? hold(false) : Status::ok();
     }
 
     // Advances the world to `frame`, applying the events of each frame as it begins; ENet goes on meanwhile
@@ -381,6 +391,13 @@ struct NetClient::Impl {
         held.clear();
         ++stats.resyncs;
         resyncedAt = static_cast<std::uint64_t>(frame);
+        std::size_t after = 0;
+        for (const auto& p : pending)
+            after += p.first >= position;
+        resyncNote = "snapshot at frame " + std::to_string(resyncedAt) + ", position " +
+                     std::to_string(position) + "; asked at position " + std::to_string(resyncFrom) + "; " +
+                     std::to_string(pending.size()) + " events kept, " + std::to_string(after) +
+                     " of them after the snapshot; next event position " + std::to_string(streamPosition);
         stats.resyncLoadMs += std::chrono::duration<double, std::milli>(Clock::now() - received).count();
         return endResync(position);
     }
@@ -446,6 +463,7 @@ struct NetClient::Impl {
             const SyncMsg m{detail::readU64(d + 1), detail::readU64(d + 9), detail::readU64(d + 17)};
             if (resyncing) {
                 keptSync = m;
+                keptSyncAt = streamPosition;
                 return Status::ok();
             }
             return sync(m);
