@@ -1,8 +1,7 @@
 // `rubble-bench netplay SCENE.cfg [--seconds T] [--clients N] [--shots-per-second R] [--workers W] [--seed S]
 //  [--late-join F] [--delay-ms D] [--jitter-ms J] [--loss L] [--burst B] [--partition-at A --partition-s P]
 //  [--placement-budget BYTES] [--placement-peak BYTES] [--placement-reserve BYTES] [--placement-hz H]
-//  [--json]
-//  [--out DIR]`
+//  [--resync-frames N] [--snapshot-cache] [--json] [--out DIR]`
 //
 // Multiplayer as separate processes over a network that misbehaves: this process hosts the scene on the
 // Bullet binding in deterministic mode (fixed 1/60 s frames paced at 60 Hz, seeded projectiles at
@@ -84,12 +83,14 @@ struct Args {
     double delayMs = 0, jitterMs = 0, loss = 0, burst = 1;
     double partitionAt = -1, partitionS = 0;
     rubble::net::PlacementBudget budget;
-    double placementHz = 10; // placements publishes a second
-    std::string out;         // folder for netplay.csv and netplay.png ("" = none)
-    int port = 0;            // client: the host's port
-    std::string samples;     // client: where it writes its placement samples
-    bool noBase = false;     // clients do not load the scene first (the snapshot brings every object)
-    std::string replay;      // client: folder where it keeps the game when the host stops
+    double placementHz = 10;    // placements publishes a second
+    std::string out;            // folder for netplay.csv and netplay.png ("" = none)
+    int port = 0;               // client: the host's port
+    std::string samples;        // client: where it writes its placement samples
+    bool noBase = false;        // clients do not load the scene first (the snapshot brings every object)
+    std::string replay;         // client: folder where it keeps the game when the host stops
+    int resyncFrames = 60;      // clients: frames behind after an outage that ask for a resync (0: never)
+    bool snapshotCache = false; // the host keeps objects compressed one by one (NetHost::setSnapshotCache)
 };
 
 // Frames between placement samples, and how far behind its latest sync a client shows placements.
@@ -159,11 +160,11 @@ Child spawn(const Args& a, std::uint16_t port, const std::string& samples) {
         close(fds[1]);
         const std::string p = std::to_string(port), w = std::to_string(a.workers), s = std::to_string(a.seed),
                           t = std::to_string(a.seconds + 60), shoot = std::to_string(a.clientShots),
-                          until = std::to_string(a.seconds);
+                          until = std::to_string(a.seconds), resync = std::to_string(a.resyncFrames);
         execl("/proc/self/exe", "rubble-bench", "netplay-client", "--port", p.c_str(), "--workers", w.c_str(),
               "--seed", s.c_str(), "--seconds", t.c_str(), "--samples", samples.c_str(), "--shoot",
               shoot.c_str(), "--shoot-for", until.c_str(), "--scene", a.noBase ? "" : a.file.c_str(),
-              static_cast<char*>(nullptr));
+              "--resync-frames", resync.c_str(), static_cast<char*>(nullptr));
         _exit(127);
     }
     close(fds[1]);
@@ -201,16 +202,18 @@ void writeResults(const std::string& dir, const std::vector<std::string>& header
     t.header = header;
     std::ifstream in(fs::path(dir) / "netplay.csv");
     std::string line;
+    std::size_t columns = 0; // of the file's header: a prefix of this one (its rows get empty cells), or 0
     bool first = true;
     while (std::getline(in, line)) {
-        if (first) { // an older header: its rows are dropped
+        if (first) { // an older header that is not a prefix of this one: its rows are dropped
             first = false;
-            if (line != [&] {
-                    std::string h;
-                    for (std::size_t i = 0; i < header.size(); ++i)
-                        h += (i ? "," : "") + header[i];
-                    return h;
-                }())
+            std::string h;
+            for (std::size_t i = 0; i < header.size(); ++i) {
+                h += (i ? "," : "") + header[i];
+                if (line == h)
+                    columns = i + 1;
+            }
+            if (columns == 0)
                 break;
             continue;
         }
@@ -218,8 +221,12 @@ void writeResults(const std::string& dir, const std::vector<std::string>& header
         std::string cell;
         for (std::istringstream ls(line); std::getline(ls, cell, ',');)
             cells.push_back(cell);
-        if (cells.size() == header.size())
+        if (!line.empty() && line.back() == ',')
+            cells.emplace_back();
+        if (cells.size() == columns) {
+            cells.resize(header.size());
             t.rows.push_back(cells);
+        }
     }
     t.rows.push_back(row);
     if (!rubble::bench::writeCsv(fs::path(dir) / "netplay.csv", t))
@@ -268,6 +275,7 @@ int runHost(const Args& a) {
     budget.mean = budget.mean * static_cast<std::size_t>(placementEvery) / 6;
     budget.peak = budget.peak * static_cast<std::size_t>(placementEvery) / 6;
     host.setPlacementBudget(budget);
+    host.setSnapshotCache(a.snapshotCache);
     const std::string tmp =
         (std::filesystem::temp_directory_path() / ("rubble-netplay-" + std::to_string(getpid()) + "-"))
             .string();
@@ -380,8 +388,9 @@ int runHost(const Args& a) {
     }
     const net::HostStats hs = host.stats();
     const double runSeconds = std::chrono::duration<double>(Clock::now() - start).count();
-    const std::uint64_t hostHash = runtime.world().geometryHash();
-    host.close(5000); // the clients hear that the host stops, report and exit
+    const std::uint64_t hostHash = runtime.world().geometryHash(), hostFrame = runtime.world().frame();
+    std::vector<std::string> unequal; // clients whose final hash is not the host's, and why
+    host.close(5000);                 // the clients hear that the host stops, report and exit
     server->reset();
     nlohmann::json clients = nlohmann::json::array();
     long long mismatched = hs.mismatchedHashes;
@@ -404,12 +413,20 @@ int runHost(const Args& a) {
         if (report.is_discarded() || !report.is_object()) {
             j = {{"error", "no report"}, {"output", out}};
             allConverged = false;
+            unequal.push_back("client " + std::to_string(c) + " gave no report");
         } else {
             mismatched += report.value("mismatched_hashes", 0LL);
             lateJoinMs = report.value("join_ms", -1.0);
-            allConverged =
-                allConverged && report.value("geometry_hash", std::string()) == std::to_string(hostHash);
+            const bool equal = report.value("geometry_hash", std::string()) == std::to_string(hostHash);
+            allConverged = allConverged && equal;
             j = report;
+            if (!equal) // what differed: where it stopped, and why
+                unequal.push_back("client " + std::to_string(c) + " ended at frame " +
+                                  std::to_string(report.value("frame", 0ULL)) + " of the host's " +
+                                  std::to_string(hostFrame) + " (" + report.value("ending", std::string()) +
+                                  "; " + std::to_string(report.value("syncs", 0LL)) + " syncs, " +
+                                  std::to_string(report.value("mismatched_hashes", 0LL)) + " mismatched, " +
+                                  std::to_string(report.value("resyncs", 0LL)) + " resyncs)");
         }
         // Placement error against the host, for bodies dynamic at the sampled frame.
         std::map<std::uint32_t, std::vector<double>> errorsAt; // lag → errors
@@ -546,8 +563,17 @@ int runHost(const Args& a) {
     r["snapshot_build_ms"] =
         hs.snapshotBuildMs / static_cast<double>(std::max<long long>(1, hs.snapshotBuilds));
     r["snapshot_chunks_sent"] = hs.snapshotChunksSent;
+    r["snapshot_cache"] = a.snapshotCache;
+    r["snapshot_objects_packed"] = hs.snapshotObjectsPacked;
+    r["objects_warmed"] = hs.objectsWarmed;
     r["snapshot_transfer_ms"] = hs.snapshotTransferMs / static_cast<double>(std::max<long long>(1, hs.joins));
+    r["resync_frames"] = a.resyncFrames;
+    r["resyncs"] = hs.resyncs;
+    r["resync_bytes"] = hs.resyncBytes / std::max<long long>(1, hs.resyncs);
+    r["resync_objects_sent"] = hs.resyncObjectsSent / std::max<long long>(1, hs.resyncs);
+    r["resync_transfer_ms"] = hs.resyncTransferMs / static_cast<double>(std::max<long long>(1, hs.resyncs));
     r["final_hashes_equal"] = allConverged;
+    r["unequal_clients"] = unequal;
     r["converge_ms"] = convergeMs;
     r["kbps_mean"] = means.empty() ? 0 : *std::max_element(means.begin(), means.end());
     r["kbps_p99"] = p99s.empty() ? 0 : *std::max_element(p99s.begin(), p99s.end());
@@ -593,7 +619,11 @@ int runHost(const Args& a) {
                       "converge_ms",
                       "late_join_ms",
                       "snapshot_bytes",
-                      "other_cpu_cores"},
+                      "other_cpu_cores",
+                      "resync_frames",
+                      "resyncs",
+                      "resync_bytes",
+                      "snapshot_build_ms"},
                      {std::filesystem::path(a.file).filename().string(),
                       std::to_string(a.clients),
                       b::fixed(runSeconds, 1),
@@ -618,7 +648,11 @@ int runHost(const Args& a) {
                       b::fixed(convergeMs, 0),
                       b::fixed(lateJoinMs, 0),
                       std::to_string(r["snapshot_bytes"].get<long long>()),
-                      b::fixed(use.other, 2)});
+                      b::fixed(use.other, 2),
+                      std::to_string(a.resyncFrames),
+                      std::to_string(hs.resyncs),
+                      std::to_string(r["resync_bytes"].get<long long>()),
+                      b::fixed(r["snapshot_build_ms"].get<double>(), 0)});
     }
     if (a.json) {
         std::cout << r.dump() << "\n";
@@ -631,6 +665,8 @@ int runHost(const Args& a) {
                   << " mismatched hashes, late join " << lateJoinMs << " ms, converge " << convergeMs
                   << " ms, final hashes equal: " << (allConverged ? "yes" : "NO") << "\n";
     }
+    for (const std::string& u : unequal)
+        std::cerr << "rubble-bench netplay: final hash differs: " << u << "\n";
     const bool shotsTaken = a.clientShots <= 0 || hs.shotsAccepted > 0;
     return mismatched == 0 && allConverged && shotsTaken && !children.empty() ? 0 : 1;
 }
@@ -659,6 +695,8 @@ int runClient(const Args& a) {
         std::cout << nlohmann::json{{"error", client.error().message}}.dump() << "\n";
         return 1;
     }
+    (*client)->setResyncFrames(a.resyncFrames);
+    (*client)->setKeepReplay(!a.replay.empty());
     Rng aim(mixSeed(a.seed, static_cast<std::uint64_t>(getpid())));
     long long shotsSent = 0;
     const auto shootAt = [&](double view) { // a shot from 30 m at a random destructible object it can see
@@ -771,6 +809,9 @@ int runClient(const Args& a) {
                      {"placements", st.placements},
                      {"placement_bytes", st.placementBytes},
                      {"shots_sent", shotsSent},
+                     {"resyncs", st.resyncs},
+                     {"first_mismatch", st.firstMismatch},
+                     {"resync_load_ms", st.resyncLoadMs},
                      {"outage",
                       {{"heard_again_s", monotonic(heardAgain)},
                        {"caught_up_s", monotonic(caughtUp)},
@@ -824,6 +865,12 @@ const rubble::tools::Registrar host{
          app.add_option("--out", a->out, "folder: add a row to netplay.csv, draw netplay.png");
          app.add_flag("--no-base", a->noBase,
                       "clients do not load the scene first: the snapshot brings every object");
+         app.add_flag("--snapshot-cache", a->snapshotCache,
+                      "the host keeps each object compressed on its own and packs new ones ahead");
+         app.add_option("--resync-frames", a->resyncFrames,
+                        "frames behind the host after an outage at which a client asks for a resync (0: "
+                        "never; it cuts the backlog itself)")
+             ->check(CLI::Range(0, 100000));
          app.add_flag("--json", a->json, "one JSON object on stdout");
          return [a] { return runHost(*a); };
      }}};
@@ -845,6 +892,7 @@ const rubble::tools::Registrar client{
          app.add_option("--scene", a->file, "world.cfg it loads before joining (\"\": none)");
          app.add_option("--replay", a->replay,
                         "folder where it keeps the game (snapshot + journal) when the host stops");
+         app.add_option("--resync-frames", a->resyncFrames, "frames behind after an outage for a resync");
          return [a] { return runClient(*a); };
      }}};
 

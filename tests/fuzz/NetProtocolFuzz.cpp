@@ -12,6 +12,7 @@
 #include "FuzzInput.hpp"
 #include "JoinSnapshot.hpp"
 #include "Placements.hpp"
+#include "Protocol.hpp"
 
 namespace {
 
@@ -75,7 +76,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         }
     } else if (mode == 3) {
         KnownObjects known, again;
-        if (decodeHello(body, n, known) && (!decodeHello(body, n, again) || again != known))
+        const bool resync = n > 0 && body[0] == static_cast<std::uint8_t>(Message::Resync); // as a Hello
+        if (decodeHello(body, n, known, resync) && (!decodeHello(body, n, again, resync) || again != known))
             fail("an accepted hello decodes differently the second time");
     } else if (mode == 4) {
         static DestructionWorld empty([] {

@@ -19,6 +19,7 @@ using net::detail::encodeHello;
 using net::detail::encodeJoinSnapshot;
 using net::detail::JoinSnapshotSize;
 using net::detail::KnownObjects;
+using net::detail::PackedObjects;
 using net::detail::SnapshotCodec;
 
 // A host whose first shot broke the wall (the column and the slab are as loaded).
@@ -85,6 +86,48 @@ TEST(JoinSnapshot, ZstdPacksASnapshotTighterThanDeflateAndDecodesToTheSameState)
         EXPECT_EQ(world->geometryHash(), fired.host.runtime.world().geometryHash());
     }
     std::printf("join snapshot: %zu raw bytes, %zu deflated, %zu with zstd\n", a.raw, a.wire, b.wire);
+}
+
+// What a world announces in its Hello, as the host decodes it.
+KnownObjects announced(const DestructionWorld& world) {
+    KnownObjects known;
+    const std::vector<std::uint8_t> hello = encodeHello(world);
+    EXPECT_TRUE(decodeHello(hello.data(), hello.size(), known));
+    return known;
+}
+
+TEST(JoinSnapshot, ObjectsPackedOneByOneAreCompressedOnceAndDecodeToTheSameState) {
+    Fired fired;
+    auto client = test::journalWorld(1);
+    const KnownObjects known = announced(*client);
+    PackedObjects cache;
+    JoinSnapshotSize first, again, whole, later;
+    const std::vector<std::uint8_t> msg =
+        encodeJoinSnapshot(fired.snapshot(), known, &first, SnapshotCodec::Zstd, nullptr, &cache);
+    ASSERT_GT(first.sent, 1u);
+    EXPECT_EQ(first.packed, first.sent);
+    EXPECT_EQ(encodeJoinSnapshot(fired.snapshot(), known, &again, SnapshotCodec::Zstd, nullptr, &cache), msg);
+    EXPECT_EQ(again.packed, 0u) << "every object came from the cache";
+    (void)encodeJoinSnapshot(fired.snapshot(), known, &whole);
+    EXPECT_EQ(first.raw, whole.raw);
+    std::printf("join snapshot: %zu bytes compressed whole, %zu packed object by object\n", whole.wire,
+                first.wire);
+    Result<Snapshot> s = decodeJoinSnapshot(msg.data(), msg.size(), *client);
+    ASSERT_TRUE(s) << s.error().message;
+    ASSERT_TRUE(restoreSnapshot(*client, std::move(*s)));
+    EXPECT_EQ(client->geometryHash(), fired.host.runtime.world().geometryHash());
+
+    fired.host.play(30); // more pieces: only they are compressed
+    fired.host.settle();
+    auto fresh = test::journalWorld(1);
+    const std::vector<std::uint8_t> next =
+        encodeJoinSnapshot(fired.snapshot(), known, &later, SnapshotCodec::Zstd, nullptr, &cache);
+    EXPECT_GT(later.packed, 0u);
+    EXPECT_LT(later.packed, later.sent);
+    Result<Snapshot> t = decodeJoinSnapshot(next.data(), next.size(), *fresh);
+    ASSERT_TRUE(t) << t.error().message;
+    ASSERT_TRUE(restoreSnapshot(*fresh, std::move(*t)));
+    EXPECT_EQ(fresh->geometryHash(), fired.host.runtime.world().geometryHash());
 }
 
 TEST(JoinSnapshot, AClientThatReplayedTheJournalHasEveryPieceById) {

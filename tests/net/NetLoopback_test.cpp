@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <thread>
@@ -340,6 +341,77 @@ TEST(NetLoopback, ClientsJoiningWithinHalfASecondShareOneSnapshotAndGetTheJourna
     EXPECT_EQ((*b)->stats().mismatchedHashes, 0);
     EXPECT_EQ(h.stats().mismatchedHashes, 0);
     EXPECT_GT((*b)->stats().events, 0);
+}
+
+TEST(NetLoopback, AJoinAfterTheHostWaitedCompressesNoObjectItHadCompressedAhead) {
+    test::NetHostRig net;
+    ASSERT_TRUE(net.server);
+    net::NetHost& h = *net.server;
+    h.setSnapshotCache(true);
+    net.rig.play(40);
+    net.rig.settle();
+    h.publish();
+    ASSERT_GT(net.rig.runtime.counters().fractures, 2);
+    ASSERT_TRUE(test::waitFor(
+        [&] {
+            return h.stats().objectsWarmed >=
+                   static_cast<long long>(net.rig.runtime.world().objects().size());
+        },
+        [&] {
+            h.service(5); // the game waits for its next frame
+            return true;
+        }));
+    DestructionWorld world(net.config);
+    std::unique_ptr<net::NetClient> client = joining(net, world);
+    ASSERT_TRUE(client);
+    EXPECT_EQ(h.stats().snapshotObjectsPacked, 0) << "every object was compressed while the host waited";
+    ASSERT_TRUE(test::waitFor([&] { return client->stats().joined && h.stats().acks > 0; },
+                              [&] {
+                                  h.service(1);
+                                  return static_cast<bool>(client->service(1));
+                              }));
+    EXPECT_EQ(world.geometryHash(), net.rig.runtime.world().geometryHash());
+    EXPECT_EQ(client->stats().mismatchedHashes, 0);
+}
+
+TEST(NetLoopback, AClientLongInOneServiceCallCuttingPiecesStillAnswersTheHost) {
+    test::NetHostRig net;
+    ASSERT_TRUE(net.server);
+    net::NetHost& h = *net.server;
+    h.setTimeout(2000); // a client silent for 2 s is dropped
+    DestructionWorld world(net.config);
+    std::unique_ptr<net::NetClient> client = joining(net, world);
+    ASSERT_TRUE(client);
+    client->setResyncFrames(0); // it cuts everything itself
+    // Each piece it cuts takes 300 ms, as on a machine with little CPU to spare.
+    client->setOnOutcome(
+        [](const FractureOutcome&) { std::this_thread::sleep_for(std::chrono::milliseconds(300)); });
+    std::atomic<bool> firing{true}, done{false};
+    std::atomic<std::uint64_t> hostFrame{0};
+    std::thread host([&] { // the host at 60 Hz in real time, firing for 1.5 s
+        for (int frame = 0; !done; ++frame) {
+            if (firing)
+                net.rig.play(1, 6);
+            else
+                net.rig.runtime.stepFrame();
+            h.publish();
+            hostFrame = net.rig.runtime.world().frame();
+            h.service(16);
+            if (frame == 90)
+                firing = false;
+        }
+    });
+    Status st = Status::ok();
+    const auto end = std::chrono::steady_clock::now() + std::chrono::minutes(2);
+    while (st && std::chrono::steady_clock::now() < end && (firing || client->stats().frame + 30 < hostFrame))
+        st = client->service(5);
+    done = true;
+    host.join();
+    ASSERT_TRUE(st) << st.message();
+    EXPECT_EQ(h.stats().clients, 1) << "the host kept it";
+    EXPECT_GT(client->stats().keepAlives, 0);
+    EXPECT_EQ(client->stats().mismatchedHashes, 0);
+    EXPECT_EQ(h.stats().mismatchedHashes, 0);
 }
 
 TEST(NetLoopback, OnlyLoopbackAddressesAndDeterministicWorlds) {

@@ -206,6 +206,81 @@ TEST(NetRelay, AClientCutOffIsSentASyncOnlyNowAndThenAndTheLatestWhenHeardAgain)
     EXPECT_EQ(h.stats().mismatchedHashes, 0);
 }
 
+TEST(NetRelay, AClientFarBehindAfterAnOutageGetsTheWorldWithItsOwnObjectsByIdInsteadOfCuttingTheBacklog) {
+    test::NetHostRig net;
+    ASSERT_TRUE(net.server);
+    test::JournalRig& host = net.rig;
+    net::NetHost& h = *net.server;
+    Follower f(h.port(), 51);
+    long long cut = 0; // fractures the client adopted itself
+    f.client->setOnOutcome([&](const FractureOutcome&) { ++cut; });
+    const auto pump = [&] {
+        h.service(1);
+        return static_cast<bool>(f.client->service(1));
+    };
+    const auto fireAndFollow = [&](int frames) { // the host fires, and the client reaches its last frame
+        for (int frame = 0; frame < frames; ++frame) {
+            host.play(1);
+            h.publish();
+            h.service(0);
+        }
+        host.settle();
+        h.publish();
+        const std::uint64_t last = host.runtime.world().frame();
+        return test::waitFor([&] { return f.client->stats().frame == last; }, pump);
+    };
+    ASSERT_TRUE(test::waitFor([&] { return f.client->stats().joined; }, pump));
+    ASSERT_TRUE(fireAndFollow(30)); // a few breaks before the outage, which it cuts itself
+    f.relay->setPartitioned(true);
+    const auto healAt = Clock::now() + std::chrono::milliseconds(1300); // longer than the client's 1 s
+    const long long fractured = host.runtime.counters().fractures, cutBefore = cut;
+    const auto step = [&](int fireEvery) { // the host goes on at its pace (0: without firing)
+        if (fireEvery > 0)
+            host.play(1, fireEvery);
+        else
+            host.runtime.stepFrame();
+        h.publish();
+        if (host.runtime.world().frame() % 6 == 0)
+            h.publishPlacements(host.runtime.placements());
+        return pump();
+    };
+    for (int frame = 0; frame < 150; ++frame) // 2.5 s of fire while it hears nothing
+        ASSERT_TRUE(step(7));
+    ASSERT_TRUE(test::waitFor([&] { return Clock::now() >= healAt; }, [&] { return step(0); }));
+    const long long missed = host.runtime.counters().fractures - fractured;
+    ASSERT_GT(missed, 3);
+    f.relay->setPartitioned(false);
+    const std::uint64_t healed = host.runtime.world().frame();
+    // The host fires every other frame meanwhile: events it records after a sync of their frame reach the
+    // client while its resync is on its way, and must follow that sync.
+    long long cutWhenResynced = -1, objectsWhenBuilt = -1;
+    ASSERT_TRUE(test::waitFor([&] { return f.client->stats().frame >= healed + 30; },
+                              [&] {
+                                  if (cutWhenResynced < 0 && f.client->stats().resyncs > 0)
+                                      cutWhenResynced = cut;
+                                  const bool ok = step(2);
+                                  if (objectsWhenBuilt < 0 && h.stats().resyncs > 0) // built in that step
+                                      objectsWhenBuilt =
+                                          static_cast<long long>(host.runtime.world().objects().size());
+                                  return ok;
+                              }))
+        << "at frame " << f.client->stats().frame << " of " << healed;
+    host.settle();
+    h.publish();
+    const std::uint64_t last = host.runtime.world().frame();
+    ASSERT_TRUE(test::waitFor([&] { return f.client->stats().frame == last; }, pump));
+    EXPECT_EQ(f.client->stats().resyncs, 1);
+    EXPECT_EQ(h.stats().resyncs, 1);
+    EXPECT_LT(cutWhenResynced - cutBefore, missed) << "the outage's pieces came by the resync, not cut by it";
+    EXPECT_GT(h.stats().resyncObjectsSent, 0);
+    EXPECT_LT(h.stats().resyncObjectsSent, objectsWhenBuilt) << "what it had unchanged went by id";
+    EXPECT_EQ(f.world->geometryHash(), host.runtime.world().geometryHash());
+    ASSERT_TRUE(fireAndFollow(60)); // and it follows the journal from there
+    EXPECT_EQ(f.world->geometryHash(), host.runtime.world().geometryHash());
+    EXPECT_EQ(f.client->stats().mismatchedHashes, 0);
+    EXPECT_EQ(h.stats().mismatchedHashes, 0);
+}
+
 TEST(NetRelay, AClientNoticesAHostThatStoppedAnsweringAfterItsTimeout) {
     test::NetHostRig net;
     ASSERT_TRUE(net.server);

@@ -20,26 +20,94 @@ Error malformed(const std::string& what) {
     return Error{ErrorCode::ParseError, "netplay: snapshot message: " + what};
 }
 
+// Compresses bytes as one Zstandard frame (level 3) onto out; false when it failed (out of memory).
+bool appendZstd(std::vector<std::uint8_t>& out, const std::uint8_t* data, std::size_t size) {
+    const std::size_t at = out.size();
+    out.resize(at + ZSTD_compressBound(size));
+    const std::size_t packed = ZSTD_compress(out.data() + at, out.size() - at, data, size, 3);
+    if (ZSTD_isError(packed))
+        return false;
+    out.resize(at + packed);
+    return true;
+}
+
+// Where the object records begin in a snapshot's bytes (after the header and the object count), and the
+// bytes after them in a snapshot without work, placements or structure.
+struct Layout {
+    std::size_t records = 0, emptyTail = 0;
+};
+const Layout& layout() {
+    static const Layout l = [] {
+        Snapshot none, one;
+        one.world.objects.emplace_back();
+        const std::vector<std::uint8_t> a = encodeSnapshot(none), b = encodeSnapshot(one);
+        std::size_t i = 0;
+        while (i < a.size() && a[i] == b[i])
+            ++i;
+        // The first byte that differs is the object count's lowest (0 against 1).
+        return Layout{i + 4, a.size() - (i + 4)};
+    }();
+    return l;
+}
+
+std::uint32_t crcOf(std::uint32_t crc, const std::uint8_t* data, std::size_t size) {
+    return static_cast<std::uint32_t>(::crc32(crc, data, static_cast<uInt>(size)));
+}
+
 } // namespace
 
-std::vector<std::uint8_t> encodeHello(const DestructionWorld& world) {
-    std::vector<std::uint8_t> out{static_cast<std::uint8_t>(Message::Hello)};
+bool packObject(const ObjectState& object, PackedObjects& cache) {
+    const auto it = cache.find(object.id);
+    if (it != cache.end() && it->second.version == object.version)
+        return true;
+    Snapshot one;
+    one.world.objects.push_back(object);
+    const std::vector<std::uint8_t> bytes = encodeSnapshot(one);
+    const Layout& l = layout();
+    PackedObject p;
+    p.version = object.version;
+    p.raw = bytes.size() - l.records - l.emptyTail;
+    p.crc = crcOf(0, bytes.data() + l.records, p.raw);
+    if (!appendZstd(p.zstd, bytes.data() + l.records, p.raw))
+        return false;
+    cache[object.id] = std::move(p);
+    return true;
+}
+
+std::uint64_t stateHash(const ObjectState& object, StateHashes* cache) {
+    if (!cache)
+        return objectStateHash(object);
+    const auto it = cache->find(object.id);
+    if (it != cache->end() && it->second.first == object.version)
+        return it->second.second;
+    const std::uint64_t h = objectStateHash(object);
+    (*cache)[object.id] = {object.version, h};
+    return h;
+}
+
+std::vector<std::uint8_t> encodeHello(const DestructionWorld& world, bool resync, StateHashes* cache) {
+    std::vector<std::uint8_t> out{static_cast<std::uint8_t>(resync ? Message::Resync : Message::Hello)};
+    if (resync)
+        putVarint(out, world.journalPosition());
     const std::vector<ObjectId> ids = world.objects();
     putVarint(out, ids.size());
     ObjectId previous = 0;
     for (ObjectId id : ids) {
         putVarint(out, id - previous); // ascending
         previous = id;
-        appendU64(out, objectStateHash(*world.object(id)));
+        appendU64(out, stateHash(*world.object(id), cache));
     }
     return out;
 }
 
-bool decodeHello(const std::uint8_t* data, std::size_t size, KnownObjects& out) {
-    if (size == 0 || data[0] != static_cast<std::uint8_t>(Message::Hello))
+bool decodeHello(const std::uint8_t* data, std::size_t size, KnownObjects& out, bool resync,
+                 std::uint64_t* position) {
+    if (size == 0 || data[0] != static_cast<std::uint8_t>(resync ? Message::Resync : Message::Hello))
         return false;
     const std::uint8_t *p = data + 1, *end = data + size;
-    std::uint64_t n = 0;
+    std::uint64_t at = 0, n = 0;
+    if (resync && !getVarint(p, end, at))
+        return false;
     if (!getVarint(p, end, n) || n > size)
         return false;
     KnownObjects known;
@@ -55,22 +123,23 @@ bool decodeHello(const std::uint8_t* data, std::size_t size, KnownObjects& out) 
     if (p != end)
         return false;
     out = std::move(known);
+    if (position)
+        *position = at;
     return true;
 }
 
 std::vector<std::uint8_t> encodeJoinSnapshot(Snapshot snapshot, const KnownObjects& known,
-                                             JoinSnapshotSize* size, SnapshotCodec codec) {
+                                             JoinSnapshotSize* size, SnapshotCodec codec, StateHashes* cache,
+                                             PackedObjects* packed) {
     std::vector<ObjectId> referenced;
     std::vector<ObjectState> sent;
     for (ObjectState& o : snapshot.world.objects) {
         const auto k = known.find(o.id);
-        if (k != known.end() && k->second == objectStateHash(o))
+        if (k != known.end() && k->second == stateHash(o, cache))
             referenced.push_back(o.id);
         else
             sent.push_back(std::move(o));
     }
-    snapshot.world.objects = std::move(sent);
-    const std::vector<std::uint8_t> raw = encodeSnapshot(snapshot);
     std::vector<std::uint8_t> out{static_cast<std::uint8_t>(Message::Snapshot)};
     putVarint(out, referenced.size());
     ObjectId previous = 0;
@@ -79,23 +148,65 @@ std::vector<std::uint8_t> encodeJoinSnapshot(Snapshot snapshot, const KnownObjec
         previous = id;
     }
     out.push_back(static_cast<std::uint8_t>(codec));
+    if (codec == SnapshotCodec::Zstd && packed) {
+        // The snapshot without objects gives the header and the rest; the records come from the cache.
+        std::size_t fresh = 0, records = 0;
+        std::uint32_t crc = 0;
+        for (ObjectState& o : sent) {
+            const auto it = packed->find(o.id);
+            if (it == packed->end() || it->second.version != o.version) {
+                if (!packObject(o, *packed))
+                    return {};
+                ++fresh;
+            }
+        }
+        snapshot.world.objects.clear();
+        std::vector<std::uint8_t> shell = encodeSnapshot(snapshot);
+        const std::size_t head = layout().records;
+        const auto count = static_cast<std::uint32_t>(sent.size());
+        for (int b = 0; b < 4; ++b)
+            shell[head - 4 + static_cast<std::size_t>(b)] = static_cast<std::uint8_t>(count >> (8 * b));
+        crc = crcOf(0, shell.data(), head);
+        for (const ObjectState& o : sent) {
+            const PackedObject& p = packed->at(o.id);
+            crc = static_cast<std::uint32_t>(
+                ::crc32_combine(crc, p.crc, static_cast<z_off_t>(p.raw))); // as if its bytes followed
+            records += p.raw;
+        }
+        crc = crcOf(crc, shell.data() + head, shell.size() - head - 4);
+        for (int b = 0; b < 4; ++b)
+            shell[shell.size() - 4 + static_cast<std::size_t>(b)] = static_cast<std::uint8_t>(crc >> (8 * b));
+        const std::size_t raw = shell.size() + records;
+        putVarint(out, raw);
+        if (!appendZstd(out, shell.data(), head))
+            return {};
+        for (const ObjectState& o : sent) {
+            const std::vector<std::uint8_t>& z = packed->at(o.id).zstd;
+            out.insert(out.end(), z.begin(), z.end());
+        }
+        if (!appendZstd(out, shell.data() + head, shell.size() - head))
+            return {};
+        if (size)
+            *size = {raw, out.size(), referenced.size(), sent.size(), fresh};
+        return out;
+    }
+    snapshot.world.objects = std::move(sent);
+    const std::vector<std::uint8_t> raw = encodeSnapshot(snapshot);
     putVarint(out, raw.size());
     const std::size_t at = out.size();
     if (codec == SnapshotCodec::Zstd) {
-        out.resize(at + ZSTD_compressBound(raw.size()));
-        const std::size_t packed = ZSTD_compress(out.data() + at, out.size() - at, raw.data(), raw.size(), 3);
-        if (ZSTD_isError(packed))
+        if (!appendZstd(out, raw.data(), raw.size()))
             return {}; // only when out of memory
-        out.resize(at + packed);
     } else {
-        uLongf packed = compressBound(static_cast<uLong>(raw.size()));
-        out.resize(at + packed);
-        if (compress2(out.data() + at, &packed, raw.data(), static_cast<uLong>(raw.size()), 1) != Z_OK)
+        uLongf deflated = compressBound(static_cast<uLong>(raw.size()));
+        out.resize(at + deflated);
+        if (compress2(out.data() + at, &deflated, raw.data(), static_cast<uLong>(raw.size()), 1) != Z_OK)
             return {}; // only when out of memory
-        out.resize(at + packed);
+        out.resize(at + deflated);
     }
     if (size)
-        *size = {raw.size(), out.size(), referenced.size()};
+        *size = {raw.size(), out.size(), referenced.size(), snapshot.world.objects.size(),
+                 snapshot.world.objects.size()};
     return out;
 }
 

@@ -24,6 +24,13 @@ using Clock = std::chrono::steady_clock;
 using detail::PublishLog;
 using detail::Track;
 
+namespace {
+constexpr auto kOutage =
+    std::chrono::seconds(1); // a host silent this long: the backlog may be worth a resync
+constexpr auto kResyncWait = std::chrono::seconds(5);      // how long it waits for a resync's first chunk
+constexpr auto kKeepAlive = std::chrono::milliseconds(50); // the longest it leaves ENet alone while cutting
+} // namespace
+
 struct NetClient::Impl {
     Impl(DestructionWorld& w, const DestructionWorld::Config& c) : world(w), config(c), player(w) {
         player.setOnOutcome([this](const FractureOutcome& o) { adopted(o); });
@@ -45,6 +52,26 @@ struct NetClient::Impl {
     std::uint64_t seed = 0;             // the host world's seed (from the snapshot)
     std::optional<Snapshot> joinedWith; // the snapshot it joined with (for a replay)
     std::vector<JournalEvent> applied;  // every event applied since
+    // Resync after an outage: far behind, it asks for the world as it is (its own objects by id) instead of
+    // cutting the backlog's pieces, and keeps the events that arrive meanwhile by journal position.
+    std::uint64_t resyncFrames = 60;  // frames behind the host after an outage that ask for one (0: never)
+    std::uint64_t streamPosition = 0; // journal position of the next event the host sends (once joined)
+    std::uint64_t skipUntil = 0;      // events before this position are in the world already (a resync)
+    std::uint64_t hostFrame = 0;      // the newest host frame named by a message
+    bool afterOutage = false;         // the host was silent for kOutage, and the world has not caught up
+    bool resyncing = false;           // asked for a resync: keeps events, no syncs
+    Clock::time_point resyncAsked;    // when
+    std::vector<std::pair<std::uint64_t, detail::WireEvent>> pending; // events kept meanwhile, by position
+    struct SyncMsg {
+        std::uint64_t frame = 0, position = 0, hash = 0;
+    };
+    std::optional<SyncMsg> keptSync; // the latest sync received while resyncing
+    std::uint64_t keptSyncAt = 0;    // the journal position of the event after it in the stream
+    std::uint64_t resyncFrom = 0;    // its journal position when it asked
+    std::uint64_t resyncedAt = 0;    // the frame of the latest resync's snapshot
+    std::string resyncNote;          // what it was (for a mismatch after it)
+    bool keepReplay = true;          // keeps the snapshot it joined (or resynced) with, for writeReplay
+    detail::StateHashes stateHashes; // its objects' state hashes, by version (Hello, Resync)
 
     // Applies the held events of the world's current frame, with the fields the host left out.
     Status applyHeld() {
@@ -73,7 +100,134 @@ struct NetClient::Impl {
         return Status::ok();
     }
 
-    // Advances the world to `frame`, applying the events of each frame as it begins.
+    // A sync: the world advanced to its frame must have its hash (checked, and reported to the host). One
+    // older than the world (sent before a resync's snapshot was taken) is passed over.
+    Status sync(const SyncMsg& m) {
+        if (m.frame < world.frame())
+            return Status::ok();
+        if (Status st = advanceTo(m.frame); !st)
+            return st;
+        const std::uint64_t mine = world.geometryHash();
+        ++stats.syncs;
+        stats.frame = world.frame();
+        if (mine != m.hash || world.journalPosition() != m.position) {
+            if (stats.mismatchedHashes++ == 0) // what differed, the first time
+                stats.firstMismatch =
+                    "frame " + std::to_string(m.frame) + ": geometry hash " + std::to_string(mine) +
+                    (mine == m.hash ? " (the host's)" : " against the host's " + std::to_string(m.hash)) +
+                    ", journal position " + std::to_string(world.journalPosition()) +
+                    (world.journalPosition() == m.position
+                         ? " (the host's)"
+                         : " against the host's " + std::to_string(m.position)) +
+                    (stats.resyncs > 0 ? ", " + std::to_string(m.frame - resyncedAt) +
+                                             " frames after its resync (" + resyncNote + ")"
+                                       : "");
+        }
+        if (afterOutage && hostFrame <= world.frame() + resyncFrames)
+            afterOutage = false; // caught up
+        std::vector<std::uint8_t> ack{static_cast<std::uint8_t>(Message::Ack)};
+        detail::appendU64(ack, m.frame);
+        detail::appendU64(ack, mine);
+        detail::sendReliable(server, ack);
+        return Status::ok();
+    }
+
+    // Takes an event (the next in the host's journal) into `held`, or `pending` while resyncing.
+    Status take(const detail::WireEvent& w) {
+        const std::uint64_t position = streamPosition++;
+        if (position < skipUntil)
+            return Status::ok(); // the resync's snapshot has it
+        ++stats.events;
+        if (resyncing) {
+            pending.emplace_back(position, w);
+            return Status::ok();
+        }
+        const std::uint32_t last = held.empty() ? 0 : held.back().event.tick;
+        if (w.event.tick < world.frame() || w.event.tick < last)
+            return Error{ErrorCode::InvalidInput,
+                         "netplay: journal event of tick " + std::to_string(w.event.tick) + " arrived late"};
+        held.push_back(w);
+        return Status::ok();
+    }
+
+    // Where it was when the host went: its frame against the host's newest, and the last message's age.
+    std::string whereItStopped() const {
+        const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(Clock::now() - heard).count();
+        return "; this world at frame " + std::to_string(world.frame()) + ", the host's newest " +
+               std::to_string(hostFrame) + ", last heard " + std::to_string(ms) + " ms ago" +
+               (resyncing ? ", waiting for a resync" : "");
+    }
+
+    // The host's newest frame, from a sync, placements or frame message about to be handled.
+    void noteHostFrame(const std::uint8_t* d, std::size_t n) {
+        if ((n == 25 && d[0] == static_cast<std::uint8_t>(Message::Sync)) ||
+            (n == 9 && d[0] == static_cast<std::uint8_t>(Message::Frame))) {
+            hostFrame = std::max(hostFrame, detail::readU64(d + 1));
+        } else if (n > 5 && d[0] == static_cast<std::uint8_t>(Message::Placements)) {
+            const std::uint8_t* p = d + 5;
+            std::uint64_t frame = 0;
+            if (detail::getVarint(p, d + n, frame))
+                hostFrame = std::max(hostFrame, frame);
+        }
+    }
+
+    // After an outage, far behind the host: asks for a resync (the events it holds wait with their
+    // positions). Gives up on one whose first chunk did not come within kResyncWait.
+    Status checkLag() {
+        const Clock::time_point now = Clock::now();
+        if (resyncing && incoming.id == 0 && now - resyncAsked > kResyncWait)
+            return endResync(0);
+        if (!afterOutage || resyncing || !stats.joined || !server || resyncFrames == 0 ||
+            hostFrame <= world.frame() + resyncFrames)
+            return Status::ok();
+        afterOutage = false;
+        if (!detail::sendReliable(server, detail::encodeHello(world, true, &stateHashes)))
+            return Error{ErrorCode::IoError, "netplay: cannot ask for a resync"};
+        resyncing = true;
+        resyncAsked = now;
+        resyncFrom = world.journalPosition();
+        std::uint64_t position = streamPosition - held.size();
+        for (const detail::WireEvent& w : held)
+            pending.emplace_back(position++, w);
+        held.clear();
+        enet_host_flush(host);
+        return Status::ok();
+    }
+
+    // Leaves resync mode: the kept events from journal position `from` on follow in the order they came,
+    // the latest sync kept among them: the events that came before it, then it, then the rest (an event the
+    // host recorded after a sync of the same frame must not be applied before that sync is checked).
+    Status endResync(std::uint64_t from) {
+        resyncing = false;
+        skipUntil = std::max(skipUntil, from);
+        const std::optional<SyncMsg> m = keptSync;
+        keptSync.reset();
+        const std::vector<std::pair<std::uint64_t, detail::WireEvent>> kept = std::move(pending);
+        pending.clear();
+        const auto hold = [&](bool beforeSync) -> Status {
+            for (const auto& [position, w] : kept) {
+                if (position < skipUntil || (m && (position < keptSyncAt) != beforeSync))
+                    continue;
+                const std::uint32_t last = held.empty() ? 0 : held.back().event.tick;
+                if (w.event.tick < world.frame() || w.event.tick < last)
+                    return Error{ErrorCode::InvalidInput, "netplay: journal event of tick " +
+                                                              std::to_string(w.event.tick) + " arrived late"};
+                held.push_back(w);
+            }
+            return applyHeld();
+        };
+        for (const auto& [position, w] : kept)
+            stats.events -= position < skipUntil; // in the snapshot
+        if (Status st = hold(true); !st)
+            return st;
+        if (m)
+            if (Status st = sync(*m); !st)
+                return st;
+        return m ? hold(false) : Status::ok();
+    }
+
+    // Advances the world to `frame`, applying the events of each frame as it begins; ENet goes on meanwhile
+    // (a long catch-up would leave the host's packets unacknowledged until it timed the client out).
     Status advanceTo(std::uint64_t frame) {
         if (Status st = applyHeld(); !st)
             return st;
@@ -82,9 +236,21 @@ struct NetClient::Impl {
                 return st;
             if (Status st = applyHeld(); !st)
                 return st;
+            keepAlive();
         }
         return Status::ok();
     }
+
+    // Lets ENet send and receive (what arrives waits for the next service) if it has not for kKeepAlive.
+    void keepAlive() {
+        const Clock::time_point now = Clock::now();
+        if (!host || now - pumped < kKeepAlive)
+            return;
+        pumped = now;
+        ++stats.keepAlives;
+        enet_host_service(host, nullptr, 0);
+    }
+    Clock::time_point pumped; // when ENet last ran
     std::vector<detail::DecodedPlacement> decoded;
     std::function<void(const FractureOutcome&)> onOutcome;
 
@@ -147,9 +313,14 @@ struct NetClient::Impl {
         const std::uint32_t id = detail::readU32(d + 1), index = detail::readU32(d + 5),
                             total = detail::readU32(d + 9);
         ackDue = true;
-        if (id == doneTransfer || (stats.joined && id != incoming.id) || total == 0 || total > (1u << 30))
+        if (id <= doneTransfer || total == 0 || total > (1u << 30))
             return Status::ok();
         const std::size_t count = (total + detail::kSnapshotChunk - 1) / detail::kSnapshotChunk;
+        if (stats.joined && !resyncing && id != incoming.id) { // a resync it gave up waiting for
+            doneTransfer = id; // acknowledged whole, so that the host stops sending it
+            doneChunks = count;
+            return Status::ok();
+        }
         if (incoming.id != id) {
             incoming = {id, total, std::vector<std::uint8_t>(total), std::vector<bool>(count), count};
         }
@@ -183,17 +354,52 @@ struct NetClient::Impl {
         if (!ackDue || !server)
             return;
         ackDue = false;
-        const std::uint32_t id = doneTransfer ? doneTransfer : incoming.id;
-        const std::size_t count = doneTransfer ? doneChunks : incoming.got.size();
+        const bool whole = incoming.id == 0; // else a transfer on its way (a resync's, after the join's)
+        const std::uint32_t id = whole ? doneTransfer : incoming.id;
+        const std::size_t count = whole ? doneChunks : incoming.got.size();
         std::vector<std::uint8_t> ack{static_cast<std::uint8_t>(Message::SnapshotAck)};
         for (int b = 0; b < 4; ++b)
             ack.push_back(static_cast<std::uint8_t>(id >> (8 * b)));
         ack.resize(5 + (count + 7) / 8, 0);
         for (std::size_t i = 0; i < count; ++i)
-            if (doneTransfer || incoming.got[i])
+            if (whole || incoming.got[i])
                 ack[5 + i / 8] |= static_cast<std::uint8_t>(1u << (i % 8));
         detail::sendUnreliable(server, ack);
         enet_host_flush(host);
+    }
+
+    // A resync's snapshot: the world becomes the host's (its own unchanged objects were sent by id), and the
+    // events kept meanwhile that the snapshot does not hold follow.
+    Status resynced(Snapshot s, Clock::time_point received) {
+        const std::uint64_t position = s.world.journalPosition;
+        const double frame = static_cast<double>(s.world.frame);
+        if (position < resyncFrom)
+            return Error{ErrorCode::InvalidInput,
+                         "netplay: the resync's snapshot (journal position " + std::to_string(position) +
+                             ") is older than this world (" + std::to_string(resyncFrom) + ")"};
+        std::optional<Snapshot> kept;
+        if (keepReplay)
+            kept = s;
+        if (Status st = restoreSnapshot(world, std::move(s)); !st)
+            return st;
+        joinedWith = std::move(kept); // a replay starts here now
+        applied.clear();
+        for (auto t = tracks.begin(); t != tracks.end();) // objects gone before the snapshot
+            t = !world.object(t->first) && (t->second.points.empty() || t->second.points.back().first < frame)
+                    ? tracks.erase(t)
+                    : std::next(t);
+        held.clear();
+        ++stats.resyncs;
+        resyncedAt = static_cast<std::uint64_t>(frame);
+        std::size_t after = 0;
+        for (const auto& p : pending)
+            after += p.first >= position;
+        resyncNote = "snapshot at frame " + std::to_string(resyncedAt) + ", position " +
+                     std::to_string(position) + "; asked at position " + std::to_string(resyncFrom) + "; " +
+                     std::to_string(pending.size()) + " events kept, " + std::to_string(after) +
+                     " of them after the snapshot; next event position " + std::to_string(streamPosition);
+        stats.resyncLoadMs += std::chrono::duration<double, std::milli>(Clock::now() - received).count();
+        return endResync(position);
     }
 
     Status receive(const std::uint8_t* d, std::size_t n) {
@@ -205,6 +411,8 @@ struct NetClient::Impl {
             Result<Snapshot> s = detail::decodeJoinSnapshot(d, n, world);
             if (!s)
                 return s.error();
+            if (stats.joined)
+                return resynced(std::move(*s), received);
             const double frame = static_cast<double>(s->world.frame);
             std::map<ObjectId, Track> fresh;
             detail::PlacementDecoder baselines;
@@ -212,8 +420,10 @@ struct NetClient::Impl {
                 fresh[p.object].add(frame, p.objectToWorld);
                 baselines.setBaseline(p.object, detail::quantize(p.objectToWorld));
             }
-            const std::uint64_t hostSeed = s->world.seed;
-            Snapshot kept = *s;
+            const std::uint64_t hostSeed = s->world.seed, position = s->world.journalPosition;
+            std::optional<Snapshot> kept;
+            if (keepReplay)
+                kept = *s;
             if (Status st = restoreSnapshot(world, std::move(*s)); !st)
                 return st;
             joinedWith = std::move(kept);
@@ -224,6 +434,7 @@ struct NetClient::Impl {
                 {}; // its datagrams start at seq 1; the snapshot's placements are no publish it had whole
             held.clear();
             seed = hostSeed;
+            streamPosition = skipUntil = position; // the host's events go on from there
             stats.joined = true;
             stats.joinMs = std::chrono::duration<double, std::milli>(Clock::now() - connected).count();
             stats.snapshotLoadMs = std::chrono::duration<double, std::milli>(Clock::now() - received).count();
@@ -238,14 +449,9 @@ struct NetClient::Impl {
             if (!detail::decodeEvents(d, n, arrived))
                 return Error{ErrorCode::ParseError,
                              "netplay: events message of " + std::to_string(n) + " bytes"};
-            for (const detail::WireEvent& w : arrived) {
-                const std::uint32_t last = held.empty() ? 0 : held.back().event.tick;
-                if (w.event.tick < world.frame() || w.event.tick < last)
-                    return Error{ErrorCode::InvalidInput, "netplay: journal event of tick " +
-                                                              std::to_string(w.event.tick) + " arrived late"};
-                held.push_back(w);
-                ++stats.events;
-            }
+            for (const detail::WireEvent& w : arrived)
+                if (Status st = take(w); !st)
+                    return st;
             return applyHeld();
         }
         case Message::Sync: {
@@ -254,26 +460,21 @@ struct NetClient::Impl {
                              "netplay: sync message of " + std::to_string(n) + " bytes"};
             if (!stats.joined)
                 return Status::ok();
-            const std::uint64_t frame = detail::readU64(d + 1), position = detail::readU64(d + 9),
-                                hash = detail::readU64(d + 17);
-            if (Status st = advanceTo(frame); !st)
-                return st;
-            const std::uint64_t mine = world.geometryHash();
-            ++stats.syncs;
-            stats.frame = world.frame();
-            if (mine != hash || world.journalPosition() != position)
-                ++stats.mismatchedHashes;
-            std::vector<std::uint8_t> ack{static_cast<std::uint8_t>(Message::Ack)};
-            detail::appendU64(ack, frame);
-            detail::appendU64(ack, mine);
-            detail::sendReliable(server, ack);
-            return Status::ok();
+            const SyncMsg m{detail::readU64(d + 1), detail::readU64(d + 9), detail::readU64(d + 17)};
+            if (resyncing) {
+                keptSync = m;
+                keptSyncAt = streamPosition;
+                return Status::ok();
+            }
+            return sync(m);
         }
         case Message::Placements:
             placements(d, n);
             return Status::ok();
         case Message::SnapshotChunk:
             return chunk(d, n);
+        case Message::Frame: // read by noteHostFrame
+            return Status::ok();
         default:
             return Error{ErrorCode::ParseError, "netplay: unknown message type " + std::to_string(d[0])};
         }
@@ -314,34 +515,55 @@ Result<std::unique_ptr<NetClient>> NetClient::connect(DestructionWorld& world,
 
 Status NetClient::service(int timeoutMs) {
     Impl& im = *impl_;
+    // Everything that arrived, first: after an outage, how far ahead the host is decides whether to ask for
+    // a resync before a sync makes it cut the backlog.
+    std::vector<ENetEvent> events;
     ENetEvent e;
     int r = enet_host_service(im.host, &e, static_cast<enet_uint32>(std::max(0, timeoutMs)));
+    const Clock::time_point started = im.pumped = Clock::now();
     for (; r > 0; r = enet_host_service(im.host, &e, 0)) {
-        if (e.type == ENET_EVENT_TYPE_CONNECT) {
+        events.push_back(e);
+        if (e.type != ENET_EVENT_TYPE_RECEIVE)
+            continue;
+        const Clock::time_point now = Clock::now();
+        if (now - im.heard > std::chrono::milliseconds(300) && im.server)
+            detail::retransmitSoon(im.server); // the host was silent: an outage ended
+        if (now - im.heard > kOutage && im.stats.joined)
+            im.afterOutage = true;
+        im.heard = now;
+        im.noteHostFrame(e.packet->data, e.packet->dataLength);
+    }
+    Status status = im.checkLag();
+    for (ENetEvent& ev : events) {
+        if (ev.type == ENET_EVENT_TYPE_RECEIVE) {
+            if (status)
+                status = im.receive(ev.packet->data, ev.packet->dataLength);
+            enet_packet_destroy(ev.packet); // after a failure, the rest is dropped
+        } else if (!status) {
+            continue;
+        } else if (ev.type == ENET_EVENT_TYPE_CONNECT) {
             im.stats.connected = true;
             detail::configurePeer(im.server, im.timeoutMs);
-            if (!detail::sendReliable(im.server, detail::encodeHello(im.world)))
-                return Error{ErrorCode::IoError, "netplay: cannot send the hello"};
-        } else if (e.type == ENET_EVENT_TYPE_RECEIVE) {
-            const Clock::time_point now = Clock::now();
-            if (now - im.heard > std::chrono::milliseconds(300) && im.server)
-                detail::retransmitSoon(im.server); // the host was silent: an outage ended
-            im.heard = now;
-            Status s = im.receive(e.packet->data, e.packet->dataLength);
-            enet_packet_destroy(e.packet);
-            if (!s)
-                return s;
-        } else if (e.type == ENET_EVENT_TYPE_DISCONNECT) {
+            if (!detail::sendReliable(im.server, detail::encodeHello(im.world, false, &im.stateHashes)))
+                status = Error{ErrorCode::IoError, "netplay: cannot send the hello"};
+        } else if (ev.type == ENET_EVENT_TYPE_DISCONNECT) {
             im.server = nullptr;
             if (!im.stats.connected)
-                return Error{ErrorCode::IoError, "netplay: no host answered"};
-            return Error{ErrorCode::IoError, e.data == detail::kGoodbye
-                                                 ? "netplay: the host closed the connection"
-                                                 : "netplay: the host stopped answering (no reply for " +
-                                                       std::to_string(im.timeoutMs) + " ms)"};
+                status = Error{ErrorCode::IoError, "netplay: no host answered"};
+            else
+                status = Error{ErrorCode::IoError,
+                               ev.data == detail::kGoodbye
+                                   ? "netplay: the host closed the connection"
+                                   : "netplay: the host stopped answering (no reply for " +
+                                         std::to_string(im.timeoutMs) + " ms" + im.whereItStopped() + ")"};
         }
     }
+    if (!status)
+        return status;
     im.acknowledgeChunks();
+    enet_host_flush(im.host); // its acks, without waiting for the next call
+    if (const Clock::time_point now = Clock::now(); now - started > std::chrono::milliseconds(300))
+        im.heard = std::max(im.heard, now); // it was not listening: what comes next is no outage
     if (r < 0)
         return Error{ErrorCode::IoError, "netplay: ENet service failed"};
     return Status::ok();
@@ -351,6 +573,16 @@ void NetClient::setTimeout(int ms) {
     impl_->timeoutMs = static_cast<enet_uint32>(std::max(1, ms));
     if (impl_->server && impl_->stats.connected)
         detail::configurePeer(impl_->server, impl_->timeoutMs);
+}
+
+void NetClient::setKeepReplay(bool keep) {
+    impl_->keepReplay = keep;
+    if (!keep)
+        impl_->joinedWith.reset();
+}
+
+void NetClient::setResyncFrames(int frames) {
+    impl_->resyncFrames = static_cast<std::uint64_t>(std::max(0, frames));
 }
 
 void NetClient::setOnOutcome(std::function<void(const FractureOutcome&)> callback) {
@@ -380,6 +612,8 @@ Status NetClient::shoot(const Vec3& origin, const Vec3& velocity) {
 Status NetClient::writeReplay(const std::filesystem::path& snapshot,
                               const std::filesystem::path& journal) const {
     const Impl& im = *impl_;
+    if (!im.keepReplay)
+        return Error{ErrorCode::InvalidInput, "netplay: this client keeps no replay (setKeepReplay)"};
     if (!im.joinedWith)
         return Error{ErrorCode::InvalidInput, "netplay: no replay before the join"};
     if (Status st = saveSnapshot(snapshot, *im.joinedWith); !st)

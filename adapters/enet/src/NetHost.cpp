@@ -25,6 +25,7 @@ constexpr int kServiceSliceMs = 2; // how long service() waits at a time while a
 constexpr std::uint64_t kReuseFrames = 30; // how old a snapshot a joining client may be given (frames)
 constexpr auto kSilence = std::chrono::milliseconds(300); // a client not heard for this long is cut off
 constexpr std::uint64_t kSilentSyncEvery = 30;            // frames between syncs to a client cut off
+constexpr auto kResyncEvery = std::chrono::seconds(3);    // the least time between two resyncs of a client
 } // namespace
 
 struct NetHost::Impl {
@@ -47,8 +48,11 @@ struct NetHost::Impl {
     PlacementBudget placementBudget;
     std::map<ENetPeer*, detail::PlacementAllowance> allowances; // per client: its saved placement bytes
 
-    std::map<ENetPeer*, std::chrono::steady_clock::time_point> heard; // when each client was last heard
-    std::map<ENetPeer*, std::uint64_t> joinOrder;                     // 0 for the first to join
+    std::map<ENetPeer*, std::chrono::steady_clock::time_point> heard;      // when each client was last heard
+    std::map<ENetPeer*, std::chrono::steady_clock::time_point> lastResync; // its latest resync
+    bool packSnapshots = false; // objects compressed one by one and kept (setSnapshotCache)
+    enet_uint32 timeoutMs = detail::kPeerTimeoutMs; // a client silent this long is dropped
+    std::map<ENetPeer*, std::uint64_t> joinOrder;   // 0 for the first to join
     std::function<void(const ShotRequest&)> shotHandler;
     ShotRules shotRules;
     std::map<ENetPeer*, double> shotTokens; // each client's bucket
@@ -63,16 +67,48 @@ struct NetHost::Impl {
         std::uint64_t frame = 0;                                 // the snapshot's frame
         std::chrono::steady_clock::time_point started;
         double credit = kChunkBurst; // chunks it may send now
+        bool resync = false;         // to a joined client far behind (Message::Resync)
     };
     std::map<ENetPeer*, Transfer> transfers;
     std::chrono::steady_clock::time_point lastPump;
     std::uint32_t nextTransfer = 1;
+    detail::StateHashes stateHashes; // objectStateHash of the world's objects, by version
+    detail::PackedObjects packed;    // their compressed snapshot records, by version
+    bool warmDue = false;            // a frame passed: objects may be new since the last warm-up
+    std::vector<ObjectId> warmQueue; // objects to pack and hash while the game waits
+
+    // Packs and hashes the objects new since the last time (so that a snapshot does not have to), until
+    // `until`.
+    void warm(std::chrono::steady_clock::time_point until) {
+        if (!warmDue)
+            return;
+        if (warmQueue.empty()) {
+            for (ObjectId id : world.objects()) {
+                const ObjectState* o = world.object(id);
+                const auto it = packed.find(id);
+                // A remainder cut in place has no mesh hash until it is read: a snapshot takes it then.
+                if ((it == packed.end() || it->second.version != o->version) && o->meshHash != 0)
+                    warmQueue.push_back(id);
+            }
+            warmDue = !warmQueue.empty();
+        }
+        while (!warmQueue.empty() && std::chrono::steady_clock::now() < until) {
+            if (const ObjectState* o = world.object(warmQueue.back())) {
+                detail::packObject(*o, packed);
+                detail::stateHash(*o, &stateHashes);
+                ++stats.objectsWarmed;
+            }
+            warmQueue.pop_back();
+        }
+    }
     // The latest snapshot built: a client that joins within kReuseFrames, announcing the same objects, gets
     // it too, and the journal since it is kept for that client.
     struct Built {
         bool valid = false;
+        bool resync = false; // without placements, for a joined client
         std::uint64_t frame = 0, position = 0;
-        detail::KnownObjects known;
+        detail::KnownObjects referenced; // the objects it sends by id, with their state hashes
+        bool reusable = false;           // referenced is all of them
         std::vector<std::uint8_t> msg;
         std::vector<ObjectPlacement> placements;
         detail::JoinSnapshotSize size;
@@ -180,13 +216,14 @@ struct NetHost::Impl {
         if (!all)
             return;
         const std::uint64_t frame = t->second.frame;
-        stats.snapshotTransferMs +=
+        const bool resynced = t->second.resync;
+        (resynced ? stats.resyncTransferMs : stats.snapshotTransferMs) +=
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t->second.started)
                 .count();
         transfers.erase(t);
         if (lastSync >= frame && hashes.count(lastSync)) // the latest sync, which it was not sent
             sendSync(peer, lastSync, lastSyncPosition, hashes[lastSync]);
-        if (placementsFrame > frame) // the latest placements, newer than its snapshot's
+        if (!resynced && placementsFrame > frame) // the latest placements, newer than its snapshot's
             sendPlacements(peer, 0);
         enet_host_flush(host);
     }
@@ -212,38 +249,74 @@ struct NetHost::Impl {
         shotHandler(r);
     }
 
-    // A client's Hello: it gets the snapshot, without the objects it has already (the latest one built, if
-    // it is recent and for the same objects).
-    void join(ENetPeer* peer, const detail::KnownObjects& known) {
+    // The latest snapshot for a client that has `known` (for a resync: without placements), built unless
+    // the latest one built is recent, of the same kind, not older than journal position `since`, and names
+    // by id only objects the client has in that state; false when it cannot be built.
+    bool build(const detail::KnownObjects& known, bool resync, std::uint64_t since = 0) {
+        const auto has = [&known](const std::pair<const ObjectId, std::uint64_t>& r) {
+            const auto k = known.find(r.first);
+            return k != known.end() && k->second == r.second;
+        };
+        if (built.valid && built.reusable && world.frame() <= built.frame + kReuseFrames &&
+            built.resync == resync && built.position >= since &&
+            std::all_of(built.referenced.begin(), built.referenced.end(), has))
+            return true;
         const auto started = std::chrono::steady_clock::now();
-        if (!built.valid || world.frame() > built.frame + kReuseFrames || built.known != known) {
-            built = {};
+        built = {};
+        if (!resync)
             built.placements = placementSource ? placementSource() : std::vector<ObjectPlacement>{};
-            built.msg = detail::encodeJoinSnapshot(takeSnapshot(world, built.placements), known, &built.size);
-            if (built.msg.empty()) {
-                built = {};
-                enet_peer_disconnect(peer, detail::kGoodbye);
-                return;
-            }
-            built.valid = true;
-            built.frame = world.frame();
-            built.position = world.journalPosition();
-            built.known = known;
-            ++stats.snapshotBuilds;
-            stats.snapshotBuildMs +=
-                std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started).count();
+        built.msg = detail::encodeJoinSnapshot(takeSnapshot(world, built.placements), known, &built.size,
+                                               detail::SnapshotCodec::Zstd, &stateHashes,
+                                               packSnapshots ? &packed : nullptr);
+        for (auto it = stateHashes.begin(); it != stateHashes.end();) // objects gone since
+            it = world.object(it->first) ? std::next(it) : stateHashes.erase(it);
+        for (auto it = packed.begin(); it != packed.end();)
+            it = world.object(it->first) ? std::next(it) : packed.erase(it);
+        if (built.msg.empty()) {
+            built = {};
+            return false;
         }
-        detail::PlacementEncoder& encoder = encoders[peer] = {};
-        for (const ObjectPlacement& p : built.placements) // the client has these from its snapshot
-            encoder.setBaseline(p.object, detail::quantize(p.objectToWorld));
+        built.valid = true;
+        built.resync = resync;
+        built.frame = world.frame();
+        built.position = world.journalPosition();
+        for (const auto& [id, hash] : known) // what it sent by id
+            if (const auto h = stateHashes.find(id); h != stateHashes.end() && h->second.second == hash &&
+                                                     world.object(id) &&
+                                                     world.object(id)->version == h->second.first)
+                built.referenced.emplace(id, hash);
+        built.reusable = built.referenced.size() == built.size.referenced;
+        ++stats.snapshotBuilds;
+        stats.snapshotObjectsPacked += static_cast<long long>(built.size.packed);
+        stats.snapshotBuildMs +=
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started).count();
+        return true;
+    }
+
+    // Starts sending the latest snapshot built to a client.
+    void startTransfer(ENetPeer* peer, bool resync) {
         Transfer& t = transfers[peer];
         t.id = nextTransfer++;
+        t.resync = resync;
         t.bytes = built.msg;
         const std::size_t chunks = (t.bytes.size() + detail::kSnapshotChunk - 1) / detail::kSnapshotChunk;
         t.acked.assign(chunks, false);
         t.sent.assign(chunks, {});
         t.frame = built.frame;
         t.started = std::chrono::steady_clock::now();
+    }
+
+    // A client's Hello: it gets the snapshot, without the objects it has already (the latest one built, if
+    // it is recent and for the same objects).
+    void join(ENetPeer* peer, const detail::KnownObjects& known) {
+        if (!build(known, false)) {
+            enet_peer_disconnect(peer, detail::kGoodbye);
+            return;
+        }
+        detail::PlacementEncoder& encoder = encoders[peer] = {};
+        for (const ObjectPlacement& p : built.placements) // the client has these from its snapshot
+            encoder.setBaseline(p.object, detail::quantize(p.objectToWorld));
+        startTransfer(peer, false);
         std::uint64_t& position = peers[peer] = built.position; // it is sent the journal since its snapshot
         if (lastSync >= built.frame) // what the others were sent since, before any sync reaches it
             sendEvents(peer, position, lastSyncPosition, lastSync);
@@ -252,6 +325,19 @@ struct NetHost::Impl {
         stats.snapshotBytes += static_cast<long long>(built.size.wire);
         stats.snapshotRawBytes += static_cast<long long>(built.size.raw);
         stats.snapshotObjectsByReference += static_cast<long long>(built.size.referenced);
+        enet_host_flush(host);
+    }
+
+    // A joined client's Resync: far behind, it gets the world as it is now without the objects it has in
+    // the same state (the pieces of what it missed), keeps the events it was sent meanwhile by their
+    // journal positions, and is sent no sync until it has it. Its placements go on as they were.
+    void resync(ENetPeer* peer, const detail::KnownObjects& known, std::uint64_t position) {
+        if (!build(known, true, position)) // not older than the client: it applied the events up to there
+            return;                        // it goes on cutting the backlog itself
+        startTransfer(peer, true);
+        ++stats.resyncs;
+        stats.resyncBytes += static_cast<long long>(built.size.wire);
+        stats.resyncObjectsSent += static_cast<long long>(built.size.sent);
         enet_host_flush(host);
     }
 
@@ -276,6 +362,17 @@ struct NetHost::Impl {
             if (!closing && !peers.count(peer) && detail::decodeHello(d, packet->dataLength, known))
                 join(peer, known);
             return;
+        }
+        if (d[0] == static_cast<std::uint8_t>(Message::Resync)) {
+            detail::KnownObjects known;
+            std::uint64_t position = 0;
+            auto last = lastResync.find(peer);
+            if (closing || !peers.count(peer) || transfers.count(peer) ||
+                (last != lastResync.end() && now - last->second < kResyncEvery) ||
+                !detail::decodeHello(d, packet->dataLength, known, true, &position))
+                return;
+            lastResync[peer] = now;
+            return resync(peer, known, position);
         }
         if (d[0] == static_cast<std::uint8_t>(Message::SnapshotAck))
             return snapshotAck(peer, d, packet->dataLength);
@@ -340,6 +437,7 @@ void NetHost::publish() {
         tokens = std::min(im.shotRules.burst, tokens + im.shotRules.perSecond / 60);
     im.lastSync = frame;
     im.lastSyncPosition = end;
+    im.warmDue = im.packSnapshots;
     while (im.hashes.size() > 4096)
         im.hashes.erase(im.hashes.begin());
     for (auto& [peer, position] : im.peers) {
@@ -350,6 +448,11 @@ void NetHost::publish() {
         const bool silent = h != im.heard.end() && std::chrono::steady_clock::now() - h->second > kSilence;
         if (!im.transfers.count(peer) && (!silent || frame % kSilentSyncEvery == 0))
             im.sendSync(peer, frame, end, hash);
+        if (silent) { // unreliable, so that after an outage it arrives before the backlog
+            std::vector<std::uint8_t> hint{static_cast<std::uint8_t>(Message::Frame)};
+            detail::appendU64(hint, frame);
+            detail::sendUnreliable(peer, hint);
+        }
     }
     // Every client has been sent everything; a client that joins later gets a snapshot, and the events
     // since the latest one are kept while it may be reused.
@@ -374,8 +477,8 @@ void NetHost::publishPlacements(const std::vector<ObjectPlacement>& placements) 
     im.placementsFrame = im.world.frame();
     // The previous protocol: 13 + 32 n bytes per 37 dynamic bodies, every time.
     const auto legacy = static_cast<long long>((dynamic + 36) / 37 * 13 + dynamic * 32);
-    for (auto& [peer, position] : im.peers)
-        if (!im.transfers.count(peer)) // else it gets them once its snapshot is in
+    for (auto& [peer, position] : im.peers) // one whose join snapshot is on its way gets them once it is in
+        if (const auto t = im.transfers.find(peer); t == im.transfers.end() || t->second.resync)
             im.sendPlacements(peer, legacy);
     enet_host_flush(im.host);
 }
@@ -425,6 +528,9 @@ void NetHost::service(int timeoutMs) {
     Impl& im = *impl_;
     const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(std::max(0, timeoutMs));
     for (;;) {
+        if (end - std::chrono::steady_clock::now() > std::chrono::milliseconds(1)) // time to spare
+            im.warm(std::min(end - std::chrono::milliseconds(1),
+                             std::chrono::steady_clock::now() + std::chrono::milliseconds(kServiceSliceMs)));
         const auto left =
             std::chrono::duration_cast<std::chrono::milliseconds>(end - std::chrono::steady_clock::now())
                 .count();
@@ -435,7 +541,7 @@ void NetHost::service(int timeoutMs) {
         for (int r = enet_host_service(im.host, &e, wait); r > 0; r = enet_host_service(im.host, &e, 0)) {
             switch (e.type) {
             case ENET_EVENT_TYPE_CONNECT: // it joins with its Hello
-                detail::configurePeer(e.peer);
+                detail::configurePeer(e.peer, im.timeoutMs);
                 if (im.closing)
                     enet_peer_disconnect(e.peer, detail::kGoodbye);
                 break;
@@ -449,6 +555,7 @@ void NetHost::service(int timeoutMs) {
                 im.encoders.erase(e.peer);
                 im.allowances.erase(e.peer);
                 im.heard.erase(e.peer);
+                im.lastResync.erase(e.peer);
                 im.joinOrder.erase(e.peer);
                 im.transfers.erase(e.peer);
                 im.shotTokens.erase(e.peer);
@@ -462,6 +569,19 @@ void NetHost::service(int timeoutMs) {
             break;
     }
     im.stats.clients = static_cast<int>(im.peers.size());
+}
+
+void NetHost::setTimeout(int ms) {
+    impl_->timeoutMs = static_cast<enet_uint32>(std::max(1, ms));
+    for (auto& [peer, position] : impl_->peers)
+        detail::configurePeer(peer, impl_->timeoutMs);
+}
+
+void NetHost::setSnapshotCache(bool on) {
+    impl_->packSnapshots = on;
+    impl_->packed.clear();
+    impl_->warmQueue.clear();
+    impl_->warmDue = false;
 }
 
 void NetHost::setShotHandler(std::function<void(const ShotRequest&)> handler, ShotRules rules) {

@@ -29,6 +29,8 @@ enum class Message : std::uint8_t {
     SnapshotChunk =
         9, ///< channel 1: u32 transfer, u32 index, u32 total bytes, then a piece of a Snapshot message
     SnapshotAck = 10, ///< client → host, channel 1: u32 transfer, then one bit per chunk it has
+    Resync = 11,      ///< client → host, once joined and far behind: as Hello; the host answers a Snapshot
+    Frame = 12,       ///< channel 1, to a client not heard lately, every frame: u64 the host's frame
 };
 
 /// Appends a little-endian float.

@@ -27,6 +27,10 @@ struct ClientStats {
     std::uint64_t frame = 0;        ///< the world's frame after the last sync
     long long placements = 0;       ///< placement records received
     long long placementBytes = 0;   ///< bytes of placement messages received
+    long long resyncs = 0;          ///< snapshots loaded after an outage instead of cutting the backlog
+    double resyncLoadMs = 0;        ///< time spent decoding and loading them (ms)
+    long long keepAlives = 0;       ///< times ENet was served from within a long catch-up
+    std::string firstMismatch;      ///< what differed at the first mismatched sync (empty: none)
 };
 
 /// A client of a NetHost on a loopback address. Its world must be built with the host's settings (any
@@ -64,6 +68,13 @@ public:
     /// How long the host may be silent before service() fails with an IoError saying it stopped answering
     /// (default 10 s: a partition shorter than that is survived, a host killed without closing is noticed).
     void setTimeout(int ms);
+    /// Whether it keeps what writeReplay needs (default true): a copy of the world it joined (or resynced)
+    /// with, which costs a copy of every object at each load.
+    void setKeepReplay(bool keep);
+    /// After an outage (the host silent for 1 s), a client more than `frames` behind the host asks for the
+    /// world as it is, its own unchanged objects by id, instead of cutting the pieces of what it missed
+    /// (default 60; 0: never, it cuts them all).
+    void setResyncFrames(int frames);
     /// Called for every outcome the world adopts (its pieces are in the world already).
     void setOnOutcome(std::function<void(const FractureOutcome&)> callback);
     /// Totals.
