@@ -81,14 +81,15 @@ struct SceneArgs {
     std::string framesCsv;
     std::string appendCsv;
     std::string pattern = "single";
-    int cells = 0;                   // shatter cells (0: the library's default)
-    int maxAwake = 0;                // awake debris budget (0: the runtime's default)
-    double physicsBudgetMs = 0;      // physics step budget (0: the runtime's default)
-    double lightPerAwake = -1;       // light pieces per budgeted awake body (< 0: the runtime's default)
-    double demolish = 0;             // seconds between demolition charges on standing targets (0: none)
-    bool structure = false;          // the stress solver on
-    double bearingFriction = 0.6;    // with structure: objects rest on each other as bearings (0: welded)
-    int structureIterations = 0;     // with structure: solver sweeps per frame (0: the library's)
+    int cells = 0;                // shatter cells (0: the library's default)
+    int maxAwake = 0;             // awake debris budget (0: the runtime's default)
+    double physicsBudgetMs = 0;   // physics step budget (0: the runtime's default)
+    double lightPerAwake = -1;    // light pieces per budgeted awake body (< 0: the runtime's default)
+    double demolish = 0;          // seconds between demolition charges on standing targets (0: none)
+    int maxHullPoints = -1;       // points per convex part's hull (0: uncapped; < 0: the binding's default)
+    bool structure = false;       // the stress solver on
+    double bearingFriction = 0.6; // with structure: objects rest on each other as bearings (0: welded)
+    int structureIterations = 0;  // with structure: solver sweeps per frame (0: the library's)
     bool structureConverged = false; // with structure: the converged Gauss-Seidel solve
     std::string structureSolver;     // with structure: gauss-seidel, conjugate-gradient, direct (or empty)
     double projectileSpeed = 120;
@@ -221,7 +222,10 @@ int runScene(const SceneArgs& a, SceneSummary* summary = nullptr) {
         rc.structure.stress.method = rubble::StressMethod::GaussSeidel;
     }
     PhysicsWorld physics;
-    BulletBinding binding(physics);
+    BulletBinding::Config bc;
+    if (a.maxHullPoints >= 0)
+        bc.maxHullPoints = a.maxHullPoints;
+    BulletBinding binding(physics, bc);
     DestructionRuntime runtime(binding, rc);
     const DestructionWorld& destruction = runtime.world();
     SceneLoadOptions lo;
@@ -581,6 +585,8 @@ rubble::tools::Registrar registrar{
          app.add_option("--demolish", args->demolish,
                         "seconds between demolition charges (8 m, 3,500 N·s) on the next standing target, as "
                         "the demo's --demolish");
+         app.add_option("--max-hull-points", args->maxHullPoints,
+                        "points per convex part's collision hull (0: uncapped; default: the binding's)");
          app.add_flag("--structure", args->structure, "stress solver on (bonds, breaking under load)");
          app.add_option("--bearing-friction", args->bearingFriction,
                         "with --structure: objects rest on each other as bearings with this friction "

@@ -58,8 +58,8 @@ void BulletBinding::createBody(BodyId id, const BodyDesc& desc) {
         e->shape = CollisionShape::sphere(desc.shape.radius);
         break;
     case BodyShape::Kind::Convex:
-        e->shape =
-            CollisionShape::fromParts(desc.shape.parts, desc.shape.points, Frame{}, config_.collisionMargin);
+        e->shape = CollisionShape::fromParts(desc.shape.parts, desc.shape.points, Frame{},
+                                             config_.collisionMargin, config_.maxHullPoints);
         break;
     }
     if (!e->shape) // nothing usable: a small box keeps the body in the world
