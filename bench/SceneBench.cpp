@@ -81,13 +81,15 @@ struct SceneArgs {
     std::string framesCsv;
     std::string appendCsv;
     std::string pattern = "single";
-    int cells = 0;                   // shatter cells (0: the library's default)
-    int maxAwake = 0;                // awake debris budget (0: the runtime's default)
-    double physicsBudgetMs = 0;      // physics step budget (0: the runtime's default)
-    double lightPerAwake = -1;       // light pieces per budgeted awake body (< 0: the runtime's default)
-    bool structure = false;          // the stress solver on
-    double bearingFriction = 0.6;    // with structure: objects rest on each other as bearings (0: welded)
-    int structureIterations = 0;     // with structure: solver sweeps per frame (0: the library's)
+    int cells = 0;                // shatter cells (0: the library's default)
+    int maxAwake = 0;             // awake debris budget (0: the runtime's default)
+    double physicsBudgetMs = 0;   // physics step budget (0: the runtime's default)
+    double lightPerAwake = -1;    // light pieces per budgeted awake body (< 0: the runtime's default)
+    double demolish = 0;          // seconds between demolition charges on standing targets (0: none)
+    int maxHullPoints = -1;       // points per convex part's hull (0: uncapped; < 0: the binding's default)
+    bool structure = false;       // the stress solver on
+    double bearingFriction = 0.6; // with structure: objects rest on each other as bearings (0: welded)
+    int structureIterations = 0;  // with structure: solver sweeps per frame (0: the library's)
     bool structureConverged = false; // with structure: the converged Gauss-Seidel solve
     std::string structureSolver;     // with structure: gauss-seidel, conjugate-gradient, direct (or empty)
     double projectileSpeed = 120;
@@ -125,6 +127,19 @@ double peakRssMb() {
         if (line.rfind("VmHWM:", 0) == 0)
             return std::stod(line.substr(6)) / 1024.0;
     return 0;
+}
+
+// Where the demo's demolition charges go: objects, and big pieces still high above the ground.
+std::vector<rubble::Vec3> standingTargets(const rubble::DestructionRuntime& runtime, double groundTop) {
+    std::vector<rubble::Vec3> out;
+    for (rubble::BodyId id : runtime.bodies()) {
+        const rubble::BodyRecord* b = runtime.body(id);
+        const rubble::Vec3 c = runtime.motion(id).transform.translation;
+        if (b->role == rubble::BodyRole::Object ||
+            (b->role == rubble::BodyRole::Piece && b->volume > 150 && c.y > groundTop + 15))
+            out.push_back(c);
+    }
+    return out;
 }
 
 // A shot: from where, how fast.
@@ -207,7 +222,10 @@ int runScene(const SceneArgs& a, SceneSummary* summary = nullptr) {
         rc.structure.stress.method = rubble::StressMethod::GaussSeidel;
     }
     PhysicsWorld physics;
-    BulletBinding binding(physics);
+    BulletBinding::Config bc;
+    if (a.maxHullPoints >= 0)
+        bc.maxHullPoints = a.maxHullPoints;
+    BulletBinding binding(physics, bc);
     DestructionRuntime runtime(binding, rc);
     const DestructionWorld& destruction = runtime.world();
     SceneLoadOptions lo;
@@ -253,7 +271,8 @@ int runScene(const SceneArgs& a, SceneSummary* summary = nullptr) {
                      "frozen_pieces,jobs_in_flight,fractures\n";
     }
     const bool idleAdoption = !a.unpaced && !a.noIdleAdoption && !a.deterministic;
-    long shots = 0;
+    long shots = 0, nextCharge = 60;
+    std::size_t charges = 0;
     long long idleFractures = 0;
     int maxPieces = 0;
     const rubble::bench::CpuMeter cpu; // whether something else ran meanwhile
@@ -269,6 +288,12 @@ int runScene(const SceneArgs& a, SceneSummary* summary = nullptr) {
         for (; shots < due; ++shots)
             if (std::optional<Shot> shot = aim(runtime, rng, a))
                 volley.push_back(*shot);
+        if (a.demolish > 0 && f >= nextCharge) { // as the demo's --demolish: the next standing target
+            nextCharge = f + std::max(1L, std::lround(a.demolish * 60));
+            const std::vector<Vec3> standing = standingTargets(runtime, loaded.groundTop);
+            if (!standing.empty())
+                runtime.blast(standing[charges++ % standing.size()], 8, 3500);
+        }
         const auto t0 = std::chrono::steady_clock::now();
         const double cpu0 = rubble::bench::threadCpuMs();
         for (const Shot& shot : volley)
@@ -557,6 +582,11 @@ rubble::tools::Registrar registrar{
          app.add_option("--light-per-awake", args->lightPerAwake,
                         "light pieces (colliding with static bodies only) per budgeted awake body; 0: "
                         "pieces over the awake budget retire (default: the runtime's)");
+         app.add_option("--demolish", args->demolish,
+                        "seconds between demolition charges (8 m, 3,500 N·s) on the next standing target, as "
+                        "the demo's --demolish");
+         app.add_option("--max-hull-points", args->maxHullPoints,
+                        "points per convex part's collision hull (0: uncapped; default: the binding's)");
          app.add_flag("--structure", args->structure, "stress solver on (bonds, breaking under load)");
          app.add_option("--bearing-friction", args->bearingFriction,
                         "with --structure: objects rest on each other as bearings with this friction "

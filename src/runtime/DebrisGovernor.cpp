@@ -200,9 +200,16 @@ GovernorActions DebrisGovernor::update(const BodyTable& bodies, const PhysicsBin
         binding.filtersMovingPairs()
             ? static_cast<int>(std::max(0.0, budget_.lightPerAwake) * static_cast<double>(awakeBudget()))
             : 0;
-    int lights = 0;
-    for (const Awake& a : stillAwake)
+    int lights = 0, settledLights = 0;
+    for (const Awake& a : stillAwake) {
+        if (a.light && a.settled) { // over the budget already: slow for long enough, it freezes where it is
+            out.freeze.push_back(a.id);
+            leaving.insert(a.id);
+            ++settledLights;
+            continue;
+        }
         lights += a.light ? 1 : 0;
+    }
     auto shed = [&](const Awake& a) {
         if (lights < lightCap) {
             out.lighten.push_back(a.id);
@@ -214,8 +221,8 @@ GovernorActions DebrisGovernor::update(const BodyTable& bodies, const PhysicsBin
         }
     };
     auto skip = [&](const Awake& a) { return a.light || leaving.count(a.id) || light_.count(a.id); };
-    int excess = static_cast<int>(stillAwake.size()) - lights + static_cast<int>(out.wake.size()) +
-                 awakeObjects - awakeBudget();
+    int excess = static_cast<int>(stillAwake.size()) - lights - settledLights +
+                 static_cast<int>(out.wake.size()) + awakeObjects - awakeBudget();
     if (excess > 0) {
         std::sort(stillAwake.begin(), stillAwake.end(), [](const Awake& a, const Awake& b) {
             return a.speed < b.speed || (a.speed == b.speed && a.id < b.id);

@@ -448,7 +448,7 @@ struct DestructionRuntime::Impl {
         searchesLeft = config.support.maxSearchesPerFrame;
     }
     void submitImpacts(FrameContext& f) {
-        collector.gather(contacts, bodies, world, binding, counters.frames);
+        collector.gather(contacts, bodies, world, binding, counters.frames, config.debris.freezeSpeed);
         f.impacts = collector.take();
         f.stats.projectileHits = f.impacts.projectileHits;
         counters.projectileHits += f.impacts.projectileHits;

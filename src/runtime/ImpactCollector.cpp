@@ -33,7 +33,7 @@ PendingImpact makeImpact(const BodyRecord& target, const Vec3& worldPoint, const
 
 void ImpactCollector::gather(const std::vector<ContactReport>& contacts, BodyTable& bodies,
                              const DestructionWorld& world, const PhysicsBinding& binding,
-                             std::uint64_t frame) {
+                             std::uint64_t frame, double wakeSpeed) {
     for (const ContactReport& c : contacts) {
         BodyRecord* a = bodies.find(c.a);
         BodyRecord* b = bodies.find(c.b);
@@ -65,12 +65,12 @@ void ImpactCollector::gather(const std::vector<ContactReport>& contacts, BodyTab
                 projectileImpacts_.push_back(std::move(p));
             continue;
         }
+        const double approach = -dot(c.relativeVelocity, c.normalOnB);
         for (BodyRecord* frozen : {a, b})
-            if (frozen->motion == BodyMotionState::Frozen) {
+            if (frozen->motion == BodyMotionState::Frozen && approach >= wakeSpeed) {
                 double& best = frozenHits_[frozen->id];
                 best = std::max(best, c.impulse);
             }
-        const double approach = -dot(c.relativeVelocity, c.normalOnB);
         if (approach < policy_.minApproachSpeed || c.impulse < policy_.collisionImpulseThreshold)
             continue;
         for (BodyRecord* target : {a, b}) {

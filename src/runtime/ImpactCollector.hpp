@@ -22,8 +22,8 @@ struct PendingImpact {
 struct ImpactBatch {
     std::vector<PendingImpact> impacts;  ///< projectile hits in contact order, then the strongest collision
                                          ///< impact of each object, by object id
-    std::map<BodyId, double> frozenHits; ///< strongest contact impulse on each frozen body (projectile hits:
-                                         ///< infinite)
+    std::map<BodyId, double> frozenHits; ///< strongest impulse of a contact closing on each frozen body
+                                         ///< (projectile hits: infinite)
     int projectileHits = 0;              ///< projectiles that hit anything
 };
 
@@ -37,9 +37,10 @@ public:
     /// Reads the policy at every call.
     explicit ImpactCollector(const ImpactPolicy& policy) : policy_(policy) {}
 
-    /// Adds one step's contacts to the frame's batch (marks projectiles spent).
+    /// Adds one step's contacts to the frame's batch (marks projectiles spent). A contact on a frozen body
+    /// is a hit only when it closes at wakeSpeed or more: what rests on it pushes every step, and is none.
     void gather(const std::vector<ContactReport>& contacts, BodyTable& bodies, const DestructionWorld& world,
-                const PhysicsBinding& binding, std::uint64_t frame);
+                const PhysicsBinding& binding, std::uint64_t frame, double wakeSpeed);
     /// The frame's batch; starts a new one.
     ImpactBatch take();
 

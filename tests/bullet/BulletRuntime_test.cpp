@@ -748,9 +748,9 @@ TEST(BulletBinding, ALightBodyPassesThroughMovingBodiesAndLandsOnStaticOnes) {
     }
 }
 
-// A frozen body (made static by setMass) stops a moving body but lets a light one through to the ground: a
-// light body it froze around would otherwise be thrown out of it.
-TEST(BulletBinding, ALightBodyPassesThroughFrozenBodies) {
+// A frozen body (made static by setMass) stops a light body as it stops a moving one: light debris lands on
+// a frozen pile instead of sinking through it and freezing inside it.
+TEST(BulletBinding, ALightBodyLandsOnFrozenBodies) {
     for (const bool light : {false, true}) {
         PhysicsWorld physics;
         BulletBinding binding(physics);
@@ -772,6 +772,27 @@ TEST(BulletBinding, ALightBodyPassesThroughFrozenBodies) {
         std::vector<ContactReport> contacts;
         for (int i = 0; i < 120; ++i)
             binding.step(1.0 / 60, contacts);
-        EXPECT_NEAR(binding.motion(3).transform.translation.y, light ? 0.25 : 1.25, 0.05) << light;
+        EXPECT_NEAR(binding.motion(3).transform.translation.y, 1.25, 0.05) << light;
+    }
+}
+
+// A heavy body set down on a frozen one pushes on it with its weight every step, over the wake impulse, and
+// does not wake it; dropped onto it, it does.
+TEST(BulletRuntime, WeightDoesNotWakeAFrozenBodyButAFallDoes) {
+    for (const double drop : {0.0, 1.0}) {
+        DestructionRuntime::Config rc;
+        rc.impacts.collisionImpulseThreshold = 1e12; // no fracture
+        Rig rig(true, 1, true, rc);
+        rig.runtime->addGround({0, -1, 0}, {10, 1, 10});
+        const ObjectId below = rig.addBox({0.5, 0.5, 0.5}, Frame{Mat3::identity(), {0, 0.5, 0}}, 2000);
+        for (int i = 0; i < 30; ++i)
+            rig.runtime->stepFrame();
+        ASSERT_EQ(rig.bodyOf(below)->motion, BodyMotionState::Frozen);
+        const ObjectId above =
+            rig.addBox({0.5, 0.5, 0.5}, Frame{Mat3::identity(), {0, 1.5 + drop, 0}}, 2000); // 2 t: 327 N·s
+        (void)above;
+        for (int i = 0; i < 60; ++i)
+            rig.runtime->stepFrame();
+        EXPECT_EQ(rig.runtime->counters().piecesWoken > 0, drop > 0) << "dropped from " << drop << " m";
     }
 }

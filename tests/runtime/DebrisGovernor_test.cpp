@@ -1,6 +1,8 @@
 // The debris governor's physics-time control, fed known step times (no wall clock).
 #include <gtest/gtest.h>
 
+#include <set>
+
 #include "ToyPhysics.hpp"
 #include "runtime/BodyTable.hpp"
 #include "runtime/DebrisGovernor.hpp"
@@ -159,6 +161,33 @@ TEST(DebrisGovernor, MovingPiecesOverTheBudgetBecomeLightBeforeAnyRetires) {
             EXPECT_FALSE(rig.physics.collidesWithMoving(id));
         EXPECT_EQ(rig.bodies.awake(), filters ? 30 : 10) << "the full ones stay within the budget";
     }
+}
+
+// A light piece that stays slow but jitters (its velocity flips each frame, so it never rests by the
+// velocity rule) is over the awake budget already: once settled, it freezes where it is.
+TEST(DebrisGovernor, ASettledLightPieceFreezesEvenWhileItJitters) {
+    GovernorRig rig(8, 40, true);
+    rig.budget.maxAwakeBodies = 10;
+    rig.budget.lightPerAwake = 2;
+    for (int f = 0; f < 15; ++f)
+        rig.apply(0, true);
+    ASSERT_EQ(rig.governor.light().size(), 20u);
+    const std::set<BodyId> light = rig.governor.light();
+    std::set<BodyId> frozen;
+    for (int f = 0; f < 30; ++f) {
+        for (BodyId id : rig.bodies.awakeIds())
+            rig.physics.setVelocity(id, {0, f % 2 ? 0.3 : -0.3, 0}, {});
+        const detail::GovernorActions a =
+            rig.governor.update(rig.bodies, rig.physics, {}, 0, true, Vec3{}, 1.0 / 60);
+        for (BodyId id : a.freeze) {
+            rig.physics.setMass(id, 0, {});
+            rig.bodies.setMotion(*rig.bodies.find(id), BodyMotionState::Frozen);
+            rig.governor.frozen(id, rig.physics.motion(id).transform.translation, 0.5);
+            frozen.insert(id);
+        }
+    }
+    for (BodyId id : light)
+        EXPECT_TRUE(frozen.count(id)) << id;
 }
 
 // When a slow step shrinks the awake budget, the room for light pieces shrinks with it: light pieces retire.

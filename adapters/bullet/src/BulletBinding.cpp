@@ -58,8 +58,8 @@ void BulletBinding::createBody(BodyId id, const BodyDesc& desc) {
         e->shape = CollisionShape::sphere(desc.shape.radius);
         break;
     case BodyShape::Kind::Convex:
-        e->shape =
-            CollisionShape::fromParts(desc.shape.parts, desc.shape.points, Frame{}, config_.collisionMargin);
+        e->shape = CollisionShape::fromParts(desc.shape.parts, desc.shape.points, Frame{},
+                                             config_.collisionMargin, config_.maxHullPoints);
         break;
     }
     if (!e->shape) // nothing usable: a small box keeps the body in the world
@@ -120,10 +120,9 @@ void BulletBinding::setMass(BodyId id, double mass, const Vec3& inertia) {
         world.addRigidBody(&rb);
         return;
     }
-    // Frozen: light bodies pass it (one overlapping it would be thrown out), static ones never pair with it.
+    // Frozen: light bodies land on it as on static ones; static and frozen ones never pair with it.
     world.addRigidBody(&rb, kFrozenFilter,
-                       btBroadphaseProxy::AllFilter ^ (btBroadphaseProxy::StaticFilter | kFrozenFilter |
-                                                       btBroadphaseProxy::DebrisFilter));
+                       btBroadphaseProxy::AllFilter ^ (btBroadphaseProxy::StaticFilter | kFrozenFilter));
 }
 
 void BulletBinding::setVelocity(BodyId id, const Vec3& linear, const Vec3& angular) {
@@ -144,7 +143,8 @@ void BulletBinding::setCollidesWithMoving(BodyId id, bool collides) {
     if (collides)
         world.addRigidBody(&rb);
     else
-        world.addRigidBody(&rb, btBroadphaseProxy::DebrisFilter, btBroadphaseProxy::StaticFilter);
+        world.addRigidBody(&rb, btBroadphaseProxy::DebrisFilter,
+                           btBroadphaseProxy::StaticFilter | kFrozenFilter);
 }
 
 BodyMotion BulletBinding::motion(BodyId id) const {

@@ -1,6 +1,8 @@
 #include "rubble/bullet/CollisionShape.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 
 #include <BulletCollision/BroadphaseCollision/btDbvt.h>
 #include <BulletCollision/CollisionShapes/btShapeHull.h>
@@ -34,7 +36,59 @@ ConvexPolytope eroded(const ConvexPolytope& part, double margin) {
     return out;
 }
 
+// Directions spread evenly over the sphere (a Fibonacci lattice): where a capped hull's support is compared.
+const std::vector<Vec3>& sphereDirections() {
+    static const std::vector<Vec3> directions = [] {
+        constexpr int n = 128;
+        const double turn = 3.14159265358979323846 * (3 - std::sqrt(5.0));
+        std::vector<Vec3> out;
+        out.reserve(n);
+        for (int i = 0; i < n; ++i) {
+            const double y = 1 - (2.0 * i + 1) / n;
+            const double r = std::sqrt(1 - y * y);
+            out.push_back({r * std::cos(turn * i), y, r * std::sin(turn * i)});
+        }
+        return out;
+    }();
+    return directions;
+}
+
 } // namespace
+
+std::vector<Vec3> CollisionShape::cappedHullPoints(const std::vector<Vec3>& points, int maxPoints) {
+    if (maxPoints < 4 || points.size() <= static_cast<std::size_t>(maxPoints))
+        return points;
+    const std::vector<Vec3>& dirs = sphereDirections();
+    std::vector<double> full(dirs.size(), -std::numeric_limits<double>::infinity());
+    std::vector<double> kept(dirs.size(), -std::numeric_limits<double>::infinity());
+    std::vector<std::size_t> extreme(dirs.size(), 0);
+    for (std::size_t d = 0; d < dirs.size(); ++d)
+        for (std::size_t i = 0; i < points.size(); ++i)
+            if (const double h = dot(dirs[d], points[i]); h > full[d]) {
+                full[d] = h;
+                extreme[d] = i;
+            }
+    // Greedy: the point that holds up the support where the kept points fall shortest.
+    std::vector<Vec3> out;
+    std::vector<char> taken(points.size(), 0);
+    while (out.size() < static_cast<std::size_t>(maxPoints)) {
+        std::size_t worst = 0;
+        double gap = 0;
+        for (std::size_t d = 0; d < dirs.size(); ++d)
+            if (full[d] - kept[d] > gap) {
+                gap = full[d] - kept[d];
+                worst = d;
+            }
+        if (gap <= 0 || taken[extreme[worst]])
+            break;
+        const Vec3& p = points[extreme[worst]];
+        taken[extreme[worst]] = 1;
+        out.push_back(p);
+        for (std::size_t d = 0; d < dirs.size(); ++d)
+            kept[d] = std::max(kept[d], dot(dirs[d], p));
+    }
+    return out.size() < 4 ? points : out;
+}
 
 CollisionShape::~CollisionShape() = default;
 
@@ -82,7 +136,8 @@ void CollisionShape::addEdge(const Vec3& a, const Vec3& b) {
 
 std::unique_ptr<CollisionShape> CollisionShape::fromParts(const std::vector<ConvexPolytope>& parts,
                                                           const std::vector<Vec3>& fallbackPoints,
-                                                          const Frame& objectToBody, double margin) {
+                                                          const Frame& objectToBody, double margin,
+                                                          int maxHullPoints) {
     std::unique_ptr<CollisionShape> s(new CollisionShape());
     s->compound_ = std::make_unique<btCompoundShape>(true, static_cast<int>(parts.size()));
     btTransform identity;
@@ -102,7 +157,7 @@ std::unique_ptr<CollisionShape> CollisionShape::fromParts(const std::vector<Conv
             core = part;
             m = 0;
         }
-        const std::vector<Vec3> verts = core.vertices();
+        const std::vector<Vec3> verts = cappedHullPoints(core.vertices(), maxHullPoints);
         if (verts.size() < 4)
             continue;
         std::vector<btVector3> points; // copied once into a hull of exactly this size

@@ -171,7 +171,7 @@ struct RUBBLE_API DebrisBudget {
     int freezeAfterFrames = 6;          ///< ... or one that rested this many frames in a row
     double freezeSpeed = 1.0;           ///< m/s (and rad/s) below which a body not gaining speed rests
                                         ///< (velocity change under g·dt / 2 a frame; docs/architecture.md)
-    double wakeImpulse = 100;           ///< a contact impulse (N·s) on a frozen piece that wakes it
+    double wakeImpulse = 100;           ///< impulse (N·s) that wakes a frozen piece, closing at freezeSpeed
     double fadeVolume = 0.02;           ///< debris below this volume (m³) ...
     double fadeDistance = 150;          ///< ... farther than this from the focus point fades into particles
     double killBelowY = -500;           ///< debris falling below this height retires

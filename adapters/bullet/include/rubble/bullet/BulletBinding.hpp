@@ -24,6 +24,8 @@ public:
         double collisionMargin = 0.02; ///< convex hull margin (hulls are eroded by it)
         double linearSleep = 0.8;      ///< sleeping threshold (m/s)
         double angularSleep = 1.0;     ///< sleeping threshold (rad/s)
+        int maxHullPoints = 0; ///< > 0: each convex part collides as a hull of at most this many points
+                               ///< (CollisionShape::cappedHullPoints)
     };
 
     /// A binding that creates its bodies in physics.

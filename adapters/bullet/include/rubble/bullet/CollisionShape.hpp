@@ -23,10 +23,15 @@ public:
     /// Compound of the convex parts (object coordinates); objectToBody maps body → object coordinates
     /// (p_object = rotation · p_body + translation). When parts is empty (or no part is usable) the convex
     /// hull of fallbackPoints (object coordinates, reduced to at most 42 points) is used; returns null when
-    /// nothing usable remains.
+    /// nothing usable remains. maxHullPoints > 0 caps each part's hull (cappedHullPoints).
     static std::unique_ptr<CollisionShape> fromParts(const std::vector<ConvexPolytope>& parts,
                                                      const std::vector<Vec3>& fallbackPoints,
-                                                     const Frame& objectToBody, double margin);
+                                                     const Frame& objectToBody, double margin,
+                                                     int maxHullPoints = 0);
+    /// At most maxPoints of the points (all when fewer, or maxPoints < 4), chosen so that the support of
+    /// their hull stays closest to that of all the points: a subset, so the capped hull lies inside the full
+    /// one.
+    static std::vector<Vec3> cappedHullPoints(const std::vector<Vec3>& points, int maxPoints);
     /// A box of the given half extents centred on the body's origin.
     static std::unique_ptr<CollisionShape> box(const Vec3& halfExtents);
     /// A sphere of the given radius centred on the body's origin.
