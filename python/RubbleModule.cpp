@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <optional>
 #include <string>
 #include <utility>
@@ -34,6 +35,7 @@ namespace py = pybind11;
 namespace {
 
 using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
+using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
 using IndexArray = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>;
 
 /// A library error on its way to Python (becomes rubble.Error).
@@ -58,6 +60,16 @@ template <class T>
 DoubleArray rows(const std::vector<T>& values, py::ssize_t columns) {
     static_assert(sizeof(T) % sizeof(double) == 0);
     DoubleArray out({static_cast<py::ssize_t>(values.size()), columns});
+    if (!values.empty())
+        std::memcpy(out.mutable_data(), values.data(), values.size() * sizeof(T));
+    return out;
+}
+
+/// An (n, columns) float32 array copied from n records of `columns` floats each (mesh attributes).
+template <class T>
+FloatArray floatRows(const std::vector<T>& values, py::ssize_t columns) {
+    static_assert(sizeof(T) % sizeof(float) == 0);
+    FloatArray out({static_cast<py::ssize_t>(values.size()), columns});
     if (!values.empty())
         std::memcpy(out.mutable_data(), values.data(), values.size() * sizeof(T));
     return out;
@@ -107,6 +119,24 @@ std::vector<T> fromRows(const DoubleArray& a) {
     return out;
 }
 
+/// Mesh attributes (stored in float) from rows of numbers; ValueError naming `what` beyond float's range.
+template <class T>
+std::vector<T> attributeRows(const py::object& input, py::ssize_t columns, const char* what) {
+    const DoubleArray a = doubleRows(input, columns, what);
+    static_assert(sizeof(T) % sizeof(float) == 0);
+    std::vector<float> f(static_cast<std::size_t>(a.size()));
+    for (std::size_t i = 0; i < f.size(); ++i) {
+        const double v = a.data()[i];
+        if (std::isfinite(v) && !(std::abs(v) <= std::numeric_limits<float>::max()))
+            throw py::value_error(std::string(what) + ": " + std::to_string(v) + " is beyond float's range");
+        f[i] = static_cast<float>(v);
+    }
+    std::vector<T> out(static_cast<std::size_t>(a.shape(0)));
+    if (!f.empty())
+        std::memcpy(static_cast<void*>(out.data()), f.data(), f.size() * sizeof(float));
+    return out;
+}
+
 /// A Mesh from numpy arrays; triangles must be integers in range.
 rubble::Mesh makeMesh(const py::object& vertices, const py::object& triangles, const py::object& materials,
                       const py::object& uvs, const py::object& normals) {
@@ -133,9 +163,9 @@ rubble::Mesh makeMesh(const py::object& vertices, const py::object& triangles, c
     if (!materials.is_none())
         mesh.materials = materials.cast<std::vector<std::uint32_t>>();
     if (!uvs.is_none())
-        mesh.uvs = fromRows<rubble::Vec2>(doubleRows(uvs, 2, "uvs"));
+        mesh.uvs = attributeRows<rubble::Vec2f>(uvs, 2, "uvs");
     if (!normals.is_none())
-        mesh.normals = fromRows<rubble::Vec3>(doubleRows(normals, 3, "normals"));
+        mesh.normals = attributeRows<rubble::Vec3f>(normals, 3, "normals");
     unwrap(mesh.validate());
     return mesh;
 }
@@ -147,11 +177,11 @@ py::object materialsOf(const rubble::Mesh& mesh) {
 }
 
 py::object uvsOf(const rubble::Mesh& mesh) {
-    return mesh.uvs.empty() ? py::object(py::none()) : rows(mesh.uvs, 2);
+    return mesh.uvs.empty() ? py::object(py::none()) : floatRows(mesh.uvs, 2);
 }
 
 py::object normalsOf(const rubble::Mesh& mesh) {
-    return mesh.normals.empty() ? py::object(py::none()) : rows(mesh.normals, 3);
+    return mesh.normals.empty() ? py::object(py::none()) : floatRows(mesh.normals, 3);
 }
 
 py::array_t<std::uint32_t> trianglesOf(const rubble::Mesh& mesh) {
