@@ -35,7 +35,6 @@ namespace py = pybind11;
 namespace {
 
 using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
-using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
 using IndexArray = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>;
 
 /// A library error on its way to Python (becomes rubble.Error).
@@ -55,21 +54,14 @@ void unwrap(const rubble::Status& status) {
         throw LibraryError{status.error()};
 }
 
-/// An (n, columns) float64 array copied from n records of `columns` doubles each.
-template <class T>
-DoubleArray rows(const std::vector<T>& values, py::ssize_t columns) {
-    static_assert(sizeof(T) % sizeof(double) == 0);
-    DoubleArray out({static_cast<py::ssize_t>(values.size()), columns});
-    if (!values.empty())
-        std::memcpy(out.mutable_data(), values.data(), values.size() * sizeof(T));
-    return out;
-}
-
-/// An (n, columns) float32 array copied from n records of `columns` floats each (mesh attributes).
-template <class T>
-FloatArray floatRows(const std::vector<T>& values, py::ssize_t columns) {
-    static_assert(sizeof(T) % sizeof(float) == 0);
-    FloatArray out({static_cast<py::ssize_t>(values.size()), columns});
+/// An (n, columns) array copied from n records of `columns` numbers each: float64 for Vec3, float32 for the
+/// mesh attributes (Vec3f, Vec2f).
+template <class T, class Scalar = decltype(T::x)>
+py::array_t<Scalar, py::array::c_style | py::array::forcecast> rows(const std::vector<T>& values,
+                                                                    py::ssize_t columns) {
+    static_assert(sizeof(T) % sizeof(Scalar) == 0);
+    py::array_t<Scalar, py::array::c_style | py::array::forcecast> out(
+        {static_cast<py::ssize_t>(values.size()), columns});
     if (!values.empty())
         std::memcpy(out.mutable_data(), values.data(), values.size() * sizeof(T));
     return out;
@@ -177,11 +169,11 @@ py::object materialsOf(const rubble::Mesh& mesh) {
 }
 
 py::object uvsOf(const rubble::Mesh& mesh) {
-    return mesh.uvs.empty() ? py::object(py::none()) : floatRows(mesh.uvs, 2);
+    return mesh.uvs.empty() ? py::object(py::none()) : rows(mesh.uvs, 2);
 }
 
 py::object normalsOf(const rubble::Mesh& mesh) {
-    return mesh.normals.empty() ? py::object(py::none()) : floatRows(mesh.normals, 3);
+    return mesh.normals.empty() ? py::object(py::none()) : rows(mesh.normals, 3);
 }
 
 py::array_t<std::uint32_t> trianglesOf(const rubble::Mesh& mesh) {
