@@ -109,7 +109,7 @@ struct HitSamples {
 /// The mesh with zero texture coordinates and material 0 (untimed), as every piece has them after its first
 /// fracture: a hit then measures what a hit on a piece costs, not a one-off fill of the attributes.
 Mesh withAttributes(Mesh mesh) {
-    mesh.uvs.assign(3 * mesh.triangles.size(), Vec2{});
+    mesh.uvs.assign(3 * mesh.triangles.size(), Vec2f{});
     mesh.materials.assign(mesh.triangles.size(), 0u);
     return mesh;
 }

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <optional>
 #include <string>
 #include <utility>
@@ -53,11 +54,14 @@ void unwrap(const rubble::Status& status) {
         throw LibraryError{status.error()};
 }
 
-/// An (n, columns) float64 array copied from n records of `columns` doubles each.
-template <class T>
-DoubleArray rows(const std::vector<T>& values, py::ssize_t columns) {
-    static_assert(sizeof(T) % sizeof(double) == 0);
-    DoubleArray out({static_cast<py::ssize_t>(values.size()), columns});
+/// An (n, columns) array copied from n records of `columns` numbers each: float64 for Vec3, float32 for the
+/// mesh attributes (Vec3f, Vec2f).
+template <class T, class Scalar = decltype(T::x)>
+py::array_t<Scalar, py::array::c_style | py::array::forcecast> rows(const std::vector<T>& values,
+                                                                    py::ssize_t columns) {
+    static_assert(sizeof(T) % sizeof(Scalar) == 0);
+    py::array_t<Scalar, py::array::c_style | py::array::forcecast> out(
+        {static_cast<py::ssize_t>(values.size()), columns});
     if (!values.empty())
         std::memcpy(out.mutable_data(), values.data(), values.size() * sizeof(T));
     return out;
@@ -107,6 +111,24 @@ std::vector<T> fromRows(const DoubleArray& a) {
     return out;
 }
 
+/// Mesh attributes (stored in float) from rows of numbers; ValueError naming `what` beyond float's range.
+template <class T>
+std::vector<T> attributeRows(const py::object& input, py::ssize_t columns, const char* what) {
+    const DoubleArray a = doubleRows(input, columns, what);
+    static_assert(sizeof(T) % sizeof(float) == 0);
+    std::vector<float> f(static_cast<std::size_t>(a.size()));
+    for (std::size_t i = 0; i < f.size(); ++i) {
+        const double v = a.data()[i];
+        if (std::isfinite(v) && !(std::abs(v) <= std::numeric_limits<float>::max()))
+            throw py::value_error(std::string(what) + ": " + std::to_string(v) + " is beyond float's range");
+        f[i] = static_cast<float>(v);
+    }
+    std::vector<T> out(static_cast<std::size_t>(a.shape(0)));
+    if (!f.empty())
+        std::memcpy(static_cast<void*>(out.data()), f.data(), f.size() * sizeof(float));
+    return out;
+}
+
 /// A Mesh from numpy arrays; triangles must be integers in range.
 rubble::Mesh makeMesh(const py::object& vertices, const py::object& triangles, const py::object& materials,
                       const py::object& uvs, const py::object& normals) {
@@ -133,9 +155,9 @@ rubble::Mesh makeMesh(const py::object& vertices, const py::object& triangles, c
     if (!materials.is_none())
         mesh.materials = materials.cast<std::vector<std::uint32_t>>();
     if (!uvs.is_none())
-        mesh.uvs = fromRows<rubble::Vec2>(doubleRows(uvs, 2, "uvs"));
+        mesh.uvs = attributeRows<rubble::Vec2f>(uvs, 2, "uvs");
     if (!normals.is_none())
-        mesh.normals = fromRows<rubble::Vec3>(doubleRows(normals, 3, "normals"));
+        mesh.normals = attributeRows<rubble::Vec3f>(normals, 3, "normals");
     unwrap(mesh.validate());
     return mesh;
 }

@@ -24,7 +24,7 @@ extern "C" {
 #endif
 
 /// Version of this C API; bumped when a struct or a function signature changes.
-#define RUBBLE_C_API_VERSION 2
+#define RUBBLE_C_API_VERSION 3
 
 /// What a call returned: RUBBLE_OK or why it failed (1-7 are the library's rubble::ErrorCode values).
 typedef RUBBLE_C_ENUM(rubble_status){
@@ -69,8 +69,8 @@ typedef struct rubble_mesh_data {
     const uint32_t* indices;   ///< 3 per triangle, counter-clockwise seen from outside
     size_t triangle_count;     ///< number of triangles
     const uint32_t* materials; ///< 1 per triangle, or NULL; cut faces carry RUBBLE_INTERIOR_MATERIAL
-    const double* uvs;         ///< 2 per triangle corner (6 per triangle), or NULL
-    const double* normals;     ///< 3 per triangle corner (9 per triangle), or NULL
+    const float* uvs;          ///< 2 per triangle corner (6 per triangle), or NULL (float since version 3)
+    const float* normals;      ///< 3 per triangle corner (9 per triangle), or NULL (float since version 3)
 } rubble_mesh_data;
 
 /// Material id of faces created by a cut (the inside of an object).

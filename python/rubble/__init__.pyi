@@ -23,6 +23,7 @@ __all__ = [
 ]
 
 Float64Array = npt.NDArray[np.float64]
+Float32Array = npt.NDArray[np.float32]
 UInt32Array = npt.NDArray[np.uint32]
 Vector3 = Sequence[float] | Float64Array
 Backend = Literal["fast", "corefine", "nef"]
@@ -53,7 +54,8 @@ class Mesh:
     ) -> None:
         """vertices (n, 3) numbers, triangles (m, 3) integers in 0..n-1, counter-clockwise seen from outside;
         optional per-triangle materials (m,), per-corner uvs (3m, 2) and normals (3m, 3). Raises ValueError for
-        wrong shapes or indices and Error for non-finite coordinates or inconsistent attributes."""
+        wrong shapes or indices or attributes beyond float32's range (they are stored in float32) and Error for
+        non-finite coordinates or inconsistent attributes."""
     @property
     def vertices(self) -> Float64Array:
         """(n, 3) float64 positions."""
@@ -64,11 +66,11 @@ class Mesh:
     def materials(self) -> UInt32Array | None:
         """(m,) uint32 material ids, or None; cut faces carry INTERIOR_MATERIAL."""
     @property
-    def uvs(self) -> Float64Array | None:
-        """(3m, 2) float64 texture coordinates per triangle corner, or None."""
+    def uvs(self) -> Float32Array | None:
+        """(3m, 2) float32 texture coordinates per triangle corner, or None."""
     @property
-    def normals(self) -> Float64Array | None:
-        """(3m, 3) float64 normals per triangle corner, or None."""
+    def normals(self) -> Float32Array | None:
+        """(3m, 3) float32 normals per triangle corner, or None."""
     @property
     def vertex_count(self) -> int:
         """Number of vertices."""

@@ -26,7 +26,8 @@
 #include "rubble/structure/Material.hpp"
 
 static_assert(sizeof(rubble::Vec3) == 3 * sizeof(double), "Vec3 is read as 3 doubles");
-static_assert(sizeof(rubble::Vec2) == 2 * sizeof(double), "Vec2 is read as 2 doubles");
+static_assert(sizeof(rubble::Vec2f) == 2 * sizeof(float) && sizeof(rubble::Vec3f) == 3 * sizeof(float),
+              "attributes are read as floats");
 static_assert(sizeof(rubble::Triangle) == 3 * sizeof(std::uint32_t), "Triangle is read as 3 uint32");
 static_assert(RUBBLE_ERROR_IO == static_cast<int>(rubble::ErrorCode::IoError) &&
                   RUBBLE_ERROR_CANCELLED == static_cast<int>(rubble::ErrorCode::Cancelled),

@@ -194,7 +194,7 @@ private:
                            std::uint32_t face, std::vector<OutTri>& out);
     void buildCaps();
     bool pointInsideMesh(const Vec3& p) const;
-    void emitAttributes(const OutTri& o, std::vector<Vec3>* normals, std::vector<Vec2>& uvs,
+    void emitAttributes(const OutTri& o, std::vector<Vec3f>* normals, std::vector<Vec2f>& uvs,
                         std::vector<std::uint32_t>& materials) const;
     Mesh assemble(std::uint32_t region) const;
     RemainderEdit assembleEdit(std::vector<std::uint32_t> removed) const;

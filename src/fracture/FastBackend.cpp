@@ -52,7 +52,7 @@ public:
         }
         // The clipper always emits uvs and materials; keep the layout identical when nothing is cut.
         if (out.remainder.uvs.empty())
-            out.remainder.uvs.assign(3 * out.remainder.triangles.size(), Vec2{});
+            out.remainder.uvs.assign(3 * out.remainder.triangles.size(), Vec2f{});
         if (out.remainder.materials.empty())
             out.remainder.materials.assign(out.remainder.triangles.size(), 0u);
         return out;

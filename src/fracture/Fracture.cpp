@@ -145,7 +145,7 @@ void finishCutFaces(Mesh& m, std::span<const ConvexPolytope> cells, double uvSca
     if (!m.hasMaterials())
         return;
     if (m.uvs.size() != 3 * m.triangles.size())
-        m.uvs.assign(3 * m.triangles.size(), Vec2{});
+        m.uvs.assign(3 * m.triangles.size(), Vec2f{});
     const std::size_t count = only ? only->size() : m.triangles.size();
     for (std::size_t i = 0; i < count; ++i) {
         const std::size_t t = only ? (*only)[i] : i;
@@ -187,7 +187,7 @@ void finishCutFaces(Mesh& m, std::span<const ConvexPolytope> cells, double uvSca
             const Vec3& p = c[static_cast<std::size_t>(k)];
             m.uvs[3 * t + static_cast<std::size_t>(k)] = {dot(p, u) * uvScale, dot(p, v) * uvScale};
             if (m.hasNormals())
-                m.normals[3 * t + static_cast<std::size_t>(k)] = n;
+                m.normals[3 * t + static_cast<std::size_t>(k)] = Vec3f(n);
         }
     }
 }
@@ -548,7 +548,7 @@ Status runInPlace(Stages& st, Mesh& mesh, HeldTopology& held, std::vector<Convex
             const std::size_t room = std::max(nT, mesh.triangles.capacity());
             if (noUvs) {
                 mesh.uvs.reserve(3 * room);
-                mesh.uvs.assign(3 * nT, Vec2{});
+                mesh.uvs.assign(3 * nT, Vec2f{});
             }
             if (noMaterials) {
                 mesh.materials.reserve(room);

@@ -676,9 +676,11 @@ void displace(RoughOutput& o, const CutFaces& faces, const RoughSettings& s,
     for (const WorkTriangle& t : work) {
         out.triangles.push_back({t.v[0], t.v[1], t.v[2]});
         out.materials.push_back(t.material);
-        out.uvs.insert(out.uvs.end(), t.uv.begin(), t.uv.end());
-        if (normals)
-            out.normals.insert(out.normals.end(), t.n.begin(), t.n.end());
+        for (int k = 0; k < 3; ++k) { // refined in double, stored in float
+            out.uvs.emplace_back(t.uv[k]);
+            if (normals)
+                out.normals.emplace_back(t.n[k]);
+        }
         if (integrals)
             integrals->add(out.positions[t.v[0]], out.positions[t.v[1]], out.positions[t.v[2]]);
     }

@@ -119,16 +119,16 @@ Mesh assembleMesh(const Mesh& input, std::vector<Vec3> positions, const std::vec
             if (hasN) {
                 const Vec3 n = normalized(cross(m.positions[tri[1]] - m.positions[tri[0]],
                                                 m.positions[tri[2]] - m.positions[tri[0]]));
-                m.normals.insert(m.normals.end(), 3, n);
+                m.normals.insert(m.normals.end(), 3, Vec3f(n));
             }
-            m.uvs.insert(m.uvs.end(), 3, Vec2{});
+            m.uvs.insert(m.uvs.end(), 3, Vec2f{});
             m.materials.push_back(kInteriorMaterial);
             continue;
         }
         const auto s = static_cast<std::size_t>(src);
         m.materials.push_back(input.material(s));
         if (!hasN && !hasUv) {
-            m.uvs.insert(m.uvs.end(), 3, Vec2{});
+            m.uvs.insert(m.uvs.end(), 3, Vec2f{});
             continue;
         }
         const auto c = input.corners(s);
@@ -146,10 +146,10 @@ Mesh assembleMesh(const Mesh& input, std::vector<Vec3> positions, const std::vec
             const double w2 = 1 - w0 - w1;
             const std::size_t b = 3 * s;
             if (hasN)
-                m.normals.push_back(normalized(input.normals[b] * w0 + input.normals[b + 1] * w1 +
-                                               input.normals[b + 2] * w2));
+                m.normals.emplace_back(normalized(w0 * input.normals[b] + w1 * input.normals[b + 1] +
+                                                  w2 * input.normals[b + 2]));
             if (hasUv) {
-                const Vec2 &u0 = input.uvs[b], &u1 = input.uvs[b + 1], &u2 = input.uvs[b + 2];
+                const Vec2f &u0 = input.uvs[b], &u1 = input.uvs[b + 1], &u2 = input.uvs[b + 2];
                 m.uvs.push_back({u0.x * w0 + u1.x * w1 + u2.x * w2, u0.y * w0 + u1.y * w1 + u2.y * w2});
             } else {
                 m.uvs.push_back({});

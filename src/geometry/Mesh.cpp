@@ -84,8 +84,8 @@ void Mesh::transform(const Mat3& rotation, const Vec3& scale, const Vec3& transl
     for (Vec3& p : positions)
         p = rotation * Vec3{p.x * scale.x, p.y * scale.y, p.z * scale.z} + translation;
     // Normals transform by the inverse transpose of rotation*scale = rotation * scale^-1.
-    for (Vec3& n : normals)
-        n = normalized(rotation * Vec3{n.x / scale.x, n.y / scale.y, n.z / scale.z});
+    for (Vec3f& n : normals)
+        n = Vec3f(normalized(rotation * Vec3{n.x / scale.x, n.y / scale.y, n.z / scale.z}));
     // A mirroring scale flips orientation: swap two corners to stay outward.
     if (scale.x * scale.y * scale.z < 0) {
         for (std::size_t t = 0; t < triangles.size(); ++t) {
@@ -108,7 +108,7 @@ Mesh Mesh::translated(const Vec3& t) const {
 void Mesh::computeFlatNormals() {
     normals.resize(3 * triangles.size());
     for (std::size_t t = 0; t < triangles.size(); ++t) {
-        const Vec3 n = normalized(triangleNormal(t));
+        const Vec3f n(normalized(triangleNormal(t)));
         normals[3 * t] = normals[3 * t + 1] = normals[3 * t + 2] = n;
     }
 }
@@ -162,13 +162,13 @@ std::uint64_t Mesh::hash() const {
     for (const Triangle& t : triangles)
         h.bytes(t.data(), sizeof(t));
     h.u64(normals.size());
-    for (const Vec3& n : normals) {
+    for (const Vec3f& n : normals) { // hashed widened to double
         h.real(n.x);
         h.real(n.y);
         h.real(n.z);
     }
     h.u64(uvs.size());
-    for (const Vec2& u : uvs) {
+    for (const Vec2f& u : uvs) {
         h.real(u.x);
         h.real(u.y);
     }

@@ -60,7 +60,7 @@ void flipTriangle(Mesh& m, std::size_t t) {
         const Vec3 n = m.triangleNormal(t);
         for (int c = 0; c < 3; ++c)
             if (dot(m.normals[3 * t + c], n) < 0)
-                m.normals[3 * t + c] = -m.normals[3 * t + c];
+                m.normals[3 * t + c] = Vec3f(-Vec3(m.normals[3 * t + c]));
     }
 }
 
@@ -318,10 +318,10 @@ HoleStats fillHoles(Mesh& m) {
             m.triangles.push_back({t[0], t[1], t[2]});
             if (m.hasNormals())
                 for (int c = 0; c < 3; ++c)
-                    m.normals.push_back(n);
+                    m.normals.emplace_back(n);
             if (m.hasUvs())
                 for (int c = 0; c < 3; ++c)
-                    m.uvs.push_back(Vec2{0, 0});
+                    m.uvs.push_back(Vec2f{0, 0});
             if (m.hasMaterials())
                 m.materials.push_back(m.materials[neighbour]);
         }

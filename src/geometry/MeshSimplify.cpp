@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <unordered_map>
 #include <unordered_set>
@@ -117,7 +118,7 @@ bool Simplifier::compatible(std::uint32_t t, std::uint32_t s) const {
     if (m_.hasNormals())
         for (std::size_t k = 0; k < 3; ++k)
             for (std::uint32_t x : {t, s}) {
-                const Vec3 d = m_.normals[3 * x + k] - m_.normals[3 * t];
+                const Vec3 d = Vec3(m_.normals[3 * x + k]) - m_.normals[3 * t];
                 if (!(std::max({std::abs(d.x), std::abs(d.y), std::abs(d.z)}) <= 1e-6))
                     return false;
             }
@@ -127,14 +128,14 @@ bool Simplifier::compatible(std::uint32_t t, std::uint32_t s) const {
         const double a11 = dot(e1, e1), a12 = dot(e1, e2), a22 = dot(e2, e2), det = a11 * a22 - a12 * a12;
         if (!(det > 0))
             return false;
-        const Vec2* ru = &m_.uvs[3 * r];
+        const Vec2f* ru = &m_.uvs[3 * r];
         for (std::size_t k = 0; k < 3; ++k) {
             const Vec3 d = oc[k] - rc[0];
             const double b1 = dot(d, e1), b2 = dot(d, e2);
             const double l1 = (a22 * b1 - a12 * b2) / det, l2 = (a11 * b2 - a12 * b1) / det, l0 = 1 - l1 - l2;
             const Vec2 want{l0 * ru[0].x + l1 * ru[1].x + l2 * ru[2].x,
                             l0 * ru[0].y + l1 * ru[1].y + l2 * ru[2].y};
-            const Vec2& have = m_.uvs[3 * o + k];
+            const Vec2 have = m_.uvs[3 * o + k];
             const double tol = params_.uvTolerance * std::max({1.0, std::abs(have.x), std::abs(have.y)});
             if (!(std::abs(want.x - have.x) <= tol) || !(std::abs(want.y - have.y) <= tol))
                 return false;
@@ -163,7 +164,7 @@ bool Simplifier::flat(const std::vector<std::uint32_t>& tris) const {
             if (!m_.hasUvs())
                 continue;
             const double q[3] = {dot(d, u), dot(d, v), 1};
-            const Vec2& uv = m_.uvs[3 * t + k];
+            const Vec2 uv = m_.uvs[3 * t + k];
             for (int a = 0; a < 3; ++a) {
                 for (int b = 0; b < 3; ++b)
                     s[a][b] += q[a] * q[b];
@@ -195,12 +196,15 @@ bool Simplifier::flat(const std::vector<std::uint32_t>& tris) const {
     double cu[3], cv[3];
     solve(su, cu);
     solve(sv, cv);
-    const double tol = params_.uvTolerance * std::max({1.0, hi[0] - lo[0], hi[1] - lo[1]});
+    // the fit's own tolerance, and the float rounding of the stored coordinates
+    const double stored = 4 * std::numeric_limits<float>::epsilon() *
+                          std::max({std::abs(lo[0]), std::abs(hi[0]), std::abs(lo[1]), std::abs(hi[1])});
+    const double tol = params_.uvTolerance * std::max({1.0, hi[0] - lo[0], hi[1] - lo[1]}) + stored;
     for (std::uint32_t t : tris)
         for (std::size_t k = 0; k < 3; ++k) {
             const Vec3 dd = m_.positions[m_.triangles[t][k]] - o;
             const double x = dot(dd, u), y = dot(dd, v);
-            const Vec2& uv = m_.uvs[3 * t + k];
+            const Vec2 uv = m_.uvs[3 * t + k];
             if (!(std::abs(cu[0] * x + cu[1] * y + cu[2] - uv.x) <= tol) ||
                 !(std::abs(cv[0] * x + cv[1] * y + cv[2] - uv.y) <= tol))
                 return false;
@@ -399,8 +403,8 @@ void Simplifier::assemble(Mesh& m, bool inPlace, const PatchOf& patchOf,
     };
     std::unordered_map<std::uint32_t, std::uint32_t> cornerOf; // a corner of the patch at each vertex
     std::vector<std::uint32_t> mats;
-    std::vector<Vec2> uvs;
-    std::vector<Vec3> normals;
+    std::vector<Vec2f> uvs;
+    std::vector<Vec3f> normals;
     for (const auto& [t, p] : patchOf) {
         run(next, t);
         next = t + 1;

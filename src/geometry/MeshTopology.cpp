@@ -175,8 +175,8 @@ std::optional<std::vector<std::uint32_t>> replaceTriangles(Mesh& mesh, MeshTopol
         growTo(topology.twin, 3 * total);
     }
     // Writes a triangle and its attributes into slot s.
-    auto put = [&](std::uint32_t s, const Triangle& tri, std::uint32_t material, const Vec2* uvs,
-                   const Vec3* normals) {
+    auto put = [&](std::uint32_t s, const Triangle& tri, std::uint32_t material, const Vec2f* uvs,
+                   const Vec3f* normals) {
         mesh.triangles[s] = tri;
         mesh.materials[s] = material;
         std::copy(uvs, uvs + 3, mesh.uvs.begin() + 3 * s);

@@ -67,8 +67,8 @@ private:
 /// Triangles with their attributes, laid out as in Mesh (normals only when the mesh has them).
 struct TriangleBatch {
     std::vector<Triangle> triangles;
-    std::vector<Vec3> normals;            ///< 3 per triangle, or empty
-    std::vector<Vec2> uvs;                ///< 3 per triangle
+    std::vector<Vec3f> normals;           ///< 3 per triangle, or empty
+    std::vector<Vec2f> uvs;               ///< 3 per triangle
     std::vector<std::uint32_t> materials; ///< 1 per triangle
 };
 

@@ -509,9 +509,9 @@ private:
                 for (int c = 0; c < 3; ++c) {
                     if (am->HasNormals()) {
                         const aiVector3D n = normalXf * am->mNormals[ids[c]];
-                        m_.normals.push_back(normalized(Vec3{n.x, n.y, n.z}));
+                        m_.normals.emplace_back(normalized(Vec3{n.x, n.y, n.z}));
                     } else {
-                        m_.normals.push_back(normalized(m_.triangleNormal(m_.triangles.size() - 1)));
+                        m_.normals.emplace_back(normalized(m_.triangleNormal(m_.triangles.size() - 1)));
                     }
                 }
             }

@@ -114,7 +114,7 @@ private:
     }
 
     Status parseNumbers(const std::vector<std::string_view>& tok, std::size_t needed, std::size_t maxUsed,
-                        const char* what, const char* const* names, double* out) {
+                        const char* what, const char* const* names, double* out, bool inFloat = false) {
         if (tok.size() - 1 < needed)
             return fail(std::string(what) + " needs " + std::to_string(needed) +
                         (needed == 1 ? " number" : " numbers") + ", got " + std::to_string(tok.size() - 1));
@@ -131,6 +131,9 @@ private:
             case NumberStatus::Ok:
                 break;
             }
+            if (inFloat && !(std::abs(v) <= std::numeric_limits<float>::max())) // attributes are float
+                return fail(std::string(what) + ": value " + quoted(tok[i]) + " for " + field +
+                            " is beyond float's range");
             if (i - 1 < maxUsed)
                 out[i - 1] = v;
         }
@@ -153,15 +156,15 @@ private:
         } else if (key == "vt") {
             static const char* const names[] = {"u", "v", "w"};
             double c[3] = {0, 0, 0};
-            if (Status s = parseNumbers(tok, 1, 3, "texture coordinate", names, c); !s)
+            if (Status s = parseNumbers(tok, 1, 3, "texture coordinate", names, c, true); !s)
                 return s;
-            texcoords_.push_back({c[0], c[1]});
+            texcoords_.emplace_back(c[0], c[1]);
         } else if (key == "vn") {
             static const char* const names[] = {"x", "y", "z"};
             double c[3] = {0, 0, 0};
-            if (Status s = parseNumbers(tok, 3, 3, "normal", names, c); !s)
+            if (Status s = parseNumbers(tok, 3, 3, "normal", names, c, true); !s)
                 return s;
-            normals_.push_back({c[0], c[1], c[2]});
+            normals_.emplace_back(c[0], c[1], c[2]);
         } else if (key == "f" || key == "fo") {
             return parseFace(tok);
         } else if (key == "o") {
@@ -307,13 +310,13 @@ private:
                 out[k] = remap_[static_cast<std::size_t>(tri.c[k].v)];
             m.triangles.push_back(out);
             if (anyNormal) {
-                const Vec3 flat = normalized(m.triangleNormal(m.triangles.size() - 1));
+                const Vec3f flat(normalized(m.triangleNormal(m.triangles.size() - 1)));
                 for (const Corner& c : tri.c)
                     m.normals.push_back(c.vn >= 0 ? normals_[static_cast<std::size_t>(c.vn)] : flat);
             }
             if (anyUv)
                 for (const Corner& c : tri.c)
-                    m.uvs.push_back(c.vt >= 0 ? texcoords_[static_cast<std::size_t>(c.vt)] : Vec2{});
+                    m.uvs.push_back(c.vt >= 0 ? texcoords_[static_cast<std::size_t>(c.vt)] : Vec2f{});
             if (hasMaterials_)
                 m.materials.push_back(tri.material);
         }
@@ -329,8 +332,8 @@ private:
     std::string name_;
     std::size_t line_ = 0;
     std::vector<Vec3> positions_;
-    std::vector<Vec2> texcoords_;
-    std::vector<Vec3> normals_;
+    std::vector<Vec2f> texcoords_;
+    std::vector<Vec3f> normals_;
     std::vector<Tri> tris_;
     std::vector<std::string> oNames_{""}, gNames_{""};
     bool sawO_ = false;

@@ -15,9 +15,11 @@
 namespace rubble {
 
 namespace {
-void appendNumber(std::string& out, double v) {
+// The shortest text that reads back as v (a float's as a float: attributes).
+template <class Real>
+void appendNumber(std::string& out, Real v) {
     char buf[64];
-    const auto [ptr, ec] = std::to_chars(buf, buf + sizeof buf, v == 0 ? 0.0 : v);
+    const auto [ptr, ec] = std::to_chars(buf, buf + sizeof buf, v == 0 ? Real(0) : v);
     out.append(buf, ec == std::errc() ? ptr : buf);
 }
 
@@ -49,26 +51,26 @@ std::string materialName(const Mesh& m, std::uint32_t id) {
     return "material_" + std::to_string(id);
 }
 
-// Deduplicates attribute values by their bit pattern, numbering them from 1 in first-use order.
+// Deduplicates attribute values (float) by their bit pattern, numbering them from 1 in first-use order.
 template <std::size_t N>
 class AttributeTable {
 public:
-    std::size_t id(const std::array<double, N>& v) {
-        std::array<std::uint64_t, N> key;
+    std::size_t id(const std::array<float, N>& v) {
+        std::array<std::uint32_t, N> key;
         for (std::size_t i = 0; i < N; ++i) {
-            const double d = v[i] == 0 ? 0.0 : v[i];
-            std::memcpy(&key[i], &d, sizeof d);
+            const float f = v[i] == 0 ? 0.0f : v[i];
+            std::memcpy(&key[i], &f, sizeof f);
         }
         auto [it, inserted] = ids_.emplace(key, values_.size() + 1);
         if (inserted)
             values_.push_back(v);
         return it->second;
     }
-    const std::vector<std::array<double, N>>& values() const { return values_; }
+    const std::vector<std::array<float, N>>& values() const { return values_; }
 
 private:
-    std::map<std::array<std::uint64_t, N>, std::size_t> ids_;
-    std::vector<std::array<double, N>> values_;
+    std::map<std::array<std::uint32_t, N>, std::size_t> ids_;
+    std::vector<std::array<float, N>> values_;
 };
 
 Status writeText(const std::filesystem::path& path, const std::string& text) {
@@ -109,7 +111,7 @@ Status writeObj(const std::filesystem::path& path, const Mesh& mesh, const ObjWr
     std::vector<std::size_t> uvId, normalId;
     if (uvs) {
         uvId.reserve(mesh.uvs.size());
-        for (const Vec2& t : mesh.uvs)
+        for (const Vec2f& t : mesh.uvs)
             uvId.push_back(uvTable.id({t.x, t.y}));
         for (const auto& t : uvTable.values()) {
             out += "vt ";
@@ -121,7 +123,7 @@ Status writeObj(const std::filesystem::path& path, const Mesh& mesh, const ObjWr
     }
     if (normals) {
         normalId.reserve(mesh.normals.size());
-        for (const Vec3& n : mesh.normals)
+        for (const Vec3f& n : mesh.normals)
             normalId.push_back(normalTable.id({n.x, n.y, n.z}));
         for (const auto& n : normalTable.values()) {
             out += "vn ";

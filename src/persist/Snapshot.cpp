@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <map>
 
@@ -25,7 +26,8 @@ using persist::ByteWriter;
 constexpr std::uint8_t kMagic[4] = {'R', 'B', 'S', 'N'};
 // Mesh arrays are copied in bulk on little-endian machines (the file's byte order); elsewhere value by value.
 constexpr bool kBulk = std::endian::native == std::endian::little && sizeof(Vec3) == 24 &&
-                       sizeof(Vec2) == 16 && sizeof(Triangle) == 12;
+                       sizeof(Vec2) == 16 && sizeof(Vec3f) == 12 && sizeof(Vec2f) == 8 &&
+                       sizeof(Triangle) == 12;
 
 template <class T>
 void writeArray(ByteWriter& w, const std::vector<T>& v, auto&& each) {
@@ -51,28 +53,37 @@ void readArray(ByteReader& r, std::vector<T>& v, std::uint32_t n, const char* fi
     }
 }
 
-// Fails at the first non-finite coordinate of records stored from offset `start` (8 bytes per coordinate).
-void checkFinite(ByteReader& r, const std::vector<Vec3>& v, std::size_t start, const char* field) {
+std::array<double, 3> coords(const Vec3& v) {
+    return {v.x, v.y, v.z};
+}
+std::array<double, 3> coords(const Vec3f& v) {
+    return {v.x, v.y, v.z};
+}
+std::array<double, 2> coords(const Vec2& v) {
+    return {v.x, v.y};
+}
+std::array<double, 2> coords(const Vec2f& v) {
+    return {v.x, v.y};
+}
+
+// Fails at the first non-finite coordinate of records stored from offset `start`, each `bytes` long.
+template <class T>
+void checkFinite(ByteReader& r, const std::vector<T>& v, std::size_t start, const char* field,
+                 const char* what = "is not finite", std::size_t bytes = sizeof(T)) {
     static const char* axis[3] = {".x", ".y", ".z"};
-    for (std::size_t i = 0; i < v.size() && r.ok(); ++i)
-        for (int k = 0; k < 3; ++k)
-            if (!(v[i][k] - v[i][k] == 0)) {
-                r.fail(start + 24 * i + 8 * static_cast<std::size_t>(k), std::string(field) + axis[k],
-                       "is not finite");
+    for (std::size_t i = 0; i < v.size() && r.ok(); ++i) {
+        const auto c = coords(v[i]);
+        for (std::size_t k = 0; k < c.size(); ++k)
+            if (!(c[k] - c[k] == 0)) {
+                r.fail(start + bytes * i + bytes / c.size() * k, std::string(field) + axis[k], what);
                 break;
             }
-}
-void checkFinite(ByteReader& r, const std::vector<Vec2>& v, std::size_t start, const char* field) {
-    for (std::size_t i = 0; i < v.size() && r.ok(); ++i) {
-        if (!(v[i].x - v[i].x == 0))
-            r.fail(start + 16 * i, std::string(field) + ".x", "is not finite");
-        else if (!(v[i].y - v[i].y == 0))
-            r.fail(start + 16 * i + 8, std::string(field) + ".y", "is not finite");
     }
 }
 
-// 2: decomposition settings, each object's mesh hash, the volume ledger. 3: the structure (read: 2 and 3).
-constexpr std::uint16_t kVersion = 4;
+// 2: decomposition settings, each object's mesh hash, the volume ledger. 3: the structure. 4: roughness.
+// 5: normals and texture coordinates in float (read: 2 to 5).
+constexpr std::uint16_t kVersion = 5;
 constexpr std::uint16_t kOldestVersion = 2;
 
 void vec(ByteWriter& w, const Vec3& v) {
@@ -110,6 +121,23 @@ double real(ByteReader& r, const char* field, const char* part = "") {
     if (r.ok() && !(v - v == 0))
         r.fail(at, std::string(field) + part, "is not finite");
     return r.ok() ? v : 0;
+}
+float single(ByteReader& r, const char* field, const char* part) {
+    const std::size_t at = r.offset();
+    const float v = r.f32(field);
+    if (r.ok() && !(v - v == 0))
+        r.fail(at, std::string(field) + part, "is not finite");
+    return r.ok() ? v : 0;
+}
+// Attributes of a version before 5 (double, stored from `start`) rounded to float; one beyond float's range
+// fails.
+template <class Wide, class Narrow>
+void narrow(ByteReader& r, const std::vector<Wide>& wide, std::vector<Narrow>& out, std::size_t start,
+            const char* field) {
+    out.reserve(wide.size());
+    for (const Wide& v : wide)
+        out.emplace_back(v);
+    checkFinite(r, out, start, field, "is beyond float's range", sizeof(Wide));
 }
 Vec3 vec(ByteReader& r, const char* field) {
     Vec3 v;
@@ -174,10 +202,14 @@ void writeObject(ByteWriter& w, const ObjectState& o) {
         for (auto i : t)
             w.u32(i);
     });
-    writeArray(w, m.normals, [&](const Vec3& n) { vec(w, n); });
-    writeArray(w, m.uvs, [&](const Vec2& u) {
-        w.f64(u.x);
-        w.f64(u.y);
+    writeArray(w, m.normals, [&](const Vec3f& n) {
+        w.f32(n.x);
+        w.f32(n.y);
+        w.f32(n.z);
+    });
+    writeArray(w, m.uvs, [&](const Vec2f& u) {
+        w.f32(u.x);
+        w.f32(u.y);
     });
     writeArray(w, m.materials, [&](std::uint32_t id) { w.u32(id); });
     w.u32(static_cast<std::uint32_t>(m.materialNames.size()));
@@ -278,25 +310,49 @@ ObjectState readObject(ByteReader& r, const std::uint8_t* data, std::uint16_t ve
         if (r.ok() && n != 0 && n != 3ull * nTri)
             r.fail(where, field, std::to_string(n) + " entries for " + std::to_string(nTri) + " triangles");
     };
+    // Per-corner attributes: float from version 5, double before (rounded to float here).
+    const bool floats = version >= 5;
     pos = r.offset();
-    const std::uint32_t nNormals = r.count("mesh.normals.count", 24);
+    const std::uint32_t nNormals = r.count("mesh.normals.count", floats ? 12 : 24);
     perCorner(nNormals, "mesh.normals.count", pos);
     start = r.offset();
-    readArray(r, m.normals, r.ok() ? nNormals : 0, "mesh.normals", [&] { return vec(r, "mesh.normals"); });
-    if (kBulk)
-        checkFinite(r, m.normals, start, "mesh.normals");
+    if (floats) {
+        readArray(r, m.normals, r.ok() ? nNormals : 0, "mesh.normals", [&] {
+            const float x = single(r, "mesh.normals", ".x"), y = single(r, "mesh.normals", ".y");
+            return Vec3f{x, y, single(r, "mesh.normals", ".z")};
+        });
+        if (kBulk)
+            checkFinite(r, m.normals, start, "mesh.normals");
+    } else {
+        std::vector<Vec3> wide;
+        readArray(r, wide, r.ok() ? nNormals : 0, "mesh.normals", [&] { return vec(r, "mesh.normals"); });
+        if (kBulk)
+            checkFinite(r, wide, start, "mesh.normals");
+        narrow(r, wide, m.normals, start, "mesh.normals");
+    }
     pos = r.offset();
-    const std::uint32_t nUvs = r.count("mesh.uvs.count", 16);
+    const std::uint32_t nUvs = r.count("mesh.uvs.count", floats ? 8 : 16);
     perCorner(nUvs, "mesh.uvs.count", pos);
     start = r.offset();
-    readArray(r, m.uvs, r.ok() ? nUvs : 0, "mesh.uvs", [&] {
-        Vec2 u;
-        u.x = real(r, "mesh.uvs", ".x");
-        u.y = real(r, "mesh.uvs", ".y");
-        return u;
-    });
-    if (kBulk)
-        checkFinite(r, m.uvs, start, "mesh.uvs");
+    if (floats) {
+        readArray(r, m.uvs, r.ok() ? nUvs : 0, "mesh.uvs", [&] {
+            const float u = single(r, "mesh.uvs", ".x");
+            return Vec2f{u, single(r, "mesh.uvs", ".y")};
+        });
+        if (kBulk)
+            checkFinite(r, m.uvs, start, "mesh.uvs");
+    } else {
+        std::vector<Vec2> wide;
+        readArray(r, wide, r.ok() ? nUvs : 0, "mesh.uvs", [&] {
+            Vec2 u;
+            u.x = real(r, "mesh.uvs", ".x");
+            u.y = real(r, "mesh.uvs", ".y");
+            return u;
+        });
+        if (kBulk)
+            checkFinite(r, wide, start, "mesh.uvs");
+        narrow(r, wide, m.uvs, start, "mesh.uvs");
+    }
     pos = r.offset();
     const std::uint32_t nMat = r.count("mesh.materials.count", 4);
     if (r.ok() && nMat != 0 && nMat != nTri)
@@ -306,6 +362,8 @@ ObjectState readObject(ByteReader& r, const std::uint8_t* data, std::uint16_t ve
     const std::uint32_t nNames = r.count("mesh.materialNames.count", 4);
     for (std::uint32_t i = 0; i < nNames && r.ok(); ++i)
         m.materialNames.push_back(text(r, data, "mesh.materialNames.length", "mesh.materialNames"));
+    if (!floats && r.ok() && (m.hasNormals() || m.hasUvs()))
+        o.meshHash = m.hash(); // the saved hash was of the attributes in double
     const std::uint32_t nParts = r.count("convexParts.count", 4);
     o.convexParts.reserve(nParts);
     for (std::uint32_t i = 0; i < nParts && r.ok(); ++i) {
@@ -465,7 +523,7 @@ std::vector<std::uint8_t> encodeSnapshot(const Snapshot& s) {
     std::size_t estimate = 64 + 10 * s.structure.nodes.size() + 25 * s.structure.bonds.size();
     for (const ObjectState& o : s.world.objects)
         estimate += 512 + 24 * o.mesh.positions.size() + 12 * o.mesh.triangles.size() +
-                    24 * o.mesh.normals.size() + 16 * o.mesh.uvs.size() + 4 * o.mesh.materials.size() +
+                    12 * o.mesh.normals.size() + 8 * o.mesh.uvs.size() + 4 * o.mesh.materials.size() +
                     256 * o.convexParts.size();
     w.data().reserve(estimate);
     w.bytes(kMagic, 4);

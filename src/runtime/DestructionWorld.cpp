@@ -32,6 +32,9 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// The world keeps the facts of meshes above this size; a hit on a smaller one finds them again in the worker.
+constexpr std::size_t kFactsKeptAboveTriangles = 1000;
+
 double msBetween(Clock::time_point a, Clock::time_point b) {
     return std::chrono::duration<double, std::milli>(b - a).count();
 }
@@ -321,8 +324,13 @@ struct DestructionWorld::Impl {
     std::uint64_t journalLength = 0;
     std::uint64_t geometrySum = 0; // Σ geometryTerm over live objects with a mesh hash (wrapping)
     std::set<ObjectId> unhashed;   // live objects whose meshHash is not computed yet (0)
-    // analyzeMesh of live objects' meshes where known (not saved: a function of the mesh, found again)
+    // analyzeMesh of live objects' meshes where known (not saved: a function of the mesh, found again), above
+    // kFactsKeptAboveTriangles: a small piece's are found again by the worker that fractures it
     std::map<ObjectId, MeshFacts> facts;
+    void keepFacts(ObjectId id, MeshFacts f) {
+        if (f.triangles > kFactsKeptAboveTriangles)
+            facts[id] = std::move(f);
+    }
 
     static std::uint64_t geometryTerm(const ObjectState& o) {
         return mixSeed(mixSeed(o.id, o.version), o.meshHash);
@@ -615,7 +623,7 @@ Result<ObjectId> DestructionWorld::addObject(ObjectDesc desc) {
     const ObjectId id = s.id;
     impl_->insertObject(std::move(state));
     if (facts)
-        impl_->facts[id] = std::move(facts).value();
+        impl_->keepFacts(id, std::move(facts).value());
     return id;
 }
 
@@ -860,7 +868,7 @@ std::vector<FractureOutcome> DestructionWorld::collect() {
             rec.stale = true; // the object was removed or replaced meanwhile: the result is discarded
         } else if (job->errorCode == ErrorCode::NoIntersection) {
             if (job->facts.fit(it->second->mesh)) // what the worker found, for the next hit
-                im.facts[job->id] = job->facts;
+                im.keepFacts(job->id, job->facts);
             rec.missed = true; // nothing of the mesh inside the cells: a miss, not a failure
         } else {
             rec.failed = true;
@@ -894,7 +902,7 @@ void DestructionWorld::commit(const FractureOutcome& split) {
     im.open.erase(o);
     im.eraseObject(im.objects.find(split.parent));
     for (std::size_t i = 0; i < s.pieces.size(); ++i) {
-        im.facts[s.pieces[i].id] = std::move(s.facts[i]);
+        im.keepFacts(s.pieces[i].id, std::move(s.facts[i]));
         im.insertObject(s.pieces[i].state);
     }
     std::vector<PendingImpact> later;

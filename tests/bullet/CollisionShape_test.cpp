@@ -53,8 +53,8 @@ TEST(CollisionShape, EdgesShareTheirCornersAndHullsHoldTheirPoints) {
     auto less = [](const Vec3& a, const Vec3& b) {
         return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z;
     };
-    auto toBody = [&](const Vec3& p) {
-        return objectToBody.rotation.transposed() * (p - objectToBody.translation);
+    auto toBody = [&](const Vec3& p) { // kept in float
+        return Vec3(Vec3f(objectToBody.rotation.transposed() * (p - objectToBody.translation)));
     };
     for (const PolytopeFace& f : part.faces())
         for (std::size_t i = 0; i < f.corners.size(); ++i) {
@@ -68,7 +68,7 @@ TEST(CollisionShape, EdgesShareTheirCornersAndHullsHoldTheirPoints) {
     EXPECT_EQ(shape->edges(), expected);
     EXPECT_EQ(shape->edgeCount(), expected.size());
     const CollisionShape::Bytes bytes = shape->bytes();
-    EXPECT_EQ(bytes.edges, corners * sizeof(Vec3) + expected.size() * 2 * sizeof(std::uint32_t));
+    EXPECT_EQ(bytes.edges, corners * sizeof(Vec3f) + expected.size() * 2 * sizeof(std::uint32_t));
     auto* hull = static_cast<btConvexHullShape*>(shape->shape());
     EXPECT_EQ(bytes.points, static_cast<std::size_t>(hull->getNumPoints()));
     EXPECT_EQ(bytes.points, corners); // the eroded hull keeps the part's combinatorics here

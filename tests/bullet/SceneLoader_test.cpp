@@ -122,7 +122,7 @@ TEST(SceneLoader, PrepareMeshHookSeesEveryObjectAndIndicesMapToTheScene) {
     int calls = 0;
     options.prepareMesh = [&](Mesh& m) {
         ++calls;
-        m.uvs.assign(m.triangles.size() * 3, Vec2{0.25, 0.5});
+        m.uvs.assign(m.triangles.size() * 3, Vec2f{0.25, 0.5});
     };
     const LoadedScene loaded = loadScene(*scene, *w.runtime, options);
     EXPECT_EQ(calls, 2);

@@ -80,14 +80,14 @@ TEST(MeshTopology, BuiltAboveTheThresholdForOneShellOnly) {
 TEST(MeshTopology, ReplacingTrianglesKeepsTheTopology) {
     Mesh mesh = makeSubdividedBox({0, 0, 0}, {1, 1, 1}, 42);
     ASSERT_GT(mesh.triangles.size(), kTopologyAboveTriangles);
-    mesh.uvs.assign(3 * mesh.triangles.size(), Vec2{});
+    mesh.uvs.assign(3 * mesh.triangles.size(), Vec2f{});
     mesh.materials.assign(mesh.triangles.size(), 0);
     mesh.normals.clear();
     MeshTopology topo = buildTopology(mesh).value();
     Rng rng(7);
     auto batchOf = [](std::vector<Triangle> tris) {
         detail::TriangleBatch b;
-        b.uvs.assign(3 * tris.size(), Vec2{});
+        b.uvs.assign(3 * tris.size(), Vec2f{});
         b.materials.assign(tris.size(), 0);
         b.triangles = std::move(tris);
         return b;

@@ -339,7 +339,7 @@ TEST(RoughFracture, SameSeedSameBytesOtherSeedOtherSurface) {
     EXPECT_EQ(test::hashPieces(*a), test::hashPieces(*b));
     // Pinned, as the flat scenes' golden hash (tests/persist/GoldenHash_test.cpp): a change of the rough
     // surface's bytes must be deliberate.
-    EXPECT_EQ(test::hashPieces(*a), 0x854b6f195a9c9f47ull);
+    EXPECT_EQ(test::hashPieces(*a), 0x93cce0998883d0c0ull);
     FractureParams other = params;
     other.roughness.seed = 1;
     auto c = fracture(input, impact, other, 42);
@@ -453,8 +453,8 @@ TEST(RoughFracture, UvsAreContinuousAcrossTheRoughFace) {
     }
     EXPECT_GT(corners, 1000u);
     EXPECT_EQ(mismatched, 0u) << "of " << corners << " cut corners";
-    EXPECT_NEAR(hi.x - lo.x, 4.0, 1e-9);
-    EXPECT_NEAR(hi.y - lo.y, 4.0, 1e-9);
+    EXPECT_NEAR(hi.x - lo.x, 4.0, 2e-6); // stored in float (values up to 6)
+    EXPECT_NEAR(hi.y - lo.y, 4.0, 2e-6);
 }
 
 // Wood (the preset's grainStretch 6): wavelengths along the grain six times the ones across it, so the
@@ -550,7 +550,7 @@ TEST(RoughFracture, NormalsAreSmoothOnTheRoughFaceAndSharpAtItsOutline) {
     Mesh input = cube();
     for (std::size_t t = 0; t < input.triangles.size(); ++t)
         for (int k = 0; k < 3; ++k)
-            input.normals.push_back(normalized(input.triangleNormal(t)));
+            input.normals.emplace_back(normalized(input.triangleNormal(t)));
     auto r = halfCut(absoluteRoughness(0.12, 0.5, 2, 20000), input);
     ASSERT_TRUE(r) << r.error().message;
     ASSERT_TRUE(r->stats.rough);
@@ -578,8 +578,9 @@ TEST(RoughFracture, NormalsAreSmoothOnTheRoughFaceAndSharpAtItsOutline) {
             const Vec3 tn = normalized(m.triangleNormal(t));
             const auto c = m.corners(t);
             for (std::size_t k = 0; k < 3; ++k) {
-                const Vec3& n = m.normals[3 * t + k];
-                EXPECT_NEAR(length(n), 1.0, 1e-9);
+                const Vec3 stored = m.normals[3 * t + k];
+                EXPECT_NEAR(length(stored), 1.0, 1e-6); // unit, rounded to float
+                const Vec3 n = normalized(stored);
                 if (m.materials[t] != kInteriorMaterial) { // the outer surface keeps its flat normals
                     EXPECT_GT(dot(n, tn), 1 - 1e-9);
                     continue;

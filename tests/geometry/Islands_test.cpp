@@ -83,7 +83,7 @@ TEST(Islands, AttributesStayWithTheirTriangles) {
     Mesh m = a;
     m.append(b);
     m.computeFlatNormals();
-    m.uvs.assign(3 * m.triangleCount(), Vec2{0.25, 0.75});
+    m.uvs.assign(3 * m.triangleCount(), Vec2f{0.25, 0.75});
     m.materialNames = {"zero", "one", "two", "three"};
     const auto islands = splitIntoIslands(m);
     ASSERT_EQ(islands.size(), 2u);

@@ -255,7 +255,7 @@ TEST(MeshCheck, SolidsTouchingAtOneVertexAreNotManifold) {
 
 TEST(MeshCheck, AttributeArraysOfTheWrongSizeAreReported) {
     Mesh m = makeBox({0, 0, 0}, {1, 1, 1});
-    m.normals.assign(5, Vec3{0, 0, 1});
+    m.normals.assign(5, Vec3f{0, 0, 1});
     m.materials.assign(3, 0);
     const MeshReport r = checkMesh(m);
     EXPECT_FALSE(r.valid());

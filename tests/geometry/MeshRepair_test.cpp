@@ -240,7 +240,7 @@ TEST(MeshRepair, OverlappingShellsAreNotMistakenForCavities) {
 
 TEST(MeshRepair, AttributeArraysOfTheWrongSizeAreDropped) {
     Mesh m = makeBox({0, 0, 0}, {1, 1, 1});
-    m.uvs.assign(7, Vec2{});
+    m.uvs.assign(7, Vec2f{});
     const RepairReport r = repairMesh(m);
     EXPECT_TRUE(r.valid()) << test::joinLines(r.unrepaired);
     EXPECT_FALSE(m.hasUvs());

@@ -51,7 +51,7 @@ std::vector<float> floats(const nlohmann::json& doc, const std::string& buffer, 
 Mesh boxWithInterior(const Vec3& lo, const Vec3& hi) {
     Mesh m = makeBox(lo, hi);
     m.computeFlatNormals();
-    m.uvs.assign(3 * m.triangles.size(), Vec2{0.25, 0.75});
+    m.uvs.assign(3 * m.triangles.size(), Vec2f{0.25, 0.75});
     m.materials.assign(m.triangles.size(), 0);
     for (std::size_t t = 0; t < 4; ++t)
         m.materials[t] = kInteriorMaterial;
@@ -128,6 +128,30 @@ TEST(GltfWriter, ReadsBackWithTheSameVolumeAndPlacement) {
     EXPECT_NEAR(b.lo.x, -4, 1e-5);
     EXPECT_NEAR(b.hi.x, 4.5, 1e-5);
     EXPECT_NEAR(b.hi.z, 6.5, 1e-5);
+}
+
+// Per-corner normals and texture coordinates come back through a glTF file (float there as here; V flipped
+// on the way out and back) within a float step.
+TEST(GltfWriter, ReadsBackNormalsAndTextureCoordinates) {
+    const auto dir = test::tempDir("GltfWriter_attributes");
+    Mesh m = makeSubdividedBox({-1, -0.5, -0.25}, {1, 0.5, 0.25}, 2);
+    for (std::size_t t = 0; t < m.triangleCount(); ++t)
+        for (const Vec3& p : m.corners(t)) {
+            m.normals.emplace_back(normalized(normalized(m.triangleNormal(t)) + 0.3 * p));
+            m.uvs.push_back({0.1 * p.x + 0.3, p.y / 3 + 0.25});
+        }
+    const auto path = dir / "box.gltf";
+    ASSERT_TRUE(writeGltf(path, {{"box", m, {}}}).isOk());
+    const auto back = readMesh(path);
+    ASSERT_TRUE(back.isOk()) << back.error().message;
+    ASSERT_EQ(back->triangleCount(), m.triangleCount());
+    ASSERT_EQ(back->normals.size(), m.normals.size());
+    ASSERT_EQ(back->uvs.size(), m.uvs.size());
+    for (std::size_t i = 0; i < m.normals.size(); ++i) {
+        EXPECT_LT(length(Vec3(back->normals[i]) - m.normals[i]), 1e-6) << "corner " << i;
+        EXPECT_NEAR(back->uvs[i].x, m.uvs[i].x, 1e-6) << "corner " << i;
+        EXPECT_NEAR(back->uvs[i].y, m.uvs[i].y, 1e-6) << "corner " << i;
+    }
 }
 
 TEST(GltfWriter, SameInputGivesIdenticalBytes) {

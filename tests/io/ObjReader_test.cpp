@@ -57,7 +57,7 @@ TEST(ObjReader, NegativeIndicesAndCornerForms) {
     ASSERT_TRUE(r->hasUvs());
     EXPECT_TRUE(r->validate().isOk());
     EXPECT_EQ(r->normals[0], (Vec3{0, 0, -1}));
-    EXPECT_EQ(r->uvs[3 * 2 + 0], (Vec2{0, 0})); // first corner of the v/vt/vn quad
+    EXPECT_EQ(r->uvs[3 * 2 + 0], (Vec2f{0, 0})); // first corner of the v/vt/vn quad
     // Corners without a normal get the flat face normal, so every normal points out of its face.
     for (std::size_t t = 0; t < r->triangleCount(); ++t)
         for (int c = 0; c < 3; ++c)
@@ -176,6 +176,9 @@ TEST(ObjReader, ErrorsNameFileLineAndWhat) {
     EXPECT_EQ(errorOf("v 1 abc 3\n"), "t.obj:1: vertex: expected a number for y, got 'abc'");
     EXPECT_EQ(errorOf("v 1 2 1e999\n"), "t.obj:1: vertex: value '1e999' for z is out of range");
     EXPECT_EQ(errorOf("vn 1 2\n"), "t.obj:1: normal needs 3 numbers, got 2");
+    EXPECT_EQ(errorOf("vn 0 1e39 0\n"), "t.obj:1: normal: value '1e39' for y is beyond float's range");
+    EXPECT_EQ(errorOf("vt 0.5 -4e38\n"),
+              "t.obj:1: texture coordinate: value '-4e38' for v is beyond float's range");
     EXPECT_EQ(errorOf("vt\n"), "t.obj:1: texture coordinate needs 1 number, got 0");
     EXPECT_EQ(errorOf(v + "f 1 2 99999999999999999999999\n"),
               "t.obj:9: face corner '99999999999999999999999': expected a vertex index, got "

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cctype>
 #include <fstream>
 #include <sstream>
 
@@ -73,6 +75,41 @@ TEST(ObjWriter, RoundTripKeepsNormalsUvsAndMaterialNames) {
     EXPECT_NE(mtl.find("newmtl moss"), std::string::npos);
     EXPECT_NE(slurp(path).find("mtllib box.mtl"), std::string::npos);
     EXPECT_TRUE(checkMesh(r.value()).valid());
+}
+
+// Normals and texture coordinates that float does not hold exactly (0.1, 1/3, a rotated normal) come back
+// bit for bit, written as a float's shortest text (at most 9 significant digits, not a double's 17).
+TEST(ObjWriter, RoundTripKeepsFloatAttributesExactlyAndShort) {
+    const auto dir = test::tempDir("ObjWriter_float_attributes");
+    Rng rng(5);
+    const Mat3 turn = rng.rotation();
+    Mesh m = makeSubdividedBox({-1, -1, -1}, {1, 1, 1}, 2);
+    for (std::size_t t = 0; t < m.triangleCount(); ++t)
+        for (const Vec3& p : m.corners(t)) {
+            m.normals.emplace_back(turn * normalized(m.triangleNormal(t)));
+            m.uvs.push_back({0.1 * p.x + 0.3, p.y / 3});
+        }
+    const auto path = dir / "box.obj";
+    ASSERT_TRUE(writeObj(path, m).isOk());
+    const auto r = readObj(path);
+    ASSERT_TRUE(r.isOk()) << r.error().message;
+    EXPECT_EQ(r->normals, m.normals);
+    EXPECT_EQ(r->uvs, m.uvs);
+    std::istringstream text(slurp(path));
+    std::size_t lines = 0;
+    for (std::string line; std::getline(text, line);) {
+        if (line.rfind("vt ", 0) != 0 && line.rfind("vn ", 0) != 0)
+            continue;
+        ++lines;
+        std::istringstream fields(line.substr(3));
+        for (std::string number; fields >> number;) {
+            const std::string mantissa = number.substr(0, number.find('e'));
+            EXPECT_LE(std::count_if(mantissa.begin(), mantissa.end(), [](char c) { return std::isdigit(c); }),
+                      10)
+                << line;
+        }
+    }
+    EXPECT_GT(lines, 10u);
 }
 
 TEST(ObjWriter, OptionsLeaveOutAttributesAndNameTheObject) {

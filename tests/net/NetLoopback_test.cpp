@@ -253,7 +253,7 @@ TEST(NetLoopback, OneLongServiceCallSendsASnapshotOfMoreThanOneBurst) {
     test::NetHostRig net;
     ASSERT_TRUE(net.server);
     net::NetHost& h = *net.server;
-    net.rig.play(360);
+    net.rig.play(480);
     DestructionWorld world(net.config); // bare: the whole snapshot travels
     std::unique_ptr<net::NetClient> client = joining(net, world);
     ASSERT_TRUE(client);

@@ -65,6 +65,76 @@ TEST(Snapshot, LoadThenSaveGivesIdenticalBytesAndGeometry) {
     EXPECT_EQ(encodeSnapshot(takeSnapshot(world, placements)), bytes);
 }
 
+// The box of tests/data/snapshot/v4-box-attributes.rsnap: flat normals and texture coordinates that float
+// does not hold exactly, one material.
+Mesh attributedBox() {
+    Mesh box = makeSubdividedBox({-1, -0.5, -0.25}, {1, 0.5, 0.25}, 2);
+    box.computeFlatNormals();
+    for (std::size_t t = 0; t < box.triangles.size(); ++t)
+        for (std::uint32_t v : box.triangles[t]) {
+            const Vec3& p = box.positions[v];
+            box.uvs.push_back({0.1 * p.x + 0.3, p.y / 3 + 0.7 * p.z});
+        }
+    box.materials.assign(box.triangles.size(), 1u);
+    return box;
+}
+
+// Normals and texture coordinates (float) survive a save and a load exactly, pieces' included, and the
+// loaded world saves the same bytes.
+TEST(Snapshot, KeepsNormalsAndTextureCoordinatesExactly) {
+    DestructionWorld world(kConfig);
+    ObjectDesc d;
+    d.mesh = attributedBox();
+    d.fracture.pattern = CellPattern::Shatter;
+    d.fracture.cells = 4;
+    const ObjectId id = world.addObject(std::move(d)).value();
+    ASSERT_TRUE(world.submitImpact(id, Impact{{0.9, 0.4, 0.25}, {0, 0, 1}, 500}));
+    for (int frame = 0; frame < 20 && world.objects().size() == 1; ++frame) {
+        world.beginFrame();
+        world.waitIdle();
+        (void)collectAndCommit(world);
+    }
+    ASSERT_GT(world.objects().size(), 2u);
+    const std::vector<std::uint8_t> bytes = encodeSnapshot(takeSnapshot(world));
+    Result<Snapshot> decoded = decodeSnapshot(bytes.data(), bytes.size(), "attributes.rsnap");
+    ASSERT_TRUE(decoded) << decoded.error().message;
+    DestructionWorld loaded(kConfig);
+    ASSERT_TRUE(restoreSnapshot(loaded, std::move(*decoded)));
+    ASSERT_EQ(loaded.objects(), world.objects());
+    for (ObjectId o : world.objects()) {
+        const Mesh& a = world.object(o)->mesh;
+        const Mesh& b = loaded.object(o)->mesh;
+        ASSERT_TRUE(a.hasNormals() && a.hasUvs()) << "object " << o;
+        EXPECT_EQ(b.normals, a.normals) << "object " << o;
+        EXPECT_EQ(b.uvs, a.uvs) << "object " << o;
+        EXPECT_EQ(loaded.object(o)->meshHash, b.hash()) << "object " << o;
+    }
+    EXPECT_EQ(loaded.geometryHash(), world.geometryHash());
+    EXPECT_EQ(encodeSnapshot(takeSnapshot(loaded)), bytes);
+}
+
+// A version-4 file (attributes in double, saved by the build before float attributes) still loads: its
+// attributes rounded to float, its mesh hash that of the rounded mesh; saving it again writes version 5.
+TEST(Snapshot, AVersion4FileLoadsWithItsAttributesRoundedToFloat) {
+    const std::filesystem::path v4 = test::sourceDir() / "tests/data/snapshot/v4-box-attributes.rsnap";
+    Result<Snapshot> r = loadSnapshot(v4);
+    ASSERT_TRUE(r) << r.error().message;
+    ASSERT_EQ(r->world.objects.size(), 1u);
+    const Mesh want = attributedBox();
+    const ObjectState& o = r->world.objects[0];
+    EXPECT_EQ(o.mesh.positions, want.positions);
+    EXPECT_EQ(o.mesh.normals, want.normals);
+    EXPECT_EQ(o.mesh.uvs, want.uvs);
+    EXPECT_EQ(o.mesh.materials, want.materials);
+    EXPECT_EQ(o.meshHash, want.hash());
+    const std::vector<std::uint8_t> again = encodeSnapshot(*r);
+    EXPECT_EQ(again[4] | again[5] << 8, 5);
+    Result<Snapshot> reloaded = decodeSnapshot(again.data(), again.size(), "again.rsnap");
+    ASSERT_TRUE(reloaded) << reloaded.error().message;
+    EXPECT_EQ(reloaded->world.objects[0].mesh, o.mesh);
+    EXPECT_EQ(encodeSnapshot(*reloaded), again);
+}
+
 // An object's shatter layout (from its material) survives a save and a load.
 TEST(Snapshot, KeepsTheShatterLayoutOfEveryObject) {
     DestructionWorld world(kConfig);
@@ -395,8 +465,8 @@ TEST(Snapshot, DamagedFilesAreRefusedNamingOffsetAndFieldAndTheWorldStaysAsItWas
     refused(b, "field crc32: checksum mismatch");
     // Another version, another format.
     b = bytes;
-    b[4] = 5;
-    refused(b, "offset 4, field version: version 5 is not supported");
+    b[4] = 6;
+    refused(b, "offset 4, field version: version 6 is not supported");
     b = bytes;
     b[0] = 'X';
     refused(b, "offset 0, field magic");

@@ -49,6 +49,10 @@ def test_mesh_from_numpy_round_trips():
     )
     np.testing.assert_array_equal(with_attributes.materials, [1, 2, 3, 4])
     assert with_attributes.uvs.shape == (12, 2) and with_attributes.normals.shape == (12, 3)
+    # Attributes are stored in float32: given in float64, they come back rounded.
+    assert with_attributes.uvs.dtype == np.float32 and with_attributes.normals.dtype == np.float32
+    tenths = rubble.Mesh(vertices, triangles, uvs=np.full((12, 2), 0.1))
+    np.testing.assert_array_equal(tenths.uvs, np.full((12, 2), 0.1, dtype=np.float32))
     assert with_attributes != mesh and rubble.Mesh(vertices, triangles) == mesh
     assert rubble.Mesh(vertices, triangles).hash() == mesh.hash()
 
@@ -272,6 +276,8 @@ def test_bad_arrays_and_arguments_raise_value_errors():
         rubble.Mesh(vertices, triangles.reshape(-1))
     with pytest.raises(ValueError, match="uvs"):
         rubble.Mesh(vertices, triangles, uvs=np.zeros((12, 3)))
+    with pytest.raises(ValueError, match="normals: .* beyond float's range"):
+        rubble.Mesh(vertices, triangles, normals=np.full((12, 3), 1e39))
     with pytest.raises(rubble.Error):  # attribute arrays of the wrong length
         rubble.Mesh(vertices, triangles, materials=[1, 2])
     bad = vertices.copy()

@@ -78,7 +78,7 @@ Mesh unwelded(const Mesh& m, bool withAttributes) {
             continue;
         const Vec3 n = normalized(m.triangleNormal(t));
         for (int k = 0; k < 3; ++k) {
-            out.normals.push_back(n);
+            out.normals.emplace_back(n);
             out.uvs.push_back({c[k].x, c[k].y});
         }
         out.materials.push_back(static_cast<std::uint32_t>(t % 3));

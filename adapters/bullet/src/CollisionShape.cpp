@@ -115,7 +115,7 @@ CollisionShape::Bytes CollisionShape::bytes() const {
         } else {
             b.shapes += sizeof(btBoxShape);
         }
-    b.edges = edgePoints_.capacity() * sizeof(Vec3) + edgeIndex_.capacity() * sizeof(edgeIndex_[0]);
+    b.edges = edgePoints_.capacity() * sizeof(Vec3f) + edgeIndex_.capacity() * sizeof(edgeIndex_[0]);
     return b;
 }
 
@@ -129,8 +129,8 @@ std::vector<std::array<Vec3, 2>> CollisionShape::edges() const {
 
 void CollisionShape::addEdge(const Vec3& a, const Vec3& b) {
     const auto i = static_cast<std::uint32_t>(edgePoints_.size());
-    edgePoints_.push_back(a);
-    edgePoints_.push_back(b);
+    edgePoints_.emplace_back(a);
+    edgePoints_.emplace_back(b);
     edgeIndex_.push_back({i, i + 1});
 }
 
@@ -175,7 +175,7 @@ std::unique_ptr<CollisionShape> CollisionShape::fromParts(const std::vector<Conv
         std::sort(corners.begin(), corners.end(), lexLess);
         const auto base = static_cast<std::uint32_t>(s->edgePoints_.size());
         for (const Vec3& c : corners)
-            s->edgePoints_.push_back(toBody(objectToBody, c));
+            s->edgePoints_.emplace_back(toBody(objectToBody, c));
         auto index = [&](const Vec3& p) {
             return base + static_cast<std::uint32_t>(
                               std::lower_bound(corners.begin(), corners.end(), p, lexLess) - corners.begin());

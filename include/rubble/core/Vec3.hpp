@@ -1,6 +1,6 @@
 #pragma once
 /// \file Vec3.hpp
-/// Small double-precision vector types used across Rubble's public API.
+/// Small vector types used across Rubble's public API (double; float for mesh attributes).
 
 #include <cmath>
 
@@ -76,12 +76,31 @@ inline bool isFinite(const Vec3& v) {
     return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
 
-/// A 2D vector, used for texture coordinates.
+/// A 2D vector (texture coordinates widened from Vec2f, plane geometry).
 struct RUBBLE_API Vec2 {
     double x = 0; ///< u / x
     double y = 0; ///< v / y
     /// Exact component-wise equality.
     constexpr bool operator==(const Vec2&) const = default;
+};
+
+/// Per-corner normals in float: widen to Vec3 implicitly, are rounded from one explicitly.
+struct RUBBLE_API Vec3f {
+    float x = 0, y = 0, z = 0;   ///< components
+    constexpr Vec3f() = default; ///< the zero vector
+    constexpr Vec3f(double a, double b, double c) : x(float(a)), y(float(b)), z(float(c)) {} ///< rounded
+    constexpr explicit Vec3f(const Vec3& v) : Vec3f(v.x, v.y, v.z) {}                        ///< rounded
+    constexpr operator Vec3() const { return {x, y, z}; }    ///< widened exactly
+    constexpr bool operator==(const Vec3f&) const = default; ///< exact equality
+};
+/// Texture coordinates in float: widen to Vec2 implicitly, are rounded from one explicitly.
+struct RUBBLE_API Vec2f {
+    float x = 0, y = 0;                                               ///< u, v
+    constexpr Vec2f() = default;                                      ///< (0, 0)
+    constexpr Vec2f(double u, double v) : x(float(u)), y(float(v)) {} ///< rounded
+    constexpr explicit Vec2f(const Vec2& v) : Vec2f(v.x, v.y) {}      ///< rounded
+    constexpr operator Vec2() const { return {x, y}; }                ///< widened exactly
+    constexpr bool operator==(const Vec2f&) const = default;          ///< exact equality
 };
 
 /// A row-major 3x3 matrix (inertia tensors, rotations).

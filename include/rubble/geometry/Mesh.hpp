@@ -23,12 +23,12 @@ inline constexpr std::uint32_t kInteriorMaterial = 0xFFFF'FFFEu;
 /// A triangle mesh as a value type: copy it, compare it, hash it.
 ///
 /// Attributes are optional. When present, `normals` and `uvs` hold one entry per triangle corner
-/// (index 3*t + c) and `materials` one entry per triangle; an empty vector means "not present".
+/// (index 3*t + c, in float) and `materials` one entry per triangle; an empty vector means "not present".
 struct RUBBLE_API Mesh {
     std::vector<Vec3> positions;            ///< vertex positions
     std::vector<Triangle> triangles;        ///< triangles as indices into positions
-    std::vector<Vec3> normals;              ///< per-corner normals (3 per triangle) or empty
-    std::vector<Vec2> uvs;                  ///< per-corner texture coordinates (3 per triangle) or empty
+    std::vector<Vec3f> normals;             ///< per-corner normals (3 per triangle) or empty
+    std::vector<Vec2f> uvs;                 ///< per-corner texture coordinates (3 per triangle) or empty
     std::vector<std::uint32_t> materials;   ///< per-triangle material id or empty
     std::vector<std::string> materialNames; ///< optional names for material ids (index = id)
 

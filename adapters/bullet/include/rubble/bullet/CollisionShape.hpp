@@ -45,7 +45,7 @@ public:
     btCollisionShape* shape() const { return root_; }
     /// Number of convex hulls (0 for a plain box or sphere).
     int childCount() const;
-    /// Edges of the parts in body coordinates (for debug drawing).
+    /// Edges of the parts in body coordinates (for debug drawing; kept in float).
     std::vector<std::array<Vec3, 2>> edges() const;
     /// Number of edges.
     std::size_t edgeCount() const { return edgeIndex_.size(); }
@@ -65,7 +65,7 @@ private:
     std::unique_ptr<btCompoundShape> compound_;
     std::vector<std::unique_ptr<btCollisionShape>> children_;
     void addEdge(const Vec3& a, const Vec3& b);
-    std::vector<Vec3> edgePoints_; // corners of the edges (a part's shared by its edges)
+    std::vector<Vec3f> edgePoints_; // corners of the edges (a part's shared by its edges), in float
     std::vector<std::array<std::uint32_t, 2>> edgeIndex_; // edges as pairs of edgePoints_
 };
 
