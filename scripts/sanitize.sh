@@ -2,12 +2,12 @@
 # Sanitizer runs (clang). Usage: scripts/sanitize.sh [all|asan|tsan|fuzz|ci|configure-asan [DIR]|configure-tsan]
 #   asan: the whole test suite built with ASan + UBSan into build-asan/ and run by CTest (every label but e2e,
 #         which needs rubble-demo and Xvfb, and bench: the benches' smoke runs drive the library code the tests
-#         reach, at ten times the cost; they run in make test and under TSan); every finding is fatal
+#         reach, at ten times the cost; they run in make test); every finding is fatal
 #         (-fno-sanitize-recover=all, halt_on_error). The libFuzzer targets are built into the same tree
 #         (scripts/fuzz.sh uses it), so one tree serves both.
 #   tsan: the threaded code, i.e. the runtime, Bullet-bridge, journal/snapshot and netplay tests (tests/runtime,
-#         tests/bullet, tests/persist, tests/net), built with TSan into build-tsan/ and run by CTest. The benches'
-#         smoke runs stay out: building rubble-bench cost more than they add to those tests (robustness.md, 7).
+#         tests/bullet, tests/persist, tests/net), built with TSan into build-tsan/ and run by CTest; no benches
+#         (robustness.md, 7).
 #   fuzz: every libFuzzer target for a fixed seed and input count (scripts/fuzz.sh ci).
 #   all:  asan, then tsan (`make sanitize`).  ci: asan, tsan, fuzz (`make sanitize-ci`, what .ci/run runs).
 # Both trees are RelWithDebInfo with -gline-tables-only instead of -g (half the object size, file:line stack traces
