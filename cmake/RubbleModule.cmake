@@ -48,8 +48,7 @@ function(rubble_shared_library target)
         LINKER_LANGUAGE CXX)
 endfunction()
 
-# rubble_test_code_uninstrumented(TARGET): under ASan, test code itself is compiled without sanitizers (the library
-# under test keeps them; the executable still links their runtime). TSan keeps them: its atomics must be seen.
+# rubble_test_code_uninstrumented(TARGET): under ASan, test code compiles without sanitizers (robustness.md, 7).
 function(rubble_test_code_uninstrumented target)
     if(RUBBLE_SANITIZE MATCHES "address")
         target_compile_options(${target} PRIVATE -fno-sanitize=all)
