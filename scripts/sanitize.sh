@@ -36,12 +36,15 @@ configure() { # dir, sanitizers, extra cmake args... (re-applied to an existing 
     CC=clang CXX=clang++ cmake -S . -B "$dir" "${common[@]}" -DRUBBLE_SANITIZE="$san" "$@" >/dev/null
 }
 
+# The ASan + UBSan tree: fuzzers, no benches, no rubble-server (only its e2e test runs it).
+asan_args=(address,undefined -DRUBBLE_BUILD_FUZZERS=ON -DRUBBLE_BUILD_BENCH=OFF -DRUBBLE_BUILD_SERVER=OFF)
+
 elapsed() { echo "$(($(date +%s) - $1)) s"; }
 
 asan() {
     local t0
     t0=$(date +%s)
-    configure build-asan address,undefined -DRUBBLE_BUILD_FUZZERS=ON -DRUBBLE_BUILD_BENCH=OFF || return 1
+    configure build-asan "${asan_args[@]}" || return 1
     cmake --build build-asan -j "$jobs" || return 1
     echo "sanitize: ASan+UBSan build took $(elapsed "$t0")"
     local status=0
@@ -105,7 +108,7 @@ case "$what" in
     tsan) run tsan ;;
     fuzz) run fuzz ;;
     ci) run asan tsan fuzz ;;
-    configure-asan) configure "${2:-build-asan}" address,undefined -DRUBBLE_BUILD_FUZZERS=ON -DRUBBLE_BUILD_BENCH=OFF ;;
+    configure-asan) configure "${2:-build-asan}" "${asan_args[@]}" ;;
     configure-tsan) configure build-tsan thread -DRUBBLE_BUILD_BENCH=OFF ;;
     *)
         echo "usage: scripts/sanitize.sh [all|asan|tsan|fuzz|ci|configure-asan [DIR]|configure-tsan]" >&2
