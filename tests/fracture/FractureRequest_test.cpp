@@ -40,16 +40,22 @@ FractureParams shatter() {
     return params;
 }
 
+/// A request to cut at impact from seed with params; the mesh is the caller's to set.
+FractureRequest atImpact(const Impact& impact, std::uint64_t seed, const FractureParams& params) {
+    FractureRequest request;
+    request.impact = impact;
+    request.seed = seed;
+    request.params = params;
+    return request;
+}
+
 TEST(FractureRequest, ALentMeshGivesTheShorthandsPiecesAndIsLeftAsItIs) {
     const Mesh cube = makeSubdividedBox({-1, -1, -1}, {1, 1, 1}, 4);
     const std::uint64_t before = cube.hash();
     const Impact impact{{0.3, 1.0, 0.2}, {0, 1, 0}, 40};
     for (const FractureParams& params : {FractureParams{}, shatter()}) {
-        FractureRequest request;
+        FractureRequest request = atImpact(impact, 7, params);
         request.mesh = &cube;
-        request.impact = impact;
-        request.seed = 7;
-        request.params = params;
         const auto viaRequest = fracture(request);
         expectSameFracture(viaRequest, fracture(cube, impact, params, 7));
         ASSERT_TRUE(viaRequest.isOk());
@@ -76,24 +82,18 @@ TEST(FractureRequest, AMeshHandedOverWithItsTopologyIsCutInPlaceAsByTheConsuming
 
     Mesh handed = sphere;
     MeshFacts handedFacts = facts;
-    FractureRequest request;
+    FractureRequest request = atImpact(impact, 5, params);
     request.consumed = &handed;
     request.consumedFacts = &handedFacts;
-    request.impact = impact;
-    request.seed = 5;
-    request.params = params;
     const auto inPlace = fracture(request);
     expectSameFracture(inPlace, fracture(Mesh(sphere), impact, params, 5, MeshFacts(facts)));
     ASSERT_TRUE(inPlace.isOk());
     EXPECT_TRUE(inPlace->stats.editedInPlace);
 
     // Lent with the same facts: a copy is cut in place, to the same bytes; the caller's mesh is untouched.
-    FractureRequest lent;
+    FractureRequest lent = atImpact(impact, 5, params);
     lent.mesh = &sphere;
     lent.known = &facts;
-    lent.impact = impact;
-    lent.seed = 5;
-    lent.params = params;
     expectSameFracture(fracture(lent), inPlace);
     EXPECT_EQ(sphere.hash(), before);
 }
