@@ -20,6 +20,7 @@
 #include "rubble/core/ParameterCheck.hpp"
 #include "rubble/core/Random.hpp"
 #include "rubble/fracture/Fracture.hpp"
+#include "rubble/fracture/FractureRequest.hpp"
 #include "rubble/geometry/MeshCheck.hpp"
 #include "rubble/geometry/MeshSimplify.hpp"
 
@@ -819,24 +820,90 @@ Result<MeshFacts> analyzeMesh(const Mesh& mesh) {
     return facts;
 }
 
+namespace {
+
+/// InvalidInput naming the field when request sets both or neither of mesh and consumed, or facts for the
+/// one it does not set.
+Status checkRequest(const FractureRequest& request) {
+    const char* wrong = nullptr;
+    if (request.mesh && request.consumed)
+        wrong = "sets both mesh and consumed (set one)";
+    else if (!request.mesh && !request.consumed)
+        wrong = "sets neither mesh nor consumed (set one)";
+    else if (request.known && !request.mesh)
+        wrong = "sets known without mesh (the facts of consumed go in consumedFacts)";
+    else if (request.consumedFacts && !request.consumed)
+        wrong = "sets consumedFacts without consumed (the facts of mesh go in known)";
+    if (wrong)
+        return makeError(ErrorCode::InvalidInput, std::string("fracture: the request ") + wrong);
+    return {};
+}
+
+/// The shorthands' request for a mesh lent.
+FractureRequest lent(const Mesh& mesh, const MeshFacts& known, const FractureParams& params) {
+    FractureRequest request;
+    request.mesh = &mesh;
+    request.known = &known;
+    request.params = params;
+    return request;
+}
+
+/// The shorthands' request for a mesh handed over with its facts.
+FractureRequest handedOver(Mesh& mesh, MeshFacts& known, const FractureParams& params) {
+    FractureRequest request;
+    request.consumed = &mesh;
+    request.consumedFacts = &known;
+    request.params = params;
+    return request;
+}
+
+/// request, cut at impact from seed.
+FractureRequest atImpact(FractureRequest request, const Impact& impact, std::uint64_t seed) {
+    request.impact = impact;
+    request.seed = seed;
+    return request;
+}
+
+/// request, cut by cells.
+FractureRequest byCells(FractureRequest request, std::vector<ConvexPolytope> cells) {
+    request.cells = std::move(cells);
+    return request;
+}
+
+} // namespace
+
+Result<FractureResult> fracture(FractureRequest request) {
+    if (Status s = checkRequest(request); !s)
+        return s.error();
+    MeshFacts unknown;
+    const bool editing = request.params.backend == BooleanKind::Fast;
+    const Place place =
+        request.mesh
+            ? Place(*request.mesh, request.known ? *request.known : unknown, editing)
+            : Place(*request.consumed, request.consumedFacts ? *request.consumedFacts : unknown, editing);
+    if (request.cells)
+        return cutWithCells(place, std::move(*request.cells), request.params);
+    return cutAtImpact(place, request.impact, request.params, request.seed);
+}
+
 Result<FractureResult> fractureWithCells(const Mesh& mesh, std::vector<ConvexPolytope> cells,
                                          const FractureParams& params, const MeshFacts& known) {
-    return cutWithCells(Place(mesh, known, params.backend == BooleanKind::Fast), std::move(cells), params);
+    return fracture(byCells(lent(mesh, known, params), std::move(cells)));
 }
 
 Result<FractureResult> fractureWithCells(Mesh&& mesh, std::vector<ConvexPolytope> cells,
                                          const FractureParams& params, MeshFacts known) {
-    return cutWithCells(Place(mesh, known, params.backend == BooleanKind::Fast), std::move(cells), params);
+    return fracture(byCells(handedOver(mesh, known, params), std::move(cells)));
 }
 
 Result<FractureResult> fracture(const Mesh& mesh, const Impact& impact, const FractureParams& params,
                                 std::uint64_t seed, const MeshFacts& known) {
-    return cutAtImpact(Place(mesh, known, params.backend == BooleanKind::Fast), impact, params, seed);
+    return fracture(atImpact(lent(mesh, known, params), impact, seed));
 }
 
 Result<FractureResult> fracture(Mesh&& mesh, const Impact& impact, const FractureParams& params,
                                 std::uint64_t seed, MeshFacts known) {
-    return cutAtImpact(Place(mesh, known, params.backend == BooleanKind::Fast), impact, params, seed);
+    return fracture(atImpact(handedOver(mesh, known, params), impact, seed));
 }
 
 } // namespace rubble

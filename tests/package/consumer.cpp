@@ -1,9 +1,11 @@
-// A game's first contact with an installed Rubble: fracture a mesh with the kernel, then let Bullet and the
-// runtime break a cube hit by a projectile. Exits non-zero when volume is not conserved or nothing breaks.
+// A game's first contact with an installed Rubble: fracture a mesh with the kernel (also as a request), then
+// let Bullet and the runtime break a cube hit by a projectile. Exits non-zero when volume is not conserved or
+// nothing breaks.
 #include <cmath>
 #include <cstdio>
 
 #include "rubble/bullet/BulletBinding.hpp"
+#include "rubble/fracture/FractureRequest.hpp"
 #include "rubble/rubble.hpp"
 
 namespace {
@@ -34,6 +36,17 @@ int main() {
                 broken->inputVolume);
     if (broken->pieces.size() < 2 || !near(volume, broken->inputVolume, 1e-9))
         return 1;
+    // The same fracture as a request: the same pieces.
+    rubble::FractureRequest request;
+    request.mesh = &cube;
+    request.impact = impact;
+    request.seed = 7;
+    const rubble::Result<rubble::FractureResult> requested = rubble::fracture(request);
+    if (!requested || requested->pieces.size() != broken->pieces.size() ||
+        requested->pieces.front().mesh.hash() != broken->pieces.front().mesh.hash()) {
+        std::fprintf(stderr, "fracture(FractureRequest) differs from fracture(mesh, impact, params, seed)\n");
+        return 1;
+    }
 
     // 2. The runtime over Bullet: a static cube on the ground, a projectile fired at it.
     rubble::bullet::PhysicsWorld physics;

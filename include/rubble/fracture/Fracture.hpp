@@ -209,8 +209,8 @@ RUBBLE_API Status checkFractureParams(const Impact& impact, const FractureParams
 /// refusals. With known facts of mesh (analyzeMesh, Piece::facts), the mesh is not validated again and, with
 /// the Fast backend, the remainder's mass properties follow from the mesh's by difference (equal to a full
 /// recomputation up to rounding; docs/megamesh.md); the pieces' meshes are the same either way.
-/// With known facts that carry a topology (MeshFacts::topology) and the Fast backend, fracture copies the
-/// mesh and its facts and runs the consuming overload below.
+/// With known facts that carry a topology (MeshFacts::topology) and the Fast backend, a copy of the mesh and
+/// its facts is cut in place. These four are shorthands for fracture(FractureRequest) (FractureRequest.hpp).
 RUBBLE_API Result<FractureResult> fracture(const Mesh& mesh, const Impact& impact,
                                            const FractureParams& params, std::uint64_t seed,
                                            const MeshFacts& known = {});
