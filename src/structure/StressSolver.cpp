@@ -26,6 +26,8 @@ using Mat6 = Eigen::Matrix<double, 6, 6>;
 constexpr int kUpdateIterations = 16;
 // Direct: the fewest unknowns an island needs for such solves (below, refactorising costs less).
 constexpr Eigen::Index kUpdateUnknowns = 2400;
+// Direct: the most constraint rows an active-set change may add or remove as an up/down-date of the factor.
+constexpr int kAmendRows = 48;
 
 Eigen::Matrix3d toEigen(const Mat3& m) {
     Eigen::Matrix3d r;
@@ -127,8 +129,35 @@ private:
     void (*set_)(int) = nullptr;
     int saved_ = 0;
 };
+// CHOLMOD's factorisation: supernodal LL' on large islands, simplicial LDL' on small ones, which an
+// active-set change up- and down-dates (cholmod_updown) instead of refactorising.
+class Factorization : public Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>> {
+public:
+    void small(bool simplicial) { setMode(simplicial ? Eigen::CholmodLDLt : Eigen::CholmodSupernodalLLt); }
+    // Makes the factorisation that of A + C C' (up) or A - C C'; false when it cannot (then unusable).
+    bool updown(bool up, const Eigen::SparseMatrix<double>& c) {
+        cholmod_factor* l = m_cholmodFactor;
+        if (!l || l->is_super || l->is_ll || c.cols() == 0)
+            return l && !l->is_super && !l->is_ll;
+        cholmod_sparse view = Eigen::viewAsCholmod(c);
+        cholmod_sparse* permuted =
+            cholmod_submatrix(&view, static_cast<int*>(l->Perm), static_cast<SuiteSparse_long>(l->n), nullptr,
+                              -1, 1, 1, &cholmod());
+        if (!permuted)
+            return false;
+        const int ok = cholmod_updown(up ? 1 : 0, permuted, l, &cholmod());
+        cholmod_free_sparse(&permuted, &cholmod());
+        return ok && l->minor == l->n;
+    }
+};
 #else
 struct SerialOpenMp {};
+// Eigen's simplicial LDL' (no up/down-dates: an active-set change refactorises).
+class Factorization : public Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> {
+public:
+    void small(bool) {}
+    bool updown(bool, const Eigen::SparseMatrix<double>&) { return false; }
+};
 #endif
 
 } // namespace
@@ -138,20 +167,17 @@ struct SerialOpenMp {};
 struct DirectIsland {
     std::vector<std::size_t> key; // its nodes in unknown order, then each bond's slot and nodes
     std::vector<char> flags;      // each corner's active and slip flags the factorisation holds
-#ifdef RUBBLE_HAVE_CHOLMOD
-    Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>> ldlt; // supernodal: dense kernels on the fill
-#else
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
-#endif
+    Factorization ldlt;
     bool analysed = false;
     bool numeric = false;  // ldlt holds a numeric factorisation of this key's pattern
     bool factored = false; // ... of the nodes' and bonds' numbers, or `matrix` holds them (until one changes)
     bool drift = false;    // `matrix` holds them: bonds broke or corners changed since ldlt was made
+    bool amended = false;  // ldlt was up- or down-dated to `assembled` since it was made (solves refined)
     double compliance = 0; // the one it was made with
     Eigen::SparseMatrix<double> matrix;
-    Eigen::SparseMatrix<double> assembled; // the last matrix assembled, of the nodes and bonds in slotKey
-    std::vector<std::size_t> slotKey;
-    std::vector<int> slots; // each triplet's place among assembled's values
+    Eigen::SparseMatrix<double> assembled; // the last matrix assembled (the nodes and bonds of assembledKey)
+    std::vector<std::size_t> assembledKey;
+    std::vector<int> slots; // each triplet's place among assembled's values (found when a key comes back)
 };
 
 // The direct solve's factorisations, one per island, and the nodes changed since the last solve.
@@ -788,8 +814,9 @@ void StressSolver::solveGaussSeidel(double tolerance) {
     const double tolerance2 = tolerance * tolerance, quiet2 = tolerance2 * 1e-4;
     std::vector<std::uint32_t> active, touched;
     std::vector<std::size_t> list;
-    // The direct solve's polish: every stallSweeps sweeps, a node on bearings still outside the tolerance
-    // whose acceleration changed by at most 1 % since the last check is stalled (the sweeps no longer move
+    // The direct solve's polish checks every stallSweeps / 4 sweeps for what the last solve left unbalanced
+    // and still moves; and every stallSweeps, a node on bearings still outside the tolerance whose
+    // acceleration changed by at most 1 % since the last such check is stalled (the sweeps no longer move
     // it), whatever the last solve said and however small its acceleration.
     const bool polish = direct_ && direct_->polishing;
     std::vector<double> seen(polish ? nodes_.size() : 0, 0.0); // each node's residual at the last check
@@ -809,13 +836,14 @@ void StressSolver::solveGaussSeidel(double tolerance) {
     const double unbalanced2 = settings_.unbalanced * settings_.unbalanced;
     for (sweeps_ = 0; sweeps_ < settings_.maxSweeps && max2 > tolerance2; ++sweeps_) {
         const int stall = settings_.stallSweeps;
-        if (sweeps_ > 0 && stall > 0 && (sweeps_ == stall || (polish && sweeps_ % stall == 0))) {
+        const int every = polish ? std::max(1, stall / 4) : stall;
+        if (sweeps_ > 0 && stall > 0 && (sweeps_ == stall || (polish && sweeps_ % every == 0))) {
             // What bearings did not hold in the last solve and still do not is left out: its bonds keep
             // their forces, it counts as unbalanced again, and the rest converges around it.
             for (std::uint32_t n : active) {
                 NodeState& s = nodes_[n];
                 bool stuck = false;
-                if (polish) { // stuck: its acceleration unchanged within 1 % over the last stallSweeps
+                if (polish && sweeps_ % stall == 0) { // stuck: unchanged within 1 % over stallSweeps
                     const double e = std::sqrt(nodeResidual(s)), last = std::sqrt(seen[n]);
                     stuck = last > 0 && e * e > tolerance2 && std::abs(e - last) <= 0.01 * last;
                     seen[n] = e * e;
@@ -998,8 +1026,9 @@ void StressSolver::solveConjugateGradient(double tolerance) {
 // (augmented Lagrangian: repeated, the forces converge to J a = 0 from the warm start). A bearing's corners
 // are held (normal and friction, sticking); a corner pulling leaves the set, one penetrating rejoins it and
 // one sticking past friction slips (its friction a force at the limit from then on), each change a numeric
-// refactorisation of the same pattern (at most three a solve). The set and the factorisation are kept
-// across solves until a node, bond or corner changes. Gauss-Seidel then meets the residual.
+// refactorisation of the same pattern or, on a small island, an up/down-date of the factor (at most three
+// a solve). The set and the factorisation are kept across solves until a node, bond or corner changes.
+// Gauss-Seidel then meets the residual.
 void StressSolver::solveDirect(double tolerance) {
     using Vec6 = Eigen::Matrix<double, 6, 1>;
     using Sparse = Eigen::SparseMatrix<double>;
@@ -1130,10 +1159,10 @@ void StressSolver::solveDirect(double tolerance) {
     };
     Eigen::Index n = 0;
     std::vector<Eigen::Triplet<double>> triplets;
-    // The island's matrix: built from triplets when its nodes or bonds changed (each triplet's place in it
-    // kept), else its values rewritten in place.
+    // The island's matrix: built from triplets when its nodes or bonds changed, else its values rewritten in
+    // place (each triplet's place in it found at the second assembly of the same nodes and bonds).
     auto assemble = [&]() -> const Sparse& {
-        const bool known = cache->slotKey == key;
+        const bool known = cache->assembledKey == key && !cache->slots.empty();
         double* values = cache->assembled.valuePtr();
         if (known)
             std::fill(values, values + cache->assembled.nonZeros(), 0.0);
@@ -1174,6 +1203,11 @@ void StressSolver::solveDirect(double tolerance) {
             return cache->assembled;
         cache->assembled.resize(n, n);
         cache->assembled.setFromTriplets(triplets.begin(), triplets.end());
+        cache->slots.clear();
+        if (cache->assembledKey != key) { // places only for a key assembled twice (a fracture's never is)
+            cache->assembledKey = key;
+            return cache->assembled;
+        }
         const int* outer = cache->assembled.outerIndexPtr();
         const int* inner = cache->assembled.innerIndexPtr();
         cache->slots.resize(triplets.size());
@@ -1182,8 +1216,77 @@ void StressSolver::solveDirect(double tolerance) {
             cache->slots[j] = static_cast<int>(
                 std::lower_bound(inner + outer[x.col()], inner + outer[x.col() + 1], x.row()) - inner);
         }
-        cache->slotKey = key;
         return cache->assembled;
+    };
+    // The corners whose held rows differ between the factorisation's flags and `flags`: each added row (over
+    // sqrt(e)) is a column of the update C+, each removed one of the downdate C-; the factorisation becomes
+    // that of A + C+ C+' - C- C-' and the assembled matrix is patched to match. False (nothing changed) when
+    // more than kAmendRows rows change or it cannot (a large island, no CHOLMOD): then it is refactorised.
+    std::vector<Eigen::Triplet<double>> ups, downs;
+    auto amend = [&](const std::vector<char>& flags) {
+        if (!cache->factored || !cache->numeric || cache->drift || cache->key != key ||
+            cache->assembledKey != key || cache->compliance != delta || n >= kUpdateUnknowns ||
+            flags.size() != cache->flags.size())
+            return false;
+        ups.clear();
+        downs.clear();
+        int columns[2] = {0, 0};
+        auto rows = [](char flag) { return (flag & 1) ? ((flag & 2) ? 1 : 3) : 0; }; // its rows 0 .. rows - 1
+        std::size_t f = 0;
+        for (std::size_t k : pattern) {
+            const BondState& b = bonds_[k];
+            const BondInterface& x = b.bond.section;
+            const Vec3 dir[3] = {x.normal, x.u, x.v};
+            const int ends[2] = {index[b.bond.a], index[b.bond.b]};
+            for (const BearingCorner& c : b.corners) {
+                const int was = rows(cache->flags[f]), now = rows(flags[f]);
+                ++f;
+                if (b.broken || was == now)
+                    continue;
+                const double kk[3] = {c.kn, c.ku, c.kv};
+                const bool up = now > was;
+                for (int d = std::min(was, now); d < std::max(was, now); ++d) {
+                    if (kk[d] <= 0)
+                        continue;
+                    Eigen::Matrix<double, 12, 1> row;
+                    row << vec6(dir[d], c.ca[d]), -vec6(dir[d], c.cb[d]);
+                    row /= std::sqrt(delta * kk[d]);
+                    for (int e = 0; e < 2; ++e) {
+                        if (ends[e] < 0)
+                            continue;
+                        for (int r = 0; r < 6; ++r)
+                            (up ? ups : downs).emplace_back(6 * ends[e] + r, columns[up], row[6 * e + r]);
+                    }
+                    ++columns[up];
+                }
+            }
+        }
+        if (columns[0] + columns[1] > kAmendRows)
+            return false;
+        Sparse change[2];
+        for (int up = 0; up < 2; ++up) {
+            change[up].resize(n, columns[up]);
+            change[up].setFromTriplets(up ? ups.begin() : downs.begin(), up ? ups.end() : downs.end());
+        }
+        // The update first: the matrix stays positive definite throughout.
+        if (!cache->ldlt.updown(true, change[1]) || !cache->ldlt.updown(false, change[0])) {
+            cache->numeric = cache->factored = false;
+            return false;
+        }
+        Sparse& a = cache->assembled;
+        const int* outer = a.outerIndexPtr();
+        const int* inner = a.innerIndexPtr();
+        double* values = a.valuePtr();
+        for (int up = 0; up < 2; ++up)
+            for (Eigen::Index j = 0; j < change[up].outerSize(); ++j)
+                for (Sparse::InnerIterator q(change[up], j); q; ++q)
+                    for (Sparse::InnerIterator r(change[up], j); r; ++r) {
+                        const int col = static_cast<int>(q.row()), row = static_cast<int>(r.row());
+                        const int* at = std::lower_bound(inner + outer[col], inner + outer[col + 1], row);
+                        values[at - inner] += (up ? 1.0 : -1.0) * q.value() * r.value();
+                    }
+        cache->amended = true;
+        return true;
     };
     auto factorize = [&] {
         std::vector<char> flags;
@@ -1192,6 +1295,10 @@ void StressSolver::solveDirect(double tolerance) {
                 flags.push_back(static_cast<char>(c.active + 2 * c.slip));
         if (cache->factored && cache->key == key && cache->flags == flags && cache->compliance == delta)
             return true; // the structure and the active set are the last factorisation's
+        if (amend(flags)) {
+            cache->flags = std::move(flags);
+            return true;
+        }
         const Sparse& m = assemble();
         cache->flags = std::move(flags);
         if (cache->numeric && cache->key == key && cache->compliance == delta && n >= kUpdateUnknowns) {
@@ -1199,9 +1306,10 @@ void StressSolver::solveDirect(double tolerance) {
             cache->drift = cache->factored = true;
             return true;
         }
-        cache->factored = cache->numeric = cache->drift = false;
+        cache->factored = cache->numeric = cache->drift = cache->amended = false;
         cache->matrix = Sparse();
         if (!cache->analysed || cache->key != key) {
+            cache->ldlt.small(n < kUpdateUnknowns);
             cache->ldlt.analyzePattern(m);
             cache->key = key;
             cache->analysed = true;
@@ -1214,13 +1322,16 @@ void StressSolver::solveDirect(double tolerance) {
         return cache->factored;
     };
     // Conjugate gradient on `matrix`, preconditioned by the factorisation of the numbers before its bonds
-    // broke or corners changed: a change of low rank takes a few iterations. False when it does not converge.
+    // broke or corners changed: a change of low rank takes a few iterations; after up/down-dates, on the
+    // assembled matrix (a refinement: none when the factor is exact). False when it does not converge.
     Eigen::VectorXd rhs, x, res, pre, way, aWay;
     auto update = [&] {
-        const Sparse& a = cache->matrix;
+        const Sparse& a = cache->drift ? cache->matrix : cache->assembled;
         x = cache->ldlt.solve(rhs);
         res = rhs - a * x;
         const double goal = 1e-10 * rhs.norm();
+        if (res.norm() <= goal)
+            return true;
         pre = cache->ldlt.solve(res);
         way = pre;
         double rz = res.dot(pre);
@@ -1252,14 +1363,15 @@ void StressSolver::solveDirect(double tolerance) {
             const Vec3 lw = s.node.inertia * s.w;
             rhs.segment<6>(6 * index[i]) = vec6(s.v * s.node.mass, lw);
         }
-        if (cache->drift && !update()) { // too far from the factorisation: a fresh one
-            cache->ldlt.factorize(cache->matrix);
+        const bool refine = cache->drift || cache->amended, solved = refine && update();
+        if (refine && !solved) { // too far from the factorisation: a fresh one
+            cache->ldlt.factorize(cache->drift ? cache->matrix : cache->assembled);
             ++factorizations_;
             cache->matrix = Sparse();
-            cache->drift = false;
+            cache->drift = cache->amended = false;
             cache->factored = cache->numeric = cache->ldlt.info() == Eigen::Success;
         }
-        if (!cache->drift)
+        if (!solved)
             x = cache->numeric ? Eigen::VectorXd(cache->ldlt.solve(rhs)) : Eigen::VectorXd::Zero(n);
         for (std::size_t k : held) {
             BondState& b = bonds_[k];

@@ -441,7 +441,11 @@ TEST(StressAnalytic, ABeamOnThreeBearingsLiftsOffOneThatWouldPull) {
         EXPECT_NEAR(r[1], 0.1 * total - 2 * r[0], 0.01 * total);
         EXPECT_NEAR(r[2], 0.9 * total + r[0], 0.01 * total);
         if (settings.method == StressMethod::Direct) {
+#ifdef RUBBLE_HAVE_CHOLMOD
+            EXPECT_EQ(s.factorizations(), 1) << "the pulling pier's corners left as a downdate";
+#else
             EXPECT_GE(s.factorizations(), 2) << "a pulling pier's corners left the active set";
+#endif
             EXPECT_LE(s.sweeps(), 12) << "the active set settles it, not the Gauss-Seidel that follows";
             EXPECT_NEAR(std::min(r[0], r[1]), 0, 1e-3 * total) << "one bearing lifts off";
         }
@@ -517,6 +521,39 @@ TEST(StressAnalytic, ABreakIsSolvedAgainstTheFactorisationBeforeIt) {
     expectSameForces(updated, fresh, 1e-9);
 }
 
+// The beam on three knife-edge bearings, its load moved from near the right end to the left end: the active
+// set changes (the pier that lifted off carries again, another lets go). The island is small, so each change
+// up- and down-dates the factorisation instead of refactorising, and the forces equal those of a copy that
+// factorises from the same state to 1e-9 of the largest (both at residual 1e-8).
+TEST(StressAnalytic, AnActiveSetChangeUpdatesTheFactorisation) {
+    Lattice l;
+    const double edge = 0.004, rho = 2400;
+    std::vector<std::uint32_t> segs;
+    for (const double x : {-1.75, 0.25, 2.25})
+        l.add(box({x - edge / 2, -1, -0.5}, {x + edge / 2, 0, 0.5}), rho, true, 0.6);
+    for (int i = 0; i < 10; ++i)
+        segs.push_back(l.add(box({-2.5 + 0.5 * i, 0, -0.5}, {-2 + 0.5 * i, 0.4, 0.5}), rho));
+    StressSettings direct = converged().back();
+    direct.residual = 1e-8;
+    StressSolver updated = l.solver(direct);
+    updated.addLoad(segs[9], {0, -2e5, 0}, {2.4, 0.4, 0});
+    updated.solve();
+    ASSERT_LE(updated.residual(), direct.residual);
+    StressSolver fresh = updated; // the same forces and active set; its next solve factorises anew
+    for (StressSolver* s : {&fresh, &updated}) {
+        s->addLoad(segs[0], {0, -2e4, 0}, {-2.4, 0.4, 0});
+        s->solve();
+        EXPECT_LE(s->residual(), direct.residual);
+        EXPECT_TRUE(s->unsupported().empty());
+    }
+    EXPECT_GE(fresh.factorizations(), 1);
+#ifdef RUBBLE_HAVE_CHOLMOD
+    EXPECT_EQ(updated.factorizations(), 0) << "the active set's changes were up/down-dates";
+#endif
+    EXPECT_EQ(updated.analyses(), 1);
+    expectSameForces(updated, fresh, 1e-9);
+}
+
 // Two welded columns on the ground are two islands, each with its own factorisation: removing the top block
 // of one refactorises that one only, while the other, loaded anew, is solved with the factorisation it kept.
 TEST(StressAnalytic, EachIslandKeepsItsOwnFactorisation) {
@@ -577,7 +614,11 @@ TEST(StressAnalytic, TheDirectSolvesPolishStopsOnABodyThatBeginsToSlide) {
     EXPECT_LT(s.sweeps(), 256) << "the sliding block is stalled, not swept to maxSweeps";
     EXPECT_GT(s.residual(), settings.residual) << "the sliding block still counts";
     expectStackCarries(s, ground, blocks, top, 0.6 * top, 2);
-    for (int frame = 0; frame < settings.unbalancedSolves; ++frame) {
+    s.addLoad(blocks[2], {1.3 * 0.6 * top, 0, 0}, {0, 1.25, 0});
+    s.solve();
+    EXPECT_LT(s.sweeps(), 40) << "unbalanced in the last solve too: set aside at the polish's first check";
+    expectStackCarries(s, ground, blocks, top, 0.6 * top, 2);
+    for (int frame = 1; frame < settings.unbalancedSolves; ++frame) {
         s.addLoad(blocks[2], {1.3 * 0.6 * top, 0, 0}, {0, 1.25, 0});
         s.solve();
     }

@@ -42,9 +42,9 @@ struct RUBBLE_API StressSettings {
     bool routeLoads = true;     ///< GaussSeidel, ConjugateGradient: a change of a node's load since the last
                             ///< solve is first passed down the welds beneath it to the ground (a warm start)
     double compliance = 1e-6; ///< Direct: each constraint's regularisation, relative to its effective mass
-    int stallSweeps = 64; ///< GaussSeidel, Direct: after this many sweeps, nodes on bearings the last solve
-                          ///< left unbalanced and still accelerating by `unbalanced` are left out (forces
-                          ///< kept); Direct also, every this many, those stuck outside `residual`; 0: never
+    int stallSweeps = 64;     ///< GaussSeidel (Direct: every quarter of it): after this many sweeps, nodes on
+                          ///< bearings the last solve left unbalanced and still accelerating by `unbalanced`
+                          ///< are left out (forces kept); Direct also, every this many, those stuck; 0: never
 };
 
 } // namespace rubble
