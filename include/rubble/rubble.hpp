@@ -8,6 +8,7 @@
 #include "rubble/core/Result.hpp"
 #include "rubble/core/Version.hpp"
 #include "rubble/fracture/Fracture.hpp"
+#include "rubble/fracture/FractureRequest.hpp"
 #include "rubble/geometry/Mesh.hpp"
 #include "rubble/io/MeshIO.hpp"
 #include "rubble/persist/JournalFile.hpp"

@@ -5,7 +5,6 @@
 #include <cstdio>
 
 #include "rubble/bullet/BulletBinding.hpp"
-#include "rubble/fracture/FractureRequest.hpp"
 #include "rubble/rubble.hpp"
 
 namespace {
