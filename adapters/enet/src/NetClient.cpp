@@ -323,6 +323,9 @@ struct NetClient::Impl {
         }
         if (incoming.id != id) {
             incoming = {id, total, std::vector<std::uint8_t>(total), std::vector<bool>(count), count};
+            if (!stats.joined)
+                stats.firstChunkMs =
+                    std::chrono::duration<double, std::milli>(Clock::now() - connected).count();
         }
         const std::size_t at = static_cast<std::size_t>(index) * detail::kSnapshotChunk;
         if (incoming.total != total || index >= count ||
@@ -411,6 +414,9 @@ struct NetClient::Impl {
             Result<Snapshot> s = detail::decodeJoinSnapshot(d, n, world);
             if (!s)
                 return s.error();
+            if (!stats.joined)
+                stats.snapshotDecodeMs =
+                    std::chrono::duration<double, std::milli>(Clock::now() - received).count();
             if (stats.joined)
                 return resynced(std::move(*s), received);
             const double frame = static_cast<double>(s->world.frame);
@@ -510,6 +516,10 @@ Result<std::unique_ptr<NetClient>> NetClient::connect(DestructionWorld& world,
     im.server = enet_host_connect(im.host, &*a, 2, 0);
     if (!im.server)
         return Error{ErrorCode::IoError, "cannot connect to " + address + ":" + std::to_string(port)};
+    enet_host_flush(im.host); // the connect goes out; the Hello's hashes are taken while it travels
+    const Clock::time_point hashing = Clock::now();
+    (void)detail::encodeHello(im.world, false, &im.stateHashes);
+    im.stats.helloMs = std::chrono::duration<double, std::milli>(Clock::now() - hashing).count();
     return client;
 }
 
@@ -544,7 +554,10 @@ Status NetClient::service(int timeoutMs) {
         } else if (ev.type == ENET_EVENT_TYPE_CONNECT) {
             im.stats.connected = true;
             detail::configurePeer(im.server, im.timeoutMs);
-            if (!detail::sendReliable(im.server, detail::encodeHello(im.world, false, &im.stateHashes)))
+            const Clock::time_point hashing = Clock::now();
+            const std::vector<std::uint8_t> hello = detail::encodeHello(im.world, false, &im.stateHashes);
+            im.stats.helloMs += std::chrono::duration<double, std::milli>(Clock::now() - hashing).count();
+            if (!detail::sendReliable(im.server, hello))
                 status = Error{ErrorCode::IoError, "netplay: cannot send the hello"};
         } else if (ev.type == ENET_EVENT_TYPE_DISCONNECT) {
             im.server = nullptr;
