@@ -157,7 +157,9 @@ TEST(NetRelay, ClientsThroughMisbehavingLinksConvergeAfterAPartitionAndAReplacem
     for (auto& f : live) {
         EXPECT_EQ(f->world->geometryHash(), hash);
         EXPECT_EQ(f->client->stats().mismatchedHashes, 0);
-        EXPECT_GT(f->client->stats().syncs, 10); // the last to join has 130 frames, fewer when it is slow
+        // At least the last frame's (its frame is the host's last): the checks above are not vacuous. How
+        // many more depends on how fast it joined, which a loaded machine decides.
+        EXPECT_GE(f->client->stats().syncs, 1);
     }
     EXPECT_EQ(h.stats().mismatchedHashes, 0);
     EXPECT_EQ(h.stats().joins, 4);
