@@ -585,6 +585,7 @@ int runHost(const Args& a) {
                           {"bytes", hs.snapshotBytes - beforeLate.snapshotBytes},
                           {"join_ms", late.value("join_ms", -1.0)},
                           {"hello_ms", late.value("hello_ms", -1.0)},
+                          {"connect_ms", late.value("connect_ms", -1.0)},
                           {"first_chunk_ms", late.value("first_chunk_ms", -1.0)},
                           {"snapshot_decode_ms", late.value("snapshot_decode_ms", -1.0)},
                           {"snapshot_load_ms", late.value("snapshot_load_ms", -1.0)}};
@@ -828,6 +829,7 @@ int runClient(const Args& a) {
                      {"joined_s", st.joined ? monotonic(connectAt) + st.joinMs / 1000 : -1.0},
                      {"scene_load_ms", baseMs},
                      {"hello_ms", st.helloMs},
+                     {"connect_ms", st.connectMs},
                      {"first_chunk_ms", st.firstChunkMs},
                      {"snapshot_decode_ms", st.snapshotDecodeMs},
                      {"snapshot_load_ms", st.snapshotLoadMs},

@@ -21,6 +21,7 @@ struct ClientStats {
     bool joined = false;            ///< the snapshot arrived and was loaded
     double joinMs = 0;              ///< connect → snapshot loaded (ms)
     double helloMs = 0;             ///< hashing its objects for the Hello, mostly while connecting (ms)
+    double connectMs = 0;           ///< of joinMs: connect → ENet's connection made (ms)
     double firstChunkMs = 0;        ///< of joinMs: connect → the snapshot's first chunk (ms)
     double snapshotLoadMs = 0;      ///< of joinMs: inflating, decoding and loading the snapshot (ms)
     double snapshotDecodeMs = 0;    ///< of snapshotLoadMs: inflating and decoding it (ms)
@@ -33,6 +34,7 @@ struct ClientStats {
     long long resyncs = 0;          ///< snapshots loaded after an outage instead of cutting the backlog
     double resyncLoadMs = 0;        ///< time spent decoding and loading them (ms)
     long long keepAlives = 0;       ///< times ENet was served from within a long catch-up
+    long long reliableResent = 0;   ///< reliable commands ENet sent again after its retransmission timeout
     std::string firstMismatch;      ///< what differed at the first mismatched sync (empty: none)
 };
 
