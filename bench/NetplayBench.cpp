@@ -370,9 +370,14 @@ int runHost(const Args& a) {
         }
         ++f;
     };
+    net::HostStats beforeLate;     // the host's totals when the late client started
+    std::size_t objectsAtLate = 0; // the world's objects then
     for (; f < frames;) {
-        if (f == lateFrame)
+        if (f == lateFrame) {
+            beforeLate = host.stats();
+            objectsAtLate = runtime.world().objects().size();
             launch();
+        }
         frame(true);
     }
     for (int i = 0; i < 600 && runtime.world().jobsInFlight() > 0; ++i)
@@ -562,6 +567,29 @@ int runHost(const Args& a) {
     r["snapshot_builds"] = hs.snapshotBuilds;
     r["snapshot_build_ms"] =
         hs.snapshotBuildMs / static_cast<double>(std::max<long long>(1, hs.snapshotBuilds));
+    const auto perBuild = [&hs](double ms) {
+        return ms / static_cast<double>(std::max<long long>(1, hs.snapshotBuilds));
+    };
+    r["snapshot_capture_ms"] = perBuild(hs.snapshotCaptureMs);
+    r["snapshot_encode_ms"] = perBuild(hs.snapshotEncodeMs);
+    r["snapshot_compress_ms"] = perBuild(hs.snapshotCompressMs);
+    if (lateFrame >= 0 && !clients.empty()) { // the late client's join, stage by stage
+        const nlohmann::json& late = clients.back();
+        r["late_join"] = {{"world_objects", objectsAtLate},
+                          {"builds", hs.snapshotBuilds - beforeLate.snapshotBuilds},
+                          {"build_ms", hs.snapshotBuildMs - beforeLate.snapshotBuildMs},
+                          {"capture_ms", hs.snapshotCaptureMs - beforeLate.snapshotCaptureMs},
+                          {"encode_ms", hs.snapshotEncodeMs - beforeLate.snapshotEncodeMs},
+                          {"compress_ms", hs.snapshotCompressMs - beforeLate.snapshotCompressMs},
+                          {"transfer_ms", hs.snapshotTransferMs - beforeLate.snapshotTransferMs},
+                          {"bytes", hs.snapshotBytes - beforeLate.snapshotBytes},
+                          {"join_ms", late.value("join_ms", -1.0)},
+                          {"hello_ms", late.value("hello_ms", -1.0)},
+                          {"connect_ms", late.value("connect_ms", -1.0)},
+                          {"first_chunk_ms", late.value("first_chunk_ms", -1.0)},
+                          {"snapshot_decode_ms", late.value("snapshot_decode_ms", -1.0)},
+                          {"snapshot_load_ms", late.value("snapshot_load_ms", -1.0)}};
+    }
     r["snapshot_chunks_sent"] = hs.snapshotChunksSent;
     r["snapshot_cache"] = a.snapshotCache;
     r["snapshot_objects_packed"] = hs.snapshotObjectsPacked;
@@ -800,6 +828,10 @@ int runClient(const Args& a) {
                      {"join_ms", st.joinMs},
                      {"joined_s", st.joined ? monotonic(connectAt) + st.joinMs / 1000 : -1.0},
                      {"scene_load_ms", baseMs},
+                     {"hello_ms", st.helloMs},
+                     {"connect_ms", st.connectMs},
+                     {"first_chunk_ms", st.firstChunkMs},
+                     {"snapshot_decode_ms", st.snapshotDecodeMs},
                      {"snapshot_load_ms", st.snapshotLoadMs},
                      {"events", st.events},
                      {"syncs", st.syncs},

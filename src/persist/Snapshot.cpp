@@ -13,6 +13,7 @@
 #include "io/FileBytes.hpp"
 #include "persist/Bytes.hpp"
 #include "persist/RoughnessRecord.hpp"
+#include "persist/SnapshotInPlace.hpp"
 #include "rubble/fracture/Roughness.hpp"
 #include "rubble/persist/JournalFile.hpp"
 #include "rubble/structure/Material.hpp"
@@ -519,12 +520,21 @@ std::uint64_t objectStateHash(const ObjectState& object) {
 }
 
 std::vector<std::uint8_t> encodeSnapshot(const Snapshot& s) {
+    std::vector<const ObjectState*> objects;
+    objects.reserve(s.world.objects.size());
+    for (const ObjectState& o : s.world.objects)
+        objects.push_back(&o);
+    return detail::encodeSnapshotWith(s, objects);
+}
+
+std::vector<std::uint8_t> detail::encodeSnapshotWith(const Snapshot& s,
+                                                     const std::vector<const ObjectState*>& objects) {
     ByteWriter w;
     std::size_t estimate = 64 + 10 * s.structure.nodes.size() + 25 * s.structure.bonds.size();
-    for (const ObjectState& o : s.world.objects)
-        estimate += 512 + 24 * o.mesh.positions.size() + 12 * o.mesh.triangles.size() +
-                    12 * o.mesh.normals.size() + 8 * o.mesh.uvs.size() + 4 * o.mesh.materials.size() +
-                    256 * o.convexParts.size();
+    for (const ObjectState* o : objects)
+        estimate += 512 + 24 * o->mesh.positions.size() + 12 * o->mesh.triangles.size() +
+                    12 * o->mesh.normals.size() + 8 * o->mesh.uvs.size() + 4 * o->mesh.materials.size() +
+                    256 * o->convexParts.size();
     w.data().reserve(estimate);
     w.bytes(kMagic, 4);
     w.u16(kVersion);
@@ -543,9 +553,9 @@ std::vector<std::uint8_t> encodeSnapshot(const Snapshot& s) {
     w.u64(s.world.frame);
     w.u32(s.world.nextId);
     w.u64(s.world.journalPosition);
-    w.u32(static_cast<std::uint32_t>(s.world.objects.size()));
-    for (const ObjectState& o : s.world.objects)
-        writeObject(w, o);
+    w.u32(static_cast<std::uint32_t>(objects.size()));
+    for (const ObjectState* o : objects)
+        writeObject(w, *o);
     w.u32(static_cast<std::uint32_t>(s.placements.size()));
     for (const ObjectPlacement& p : s.placements) {
         w.u32(p.object);

@@ -7,6 +7,7 @@
 #include <string>
 #include <utility>
 
+#include "persist/SnapshotInPlace.hpp"
 #include "rubble/collision/ConvexDecomposition.hpp"
 #include "rubble/structure/Material.hpp"
 #include "runtime/StateAccess.hpp"
@@ -15,7 +16,10 @@ namespace rubble {
 
 using detail::StateAccess;
 
-WorldState captureState(const DestructionWorld& world) {
+namespace {
+
+// The world's state without its objects.
+WorldState captureSettingsAndWork(const DestructionWorld& world) {
     const DestructionWorld::Config& c = StateAccess::config(world);
     WorldState w;
     w.seed = c.seed;
@@ -27,7 +31,6 @@ WorldState captureState(const DestructionWorld& world) {
     w.frame = world.frame();
     w.nextId = StateAccess::nextId(world);
     w.journalPosition = world.journalPosition();
-    w.objects = StateAccess::objects(world);
     for (const detail::WorldWork& work : StateAccess::work(world)) {
         PendingWork p{work.object, work.version, work.inFlight, work.readyFrame, {}, {}};
         for (const detail::TickedImpact& t : work.impacts) {
@@ -37,6 +40,22 @@ WorldState captureState(const DestructionWorld& world) {
         w.work.push_back(std::move(p));
     }
     return w;
+}
+
+} // namespace
+
+WorldState captureState(const DestructionWorld& world) {
+    WorldState w = captureSettingsAndWork(world);
+    w.objects = StateAccess::objects(world);
+    return w;
+}
+
+detail::StateInPlace detail::captureInPlace(const DestructionWorld& world) {
+    (void)world.geometryHash(); // computes the mesh hashes not computed yet
+    StateInPlace s{captureSettingsAndWork(world), {}};
+    for (ObjectId id : world.objects())
+        s.objects.push_back(world.object(id));
+    return s;
 }
 
 namespace {

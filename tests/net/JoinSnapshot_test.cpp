@@ -13,10 +13,13 @@
 namespace rubble {
 namespace {
 
+using net::detail::captureJoin;
 using net::detail::decodeHello;
 using net::detail::decodeJoinSnapshot;
 using net::detail::encodeHello;
+using net::detail::encodeJoin;
 using net::detail::encodeJoinSnapshot;
+using net::detail::JoinCapture;
 using net::detail::JoinSnapshotSize;
 using net::detail::KnownObjects;
 using net::detail::PackedObjects;
@@ -128,6 +131,47 @@ TEST(JoinSnapshot, ObjectsPackedOneByOneAreCompressedOnceAndDecodeToTheSameState
     ASSERT_TRUE(t) << t.error().message;
     ASSERT_TRUE(restoreSnapshot(*fresh, std::move(*t)));
     EXPECT_EQ(fresh->geometryHash(), fired.host.runtime.world().geometryHash());
+}
+
+TEST(JoinSnapshot, ACaptureOfWhatTheClientLacksGivesTheSameMessageAsTheWholeWorldsSnapshot) {
+    Fired fired;
+    const DestructionWorld& world = fired.host.runtime.world();
+    auto client = test::journalWorld(1);
+    const KnownObjects known = announced(*client);
+    KnownObjects changed = known;
+    for (auto& [id, hash] : changed) // one object the client has in another state
+        if (world.object(id) && world.object(id)->version == 0) {
+            hash ^= 1;
+            break;
+        }
+    const std::vector<ObjectPlacement> placements = fired.host.runtime.placements();
+    const KnownObjects none;
+    const KnownObjects* const sets[] = {&known, &changed, &none};
+    for (const KnownObjects* set : sets) {
+        const KnownObjects& k = *set;
+        JoinSnapshotSize whole, chosen;
+        const std::vector<std::uint8_t> expected =
+            encodeJoinSnapshot(takeSnapshot(world, placements), k, &whole);
+        JoinCapture capture = captureJoin(world, k, placements);
+        EXPECT_EQ(capture.sent.size() + capture.byId.size(), world.objects().size());
+        EXPECT_TRUE(capture.rest.world.objects.empty());
+        for (const ObjectState* o : capture.sent)
+            EXPECT_EQ(o, world.object(o->id)) << "read where the world keeps it, not copied";
+        const std::vector<std::uint8_t> msg = encodeJoin(std::move(capture), &chosen);
+        EXPECT_EQ(msg, expected) << "byte for byte";
+        EXPECT_EQ(chosen.referenced, whole.referenced);
+        if (set == &known) {
+            EXPECT_GT(chosen.referenced, 0u);
+        }
+        Result<Snapshot> s = decodeJoinSnapshot(msg.data(), msg.size(), *client);
+        ASSERT_TRUE(s) << s.error().message;
+        EXPECT_EQ(encodeSnapshot(*s), encodeSnapshot(takeSnapshot(world, placements))) << "the host's state";
+    }
+    PackedObjects cache, other; // the same with objects compressed one by one
+    JoinCapture capture = captureJoin(world, known, placements);
+    EXPECT_EQ(encodeJoin(std::move(capture), nullptr, SnapshotCodec::Zstd, &cache),
+              encodeJoinSnapshot(takeSnapshot(world, placements), known, nullptr, SnapshotCodec::Zstd,
+                                 nullptr, &other));
 }
 
 TEST(JoinSnapshot, AClientThatReplayedTheJournalHasEveryPieceById) {

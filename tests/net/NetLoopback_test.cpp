@@ -374,6 +374,31 @@ TEST(NetLoopback, AJoinAfterTheHostWaitedCompressesNoObjectItHadCompressedAhead)
     EXPECT_EQ(client->stats().mismatchedHashes, 0);
 }
 
+TEST(NetLoopback, AClientHashesItsObjectsForTheHelloWhileItConnects) {
+    test::NetHostRig net;
+    ASSERT_TRUE(net.server);
+    net::NetHost& h = *net.server;
+    net.rig.play(20);
+    net.rig.settle();
+    h.publish();
+    std::unique_ptr<DestructionWorld> world = test::journalWorld(1); // the client loaded the scene
+    auto connecting = net::NetClient::connect(*world, net.config, "127.0.0.1", h.port());
+    ASSERT_TRUE(connecting);
+    net::NetClient& client = **connecting;
+    EXPECT_FALSE(client.stats().connected);
+    EXPECT_GT(client.stats().helloMs, 0) << "its objects are hashed while the connection is being made";
+    ASSERT_TRUE(test::waitFor([&] { return client.stats().joined && h.stats().acks > 0; },
+                              [&] {
+                                  h.service(1);
+                                  return static_cast<bool>(client.service(1));
+                              }));
+    EXPECT_GT(h.stats().snapshotObjectsByReference, 0);
+    EXPECT_EQ(world->geometryHash(), net.rig.runtime.world().geometryHash());
+    EXPECT_EQ(client.stats().mismatchedHashes, 0);
+    EXPECT_GT(client.stats().firstChunkMs, 0);
+    EXPECT_LE(client.stats().snapshotDecodeMs, client.stats().snapshotLoadMs);
+}
+
 TEST(NetLoopback, AClientLongInOneServiceCallCuttingPiecesStillAnswersTheHost) {
     test::NetHostRig net;
     ASSERT_TRUE(net.server);

@@ -4,10 +4,12 @@
 #include <zstd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <string>
 
 #include "Placements.hpp"
 #include "Protocol.hpp"
+#include "persist/SnapshotInPlace.hpp"
 
 namespace rubble::net::detail {
 
@@ -128,18 +130,57 @@ bool decodeHello(const std::uint8_t* data, std::size_t size, KnownObjects& out, 
     return true;
 }
 
+namespace {
+
+// Whether a client that has `known` has this object in the same state.
+bool has(const KnownObjects& known, const ObjectState& o, StateHashes* cache) {
+    const auto k = known.find(o.id);
+    return k != known.end() && k->second == stateHash(o, cache);
+}
+
+double msSince(std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+}
+
+} // namespace
+
+JoinCapture captureJoin(const DestructionWorld& world, const KnownObjects& known,
+                        std::vector<ObjectPlacement> placements, StateHashes* cache) {
+    rubble::detail::StateInPlace in = rubble::detail::captureInPlace(world);
+    JoinCapture c;
+    c.rest.world = std::move(in.rest);
+    c.rest.placements = std::move(placements);
+    for (const ObjectState* o : in.objects) {
+        if (has(known, *o, cache))
+            c.byId.push_back(o->id);
+        else
+            c.sent.push_back(o);
+    }
+    return c;
+}
+
 std::vector<std::uint8_t> encodeJoinSnapshot(Snapshot snapshot, const KnownObjects& known,
                                              JoinSnapshotSize* size, SnapshotCodec codec, StateHashes* cache,
                                              PackedObjects* packed) {
-    std::vector<ObjectId> referenced;
-    std::vector<ObjectState> sent;
-    for (ObjectState& o : snapshot.world.objects) {
-        const auto k = known.find(o.id);
-        if (k != known.end() && k->second == stateHash(o, cache))
-            referenced.push_back(o.id);
+    JoinCapture c;
+    c.owned = std::move(snapshot.world.objects);
+    c.rest = std::move(snapshot);
+    c.rest.world.objects.clear();
+    for (const ObjectState& o : c.owned) {
+        if (has(known, o, cache))
+            c.byId.push_back(o.id);
         else
-            sent.push_back(std::move(o));
+            c.sent.push_back(&o);
     }
+    return encodeJoin(std::move(c), size, codec, packed); // the vector moves, its objects stay
+}
+
+std::vector<std::uint8_t> encodeJoin(JoinCapture capture, JoinSnapshotSize* size, SnapshotCodec codec,
+                                     PackedObjects* packed) {
+    const auto started = std::chrono::steady_clock::now();
+    const Snapshot& snapshot = capture.rest;
+    const std::vector<ObjectId>& referenced = capture.byId;
+    const std::vector<const ObjectState*>& sent = capture.sent;
     std::vector<std::uint8_t> out{static_cast<std::uint8_t>(Message::Snapshot)};
     putVarint(out, referenced.size());
     ObjectId previous = 0;
@@ -152,23 +193,22 @@ std::vector<std::uint8_t> encodeJoinSnapshot(Snapshot snapshot, const KnownObjec
         // The snapshot without objects gives the header and the rest; the records come from the cache.
         std::size_t fresh = 0, records = 0;
         std::uint32_t crc = 0;
-        for (ObjectState& o : sent) {
-            const auto it = packed->find(o.id);
-            if (it == packed->end() || it->second.version != o.version) {
-                if (!packObject(o, *packed))
+        for (const ObjectState* o : sent) {
+            const auto it = packed->find(o->id);
+            if (it == packed->end() || it->second.version != o->version) {
+                if (!packObject(*o, *packed))
                     return {};
                 ++fresh;
             }
         }
-        snapshot.world.objects.clear();
         std::vector<std::uint8_t> shell = encodeSnapshot(snapshot);
         const std::size_t head = layout().records;
         const auto count = static_cast<std::uint32_t>(sent.size());
         for (int b = 0; b < 4; ++b)
             shell[head - 4 + static_cast<std::size_t>(b)] = static_cast<std::uint8_t>(count >> (8 * b));
         crc = crcOf(0, shell.data(), head);
-        for (const ObjectState& o : sent) {
-            const PackedObject& p = packed->at(o.id);
+        for (const ObjectState* o : sent) {
+            const PackedObject& p = packed->at(o->id);
             crc = static_cast<std::uint32_t>(
                 ::crc32_combine(crc, p.crc, static_cast<z_off_t>(p.raw))); // as if its bytes followed
             records += p.raw;
@@ -180,18 +220,19 @@ std::vector<std::uint8_t> encodeJoinSnapshot(Snapshot snapshot, const KnownObjec
         putVarint(out, raw);
         if (!appendZstd(out, shell.data(), head))
             return {};
-        for (const ObjectState& o : sent) {
-            const std::vector<std::uint8_t>& z = packed->at(o.id).zstd;
+        for (const ObjectState* o : sent) {
+            const std::vector<std::uint8_t>& z = packed->at(o->id).zstd;
             out.insert(out.end(), z.begin(), z.end());
         }
         if (!appendZstd(out, shell.data() + head, shell.size() - head))
             return {};
         if (size)
-            *size = {raw, out.size(), referenced.size(), sent.size(), fresh};
+            *size = {raw, out.size(), referenced.size(), sent.size(), fresh, 0, msSince(started)};
         return out;
     }
-    snapshot.world.objects = std::move(sent);
-    const std::vector<std::uint8_t> raw = encodeSnapshot(snapshot);
+    const std::vector<std::uint8_t> raw = rubble::detail::encodeSnapshotWith(snapshot, sent);
+    const double encodeMs = msSince(started);
+    const auto compressing = std::chrono::steady_clock::now();
     putVarint(out, raw.size());
     const std::size_t at = out.size();
     if (codec == SnapshotCodec::Zstd) {
@@ -205,8 +246,8 @@ std::vector<std::uint8_t> encodeJoinSnapshot(Snapshot snapshot, const KnownObjec
         out.resize(at + deflated);
     }
     if (size)
-        *size = {raw.size(), out.size(), referenced.size(), snapshot.world.objects.size(),
-                 snapshot.world.objects.size()};
+        *size = {raw.size(),  out.size(), referenced.size(),   sent.size(),
+                 sent.size(), encodeMs,   msSince(compressing)};
     return out;
 }
 

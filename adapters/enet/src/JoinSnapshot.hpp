@@ -42,19 +42,37 @@ std::vector<std::uint8_t> encodeHello(const DestructionWorld& world, bool resync
 bool decodeHello(const std::uint8_t* data, std::size_t size, KnownObjects& out, bool resync = false,
                  std::uint64_t* position = nullptr);
 
-/// Sizes of a join snapshot.
+/// Sizes of a join snapshot, and the time its encoding took.
 struct JoinSnapshotSize {
     std::size_t raw = 0;        ///< encodeSnapshot bytes of the objects sent
     std::size_t wire = 0;       ///< the message
     std::size_t referenced = 0; ///< objects sent by id
     std::size_t sent = 0;       ///< objects in the compressed snapshot
     std::size_t packed = 0;     ///< of those, compressed for this message (the rest came from the cache)
+    double encodeMs = 0;        ///< encodeSnapshot (ms)
+    double compressMs = 0;      ///< compressing it (ms)
 };
 /// How the rest of the snapshot is compressed.
 enum class SnapshotCodec : std::uint8_t {
     Deflate = 0, ///< zlib, level 1
     Zstd = 1,    ///< Zstandard, level 3: a third smaller than Deflate, and faster
 };
+/// What a client that has `known` lacks of a world: the world's snapshot without objects, the objects it
+/// lacks where the world keeps them (not copied), and the ids of those it has.
+struct JoinCapture {
+    Snapshot rest;                        ///< settings, counters, work and placements; no objects
+    std::vector<const ObjectState*> sent; ///< the objects it lacks, ascending id: valid while they are
+    std::vector<ObjectId> byId;           ///< the objects it has in the same state, ascending
+    std::vector<ObjectState> owned;       ///< what `sent` points into when it is not a world
+};
+/// The capture for a client that has `known` (hashes from `cache`, when given): valid until the world
+/// changes.
+JoinCapture captureJoin(const DestructionWorld& world, const KnownObjects& known,
+                        std::vector<ObjectPlacement> placements, StateHashes* cache = nullptr);
+/// The Snapshot message of a capture (as encodeJoinSnapshot below).
+std::vector<std::uint8_t> encodeJoin(JoinCapture capture, JoinSnapshotSize* size = nullptr,
+                                     SnapshotCodec codec = SnapshotCodec::Zstd,
+                                     PackedObjects* packed = nullptr);
 /// A Snapshot message (type byte first) for a client that has `known` (hashes from `cache`, when given).
 /// With `packed` (and Zstandard), the compressed snapshot is a Zstandard frame of the header, one per object
 /// record, from `packed` when it holds the object's version (else packed and kept there), and one of the

@@ -241,6 +241,20 @@ struct NetClient::Impl {
         return Status::ok();
     }
 
+    // The connection is made: the Hello goes out in the datagram that carries ENet's acknowledgement of it
+    // (queued before ENet runs again). Sent after it, in a datagram of its own, it could overtake that
+    // acknowledgement, and the host drops a reliable command of a peer not yet connected: it came again
+    // after ENet's first retransmission timeout, about 0.5 s later. False when it could not be queued.
+    bool hello() {
+        stats.connected = true;
+        stats.connectMs = std::chrono::duration<double, std::milli>(Clock::now() - connected).count();
+        detail::configurePeer(server, timeoutMs);
+        const Clock::time_point hashing = Clock::now();
+        const std::vector<std::uint8_t> msg = detail::encodeHello(world, false, &stateHashes);
+        stats.helloMs += std::chrono::duration<double, std::milli>(Clock::now() - hashing).count();
+        return detail::sendReliable(server, msg);
+    }
+
     // Lets ENet send and receive (what arrives waits for the next service) if it has not for kKeepAlive.
     void keepAlive() {
         const Clock::time_point now = Clock::now();
@@ -251,6 +265,7 @@ struct NetClient::Impl {
         enet_host_service(host, nullptr, 0);
     }
     Clock::time_point pumped; // when ENet last ran
+    enet_uint32 lostSeen = 0; // ENet's packetsLost of the host's peer when last read (it restarts every 10 s)
     std::vector<detail::DecodedPlacement> decoded;
     std::function<void(const FractureOutcome&)> onOutcome;
 
@@ -323,6 +338,9 @@ struct NetClient::Impl {
         }
         if (incoming.id != id) {
             incoming = {id, total, std::vector<std::uint8_t>(total), std::vector<bool>(count), count};
+            if (!stats.joined)
+                stats.firstChunkMs =
+                    std::chrono::duration<double, std::milli>(Clock::now() - connected).count();
         }
         const std::size_t at = static_cast<std::size_t>(index) * detail::kSnapshotChunk;
         if (incoming.total != total || index >= count ||
@@ -411,6 +429,9 @@ struct NetClient::Impl {
             Result<Snapshot> s = detail::decodeJoinSnapshot(d, n, world);
             if (!s)
                 return s.error();
+            if (!stats.joined)
+                stats.snapshotDecodeMs =
+                    std::chrono::duration<double, std::milli>(Clock::now() - received).count();
             if (stats.joined)
                 return resynced(std::move(*s), received);
             const double frame = static_cast<double>(s->world.frame);
@@ -510,6 +531,10 @@ Result<std::unique_ptr<NetClient>> NetClient::connect(DestructionWorld& world,
     im.server = enet_host_connect(im.host, &*a, 2, 0);
     if (!im.server)
         return Error{ErrorCode::IoError, "cannot connect to " + address + ":" + std::to_string(port)};
+    enet_host_flush(im.host); // the connect goes out; the Hello's hashes are taken while it travels
+    const Clock::time_point hashing = Clock::now();
+    (void)detail::encodeHello(im.world, false, &im.stateHashes);
+    im.stats.helloMs = std::chrono::duration<double, std::milli>(Clock::now() - hashing).count();
     return client;
 }
 
@@ -521,8 +546,11 @@ Status NetClient::service(int timeoutMs) {
     ENetEvent e;
     int r = enet_host_service(im.host, &e, static_cast<enet_uint32>(std::max(0, timeoutMs)));
     const Clock::time_point started = im.pumped = Clock::now();
+    bool helloSent = true;
     for (; r > 0; r = enet_host_service(im.host, &e, 0)) {
         events.push_back(e);
+        if (e.type == ENET_EVENT_TYPE_CONNECT) // before ENet runs again: see hello()
+            helloSent = im.hello();
         if (e.type != ENET_EVENT_TYPE_RECEIVE)
             continue;
         const Clock::time_point now = Clock::now();
@@ -541,11 +569,8 @@ Status NetClient::service(int timeoutMs) {
             enet_packet_destroy(ev.packet); // after a failure, the rest is dropped
         } else if (!status) {
             continue;
-        } else if (ev.type == ENET_EVENT_TYPE_CONNECT) {
-            im.stats.connected = true;
-            detail::configurePeer(im.server, im.timeoutMs);
-            if (!detail::sendReliable(im.server, detail::encodeHello(im.world, false, &im.stateHashes)))
-                status = Error{ErrorCode::IoError, "netplay: cannot send the hello"};
+        } else if (ev.type == ENET_EVENT_TYPE_CONNECT && !helloSent) {
+            status = Error{ErrorCode::IoError, "netplay: cannot send the hello"};
         } else if (ev.type == ENET_EVENT_TYPE_DISCONNECT) {
             im.server = nullptr;
             if (!im.stats.connected)
@@ -560,6 +585,11 @@ Status NetClient::service(int timeoutMs) {
     }
     if (!status)
         return status;
+    if (im.server) {
+        if (im.server->packetsLost >= im.lostSeen)
+            im.stats.reliableResent += im.server->packetsLost - im.lostSeen;
+        im.lostSeen = im.server->packetsLost;
+    }
     im.acknowledgeChunks();
     enet_host_flush(im.host); // its acks, without waiting for the next call
     if (const Clock::time_point now = Clock::now(); now - started > std::chrono::milliseconds(300))

@@ -265,9 +265,11 @@ struct NetHost::Impl {
         built = {};
         if (!resync)
             built.placements = placementSource ? placementSource() : std::vector<ObjectPlacement>{};
-        built.msg = detail::encodeJoinSnapshot(takeSnapshot(world, built.placements), known, &built.size,
-                                               detail::SnapshotCodec::Zstd, &stateHashes,
-                                               packSnapshots ? &packed : nullptr);
+        detail::JoinCapture capture = detail::captureJoin(world, known, built.placements, &stateHashes);
+        const double captureMs =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started).count();
+        built.msg = detail::encodeJoin(std::move(capture), &built.size, detail::SnapshotCodec::Zstd,
+                                       packSnapshots ? &packed : nullptr);
         for (auto it = stateHashes.begin(); it != stateHashes.end();) // objects gone since
             it = world.object(it->first) ? std::next(it) : stateHashes.erase(it);
         for (auto it = packed.begin(); it != packed.end();)
@@ -290,6 +292,9 @@ struct NetHost::Impl {
         stats.snapshotObjectsPacked += static_cast<long long>(built.size.packed);
         stats.snapshotBuildMs +=
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started).count();
+        stats.snapshotCaptureMs += captureMs;
+        stats.snapshotEncodeMs += built.size.encodeMs;
+        stats.snapshotCompressMs += built.size.compressMs;
         return true;
     }
 

@@ -20,7 +20,11 @@ struct ClientStats {
     bool connected = false;         ///< the host accepted the connection
     bool joined = false;            ///< the snapshot arrived and was loaded
     double joinMs = 0;              ///< connect → snapshot loaded (ms)
+    double helloMs = 0;             ///< hashing its objects for the Hello, mostly while connecting (ms)
+    double connectMs = 0;           ///< of joinMs: connect → ENet's connection made (ms)
+    double firstChunkMs = 0;        ///< of joinMs: connect → the snapshot's first chunk (ms)
     double snapshotLoadMs = 0;      ///< of joinMs: inflating, decoding and loading the snapshot (ms)
+    double snapshotDecodeMs = 0;    ///< of snapshotLoadMs: inflating and decoding it (ms)
     long long events = 0;           ///< journal events applied
     long long syncs = 0;            ///< frame syncs checked
     long long mismatchedHashes = 0; ///< syncs whose geometry hash differed from the host's
@@ -30,6 +34,7 @@ struct ClientStats {
     long long resyncs = 0;          ///< snapshots loaded after an outage instead of cutting the backlog
     double resyncLoadMs = 0;        ///< time spent decoding and loading them (ms)
     long long keepAlives = 0;       ///< times ENet was served from within a long catch-up
+    long long reliableResent = 0;   ///< reliable commands ENet sent again after its retransmission timeout
     std::string firstMismatch;      ///< what differed at the first mismatched sync (empty: none)
 };
 
@@ -39,8 +44,9 @@ struct ClientStats {
 /// state: a client that loaded the host's scene joins with a much smaller snapshot.
 class NetClient {
 public:
-    /// Starts connecting to address:port (a loopback address); service() completes it (ENet gives up after
-    /// about 5 s without an answer, and service() then fails).
+    /// Starts connecting to address:port (a loopback address) and, while the connection is being made, hashes
+    /// the world's objects for the Hello; service() completes it (ENet gives up after about 5 s without an
+    /// answer, and service() then fails).
     static Result<std::unique_ptr<NetClient>> connect(DestructionWorld& world,
                                                       const DestructionWorld::Config& config,
                                                       const std::string& address, std::uint16_t port);

@@ -30,6 +30,9 @@ struct HostStats {
     long long snapshotObjectsPacked = 0;      ///< objects compressed while building (the rest were cached)
     long long objectsWarmed = 0;              ///< objects compressed and hashed ahead, while the game waited
     double snapshotBuildMs = 0;               ///< time spent taking, encoding and compressing snapshots (ms)
+    double snapshotCaptureMs = 0;             ///< of snapshotBuildMs: placements and the world's state (ms)
+    double snapshotEncodeMs = 0;              ///< of snapshotBuildMs: encoding it (ms)
+    double snapshotCompressMs = 0;            ///< of snapshotBuildMs: compressing it (ms)
     long long snapshotChunksSent = 0;         ///< snapshot chunks sent, resends included
     double snapshotTransferMs =
         0;                 ///< time from sending snapshots' first chunks to their last acknowledgement (ms)
