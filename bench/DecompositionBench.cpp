@@ -108,7 +108,7 @@ Row measure(const std::string& name, const rubble::Mesh& mesh, const rubble::Vec
     } else {
         // Stand-in pieces: the input as the remainder, the clipped cell as the debris.
         rubble::ConvexPolytope debris = rubble::ConvexPolytope::fromAabb(mesh.bounds());
-        for (const rubble::PolytopeFace& f : cells[0].faces())
+        for (const rubble::PolytopeFaceView& f : cells[0].faces())
             debris = debris.clipped(f.plane);
         pieces = {mesh, debris.toMesh()};
         pieceCells = {-1, 0};

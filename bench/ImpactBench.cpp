@@ -122,7 +122,7 @@ double outsideParts(const rubble::Vec3& p, const std::vector<rubble::ConvexPolyt
     for (const rubble::ConvexPolytope& part : parts) {
         if (part.contains(p))
             return 0;
-        for (const rubble::PolytopeFace& f : part.faces()) {
+        for (const rubble::PolytopeFaceView& f : part.faces()) {
             const std::size_t n = f.corners.size();
             bool inside = n >= 3;
             double edges = std::numeric_limits<double>::infinity();

@@ -74,7 +74,7 @@ double clipOnly(const Mesh& mesh, const std::vector<ConvexPolytope>& cells, std:
     for (const auto& [k, t] : work) {
         const auto c = mesh.corners(t);
         poly.assign(c.begin(), c.end());
-        for (const PolytopeFace& f : cells[k].faces()) {
+        for (const PolytopeFaceView& f : cells[k].faces()) {
             next.clear();
             for (std::size_t i = 0; i < poly.size(); ++i) {
                 const Vec3& a = poly[i];

@@ -65,7 +65,7 @@ double capacityBytes(const std::vector<T>& v) {
 // Bytes of the live pieces' containers, summed over every body that carries a world object.
 struct Split {
     double positions = 0, triangles = 0, normals = 0, uvs = 0, materials = 0;
-    double parts = 0;                     // convex parts: face arrays and their corners
+    double parts = 0;                     // convex parts: faces, corners and corner indices
     double hulls = 0, edges = 0;          // the binding's collision shapes and debug edges
     double bodies = 0;                    // rigid bodies and the binding's entries
     double spare = 0;                     // of the mesh arrays above, capacity beyond size
@@ -102,11 +102,8 @@ Split split(const DestructionRuntime& runtime, const BulletBinding& binding, boo
                    spareBytes(m.uvs) + spareBytes(m.materials);
         s.meshTriangles += static_cast<double>(m.triangles.size());
         s.parts += capacityBytes(o->convexParts);
-        for (const ConvexPolytope& p : o->convexParts) {
-            s.parts += capacityBytes(p.faces());
-            for (const PolytopeFace& f : p.faces())
-                s.parts += capacityBytes(f.corners);
-        }
+        for (const ConvexPolytope& p : o->convexParts)
+            s.parts += static_cast<double>(p.heapBytes());
         s.parts_ += static_cast<double>(o->convexParts.size());
         if (const CollisionShape* shape = binding.shape(id)) {
             const CollisionShape::Bytes b = shape->bytes();

@@ -190,7 +190,7 @@ Result<ConvexPolytope> pushedOutHull(const std::vector<Vec3>& points, std::size_
         return convexHull(points);
     // Each face plane of the inner hull pushed out to the farthest point: the polytope contains them all.
     ConvexPolytope out = ConvexPolytope::fromAabb(box);
-    for (const PolytopeFace& f : inner->faces()) {
+    for (const PolytopeFaceView& f : inner->faces()) {
         double offset = -std::numeric_limits<double>::infinity();
         for (const Vec3& p : points)
             offset = std::max(offset, dot(f.plane.normal, p));
@@ -215,7 +215,7 @@ Result<ConvexPolytope> boundedHull(const std::vector<Vec3>& points, std::size_t 
     // Supporting planes of the exact hull only (so the result contains every point), added where the polytope
     // reaches farthest out of the hull, a batch per round, from the points' box: until it reaches at most
     // half of kPartHullTolerance out, or (past maxFaces / 2 faces) at most maxFaces faces.
-    const std::vector<PolytopeFace>& facets = exact->faces();
+    const PolytopeFaces facets = exact->faces();
     Aabb box;
     for (const Vec3& p : points)
         box.extend(p);
@@ -229,7 +229,7 @@ Result<ConvexPolytope> boundedHull(const std::vector<Vec3>& points, std::size_t 
     for (std::size_t round = 0; round < maxFaces; ++round) {
         std::vector<std::pair<double, std::size_t>> violated; // (distance, facet), one per facet
         std::vector<bool> taken(facets.size(), false);
-        for (const PolytopeFace& f : out.faces())
+        for (const PolytopeFaceView& f : out.faces())
             for (const Vec3& c : f.corners) {
                 auto [it, fresh] = reach.try_emplace(std::make_tuple(c.x, c.y, c.z));
                 if (fresh) {

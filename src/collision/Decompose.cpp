@@ -239,7 +239,7 @@ public:
             if (!tb.overlaps(rb))
                 continue;
             poly.assign(c.begin(), c.end());
-            for (const PolytopeFace& f : region.faces()) {
+            for (const PolytopeFaceView& f : region.faces()) {
                 detail::splitPolygon(poly, f.plane, inner, outer);
                 poly.swap(inner);
                 if (poly.size() < 3)
@@ -292,20 +292,20 @@ public:
     /// deepest sample and the chunks are compared in order, as one pass over the faces would.
     void measureDepth(Part& part) {
         part.depth = 0;
-        std::vector<const PolytopeFace*> cuts;
-        for (const PolytopeFace& f : part.region.faces())
+        std::vector<Plane> cuts;
+        for (const PolytopeFaceView& f : part.region.faces())
             if (f.tag >= 0)
-                cuts.push_back(&f);
+                cuts.push_back(f.plane);
         // Through a proxy, only the kProxyDepthFaces largest hull faces are sampled (pockets lie under large
         // faces that bridge them).
-        const std::vector<PolytopeFace>& hullFaces = part.hull.faces();
+        const PolytopeFaces hullFaces = part.hull.faces();
         std::vector<std::size_t> order(hullFaces.size());
         for (std::size_t i = 0; i < order.size(); ++i)
             order[i] = i;
         if (proxied() && order.size() > kProxyDepthFaces) {
             std::vector<double> area(hullFaces.size(), 0);
             for (std::size_t i = 0; i < hullFaces.size(); ++i) {
-                const auto& c = hullFaces[i].corners;
+                const PolytopeCorners c = hullFaces[i].corners;
                 for (std::size_t k = 1; k + 1 < c.size(); ++k)
                     area[i] += length(cross(c[k] - c[0], c[k + 1] - c[0]));
             }
@@ -318,7 +318,7 @@ public:
         const detail::PolygonBvh bvh(part.surface);
         std::vector<Plane> planes;
         planes.reserve(hullFaces.size());
-        for (const PolytopeFace& f : hullFaces)
+        for (const PolytopeFaceView& f : hullFaces)
             planes.push_back(f.plane);
         const detail::HullPlaneTree exitTree(hullFaces, planes);
         // The hull's box, padded: a ray leaves it no earlier than it leaves the hull.
@@ -348,15 +348,14 @@ public:
     };
 
     /// The deepest pocket under the samples of one hull face, where deeper than `best` so far.
-    void faceDepth(const PolytopeFace& hf, const std::vector<Plane>& planes,
-                   const detail::HullPlaneTree& exitTree, const std::vector<const PolytopeFace*>& cuts,
+    void faceDepth(const PolytopeFaceView& hf, const std::vector<Plane>& planes,
+                   const detail::HullPlaneTree& exitTree, const std::vector<Plane>& cuts,
                    const detail::PolygonBvh& bvh, const Aabb& box, Deepest& best) const {
         const double delta = 1e-9 * std::max(diag_, 1.0);
         const double planeTol = 1e-7 * std::max(diag_, 1.0);
         bool onCut = false;
-        for (const PolytopeFace* c : cuts)
-            if (dot(c->plane.normal, hf.plane.normal) > 1 - 1e-9 &&
-                std::abs(c->plane.offset - hf.plane.offset) < planeTol)
+        for (const Plane& c : cuts)
+            if (dot(c.normal, hf.plane.normal) > 1 - 1e-9 && std::abs(c.offset - hf.plane.offset) < planeTol)
                 onCut = true;
         if (onCut)
             return;
@@ -675,7 +674,7 @@ public:
         if (!hull)
             return hull.error();
         double area = 0;
-        for (const PolytopeFace& f : hull->faces())
+        for (const PolytopeFaceView& f : hull->faces())
             for (std::size_t i = 1; i + 1 < f.corners.size(); ++i)
                 area += 0.5 * length(cross(f.corners[i] - f.corners[0], f.corners[i + 1] - f.corners[0]));
         // A part convex to within kConvexTolerance of the diagonal is not split (rounding is not concavity).

@@ -74,7 +74,7 @@ std::string serialize(std::uint64_t key, const Decomposition& d) {
     w.put(static_cast<std::uint32_t>(d.parts.size()));
     for (const ConvexPolytope& p : d.parts) {
         w.put(static_cast<std::uint32_t>(p.faces().size()));
-        for (const PolytopeFace& f : p.faces()) {
+        for (const PolytopeFaceView& f : p.faces()) {
             w.put(f.plane.normal);
             w.put(f.plane.offset);
             w.put(f.tag);

@@ -17,11 +17,10 @@ namespace rubble::detail {
 class HullPlaneTree {
 public:
     /// faces: the hull's faces (their centres place the planes); planes[i] is faces[i]'s plane.
-    HullPlaneTree(const std::vector<PolytopeFace>& faces, const std::vector<Plane>& planes)
-        : planes_(planes) {
+    HullPlaneTree(const PolytopeFaces& faces, const std::vector<Plane>& planes) : planes_(planes) {
         centres_.reserve(faces.size());
         double scale = 0;
-        for (const PolytopeFace& f : faces) {
+        for (const PolytopeFaceView& f : faces) {
             Vec3 c;
             for (const Vec3& p : f.corners)
                 c += p;

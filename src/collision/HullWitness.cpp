@@ -214,7 +214,7 @@ std::size_t keepNearHull(std::vector<ConvexPolytope>& parts, const Mesh& mesh, d
     auto near = [&](const Vec3& c) {
         if (witness)
             return witness->near(c);
-        for (const PolytopeFace& f : hull->faces())
+        for (const PolytopeFaceView& f : hull->faces())
             if (f.plane.signedDistance(c) > reach)
                 return false;
         return true;

@@ -21,7 +21,7 @@ void keepInsideHull(std::vector<ConvexPolytope>& parts, const ConvexPolytope& hu
             double reach = margin;
             const Plane* worst = nullptr;
             for (const Vec3& c : part.vertices())
-                for (const PolytopeFace& h : hull.faces())
+                for (const PolytopeFaceView& h : hull.faces())
                     if (const double d = h.plane.signedDistance(c); d > reach) {
                         reach = d;
                         worst = &h.plane;
@@ -89,7 +89,7 @@ std::vector<Polygon> clipTrianglesToRegion(const Mesh& mesh, const ConvexPolytop
         if (!tb.overlaps(rb))
             continue;
         Polygon poly{c[0], c[1], c[2]};
-        for (const PolytopeFace& f : region.faces()) {
+        for (const PolytopeFaceView& f : region.faces()) {
             splitPolygon(poly, f.plane, in, outside);
             poly.swap(in);
             if (poly.size() < 3)

@@ -20,7 +20,7 @@ double distanceToParts(const Vec3& p, const std::vector<ConvexPolytope>& parts,
     bool covered = false; // p lies in (or on the boundary of) some part
     for (std::size_t k = 0; k < parts.size(); ++k) {
         double out = -std::numeric_limits<double>::infinity();
-        for (const PolytopeFace& f : parts[k].faces())
+        for (const PolytopeFaceView& f : parts[k].faces())
             out = std::max(out, f.plane.signedDistance(p));
         if (out <= 0) {
             covered = true;

@@ -44,7 +44,7 @@ Sides sidesOf(const ConvexPolytope& p, const Plane& plane) {
         1e-12 * std::max(1.0, std::max({std::abs(b.lo.x), std::abs(b.lo.y), std::abs(b.lo.z),
                                         std::abs(b.hi.x), std::abs(b.hi.y), std::abs(b.hi.z)}));
     Sides s;
-    for (const PolytopeFace& f : p.faces())
+    for (const PolytopeFaceView& f : p.faces())
         for (const Vec3& c : f.corners) {
             const double d = plane.signedDistance(c);
             s.out |= d > tol;
@@ -57,7 +57,7 @@ Sides sidesOf(const ConvexPolytope& p, const Plane& plane) {
 ConvexPolytope intersectCell(const ConvexPolytope& part, const ConvexPolytope& cell) {
     ConvexPolytope inside;
     const ConvexPolytope* current = &part;
-    for (const PolytopeFace& f : cell.faces()) {
+    for (const PolytopeFaceView& f : cell.faces()) {
         const Sides s = sidesOf(*current, f.plane);
         if (!s.out)
             continue;
@@ -74,7 +74,7 @@ ConvexPolytope intersectCell(const ConvexPolytope& part, const ConvexPolytope& c
 /// part − cell as at most one fragment per cell plane: outside plane j and inside planes < j.
 void subtractCell(const ConvexPolytope& part, const ConvexPolytope& cell, std::vector<ConvexPolytope>& out) {
     ConvexPolytope rest = part;
-    for (const PolytopeFace& f : cell.faces()) {
+    for (const PolytopeFaceView& f : cell.faces()) {
         const Sides s = sidesOf(rest, f.plane);
         if (!s.out) { // nothing outside this plane: rest unchanged (a flat rest on the plane is both)
             if (!s.in)
@@ -108,12 +108,12 @@ std::vector<OuterFace> outerFaces(const std::vector<ConvexPolytope>& cells,
     std::vector<OuterFace> out;
     for (std::size_t c = 0; c < cells.size(); ++c) {
         const double tol = 1e-9 * (cellBounds[c].diagonal() + 1);
-        for (const PolytopeFace& f : cells[c].faces()) {
+        for (const PolytopeFaceView& f : cells[c].faces()) {
             bool shared = false;
             for (std::size_t d = 0; d < cells.size() && !shared; ++d) {
                 if (d == c || !cellBounds[d].overlaps(cellBounds[c], tol))
                     continue;
-                for (const PolytopeFace& g : cells[d].faces())
+                for (const PolytopeFaceView& g : cells[d].faces())
                     if (dot(f.plane.normal, g.plane.normal) < -1 + 1e-9 &&
                         std::abs(f.plane.offset + g.plane.offset) < tol) {
                         shared = true;
@@ -266,9 +266,9 @@ private:
                 scale = std::max({scale, std::abs(p.x), std::abs(p.y), std::abs(p.z)});
         const double margin = 1e-6 * scale;
         auto beyond = [margin](const ConvexPolytope& planes, const ConvexPolytope& points) {
-            for (const PolytopeFace& f : planes.faces()) {
+            for (const PolytopeFaceView& f : planes.faces()) {
                 bool all = true;
-                for (const PolytopeFace& g : points.faces()) {
+                for (const PolytopeFaceView& g : points.faces()) {
                     for (const Vec3& p : g.corners)
                         if (!(f.plane.signedDistance(p) > margin)) {
                             all = false;
@@ -824,7 +824,7 @@ void fitPiece(std::size_t i, Assignment& a, const PieceSet& pieces,
         for (const ConvexPolytope& p : parts) {
             sum += p.volume();
             if (highPoly) { // corners as they are (repeats do not change a hull; welding is a sort)
-                for (const PolytopeFace& f : p.faces())
+                for (const PolytopeFaceView& f : p.faces())
                     pts.insert(pts.end(), f.corners.begin(), f.corners.end());
                 continue;
             }

@@ -31,7 +31,7 @@ Result<CellComplex> buildCellComplex(const std::vector<ConvexPolytope>& polytope
         cell.box = polytopes[c].bounds();
         std::unordered_map<std::uint64_t, std::uint32_t> localFaceOfEdge;
         std::vector<std::vector<std::uint32_t>> loops;
-        for (const PolytopeFace& f : polytopes[c].faces()) {
+        for (const PolytopeFaceView& f : polytopes[c].faces()) {
             std::vector<std::uint32_t> loop;
             for (const Vec3& p : f.corners) {
                 auto [it, inserted] = index.emplace(std::make_tuple(p.x, p.y, p.z),
@@ -101,7 +101,7 @@ Result<CellComplex> buildCellComplex(const std::vector<ConvexPolytope>& polytope
                 continue;
             auto separates = [&](std::uint32_t a, std::uint32_t b) {
                 const std::vector<Vec3> others = polytopes[b].vertices();
-                for (const PolytopeFace& f : polytopes[a].faces())
+                for (const PolytopeFaceView& f : polytopes[a].faces())
                     if (std::all_of(others.begin(), others.end(),
                                     [&](const Vec3& p) { return f.plane.signedDistance(p) >= -eps; }))
                         return true;

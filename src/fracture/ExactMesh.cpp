@@ -45,7 +45,7 @@ void addCell(const ConvexPolytope& cell, SM& sm, const std::function<void(SM::Fa
             it->second = sm.add_vertex(K::Point_3(p.x, p.y, p.z));
         return it->second;
     };
-    for (const PolytopeFace& face : cell.faces()) {
+    for (const PolytopeFaceView& face : cell.faces()) {
         std::vector<SM::Vertex_index> loop;
         for (const Vec3& c : face.corners) {
             const SM::Vertex_index v = vertex(c);

@@ -165,7 +165,7 @@ void finishCutFaces(Mesh& m, std::span<const ConvexPolytope> cells, double uvSca
         for (const ConvexPolytope& cell : cells) {
             if (!cell.bounds().overlaps(box, tolerance))
                 continue;
-            for (const PolytopeFace& f : cell.faces()) {
+            for (const PolytopeFaceView& f : cell.faces()) {
                 if (std::abs(dot(f.plane.normal, tn)) < 0.5 * length(tn))
                     continue;
                 const double e =

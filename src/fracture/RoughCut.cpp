@@ -101,7 +101,6 @@ std::uint64_t edgeKey(std::uint32_t a, std::uint32_t b) {
 
 /// A new cut face: a face of a cell, with its plane's normal in the same direction for both sides.
 struct CutFace {
-    const PolytopeFace* face = nullptr;
     Vec3 normal; // the plane's normal, its largest component positive
     Vec3 u, v;   // cutBasis
 };
@@ -113,8 +112,8 @@ public:
         for (const ConvexPolytope& c : cells) {
             first_.push_back(faces_.size());
             bounds_.push_back(c.bounds());
-            for (const PolytopeFace& f : c.faces()) {
-                CutFace cf{&f, f.plane.normal, {}, {}};
+            for (const PolytopeFaceView& f : c.faces()) {
+                CutFace cf{f.plane.normal, {}, {}};
                 int big = 0;
                 for (int a = 1; a < 3; ++a)
                     if (std::abs(cf.normal[a]) > std::abs(cf.normal[big]))
@@ -143,7 +142,7 @@ public:
         for (std::size_t k = 0; k < cells_.size(); ++k) {
             if (cells_[k].empty() || !bounds_[k].overlaps(box, onPlane_))
                 continue;
-            for (const PolytopeFace& g : cells_[k].faces()) {
+            for (const PolytopeFaceView& g : cells_[k].faces()) {
                 const double c = std::abs(dot(g.plane.normal, nf));
                 if (c > 0.99985 || std::abs(g.plane.signedDistance(a)) > onPlane_ || // coplanar: 1°
                     std::abs(g.plane.signedDistance(b)) > onPlane_ || !insidePolygon(g, mid))
@@ -170,9 +169,9 @@ public:
         for (std::size_t k = 0; k < cells_.size(); ++k) {
             if (cells_[k].empty() || !bounds_[k].overlaps(box, onPlane_))
                 continue;
-            const auto& faces = cells_[k].faces();
+            const PolytopeFaces faces = cells_[k].faces();
             for (std::size_t j = 0; j < faces.size(); ++j) {
-                const PolytopeFace& f = faces[j];
+                const PolytopeFaceView f = faces[j];
                 if (std::abs(dot(f.plane.normal, tn)) < 0.5 * tl)
                     continue;
                 bool on = true;
@@ -187,7 +186,7 @@ public:
     }
 
 private:
-    bool insidePolygon(const PolytopeFace& f, const Vec3& p) const {
+    bool insidePolygon(const PolytopeFaceView& f, const Vec3& p) const {
         const std::size_t n = f.corners.size();
         for (std::size_t i = 0; i < n; ++i) {
             const Vec3& a = f.corners[i];

@@ -32,7 +32,7 @@ double gapAlong(const std::vector<Vec3>& a, const std::vector<Vec3>& b, const Ve
 
 std::vector<Vec3> edgeDirections(const ConvexPolytope& p) {
     std::vector<Vec3> out;
-    for (const PolytopeFace& f : p.faces())
+    for (const PolytopeFaceView& f : p.faces())
         for (std::size_t i = 0; i < f.corners.size(); ++i) {
             const Vec3 &from = f.corners[i], &to = f.corners[(i + 1) % f.corners.size()];
             if (std::tie(from.x, from.y, from.z) > std::tie(to.x, to.y, to.z))
@@ -48,19 +48,17 @@ std::vector<Vec3> edgeDirections(const ConvexPolytope& p) {
 } // namespace
 
 ConvexPolytope ConvexPolytope::transformed(const Frame& f) const {
-    std::vector<PolytopeFace> faces;
-    faces.reserve(faces_.size());
-    for (const PolytopeFace& face : faces_) {
-        PolytopeFace out;
-        out.tag = face.tag;
-        out.corners.reserve(face.corners.size());
-        for (const Vec3& c : face.corners)
-            out.corners.push_back(f.apply(c));
-        const Vec3 n = f.rotation * face.plane.normal;
-        out.plane = out.corners.empty() ? Plane{n, 0} : Plane::fromPointNormal(out.corners.front(), n);
-        faces.push_back(std::move(out));
+    ConvexPolytope out = *this;
+    for (Vec3& c : out.corners_)
+        c = f.apply(c);
+    for (std::size_t i = 0; i < out.faces_.size(); ++i) {
+        const Vec3 n = f.rotation * faces_[i].plane.normal;
+        const std::size_t end = i + 1 < faces_.size() ? faces_[i + 1].first : index_.size();
+        out.faces_[i].plane = end > faces_[i].first
+                                  ? Plane::fromPointNormal(out.corners_[index_[faces_[i].first]], n)
+                                  : Plane{n, 0};
     }
-    return fromFaces(std::move(faces));
+    return out;
 }
 
 bool withinGap(const ConvexPolytope& a, const ConvexPolytope& b, double gap) {
@@ -72,7 +70,7 @@ bool withinGap(const ConvexPolytope& a, const ConvexPolytope& b, double gap) {
             return false;
     const std::vector<Vec3> va = a.vertices(), vb = b.vertices();
     for (const ConvexPolytope* p : {&a, &b})
-        for (const PolytopeFace& f : p->faces())
+        for (const PolytopeFaceView& f : p->faces())
             if (gapAlong(va, vb, f.plane.normal) > gap)
                 return false;
     const std::vector<Vec3> ea = edgeDirections(a), eb = edgeDirections(b);

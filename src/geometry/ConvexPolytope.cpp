@@ -1,6 +1,8 @@
 #include "rubble/geometry/ConvexPolytope.hpp"
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
 #include <map>
 
@@ -27,51 +29,82 @@ bool lexLess(const Vec3& a, const Vec3& b) {
 
 ConvexPolytope ConvexPolytope::fromAabb(const Aabb& box) {
     const Vec3 l = box.lo, h = box.hi;
-    const Vec3 v[8] = {{l.x, l.y, l.z}, {h.x, l.y, l.z}, {h.x, h.y, l.z}, {l.x, h.y, l.z},
-                       {l.x, l.y, h.z}, {h.x, l.y, h.z}, {h.x, h.y, h.z}, {l.x, h.y, h.z}};
-    auto face = [&](Vec3 n, double off, std::initializer_list<int> ids) {
-        PolytopeFace f;
-        f.plane = {n, off};
-        for (int i : ids)
-            f.corners.push_back(v[i]);
-        return f;
-    };
     ConvexPolytope p;
-    p.faces_ = {face({-1, 0, 0}, -l.x, {0, 4, 7, 3}), face({1, 0, 0}, h.x, {1, 2, 6, 5}),
-                face({0, -1, 0}, -l.y, {0, 1, 5, 4}), face({0, 1, 0}, h.y, {3, 7, 6, 2}),
-                face({0, 0, -1}, -l.z, {0, 3, 2, 1}), face({0, 0, 1}, h.z, {4, 5, 6, 7})};
+    p.corners_ = {{l.x, l.y, l.z}, {h.x, l.y, l.z}, {h.x, h.y, l.z}, {l.x, h.y, l.z},
+                  {l.x, l.y, h.z}, {h.x, l.y, h.z}, {h.x, h.y, h.z}, {l.x, h.y, h.z}};
+    p.index_ = {0, 4, 7, 3, 1, 2, 6, 5, 0, 1, 5, 4, 3, 7, 6, 2, 0, 3, 2, 1, 4, 5, 6, 7};
+    p.faces_ = {{{{-1, 0, 0}, -l.x}, 0, -1}, {{{1, 0, 0}, h.x}, 4, -1},    {{{0, -1, 0}, -l.y}, 8, -1},
+                {{{0, 1, 0}, h.y}, 12, -1},  {{{0, 0, -1}, -l.z}, 16, -1}, {{{0, 0, 1}, h.z}, 20, -1}};
     return p;
 }
 
 ConvexPolytope ConvexPolytope::fromFaces(std::vector<PolytopeFace> faces) {
+    // corners shared where their bits are equal, so that every face keeps its corners exactly
+    struct Ref {
+        std::array<std::uint64_t, 3> bits;
+        std::uint32_t at;
+    };
+    std::vector<Ref> refs;
+    for (const PolytopeFace& f : faces)
+        for (const Vec3& c : f.corners)
+            refs.push_back({{std::bit_cast<std::uint64_t>(c.x), std::bit_cast<std::uint64_t>(c.y),
+                             std::bit_cast<std::uint64_t>(c.z)},
+                            static_cast<std::uint32_t>(refs.size())});
+    std::sort(refs.begin(), refs.end(), [](const Ref& a, const Ref& b) { return a.bits < b.bits; });
     ConvexPolytope p;
-    p.faces_ = std::move(faces);
+    p.index_.resize(refs.size());
+    std::vector<Vec3> flat;
+    flat.reserve(refs.size());
+    for (const PolytopeFace& f : faces)
+        flat.insert(flat.end(), f.corners.begin(), f.corners.end());
+    for (std::size_t i = 0; i < refs.size(); ++i) {
+        if (i == 0 || refs[i].bits != refs[i - 1].bits)
+            p.corners_.push_back(flat[refs[i].at]);
+        p.index_[refs[i].at] = static_cast<std::uint32_t>(p.corners_.size() - 1);
+    }
+    p.corners_.shrink_to_fit();
+    p.faces_.reserve(faces.size());
+    std::uint32_t first = 0;
+    for (const PolytopeFace& f : faces) {
+        p.faces_.push_back({f.plane, first, f.tag});
+        first += static_cast<std::uint32_t>(f.corners.size());
+    }
     return p;
 }
 
+std::vector<PolytopeFace> ConvexPolytope::faceList() const {
+    std::vector<PolytopeFace> out;
+    out.reserve(faces_.size());
+    for (const PolytopeFaceView& f : faces())
+        out.push_back({f.plane, std::vector<Vec3>(f.corners.begin(), f.corners.end()), f.tag});
+    return out;
+}
+
 std::vector<Vec3> ConvexPolytope::vertices() const {
-    std::vector<Vec3> out;
-    for (const auto& f : faces_)
-        out.insert(out.end(), f.corners.begin(), f.corners.end());
+    std::vector<Vec3> out = corners_;
     std::sort(out.begin(), out.end(), lexLess);
     out.erase(std::unique(out.begin(), out.end()), out.end());
     return out;
 }
 
+std::size_t ConvexPolytope::heapBytes() const {
+    return faces_.capacity() * sizeof(Face) + corners_.capacity() * sizeof(Vec3) +
+           index_.capacity() * sizeof(std::uint32_t);
+}
+
 Aabb ConvexPolytope::bounds() const {
     Aabb b;
-    for (const auto& f : faces_)
-        for (const Vec3& c : f.corners)
-            b.extend(c);
+    for (const Vec3& c : corners_)
+        b.extend(c);
     return b;
 }
 
 double ConvexPolytope::volume() const {
     if (empty())
         return 0;
-    const Vec3 r = faces_[0].corners[0];
+    const Vec3 r = corners_[index_[0]];
     double v = 0;
-    for (const auto& f : faces_)
+    for (const PolytopeFaceView& f : faces())
         for (std::size_t i = 1; i + 1 < f.corners.size(); ++i)
             v += dot(f.corners[0] - r, cross(f.corners[i] - r, f.corners[i + 1] - r));
     return v / 6.0;
@@ -80,10 +113,10 @@ double ConvexPolytope::volume() const {
 Vec3 ConvexPolytope::centroid() const {
     if (empty())
         return {};
-    const Vec3 r = faces_[0].corners[0];
+    const Vec3 r = corners_[index_[0]];
     double v = 0;
     Vec3 c;
-    for (const auto& f : faces_)
+    for (const PolytopeFaceView& f : faces())
         for (std::size_t i = 1; i + 1 < f.corners.size(); ++i) {
             const Vec3 a = f.corners[0] - r, b = f.corners[i] - r, d = f.corners[i + 1] - r;
             const double w = dot(a, cross(b, d));
@@ -96,7 +129,7 @@ Vec3 ConvexPolytope::centroid() const {
 bool ConvexPolytope::contains(const Vec3& p, double eps) const {
     if (empty())
         return false;
-    for (const auto& f : faces_)
+    for (const Face& f : faces_)
         if (f.plane.signedDistance(p) > eps)
             return false;
     return true;
@@ -109,77 +142,135 @@ ConvexPolytope ConvexPolytope::clipped(const Plane& plane, std::int32_t tag, dou
     const Aabb b = bounds();
     const double tol = eps * std::max(1.0, std::max({std::abs(b.lo.x), std::abs(b.lo.y), std::abs(b.lo.z),
                                                      std::abs(b.hi.x), std::abs(b.hi.y), std::abs(b.hi.z)}));
+    constexpr std::uint32_t kNone = ~0u;
+    // This thread's work arrays (clipping runs often: no allocation but the result's).
+    struct Crossing {
+        std::uint32_t a, c; // the edge's old corners, a < c
+        Vec3 p;
+        std::uint32_t at; // its index in the result, or kNone until a face uses it
+    };
+    thread_local struct {
+        ConvexPolytope out;
+        std::vector<double> dist;
+        std::vector<std::uint32_t> kept, pending, cap;
+        std::vector<Crossing> crossings;
+        std::vector<std::pair<Vec3, std::uint32_t>> capPoints;
+        std::vector<std::pair<double, std::uint32_t>> ordered;
+    } work;
+    // signed distance of each corner, snapped to 0 within tol
+    std::vector<double>& dist = work.dist;
+    dist.resize(corners_.size());
     bool anyOut = false, anyIn = false;
-    for (const auto& f : faces_)
-        for (const Vec3& c : f.corners) {
-            const double d = plane.signedDistance(c);
-            anyOut |= d > tol;
-            anyIn |= d < -tol;
-        }
+    for (std::size_t i = 0; i < corners_.size(); ++i) {
+        const double d = plane.signedDistance(corners_[i]);
+        anyOut |= d > tol;
+        anyIn |= d < -tol;
+        dist[i] = std::abs(d) <= tol ? 0 : d;
+    }
     if (!anyOut)
         return *this;
     if (!anyIn)
         return {};
 
-    ConvexPolytope out;
-    out.faces_.reserve(faces_.size() + 1);
-    std::vector<Vec3> capPoints;
-    for (const auto& f : faces_) {
-        PolytopeFace nf;
-        nf.plane = f.plane;
-        nf.tag = f.tag;
-        const std::size_t n = f.corners.size();
-        nf.corners.reserve(n + 1);
-        for (std::size_t i = 0; i < n; ++i) {
-            const Vec3& a = f.corners[i];
-            const Vec3& c = f.corners[(i + 1) % n];
-            double da = plane.signedDistance(a), dc = plane.signedDistance(c);
-            if (std::abs(da) <= tol)
-                da = 0;
-            if (std::abs(dc) <= tol)
-                dc = 0;
+    // A new corner is a kept corner (its old index) or a point where an edge crosses the plane; both are
+    // added to out.corners_ only when a face or the cap uses them.
+    std::vector<std::uint32_t>& kept = work.kept;
+    kept.assign(corners_.size(), kNone);
+    std::vector<Crossing>& crossings = work.crossings;
+    crossings.clear();
+    ConvexPolytope& out = work.out; // returned as an exact-size copy
+    out.faces_.clear();
+    out.corners_.clear();
+    out.index_.clear();
+    auto keep = [&](std::uint32_t old) {
+        if (kept[old] == kNone) {
+            kept[old] = static_cast<std::uint32_t>(out.corners_.size());
+            out.corners_.push_back(corners_[old]);
+        }
+        return kept[old];
+    };
+    auto place = [&](Crossing& x) {
+        if (x.at == kNone) {
+            x.at = static_cast<std::uint32_t>(out.corners_.size());
+            out.corners_.push_back(x.p);
+        }
+        return x.at;
+    };
+    // a face's corners until it is known to keep three: an old index, or kCrossing | a crossing
+    constexpr std::uint32_t kCrossing = 1u << 31;
+    std::vector<std::uint32_t>& pending = work.pending;
+    std::vector<std::uint32_t>& cap = work.cap; // the same encoding, the points on the plane
+    cap.clear();
+    for (std::size_t fi = 0; fi < faces_.size(); ++fi) {
+        const std::uint32_t first = faces_[fi].first;
+        const std::uint32_t end =
+            fi + 1 < faces_.size() ? faces_[fi + 1].first : static_cast<std::uint32_t>(index_.size());
+        const std::uint32_t n = end - first;
+        pending.clear();
+        for (std::uint32_t i = 0; i < n; ++i) {
+            const std::uint32_t ia = index_[first + i], ic = index_[first + (i + 1) % n];
+            const double da = dist[ia], dc = dist[ic];
             if (da <= 0) {
-                nf.corners.push_back(a);
+                pending.push_back(ia);
                 if (da == 0)
-                    capPoints.push_back(a);
+                    cap.push_back(ia);
             }
             if ((da < 0 && dc > 0) || (da > 0 && dc < 0)) {
-                const Vec3 x = edgePlanePoint(a, c, da, dc);
-                nf.corners.push_back(x);
-                capPoints.push_back(x);
+                const Vec3 x = edgePlanePoint(corners_[ia], corners_[ic], da, dc);
+                const std::uint32_t lo = std::min(ia, ic), hi = std::max(ia, ic);
+                std::size_t k = 0;
+                while (k < crossings.size() &&
+                       !(crossings[k].a == lo && crossings[k].c == hi &&
+                         std::bit_cast<std::array<std::uint64_t, 3>>(crossings[k].p) ==
+                             std::bit_cast<std::array<std::uint64_t, 3>>(x)))
+                    ++k;
+                if (k == crossings.size())
+                    crossings.push_back({lo, hi, x, kNone});
+                pending.push_back(kCrossing | static_cast<std::uint32_t>(k));
+                cap.push_back(kCrossing | static_cast<std::uint32_t>(k));
             }
         }
-        if (nf.corners.size() >= 3)
-            out.faces_.push_back(std::move(nf));
+        if (pending.size() < 3)
+            continue;
+        out.faces_.push_back(
+            {faces_[fi].plane, static_cast<std::uint32_t>(out.index_.size()), faces_[fi].tag});
+        for (std::uint32_t e : pending)
+            out.index_.push_back((e & kCrossing) ? place(crossings[e & ~kCrossing]) : keep(e));
     }
+    auto pointOf = [&](std::uint32_t e) {
+        return (e & kCrossing) ? crossings[e & ~kCrossing].p : corners_[e];
+    };
     // Cap face: the points on the plane, ordered counter-clockwise around the outward normal.
-    std::sort(capPoints.begin(), capPoints.end(), lexLess);
-    capPoints.erase(std::unique(capPoints.begin(), capPoints.end()), capPoints.end());
+    std::vector<std::pair<Vec3, std::uint32_t>>& capPoints = work.capPoints;
+    capPoints.clear();
+    for (std::uint32_t e : cap)
+        capPoints.emplace_back(pointOf(e), e);
+    std::sort(capPoints.begin(), capPoints.end(),
+              [](const auto& x, const auto& y) { return lexLess(x.first, y.first); });
+    capPoints.erase(std::unique(capPoints.begin(), capPoints.end(),
+                                [](const auto& x, const auto& y) { return x.first == y.first; }),
+                    capPoints.end());
     if (capPoints.size() >= 3) {
         Vec3 center;
-        for (const Vec3& p : capPoints)
+        for (const auto& [p, e] : capPoints)
             center += p;
         center = center / static_cast<double>(capPoints.size());
         const Vec3 n = plane.normal;
         const Vec3 u = normalized(std::abs(n.x) < 0.9 ? cross(n, Vec3{1, 0, 0}) : cross(n, Vec3{0, 1, 0}));
         const Vec3 v = cross(n, u);
-        std::vector<std::pair<double, Vec3>> ordered;
-        ordered.reserve(capPoints.size());
-        for (const Vec3& p : capPoints)
-            ordered.emplace_back(detail::pseudoAngle(dot(p - center, u), dot(p - center, v)), p);
+        std::vector<std::pair<double, std::uint32_t>>& ordered = work.ordered;
+        ordered.clear();
+        for (const auto& [p, e] : capPoints)
+            ordered.emplace_back(detail::pseudoAngle(dot(p - center, u), dot(p - center, v)), e);
         std::sort(ordered.begin(), ordered.end(),
                   [](const auto& x, const auto& y) { return x.first < y.first; });
-        PolytopeFace cap;
-        cap.plane = plane;
-        cap.tag = tag;
-        cap.corners.reserve(ordered.size());
-        for (const auto& [angle, p] : ordered)
-            cap.corners.push_back(p);
-        out.faces_.push_back(std::move(cap));
+        out.faces_.push_back({plane, static_cast<std::uint32_t>(out.index_.size()), tag});
+        for (const auto& [angle, e] : ordered)
+            out.index_.push_back((e & kCrossing) ? place(crossings[e & ~kCrossing]) : keep(e));
     }
     if (out.faces_.size() < 4 || out.volume() <= 0)
         return {};
-    return out;
+    return ConvexPolytope(out);
 }
 
 Mesh ConvexPolytope::toMesh() const {
@@ -193,9 +284,9 @@ Mesh ConvexPolytope::toMesh() const {
         return it->second;
     };
     bool tagged = false;
-    for (const auto& f : faces_)
+    for (const Face& f : faces_)
         tagged |= f.tag >= 0;
-    for (const auto& f : faces_) {
+    for (const PolytopeFaceView& f : faces()) {
         std::vector<std::uint32_t> ids;
         for (const Vec3& c : f.corners) {
             const std::uint32_t i = id(c);

@@ -76,7 +76,7 @@ Status writeDecompositionFile(const std::filesystem::path& path, const Decomposi
     json parts = json::array();
     for (const ConvexPolytope& part : file.parts) {
         json faces = json::array();
-        for (const PolytopeFace& f : part.faces()) {
+        for (const PolytopeFaceView& f : part.faces()) {
             json corners = json::array();
             for (const Vec3& c : f.corners)
                 corners.push_back(vec(c));

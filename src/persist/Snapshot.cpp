@@ -219,7 +219,7 @@ void writeObject(ByteWriter& w, const ObjectState& o) {
     w.u32(static_cast<std::uint32_t>(o.convexParts.size()));
     for (const ConvexPolytope& part : o.convexParts) {
         w.u32(static_cast<std::uint32_t>(part.faces().size()));
-        for (const PolytopeFace& face : part.faces()) {
+        for (const PolytopeFaceView& face : part.faces()) {
             vec(w, face.plane.normal);
             w.f64(face.plane.offset);
             w.i32(face.tag);

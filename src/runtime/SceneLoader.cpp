@@ -19,7 +19,7 @@ std::string where(const SceneConfig& scene, const SceneObject& o) {
 
 // A polytope scaled per axis by s (all positive).
 ConvexPolytope scaledPolytope(const ConvexPolytope& p, const Vec3& s) {
-    std::vector<PolytopeFace> faces = p.faces();
+    std::vector<PolytopeFace> faces = p.faceList();
     for (PolytopeFace& f : faces) {
         for (Vec3& c : f.corners)
             c = {c.x * s.x, c.y * s.y, c.z * s.z};

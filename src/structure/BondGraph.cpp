@@ -47,7 +47,7 @@ void basisOf(const Vec3& n, Vec3& u, Vec3& v) {
 }
 
 // The overlap of face fa (of the first solid) and fb (of the second), or nothing.
-void facePatch(const PolytopeFace& fa, const PolytopeFace& fb, const BondSettings& s,
+void facePatch(const PolytopeFaceView& fa, const PolytopeFaceView& fb, const BondSettings& s,
                std::vector<Patch>& out) {
     const double cosTol = std::cos(s.angleTolerance * std::numbers::pi / 180);
     if (dot(fa.plane.normal, fb.plane.normal) > -cosTol)
@@ -62,8 +62,8 @@ void facePatch(const PolytopeFace& fa, const PolytopeFace& fb, const BondSetting
     for (const Vec3& c : fa.corners)
         pa.push_back({dot(c - o, u), dot(c - o, v)});
     // fb is counter-clockwise about its own normal (opposite), so clockwise here: reverse it.
-    for (auto it = fb.corners.rbegin(); it != fb.corners.rend(); ++it)
-        pb.push_back({dot(*it - o, u), dot(*it - o, v)});
+    for (std::size_t i = fb.corners.size(); i-- > 0;)
+        pb.push_back({dot(fb.corners[i] - o, u), dot(fb.corners[i] - o, v)});
     const std::vector<Vec2> ov = clipConvex(pb, pa);
     if (ov.size() < 3)
         return;
@@ -113,8 +113,8 @@ BondInterface bondInterface(const std::vector<ConvexPolytope>& a, const std::vec
         for (const ConvexPolytope& pb : b) {
             if (apart(pa.bounds(), pb.bounds(), settings.gap))
                 continue;
-            for (const PolytopeFace& fa : pa.faces())
-                for (const PolytopeFace& fb : pb.faces())
+            for (const PolytopeFaceView& fa : pa.faces())
+                for (const PolytopeFaceView& fb : pb.faces())
                     facePatch(fa, fb, settings, patches);
         }
     BondInterface out;

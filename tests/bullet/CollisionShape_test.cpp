@@ -56,7 +56,7 @@ TEST(CollisionShape, EdgesShareTheirCornersAndHullsHoldTheirPoints) {
     auto toBody = [&](const Vec3& p) { // kept in float
         return Vec3(Vec3f(objectToBody.rotation.transposed() * (p - objectToBody.translation)));
     };
-    for (const PolytopeFace& f : part.faces())
+    for (const PolytopeFaceView& f : part.faces())
         for (std::size_t i = 0; i < f.corners.size(); ++i) {
             const Vec3& a = f.corners[i];
             const Vec3& c = f.corners[(i + 1) % f.corners.size()];

@@ -55,7 +55,7 @@ void expectCovers(const Mesh& mesh, const std::vector<ConvexPolytope>& parts, do
         for (const ConvexPolytope& p : parts) {
             in |= p.contains(v, eps);
             double out = 0;
-            for (const PolytopeFace& f : p.faces())
+            for (const PolytopeFaceView& f : p.faces())
                 out = std::max(out, f.plane.signedDistance(v));
             nearest = std::min(nearest, out);
         }
@@ -86,7 +86,7 @@ TEST(ConvexHull, CubePointsGiveSixMergedFaces) {
         EXPECT_TRUE(h->contains(p, 1e-12));
     EXPECT_FALSE(h->contains({1.1, 0.5, 0.5}, 1e-12));
     // Outward planes and counter-clockwise corners: each face's corner winding agrees with its normal.
-    for (const PolytopeFace& f : h->faces()) {
+    for (const PolytopeFaceView& f : h->faces()) {
         const Vec3 n = cross(f.corners[1] - f.corners[0], f.corners[2] - f.corners[0]);
         EXPECT_GT(dot(n, f.plane.normal), 0);
     }
@@ -255,7 +255,7 @@ TEST(UpdateDecomposition, ChainedUpdatesOfConvexPiecesStillCoverThem) {
         ConvexPolytope nextObject;
         for (std::size_t c = 0; c < all.size(); ++c) {
             ConvexPolytope piece = object;
-            for (const PolytopeFace& f : all[c].faces())
+            for (const PolytopeFaceView& f : all[c].faces())
                 piece = piece.clipped(f.plane);
             if (piece.empty())
                 continue;

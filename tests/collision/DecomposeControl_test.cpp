@@ -52,7 +52,7 @@ Mesh torus() {
 std::vector<double> coordinates(const Decomposition& d) {
     std::vector<double> out;
     for (const ConvexPolytope& p : d.parts)
-        for (const PolytopeFace& f : p.faces())
+        for (const PolytopeFaceView& f : p.faces())
             for (const Vec3& c : f.corners)
                 out.insert(out.end(), {c.x, c.y, c.z});
     return out;

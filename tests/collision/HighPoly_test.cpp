@@ -131,7 +131,7 @@ TEST(HighPoly, ChainedUpdatesOnA100kTorusKeepConvexCoveringPartsWithinBudgetAndE
             for (const ConvexPolytope& p : parts) {
                 EXPECT_LE(p.faces().size(), dp.maxPartFaces);
                 const std::vector<Vec3> corners = p.vertices();
-                for (const PolytopeFace& f : p.faces()) // convex: every corner behind every face plane
+                for (const PolytopeFaceView& f : p.faces()) // convex: every corner behind every face plane
                     for (const Vec3& v : corners)
                         ASSERT_LE(f.plane.signedDistance(v), eps);
                 partVolume += p.volume();

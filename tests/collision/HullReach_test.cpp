@@ -73,7 +73,7 @@ TEST(HullReach, AWitnessedPointLiesWithinReachOfTheHull) {
         for (int i = 0; i < 1500; ++i) {
             const Vec3 p = rng.inBox(box.lo, box.hi);
             double out = -1e300;
-            for (const PolytopeFace& f : hull.faces())
+            for (const PolytopeFaceView& f : hull.faces())
                 out = std::max(out, f.plane.signedDistance(p));
             const bool in = windingNumber(mesh, p) > 0.5;
             const bool n = witness.near(p);

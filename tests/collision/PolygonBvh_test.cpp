@@ -87,12 +87,12 @@ TEST(HullPlaneTree, FindsTheSameExitAsAScanOfEveryPlane) {
     const ConvexPolytope hull = convexHull(points).value();
     ASSERT_GT(hull.faces().size(), 1000u);
     std::vector<Plane> planes;
-    for (const PolytopeFace& f : hull.faces())
+    for (const PolytopeFaceView& f : hull.faces())
         planes.push_back(f.plane);
     const detail::HullPlaneTree tree(hull.faces(), planes);
     int exits = 0, none = 0;
     for (int i = 0; i < 4000; ++i) {
-        const PolytopeFace& f = hull.faces()[rng.below(hull.faces().size())];
+        const PolytopeFaceView& f = hull.faces()[rng.below(hull.faces().size())];
         Vec3 o;
         Vec3 dir = -f.plane.normal;
         switch (i % 3) {

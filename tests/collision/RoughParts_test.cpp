@@ -40,8 +40,8 @@ double partDistance(const ConvexPolytope& part, const Vec3& p) {
     if (part.contains(p))
         return 0;
     double d = std::numeric_limits<double>::infinity();
-    for (const PolytopeFace& f : part.faces())
-        d = std::min(d, polygonDistance(p, f.corners, f.plane.normal));
+    for (const PolytopeFaceView& f : part.faces())
+        d = std::min(d, polygonDistance(p, {f.corners.begin(), f.corners.end()}, f.plane.normal));
     return d;
 }
 
@@ -95,7 +95,7 @@ TEST(RoughParts, PartsAndRoughSurfaceStayWithinTheAmplitudeOfEachOther) {
                 farVertex = std::max(farVertex, near);
             }
             for (const ConvexPolytope& part : parts[p]) // the parts within the amplitude of the rough piece
-                for (const PolytopeFace& f : part.faces())
+                for (const PolytopeFaceView& f : part.faces())
                     for (const Vec3& c : f.corners)
                         farCorner = std::max(farCorner, meshDistance(m, c));
             for (std::size_t t = 0; t < m.triangles.size(); ++t)

@@ -21,7 +21,7 @@ void checkConvexCell(const ConvexPolytope& cell, double size) {
     ASSERT_FALSE(cell.empty());
     const auto verts = cell.vertices();
     for (std::size_t i = 0; i < cell.faces().size(); ++i) {
-        const PolytopeFace& f = cell.faces()[i];
+        const PolytopeFaceView& f = cell.faces()[i];
         EXPECT_EQ(f.tag, static_cast<std::int32_t>(i));
         EXPECT_NEAR(length(f.plane.normal), 1.0, 1e-12);
         Vec3 n;
@@ -273,7 +273,7 @@ TEST(CellGenerator, RadialCellsAreWedgesThroughThePane) {
         ASSERT_EQ(cells.size(), 24u);
         int across = 0, caps = 0, faces = 0;
         for (const ConvexPolytope& c : cells)
-            for (const PolytopeFace& f : c.faces()) {
+            for (const PolytopeFaceView& f : c.faces()) {
                 const double along = std::abs(dot(f.plane.normal, normal));
                 ++faces;
                 across += along < 0.3 ? 1 : 0;

@@ -70,7 +70,7 @@ TEST(ConvexCellClipper, ConvexMeshMatchesPolytopeClipping) {
             const Vec3 c{rng.uniform(-1.2, 1.2), rng.uniform(-1.2, 1.2), rng.uniform() < 0.5 ? 1.0 : -1.0};
             const ConvexPolytope cell = randomCell(rng, c, rng.uniform(0.2, 0.8));
             ConvexPolytope expected = cubePolytope;
-            for (const PolytopeFace& f : cell.faces())
+            for (const PolytopeFaceView& f : cell.faces())
                 expected = expected.clipped(f.plane);
             auto r = detail::clipByConvexCell(cube, cell);
             ASSERT_TRUE(r) << r.error().message;

@@ -181,7 +181,7 @@ std::size_t displacedNewCutVertices(const Mesh& before, const FractureResult& r)
                     continue;
                 double nearest = 1e300;
                 for (const ConvexPolytope& cell : r.cells)
-                    for (const PolytopeFace& f : cell.faces())
+                    for (const PolytopeFaceView& f : cell.faces())
                         nearest = std::min(nearest, std::abs(f.plane.signedDistance(c)));
                 if (nearest > 1e-6)
                     moved.emplace(c.x, c.y, c.z);

@@ -66,7 +66,7 @@ TEST(ConvexContact, TransformedKeepsVolumeAndMovesTheCentroid) {
     EXPECT_NEAR(c.x, 3, 1e-12);
     EXPECT_NEAR(c.y, -2, 1e-12);
     EXPECT_NEAR(c.z, 7, 1e-12);
-    for (const PolytopeFace& face : q.faces())
+    for (const PolytopeFaceView& face : q.faces())
         for (const Vec3& corner : face.corners)
             EXPECT_NEAR(dot(face.plane.normal, corner), face.plane.offset, 1e-12);
     const ConvexPolytope back = q.transformed(f.inverse());

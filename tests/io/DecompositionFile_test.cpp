@@ -31,7 +31,7 @@ TEST(DecompositionFile, RoundTripIsExact) {
     for (std::size_t i = 0; i < 2; ++i) {
         ASSERT_EQ(back->parts[i].faces().size(), f.parts[i].faces().size());
         for (std::size_t k = 0; k < f.parts[i].faces().size(); ++k) {
-            EXPECT_EQ(back->parts[i].faces()[k].corners, f.parts[i].faces()[k].corners);
+            EXPECT_EQ(back->parts[i].faceList()[k].corners, f.parts[i].faceList()[k].corners);
             EXPECT_EQ(back->parts[i].faces()[k].plane.offset, f.parts[i].faces()[k].plane.offset);
         }
     }

@@ -69,9 +69,9 @@ inline double reachOutsideHull(const Mesh& piece, const std::vector<ConvexPolyto
         return 0;
     double worst = 0;
     for (const ConvexPolytope& part : parts)
-        for (const PolytopeFace& f : part.faces())
+        for (const PolytopeFaceView& f : part.faces())
             for (const Vec3& c : f.corners)
-                for (const PolytopeFace& h : hull->faces())
+                for (const PolytopeFaceView& h : hull->faces())
                     worst = std::max(worst, h.plane.signedDistance(c));
     return worst / piece.bounds().diagonal();
 }

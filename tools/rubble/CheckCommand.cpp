@@ -159,7 +159,7 @@ double outsideHull(const rubble::Mesh& object, const std::vector<rubble::Mesh>& 
     double worst = 0;
     for (const rubble::Mesh& part : parts)
         for (const rubble::Vec3& p : part.positions)
-            for (const rubble::PolytopeFace& f : hull->faces())
+            for (const rubble::PolytopeFaceView& f : hull->faces())
                 worst = std::max(worst, f.plane.signedDistance(p));
     return worst;
 }

@@ -28,7 +28,7 @@ bool lexLess(const Vec3& a, const Vec3& b) {
 // The part shrunk by margin along every face plane (empty when it is thinner than 2·margin).
 ConvexPolytope eroded(const ConvexPolytope& part, double margin) {
     ConvexPolytope out = part;
-    for (const PolytopeFace& f : part.faces()) {
+    for (const PolytopeFaceView& f : part.faces()) {
         out = out.clipped(Plane{f.plane.normal, f.plane.offset - margin}, f.tag);
         if (out.empty())
             break;
@@ -180,7 +180,7 @@ std::unique_ptr<CollisionShape> CollisionShape::fromParts(const std::vector<Conv
             return base + static_cast<std::uint32_t>(
                               std::lower_bound(corners.begin(), corners.end(), p, lexLess) - corners.begin());
         };
-        for (const PolytopeFace& f : part.faces())
+        for (const PolytopeFaceView& f : part.faces())
             for (std::size_t i = 0; i < f.corners.size(); ++i) {
                 const Vec3& a = f.corners[i];
                 const Vec3& c = f.corners[(i + 1) % f.corners.size()];
