@@ -129,14 +129,15 @@ double peakRssMb() {
     return 0;
 }
 
-// Where the demo's demolition charges go: objects, and big pieces still high above the ground.
+// Where the demo's demolition charges go: static objects, and big static pieces still high above the ground.
 std::vector<rubble::Vec3> standingTargets(const rubble::DestructionRuntime& runtime, double groundTop) {
     std::vector<rubble::Vec3> out;
     for (rubble::BodyId id : runtime.bodies()) {
         const rubble::BodyRecord* b = runtime.body(id);
         const rubble::Vec3 c = runtime.motion(id).transform.translation;
-        if (b->role == rubble::BodyRole::Object ||
-            (b->role == rubble::BodyRole::Piece && b->volume > 150 && c.y > groundTop + 15))
+        if (b->motion == rubble::BodyMotionState::Static &&
+            (b->role == rubble::BodyRole::Object ||
+             (b->role == rubble::BodyRole::Piece && b->volume > 150 && c.y > groundTop + 15)))
             out.push_back(c);
     }
     return out;

@@ -885,8 +885,9 @@ std::vector<V3> Game::targets() const {
     for (BodyId id : runtime_->bodies()) {
         const BodyRecord* b = runtime_->body(id);
         const rubble::Vec3 c = runtime_->motion(id).transform.translation;
-        if (b->role == BodyRole::Object ||
-            (b->role == BodyRole::Piece && b->volume > 150 && c.y > groundTop_ + 15))
+        if (b->motion == rubble::BodyMotionState::Static &&
+            (b->role == BodyRole::Object ||
+             (b->role == BodyRole::Piece && b->volume > 150 && c.y > groundTop_ + 15)))
             out.push_back(toV3(c));
     }
     return out;

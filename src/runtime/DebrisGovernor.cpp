@@ -51,6 +51,7 @@ void DebrisGovernor::frozen(BodyId id, const Vec3& center, double radius) {
 void DebrisGovernor::thawed(BodyId id) {
     awake_.erase(id);
     light_.erase(id);
+    waiting_.erase(id);
     auto it = frozen_.find(id);
     if (it == frozen_.end())
         return;
@@ -91,14 +92,14 @@ void DebrisGovernor::wakeNear(const Aabb& box, double margin) {
     if (cells.empty() && !box.empty()) { // a huge box
         for (const auto& [id, e] : frozen_)
             if (near(id))
-                toWake_.push_back(id);
+                waiting_.insert(id);
         return;
     }
     for (Cell c : cells)
         if (auto g = grid_.find(c); g != grid_.end())
             for (BodyId id : g->second)
                 if (near(id))
-                    toWake_.push_back(id);
+                    waiting_.insert(id);
 }
 
 GovernorActions DebrisGovernor::update(const BodyTable& bodies, const PhysicsBinding& binding,
@@ -119,10 +120,19 @@ GovernorActions DebrisGovernor::update(const BodyTable& bodies, const PhysicsBin
         wakeNear(Aabb{w.center - r, w.center + r}, w.margin);
         it = watched_.erase(it);
     }
-    woken.insert(toWake_.begin(), toWake_.end());
-    toWake_.clear();
+    auto isFrozen = [&](BodyId id) {
+        const BodyRecord* r = bodies.find(id);
+        return r && r->motion == BodyMotionState::Frozen;
+    };
+    // What lost its support wakes within the awake budget (light pieces are outside it); the rest waits,
+    // frozen: a wake over the budget only turns another moving piece light, whose fall wakes more.
+    int room = awakeBudget() - (bodies.awake() - static_cast<int>(light_.size())) -
+               static_cast<int>(std::count_if(woken.begin(), woken.end(), isFrozen));
+    for (auto it = waiting_.begin(); it != waiting_.end() && room > 0; it = waiting_.erase(it))
+        if (isFrozen(*it) && woken.insert(*it).second)
+            --room;
     for (BodyId id : woken)
-        if (const BodyRecord* r = bodies.find(id); r && r->motion == BodyMotionState::Frozen)
+        if (isFrozen(id))
             out.wake.push_back(id);
 
     const Vec3 g = binding.gravity();

@@ -45,8 +45,10 @@ public:
     /// A body left the simulation.
     void removed(BodyId id);
     /// Frozen bodies whose bounds come within `margin` of the box (they lose what they rest on when a body
-    /// there moves or breaks); they are woken at the next update.
+    /// there moves or breaks); they are woken at the next update that has awake budget to spare for them.
     void wakeNear(const Aabb& box, double margin);
+    /// Frozen bodies waiting for awake budget to wake (wakeNear), ascending.
+    const std::set<BodyId>& waiting() const { return waiting_; }
     /// The awake budget in force.
     int awakeBudget() const { return awakeBudget_ < 0 ? budget_.maxAwakeBodies : awakeBudget_; }
     /// Light pieces (over the awake budget, colliding with static bodies only), ascending.
@@ -75,7 +77,7 @@ private:
     std::map<BodyId, FrozenEntry> frozen_;
     std::map<BodyId, WokenEntry> watched_; // woken bodies whose old neighbourhood still rests on their place
     std::unordered_map<Cell, std::vector<BodyId>> grid_;
-    std::vector<BodyId> toWake_;
+    std::set<BodyId> waiting_; // frozen bodies to wake once the awake budget has room
     std::set<BodyId> light_;
     int awakeBudget_ = -1;  // < 0: the configured maximum
     double smoothedMs_ = 0; // moving average of the physics step

@@ -448,7 +448,8 @@ struct DestructionRuntime::Impl {
         searchesLeft = config.support.maxSearchesPerFrame;
     }
     void submitImpacts(FrameContext& f) {
-        collector.gather(contacts, bodies, world, binding, counters.frames, config.debris.freezeSpeed);
+        collector.gather(contacts, bodies, world, binding, counters.frames, config.debris.freezeSpeed,
+                         governor.light());
         f.impacts = collector.take();
         f.stats.projectileHits = f.impacts.projectileHits;
         counters.projectileHits += f.impacts.projectileHits;

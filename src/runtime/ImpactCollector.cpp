@@ -33,7 +33,7 @@ PendingImpact makeImpact(const BodyRecord& target, const Vec3& worldPoint, const
 
 void ImpactCollector::gather(const std::vector<ContactReport>& contacts, BodyTable& bodies,
                              const DestructionWorld& world, const PhysicsBinding& binding,
-                             std::uint64_t frame, double wakeSpeed) {
+                             std::uint64_t frame, double wakeSpeed, const std::set<BodyId>& light) {
     for (const ContactReport& c : contacts) {
         BodyRecord* a = bodies.find(c.a);
         BodyRecord* b = bodies.find(c.b);
@@ -65,6 +65,8 @@ void ImpactCollector::gather(const std::vector<ContactReport>& contacts, BodyTab
                 projectileImpacts_.push_back(std::move(p));
             continue;
         }
+        if (light.count(a->id) || light.count(b->id)) // over the awake budget: it only lands
+            continue;
         const double approach = -dot(c.relativeVelocity, c.normalOnB);
         for (BodyRecord* frozen : {a, b})
             if (frozen->motion == BodyMotionState::Frozen && approach >= wakeSpeed) {

@@ -2,6 +2,7 @@
 // Turns the contacts of a physics step into impacts on objects (ImpactPolicy: thresholds and coalescing).
 
 #include <map>
+#include <set>
 #include <vector>
 
 #include "rubble/runtime/DestructionRuntime.hpp"
@@ -39,8 +40,10 @@ public:
 
     /// Adds one step's contacts to the frame's batch (marks projectiles spent). A contact on a frozen body
     /// is a hit only when it closes at wakeSpeed or more: what rests on it pushes every step, and is none.
+    /// A contact of a light body (one of `light`, over the awake budget) neither breaks nor wakes anything.
     void gather(const std::vector<ContactReport>& contacts, BodyTable& bodies, const DestructionWorld& world,
-                const PhysicsBinding& binding, std::uint64_t frame, double wakeSpeed);
+                const PhysicsBinding& binding, std::uint64_t frame, double wakeSpeed,
+                const std::set<BodyId>& light);
     /// The frame's batch; starts a new one.
     ImpactBatch take();
 

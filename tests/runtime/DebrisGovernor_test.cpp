@@ -1,11 +1,15 @@
-// The debris governor's physics-time control, fed known step times (no wall clock).
+// The debris governor's physics-time control, fed known step times (no wall clock), its light pieces and
+// its wakes.
 #include <gtest/gtest.h>
 
 #include <set>
 
 #include "ToyPhysics.hpp"
+#include "rubble/geometry/Mesh.hpp"
+#include "rubble/runtime/DestructionWorld.hpp"
 #include "runtime/BodyTable.hpp"
 #include "runtime/DebrisGovernor.hpp"
+#include "runtime/ImpactCollector.hpp"
 
 namespace rubble {
 namespace {
@@ -204,6 +208,95 @@ TEST(DebrisGovernor, LightPiecesRetireWhenTheBudgetShrinks) {
     EXPECT_GT(retired, 0);
     EXPECT_LE(static_cast<int>(rig.governor.light().size()), rig.governor.awakeBudget());
     EXPECT_LE(rig.bodies.awake() - static_cast<int>(rig.governor.light().size()), rig.governor.awakeBudget());
+}
+
+// A light piece (over the awake budget) that lands hard on frozen debris neither wakes nor breaks it, nor
+// breaks itself: a wake spends awake budget there is none of, and the pieces of a break would be light too.
+// The same landing by a piece within the budget does both.
+TEST(DebrisGovernor, ALightPieceLandingOnFrozenDebrisNeitherWakesNorBreaksIt) {
+    ImpactPolicy policy;
+    policy.graceFrames = 0;
+    detail::ImpactCollector collector(policy);
+    DestructionWorld::Config wc;
+    wc.workers = 1;
+    wc.deterministic = true;
+    DestructionWorld world(wc);
+    test::ToyPhysics physics(toyConfig(true));
+    detail::BodyTable bodies;
+    for (BodyId id : {BodyId{1}, BodyId{2}}) { // 1 falls onto 2, which is frozen
+        ObjectDesc d;
+        d.mesh = makeBox({-0.5, -0.5, -0.5}, {0.5, 0.5, 0.5});
+        d.impulseThreshold = 1;
+        const Result<ObjectId> object = world.addObject(std::move(d));
+        ASSERT_TRUE(object);
+        BodyDesc b;
+        b.mass = id == 1 ? 1000 : 0;
+        b.transform.translation = {0, id == 1 ? 1.0 : 0.0, 0};
+        physics.createBody(id, b);
+        BodyRecord r;
+        r.id = id;
+        r.role = BodyRole::Piece;
+        r.motion = id == 1 ? BodyMotionState::Dynamic : BodyMotionState::Frozen;
+        r.hasObject = true;
+        r.object = *object;
+        r.volume = 1;
+        bodies.insert(r);
+    }
+    ContactReport c; // 1 t closing at 8 m/s: 8,000 N·s, over the collision threshold and the wake impulse
+    c.a = 1;
+    c.b = 2;
+    c.pointOnA = c.pointOnB = {0, 0.5, 0};
+    c.normalOnB = {0, 1, 0};
+    c.relativeVelocity = {0, -8, 0};
+    c.impulse = 8000;
+    for (const bool light : {false, true}) {
+        collector.gather({c}, bodies, world, physics, 100, 1.0,
+                         light ? std::set<BodyId>{1} : std::set<BodyId>{});
+        const detail::ImpactBatch batch = collector.take();
+        EXPECT_EQ(batch.frozenHits.count(2), light ? 0u : 1u) << "light " << light;
+        EXPECT_EQ(batch.impacts.size(), light ? 0u : 2u) << "light " << light;
+    }
+}
+
+// Frozen debris that lost its support wakes within the awake budget; the rest waits, frozen, for room: a wake
+// over the budget only turns another moving piece light, and its fall through the pile wakes more.
+TEST(DebrisGovernor, WhatLostItsSupportWakesOnlyWithinTheAwakeBudget) {
+    GovernorRig rig(8, 4); // four falling pieces, ids 1-4
+    rig.budget.maxAwakeBodies = 5;
+    for (BodyId id = 11; id <= 13; ++id) { // three frozen pieces in a row
+        BodyDesc d;
+        d.shape.kind = BodyShape::Kind::Box;
+        d.transform.translation = {1.0 * id, 0, 0};
+        rig.physics.createBody(id, d);
+        BodyRecord r;
+        r.id = id;
+        r.role = BodyRole::Piece;
+        r.motion = BodyMotionState::Frozen;
+        r.volume = 1;
+        rig.bodies.insert(r);
+        rig.governor.frozen(id, d.transform.translation, 0.5);
+    }
+    auto update = [&] {
+        const detail::GovernorActions a =
+            rig.governor.update(rig.bodies, rig.physics, {}, 0, true, Vec3{}, 1.0 / 60);
+        for (BodyId id : a.wake) {
+            rig.governor.thawed(id);
+            rig.physics.setMass(id, 1, {1, 1, 1});
+            rig.bodies.setMotion(*rig.bodies.find(id), BodyMotionState::Dynamic);
+        }
+        return a.wake;
+    };
+    rig.governor.wakeNear(Aabb{{10, -1, -1}, {14, 1, 1}}, 0.1); // what they rested on left
+    EXPECT_EQ(update(), std::vector<BodyId>{11}) << "4 of 5 awake: room for one";
+    EXPECT_EQ(rig.governor.waiting(), (std::set<BodyId>{12, 13}));
+    EXPECT_TRUE(update().empty()) << "no room";
+    for (BodyId id = 1; id <= 3; ++id) { // three falling pieces leave
+        rig.governor.removed(id);
+        rig.bodies.erase(id);
+        rig.physics.removeBody(id);
+    }
+    EXPECT_EQ(update(), (std::vector<BodyId>{12, 13}));
+    EXPECT_TRUE(rig.governor.waiting().empty());
 }
 
 } // namespace
