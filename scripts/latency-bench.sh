@@ -14,6 +14,7 @@
 # RUBBLE_SEED_MEDIA overrides ../shared/seed/media; RUBBLE_BENCH_RESULTS the output folder.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
+. "$root/scripts/bench-lib.sh"
 build="${1:?usage: scripts/latency-bench.sh BUILD_DIR [SECONDS] [ROUNDS] [CONFIG...]}"
 seconds="${2:-15}"
 rounds="${3:-2}"
@@ -22,19 +23,15 @@ configs=("$@")
 [ ${#configs[@]} -gt 0 ] ||
     configs=("default=--workers -1" "workers-2=--workers 2" "workers-2+yield-10=--workers 2 --raster-yield 10")
 demo="$build/bin/rubble-demo"
-[ -x "$demo" ] || { echo "latency-bench: $demo not found (build rubble-demo first)" >&2; exit 1; }
-media="${RUBBLE_SEED_MEDIA:-$root/../shared/seed/media}"
+need_binary latency-bench "$demo"
 scene="$media/world.cfg"
-[ -f "$scene" ] || { echo "latency-bench: $scene not found: skipped (the thesis's scenes are not part of the repository)"; exit 0; }
-results="${RUBBLE_BENCH_RESULTS:-$root/bench/results}"
-mkdir -p "$results"
+need_media latency-bench "$scene"
 csv="$results/latency.csv"
 [ -f "$csv" ] || echo "date_utc,label,options,scene,seconds,frames,fps_p50,fps_p99,frame_ms_p50,frame_ms_p99,shots,fractures,latency_count,latency_p50_ms,latency_p99_ms,latency_max_ms,worker_nice,workers_at_nice,raster_threads,demo_cpu_ms_per_frame,own_cpu_cores,other_cpu_cores,command,visible_p50_ms,visible_p99_ms,job_cpu_share" >"$csv"
 stages="$results/latency_stages.csv"
 [ -f "$stages" ] || echo "date_utc,label,options,stage,p50_ms,p99_ms,tail_mean_ms,at_p99_ms,tail_count,other_cpu_cores" >"$stages"
 work=$(mktemp -d /tmp/rubble-latency.XXXXXX)
 trap 'rm -rf "$work"' EXIT
-. "$root/scripts/bench-configs.sh"
 
 for ((r = 1; r <= rounds; ++r)); do
     for config in "${configs[@]}"; do

@@ -8,13 +8,12 @@
 # Usage: scripts/light-bench.sh BUILD_DIR [SECONDS] [RUNS]
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
+. "$root/scripts/bench-lib.sh"
 build="${1:?usage: scripts/light-bench.sh BUILD_DIR [SECONDS] [RUNS]}"
 seconds="${2:-60}"
 runs="${3:-1}"
 bench="$build/bin/rubble-bench"
-[ -x "$bench" ] || { echo "light-bench: $bench not found (build rubble-bench first)" >&2; exit 1; }
-results="${RUBBLE_BENCH_RESULTS:-$root/bench/results}"
-mkdir -p "$results"
+need_binary light-bench "$bench"
 csv="$results/demolition_light.csv"
 echo "mode,light_per_awake,seed,seconds,frame_p50_ms,frame_p99_ms,physics_p50_ms,physics_p99_ms,fractures,pieces_alive,awake_pieces,light_pieces,frozen_pieces,pieces_made_light,retired_awake,retired_dust,latency_p50_ms,own_cpu_cores,other_cpu_cores" >"$csv"
 for ((r = 1; r <= runs; ++r)); do

@@ -5,11 +5,12 @@
 # Usage: scripts/readme-animation.sh BUILD_DIR [SECONDS] [WIDTH]   (needs xvfb and ffmpeg: install-deps.sh all)
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
+. "$root/scripts/bench-lib.sh"
 build="${1:?usage: scripts/readme-animation.sh BUILD_DIR [SECONDS] [WIDTH]}"
 seconds="${2:-30}"
 width="${3:-480}"
 demo="$build/bin/rubble-demo"
-[ -x "$demo" ] || { echo "readme-animation: $demo not found (build the tree first)" >&2; exit 1; }
+need_binary readme-animation "$demo"
 for tool in xvfb-run ffmpeg; do
     command -v "$tool" >/dev/null || { echo "readme-animation: $tool missing (scripts/install-deps.sh all)" >&2; exit 1; }
 done

@@ -8,18 +8,16 @@
 # are a busy machine's. RUBBLE_SEED_MEDIA overrides ../shared/seed/media; RUBBLE_BENCH_RESULTS the output.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
+. "$root/scripts/bench-lib.sh"
 build="${1:?usage: scripts/render-bench.sh BUILD_DIR [SECONDS] [LABEL] [demo options...]}"
 seconds="${2:-20}"
 label="${3:-default}"
 shift $(($# < 3 ? $# : 3))
 demo="$build/bin/rubble-demo"
-[ -x "$demo" ] || { echo "render-bench: $demo not found (build the tree first)" >&2; exit 1; }
-media="${RUBBLE_SEED_MEDIA:-$root/../shared/seed/media}"
+need_binary render-bench "$demo"
 scene="$media/performance_test.cfg"
-[ -f "$scene" ] || { echo "render-bench: $scene not found: skipped (the thesis's scenes are not part of the repository)"; exit 0; }
+need_media render-bench "$scene"
 command -v Xvfb >/dev/null || { echo "render-bench: Xvfb missing (apt-get install xvfb)" >&2; exit 1; }
-results="${RUBBLE_BENCH_RESULTS:-$root/bench/results}"
-mkdir -p "$results"
 out=$(mktemp -d /tmp/rubble-render.XXXXXX)
 xvfb_pid=""
 trap '[ -n "$xvfb_pid" ] && kill "$xvfb_pid" 2>/dev/null; rm -rf "$out"' EXIT
@@ -34,8 +32,6 @@ xvfb_pid=$!
 for _ in $(seq 1 100); do [ -e "/tmp/.X11-unix/X${disp#:}" ] && break; sleep 0.1; done
 
 ticks() { awk '{print $14 + $15}' "/proc/$1/stat"; }     # utime + stime of a process
-busy() { awk '/^cpu /{print $2 + $3 + $4 + $7 + $8 + $9; exit}' /proc/stat; }
-hz=$(getconf CLK_TCK)
 cores=$(nproc)
 args=(--scene "$scene" --autopilot "$seconds" --window --width 1920 --height 1080 --out "$out/run" "$@")
 x0=$(ticks "$xvfb_pid")

@@ -7,13 +7,12 @@
 # Usage: [RUBBLE_BEFORE_BENCH=BIN] scripts/rest-bench.sh BUILD_DIR [SECONDS] [RUNS]
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
+. "$root/scripts/bench-lib.sh"
 build="${1:?usage: scripts/rest-bench.sh BUILD_DIR [SECONDS] [RUNS]}"
 seconds="${2:-60}"
 runs="${3:-1}"
 bench="$build/bin/rubble-bench"
-[ -x "$bench" ] || { echo "rest-bench: $bench not found (build rubble-bench first)" >&2; exit 1; }
-results="${RUBBLE_BENCH_RESULTS:-$root/bench/results}"
-mkdir -p "$results"
+need_binary rest-bench "$bench"
 csv="$results/demolition_rest.csv"
 [ -f "$csv" ] || echo "date_utc,label,seed,seconds,frame_p50_ms,frame_p99_ms,physics_p50_ms,physics_p99_ms,fractures,pieces_alive,awake_pieces,light_pieces,frozen_pieces,pieces_woken,retired_awake,retired_dust,own_cpu_cores,other_cpu_cores" >"$csv"
 labels=(after cap16)

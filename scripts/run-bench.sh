@@ -6,12 +6,11 @@
 # RUBBLE_SCENE_SECONDS sets the length of each scene run (default 60; scripts/scene-bench.sh).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
+. "$root/scripts/bench-lib.sh"
 build="${1:?usage: scripts/run-bench.sh BUILD_DIR [suite options]}"
 shift
 bench="$build/bin/rubble-bench"
-[ -x "$bench" ] || { echo "run-bench: $bench not found (build the tree first: make release)" >&2; exit 1; }
-results="${RUBBLE_BENCH_RESULTS:-$root/bench/results}"
-mkdir -p "$results"
+need_binary run-bench "$bench" "make release"
 
 status=0
 echo "== decomposition"

@@ -12,13 +12,11 @@
 # media folder. Each row's other_cpu_cores says how much else ran meanwhile: re-run rows where it is not ~0.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
+. "$root/scripts/bench-lib.sh"
 build="${1:?usage: scripts/scene-bench.sh BUILD_DIR [SECONDS]}"
 seconds="${2:-60}"
 bench="$build/bin/rubble-bench"
-[ -x "$bench" ] || { echo "scene-bench: $bench not found (build the tree first: make release)" >&2; exit 1; }
-results="${RUBBLE_BENCH_RESULTS:-$root/bench/results}"
-media="${RUBBLE_SEED_MEDIA:-$root/../shared/seed/media}"
-mkdir -p "$results"
+need_binary scene-bench "$bench" "make release"
 
 scenes=("$root/assets/scenes/cube_test.cfg" "$root/assets/scenes/cube_test_10092.cfg"
         "$root/assets/scenes/performance_test.cfg")

@@ -8,6 +8,7 @@
 # Usage: scripts/showcase-bench.sh BUILD_DIR [SECONDS] [ROUNDS] [LABEL=OPTIONS...]
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
+. "$root/scripts/bench-lib.sh"
 build="${1:?usage: scripts/showcase-bench.sh BUILD_DIR [SECONDS] [ROUNDS] [LABEL=OPTIONS...]}"
 seconds="${2:-30}"
 rounds="${3:-1}"
@@ -15,14 +16,11 @@ shift $(($# < 3 ? $# : 3))
 configs=("$@")
 [ ${#configs[@]} -gt 0 ] || configs=("default=")
 demo="$build/bin/rubble-demo"
-[ -x "$demo" ] || { echo "showcase-bench: $demo not found (build rubble-demo first)" >&2; exit 1; }
-results="${RUBBLE_BENCH_RESULTS:-$root/bench/results}"
-mkdir -p "$results"
+need_binary showcase-bench "$demo"
 csv="$results/showcase.csv"
 [ -f "$csv" ] || echo "date_utc,label,options,sim_seconds,frames,fractures,pieces_created,pieces_live,pieces_awake,pieces_light,pieces_frozen,retired_awake,retired_dust,frame_p50_before_first_blast_ms,frame_p50_last_150_frames_ms,end_over_before,step_p50_last_150_frames_ms,geometry_hash,own_cpu_cores,other_cpu_cores" >"$csv"
 work=$(mktemp -d /tmp/rubble-showcase-bench.XXXXXX)
 trap 'rm -rf "$work"' EXIT
-. "$root/scripts/bench-configs.sh"
 for ((r = 1; r <= rounds; ++r)); do
     for config in "${configs[@]}"; do
         split_config "$config"
