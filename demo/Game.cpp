@@ -193,6 +193,7 @@ bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const Game
     const rubble::LoadedScene loaded = rubble::loadScene(scene, *runtime_, lo);
     for (const auto& w : loaded.warnings)
         warnings.push_back(w);
+    notePlacedDynamic();
 
     // Ground: a solid unit cube scaled (thesis: "generated as a solid cube with 1x1x1 size").
     if (loaded.ground) {
@@ -878,6 +879,15 @@ std::vector<double> Game::takeNewLatencies() {
     return out;
 }
 
+void Game::notePlacedDynamic() {
+    placedDynamic_.clear();
+    for (BodyId id : runtime_->bodies()) {
+        const BodyRecord* b = runtime_->body(id);
+        if (b->role == BodyRole::Object && b->motion == rubble::BodyMotionState::Dynamic)
+            placedDynamic_[id] = runtime_->motion(id).transform.translation;
+    }
+}
+
 std::vector<V3> Game::targets() const {
     std::vector<V3> out;
     if (!runtime_)
@@ -885,9 +895,12 @@ std::vector<V3> Game::targets() const {
     for (BodyId id : runtime_->bodies()) {
         const BodyRecord* b = runtime_->body(id);
         const rubble::Vec3 c = runtime_->motion(id).transform.translation;
-        if (b->motion == rubble::BodyMotionState::Static &&
-            (b->role == BodyRole::Object ||
-             (b->role == BodyRole::Piece && b->volume > 150 && c.y > groundTop_ + 15)))
+        const auto placed = placedDynamic_.find(id);
+        const bool standingDynamic =
+            placed != placedDynamic_.end() && rubble::length(c - placed->second) < 1.0;
+        if (standingDynamic || (b->motion == rubble::BodyMotionState::Static &&
+                                (b->role == BodyRole::Object ||
+                                 (b->role == BodyRole::Piece && b->volume > 150 && c.y > groundTop_ + 15))))
             out.push_back(toV3(c));
     }
     return out;
@@ -1013,6 +1026,7 @@ bool Game::loadSnapshot(const std::string& path, Renderer& renderer, std::string
         addVisual(id, runtime_->world().object(b->object)->mesh, look == looks_.end() ? Look{} : look->second,
                   0.0f, renderer);
     }
+    notePlacedDynamic();
     message = std::to_string(objects) + " objects";
     return true;
 }

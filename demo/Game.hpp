@@ -225,6 +225,8 @@ private:
     void journaled(const rubble::JournalEvent& e);
     void creditHits();
     void onAdopted(const rubble::FractureOutcome& outcome, Renderer& renderer);
+    /// Records where the objects that are dynamic from the start stand (targets until they move).
+    void notePlacedDynamic();
     void addVisual(rubble::BodyId body, const rubble::Mesh& mesh, const Look& look, float heat,
                    Renderer& renderer);
     void controlVehicle(const ControlInput& input, float dt);
@@ -249,6 +251,8 @@ private:
     std::vector<rubble::JournalEvent> journal_; // every accepted impact and removal since load()
     std::unordered_map<rubble::BodyId, Visual> visuals_;
     std::map<rubble::ObjectId, Look> looks_;
+    std::unordered_map<rubble::BodyId, rubble::Vec3>
+        placedDynamic_; // objects dynamic at load: where they stood
     rubble::BodyId vehicle_ = 0;
     float speed_ = 30;
     float fireCooldown_ = 0;
