@@ -112,6 +112,10 @@ int runJoin(const JoinOptions& options, GlContext& gl, Renderer& renderer, const
         fv.fbo = gl.framebuffer();
         fv.eye = centre + V3{std::sin(yaw) * distance, 0.45f * distance, std::cos(yaw) * distance};
         fv.eye.y = std::max(fv.eye.y, groundTop + 1.5f);
+        if (options.camera) {
+            fv.eye = options.camera->first;
+            centre = options.camera->second;
+        }
         fv.view = lookAt(fv.eye, centre, V3{0, 1, 0});
         fv.proj = perspective(
             1.05f, static_cast<float>(fv.width) / static_cast<float>(std::max(fv.height, 1)), 0.5f, 3000.0f);
@@ -142,8 +146,9 @@ int runJoin(const JoinOptions& options, GlContext& gl, Renderer& renderer, const
             std::snprintf(name, sizeof name, "join_%04d.png", ++screenshots);
             const auto path = std::filesystem::path(options.out) / name;
             if (writePng(path, rgb, sw, sh))
-                std::printf("screenshot %s frame=%llu\n", path.string().c_str(),
-                            static_cast<unsigned long long>(st.frame));
+                std::printf("screenshot %s frame=%llu shown=%lld\n", path.string().c_str(),
+                            static_cast<unsigned long long>(st.frame),
+                            static_cast<long long>(st.frame) - static_cast<long long>(NetView::kViewLag));
             nextShot = (static_cast<long>(st.frame) / shotEvery + 1) * shotEvery;
         }
         gl.present();

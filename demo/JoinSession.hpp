@@ -4,9 +4,12 @@
 /// the pieces itself from the host's journal events and draws them where the host's placements put them.
 
 #include <cstdint>
+#include <optional>
 #include <string>
+#include <utility>
 
 #include "GlContext.hpp"
+#include "Math.hpp"
 #include "Renderer.hpp"
 #include "rubble/rubble.hpp"
 
@@ -14,14 +17,15 @@ namespace demo {
 
 /// What --join needs from the command line.
 struct JoinOptions {
-    std::string address;        ///< host address (loopback only)
-    std::uint16_t port = 0;     ///< host port
-    int workers = -1;           ///< fracture workers of the client world
-    std::string out;            ///< folder for screenshots (empty: none)
-    double screenshotEvery = 0; ///< host seconds between screenshots (0: none)
-    bool stats = false;         ///< print a stats line every statsEvery drawn frames
-    int statsEvery = 30;        ///< drawn frames between stats lines
-    double fireEvery = 0;       ///< seconds between automatic shots (0: only Space fires)
+    std::string address;                     ///< host address (loopback only)
+    std::uint16_t port = 0;                  ///< host port
+    int workers = -1;                        ///< fracture workers of the client world
+    std::string out;                         ///< folder for screenshots (empty: none)
+    double screenshotEvery = 0;              ///< host seconds between screenshots (0: none)
+    bool stats = false;                      ///< print a stats line every statsEvery drawn frames
+    int statsEvery = 30;                     ///< drawn frames between stats lines
+    double fireEvery = 0;                    ///< seconds between automatic shots (0: only Space fires)
+    std::optional<std::pair<V3, V3>> camera; ///< --camera: a fixed (eye, target) instead of the orbit
 };
 
 /// Splits "HOST:PORT"; false with a message naming the bad part.

@@ -327,7 +327,9 @@ int parseOptions(int argc, char** argv, Options& o) {
     cli.add_flag("--mute", o.mute, "no sound (headless runs have none: no audio device is opened)");
     cli.add_option("--audio-wav", o.audioWav,
                    "FILE: the run's sound, mixed in step with game time, written as a WAV file (no device)");
-    cli.add_option("--camera", o.camera, "EX,EY,EZ,TX,TY,TZ: a fixed camera at EX,EY,EZ looking at TX,TY,TZ");
+    cli.add_option(
+        "--camera", o.camera,
+        "EX,EY,EZ,TX,TY,TZ: a fixed camera at EX,EY,EZ looking at TX,TY,TZ (also in the --join window)");
     cli.add_flag("--bilinear", o.bilinear, "software quality: bilinear textures instead of nearest texels");
     cli.add_option("--record", o.record,
                    "write the destruction journal (every impact and removal, 48 bytes each) to FILE at exit");
@@ -565,7 +567,8 @@ int setUp(App& app, RunMode& mode) {
 int joinMode(App& app) {
     const Options& o = app.opt;
     std::string error;
-    demo::JoinOptions j{{}, 0, o.workers, o.out, o.screenshotEvery, o.stats, o.statsEvery, o.joinFire};
+    demo::JoinOptions j{{},           0,          o.workers, o.out, o.screenshotEvery, o.stats,
+                        o.statsEvery, o.joinFire, app.camera};
     if (!demo::parseHostPort(o.join, j.address, j.port, error) || !prepareRenderer(app, error)) {
         std::fprintf(stderr, "error: %s\n", error.c_str());
         return 1;
