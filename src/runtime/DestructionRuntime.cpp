@@ -743,7 +743,7 @@ int DestructionRuntime::blast(const Vec3& center, double radius, double impulse,
     // bodies() is a copy; an accepted impact changes no body before the next frame anyway
     for (BodyId id : bodies()) {
         const BodyRecord* b = body(id);
-        if (!b || !b->hasObject)
+        if (!b || !b->hasObject || b->volume < impl_->config.impacts.minFractureVolume)
             continue;
         const Vec3 c = motion(id).transform.translation;
         const Vec3 d = center - c;

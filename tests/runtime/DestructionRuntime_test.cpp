@@ -417,6 +417,25 @@ TEST(DestructionRuntime, BlastHitsEveryObjectInRangeWithAnImpulseFallingOffToIts
     EXPECT_NE(rig.runtime.bodyOf(sturdy), nullptr);
 }
 
+TEST(DestructionRuntime, BlastSkipsBodiesBelowTheMinimumFractureVolume) {
+    ToyRig rig;
+    const ObjectId small = rig.addBox({0.5, 0.5, 0.5}, {2, 0.5, 0}, true); // 1 m³
+    const ObjectId large = rig.addBox({1, 1, 1}, {-3, 1, 0}, true);        // 8 m³
+    ImpactPolicy policy = rig.runtime.config().impacts;
+    policy.minFractureVolume = 2;
+    rig.runtime.setImpactPolicy(policy);
+    std::vector<JournalEvent> hits;
+    rig.runtime.setJournalSink([&](const JournalEvent& e) { hits.push_back(e); });
+    EXPECT_EQ(rig.runtime.blast({0, 0.5, 0}, 8, 1000), 1) << "only the large box is hit";
+    ASSERT_EQ(hits.size(), 1u);
+    EXPECT_EQ(hits[0].object, large);
+    policy.minFractureVolume = 0;
+    rig.runtime.setImpactPolicy(policy);
+    EXPECT_EQ(rig.runtime.blast({0, 0.5, 0}, 8, 1000), 2) << "without the minimum both are";
+    ASSERT_EQ(hits.size(), 3u);
+    EXPECT_TRUE(hits[1].object == small || hits[2].object == small);
+}
+
 TEST(DestructionRuntime, PhysicsTimeBudgetShrinksTheAwakeBudgetOutsideDeterministicMode) {
     for (const bool deterministic : {false, true}) {
         DestructionRuntime::Config c = ToyRig::defaults();

@@ -329,7 +329,8 @@ public:
     /// A blast: an impact on every destructible object whose bounding sphere meets the sphere of `radius`
     /// around `center`, at the point of its bounding sphere nearest the centre (pushed in), its normal toward
     /// the centre, the impulse falling off linearly from `impulse` to `edgeShare` of it across the radius.
-    /// Returns the impacts accepted.
+    /// Bodies below the impact policy's minFractureVolume are skipped, as their contacts are. Returns the
+    /// impacts accepted.
     int blast(const Vec3& center, double radius, double impulse, double edgeShare = 0.4);
 
     /// One frame, a list of stages: physics step, contacts → impacts, anchors classified, splits adopted
