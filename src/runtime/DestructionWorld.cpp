@@ -20,6 +20,7 @@
 #include "rubble/core/ParameterCheck.hpp"
 #include "rubble/core/Random.hpp"
 #include "rubble/core/ThreadPool.hpp"
+#include "rubble/fracture/FractureRequest.hpp"
 #include "rubble/geometry/MassProperties.hpp"
 #include "rubble/geometry/MeshCheck.hpp"
 #include "rubble/geometry/MeshRepair.hpp"
@@ -194,12 +195,18 @@ void runJob(Job& job) {
     if (edits)
         editable = editableCopy(mesh, job.facts);
     job.prepareMs = msBetween(job.started, Clock::now());
-    Result<FractureResult> r = Error{ErrorCode::NoIntersection, "no cells"};
-    if (job.impacts.size() == 1 && edits) {
-        r = fracture(std::move(editable.first), job.impacts.front().impact, job.params, mixSeed(job.seed, 0),
-                     std::move(editable.second));
-    } else if (job.impacts.size() == 1) {
-        r = fracture(mesh, job.impacts.front().impact, job.params, mixSeed(job.seed, 0), job.facts);
+    FractureRequest request;
+    request.params = job.params;
+    if (edits) {
+        request.consumed = &editable.first;
+        request.consumedFacts = &editable.second;
+    } else {
+        request.mesh = &mesh;
+        request.known = &job.facts;
+    }
+    if (job.impacts.size() == 1) {
+        request.impact = job.impacts.front().impact;
+        request.seed = mixSeed(job.seed, 0);
     } else {
         // Union of the cells of every merged impact; a cell overlapping an accepted one is skipped so that
         // the cells stay disjoint (the overlapping region is already cut by the earlier impact's cells).
@@ -218,13 +225,9 @@ void runJob(Job& job) {
             }
         }
         job.cellMs = msBetween(tc, Clock::now());
-        if (edits) {
-            r = fractureWithCells(std::move(editable.first), std::move(cells), job.params,
-                                  std::move(editable.second));
-        } else {
-            r = fractureWithCells(mesh, std::move(cells), job.params, job.facts);
-        }
+        request.cells = std::move(cells);
     }
+    Result<FractureResult> r = fracture(std::move(request));
     if (!r) {
         job.errorCode = r.error().code;
         job.error = r.error().message;
