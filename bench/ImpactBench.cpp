@@ -76,6 +76,7 @@ struct PartsQuality {
 /// Samples of one backend on one case.
 struct Samples {
     std::vector<double> pieces, withParts, cell, boolean, islands, mass, decomposition;
+    std::vector<double> concavity; // recordConcavity of the pieces and their parts (not in withParts)
     std::vector<double> piecesCpu; // impact → pieces in the calling thread's CPU time
     std::vector<double> excess;    // (Σ part volume − Σ piece volume) / Σ piece volume
     int fallbacks = 0, failures = 0;
@@ -213,6 +214,8 @@ void runOnce(Case& c, rubble::BooleanKind kind, std::uint64_t seed, bool compare
     const auto t2 = Clock::now();
     const auto parts = rubble::updateDecomposition(c.parentParts, r->cells, meshes, pieceCells);
     const auto t3 = Clock::now();
+    rubble::recordConcavity(*r, parts);
+    s.concavity.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t3).count());
     // The copies of the piece meshes are the caller's choice (the runtime makes them too) and not timed.
     const double piecesMs = std::chrono::duration<double, std::milli>(t1 - t0).count();
     const double partsMs = std::chrono::duration<double, std::milli>(t3 - t2).count();
@@ -551,6 +554,7 @@ int runBench(const BenchArgs& args) {
                     "speedup_vs_thesis",
                     "pieces_cpu_median_ms",
                     "cut_triangles_max",
+                    "concavity_ms",
                     "other_cpu_cores"};
     std::string failures;
     for (const Case& c : cases)
@@ -583,6 +587,7 @@ int runBench(const BenchArgs& args) {
                                   reference ? fixed(c.thesisS * 1000 / withParts.median, 0) : "",
                                   fixed(stats(s.piecesCpu).median),
                                   std::to_string(s.mostCut),
+                                  fixed(stats(s.concavity).median),
                                   fixed(otherCpu, 2)});
             if (s.failures > 0)
                 failures += c.name + " " + backendName(kind) + ": " + std::to_string(s.failures) + " of " +

@@ -2,10 +2,12 @@
 //
 // Every part is a convex region R (an enlarged bounding box cut by planes) and its convex shape is the exact
 // hull of (solid ∩ R): the hull of the mesh triangles clipped to R plus R's corners inside the solid. Regions
-// partition space, so parts never overlap and together cover the solid. The part whose hull is deepest
-// away from the mesh (rays cast inward from its hull faces) is split next, by the candidate plane (axis and
-// principal-axis planes through the deepest pocket) that gives the smallest total hull volume, until
-// params.maxParts or every part is within params.concavity · diagonal of the mesh.
+// partition space, so parts never overlap and together cover the solid. The part whose surface lies deepest
+// inside its hull (what partConcavity measures) is split next, by the candidate plane (axis and
+// principal-axis planes through that surface point) that gives the smallest total hull volume; when that
+// split removes less than half the volume that the split through the deepest ray pocket (rays cast inward
+// from hull faces) of the part deepest by that measure removes, the latter is taken. Until
+// params.maxParts or every part is within params.concavity · diagonal of the mesh by both measures.
 //
 // A mesh above params.proxyAboveTriangles is searched through a bounded proxy (its vertices clustered on a
 // grid): the regions come from the proxy, and each part is then the bounded hull of the exact mesh inside
@@ -44,9 +46,13 @@ struct Part {
     std::vector<Polygon> surface; // mesh triangles clipped to region
     std::vector<Vec3> points;     // the surface's corners, each once, sorted as pointLess orders them
     ConvexPolytope hull;
-    double depth = 0; // deepest pocket between hull and mesh
-    Vec3 pocket;      // where that pocket's bottom is
-    Vec3 pocketDir;   // inward hull normal there
+    double depth = 0;        // deepest pocket between hull and mesh
+    Vec3 pocket;             // where that pocket's bottom is
+    Vec3 pocketDir;          // inward hull normal there
+    double surfaceDepth = 0; // deepest surface sample below the hull's boundary (what partConcavity measures)
+    Vec3 surfacePocket;      // that sample
+    Vec3 surfaceDir;         // inward normal of the hull face nearest it
+    std::vector<Vec3> exactSamples; // through a proxy: the exact mesh's vertices in region
 };
 
 /// Cells of the proxy grid along each axis of the bounding box (a finer grid is tried once when the proxy's
@@ -64,6 +70,8 @@ constexpr std::size_t kDepthChunk = 32;
 constexpr double kSearchShare = 0.9;
 /// Most points per side in the hull that bounds a candidate split's score from below.
 constexpr std::size_t kBoundPoints = 256;
+/// The surface pocket's split wins unless it removes less than this share of the ray pocket's hull volume.
+constexpr double kGainShare = 0.5;
 /// Concavity below this fraction of the diagonal is rounding: such a part is convex.
 constexpr double kConvexTolerance = 1e-9;
 
@@ -341,6 +349,44 @@ public:
             }
     }
 
+    /// The surface sample (corners, polygon centres, exact vertices) deepest inside the part's hull.
+    static void measureSurfaceDepth(Part& part) {
+        part.surfaceDepth = 0;
+        const PolytopeFaces faces = part.hull.faces();
+        std::vector<Plane> planes;
+        planes.reserve(faces.size());
+        for (const PolytopeFaceView& f : faces)
+            planes.push_back(f.plane);
+        auto visit = [&](const Vec3& p) {
+            double d = std::numeric_limits<double>::infinity();
+            std::size_t nearest = 0;
+            for (std::size_t k = 0; k < planes.size(); ++k) {
+                const double s = -planes[k].signedDistance(p);
+                if (s < d) {
+                    d = s;
+                    nearest = k;
+                    if (d <= part.surfaceDepth)
+                        return; // cannot be deeper than the deepest so far
+                }
+            }
+            if (d > part.surfaceDepth && !planes.empty()) {
+                part.surfaceDepth = d;
+                part.surfacePocket = p;
+                part.surfaceDir = -planes[nearest].normal;
+            }
+        };
+        for (const Polygon& poly : part.surface) {
+            Vec3 g;
+            for (const Vec3& c : poly)
+                g += c;
+            visit(g / static_cast<double>(poly.size()));
+        }
+        for (const Vec3& p : part.points)
+            visit(p);
+        for (const Vec3& p : part.exactSamples)
+            visit(p);
+    }
+
     /// A pocket's depth, bottom and ray direction.
     struct Deepest {
         double depth = 0;
@@ -546,18 +592,19 @@ public:
         return {subsetVolume(in, kBoundPoints), subsetVolume(out, kBoundPoints)};
     }
 
-    /// The split of part by a plane through its pocket with the least score (the first of equal scores), as
-    /// evaluating every candidate would find it. Candidates are tried in the order of a lower bound of their
-    /// score, a batch at a time on the job system, and those whose bound already loses are skipped
-    /// (hullVertices: part.hull.vertices()).
+    /// The split of part by a plane through `at` (one of its pockets) with the least score (the first of
+    /// equal scores), as evaluating every candidate would find it. Candidates are tried in the order of a
+    /// lower bound of their score, a batch at a time on the job system, and those whose bound already loses
+    /// are skipped (hullVertices: part.hull.vertices()); nullopt too when no score is below `beat`.
     std::optional<Split> bestSplit(const Part& part, const std::vector<Vec3>& hullVertices,
-                                   const std::vector<Vec3>& normals) {
+                                   const std::vector<Vec3>& normals, const Vec3& at,
+                                   double beat = std::numeric_limits<double>::infinity()) {
         const std::size_t n = normals.size();
         std::vector<double> bound(n, 0);
         std::vector<std::array<double, 2>> sides(n, {0, 0});
         parallelFor(n, [&](std::size_t i) {
             if (!stopped()) {
-                sides[i] = splitBound(part, hullVertices, Plane::fromPointNormal(part.pocket, normals[i]));
+                sides[i] = splitBound(part, hullVertices, Plane::fromPointNormal(at, normals[i]));
                 bound[i] = sides[i][0] + sides[i][1];
             }
         });
@@ -570,7 +617,8 @@ public:
         std::size_t chosenIndex = n;
         // A candidate can still win while its bound does not exceed the best score (with room for the
         // rounding of two hulls' volumes: a bound may equal a score).
-        auto mayWin = [&](std::size_t i) { return !chosen || bound[i] <= chosen->score * (1 + 1e-9); };
+        auto best = [&] { return std::min(chosen ? chosen->score : beat, beat) * (1 + 1e-9); };
+        auto mayWin = [&](std::size_t i) { return bound[i] <= best(); };
         const std::size_t batch =
             control_.jobs ? static_cast<std::size_t>(std::max(1, control_.jobs->workerCount()) + 1) : 1;
         for (std::size_t next = 0; next < n && !stopped();) {
@@ -579,12 +627,11 @@ public:
                 if (mayWin(order[next]))
                     take.push_back(order[next]);
             std::vector<std::optional<Split>> tries(take.size());
-            const double cutoff =
-                chosen ? chosen->score * (1 + 1e-9) : std::numeric_limits<double>::infinity();
+            const double cutoff = best();
             parallelFor(take.size(), [&](std::size_t k) {
                 if (!stopped())
-                    tries[k] = trySplit(part, Plane::fromPointNormal(part.pocket, normals[take[k]]), cutoff,
-                                        sides[take[k]]);
+                    tries[k] =
+                        trySplit(part, Plane::fromPointNormal(at, normals[take[k]]), cutoff, sides[take[k]]);
             });
             for (std::size_t k = 0; k < take.size(); ++k)
                 if (tries[k] && (!chosen || tries[k]->score < chosen->score ||
@@ -596,7 +643,7 @@ public:
         return chosen;
     }
 
-    std::vector<Vec3> candidateNormals(const Part& part, const std::vector<Vec3>& v) const {
+    std::vector<Vec3> candidateNormals(const std::vector<Vec3>& v, const Vec3& pocketDir) const {
         std::vector<Vec3> normals = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
         // Principal axes of the hull's vertices.
         Vec3 mean;
@@ -638,7 +685,7 @@ public:
         // Axes perpendicular to the pocket direction.
         const std::size_t base = normals.size();
         for (std::size_t i = 0; i < base; ++i) {
-            const Vec3 n = normalized(normals[i] - part.pocketDir * dot(normals[i], part.pocketDir));
+            const Vec3 n = normalized(normals[i] - pocketDir * dot(normals[i], pocketDir));
             bool dup = lengthSquared(n) < 0.5;
             for (const Vec3& m : normals)
                 dup |= std::abs(dot(n, m)) > 0.999;
@@ -705,39 +752,97 @@ public:
             root.surface = std::move(surface);
             root.points = cornersOf(root.surface);
             root.hull = std::move(hull.value());
+            if (proxied())
+                root.exactSamples = exact_.positions;
             measureDepth(root);
+            measureSurfaceDepth(root);
             parts.push_back(std::move(root));
         }
-        std::vector<bool> done(1, false);
+        // Per part and pocket kind (0: surface depth, 1: ray depth), its best split once tried.
+        struct Pending {
+            bool tried = false;
+            std::optional<Split> split;
+            double gain = 0; // hull volume the split removes
+        };
+        std::vector<std::array<Pending, 2>> pending(1);
+        // A search under a finite `beat` that finds nothing is not kept: it says only that nothing beat it.
+        auto splitOf = [&](std::size_t i, int kind, double beat) -> Pending& {
+            Pending& p = pending[i][kind];
+            if (p.tried)
+                return p;
+            const Part& part = parts[i];
+            const std::vector<Vec3> hullVertices = part.hull.vertices();
+            const std::vector<Vec3> normals =
+                candidateNormals(hullVertices, kind == 0 ? part.surfaceDir : part.pocketDir);
+            p.split =
+                bestSplit(part, hullVertices, normals, kind == 0 ? part.surfacePocket : part.pocket, beat);
+            ++nextTag_;
+            if (p.split && p.split->score > part.hull.volume() * (1 + 1e-9))
+                p.split.reset();
+            p.tried = p.split || !std::isfinite(beat);
+            if (p.split)
+                p.gain = part.hull.volume() - p.split->score;
+            return p;
+        };
+        const double limit = std::max(threshold, kFlatDepth * diag_);
         while (static_cast<int>(parts.size()) < params_.maxParts) {
             if (stopped())
                 return out;
-            int best = -1;
+            // The part deepest by each measure whose split of that kind is not known to fail.
+            std::array<int, 2> best = {-1, -1};
             for (std::size_t i = 0; i < parts.size(); ++i)
-                if (!done[i] && parts[i].depth > std::max(threshold, kFlatDepth * diag_) &&
-                    (best < 0 || parts[i].depth > parts[best].depth))
-                    best = static_cast<int>(i);
-            if (best < 0)
+                for (int kind = 0; kind < 2; ++kind) {
+                    const auto depthOf = [&](std::size_t j) {
+                        return kind == 0 ? parts[j].surfaceDepth : parts[j].depth;
+                    };
+                    const Pending& p = pending[i][kind];
+                    if (!(p.tried && !p.split) && depthOf(i) > limit &&
+                        (best[kind] < 0 || depthOf(i) > depthOf(static_cast<std::size_t>(best[kind]))))
+                        best[kind] = static_cast<int>(i);
+                }
+            if (best[0] < 0 && best[1] < 0)
                 break;
-            // The search is done when the parts reach the budget or the deepest pocket the threshold.
-            report(kSearchShare * std::max(static_cast<double>(parts.size()) / params_.maxParts,
-                                           threshold / parts[best].depth));
-            const Part& part = parts[best];
-            const std::vector<Vec3> hullVertices = part.hull.vertices();
-            const std::vector<Vec3> normals = candidateNormals(part, hullVertices);
-            std::optional<Split> chosen = bestSplit(part, hullVertices, normals);
-            if (!chosen || chosen->score > part.hull.volume() * (1 + 1e-9)) {
-                done[best] = true;
-                continue;
+            // The search is done when the parts reach the budget or the deepest pockets the threshold.
+            double deepest = 0;
+            if (best[0] >= 0)
+                deepest = parts[best[0]].surfaceDepth;
+            if (best[1] >= 0)
+                deepest = std::max(deepest, parts[best[1]].depth);
+            report(kSearchShare *
+                   std::max(static_cast<double>(parts.size()) / params_.maxParts, threshold / deepest));
+            // The surface pocket's split, unless the ray pocket's removes more than 1 / kGainShare times as
+            // much hull volume (searched only for scores that would).
+            const double inf = std::numeric_limits<double>::infinity();
+            std::array<Pending*, 2> tries = {nullptr, nullptr};
+            if (best[0] >= 0 && !(tries[0] = &splitOf(static_cast<std::size_t>(best[0]), 0, inf))->split)
+                continue; // no split: known to fail now
+            if (best[1] >= 0) {
+                const std::size_t b = static_cast<std::size_t>(best[1]);
+                const double beat = tries[0] ? parts[b].hull.volume() - tries[0]->gain / kGainShare : inf;
+                if (beat > 0) {
+                    tries[1] = &splitOf(b, 1, beat);
+                    if (!tries[1]->split && tries[1]->tried)
+                        continue;
+                    if (!tries[1]->split)
+                        tries[1] = nullptr;
+                }
             }
-            ++nextTag_;
-            surfaceSplit(part, *chosen);
-            measureDepth(chosen->left);
-            measureDepth(chosen->right);
-            parts[best] = std::move(chosen->left);
-            done[best] = false;
-            parts.push_back(std::move(chosen->right));
-            done.push_back(false);
+            if (stopped())
+                continue;
+            const int kind = tries[0] && (!tries[1] || tries[0]->gain >= kGainShare * tries[1]->gain) ? 0 : 1;
+            const std::size_t at = static_cast<std::size_t>(best[kind]);
+            Split chosen = std::move(*tries[kind]->split);
+            surfaceSplit(parts[at], chosen);
+            for (const Vec3& p : parts[at].exactSamples)
+                (chosen.plane.signedDistance(p) < 0 ? chosen.left : chosen.right).exactSamples.push_back(p);
+            for (Part* side : {&chosen.left, &chosen.right}) {
+                measureDepth(*side);
+                measureSurfaceDepth(*side);
+            }
+            parts[at] = std::move(chosen.left);
+            pending[at] = {};
+            parts.push_back(std::move(chosen.right));
+            pending.emplace_back();
         }
         report(kSearchShare);
         const double minVol = params_.minPartVolumeFraction * out.meshVolume;

@@ -80,4 +80,11 @@ std::vector<double> pieceConcavity(const FractureResult& result,
     return out;
 }
 
+const std::vector<double>& recordConcavity(FractureResult& result,
+                                           const std::vector<std::vector<ConvexPolytope>>& parts,
+                                           std::size_t samples) {
+    result.concavity = pieceConcavity(result, parts, samples);
+    return result.concavity;
+}
+
 } // namespace rubble

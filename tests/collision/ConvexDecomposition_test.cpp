@@ -11,6 +11,7 @@
 #include "collision/MeshRegion.hpp"
 #include "rubble/collision/CollisionTolerance.hpp"
 #include "rubble/collision/ConvexDecomposition.hpp"
+#include "rubble/collision/PartConcavity.hpp"
 #include "rubble/core/Random.hpp"
 #include "rubble/fracture/Fracture.hpp"
 #include "rubble/geometry/MassProperties.hpp"
@@ -213,6 +214,47 @@ TEST(Decompose, SeedModels) {
             EXPECT_EQ(d->parts.size(), 1u) << name;
         }
     }
+}
+
+/// A unit cube with a thin slot (x in [0.3, 0.32], y from 0.5 up, through z) that no pocket ray enters.
+Mesh makeSlottedCube() {
+    const Vec2 outline[8] = {{0, 0}, {1, 0}, {1, 1}, {0.32, 1}, {0.32, 0.5}, {0.3, 0.5}, {0.3, 1}, {0, 1}};
+    const std::uint32_t caps[6][3] = {{0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {0, 4, 5}, {0, 5, 7}, {5, 6, 7}};
+    Mesh m;
+    for (int z = 0; z < 2; ++z)
+        for (const Vec2& p : outline)
+            m.positions.push_back({p.x, p.y, double(z)});
+    for (const auto& t : caps) {
+        m.triangles.push_back({t[0], t[2], t[1]});
+        m.triangles.push_back({t[0] + 8, t[1] + 8, t[2] + 8});
+    }
+    for (std::uint32_t i = 0; i < 8; ++i) {
+        const std::uint32_t j = (i + 1) % 8;
+        m.triangles.push_back({i, j, j + 8});
+        m.triangles.push_back({i, j + 8, i + 8});
+    }
+    return m;
+}
+
+TEST(Decompose, SplitsASlotThatNoPocketRayEnters) {
+    // By the pocket rays alone the cube was one part, its hull, at a concavity of 18 % of the diagonal.
+    const Mesh m = makeSlottedCube();
+    ASSERT_TRUE(test::closedAndOriented(m));
+    auto d = decompose(m);
+    ASSERT_TRUE(d);
+    EXPECT_GE(d->parts.size(), 2u);
+    EXPECT_LE(partConcavity(m, d->parts), DecompositionParams{}.concavity);
+    expectCovers(m, d->parts, 1e-9 * diag(m));
+}
+
+TEST(Decompose, SplitsAThinPlateWhoseSurfaceIsNearItsHull) {
+    // A thin L plate: its surface is within half its thickness of its hull (a sixth more than its volume).
+    const Mesh m = makeLPrism(0.05);
+    auto d = decompose(m);
+    ASSERT_TRUE(d);
+    EXPECT_GE(d->parts.size(), 2u);
+    EXPECT_LT(d->excess(), 0.05);
+    expectCovers(m, d->parts, 1e-9 * diag(m));
 }
 
 /// Voronoi cells of sites inside a box (each the box clipped by bisector planes), tagged by plane index.

@@ -1,5 +1,7 @@
 // decompose() and the decomposition cache under a DecomposeControl: progress, cancelling, a job system;
 // partConcavity's coverage and the concavity of a fracture's pieces.
+#include <algorithm>
+
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -180,6 +182,25 @@ TEST(DecomposeControl, CacheDecomposesUnderControlAndKeepsNoCancelledEntry) {
         EXPECT_EQ(which->hits(), 1u);
         EXPECT_EQ(coordinates(again.value()), coordinates(d.value()));
     }
+}
+
+TEST(PieceConcavity, AFractureResultCarriesItWhenAsked) {
+    const Mesh cube = makeSubdividedBox({-1, -1, -1}, {1, 1, 1}, 7);
+    Impact hit;
+    hit.point = {0.3, 1, 0.2};
+    hit.normal = {0, 1, 0};
+    hit.impulse = 40;
+    auto fr = fracture(cube, hit, FractureParams{}, 7);
+    ASSERT_TRUE(fr) << fr.error().message;
+    EXPECT_TRUE(fr->concavity.empty()); // opt-in
+    auto parts = updateDecomposition(decompose(cube)->parts, *fr);
+    parts.back().clear(); // a piece without parts reads -1
+    const std::vector<double>& recorded = recordConcavity(*fr, parts);
+    EXPECT_EQ(&recorded, &fr->concavity);
+    ASSERT_EQ(fr->concavity.size(), fr->pieces.size());
+    EXPECT_EQ(fr->concavity, pieceConcavity(*fr, parts));
+    EXPECT_EQ(fr->concavity.back(), -1);
+    EXPECT_GT(*std::max_element(fr->concavity.begin(), fr->concavity.end()), 0);
 }
 
 TEST(PieceConcavity, EveryPieceOfAFractureAsPartConcavity) {

@@ -188,6 +188,8 @@ struct RUBBLE_API FractureResult {
     double inputVolume = 0;            ///< volume of the input mesh
     double droppedVolume = 0;          ///< volume of pieces dropped as too small
     FractureStats stats;               ///< how it went
+    std::vector<double> concavity;     ///< per piece, its parts' partConcavity (-1: none); opt-in, see
+                                       ///< recordConcavity (rubble/collision/PartConcavity.hpp)
 };
 
 /// The cut of one impact on a mesh with the given bounds. SingleCell and Shatter: the params' pattern and
