@@ -4,6 +4,7 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <map>
 #include <set>
 #include <string>
@@ -40,6 +41,13 @@ bool isRotation(const Mat3& r) {
 }
 
 using Clock = std::chrono::steady_clock;
+
+// This thread's CPU time, ms.
+double threadCpuMs() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
+}
 
 double msSince(Clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
@@ -397,6 +405,7 @@ struct DestructionRuntime::Impl {
         if (!config.structure.enabled)
             return;
         const auto t0 = Clock::now();
+        const double cpu0 = threadCpuMs();
         int broken = 0;
         const std::vector<BodyId> fallen = structure.step(binding.gravity(), broken);
         stats.structureResidual = structure.residual();
@@ -413,6 +422,7 @@ struct DestructionRuntime::Impl {
             ++counters.piecesCollapsed;
         }
         stats.structureMs += msSince(t0); // what rested on the fallen is checked at the next support stage
+        stats.structureCpuMs += threadCpuMs() - cpu0;
     }
 
     // A restored static object joins the structure: as saved, or (nothing saved) as a scene object at load.

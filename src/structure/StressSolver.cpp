@@ -177,18 +177,32 @@ struct DirectIsland {
     Eigen::SparseMatrix<double> matrix;
     Eigen::SparseMatrix<double> assembled; // the last matrix assembled (the nodes and bonds of assembledKey)
     std::vector<std::size_t> assembledKey;
-    std::vector<int> slots; // each triplet's place among assembled's values (found when a key comes back)
+    std::vector<std::array<int, 4>> places; // each bond's blocks' offsets in their columns' runs (-1: held)
+};
+
+// A bond's 12 x 12 block of J^T E^-1 J, kept while its lever arms, break state and corners' flags stay.
+struct BondBlock {
+    Eigen::Matrix<double, 12, 12> block;
+    std::vector<char> flags; // each corner's active and slip flags it was made with
+    double compliance = 0;   // 0: none made since the bond last changed
+    bool broken = false;
 };
 
 // The direct solve's factorisations, one per island, and the nodes changed since the last solve.
 struct StressSolver::DirectCache {
     std::map<std::uint32_t, std::unique_ptr<DirectIsland>> islands; // by the island's lowest node
-    std::vector<char> touched; // a node whose island's numbers changed (its bonds, its mass, its root)
+    std::vector<char> touched;     // a node whose island's numbers changed (its bonds, its mass, its root)
+    std::vector<BondBlock> blocks; // by bond slot
     bool polishing = false; // its Gauss-Seidel polish runs: stalls what stops converging (solveGaussSeidel)
     void touch(std::uint32_t node) {
         if (node >= touched.size())
             touched.resize(node + 1, 0);
         touched[node] = 1;
+    }
+    // The bond's lever arms or corners were made again (added, removed, a node's root changed).
+    void forget(std::size_t bond) {
+        if (bond < blocks.size())
+            blocks[bond].compliance = 0;
     }
 };
 
@@ -300,6 +314,8 @@ std::size_t StressSolver::addBond(Bond bond, StrengthLimits limits) {
         freeBonds_.pop_back();
         bonds_[i] = std::move(s);
     }
+    if (direct_)
+        direct_->forget(i);
     for (std::uint32_t n : {bonds_[i].bond.a, bonds_[i].bond.b}) {
         std::vector<std::size_t>& list = nodes_[n].bonds;
         list.insert(std::upper_bound(list.begin(), list.end(), i), i);
@@ -323,6 +339,8 @@ void StressSolver::removeBond(std::size_t i) {
             direct_->touch(n);
     }
     reachValid_ = false;
+    if (direct_)
+        direct_->forget(i);
     b = BondState{};
     b.removed = b.broken = true;
     freeBonds_.insert(std::upper_bound(freeBonds_.begin(), freeBonds_.end(), i, std::greater<>()), i);
@@ -343,8 +361,10 @@ void StressSolver::setRoot(std::uint32_t node, bool root) {
     for (std::size_t i : n.bonds) {
         prepare(bonds_[i]);
         markDirty(bonds_[i].bond.other(node));
-        if (direct_)
+        if (direct_) {
             direct_->touch(bonds_[i].bond.other(node));
+            direct_->forget(i);
+        }
     }
     reachValid_ = false;
 }
@@ -542,7 +562,7 @@ void StressSolver::solve() {
         route(routes_);
     if (!newcomers.empty() && settings_.method != StressMethod::Direct)
         settleAmong(newcomers, settings_.residual * scale);
-    factorizations_ = 0;
+    factorizations_ = blocksMade_ = 0;
     switch (settings_.method) {
     case StressMethod::SweepBudget:
         solveSweepBudget();
@@ -1130,10 +1150,23 @@ void StressSolver::solveDirect(double tolerance) {
         v = {x[o], x[o + 1], x[o + 2]};
         w = {x[o + 3], x[o + 4], x[o + 5]};
     };
-    // A bond's 12 x 12 block of J^T E^-1 J over its two nodes (its held constraints).
-    std::vector<Eigen::Matrix<double, 12, 12>> blocks;
-    std::vector<char> stale;
-    auto blockOf = [&](const BondState& b, Eigen::Matrix<double, 12, 12>& block) {
+    // A bond's 12 x 12 block of J^T E^-1 J (its held constraints), made again only when it changed.
+    std::vector<char> signature;
+    auto blockOf = [&](std::size_t k) -> const Eigen::Matrix<double, 12, 12>& {
+        const BondState& b = bonds_[k];
+        signature.clear();
+        for (const BearingCorner& c : b.corners)
+            signature.push_back(static_cast<char>(c.active + 2 * c.slip));
+        if (k >= caches.blocks.size())
+            caches.blocks.resize(bonds_.size());
+        BondBlock& cached = caches.blocks[k];
+        if (cached.compliance == delta && cached.broken == b.broken && cached.flags == signature)
+            return cached.block;
+        cached.compliance = delta;
+        cached.broken = b.broken;
+        cached.flags = signature;
+        ++blocksMade_;
+        Eigen::Matrix<double, 12, 12>& block = cached.block;
         block.setZero();
         if (!b.broken && b.corners.empty()) {
             Eigen::Matrix<double, 6, 12> j;
@@ -1156,67 +1189,91 @@ void StressSolver::solveDirect(double tolerance) {
                 }
             }
         }
+        return block;
     };
     Eigen::Index n = 0;
-    std::vector<Eigen::Triplet<double>> triplets;
-    // The island's matrix: built from triplets when its nodes or bonds changed, else its values rewritten in
-    // place (each triplet's place in it found at the second assembly of the same nodes and bonds).
+    std::vector<std::vector<int>> near; // each island node's neighbours and itself (its column's row blocks)
+    // The island's matrix by 6 x 6 blocks: its pattern made when its key changes, masses then bonds added.
     auto assemble = [&]() -> const Sparse& {
-        const bool known = cache->assembledKey == key && !cache->slots.empty();
-        double* values = cache->assembled.valuePtr();
-        if (known)
-            std::fill(values, values + cache->assembled.nonZeros(), 0.0);
-        triplets.clear();
-        if (!known)
-            triplets.reserve(12 * order.size() + 4 * 36 * pattern.size());
-        std::size_t t = 0;
-        auto emit = [&](int r, int c, double v) {
-            if (known)
-                values[cache->slots[t++]] += v;
-            else
-                triplets.emplace_back(r, c, v);
+        Sparse& a = cache->assembled;
+        if (cache->assembledKey != key) {
+            near.assign(order.size(), {});
+            for (std::size_t j = 0; j < order.size(); ++j)
+                near[j].push_back(static_cast<int>(j));
+            for (std::size_t k : pattern) {
+                const int e = index[bonds_[k].bond.a], f = index[bonds_[k].bond.b];
+                if (e >= 0 && f >= 0) {
+                    near[e].push_back(f);
+                    near[f].push_back(e);
+                }
+            }
+            Eigen::Index nonZeros = 0;
+            for (std::vector<int>& rows : near) {
+                std::sort(rows.begin(), rows.end());
+                rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
+                nonZeros += 36 * static_cast<Eigen::Index>(rows.size());
+            }
+            a = Sparse(n, n);
+            a.resizeNonZeros(nonZeros);
+            int* outer = a.outerIndexPtr();
+            int* inner = a.innerIndexPtr();
+            outer[0] = 0;
+            for (std::size_t j = 0; j < order.size(); ++j)
+                for (int q = 0; q < 6; ++q) {
+                    int* at = inner + outer[6 * j + q];
+                    for (int r : near[j])
+                        for (int p = 0; p < 6; ++p)
+                            *at++ = 6 * r + p;
+                    outer[6 * j + q + 1] = static_cast<int>(at - inner);
+                }
+            // Each bond's block (e, f): its offset in the runs of f's six columns (-1: an end is held).
+            cache->places.resize(pattern.size());
+            for (std::size_t p = 0; p < pattern.size(); ++p) {
+                const int ends[2] = {index[bonds_[pattern[p]].bond.a], index[bonds_[pattern[p]].bond.b]};
+                for (int e = 0; e < 2; ++e)
+                    for (int f = 0; f < 2; ++f)
+                        cache->places[p][2 * e + f] =
+                            ends[e] < 0 || ends[f] < 0
+                                ? -1
+                                : 6 * static_cast<int>(std::lower_bound(near[ends[f]].begin(),
+                                                                        near[ends[f]].end(), ends[e]) -
+                                                       near[ends[f]].begin());
+            }
+            cache->assembledKey = key;
+        }
+        const int* outer = a.outerIndexPtr();
+        const int* inner = a.innerIndexPtr();
+        double* values = a.valuePtr();
+        std::fill(values, values + a.nonZeros(), 0.0);
+        auto at = [&](int row, int col) -> double& { // row within the column's run, found by search
+            return values[std::lower_bound(inner + outer[col], inner + outer[col + 1], row) - inner];
         };
         for (std::uint32_t i : order) {
             const NodeState& s = nodes_[i];
             const int o = 6 * index[i];
             for (int r = 0; r < 3; ++r) {
-                emit(o + r, o + r, s.node.mass);
+                at(o + r, o + r) += s.node.mass;
                 for (int c = 0; c < 3; ++c)
-                    emit(o + 3 + r, o + 3 + c, s.node.inertia.m[r][c]);
+                    at(o + 3 + r, o + 3 + c) += s.node.inertia.m[r][c];
             }
         }
         for (std::size_t p = 0; p < pattern.size(); ++p) {
             const BondState& b = bonds_[pattern[p]];
-            if (stale[p]) // else unchanged since the last round
-                blockOf(b, blocks[p]);
-            stale[p] = 0;
-            const Eigen::Matrix<double, 12, 12>& block = blocks[p];
+            const Eigen::Matrix<double, 12, 12>& block = blockOf(pattern[p]);
             const int ends[2] = {index[b.bond.a], index[b.bond.b]};
             for (int e = 0; e < 2; ++e)
-                for (int f = 0; f < 2; ++f)
-                    if (ends[e] >= 0 && ends[f] >= 0)
+                for (int f = 0; f < 2; ++f) {
+                    const int place = cache->places[p][2 * e + f];
+                    if (place < 0)
+                        continue;
+                    for (int c = 0; c < 6; ++c) {
+                        double* column = values + outer[6 * ends[f] + c] + place;
                         for (int r = 0; r < 6; ++r)
-                            for (int c = 0; c < 6; ++c)
-                                emit(6 * ends[e] + r, 6 * ends[f] + c, block(6 * e + r, 6 * f + c));
+                            column[r] += block(6 * e + r, 6 * f + c);
+                    }
+                }
         }
-        if (known)
-            return cache->assembled;
-        cache->assembled.resize(n, n);
-        cache->assembled.setFromTriplets(triplets.begin(), triplets.end());
-        cache->slots.clear();
-        if (cache->assembledKey != key) { // places only for a key assembled twice (a fracture's never is)
-            cache->assembledKey = key;
-            return cache->assembled;
-        }
-        const int* outer = cache->assembled.outerIndexPtr();
-        const int* inner = cache->assembled.innerIndexPtr();
-        cache->slots.resize(triplets.size());
-        for (std::size_t j = 0; j < triplets.size(); ++j) {
-            const Eigen::Triplet<double>& x = triplets[j];
-            cache->slots[j] = static_cast<int>(
-                std::lower_bound(inner + outer[x.col()], inner + outer[x.col() + 1], x.row()) - inner);
-        }
-        return cache->assembled;
+        return a;
     };
     // The corners whose held rows differ between the factorisation's flags and `flags`: each added row (over
     // sqrt(e)) is a column of the update C+, each removed one of the downdate C-; the factorisation becomes
@@ -1459,8 +1516,6 @@ void StressSolver::solveDirect(double tolerance) {
                 held.push_back(k);
         n = static_cast<Eigen::Index>(6 * order.size());
         rhs.resize(n);
-        blocks.assign(pattern.size(), Eigen::Matrix<double, 12, 12>::Zero());
-        stale.assign(pattern.size(), 1);
         for (int round = 0; round < 3 && factorize(); ++round) {
             double last = worst();
             for (int i = 0; i < 12 && last > target2; ++i) {
@@ -1496,7 +1551,6 @@ void StressSolver::solveDirect(double tolerance) {
                             dot(na.v - nb.v, b.bond.section.normal) + dot(na.w, c.ca[0]) - dot(nb.w, c.cb[0]);
                         c.active = moved = rel > tolerance;
                     }
-                    stale[p] = stale[p] || moved;
                     changed = changed || moved;
                 }
             }

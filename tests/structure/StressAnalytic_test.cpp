@@ -554,6 +554,59 @@ TEST(StressAnalytic, AnActiveSetChangeUpdatesTheFactorisation) {
     expectSameForces(updated, fresh, 1e-9);
 }
 
+// A 3 x 3 x 3 block of welded bricks whose top middle brick is replaced by two halves (as a fracture replaces
+// a body by its pieces): the solve after it makes the blocks of the halves' nine new bonds only, keeping
+// every other bond's, and its forces equal, bit for bit, those of a copy that makes every block anew.
+TEST(StressAnalytic, AFractureMakesOnlyItsNewBondsBlocks) {
+    Lattice l;
+    const double rho = 1900;
+    l.add(box({-1, -1, -1}, {4, 0, 4}), rho, true);
+    for (int y = 0; y < 3; ++y)
+        for (int x = 0; x < 3; ++x)
+            for (int z = 0; z < 3; ++z)
+                l.add(box({double(x), 0.5 * y, double(z)}, {x + 1.0, 0.5 * (y + 1), z + 1.0}), rho);
+    StressSettings direct = converged().back();
+    direct.residual = 1e-8;
+    StressSolver s = l.solver(direct);
+    s.solve();
+    ASSERT_LE(s.residual(), direct.residual);
+    EXPECT_EQ(s.blocksMade(), static_cast<int>(s.bondCount())) << "the first solve makes every block";
+    const std::uint32_t top = 1 + 2 * 9 + 1 * 3 + 1; // y = 2, x = 1, z = 1
+    s.removeNode(top);
+    const std::vector<ConvexPolytope> halves[2] = {{box({1, 1, 1}, {1.5, 1.5, 2})},
+                                                   {box({1.5, 1, 1}, {2, 1.5, 2})}};
+    std::uint32_t ids[2];
+    for (int h = 0; h < 2; ++h)
+        ids[h] = s.addNode(structureNode(halves[h], rho, false));
+    int added = 0;
+    auto bond = [&](std::uint32_t a, const std::vector<ConvexPolytope>& pa, std::uint32_t b,
+                    const std::vector<ConvexPolytope>& pb) {
+        Bond k;
+        k.a = std::min(a, b);
+        k.b = std::max(a, b);
+        k.section = a < b ? bondInterface(pa, pb, {}) : bondInterface(pb, pa, {});
+        if (k.section.area > 0) {
+            s.addBond(k, {});
+            ++added;
+        }
+    };
+    bond(ids[0], halves[0], ids[1], halves[1]);
+    for (int h = 0; h < 2; ++h)
+        for (std::uint32_t other = 1; other < l.solids.size(); ++other)
+            if (other != top)
+                bond(ids[h], halves[h], other, l.solids[other]);
+    ASSERT_EQ(added, 9) << "between the halves, to the brick beneath and to three side bricks each";
+    StressSolver fresh = s; // the same state; its next solve makes every block anew
+    for (StressSolver* x : {&fresh, &s}) {
+        x->addLoad(ids[1], {1e4, -5e4, 0}, {1.8, 1.5, 1.5});
+        x->solve();
+        EXPECT_LE(x->residual(), direct.residual);
+    }
+    EXPECT_EQ(s.blocksMade(), added) << "the other bonds' blocks were kept";
+    EXPECT_GT(fresh.blocksMade(), 50);
+    expectSameForces(s, fresh, 0);
+}
+
 // Two welded columns on the ground are two islands, each with its own factorisation: removing the top block
 // of one refactorises that one only, while the other, loaded anew, is solved with the factorisation it kept.
 TEST(StressAnalytic, EachIslandKeepsItsOwnFactorisation) {

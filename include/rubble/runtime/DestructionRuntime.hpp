@@ -209,6 +209,7 @@ struct RUBBLE_API FrameStats {
     double supportMs = 0;         ///< of adoptMs: support (neighbour tests, searches, collapses)
     int bondsBroken = 0;          ///< structure bonds broken by stress or damage
     double structureMs = 0;       ///< of adoptMs: bond graph and stress solve
+    double structureCpuMs = 0;    ///< the same stage's thread CPU time (what other processes took excluded)
     double structureResidual = 0; ///< relative residual of the stress solve the frame acted on (0: none)
     double physicsMs = 0;         ///< physics step incl. contact gathering
     double adoptMs = 0;           ///< submit + collect + adoption + governor

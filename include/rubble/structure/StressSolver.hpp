@@ -96,6 +96,9 @@ public:
     int factorizations() const { return factorizations_; }
     /// Direct: symbolic analyses so far (a new one only when the nodes or the bonds present change).
     int analyses() const { return analyses_; }
+    /// Direct: bonds whose 12 x 12 block the last solve() made anew (new, or their break or active set
+    /// changed).
+    int blocksMade() const { return blocksMade_; }
     /// The last solve()'s relative residual: the largest remaining acceleration of a supported node (its
     /// linear and angular parts in the mass metric, m/s^2) over the largest acceleration the loads alone
     /// give.
@@ -211,6 +214,7 @@ private:
     int sweeps_ = 0;
     int factorizations_ = 0;
     int analyses_ = 0;
+    int blocksMade_ = 0;
     struct DirectCache;                   // Direct: the symbolic factorisation and its pattern
     std::shared_ptr<DirectCache> direct_; // (a copy shares it until its next solve)
     double residual_ = 0;
