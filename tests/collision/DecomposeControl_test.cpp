@@ -184,13 +184,23 @@ TEST(DecomposeControl, CacheDecomposesUnderControlAndKeepsNoCancelledEntry) {
     }
 }
 
-TEST(PieceConcavity, AFractureResultCarriesItWhenAsked) {
-    const Mesh cube = makeSubdividedBox({-1, -1, -1}, {1, 1, 1}, 7);
+// A 10k-triangle cube bitten near its top face.
+const Mesh& bittenCube() {
+    static const Mesh cube = makeSubdividedBox({-1, -1, -1}, {1, 1, 1}, 7);
+    return cube;
+}
+
+Result<FractureResult> biteTheCube() {
     Impact hit;
     hit.point = {0.3, 1, 0.2};
     hit.normal = {0, 1, 0};
     hit.impulse = 40;
-    auto fr = fracture(cube, hit, FractureParams{}, 7);
+    return fracture(bittenCube(), hit, FractureParams{}, 7);
+}
+
+TEST(PieceConcavity, AFractureResultCarriesItWhenAsked) {
+    const Mesh& cube = bittenCube();
+    auto fr = biteTheCube();
     ASSERT_TRUE(fr) << fr.error().message;
     EXPECT_TRUE(fr->concavity.empty()); // opt-in
     auto parts = updateDecomposition(decompose(cube)->parts, *fr);
@@ -204,12 +214,8 @@ TEST(PieceConcavity, AFractureResultCarriesItWhenAsked) {
 }
 
 TEST(PieceConcavity, EveryPieceOfAFractureAsPartConcavity) {
-    const Mesh cube = makeSubdividedBox({-1, -1, -1}, {1, 1, 1}, 7);
-    Impact hit;
-    hit.point = {0.3, 1, 0.2};
-    hit.normal = {0, 1, 0};
-    hit.impulse = 40;
-    auto fr = fracture(cube, hit, FractureParams{}, 7);
+    const Mesh& cube = bittenCube();
+    auto fr = biteTheCube();
     ASSERT_TRUE(fr) << fr.error().message;
     ASSERT_GE(fr->pieces.size(), 2u);
     const auto parts = updateDecomposition(decompose(cube)->parts, *fr);
