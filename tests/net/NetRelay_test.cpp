@@ -216,9 +216,13 @@ TEST(NetRelay, AClientFarBehindAfterAnOutageGetsTheWorldWithItsOwnObjectsByIdIns
     Follower f(h.port(), 51);
     long long cut = 0; // fractures the client adopted itself
     f.client->setOnOutcome([&](const FractureOutcome&) { ++cut; });
+    std::string failure; // why the client's service failed, if it did
     const auto pump = [&] {
         h.service(1);
-        return static_cast<bool>(f.client->service(1));
+        const Status s = f.client->service(1);
+        if (!s)
+            failure = s.message();
+        return static_cast<bool>(s);
     };
     const auto fireAndFollow = [&](int frames) { // the host fires, and the client reaches its last frame
         for (int frame = 0; frame < frames; ++frame) {
@@ -247,8 +251,8 @@ TEST(NetRelay, AClientFarBehindAfterAnOutageGetsTheWorldWithItsOwnObjectsByIdIns
         return pump();
     };
     for (int frame = 0; frame < 150; ++frame) // 2.5 s of fire while it hears nothing
-        ASSERT_TRUE(step(7));
-    ASSERT_TRUE(test::waitFor([&] { return Clock::now() >= healAt; }, [&] { return step(0); }));
+        ASSERT_TRUE(step(7)) << failure;
+    ASSERT_TRUE(test::waitFor([&] { return Clock::now() >= healAt; }, [&] { return step(0); })) << failure;
     const long long missed = host.runtime.counters().fractures - fractured;
     ASSERT_GT(missed, 3);
     f.relay->setPartitioned(false);
@@ -266,11 +270,11 @@ TEST(NetRelay, AClientFarBehindAfterAnOutageGetsTheWorldWithItsOwnObjectsByIdIns
                                           static_cast<long long>(host.runtime.world().objects().size());
                                   return ok;
                               }))
-        << "at frame " << f.client->stats().frame << " of " << healed;
+        << "at frame " << f.client->stats().frame << " of " << healed << ": " << failure;
     host.settle();
     h.publish();
     const std::uint64_t last = host.runtime.world().frame();
-    ASSERT_TRUE(test::waitFor([&] { return f.client->stats().frame == last; }, pump));
+    ASSERT_TRUE(test::waitFor([&] { return f.client->stats().frame == last; }, pump)) << failure;
     EXPECT_EQ(f.client->stats().resyncs, 1);
     EXPECT_EQ(h.stats().resyncs, 1);
     EXPECT_LT(cutWhenResynced - cutBefore, missed) << "the outage's pieces came by the resync, not cut by it";
