@@ -235,8 +235,8 @@ TEST(NetRelay, AClientFarBehindAfterAnOutageGetsTheWorldWithItsOwnObjectsByIdIns
         const std::uint64_t last = host.runtime.world().frame();
         return test::waitFor([&] { return f.client->stats().frame == last; }, pump);
     };
-    ASSERT_TRUE(test::waitFor([&] { return f.client->stats().joined; }, pump));
-    ASSERT_TRUE(fireAndFollow(30)); // a few breaks before the outage, which it cuts itself
+    ASSERT_TRUE(test::waitFor([&] { return f.client->stats().joined; }, pump)) << failure;
+    ASSERT_TRUE(fireAndFollow(30)) << failure; // a few breaks before the outage, which it cuts itself
     f.relay->setPartitioned(true);
     const auto healAt = Clock::now() + std::chrono::milliseconds(1300); // longer than the client's 1 s
     const long long fractured = host.runtime.counters().fractures, cutBefore = cut;
@@ -281,7 +281,7 @@ TEST(NetRelay, AClientFarBehindAfterAnOutageGetsTheWorldWithItsOwnObjectsByIdIns
     EXPECT_GT(h.stats().resyncObjectsSent, 0);
     EXPECT_LT(h.stats().resyncObjectsSent, objectsWhenBuilt) << "what it had unchanged went by id";
     EXPECT_EQ(f.world->geometryHash(), host.runtime.world().geometryHash());
-    ASSERT_TRUE(fireAndFollow(60)); // and it follows the journal from there
+    ASSERT_TRUE(fireAndFollow(60)) << failure; // and it follows the journal from there
     EXPECT_EQ(f.world->geometryHash(), host.runtime.world().geometryHash());
     EXPECT_EQ(f.client->stats().mismatchedHashes, 0);
     EXPECT_EQ(h.stats().mismatchedHashes, 0);
