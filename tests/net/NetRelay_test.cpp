@@ -14,6 +14,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <thread>
@@ -309,6 +310,58 @@ TEST(NetRelay, AClientsHelloTravelsWithTheConnectionSoThatAJitteryLinkNeverDelay
         // A Hello that overtook ENet's acknowledgement of the connection was dropped by the host and sent
         // again after ENet's retransmission timeout.
         EXPECT_EQ((*client)->stats().reliableResent, 0) << "client " << seed;
+    }
+}
+
+TEST(NetRelay, AHandshakeLostForSecondsIsSentAgainEveryHalfSecondNotAfterDoublingTimers) {
+    test::NetHostRig net;
+    ASSERT_TRUE(net.server);
+    net::NetHost& h = *net.server;
+    h.publish();
+    // ENet's own timers double at every loss: 0.5, 1.5, 3.5, 7.5, 15.5 s after the first try, so a
+    // handshake lost for 8 s got through at 15.5 s; each side now sends it again every 0.5 s.
+    constexpr double kLostS = 8;
+    net::LinkProfile cut;
+    cut.partitionStartS = 0;
+    cut.partitionS = kLostS;
+    struct Joiner {
+        std::unique_ptr<net::UdpRelay> relay;
+        std::unique_ptr<DestructionWorld> world;
+        std::unique_ptr<net::NetClient> client;
+    };
+    std::vector<Joiner> joiners(2); // the client's connect lost; the host's answers lost
+    for (std::size_t i = 0; i < joiners.size(); ++i) {
+        auto relay = net::UdpRelay::start(h.port(), i == 0 ? cut : net::LinkProfile{},
+                                          i == 0 ? net::LinkProfile{} : cut, 7);
+        ASSERT_TRUE(relay) << relay.error().message;
+        joiners[i].relay = std::move(*relay);
+        joiners[i].world = std::make_unique<DestructionWorld>(net.config);
+        auto c =
+            net::NetClient::connect(*joiners[i].world, net.config, "127.0.0.1", joiners[i].relay->port());
+        ASSERT_TRUE(c) << c.error().message;
+        joiners[i].client = std::move(*c);
+        joiners[i].client->setTimeout(30000);
+    }
+    std::string failure;
+    ASSERT_TRUE(test::waitFor(
+        [&] {
+            return std::all_of(joiners.begin(), joiners.end(),
+                               [](const Joiner& j) { return j.client->stats().joined; });
+        },
+        [&] {
+            h.service(1);
+            for (Joiner& j : joiners)
+                if (Status st = j.client->service(1); !st) {
+                    failure = st.message();
+                    return false;
+                }
+            return true;
+        }))
+        << failure;
+    for (std::size_t i = 0; i < joiners.size(); ++i) {
+        const double ms = joiners[i].client->stats().connectMs;
+        EXPECT_GE(ms, kLostS * 1000 - 100) << (i == 0 ? "connect lost" : "answers lost");
+        EXPECT_LT(ms, (kLostS + 4) * 1000) << (i == 0 ? "connect lost" : "answers lost");
     }
 }
 

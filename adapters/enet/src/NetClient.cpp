@@ -531,6 +531,7 @@ Result<std::unique_ptr<NetClient>> NetClient::connect(DestructionWorld& world,
     im.server = enet_host_connect(im.host, &*a, 2, 0);
     if (!im.server)
         return Error{ErrorCode::IoError, "cannot connect to " + address + ":" + std::to_string(port)};
+    enet_peer_timeout(im.server, 0, im.timeoutMs, im.timeoutMs); // no host answered within the timeout
     enet_host_flush(im.host); // the connect goes out; the Hello's hashes are taken while it travels
     const Clock::time_point hashing = Clock::now();
     (void)detail::encodeHello(im.world, false, &im.stateHashes);
@@ -543,6 +544,8 @@ Status NetClient::service(int timeoutMs) {
     // Everything that arrived, first: after an outage, how far ahead the host is decides whether to ask for
     // a resync before a sync makes it cut the backlog.
     std::vector<ENetEvent> events;
+    if (im.server && im.server->state == ENET_PEER_STATE_CONNECTING)
+        detail::retryEvery(im.server, detail::kHandshakeRetryMs);
     ENetEvent e;
     int r = enet_host_service(im.host, &e, static_cast<enet_uint32>(std::max(0, timeoutMs)));
     const Clock::time_point started = im.pumped = Clock::now();
@@ -574,7 +577,8 @@ Status NetClient::service(int timeoutMs) {
         } else if (ev.type == ENET_EVENT_TYPE_DISCONNECT) {
             im.server = nullptr;
             if (!im.stats.connected)
-                status = Error{ErrorCode::IoError, "netplay: no host answered"};
+                status = Error{ErrorCode::IoError,
+                               "netplay: no host answered within " + std::to_string(im.timeoutMs) + " ms"};
             else
                 status = Error{ErrorCode::IoError,
                                ev.data == detail::kGoodbye
@@ -603,6 +607,8 @@ void NetClient::setTimeout(int ms) {
     impl_->timeoutMs = static_cast<enet_uint32>(std::max(1, ms));
     if (impl_->server && impl_->stats.connected)
         detail::configurePeer(impl_->server, impl_->timeoutMs);
+    else if (impl_->server) // still connecting: nothing may be sent to the host yet
+        enet_peer_timeout(impl_->server, 0, impl_->timeoutMs, impl_->timeoutMs);
 }
 
 void NetClient::setKeepReplay(bool keep) {

@@ -542,6 +542,9 @@ void NetHost::service(int timeoutMs) {
         // While a snapshot is on its way, wake often enough to pace its chunks.
         const auto wait = static_cast<enet_uint32>(
             std::max<long long>(0, im.transfers.empty() ? left : std::min<long long>(left, kServiceSliceMs)));
+        for (std::size_t i = 0; i < im.host->peerCount; ++i) // clients whose connection is being made
+            if (im.host->peers[i].state == ENET_PEER_STATE_ACKNOWLEDGING_CONNECT)
+                detail::retryEvery(&im.host->peers[i], detail::kHandshakeRetryMs);
         ENetEvent e;
         for (int r = enet_host_service(im.host, &e, wait); r > 0; r = enet_host_service(im.host, &e, 0)) {
             switch (e.type) {

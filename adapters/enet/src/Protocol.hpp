@@ -2,6 +2,7 @@
 // Private: the messages of loopback multiplayer (docs/netplay.md) and ENet helpers.
 
 #include <enet/enet.h>
+#include <enet/time.h>
 
 #include <algorithm>
 #include <array>
@@ -155,6 +156,21 @@ inline void retransmitSoon(ENetPeer* peer) {
          it != enet_list_end(&peer->sentReliableCommands); it = enet_list_next(it)) {
         auto* c = reinterpret_cast<ENetOutgoingCommand*>(it);
         c->roundTripTimeout = std::min<enet_uint32>(c->roundTripTimeout, 1);
+    }
+}
+
+/// How often a connection being made sends its handshake again while no answer comes.
+inline constexpr enet_uint32 kHandshakeRetryMs = 500;
+
+/// While a connection is being made, its unacknowledged reliable commands (the connect, or the host's
+/// verification of it) are sent again every `everyMs` instead of after timers that double at every loss.
+inline void retryEvery(ENetPeer* peer, enet_uint32 everyMs) {
+    for (ENetListIterator it = enet_list_begin(&peer->sentReliableCommands);
+         it != enet_list_end(&peer->sentReliableCommands); it = enet_list_next(it)) {
+        auto* c = reinterpret_cast<ENetOutgoingCommand*>(it);
+        c->roundTripTimeout = std::min(c->roundTripTimeout, everyMs);
+        if (ENET_TIME_LESS(c->sentTime + c->roundTripTimeout, peer->nextTimeout))
+            peer->nextTimeout = c->sentTime + c->roundTripTimeout; // when ENet looks at its timers again
     }
 }
 

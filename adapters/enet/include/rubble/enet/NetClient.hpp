@@ -45,8 +45,8 @@ struct ClientStats {
 class NetClient {
 public:
     /// Starts connecting to address:port (a loopback address) and, while the connection is being made, hashes
-    /// the world's objects for the Hello; service() completes it (ENet gives up after about 5 s without an
-    /// answer, and service() then fails).
+    /// the world's objects for the Hello; service() completes it, sending the handshake again every 0.5 s
+    /// while no answer comes, and fails when none came within the timeout (setTimeout; 10 s by default).
     static Result<std::unique_ptr<NetClient>> connect(DestructionWorld& world,
                                                       const DestructionWorld::Config& config,
                                                       const std::string& address, std::uint16_t port);
@@ -71,8 +71,9 @@ public:
     Status writeReplay(const std::filesystem::path& snapshot, const std::filesystem::path& journal) const;
     /// Host frame of the latest placement received for an object (empty when none arrived).
     std::optional<double> placementFrame(ObjectId object) const;
-    /// How long the host may be silent before service() fails with an IoError saying it stopped answering
-    /// (default 10 s: a partition shorter than that is survived, a host killed without closing is noticed).
+    /// How long the host may be silent before service() fails with an IoError saying it stopped answering,
+    /// or that no host answered while connecting (default 10 s: a partition shorter than that is survived, a
+    /// host killed without closing is noticed).
     void setTimeout(int ms);
     /// Whether it keeps what writeReplay needs (default true): a copy of the world it joined (or resynced)
     /// with, which costs a copy of every object at each load.
