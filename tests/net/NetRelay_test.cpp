@@ -215,8 +215,8 @@ TEST(NetRelay, AClientFarBehindAfterAnOutageGetsTheWorldWithItsOwnObjectsByIdIns
     test::JournalRig& host = net.rig;
     net::NetHost& h = *net.server;
     Follower f(h.port(), 51);
-    long long cut = 0; // fractures the client adopted itself
-    f.client->setOnOutcome([&](const FractureOutcome&) { ++cut; });
+    long long cutUnsynced = 0; // fractures the client adopted itself before any resync
+    f.client->setOnOutcome([&](const FractureOutcome&) { cutUnsynced += f.client->stats().resyncs == 0; });
     std::string failure; // why the client's service failed, if it did
     const auto pump = [&] {
         h.service(1);
@@ -240,7 +240,7 @@ TEST(NetRelay, AClientFarBehindAfterAnOutageGetsTheWorldWithItsOwnObjectsByIdIns
     ASSERT_TRUE(fireAndFollow(30)) << failure; // a few breaks before the outage, which it cuts itself
     f.relay->setPartitioned(true);
     const auto healAt = Clock::now() + std::chrono::milliseconds(1300); // longer than the client's 1 s
-    const long long fractured = host.runtime.counters().fractures, cutBefore = cut;
+    const long long fractured = host.runtime.counters().fractures, cutBefore = cutUnsynced;
     const auto step = [&](int fireEvery) { // the host goes on at its pace (0: without firing)
         if (fireEvery > 0)
             host.play(1, fireEvery);
@@ -260,11 +260,9 @@ TEST(NetRelay, AClientFarBehindAfterAnOutageGetsTheWorldWithItsOwnObjectsByIdIns
     const std::uint64_t healed = host.runtime.world().frame();
     // The host fires every other frame meanwhile: events it records after a sync of their frame reach the
     // client while its resync is on its way, and must follow that sync.
-    long long cutWhenResynced = -1, objectsWhenBuilt = -1;
+    long long objectsWhenBuilt = -1;
     ASSERT_TRUE(test::waitFor([&] { return f.client->stats().frame >= healed + 30; },
                               [&] {
-                                  if (cutWhenResynced < 0 && f.client->stats().resyncs > 0)
-                                      cutWhenResynced = cut;
                                   const bool ok = step(2);
                                   if (objectsWhenBuilt < 0 && h.stats().resyncs > 0) // built in that step
                                       objectsWhenBuilt =
@@ -278,7 +276,7 @@ TEST(NetRelay, AClientFarBehindAfterAnOutageGetsTheWorldWithItsOwnObjectsByIdIns
     ASSERT_TRUE(test::waitFor([&] { return f.client->stats().frame == last; }, pump)) << failure;
     EXPECT_EQ(f.client->stats().resyncs, 1);
     EXPECT_EQ(h.stats().resyncs, 1);
-    EXPECT_LT(cutWhenResynced - cutBefore, missed) << "the outage's pieces came by the resync, not cut by it";
+    EXPECT_LT(cutUnsynced - cutBefore, missed) << "the outage's pieces came by the resync, not cut by it";
     EXPECT_GT(h.stats().resyncObjectsSent, 0);
     EXPECT_LT(h.stats().resyncObjectsSent, objectsWhenBuilt) << "what it had unchanged went by id";
     EXPECT_EQ(f.world->geometryHash(), host.runtime.world().geometryHash());
