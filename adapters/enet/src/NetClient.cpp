@@ -247,6 +247,7 @@ struct NetClient::Impl {
     // after ENet's first retransmission timeout, about 0.5 s later. False when it could not be queued.
     bool hello() {
         stats.connected = true;
+        heard = Clock::now(); // silence counts from the connection
         stats.connectMs = std::chrono::duration<double, std::milli>(Clock::now() - connected).count();
         detail::configurePeer(server, timeoutMs);
         const Clock::time_point hashing = Clock::now();
@@ -557,7 +558,7 @@ Status NetClient::service(int timeoutMs) {
         if (e.type != ENET_EVENT_TYPE_RECEIVE)
             continue;
         const Clock::time_point now = Clock::now();
-        if (now - im.heard > std::chrono::milliseconds(300) && im.server)
+        if (now - im.heard > std::chrono::milliseconds(300) && im.server && im.stats.connected)
             detail::retransmitSoon(im.server); // the host was silent: an outage ended
         if (now - im.heard > kOutage && im.stats.joined)
             im.afterOutage = true;

@@ -149,21 +149,11 @@ inline void configurePeer(ENetPeer* peer, enet_uint32 timeoutMs = kPeerTimeoutMs
     enet_peer_throttle_configure(peer, ENET_PEER_PACKET_THROTTLE_INTERVAL, 0, 0);
 }
 
-/// After an outage, the peer's unacknowledged reliable commands are sent again at the next service instead
-/// of after their timers, which doubled at every retransmission during the outage.
-inline void retransmitSoon(ENetPeer* peer) {
-    for (ENetListIterator it = enet_list_begin(&peer->sentReliableCommands);
-         it != enet_list_end(&peer->sentReliableCommands); it = enet_list_next(it)) {
-        auto* c = reinterpret_cast<ENetOutgoingCommand*>(it);
-        c->roundTripTimeout = std::min<enet_uint32>(c->roundTripTimeout, 1);
-    }
-}
-
-/// How often a connection being made sends its handshake again while no answer comes.
+/// How often a connection being made sends its handshake again while no answer comes (retryEvery).
 inline constexpr enet_uint32 kHandshakeRetryMs = 500;
 
-/// While a connection is being made, its unacknowledged reliable commands (the connect, or the host's
-/// verification of it) are sent again every `everyMs` instead of after timers that double at every loss.
+/// The peer's unacknowledged reliable commands go out again `everyMs` after they were last sent (at the
+/// first service from then), instead of after ENet's timers, which double at every loss.
 inline void retryEvery(ENetPeer* peer, enet_uint32 everyMs) {
     for (ENetListIterator it = enet_list_begin(&peer->sentReliableCommands);
          it != enet_list_end(&peer->sentReliableCommands); it = enet_list_next(it)) {
@@ -172,6 +162,12 @@ inline void retryEvery(ENetPeer* peer, enet_uint32 everyMs) {
         if (ENET_TIME_LESS(c->sentTime + c->roundTripTimeout, peer->nextTimeout))
             peer->nextTimeout = c->sentTime + c->roundTripTimeout; // when ENet looks at its timers again
     }
+}
+
+/// After an outage, the peer's unacknowledged reliable commands are sent again at the next service instead
+/// of after their timers, which doubled at every retransmission during the outage.
+inline void retransmitSoon(ENetPeer* peer) {
+    retryEvery(peer, 1);
 }
 
 /// Resolves a loopback address (127.0.0.0/8, "localhost"); anything else is refused.
