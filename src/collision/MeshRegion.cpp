@@ -2,33 +2,95 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <map>
 #include <numbers>
+#include <optional>
 #include <unordered_map>
 
 #include "rubble/collision/ConvexDecomposition.hpp"
 
 namespace rubble::detail {
 
+namespace {
+
+// How far a part reaches out of one hull plane, as of one round of keepInsideHull.
+struct PlaneReach {
+    double reach = 0;        // the farthest corner's signed distance (an upper bound in later rounds)
+    std::uint32_t plane = 0; // index into the hull's planes
+    std::size_t corner = 0;  // the first corner that reaches that far
+    std::size_t round = 0;   // the round whose corners gave it
+    bool operator<(const PlaneReach& o) const { return reach < o.reach; }
+};
+
+// The farthest corner out of plane, and the first one that reaches that far.
+PlaneReach farthest(const std::vector<Vec3>& corners, const Plane& plane, double margin) {
+    PlaneReach r{margin};
+    for (std::size_t k = 0; k < corners.size(); ++k)
+        if (const double d = plane.signedDistance(corners[k]); d > r.reach) {
+            r.reach = d;
+            r.corner = k;
+        }
+    return r;
+}
+
+} // namespace
+
 void keepInsideHull(std::vector<ConvexPolytope>& parts, const ConvexPolytope& hull, double margin) {
+    std::vector<Plane> planes;
+    planes.reserve(hull.faces().size());
+    for (const PolytopeFaceView& h : hull.faces())
+        planes.push_back(h.plane);
     std::vector<ConvexPolytope> kept;
     kept.reserve(parts.size());
+    std::vector<PlaneReach> heap, tied;
     for (ConvexPolytope& part : parts) {
         // The hull plane that the part's farthest corner is farthest out of, one at a time: a part that
-        // reaches out at one place is clipped there only.
+        // reaches out at one place is clipped there only. A clip moves no corner farther out of any plane, so
+        // a plane's reach from an earlier round bounds its reach now: only the planes that could be the
+        // farthest are measured again (the first corner, then the first plane, among equal reaches).
+        heap.clear();
+        std::vector<Vec3> corners = part.vertices();
+        for (std::uint32_t i = 0; i < planes.size(); ++i)
+            if (PlaneReach r = farthest(corners, planes[i], margin); r.reach > margin) {
+                r.plane = i;
+                heap.push_back(r);
+            }
+        std::make_heap(heap.begin(), heap.end());
         for (std::size_t round = 0; round < kMaxHullClips && !part.empty(); ++round) {
-            double reach = margin;
-            const Plane* worst = nullptr;
-            for (const Vec3& c : part.vertices())
-                for (const PolytopeFaceView& h : hull.faces())
-                    if (const double d = h.plane.signedDistance(c); d > reach) {
-                        reach = d;
-                        worst = &h.plane;
+            if (round > 0)
+                corners = part.vertices();
+            std::optional<PlaneReach> worst;
+            tied.clear();
+            while (!heap.empty() && (!worst || heap.front().reach >= worst->reach)) {
+                std::pop_heap(heap.begin(), heap.end());
+                PlaneReach r = heap.back();
+                heap.pop_back();
+                if (r.round != round) { // measured before the last clip: measure it again
+                    const std::uint32_t plane = r.plane;
+                    r = farthest(corners, planes[plane], margin);
+                    r.plane = plane;
+                    r.round = round;
+                    if (r.reach > margin) {
+                        heap.push_back(r);
+                        std::push_heap(heap.begin(), heap.end());
                     }
+                    continue;
+                }
+                if (!worst || r.reach > worst->reach ||
+                    (r.reach == worst->reach &&
+                     (r.corner < worst->corner || (r.corner == worst->corner && r.plane < worst->plane))))
+                    worst = r;
+                tied.push_back(r);
+            }
             if (!worst)
                 break;
-            part = part.clipped(*worst);
+            for (const PlaneReach& r : tied) { // still bounds for the next round
+                heap.push_back(r);
+                std::push_heap(heap.begin(), heap.end());
+            }
+            part = part.clipped(planes[worst->plane]);
         }
         if (!part.empty())
             kept.push_back(std::move(part));
