@@ -1,7 +1,8 @@
 // Multiplayer on a network that misbehaves: three clients, each through its own seeded relay (delay, jitter,
 // burst loss, reordering, duplication), one of them partitioned and healed, one killed and replaced; and a
 // host that rogue traffic neither crashes nor changes; a host gone silent is noticed after the client's
-// timeout. Every wait is for a condition, with a deadline.
+// timeout; a handshake lost for seconds gets through soon after the link returns. Every wait is for a
+// condition, with a deadline.
 #include "rubble/enet/NetClient.hpp"
 #include "rubble/enet/NetHost.hpp"
 #include "rubble/enet/UdpRelay.hpp"
