@@ -44,12 +44,10 @@ void keepInsideHull(std::vector<ConvexPolytope>& parts, const ConvexPolytope& hu
         planes.push_back(h.plane);
     std::vector<ConvexPolytope> kept;
     kept.reserve(parts.size());
-    std::vector<PlaneReach> heap, tied;
+    std::vector<PlaneReach> heap, measured;
     for (ConvexPolytope& part : parts) {
-        // The hull plane that the part's farthest corner is farthest out of, one at a time: a part that
-        // reaches out at one place is clipped there only. A clip moves no corner farther out of any plane, so
-        // a plane's reach from an earlier round bounds its reach now: only the planes that could be the
-        // farthest are measured again (the first corner, then the first plane, among equal reaches).
+        // Clipped by the plane it reaches farthest out of, one at a time; earlier reaches are upper bounds
+        // (docs/collision.md, "The hull clip measured lazily").
         heap.clear();
         std::vector<Vec3> corners = part.vertices();
         for (std::uint32_t i = 0; i < planes.size(); ++i)
@@ -62,7 +60,7 @@ void keepInsideHull(std::vector<ConvexPolytope>& parts, const ConvexPolytope& hu
             if (round > 0)
                 corners = part.vertices();
             std::optional<PlaneReach> worst;
-            tied.clear();
+            measured.clear();
             while (!heap.empty() && (!worst || heap.front().reach >= worst->reach)) {
                 std::pop_heap(heap.begin(), heap.end());
                 PlaneReach r = heap.back();
@@ -82,11 +80,11 @@ void keepInsideHull(std::vector<ConvexPolytope>& parts, const ConvexPolytope& hu
                     (r.reach == worst->reach &&
                      (r.corner < worst->corner || (r.corner == worst->corner && r.plane < worst->plane))))
                     worst = r;
-                tied.push_back(r);
+                measured.push_back(r);
             }
             if (!worst)
                 break;
-            for (const PlaneReach& r : tied) { // still bounds for the next round
+            for (const PlaneReach& r : measured) { // still bounds for the next round
                 heap.push_back(r);
                 std::push_heap(heap.begin(), heap.end());
             }
