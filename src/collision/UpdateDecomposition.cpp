@@ -207,6 +207,29 @@ void subtractUnion(const ConvexPolytope& region, const std::vector<ConvexPolytop
 }
 
 /// Volume of a shape inside each cell it reaches: (cell index, volume).
+/// The pyramid over a face with its apex beyond the face's plane: the part of hull(face ∪ apex) outside the
+/// face.
+ConvexPolytope pyramid(const PolytopeFaceView& base, const Vec3& apex) {
+    std::vector<Vec3> ring(base.corners.begin(), base.corners.end());
+    Vec3 mid = apex;
+    for (const Vec3& q : ring)
+        mid += q;
+    mid = mid / static_cast<double>(ring.size() + 1);
+    std::vector<PolytopeFace> faces;
+    auto add = [&](std::vector<Vec3> corners) { // oriented away from the pyramid's centroid
+        Vec3 n = normalized(cross(corners[1] - corners[0], corners[2] - corners[0]));
+        if (dot(n, mid - corners[0]) > 0) {
+            std::reverse(corners.begin(), corners.end());
+            n = -n;
+        }
+        faces.push_back({Plane{n, dot(n, corners[0])}, std::move(corners), -1});
+    };
+    for (std::size_t e = 0; e < ring.size(); ++e)
+        add({ring[e], ring[(e + 1) % ring.size()], apex});
+    add(std::move(ring));
+    return ConvexPolytope::fromFaces(std::move(faces));
+}
+
 using Overlaps = std::vector<std::pair<std::uint32_t, double>>;
 
 /// The cells whose pieces a remainder's parts must stay out of, and the overlap each cell still allows (a
@@ -232,11 +255,61 @@ public:
         return out;
     }
     /// How far the overlaps exceed what the cells still allow (0: they fit).
-    double excess(const Overlaps& o) const {
+    double excess(const Overlaps& o) const { return excessAt(o, epoch()); }
+    /// The same against what the cells allowed at an earlier epoch (the count of take() calls before it).
+    double excessAt(const Overlaps& o, std::size_t epoch) const {
+        const std::vector<double>& left = epoch < history_.size() ? history_[epoch] : left_;
         double e = 0;
         for (const auto& [c, v] : o)
-            e += std::max(0.0, v - left_[c]);
+            e += std::max(0.0, v - left[c]);
         return e;
+    }
+    std::size_t epoch() const { return history_.size(); }
+    /// A lower bound of excess(added(overlaps(hull(a ∪ b)), ownedA, ownedB)), without the hull: the cone from
+    /// a corner of one part over the other part lies in their joint hull (0 when nothing is proven).
+    double excessAtLeast(const ConvexPolytope& a, const Overlaps& ownedA, const ConvexPolytope& b,
+                         const Overlaps& ownedB) const {
+        Aabb joint = a.bounds();
+        joint.extend(b.bounds());
+        auto ownedIn = [](const Overlaps& o, std::size_t c) {
+            double v = 0;
+            for (const auto& [d, w] : o)
+                v += d == c ? w : 0;
+            return v;
+        };
+        for (int side = 0; side < 2; ++side) {
+            const ConvexPolytope& from = side == 0 ? a : b;
+            const ConvexPolytope& to = side == 0 ? b : a;
+            const Overlaps& ownedTo = side == 0 ? ownedB : ownedA;
+            std::vector<ConvexPolytope> cone; // built for the first cell that can overlap
+            for (std::size_t c = 0; c < cells_.size(); ++c) {
+                if (!(left_[c] < std::numeric_limits<double>::infinity()) || !joint.overlaps(bounds_[c]))
+                    continue;
+                if (cone.empty()) {
+                    // The apex: the corner of `from` nearest to this cell's box centre.
+                    const Vec3 g = bounds_[c].center();
+                    Vec3 apex = from.corners().front();
+                    for (const Vec3& p : from.corners())
+                        if (lengthSquared(p - g) < lengthSquared(apex - g))
+                            apex = p;
+                    const double flat = 1e-9 * joint.diagonal();
+                    for (const PolytopeFaceView& f : to.faces())
+                        if (f.plane.signedDistance(apex) > flat)
+                            cone.push_back(pyramid(f, apex));
+                    if (cone.empty())
+                        break;
+                }
+                double inside = ownedIn(ownedTo, c);
+                for (const ConvexPolytope& p : cone)
+                    inside += intersectCell(p, cells_[c]).volume();
+                // Margins for the rounding of two different clippings of the same volume.
+                const double before = ownedIn(ownedA, c) + ownedIn(ownedB, c);
+                const double e = inside - before - left_[c] * (1 + 1e-6) - 1e-9 * inside;
+                if (e > 0)
+                    return e;
+            }
+        }
+        return 0;
     }
     /// What a merged hull overlaps beyond what the two parts it replaces overlapped already.
     static Overlaps added(const Overlaps& merged, const Overlaps& a, const Overlaps& b) {
@@ -252,6 +325,7 @@ public:
         return out;
     }
     void take(const Overlaps& o) {
+        history_.push_back(left_);
         for (const auto& [c, v] : o)
             left_[c] -= v;
     }
@@ -288,6 +362,7 @@ private:
     const std::vector<ConvexPolytope>& cells_;
     const std::vector<Aabb>& bounds_;
     std::vector<double> left_;
+    std::vector<std::vector<double>> history_; // left_ before each take()
 };
 
 /// The points extreme in the 26 directions of a cube's faces, edges and corners (repeats removed).
@@ -458,8 +533,10 @@ void mergeToBudget(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t
     struct Candidate {
         double cost;
         std::size_t i, j;
-        std::uint32_t vi, vj; // versions of i and j when ranked
-        bool covers = false;  // its hull covers a crater beyond the guard's allowance; cost is that excess
+        std::uint32_t vi, vj;   // versions of i and j when ranked
+        bool covers = false;    // its hull covers a crater beyond the guard's allowance; cost is that excess
+        bool estimated = false; // covers by a lower bound: cost is a lower bound, its hull not yet computed
+        std::size_t epoch = 0;  // the guard's epoch when it was refused
         bool operator>(const Candidate& o) const { return covers != o.covers ? covers : cost > o.cost; }
     };
     struct Hull {
@@ -542,6 +619,24 @@ void mergeToBudget(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t
                 fn(std::min(byX[a], byX[b]), std::max(byX[a], byX[b]));
     };
     forEachNearPair(consider);
+    // Pairs refused by a lower bound get their true hull and excess once a covering pair is to be taken.
+    std::size_t estimated = 0;
+    auto settleEstimates = [&] {
+        std::vector<Candidate> settled;
+        for (Candidate& c : heap) {
+            if (c.estimated && alive[c.i] && alive[c.j] && version[c.i] == c.vi && version[c.j] == c.vj) {
+                const Hull* h = jointHull(c);
+                if (!h)
+                    continue;
+                c.cost = guard->excessAt(h->added, c.epoch);
+                c.estimated = false;
+            }
+            settled.push_back(c);
+        }
+        heap = std::move(settled);
+        std::make_heap(heap.begin(), heap.end(), std::greater<>());
+        estimated = 0;
+    };
     std::size_t count = n, limit = budget;
     std::vector<Candidate> picked;
     while (count > limit) {
@@ -552,6 +647,10 @@ void mergeToBudget(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t
             if (heap.front().covers && count <= stretch) {
                 limit = count; // a crater kept open is worth a few more parts
                 break;
+            }
+            if (heap.front().covers && estimated > 0) {
+                settleEstimates();
+                continue;
             }
             std::pop_heap(heap.begin(), heap.end(), std::greater<>());
             const Candidate c = heap.back();
@@ -572,17 +671,31 @@ void mergeToBudget(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t
         std::size_t best = picked.size();
         Hull* bestHull = nullptr;
         std::vector<bool> failed(picked.size(), false);
+        auto refuse = [&](Candidate& c, double e) { // ranked again behind the others
+            c.covers = true;
+            c.cost = e;
+            blocked[c.i].push_back(c.j);
+            blocked[c.j].push_back(c.i);
+            heap.push_back(c);
+            std::push_heap(heap.begin(), heap.end(), std::greater<>());
+        };
         for (std::size_t k = 0; k < picked.size(); ++k) {
-            Hull* h = jointHull(picked[k]);
+            Candidate& c = picked[k];
+            if (guard && !c.covers)
+                if (const double e = guard->excessAtLeast(parts[c.i], owned[c.i], parts[c.j], owned[c.j]);
+                    e > 0) {
+                    c.estimated = true;
+                    c.epoch = guard->epoch();
+                    ++estimated;
+                    refuse(c, e);
+                    failed[k] = true;
+                    continue;
+                }
+            Hull* h = jointHull(c);
             failed[k] = h == nullptr;
-            if (h && guard && !picked[k].covers) {
-                if (const double e = guard->excess(h->added); e > 0) { // ranked again behind the others
-                    picked[k].covers = true;
-                    picked[k].cost = e;
-                    blocked[picked[k].i].push_back(picked[k].j);
-                    blocked[picked[k].j].push_back(picked[k].i);
-                    heap.push_back(picked[k]);
-                    std::push_heap(heap.begin(), heap.end(), std::greater<>());
+            if (h && guard && !c.covers) {
+                if (const double e = guard->excess(h->added); e > 0) {
+                    refuse(c, e);
                     failed[k] = true;
                     continue;
                 }
