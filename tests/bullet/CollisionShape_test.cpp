@@ -7,6 +7,7 @@
 #include "rubble/bullet/CollisionShape.hpp"
 #include "rubble/bullet/Convert.hpp"
 #include "rubble/bullet/PhysicsWorld.hpp"
+#include "rubble/collision/ConvexDecomposition.hpp"
 #include "rubble/core/Random.hpp"
 #include "rubble/geometry/ConvexPolytope.hpp"
 #include "rubble/geometry/MassProperties.hpp"
@@ -34,6 +35,46 @@ TEST(CollisionShape, ErodedHullPlusMarginMatchesThePart) {
     EXPECT_NEAR(hi.y() + m, 0.5, 1e-5);
     EXPECT_NEAR(hi.z() + m, 2.0, 1e-5);
     EXPECT_EQ(shape->edges().size(), 12u);
+}
+
+// The core a hull collides with (its corners + the margin make the part): the part clipped by every face
+// plane moved in by the margin, found from the corners' planes instead of one clip per face.
+TEST(CollisionShape, CoreCornersAreThePartShrunkByTheMargin) {
+    auto clippedCore = [](const ConvexPolytope& part, double margin) {
+        ConvexPolytope out = part;
+        for (const PolytopeFaceView& f : part.faces())
+            out = out.clipped(Plane{f.plane.normal, f.plane.offset - margin});
+        return out;
+    };
+    Rng rng(7);
+    std::vector<ConvexPolytope> parts;
+    parts.push_back(ConvexPolytope::fromAabb(Aabb{{0, 0, 0}, {2, 1, 4}}));
+    parts.push_back(parts.back().clipped(Plane{normalized(Vec3{1, 1, 1}), 2.5}));
+    for (int k = 0; k < 40; ++k) {
+        std::vector<Vec3> points;
+        for (int i = 0; i < 8 + k; ++i)
+            points.push_back({rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)});
+        auto hull = convexHull(points);
+        ASSERT_TRUE(hull);
+        parts.push_back(std::move(hull).value());
+    }
+    double worstShare = 1;
+    for (const ConvexPolytope& part : parts) {
+        const double margin = 0.02;
+        const ConvexPolytope reference = clippedCore(part, margin);
+        const std::vector<Vec3> core = CollisionShape::coreCorners(part, margin);
+        ASSERT_GE(core.size(), 4u);
+        for (const Vec3& c : core) // never outside: hull + margin stays in the part
+            EXPECT_TRUE(reference.contains(c, 1e-9));
+        auto coreHull = convexHull(core);
+        ASSERT_TRUE(coreHull);
+        worstShare = std::min(worstShare, coreHull->volume() / reference.volume());
+    }
+    EXPECT_NEAR(CollisionShape::coreCorners(parts[0], 0.02).size(), 8u, 0);
+    EXPECT_GT(worstShare, 0.99); // and it misses little (only near faces narrower than the margin)
+    // Thinner than twice the margin: nothing left.
+    EXPECT_TRUE(
+        CollisionShape::coreCorners(ConvexPolytope::fromAabb(Aabb{{0, 0, 0}, {1, 1, 0.03}}), 0.02).empty());
 }
 
 // The debug edges are the parts' polygon edges in body coordinates, each corner held once, and every hull

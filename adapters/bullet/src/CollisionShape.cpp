@@ -36,6 +36,69 @@ ConvexPolytope eroded(const ConvexPolytope& part, double margin) {
     return out;
 }
 
+// The corners of the part shrunk by margin: where three moved-in face planes through one corner meet, inside
+// every moved plane. Complete while no face is narrower than the margin (a corner then comes from planes that
+// shared none, and the core is that much smaller); empty when fewer than four corners are found.
+std::vector<Vec3> shiftedCorners(const ConvexPolytope& part, double margin) {
+    constexpr std::size_t kMostFacesAtCorner = 24;
+    const std::vector<Vec3>& corners = part.corners();
+    std::vector<std::uint32_t> start(corners.size() + 1, 0); // faces at corner k: at[start[k], start[k + 1])
+    std::vector<Plane> planes;
+    planes.reserve(part.faces().size());
+    for (const PolytopeFaceView& f : part.faces()) {
+        planes.push_back({f.plane.normal, f.plane.offset - margin});
+        for (const Vec3& c : f.corners)
+            ++start[static_cast<std::size_t>(&c - corners.data()) + 1];
+    }
+    for (std::size_t k = 0; k < corners.size(); ++k)
+        start[k + 1] += start[k];
+    std::vector<std::uint32_t> at(start.back()), next(start.begin(), start.end() - 1);
+    std::uint32_t face = 0;
+    for (const PolytopeFaceView& f : part.faces()) {
+        for (const Vec3& c : f.corners)
+            at[next[static_cast<std::size_t>(&c - corners.data())]++] = face;
+        ++face;
+    }
+    const Aabb b = part.bounds();
+    const double tol = 1e-9 * std::max(1.0, std::max({std::abs(b.lo.x), std::abs(b.lo.y), std::abs(b.lo.z),
+                                                      std::abs(b.hi.x), std::abs(b.hi.y), std::abs(b.hi.z)}));
+    std::vector<Vec3> out;
+    for (std::size_t k = 0; k < corners.size(); ++k) {
+        const std::uint32_t* f = at.data() + start[k];
+        const std::size_t n = start[k + 1] - start[k];
+        if (n > kMostFacesAtCorner)
+            return {};
+        auto insideAll = [&](const Vec3& x, const std::uint32_t* ids, std::size_t count) {
+            for (std::size_t i = 0; i < count; ++i)
+                if (!(planes[ids[i]].signedDistance(x) <= tol))
+                    return false;
+            return true;
+        };
+        for (std::size_t i = 0; i < n; ++i)
+            for (std::size_t j = i + 1; j < n; ++j)
+                for (std::size_t l = j + 1; l < n; ++l) {
+                    const Plane& p = planes[f[i]];
+                    const Plane& q = planes[f[j]];
+                    const Plane& r = planes[f[l]];
+                    const Vec3 qr = cross(q.normal, r.normal), rp = cross(r.normal, p.normal),
+                               pq = cross(p.normal, q.normal);
+                    const double det = dot(p.normal, qr);
+                    if (!(std::abs(det) > 1e-9))
+                        continue;
+                    const Vec3 x = (qr * p.offset + rp * q.offset + pq * r.offset) / det;
+                    if (insideAll(x, f, n)) // near this corner first, then everywhere
+                        if (std::all_of(planes.begin(), planes.end(),
+                                        [&](const Plane& plane) { return plane.signedDistance(x) <= tol; }))
+                            out.push_back(x);
+                }
+    }
+    std::sort(out.begin(), out.end(), lexLess);
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    if (out.size() < 4)
+        return {};
+    return out;
+}
+
 // Directions spread evenly over the sphere (a Fibonacci lattice): where a capped hull's support is compared.
 const std::vector<Vec3>& sphereDirections() {
     static const std::vector<Vec3> directions = [] {
@@ -88,6 +151,14 @@ std::vector<Vec3> CollisionShape::cappedHullPoints(const std::vector<Vec3>& poin
             kept[d] = std::max(kept[d], dot(dirs[d], p));
     }
     return out.size() < 4 ? points : out;
+}
+
+std::vector<Vec3> CollisionShape::coreCorners(const ConvexPolytope& part, double margin) {
+    if (!(margin > 0))
+        return part.vertices();
+    if (std::vector<Vec3> fast = shiftedCorners(part, margin); !fast.empty())
+        return fast;
+    return eroded(part, margin).vertices();
 }
 
 CollisionShape::~CollisionShape() = default;
@@ -148,16 +219,16 @@ std::unique_ptr<CollisionShape> CollisionShape::fromParts(const std::vector<Conv
         const Aabb b = part.bounds();
         const Vec3 size = b.size();
         double m = std::min(margin, 0.2 * std::min({size.x, size.y, size.z}));
-        ConvexPolytope core = m > 0 ? eroded(part, m) : part;
+        std::vector<Vec3> core = coreCorners(part, m);
         for (int attempt = 0; attempt < 4 && core.empty() && m > 0; ++attempt) {
             m *= 0.25;
-            core = eroded(part, m);
+            core = coreCorners(part, m);
         }
         if (core.empty()) {
-            core = part;
+            core = part.vertices();
             m = 0;
         }
-        const std::vector<Vec3> verts = cappedHullPoints(core.vertices(), maxHullPoints);
+        const std::vector<Vec3> verts = cappedHullPoints(core, maxHullPoints);
         if (verts.size() < 4)
             continue;
         std::vector<btVector3> points; // copied once into a hull of exactly this size

@@ -32,6 +32,9 @@ public:
     /// their hull stays closest to that of all the points: a subset, so the capped hull lies inside the full
     /// one.
     static std::vector<Vec3> cappedHullPoints(const std::vector<Vec3>& points, int maxPoints);
+    /// The distinct corners of the part shrunk by margin along every face plane, sorted; empty when nothing
+    /// is left.
+    static std::vector<Vec3> coreCorners(const ConvexPolytope& part, double margin);
     /// A box of the given half extents centred on the body's origin.
     static std::unique_ptr<CollisionShape> box(const Vec3& halfExtents);
     /// A sphere of the given radius centred on the body's origin.
