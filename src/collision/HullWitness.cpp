@@ -28,21 +28,36 @@ double segmentDistance(const Vec3& p, const Vec3& a, const Vec3& b) {
 
 } // namespace
 
-std::vector<bool> usedVertices(const Mesh& mesh) {
-    std::vector<bool> used(mesh.positions.size(), false);
+std::vector<std::uint8_t> usedVertices(const Mesh& mesh) {
+    std::vector<std::uint8_t> used(mesh.positions.size(), 0);
     for (const Triangle& t : mesh.triangles)
         for (std::uint32_t v : t)
-            used[v] = true;
+            used[v] = 1;
     return used;
 }
 
 HullWitness::HullWitness(const Mesh& mesh, double reach)
-    : mesh_(mesh), reach_(reach), used_(usedVertices(mesh)) {
+    : mesh_(mesh), reach_(reach), used_(mesh.positions.size(), 0) {
+    // One pass over the triangles: the vertices they use, and those longer than reach (two rows across),
+    // which also give the points where the rows' centre lines cross them (their vertices alone leave rows
+    // empty).
+    const double reach2 = reach * reach;
+    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+        const Triangle& tri = mesh.triangles[t];
+        used_[tri[0]] = used_[tri[1]] = used_[tri[2]] = 1;
+        const Vec3 &p0 = mesh.positions[tri[0]], &p1 = mesh.positions[tri[1]], &p2 = mesh.positions[tri[2]];
+        const double longest =
+            std::max({lengthSquared(p1 - p0), lengthSquared(p2 - p1), lengthSquared(p0 - p2)});
+        if (longest > reach2)
+            large_.push_back(t);
+    }
     for (std::size_t v = 0; v < mesh.positions.size(); ++v)
         if (used_[v])
             box_.extend(mesh.positions[v]);
-    if (box_.empty() || !(reach > 0))
+    if (box_.empty() || !(reach > 0)) {
+        large_.clear();
         return;
+    }
     // Rows half of reach across: a point near the hull finds a row's segment near it among a few rows.
     const Vec3 extent = box_.size();
     for (int a = 0; a < 3; ++a) {
@@ -61,20 +76,14 @@ HullWitness::HullWitness(const Mesh& mesh, double reach)
         const int cell[3] = {cellOf(0, p.x), cellOf(1, p.y), cellOf(2, p.z)};
         for (int a = 0; a < 3; ++a) {
             const int b = (a + 1) % 3, c = (a + 2) % 3;
-            rows_[a][static_cast<std::size_t>(cell[b]) * cells_[c] + cell[c]].add(p, a);
+            rows_[a][static_cast<std::size_t>(cell[b]) * cells_[c] + cell[c]].add(
+                p[a], static_cast<std::uint32_t>(v));
         }
     }
-    // Triangles longer than reach (two rows across) also give the points where the rows' centre lines cross
-    // them; their vertices alone leave rows empty.
-    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    for (std::size_t t : large_) {
         const auto c = mesh.corners(t);
-        const double longest =
-            std::max({lengthSquared(c[1] - c[0]), lengthSquared(c[2] - c[1]), lengthSquared(c[0] - c[2])});
-        if (longest > reach * reach) {
-            large_.push_back(t);
-            for (int a = 0; a < 3; ++a)
-                crossRows(a, c[0], c[1], c[2]);
-        }
+        for (int a = 0; a < 3; ++a)
+            crossRows(a, c[0], c[1], c[2]);
     }
 }
 
@@ -96,7 +105,9 @@ void HullWitness::crossRows(int a, const Vec3& p0, const Vec3& p1, const Vec3& p
             if (w1 < 0 || w2 < 0 || w1 + w2 > 1)
                 continue;
             const Vec3 q = p0 + (p1 - p0) * w1 + (p2 - p0) * w2; // on the triangle
-            rows_[a][static_cast<std::size_t>(i) * cells_[c] + j].add(q, a);
+            rows_[a][static_cast<std::size_t>(i) * cells_[c] + j].add(
+                q[a], static_cast<std::uint32_t>(mesh_.positions.size() + crossings_.size()));
+            crossings_.push_back(q);
         }
 }
 
@@ -153,7 +164,7 @@ bool HullWitness::near(const Vec3& p) const {
     for (int a = 0; a < 3; ++a) {
         const int b = (a + 1) % 3, c = (a + 2) % 3;
         const Span& own = rows_[a][static_cast<std::size_t>(cellOf(b, p[b])) * cells_[c] + cellOf(c, p[c])];
-        if (own.set && segmentDistance(p, own.lo, own.hi) <= reach_)
+        if (own.set() && segmentDistance(p, pointOf(own.lo), pointOf(own.hi)) <= reach_)
             return true;
     }
     for (int a = 0; a < 3; ++a) {
@@ -163,7 +174,7 @@ bool HullWitness::near(const Vec3& p) const {
         for (int i = b0; i <= b1; ++i)
             for (int j = c0; j <= c1; ++j) {
                 const Span& s = rows_[a][static_cast<std::size_t>(i) * cells_[c] + j];
-                if (s.set && segmentDistance(p, s.lo, s.hi) <= reach_)
+                if (s.set() && segmentDistance(p, pointOf(s.lo), pointOf(s.hi)) <= reach_)
                     return true;
             }
     }
@@ -219,7 +230,7 @@ std::size_t keepNearHull(std::vector<ConvexPolytope>& parts, const Mesh& mesh, d
                 return false;
         return true;
     };
-    std::vector<bool> used;
+    std::vector<std::uint8_t> used;
     std::vector<ConvexPolytope> kept;
     kept.reserve(parts.size());
     std::size_t replaced = 0;

@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "rubble/geometry/ConvexPolytope.hpp"
@@ -15,8 +16,8 @@ namespace rubble::detail {
 /// margin for rounding).
 inline constexpr double kHullReachShare = 0.9;
 
-/// Which vertices the mesh's triangles use.
-std::vector<bool> usedVertices(const Mesh& mesh);
+/// Which vertices the mesh's triangles use (1 when used).
+std::vector<std::uint8_t> usedVertices(const Mesh& mesh);
 
 /// Witnesses that a point lies near a closed mesh's convex hull, from one pass over the mesh. The vertices
 /// go on the rows of three grids, one per axis: each row (a square tube along the axis) keeps its vertices
@@ -29,27 +30,37 @@ public:
     HullWitness(const Mesh& mesh, double reach);
     /// True when p provably lies within reach of the mesh's convex hull.
     bool near(const Vec3& p) const;
-    /// Which vertices the mesh's triangles use.
-    const std::vector<bool>& used() const { return used_; }
+    /// Which vertices the mesh's triangles use (1 when used).
+    const std::vector<std::uint8_t>& used() const { return used_; }
 
 private:
-    struct Span {
-        Vec3 lo, hi; // the row's points least and greatest along its axis
-        bool set = false;
-        void add(const Vec3& p, int axis) {
-            if (!set || p[axis] < lo[axis])
-                lo = p;
-            if (!set || p[axis] > hi[axis])
-                hi = p;
-            set = true;
+    struct Span { // the row's points least and greatest along its axis: their keys (that coordinate) and ids
+        double loKey = std::numeric_limits<double>::infinity();
+        double hiKey = -std::numeric_limits<double>::infinity();
+        std::uint32_t lo = 0, hi = 0;
+        bool set() const { return loKey <= hiKey; }
+        void add(double key, std::uint32_t id) {
+            if (key < loKey) {
+                loKey = key;
+                lo = id;
+            }
+            if (key > hiKey) {
+                hiKey = key;
+                hi = id;
+            }
         }
     };
+    // A row point's id: a vertex index, or the mesh's vertex count + an index into crossings_.
+    const Vec3& pointOf(std::uint32_t id) const {
+        return id < mesh_.positions.size() ? mesh_.positions[id] : crossings_[id - mesh_.positions.size()];
+    }
     const Mesh& mesh_;
     double reach_;
     Aabb box_;
     int cells_[3] = {1, 1, 1};
     double cell_[3] = {1, 1, 1};
-    std::vector<Span> rows_[3]; // rows_[a]: rows along axis a, indexed by the other two axes' cells
+    std::vector<Span> rows_[3];   // rows_[a]: rows along axis a, indexed by the other two axes' cells
+    std::vector<Vec3> crossings_; // points where long triangles cross rows' centre lines
     // Built on the first point that no row proves near (mutable: near() is the only use):
     mutable bool bucketsBuilt_ = false;
     mutable std::vector<std::size_t> large_;         // triangles longer than reach (by bucket once built)
@@ -60,7 +71,7 @@ private:
     // Puts the points where the centre lines of the rows along axis a cross triangle p0 p1 p2 on those rows.
     void crossRows(int a, const Vec3& p0, const Vec3& p1, const Vec3& p2);
     int bucketOf(int axis, double x) const;
-    std::vector<bool> used_;
+    std::vector<std::uint8_t> used_;
     int cellOf(int axis, double x) const;
 };
 
