@@ -206,7 +206,6 @@ void subtractUnion(const ConvexPolytope& region, const std::vector<ConvexPolytop
     subtractSequentially(region, cells, cellBounds, out);
 }
 
-/// Volume of a shape inside each cell it reaches: (cell index, volume).
 /// The pyramid over a face with its apex beyond the face's plane: the part of hull(face ∪ apex) outside the
 /// face.
 ConvexPolytope pyramid(const PolytopeFaceView& base, const Vec3& apex) {
@@ -230,6 +229,7 @@ ConvexPolytope pyramid(const PolytopeFaceView& base, const Vec3& apex) {
     return ConvexPolytope::fromFaces(std::move(faces));
 }
 
+/// Volume of a shape inside each cell it reaches: (cell index, volume).
 using Overlaps = std::vector<std::pair<std::uint32_t, double>>;
 
 /// The cells whose pieces a remainder's parts must stay out of, and the overlap each cell still allows (a
@@ -281,12 +281,12 @@ public:
             const ConvexPolytope& from = side == 0 ? a : b;
             const ConvexPolytope& to = side == 0 ? b : a;
             const Overlaps& ownedTo = side == 0 ? ownedB : ownedA;
-            std::vector<ConvexPolytope> cone; // built for the first cell that can overlap
+            std::vector<std::pair<double, ConvexPolytope>> cone; // (volume, pyramid), largest first
             for (std::size_t c = 0; c < cells_.size(); ++c) {
                 if (!(left_[c] < std::numeric_limits<double>::infinity()) || !joint.overlaps(bounds_[c]))
                     continue;
                 if (cone.empty()) {
-                    // The apex: the corner of `from` nearest to this cell's box centre.
+                    // The apex: the corner of `from` nearest to the first such cell's box centre.
                     const Vec3 g = bounds_[c].center();
                     Vec3 apex = from.corners().front();
                     for (const Vec3& p : from.corners())
@@ -294,19 +294,26 @@ public:
                             apex = p;
                     const double flat = 1e-9 * joint.diagonal();
                     for (const PolytopeFaceView& f : to.faces())
-                        if (f.plane.signedDistance(apex) > flat)
-                            cone.push_back(pyramid(f, apex));
+                        if (f.plane.signedDistance(apex) > flat) {
+                            ConvexPolytope p = pyramid(f, apex);
+                            const double v = p.volume();
+                            cone.emplace_back(v, std::move(p));
+                        }
                     if (cone.empty())
                         break;
+                    std::stable_sort(cone.begin(), cone.end(),
+                                     [](const auto& x, const auto& y) { return x.first > y.first; });
                 }
-                double inside = ownedIn(ownedTo, c);
-                for (const ConvexPolytope& p : cone)
-                    inside += intersectCell(p, cells_[c]).volume();
                 // Margins for the rounding of two different clippings of the same volume.
                 const double before = ownedIn(ownedA, c) + ownedIn(ownedB, c);
-                const double e = inside - before - left_[c] * (1 + 1e-6) - 1e-9 * inside;
-                if (e > 0)
-                    return e;
+                double inside = ownedIn(ownedTo, c);
+                for (const auto& [v, p] : cone) {
+                    if (!p.bounds().overlaps(bounds_[c]))
+                        continue;
+                    inside += intersectCell(p, cells_[c]).volume();
+                    if (const double e = inside - before - left_[c] * (1 + 1e-6) - 1e-9 * inside; e > 0)
+                        return e;
+                }
             }
         }
         return 0;
