@@ -50,11 +50,22 @@ void keepInsideHull(std::vector<ConvexPolytope>& parts, const ConvexPolytope& hu
         // (docs/collision.md, "The hull clip measured lazily").
         heap.clear();
         std::vector<Vec3> corners = part.vertices();
-        for (std::uint32_t i = 0; i < planes.size(); ++i)
+        // A plane that the part's box does not reach out of (with room for rounding) is not measured.
+        const Aabb box = part.bounds();
+        const Vec3 mid = box.center(), half = box.size() * 0.5;
+        const double room =
+            1e-12 * (std::abs(mid.x) + std::abs(mid.y) + std::abs(mid.z) + half.x + half.y + half.z);
+        for (std::uint32_t i = 0; i < planes.size(); ++i) {
+            const Vec3& n = planes[i].normal;
+            const double boxReach = planes[i].signedDistance(mid) + std::abs(n.x) * half.x +
+                                    std::abs(n.y) * half.y + std::abs(n.z) * half.z;
+            if (boxReach + room * (1 + std::abs(planes[i].offset)) <= margin)
+                continue;
             if (PlaneReach r = farthest(corners, planes[i], margin); r.reach > margin) {
                 r.plane = i;
                 heap.push_back(r);
             }
+        }
         std::make_heap(heap.begin(), heap.end());
         for (std::size_t round = 0; round < kMaxHullClips && !part.empty(); ++round) {
             if (round > 0)
