@@ -7,6 +7,7 @@
 #include <map>
 #include <numbers>
 #include <optional>
+#include <tuple>
 #include <unordered_map>
 
 #include "rubble/collision/ConvexDecomposition.hpp"
@@ -15,22 +16,30 @@ namespace rubble::detail {
 
 namespace {
 
+bool lexLess(const Vec3& a, const Vec3& b) {
+    return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
+}
+
 // How far a part reaches out of one hull plane, as of one round of keepInsideHull.
 struct PlaneReach {
     double reach = 0;        // the farthest corner's signed distance (an upper bound in later rounds)
     std::uint32_t plane = 0; // index into the hull's planes
-    std::size_t corner = 0;  // the first corner that reaches that far
+    Vec3 corner;             // the least corner (lexicographically) that reaches that far
     std::size_t round = 0;   // the round whose corners gave it
     bool operator<(const PlaneReach& o) const { return reach < o.reach; }
 };
 
-// The farthest corner out of plane, and the first one that reaches that far.
+// The farthest corner out of plane (beyond margin), the least one of those that reach that far.
 PlaneReach farthest(const std::vector<Vec3>& corners, const Plane& plane, double margin) {
-    PlaneReach r{margin};
-    for (std::size_t k = 0; k < corners.size(); ++k)
-        if (const double d = plane.signedDistance(corners[k]); d > r.reach) {
+    PlaneReach r;
+    r.reach = margin;
+    bool found = false;
+    for (const Vec3& c : corners)
+        if (const double d = plane.signedDistance(c);
+            d > r.reach || (found && d == r.reach && lexLess(c, r.corner))) {
             r.reach = d;
-            r.corner = k;
+            r.corner = c;
+            found = true;
         }
     return r;
 }
@@ -49,7 +58,7 @@ void keepInsideHull(std::vector<ConvexPolytope>& parts, const ConvexPolytope& hu
         // Clipped by the plane it reaches farthest out of, one at a time; earlier reaches are upper bounds
         // (docs/collision.md, "The hull clip measured lazily").
         heap.clear();
-        std::vector<Vec3> corners = part.vertices();
+        const std::vector<Vec3>* corners = &part.corners();
         // A plane that the part's box does not reach out of (with room for rounding) is not measured.
         const Aabb box = part.bounds();
         const Vec3 mid = box.center(), half = box.size() * 0.5;
@@ -61,7 +70,7 @@ void keepInsideHull(std::vector<ConvexPolytope>& parts, const ConvexPolytope& hu
                                     std::abs(n.y) * half.y + std::abs(n.z) * half.z;
             if (boxReach + room * (1 + std::abs(planes[i].offset)) <= margin)
                 continue;
-            if (PlaneReach r = farthest(corners, planes[i], margin); r.reach > margin) {
+            if (PlaneReach r = farthest(*corners, planes[i], margin); r.reach > margin) {
                 r.plane = i;
                 heap.push_back(r);
             }
@@ -69,7 +78,7 @@ void keepInsideHull(std::vector<ConvexPolytope>& parts, const ConvexPolytope& hu
         std::make_heap(heap.begin(), heap.end());
         for (std::size_t round = 0; round < kMaxHullClips && !part.empty(); ++round) {
             if (round > 0)
-                corners = part.vertices();
+                corners = &part.corners();
             std::optional<PlaneReach> worst;
             measured.clear();
             while (!heap.empty() && (!worst || heap.front().reach >= worst->reach)) {
@@ -78,7 +87,7 @@ void keepInsideHull(std::vector<ConvexPolytope>& parts, const ConvexPolytope& hu
                 heap.pop_back();
                 if (r.round != round) { // measured before the last clip: measure it again
                     const std::uint32_t plane = r.plane;
-                    r = farthest(corners, planes[plane], margin);
+                    r = farthest(*corners, planes[plane], margin);
                     r.plane = plane;
                     r.round = round;
                     if (r.reach > margin) {
@@ -88,8 +97,8 @@ void keepInsideHull(std::vector<ConvexPolytope>& parts, const ConvexPolytope& hu
                     continue;
                 }
                 if (!worst || r.reach > worst->reach ||
-                    (r.reach == worst->reach &&
-                     (r.corner < worst->corner || (r.corner == worst->corner && r.plane < worst->plane))))
+                    (r.reach == worst->reach && (lexLess(r.corner, worst->corner) ||
+                                                 (r.corner == worst->corner && r.plane < worst->plane))))
                     worst = r;
                 measured.push_back(r);
             }
