@@ -89,26 +89,31 @@ HullWitness::HullWitness(const Mesh& mesh, double reach)
 
 void HullWitness::crossRows(int a, const Vec3& p0, const Vec3& p1, const Vec3& p2) {
     const int b = (a + 1) % 3, c = (a + 2) % 3;
-    // The triangle projected along axis a: (b, c) coordinates and twice its signed area.
-    const double area = (p1[b] - p0[b]) * (p2[c] - p0[c]) - (p2[b] - p0[b]) * (p1[c] - p0[c]);
+    // The triangle projected along axis a: (b, c) coordinates of its edges and twice its signed area.
+    const double p0b = p0[b], p0c = p0[c];
+    const double e1b = p1[b] - p0b, e1c = p1[c] - p0c, e2b = p2[b] - p0b, e2c = p2[c] - p0c;
+    const double area = e1b * e2c - e2b * e1c;
     if (std::abs(area) <= 1e-12 * lengthSquared(p1 - p0 + p2 - p0))
         return;
-    const int b0 = cellOf(b, std::min({p0[b], p1[b], p2[b]})),
-              b1 = cellOf(b, std::max({p0[b], p1[b], p2[b]}));
-    const int c0 = cellOf(c, std::min({p0[c], p1[c], p2[c]})),
-              c1 = cellOf(c, std::max({p0[c], p1[c], p2[c]}));
-    for (int i = b0; i <= b1; ++i)
+    const int b0 = cellOf(b, std::min({p0b, p1[b], p2[b]})), b1 = cellOf(b, std::max({p0b, p1[b], p2[b]}));
+    const int c0 = cellOf(c, std::min({p0c, p1[c], p2[c]})), c1 = cellOf(c, std::max({p0c, p1[c], p2[c]}));
+    const Vec3 e1 = p1 - p0, e2 = p2 - p0;
+    const double loB = box_.lo[b], loC = box_.lo[c], cellB = cell_[b], cellC = cell_[c];
+    for (int i = b0; i <= b1; ++i) {
+        const double du = (loB + (i + 0.5) * cellB) - p0b;
+        const double du2 = du * e2c, du1 = du * e1c;
         for (int j = c0; j <= c1; ++j) {
-            const double u = box_.lo[b] + (i + 0.5) * cell_[b], v = box_.lo[c] + (j + 0.5) * cell_[c];
-            const double w1 = ((u - p0[b]) * (p2[c] - p0[c]) - (p2[b] - p0[b]) * (v - p0[c])) / area;
-            const double w2 = ((p1[b] - p0[b]) * (v - p0[c]) - (u - p0[b]) * (p1[c] - p0[c])) / area;
+            const double dv = (loC + (j + 0.5) * cellC) - p0c;
+            const double w1 = (du2 - e2b * dv) / area;
+            const double w2 = (e1b * dv - du1) / area;
             if (w1 < 0 || w2 < 0 || w1 + w2 > 1)
                 continue;
-            const Vec3 q = p0 + (p1 - p0) * w1 + (p2 - p0) * w2; // on the triangle
+            const Vec3 q = p0 + e1 * w1 + e2 * w2; // on the triangle
             rows_[a][static_cast<std::size_t>(i) * cells_[c] + j].add(
                 q[a], static_cast<std::uint32_t>(mesh_.positions.size() + crossings_.size()));
             crossings_.push_back(q);
         }
+    }
 }
 
 void HullWitness::buildBuckets() const {
