@@ -271,12 +271,6 @@ public:
                          const Overlaps& ownedB) const {
         Aabb joint = a.bounds();
         joint.extend(b.bounds());
-        auto ownedIn = [](const Overlaps& o, std::size_t c) {
-            double v = 0;
-            for (const auto& [d, w] : o)
-                v += d == c ? w : 0;
-            return v;
-        };
         for (int side = 0; side < 2; ++side) {
             const ConvexPolytope& from = side == 0 ? a : b;
             const ConvexPolytope& to = side == 0 ? b : a;
@@ -304,13 +298,13 @@ public:
                     std::stable_sort(cone.begin(), cone.end(),
                                      [](const auto& x, const auto& y) { return x.first > y.first; });
                 }
-                // Margins for the rounding of two different clippings of the same volume.
-                const double before = ownedIn(ownedA, c) + ownedIn(ownedB, c);
-                double inside = ownedIn(ownedTo, c);
+                const double before = inCell(ownedA, c) + inCell(ownedB, c);
+                double inside = inCell(ownedTo, c);
                 for (const auto& [v, p] : cone) {
                     if (!p.bounds().overlaps(bounds_[c]))
                         continue;
                     inside += intersectCell(p, cells_[c]).volume();
+                    // Margins for the rounding of two different clippings of the same volume.
                     if (const double e = inside - before - left_[c] * (1 + 1e-6) - 1e-9 * inside; e > 0)
                         return e;
                 }
@@ -322,10 +316,7 @@ public:
     static Overlaps added(const Overlaps& merged, const Overlaps& a, const Overlaps& b) {
         Overlaps out;
         for (const auto& [c, v] : merged) {
-            double before = 0;
-            for (const Overlaps* o : {&a, &b})
-                for (const auto& [d, w] : *o)
-                    before += d == c ? w : 0;
+            const double before = inCell(a, c) + inCell(b, c);
             if (v > before)
                 out.emplace_back(c, v - before);
         }
@@ -338,6 +329,13 @@ public:
     }
 
 private:
+    /// The overlap that o lists for cell c (0 when none).
+    static double inCell(const Overlaps& o, std::size_t c) {
+        double v = 0;
+        for (const auto& [d, w] : o)
+            v += d == c ? w : 0;
+        return v;
+    }
     /// True when a face plane of either polytope has the other's corners all beyond it by far more than the
     /// clipping's tolerance: their intersection is empty, without clipping.
     static bool separated(const ConvexPolytope& a, const Aabb& ab, const ConvexPolytope& b, const Aabb& bb) {
