@@ -38,9 +38,7 @@ std::vector<std::uint8_t> usedVertices(const Mesh& mesh) {
 
 HullWitness::HullWitness(const Mesh& mesh, double reach)
     : mesh_(mesh), reach_(reach), used_(mesh.positions.size(), 0) {
-    // One pass over the triangles: the vertices they use, and those longer than reach (two rows across),
-    // which also give the points where the rows' centre lines cross them (their vertices alone leave rows
-    // empty).
+    // One pass over the triangles: the used vertices, and the triangles longer than reach (crossRows).
     const double reach2 = reach * reach;
     for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
         const Triangle& tri = mesh.triangles[t];

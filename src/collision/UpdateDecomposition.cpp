@@ -206,8 +206,7 @@ void subtractUnion(const ConvexPolytope& region, const std::vector<ConvexPolytop
     subtractSequentially(region, cells, cellBounds, out);
 }
 
-/// The pyramid over a face with its apex beyond the face's plane: the part of hull(face ∪ apex) outside the
-/// face.
+/// The pyramid over a face to an apex beyond its plane.
 ConvexPolytope pyramid(const PolytopeFaceView& base, const Vec3& apex) {
     std::vector<Vec3> ring(base.corners.begin(), base.corners.end());
     Vec3 mid = apex;
@@ -265,8 +264,7 @@ public:
         return e;
     }
     std::size_t epoch() const { return history_.size(); }
-    /// A lower bound of excess(added(overlaps(hull(a ∪ b)), ownedA, ownedB)), without the hull: the cone from
-    /// a corner of one part over the other part lies in their joint hull (0 when nothing is proven).
+    /// A lower bound of the excess of hull(a ∪ b), from a cone inside it (docs/collision.md); 0: none proven.
     double excessAtLeast(const ConvexPolytope& a, const Overlaps& ownedA, const ConvexPolytope& b,
                          const Overlaps& ownedB) const {
         Aabb joint = a.bounds();

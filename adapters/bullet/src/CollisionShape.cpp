@@ -36,9 +36,7 @@ ConvexPolytope eroded(const ConvexPolytope& part, double margin) {
     return out;
 }
 
-// The corners of the part shrunk by margin: where three moved-in face planes through one corner meet, inside
-// every moved plane. Complete while no face is narrower than the margin (a corner then comes from planes that
-// shared none, and the core is that much smaller); empty when fewer than four corners are found.
+// The part's core corners from its corners' moved-in planes (docs/collision.md); empty when under four.
 std::vector<Vec3> shiftedCorners(const ConvexPolytope& part, double margin) {
     constexpr std::size_t kMostFacesAtCorner = 24;
     const std::vector<Vec3>& corners = part.corners();
