@@ -12,6 +12,7 @@
 
 #include "io/FileBytes.hpp"
 #include "persist/Bytes.hpp"
+#include "persist/CornerTable.hpp"
 #include "persist/RoughnessRecord.hpp"
 #include "persist/SnapshotInPlace.hpp"
 #include "rubble/fracture/Roughness.hpp"
@@ -30,14 +31,20 @@ constexpr bool kBulk = std::endian::native == std::endian::little && sizeof(Vec3
                        sizeof(Vec2) == 16 && sizeof(Vec3f) == 12 && sizeof(Vec2f) == 8 &&
                        sizeof(Triangle) == 12;
 
+// Writes v's items without a count: in bulk on little-endian machines, else with `each`.
 template <class T>
-void writeArray(ByteWriter& w, const std::vector<T>& v, auto&& each) {
-    w.u32(static_cast<std::uint32_t>(v.size()));
+void writeItems(ByteWriter& w, const std::vector<T>& v, auto&& each) {
     if constexpr (kBulk)
         w.bytes(v.data(), v.size() * sizeof(T));
     else
         for (const T& x : v)
             each(x);
+}
+// Writes v's count, then its items.
+template <class T>
+void writeArray(ByteWriter& w, const std::vector<T>& v, auto&& each) {
+    w.u32(static_cast<std::uint32_t>(v.size()));
+    writeItems(w, v, each);
 }
 
 // Reads n records of T (bytes each) in bulk when possible, else with `each`; then `check` every record
@@ -83,8 +90,8 @@ void checkFinite(ByteReader& r, const std::vector<T>& v, std::size_t start, cons
 }
 
 // 2: decomposition settings, each object's mesh hash, the volume ledger. 3: the structure. 4: roughness.
-// 5: normals and texture coordinates in float (read: 2 to 5).
-constexpr std::uint16_t kVersion = 5;
+// 5: normals and texture coordinates in float. 6: mesh corners and part corners each once (read: 2 to 6).
+constexpr std::uint16_t kVersion = 6;
 constexpr std::uint16_t kOldestVersion = 2;
 
 void vec(ByteWriter& w, const Vec3& v) {
@@ -172,6 +179,118 @@ std::string text(ByteReader& r, const std::uint8_t* data, const char* lengthFiel
     return s;
 }
 
+// Version 6: the positions, then each distinct corner once (CornerTable) and the triangles as its codes.
+void writeMesh(ByteWriter& w, const Mesh& m) {
+    writeArray(w, m.positions, [&](const Vec3& p) { vec(w, p); });
+    const std::size_t corners = 3 * m.triangles.size();
+    const bool normals = m.normals.size() == corners && corners > 0;
+    const bool uvs = m.uvs.size() == corners && corners > 0;
+    w.u32(static_cast<std::uint32_t>(m.triangles.size()));
+    w.u8(static_cast<std::uint8_t>((normals ? 1 : 0) | (uvs ? 2 : 0)));
+    if (!normals && !uvs) {
+        writeItems(w, m.triangles, [&](const Triangle& t) {
+            for (auto i : t)
+                w.u32(i);
+        });
+    } else {
+        const persist::CornerTable t = persist::cornerTable(m, normals, uvs);
+        writeArray(w, t.vertex, [&](std::uint32_t v) { w.u32(v); });
+        writeItems(w, t.normals, [&](const Vec3f& n) {
+            for (float x : {n.x, n.y, n.z})
+                w.f32(x);
+        });
+        writeItems(w, t.uvs, [&](const Vec2f& u) {
+            for (float x : {u.x, u.y})
+                w.f32(x);
+        });
+        writeItems(w, t.codes, [&](std::uint32_t c) { w.u32(c); });
+    }
+    writeArray(w, m.materials, [&](std::uint32_t id) { w.u32(id); });
+    w.u32(static_cast<std::uint32_t>(m.materialNames.size()));
+    for (const std::string& s : m.materialNames)
+        text(w, s);
+}
+
+// A part's corners in the order its faces first use them, bit-equal ones once (as fromFaces shares them), and
+// each face corner's index in that list: the same for a part and the part a load makes of it.
+struct PartCorners {
+    std::vector<const Vec3*> corners;
+    std::vector<std::uint32_t> index; // face after face
+};
+PartCorners partCorners(const ConvexPolytope& part) {
+    const Vec3* base = part.corners().data();
+    struct Use {
+        std::array<std::uint64_t, 3> bits;
+        std::uint32_t first; // the first face corner that uses it
+        std::uint32_t at;    // this face corner
+    };
+    std::vector<Use> uses;
+    for (const PolytopeFaceView& face : part.faces())
+        for (const Vec3& c : face.corners) {
+            const auto at = static_cast<std::uint32_t>(uses.size());
+            uses.push_back({{std::bit_cast<std::uint64_t>(c.x), std::bit_cast<std::uint64_t>(c.y),
+                             std::bit_cast<std::uint64_t>(c.z)},
+                            at,
+                            at});
+        }
+    std::vector<Use> sorted = uses;
+    std::sort(sorted.begin(), sorted.end(),
+              [](const Use& a, const Use& b) { return a.bits != b.bits ? a.bits < b.bits : a.at < b.at; });
+    for (std::size_t i = 1; i < sorted.size(); ++i)
+        if (sorted[i].bits == sorted[i - 1].bits)
+            sorted[i].first = sorted[i - 1].first;
+    for (const Use& u : sorted)
+        uses[u.at].first = u.first;
+    PartCorners out;
+    out.index.resize(uses.size());
+    std::vector<std::uint32_t> renumbered(uses.size(), ~std::uint32_t{0});
+    std::size_t at = 0;
+    for (const PolytopeFaceView& face : part.faces())
+        for (const Vec3& c : face.corners) {
+            std::uint32_t& n = renumbered[uses[at].first];
+            if (n == ~std::uint32_t{0}) {
+                n = static_cast<std::uint32_t>(out.corners.size());
+                out.corners.push_back(base + (&c - base));
+            }
+            out.index[at++] = n;
+        }
+    return out;
+}
+
+// Bytes of a corner index in a part of n corners (version 6).
+int indexBytes(std::size_t n) {
+    return n <= 256 ? 1 : n <= 65536 ? 2 : 4;
+}
+
+// Version 6: each part's corners once (partCorners), its faces as planes, tags and corner indices.
+void writeParts(ByteWriter& w, const std::vector<ConvexPolytope>& parts) {
+    w.u32(static_cast<std::uint32_t>(parts.size()));
+    for (const ConvexPolytope& part : parts) {
+        const PartCorners corners = partCorners(part);
+        w.u32(static_cast<std::uint32_t>(corners.corners.size()));
+        for (const Vec3* c : corners.corners)
+            vec(w, *c);
+        const int bytes = indexBytes(corners.corners.size());
+        std::size_t at = 0;
+        w.u32(static_cast<std::uint32_t>(part.faces().size()));
+        for (const PolytopeFaceView& face : part.faces()) {
+            vec(w, face.plane.normal);
+            w.f64(face.plane.offset);
+            w.i32(face.tag);
+            w.u32(static_cast<std::uint32_t>(face.corners.size()));
+            for (std::size_t k = 0; k < face.corners.size(); ++k) {
+                const std::uint32_t i = corners.index[at++];
+                if (bytes == 1)
+                    w.u8(static_cast<std::uint8_t>(i));
+                else if (bytes == 2)
+                    w.u16(static_cast<std::uint16_t>(i));
+                else
+                    w.u32(i);
+            }
+        }
+    }
+}
+
 void writeObject(ByteWriter& w, const ObjectState& o) {
     w.u32(o.id);
     w.u32(o.version);
@@ -197,38 +316,176 @@ void writeObject(ByteWriter& w, const ObjectState& o) {
     mat(w, o.mass.inertia);
     vec(w, o.mass.principalMoments);
     mat(w, o.mass.principalAxes);
-    const Mesh& m = o.mesh;
-    writeArray(w, m.positions, [&](const Vec3& p) { vec(w, p); });
-    writeArray(w, m.triangles, [&](const Triangle& t) {
-        for (auto i : t)
-            w.u32(i);
-    });
-    writeArray(w, m.normals, [&](const Vec3f& n) {
-        w.f32(n.x);
-        w.f32(n.y);
-        w.f32(n.z);
-    });
-    writeArray(w, m.uvs, [&](const Vec2f& u) {
-        w.f32(u.x);
-        w.f32(u.y);
-    });
-    writeArray(w, m.materials, [&](std::uint32_t id) { w.u32(id); });
-    w.u32(static_cast<std::uint32_t>(m.materialNames.size()));
-    for (const std::string& s : m.materialNames)
-        text(w, s);
-    w.u32(static_cast<std::uint32_t>(o.convexParts.size()));
-    for (const ConvexPolytope& part : o.convexParts) {
-        w.u32(static_cast<std::uint32_t>(part.faces().size()));
-        for (const PolytopeFaceView& face : part.faces()) {
-            vec(w, face.plane.normal);
-            w.f64(face.plane.offset);
-            w.i32(face.tag);
-            w.u32(static_cast<std::uint32_t>(face.corners.size()));
-            for (const Vec3& c : face.corners)
-                vec(w, c);
-        }
-    }
+    writeMesh(w, o.mesh);
+    writeParts(w, o.convexParts);
     text(w, o.warning);
+}
+
+// Reads the mesh's positions (every version).
+void readPositions(ByteReader& r, Mesh& m) {
+    const std::uint32_t n = r.count("mesh.positions.count", 24);
+    const std::size_t start = r.offset();
+    readArray(r, m.positions, n, "mesh.positions", [&] { return vec(r, "mesh.positions"); });
+    if (kBulk)
+        checkFinite(r, m.positions, start, "mesh.positions");
+}
+
+// Fails at the first vertex index of m's triangles (stored from `start`) beyond its positions.
+void checkTriangles(ByteReader& r, const Mesh& m, std::size_t start) {
+    for (std::size_t i = 0; i < m.triangles.size() && r.ok(); ++i)
+        for (int k = 0; k < 3; ++k)
+            if (m.triangles[i][k] >= m.positions.size()) {
+                r.fail(start + 12 * i + 4 * k, "mesh.triangles",
+                       "vertex index " + std::to_string(m.triangles[i][k]) + " out of range (" +
+                           std::to_string(m.positions.size()) + ")");
+                break;
+            }
+}
+
+// Reads the per-triangle material ids and the material names (every version).
+void readMaterials(ByteReader& r, const std::uint8_t* data, Mesh& m) {
+    const std::size_t pos = r.offset();
+    const std::uint32_t nMat = r.count("mesh.materials.count", 4);
+    if (r.ok() && nMat != 0 && nMat != m.triangles.size())
+        r.fail(pos, "mesh.materials.count",
+               std::to_string(nMat) + " entries for " + std::to_string(m.triangles.size()) + " triangles");
+    readArray(r, m.materials, r.ok() ? nMat : 0, "mesh.materials", [&] { return r.u32("mesh.materials"); });
+    const std::uint32_t nNames = r.count("mesh.materialNames.count", 4);
+    for (std::uint32_t i = 0; i < nNames && r.ok(); ++i)
+        m.materialNames.push_back(text(r, data, "mesh.materialNames.length", "mesh.materialNames"));
+}
+
+// Version 6 (writeMesh).
+void readMesh(ByteReader& r, const std::uint8_t* data, Mesh& m) {
+    readPositions(r, m);
+    const std::uint32_t nTri = r.count("mesh.triangles.count", 12);
+    std::size_t pos = r.offset();
+    const std::uint8_t attributes = r.u8("mesh.attributes");
+    if (r.ok() && attributes > 3)
+        r.fail(pos, "mesh.attributes", "is " + std::to_string(attributes) + ", expected 0 to 3");
+    if (r.ok() && attributes != 0 && nTri == 0)
+        r.fail(pos, "mesh.attributes", "is " + std::to_string(attributes) + " for a mesh without triangles");
+    if (!r.ok())
+        return;
+    if (attributes == 0) {
+        const std::size_t start = r.offset();
+        readArray(r, m.triangles, nTri, "mesh.triangles", [&] {
+            Triangle t{};
+            for (auto& v : t)
+                v = r.u32("mesh.triangles");
+            return t;
+        });
+        checkTriangles(r, m, start);
+    } else {
+        persist::CornerTable t;
+        const bool normals = attributes & 1, uvs = attributes & 2;
+        const std::uint32_t n = r.count("mesh.corners.count", 4 + (normals ? 12 : 0) + (uvs ? 8 : 0));
+        std::size_t start = r.offset();
+        readArray(r, t.vertex, n, "mesh.corners.vertex", [&] { return r.u32("mesh.corners.vertex"); });
+        if (const persist::CornerError e = persist::checkCornerVertices(t, m.positions.size());
+            r.ok() && !e.what.empty())
+            r.fail(start + 4 * e.index, "mesh.corners.vertex", e.what);
+        start = r.offset();
+        if (normals) {
+            readArray(r, t.normals, r.ok() ? n : 0, "mesh.corners.normals", [&] {
+                const float x = single(r, "mesh.corners.normals", ".x"),
+                            y = single(r, "mesh.corners.normals", ".y");
+                return Vec3f{x, y, single(r, "mesh.corners.normals", ".z")};
+            });
+            if (kBulk)
+                checkFinite(r, t.normals, start, "mesh.corners.normals");
+        }
+        start = r.offset();
+        if (uvs) {
+            readArray(r, t.uvs, r.ok() ? n : 0, "mesh.corners.uvs", [&] {
+                const float u = single(r, "mesh.corners.uvs", ".x");
+                return Vec2f{u, single(r, "mesh.corners.uvs", ".y")};
+            });
+            if (kBulk)
+                checkFinite(r, t.uvs, start, "mesh.corners.uvs");
+        }
+        start = r.offset();
+        if (r.ok() && 12ull * nTri > r.remaining())
+            r.fail(start, "mesh.triangles.codes",
+                   "file ends before its " + std::to_string(3ull * nTri) + " codes");
+        readArray(r, t.codes, r.ok() ? 3 * nTri : 0, "mesh.triangles.codes",
+                  [&] { return r.u32("mesh.triangles.codes"); });
+        if (r.ok())
+            if (const persist::CornerError e = persist::expandCorners(t, m.positions.size(), m);
+                !e.what.empty())
+                r.fail(start + 4 * e.index, "mesh.triangles.codes", e.what);
+    }
+    readMaterials(r, data, m);
+}
+
+// The first corner bit-equal to an earlier one, or corners.size().
+std::size_t repeatedCorner(const std::vector<Vec3>& corners) {
+    std::vector<std::pair<std::array<std::uint64_t, 3>, std::size_t>> bits;
+    bits.reserve(corners.size());
+    for (std::size_t i = 0; i < corners.size(); ++i)
+        bits.push_back(
+            {{std::bit_cast<std::uint64_t>(corners[i].x), std::bit_cast<std::uint64_t>(corners[i].y),
+              std::bit_cast<std::uint64_t>(corners[i].z)},
+             i});
+    std::sort(bits.begin(), bits.end());
+    std::size_t first = corners.size();
+    for (std::size_t i = 1; i < bits.size(); ++i)
+        if (bits[i].first == bits[i - 1].first)
+            first = std::min(first, bits[i].second);
+    return first;
+}
+
+// Version 6 (writeParts): the polytopes fromFaces makes of the faces with their corners, as before it.
+std::vector<ConvexPolytope> readParts(ByteReader& r) {
+    std::vector<ConvexPolytope> parts;
+    const std::uint32_t nParts = r.count("convexParts.count", 8);
+    parts.reserve(nParts);
+    for (std::uint32_t i = 0; i < nParts && r.ok(); ++i) {
+        const std::uint32_t nCorners = r.count("convexParts.corners.count", 24);
+        std::vector<Vec3> corners;
+        corners.reserve(nCorners);
+        for (std::uint32_t c = 0; c < nCorners && r.ok(); ++c)
+            corners.push_back(vec(r, "convexParts.corners"));
+        if (r.ok())
+            if (const std::size_t twin = repeatedCorner(corners); twin < corners.size())
+                r.fail(r.offset() - 24 * (corners.size() - twin), "convexParts.corners",
+                       "corner " + std::to_string(twin) + " repeats an earlier one");
+        const int bytes = indexBytes(nCorners);
+        std::uint32_t used = 0; // corners come in the order the faces first use them
+        const std::uint32_t nFaces = r.count("convexParts.faces.count", 40);
+        std::vector<PolytopeFace> faces;
+        faces.reserve(nFaces);
+        for (std::uint32_t k = 0; k < nFaces && r.ok(); ++k) {
+            PolytopeFace face;
+            face.plane.normal = vec(r, "convexParts.plane.normal");
+            face.plane.offset = real(r, "convexParts.plane.offset");
+            face.tag = r.i32("convexParts.tag");
+            const std::uint32_t n =
+                r.count("convexParts.face.corners.count", static_cast<std::size_t>(bytes));
+            face.corners.reserve(n);
+            for (std::uint32_t c = 0; c < n && r.ok(); ++c) {
+                const std::size_t at = r.offset();
+                const std::uint32_t index = bytes == 1   ? r.u8("convexParts.face.corners")
+                                            : bytes == 2 ? r.u16("convexParts.face.corners")
+                                                         : r.u32("convexParts.face.corners");
+                if (r.ok() && (index >= nCorners || index > used))
+                    r.fail(at, "convexParts.face.corners",
+                           "corner " + std::to_string(index) +
+                               (index >= nCorners ? " out of range (" : " before its turn (") +
+                               std::to_string(index >= nCorners ? nCorners : used) + ")");
+                if (!r.ok())
+                    break;
+                used += index == used;
+                face.corners.push_back(corners[index]);
+            }
+            faces.push_back(std::move(face));
+        }
+        if (r.ok() && used != nCorners)
+            r.fail(r.offset(), "convexParts.corners",
+                   std::to_string(nCorners - used) + " corners are never used");
+        parts.push_back(ConvexPolytope::fromFaces(std::move(faces)));
+    }
+    return parts;
 }
 
 ObjectState readObject(ByteReader& r, const std::uint8_t* data, std::uint16_t version) {
@@ -286,103 +543,93 @@ ObjectState readObject(ByteReader& r, const std::uint8_t* data, std::uint16_t ve
     o.mass.principalMoments = vec(r, "mass.principalMoments");
     o.mass.principalAxes = mat(r, "mass.principalAxes");
     Mesh& m = o.mesh;
-    const std::uint32_t nPos = r.count("mesh.positions.count", 24);
-    std::size_t start = r.offset();
-    readArray(r, m.positions, nPos, "mesh.positions", [&] { return vec(r, "mesh.positions"); });
-    if (kBulk)
-        checkFinite(r, m.positions, start, "mesh.positions");
-    const std::uint32_t nTri = r.count("mesh.triangles.count", 12);
-    start = r.offset();
-    readArray(r, m.triangles, nTri, "mesh.triangles", [&] {
-        Triangle t{};
-        for (auto& v : t)
-            v = r.u32("mesh.triangles");
-        return t;
-    });
-    for (std::size_t i = 0; i < m.triangles.size() && r.ok(); ++i)
-        for (int k = 0; k < 3; ++k)
-            if (m.triangles[i][k] >= nPos) {
-                r.fail(start + 12 * i + 4 * k, "mesh.triangles",
-                       "vertex index " + std::to_string(m.triangles[i][k]) + " out of range (" +
-                           std::to_string(nPos) + ")");
-                break;
-            }
-    auto perCorner = [&](std::uint32_t n, const char* field, std::size_t where) {
-        if (r.ok() && n != 0 && n != 3ull * nTri)
-            r.fail(where, field, std::to_string(n) + " entries for " + std::to_string(nTri) + " triangles");
-    };
-    // Per-corner attributes: float from version 5, double before (rounded to float here).
-    const bool floats = version >= 5;
-    pos = r.offset();
-    const std::uint32_t nNormals = r.count("mesh.normals.count", floats ? 12 : 24);
-    perCorner(nNormals, "mesh.normals.count", pos);
-    start = r.offset();
-    if (floats) {
-        readArray(r, m.normals, r.ok() ? nNormals : 0, "mesh.normals", [&] {
-            const float x = single(r, "mesh.normals", ".x"), y = single(r, "mesh.normals", ".y");
-            return Vec3f{x, y, single(r, "mesh.normals", ".z")};
-        });
-        if (kBulk)
-            checkFinite(r, m.normals, start, "mesh.normals");
+    if (version >= 6) {
+        readMesh(r, data, m);
     } else {
-        std::vector<Vec3> wide;
-        readArray(r, wide, r.ok() ? nNormals : 0, "mesh.normals", [&] { return vec(r, "mesh.normals"); });
-        if (kBulk)
-            checkFinite(r, wide, start, "mesh.normals");
-        narrow(r, wide, m.normals, start, "mesh.normals");
-    }
-    pos = r.offset();
-    const std::uint32_t nUvs = r.count("mesh.uvs.count", floats ? 8 : 16);
-    perCorner(nUvs, "mesh.uvs.count", pos);
-    start = r.offset();
-    if (floats) {
-        readArray(r, m.uvs, r.ok() ? nUvs : 0, "mesh.uvs", [&] {
-            const float u = single(r, "mesh.uvs", ".x");
-            return Vec2f{u, single(r, "mesh.uvs", ".y")};
+        readPositions(r, m);
+        const std::uint32_t nTri = r.count("mesh.triangles.count", 12);
+        std::size_t start = r.offset();
+        readArray(r, m.triangles, nTri, "mesh.triangles", [&] {
+            Triangle t{};
+            for (auto& v : t)
+                v = r.u32("mesh.triangles");
+            return t;
         });
-        if (kBulk)
-            checkFinite(r, m.uvs, start, "mesh.uvs");
-    } else {
-        std::vector<Vec2> wide;
-        readArray(r, wide, r.ok() ? nUvs : 0, "mesh.uvs", [&] {
-            Vec2 u;
-            u.x = real(r, "mesh.uvs", ".x");
-            u.y = real(r, "mesh.uvs", ".y");
-            return u;
-        });
-        if (kBulk)
-            checkFinite(r, wide, start, "mesh.uvs");
-        narrow(r, wide, m.uvs, start, "mesh.uvs");
-    }
-    pos = r.offset();
-    const std::uint32_t nMat = r.count("mesh.materials.count", 4);
-    if (r.ok() && nMat != 0 && nMat != nTri)
-        r.fail(pos, "mesh.materials.count",
-               std::to_string(nMat) + " entries for " + std::to_string(nTri) + " triangles");
-    readArray(r, m.materials, r.ok() ? nMat : 0, "mesh.materials", [&] { return r.u32("mesh.materials"); });
-    const std::uint32_t nNames = r.count("mesh.materialNames.count", 4);
-    for (std::uint32_t i = 0; i < nNames && r.ok(); ++i)
-        m.materialNames.push_back(text(r, data, "mesh.materialNames.length", "mesh.materialNames"));
-    if (!floats && r.ok() && (m.hasNormals() || m.hasUvs()))
-        o.meshHash = m.hash(); // the saved hash was of the attributes in double
-    const std::uint32_t nParts = r.count("convexParts.count", 4);
-    o.convexParts.reserve(nParts);
-    for (std::uint32_t i = 0; i < nParts && r.ok(); ++i) {
-        const std::uint32_t nFaces = r.count("convexParts.faces.count", 40);
-        std::vector<PolytopeFace> faces;
-        faces.reserve(nFaces);
-        for (std::uint32_t k = 0; k < nFaces && r.ok(); ++k) {
-            PolytopeFace face;
-            face.plane.normal = vec(r, "convexParts.plane.normal");
-            face.plane.offset = real(r, "convexParts.plane.offset");
-            face.tag = r.i32("convexParts.tag");
-            const std::uint32_t nCorners = r.count("convexParts.corners.count", 24);
-            face.corners.reserve(nCorners);
-            for (std::uint32_t c = 0; c < nCorners && r.ok(); ++c)
-                face.corners.push_back(vec(r, "convexParts.corners"));
-            faces.push_back(std::move(face));
+        checkTriangles(r, m, start);
+        auto perCorner = [&](std::uint32_t n, const char* field, std::size_t where) {
+            if (r.ok() && n != 0 && n != 3ull * nTri)
+                r.fail(where, field,
+                       std::to_string(n) + " entries for " + std::to_string(nTri) + " triangles");
+        };
+        // Per-corner attributes: float from version 5, double before (rounded to float here).
+        const bool floats = version >= 5;
+        pos = r.offset();
+        const std::uint32_t nNormals = r.count("mesh.normals.count", floats ? 12 : 24);
+        perCorner(nNormals, "mesh.normals.count", pos);
+        start = r.offset();
+        if (floats) {
+            readArray(r, m.normals, r.ok() ? nNormals : 0, "mesh.normals", [&] {
+                const float x = single(r, "mesh.normals", ".x"), y = single(r, "mesh.normals", ".y");
+                return Vec3f{x, y, single(r, "mesh.normals", ".z")};
+            });
+            if (kBulk)
+                checkFinite(r, m.normals, start, "mesh.normals");
+        } else {
+            std::vector<Vec3> wide;
+            readArray(r, wide, r.ok() ? nNormals : 0, "mesh.normals", [&] { return vec(r, "mesh.normals"); });
+            if (kBulk)
+                checkFinite(r, wide, start, "mesh.normals");
+            narrow(r, wide, m.normals, start, "mesh.normals");
         }
-        o.convexParts.push_back(ConvexPolytope::fromFaces(std::move(faces)));
+        pos = r.offset();
+        const std::uint32_t nUvs = r.count("mesh.uvs.count", floats ? 8 : 16);
+        perCorner(nUvs, "mesh.uvs.count", pos);
+        start = r.offset();
+        if (floats) {
+            readArray(r, m.uvs, r.ok() ? nUvs : 0, "mesh.uvs", [&] {
+                const float u = single(r, "mesh.uvs", ".x");
+                return Vec2f{u, single(r, "mesh.uvs", ".y")};
+            });
+            if (kBulk)
+                checkFinite(r, m.uvs, start, "mesh.uvs");
+        } else {
+            std::vector<Vec2> wide;
+            readArray(r, wide, r.ok() ? nUvs : 0, "mesh.uvs", [&] {
+                Vec2 u;
+                u.x = real(r, "mesh.uvs", ".x");
+                u.y = real(r, "mesh.uvs", ".y");
+                return u;
+            });
+            if (kBulk)
+                checkFinite(r, wide, start, "mesh.uvs");
+            narrow(r, wide, m.uvs, start, "mesh.uvs");
+        }
+        readMaterials(r, data, m);
+        if (!floats && r.ok() && (m.hasNormals() || m.hasUvs()))
+            o.meshHash = m.hash(); // the saved hash was of the attributes in double
+    }
+    if (version >= 6) {
+        o.convexParts = readParts(r);
+    } else {
+        const std::uint32_t nParts = r.count("convexParts.count", 4);
+        o.convexParts.reserve(nParts);
+        for (std::uint32_t i = 0; i < nParts && r.ok(); ++i) {
+            const std::uint32_t nFaces = r.count("convexParts.faces.count", 40);
+            std::vector<PolytopeFace> faces;
+            faces.reserve(nFaces);
+            for (std::uint32_t k = 0; k < nFaces && r.ok(); ++k) {
+                PolytopeFace face;
+                face.plane.normal = vec(r, "convexParts.plane.normal");
+                face.plane.offset = real(r, "convexParts.plane.offset");
+                face.tag = r.i32("convexParts.tag");
+                const std::uint32_t nCorners = r.count("convexParts.corners.count", 24);
+                face.corners.reserve(nCorners);
+                for (std::uint32_t c = 0; c < nCorners && r.ok(); ++c)
+                    face.corners.push_back(vec(r, "convexParts.corners"));
+                faces.push_back(std::move(face));
+            }
+            o.convexParts.push_back(ConvexPolytope::fromFaces(std::move(faces)));
+        }
     }
     o.warning = text(r, data, "warning.length", "warning");
     return o;

@@ -114,7 +114,7 @@ TEST(Snapshot, KeepsNormalsAndTextureCoordinatesExactly) {
 }
 
 // A version-4 file (attributes in double, saved by the build before float attributes) still loads: its
-// attributes rounded to float, its mesh hash that of the rounded mesh; saving it again writes version 5.
+// attributes rounded to float, its mesh hash that of the rounded mesh; saving it again writes version 6.
 TEST(Snapshot, AVersion4FileLoadsWithItsAttributesRoundedToFloat) {
     const std::filesystem::path v4 = test::sourceDir() / "tests/data/snapshot/v4-box-attributes.rsnap";
     Result<Snapshot> r = loadSnapshot(v4);
@@ -128,7 +128,7 @@ TEST(Snapshot, AVersion4FileLoadsWithItsAttributesRoundedToFloat) {
     EXPECT_EQ(o.mesh.materials, want.materials);
     EXPECT_EQ(o.meshHash, want.hash());
     const std::vector<std::uint8_t> again = encodeSnapshot(*r);
-    EXPECT_EQ(again[4] | again[5] << 8, 5);
+    EXPECT_EQ(again[4] | again[5] << 8, 6);
     Result<Snapshot> reloaded = decodeSnapshot(again.data(), again.size(), "again.rsnap");
     ASSERT_TRUE(reloaded) << reloaded.error().message;
     EXPECT_EQ(reloaded->world.objects[0].mesh, o.mesh);
@@ -465,8 +465,8 @@ TEST(Snapshot, DamagedFilesAreRefusedNamingOffsetAndFieldAndTheWorldStaysAsItWas
     refused(b, "field crc32: checksum mismatch");
     // Another version, another format.
     b = bytes;
-    b[4] = 6;
-    refused(b, "offset 4, field version: version 6 is not supported");
+    b[4] = 7;
+    refused(b, "offset 4, field version: version 7 is not supported");
     b = bytes;
     b[0] = 'X';
     refused(b, "offset 0, field magic");
@@ -482,11 +482,19 @@ TEST(Snapshot, DamagedFilesAreRefusedNamingOffsetAndFieldAndTheWorldStaysAsItWas
     const std::size_t meshAt = firstObject + 4 + 4 + 8 + 1 + 8 + 8 + 8 + 1 + 4 + 4 + 40 + 1 + 8 + 8 + 1 +
                                roughness + 8 + 24 + 72 + 24 + 72; // positions.count
     const std::uint32_t nPos = m.snapshot.world.objects[0].mesh.positions.size();
-    const std::size_t firstIndex = meshAt + 4 + 24 * nPos + 4;
+    const Mesh& mesh0 = m.snapshot.world.objects[0].mesh;
+    const bool corners = mesh0.hasNormals() || mesh0.hasUvs(); // a corner table (version 6) before triangles
+    const std::size_t attributesAt = meshAt + 4 + 24 * nPos + 4;
+    const std::size_t firstIndex = attributesAt + 1 + (corners ? 4 : 0);
     b = bytes;
     b[firstIndex + 2] = 0x10;
     refix(b);
-    refused(b, "offset " + std::to_string(firstIndex) + ", field objects[0].mesh.triangles: vertex index");
+    refused(b, "offset " + std::to_string(firstIndex) + ", field objects[0].mesh." +
+                   (corners ? "corners.vertex" : "triangles") + ": vertex index");
+    b = bytes;
+    b[attributesAt] = 4;
+    refix(b);
+    refused(b, "offset " + std::to_string(attributesAt) + ", field objects[0].mesh.attributes: is 4");
     b = bytes;
     for (int k = 0; k < 8; ++k)
         b[meshAt + 4 + k] = 0xFF; // positions[0].x = NaN
