@@ -218,7 +218,6 @@ struct PartCorners {
     std::vector<std::uint32_t> index; // face after face
 };
 PartCorners partCorners(const ConvexPolytope& part) {
-    const Vec3* base = part.corners().data();
     struct Use {
         std::array<std::uint64_t, 3> bits;
         std::uint32_t first; // the first face corner that uses it
@@ -250,7 +249,7 @@ PartCorners partCorners(const ConvexPolytope& part) {
             std::uint32_t& n = renumbered[uses[at].first];
             if (n == ~std::uint32_t{0}) {
                 n = static_cast<std::uint32_t>(out.corners.size());
-                out.corners.push_back(base + (&c - base));
+                out.corners.push_back(&c);
             }
             out.index[at++] = n;
         }
@@ -321,6 +320,28 @@ void writeObject(ByteWriter& w, const ObjectState& o) {
     text(w, o.warning);
 }
 
+// Reads n float normals (none after a failure), failing at the first non-finite one.
+void readNormals(ByteReader& r, std::vector<Vec3f>& v, std::uint32_t n, const char* field) {
+    const std::size_t start = r.offset();
+    readArray(r, v, r.ok() ? n : 0, field, [&] {
+        const float x = single(r, field, ".x"), y = single(r, field, ".y");
+        return Vec3f{x, y, single(r, field, ".z")};
+    });
+    if (kBulk)
+        checkFinite(r, v, start, field);
+}
+
+// Reads n float texture coordinates (none after a failure), failing at the first non-finite one.
+void readUvs(ByteReader& r, std::vector<Vec2f>& v, std::uint32_t n, const char* field) {
+    const std::size_t start = r.offset();
+    readArray(r, v, r.ok() ? n : 0, field, [&] {
+        const float u = single(r, field, ".x");
+        return Vec2f{u, single(r, field, ".y")};
+    });
+    if (kBulk)
+        checkFinite(r, v, start, field);
+}
+
 // Reads the mesh's positions (every version).
 void readPositions(ByteReader& r, Mesh& m) {
     const std::uint32_t n = r.count("mesh.positions.count", 24);
@@ -330,8 +351,15 @@ void readPositions(ByteReader& r, Mesh& m) {
         checkFinite(r, m.positions, start, "mesh.positions");
 }
 
-// Fails at the first vertex index of m's triangles (stored from `start`) beyond its positions.
-void checkTriangles(ByteReader& r, const Mesh& m, std::size_t start) {
+// Reads n triangles, failing at the first vertex index beyond m's positions.
+void readTriangles(ByteReader& r, Mesh& m, std::uint32_t n) {
+    const std::size_t start = r.offset();
+    readArray(r, m.triangles, n, "mesh.triangles", [&] {
+        Triangle t{};
+        for (auto& v : t)
+            v = r.u32("mesh.triangles");
+        return t;
+    });
     for (std::size_t i = 0; i < m.triangles.size() && r.ok(); ++i)
         for (int k = 0; k < 3; ++k)
             if (m.triangles[i][k] >= m.positions.size()) {
@@ -368,14 +396,7 @@ void readMesh(ByteReader& r, const std::uint8_t* data, Mesh& m) {
     if (!r.ok())
         return;
     if (attributes == 0) {
-        const std::size_t start = r.offset();
-        readArray(r, m.triangles, nTri, "mesh.triangles", [&] {
-            Triangle t{};
-            for (auto& v : t)
-                v = r.u32("mesh.triangles");
-            return t;
-        });
-        checkTriangles(r, m, start);
+        readTriangles(r, m, nTri);
     } else {
         persist::CornerTable t;
         const bool normals = attributes & 1, uvs = attributes & 2;
@@ -386,24 +407,10 @@ void readMesh(ByteReader& r, const std::uint8_t* data, Mesh& m) {
             r.ok() && !e.what.empty())
             r.fail(start + 4 * e.index, "mesh.corners.vertex", e.what);
         start = r.offset();
-        if (normals) {
-            readArray(r, t.normals, r.ok() ? n : 0, "mesh.corners.normals", [&] {
-                const float x = single(r, "mesh.corners.normals", ".x"),
-                            y = single(r, "mesh.corners.normals", ".y");
-                return Vec3f{x, y, single(r, "mesh.corners.normals", ".z")};
-            });
-            if (kBulk)
-                checkFinite(r, t.normals, start, "mesh.corners.normals");
-        }
-        start = r.offset();
-        if (uvs) {
-            readArray(r, t.uvs, r.ok() ? n : 0, "mesh.corners.uvs", [&] {
-                const float u = single(r, "mesh.corners.uvs", ".x");
-                return Vec2f{u, single(r, "mesh.corners.uvs", ".y")};
-            });
-            if (kBulk)
-                checkFinite(r, t.uvs, start, "mesh.corners.uvs");
-        }
+        if (normals)
+            readNormals(r, t.normals, n, "mesh.corners.normals");
+        if (uvs)
+            readUvs(r, t.uvs, n, "mesh.corners.uvs");
         start = r.offset();
         if (r.ok() && 12ull * nTri > r.remaining())
             r.fail(start, "mesh.triangles.codes",
@@ -435,14 +442,16 @@ std::size_t repeatedCorner(const std::vector<Vec3>& corners) {
     return first;
 }
 
-// Version 6 (writeParts): the polytopes fromFaces makes of the faces with their corners, as before it.
-std::vector<ConvexPolytope> readParts(ByteReader& r) {
+// The convex parts (version 6: writeParts; before, each face with its corners' coordinates): the polytopes
+// fromFaces makes of the faces with their corners.
+std::vector<ConvexPolytope> readParts(ByteReader& r, std::uint16_t version) {
+    const bool shared = version >= 6;
     std::vector<ConvexPolytope> parts;
-    const std::uint32_t nParts = r.count("convexParts.count", 8);
+    const std::uint32_t nParts = r.count("convexParts.count", shared ? 8 : 4);
     parts.reserve(nParts);
     for (std::uint32_t i = 0; i < nParts && r.ok(); ++i) {
-        const std::uint32_t nCorners = r.count("convexParts.corners.count", 24);
         std::vector<Vec3> corners;
+        const std::uint32_t nCorners = shared ? r.count("convexParts.corners.count", 24) : 0;
         corners.reserve(nCorners);
         for (std::uint32_t c = 0; c < nCorners && r.ok(); ++c)
             corners.push_back(vec(r, "convexParts.corners"));
@@ -460,6 +469,14 @@ std::vector<ConvexPolytope> readParts(ByteReader& r) {
             face.plane.normal = vec(r, "convexParts.plane.normal");
             face.plane.offset = real(r, "convexParts.plane.offset");
             face.tag = r.i32("convexParts.tag");
+            if (!shared) {
+                const std::uint32_t n = r.count("convexParts.corners.count", 24);
+                face.corners.reserve(n);
+                for (std::uint32_t c = 0; c < n && r.ok(); ++c)
+                    face.corners.push_back(vec(r, "convexParts.corners"));
+                faces.push_back(std::move(face));
+                continue;
+            }
             const std::uint32_t n =
                 r.count("convexParts.face.corners.count", static_cast<std::size_t>(bytes));
             face.corners.reserve(n);
@@ -486,6 +503,54 @@ std::vector<ConvexPolytope> readParts(ByteReader& r) {
         parts.push_back(ConvexPolytope::fromFaces(std::move(faces)));
     }
     return parts;
+}
+
+// Versions 2 to 5: each mesh array with its count; attributes per corner, in double before version 5.
+void readMeshBefore6(ByteReader& r, const std::uint8_t* data, std::uint16_t version, ObjectState& o) {
+    Mesh& m = o.mesh;
+    readPositions(r, m);
+    const std::uint32_t nTri = r.count("mesh.triangles.count", 12);
+    readTriangles(r, m, nTri);
+    auto perCorner = [&](std::uint32_t n, const char* field, std::size_t where) {
+        if (r.ok() && n != 0 && n != 3ull * nTri)
+            r.fail(where, field, std::to_string(n) + " entries for " + std::to_string(nTri) + " triangles");
+    };
+    // Per-corner attributes: float from version 5, double before (rounded to float here).
+    const bool floats = version >= 5;
+    std::size_t pos = r.offset();
+    const std::uint32_t nNormals = r.count("mesh.normals.count", floats ? 12 : 24);
+    perCorner(nNormals, "mesh.normals.count", pos);
+    std::size_t start = r.offset();
+    if (floats) {
+        readNormals(r, m.normals, nNormals, "mesh.normals");
+    } else {
+        std::vector<Vec3> wide;
+        readArray(r, wide, r.ok() ? nNormals : 0, "mesh.normals", [&] { return vec(r, "mesh.normals"); });
+        if (kBulk)
+            checkFinite(r, wide, start, "mesh.normals");
+        narrow(r, wide, m.normals, start, "mesh.normals");
+    }
+    pos = r.offset();
+    const std::uint32_t nUvs = r.count("mesh.uvs.count", floats ? 8 : 16);
+    perCorner(nUvs, "mesh.uvs.count", pos);
+    start = r.offset();
+    if (floats) {
+        readUvs(r, m.uvs, nUvs, "mesh.uvs");
+    } else {
+        std::vector<Vec2> wide;
+        readArray(r, wide, r.ok() ? nUvs : 0, "mesh.uvs", [&] {
+            Vec2 u;
+            u.x = real(r, "mesh.uvs", ".x");
+            u.y = real(r, "mesh.uvs", ".y");
+            return u;
+        });
+        if (kBulk)
+            checkFinite(r, wide, start, "mesh.uvs");
+        narrow(r, wide, m.uvs, start, "mesh.uvs");
+    }
+    readMaterials(r, data, m);
+    if (!floats && r.ok() && (m.hasNormals() || m.hasUvs()))
+        o.meshHash = m.hash(); // the saved hash was of the attributes in double
 }
 
 ObjectState readObject(ByteReader& r, const std::uint8_t* data, std::uint16_t version) {
@@ -542,95 +607,11 @@ ObjectState readObject(ByteReader& r, const std::uint8_t* data, std::uint16_t ve
     o.mass.inertia = mat(r, "mass.inertia");
     o.mass.principalMoments = vec(r, "mass.principalMoments");
     o.mass.principalAxes = mat(r, "mass.principalAxes");
-    Mesh& m = o.mesh;
-    if (version >= 6) {
-        readMesh(r, data, m);
-    } else {
-        readPositions(r, m);
-        const std::uint32_t nTri = r.count("mesh.triangles.count", 12);
-        std::size_t start = r.offset();
-        readArray(r, m.triangles, nTri, "mesh.triangles", [&] {
-            Triangle t{};
-            for (auto& v : t)
-                v = r.u32("mesh.triangles");
-            return t;
-        });
-        checkTriangles(r, m, start);
-        auto perCorner = [&](std::uint32_t n, const char* field, std::size_t where) {
-            if (r.ok() && n != 0 && n != 3ull * nTri)
-                r.fail(where, field,
-                       std::to_string(n) + " entries for " + std::to_string(nTri) + " triangles");
-        };
-        // Per-corner attributes: float from version 5, double before (rounded to float here).
-        const bool floats = version >= 5;
-        pos = r.offset();
-        const std::uint32_t nNormals = r.count("mesh.normals.count", floats ? 12 : 24);
-        perCorner(nNormals, "mesh.normals.count", pos);
-        start = r.offset();
-        if (floats) {
-            readArray(r, m.normals, r.ok() ? nNormals : 0, "mesh.normals", [&] {
-                const float x = single(r, "mesh.normals", ".x"), y = single(r, "mesh.normals", ".y");
-                return Vec3f{x, y, single(r, "mesh.normals", ".z")};
-            });
-            if (kBulk)
-                checkFinite(r, m.normals, start, "mesh.normals");
-        } else {
-            std::vector<Vec3> wide;
-            readArray(r, wide, r.ok() ? nNormals : 0, "mesh.normals", [&] { return vec(r, "mesh.normals"); });
-            if (kBulk)
-                checkFinite(r, wide, start, "mesh.normals");
-            narrow(r, wide, m.normals, start, "mesh.normals");
-        }
-        pos = r.offset();
-        const std::uint32_t nUvs = r.count("mesh.uvs.count", floats ? 8 : 16);
-        perCorner(nUvs, "mesh.uvs.count", pos);
-        start = r.offset();
-        if (floats) {
-            readArray(r, m.uvs, r.ok() ? nUvs : 0, "mesh.uvs", [&] {
-                const float u = single(r, "mesh.uvs", ".x");
-                return Vec2f{u, single(r, "mesh.uvs", ".y")};
-            });
-            if (kBulk)
-                checkFinite(r, m.uvs, start, "mesh.uvs");
-        } else {
-            std::vector<Vec2> wide;
-            readArray(r, wide, r.ok() ? nUvs : 0, "mesh.uvs", [&] {
-                Vec2 u;
-                u.x = real(r, "mesh.uvs", ".x");
-                u.y = real(r, "mesh.uvs", ".y");
-                return u;
-            });
-            if (kBulk)
-                checkFinite(r, wide, start, "mesh.uvs");
-            narrow(r, wide, m.uvs, start, "mesh.uvs");
-        }
-        readMaterials(r, data, m);
-        if (!floats && r.ok() && (m.hasNormals() || m.hasUvs()))
-            o.meshHash = m.hash(); // the saved hash was of the attributes in double
-    }
-    if (version >= 6) {
-        o.convexParts = readParts(r);
-    } else {
-        const std::uint32_t nParts = r.count("convexParts.count", 4);
-        o.convexParts.reserve(nParts);
-        for (std::uint32_t i = 0; i < nParts && r.ok(); ++i) {
-            const std::uint32_t nFaces = r.count("convexParts.faces.count", 40);
-            std::vector<PolytopeFace> faces;
-            faces.reserve(nFaces);
-            for (std::uint32_t k = 0; k < nFaces && r.ok(); ++k) {
-                PolytopeFace face;
-                face.plane.normal = vec(r, "convexParts.plane.normal");
-                face.plane.offset = real(r, "convexParts.plane.offset");
-                face.tag = r.i32("convexParts.tag");
-                const std::uint32_t nCorners = r.count("convexParts.corners.count", 24);
-                face.corners.reserve(nCorners);
-                for (std::uint32_t c = 0; c < nCorners && r.ok(); ++c)
-                    face.corners.push_back(vec(r, "convexParts.corners"));
-                faces.push_back(std::move(face));
-            }
-            o.convexParts.push_back(ConvexPolytope::fromFaces(std::move(faces)));
-        }
-    }
+    if (version >= 6)
+        readMesh(r, data, o.mesh);
+    else
+        readMeshBefore6(r, data, version, o);
+    o.convexParts = readParts(r, version);
     o.warning = text(r, data, "warning.length", "warning");
     return o;
 }
