@@ -77,6 +77,34 @@ TEST(CollisionShape, CoreCornersAreThePartShrunkByTheMargin) {
         CollisionShape::coreCorners(ConvexPolytope::fromAabb(Aabb{{0, 0, 0}, {1, 1, 0.03}}), 0.02).empty());
 }
 
+// A corner on more faces than the corner triples are tried for (a cone's apex on 40): the core comes from the
+// polar of the moved-in planes instead of 41 clips, and is the clipped core up to rounding.
+TEST(CollisionShape, ACornerOnManyFacesGivesTheCoreOfTheMovedInPlanes) {
+    std::vector<Vec3> points{{0, 2, 0}};
+    for (int i = 0; i < 40; ++i) {
+        const double a = 2 * 3.14159265358979323846 * i / 40;
+        points.push_back({std::cos(a), 0, std::sin(a)});
+    }
+    auto cone = convexHull(points);
+    ASSERT_TRUE(cone);
+    std::size_t atApex = 0;
+    for (const PolytopeFaceView& f : cone->faces())
+        for (const Vec3& c : f.corners)
+            atApex += c == points[0];
+    ASSERT_GT(atApex, 24u);
+    const double margin = 0.04;
+    ConvexPolytope reference = *cone;
+    for (const PolytopeFaceView& f : cone->faces())
+        reference = reference.clipped(Plane{f.plane.normal, f.plane.offset - margin});
+    const std::vector<Vec3> core = CollisionShape::coreCorners(*cone, margin);
+    ASSERT_GE(core.size(), 4u);
+    for (const Vec3& c : core)
+        EXPECT_TRUE(reference.contains(c, 1e-9));
+    auto coreHull = convexHull(core);
+    ASSERT_TRUE(coreHull);
+    EXPECT_NEAR(coreHull->volume() / reference.volume(), 1.0, 1e-6);
+}
+
 // The debug edges are the parts' polygon edges in body coordinates, each corner held once, and every hull
 // holds exactly its points.
 TEST(CollisionShape, EdgesShareTheirCornersAndHullsHoldTheirPoints) {

@@ -8,6 +8,7 @@
 #include <BulletCollision/CollisionShapes/btShapeHull.h>
 
 #include "rubble/bullet/Convert.hpp"
+#include "rubble/collision/ConvexDecomposition.hpp"
 
 namespace rubble::bullet {
 namespace {
@@ -97,6 +98,37 @@ std::vector<Vec3> shiftedCorners(const ConvexPolytope& part, double margin) {
     return out;
 }
 
+// The part's core as the polar of its moved-in planes' dual points about its centroid: each facet of their
+// hull is a corner of the core (docs/collision.md); empty when the centroid is not well inside every moved
+// plane or the hull fails.
+std::vector<Vec3> polarCorners(const ConvexPolytope& part, double margin) {
+    const Vec3 c = part.centroid();
+    const double scale = std::max(1.0, part.bounds().diagonal());
+    std::vector<Vec3> dual;
+    dual.reserve(part.faces().size());
+    for (const PolytopeFaceView& f : part.faces()) {
+        const double gap = f.plane.offset - margin - dot(f.plane.normal, c);
+        if (!(gap > 1e-6 * scale))
+            return {};
+        dual.push_back(f.plane.normal / gap);
+    }
+    Result<ConvexPolytope> hull = convexHull(dual);
+    if (!hull)
+        return {};
+    std::vector<Vec3> out;
+    out.reserve(hull->faces().size());
+    for (const PolytopeFaceView& f : hull->faces()) {
+        if (!(f.plane.offset > 0))
+            return {};
+        out.push_back(c + f.plane.normal / f.plane.offset);
+    }
+    std::sort(out.begin(), out.end(), lexLess);
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    if (out.size() < 4)
+        return {};
+    return out;
+}
+
 // Directions spread evenly over the sphere (a Fibonacci lattice): where a capped hull's support is compared.
 const std::vector<Vec3>& sphereDirections() {
     static const std::vector<Vec3> directions = [] {
@@ -156,6 +188,8 @@ std::vector<Vec3> CollisionShape::coreCorners(const ConvexPolytope& part, double
         return part.vertices();
     if (std::vector<Vec3> fast = shiftedCorners(part, margin); !fast.empty())
         return fast;
+    if (std::vector<Vec3> polar = polarCorners(part, margin); !polar.empty())
+        return polar;
     return eroded(part, margin).vertices();
 }
 
