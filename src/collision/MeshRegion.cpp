@@ -10,15 +10,12 @@
 #include <tuple>
 #include <unordered_map>
 
+#include "geometry/PointBits.hpp"
 #include "rubble/collision/ConvexDecomposition.hpp"
 
 namespace rubble::detail {
 
 namespace {
-
-bool lexLess(const Vec3& a, const Vec3& b) {
-    return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
-}
 
 // How far a part reaches out of one hull plane, as of one round of keepInsideHull.
 struct PlaneReach {

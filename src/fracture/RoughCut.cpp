@@ -12,6 +12,7 @@
 #include <tuple>
 #include <unordered_map>
 
+#include "geometry/PointBits.hpp"
 #include "rubble/core/Random.hpp"
 
 namespace rubble::detail {
@@ -89,10 +90,6 @@ double segmentDistance2(const Vec3& p, const Vec3& a, const Vec3& b) {
     t = std::clamp(t, 0.0, 1.0);
     const Vec3 d = p - (a + ab * t);
     return dot(d, d);
-}
-
-bool lexLess(const Vec3& a, const Vec3& b) {
-    return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
 }
 
 std::uint64_t edgeKey(std::uint32_t a, std::uint32_t b) {

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <map>
 
+#include "geometry/PointBits.hpp"
 #include "geometry/PseudoAngle.hpp"
 
 namespace rubble {
@@ -22,9 +23,8 @@ Vec3 edgePlanePoint(Vec3 a, Vec3 b, double da, double db) {
     return a + (b - a) * t;
 }
 
-bool lexLess(const Vec3& a, const Vec3& b) {
-    return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
-}
+using detail::lexLess;
+using detail::pointBits;
 } // namespace
 
 ConvexPolytope ConvexPolytope::fromAabb(const Aabb& box) {
@@ -47,9 +47,7 @@ ConvexPolytope ConvexPolytope::fromFaces(std::vector<PolytopeFace> faces) {
     std::vector<Ref> refs;
     for (const PolytopeFace& f : faces)
         for (const Vec3& c : f.corners)
-            refs.push_back({{std::bit_cast<std::uint64_t>(c.x), std::bit_cast<std::uint64_t>(c.y),
-                             std::bit_cast<std::uint64_t>(c.z)},
-                            static_cast<std::uint32_t>(refs.size())});
+            refs.push_back({pointBits(c), static_cast<std::uint32_t>(refs.size())});
     std::sort(refs.begin(), refs.end(), [](const Ref& a, const Ref& b) { return a.bits < b.bits; });
     ConvexPolytope p;
     p.index_.resize(refs.size());
@@ -219,10 +217,8 @@ ConvexPolytope ConvexPolytope::clipped(const Plane& plane, std::int32_t tag, dou
                 const Vec3 x = edgePlanePoint(corners_[ia], corners_[ic], da, dc);
                 const std::uint32_t lo = std::min(ia, ic), hi = std::max(ia, ic);
                 std::size_t k = 0;
-                while (k < crossings.size() &&
-                       !(crossings[k].a == lo && crossings[k].c == hi &&
-                         std::bit_cast<std::array<std::uint64_t, 3>>(crossings[k].p) ==
-                             std::bit_cast<std::array<std::uint64_t, 3>>(x)))
+                while (k < crossings.size() && !(crossings[k].a == lo && crossings[k].c == hi &&
+                                                 pointBits(crossings[k].p) == pointBits(x)))
                     ++k;
                 if (k == crossings.size())
                     crossings.push_back({lo, hi, x, kNone});

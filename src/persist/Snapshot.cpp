@@ -10,6 +10,7 @@
 #include <bit>
 #include <map>
 
+#include "geometry/PointBits.hpp"
 #include "io/FileBytes.hpp"
 #include "persist/Bytes.hpp"
 #include "persist/CornerTable.hpp"
@@ -227,10 +228,7 @@ PartCorners partCorners(const ConvexPolytope& part) {
     for (const PolytopeFaceView& face : part.faces())
         for (const Vec3& c : face.corners) {
             const auto at = static_cast<std::uint32_t>(uses.size());
-            uses.push_back({{std::bit_cast<std::uint64_t>(c.x), std::bit_cast<std::uint64_t>(c.y),
-                             std::bit_cast<std::uint64_t>(c.z)},
-                            at,
-                            at});
+            uses.push_back({detail::pointBits(c), at, at});
         }
     std::vector<Use> sorted = uses;
     std::sort(sorted.begin(), sorted.end(),
@@ -430,10 +428,7 @@ std::size_t repeatedCorner(const std::vector<Vec3>& corners) {
     std::vector<std::pair<std::array<std::uint64_t, 3>, std::size_t>> bits;
     bits.reserve(corners.size());
     for (std::size_t i = 0; i < corners.size(); ++i)
-        bits.push_back(
-            {{std::bit_cast<std::uint64_t>(corners[i].x), std::bit_cast<std::uint64_t>(corners[i].y),
-              std::bit_cast<std::uint64_t>(corners[i].z)},
-             i});
+        bits.push_back({detail::pointBits(corners[i]), i});
     std::sort(bits.begin(), bits.end());
     std::size_t first = corners.size();
     for (std::size_t i = 1; i < bits.size(); ++i)
