@@ -55,6 +55,8 @@ TEST(JoinSnapshot, AClientWithTheSceneGetsItsUnbrokenObjectsByIdAndEndsInTheHost
     const std::size_t full = encodeSnapshot(fired.snapshot()).size();
     EXPECT_LT(size.raw, full) << "without the unbroken objects";
     EXPECT_LT(size.wire, size.raw / 2) << "compressed";
+    EXPECT_LT(size.wire, encodeJoinSnapshot(fired.snapshot(), KnownObjects{}).size())
+        << "smaller than the whole world compressed";
     EXPECT_EQ(size.wire, msg.size());
 
     Result<Snapshot> s = decodeJoinSnapshot(msg.data(), msg.size(), *client);
