@@ -26,6 +26,15 @@ bool lexLess(const Vec3& a, const Vec3& b) {
     return a.z < b.z;
 }
 
+// The points sorted, each once; empty when under four (no core).
+std::vector<Vec3> distinctCorners(std::vector<Vec3> points) {
+    std::sort(points.begin(), points.end(), lexLess);
+    points.erase(std::unique(points.begin(), points.end()), points.end());
+    if (points.size() < 4)
+        return {};
+    return points;
+}
+
 // The part shrunk by margin along every face plane (empty when it is thinner than 2·margin).
 ConvexPolytope eroded(const ConvexPolytope& part, double margin) {
     ConvexPolytope out = part;
@@ -91,11 +100,7 @@ std::vector<Vec3> shiftedCorners(const ConvexPolytope& part, double margin) {
                             out.push_back(x);
                 }
     }
-    std::sort(out.begin(), out.end(), lexLess);
-    out.erase(std::unique(out.begin(), out.end()), out.end());
-    if (out.size() < 4)
-        return {};
-    return out;
+    return distinctCorners(std::move(out));
 }
 
 // The part's core as the polar of its moved-in planes' dual points about its centroid: each facet of their
@@ -122,11 +127,7 @@ std::vector<Vec3> polarCorners(const ConvexPolytope& part, double margin) {
             return {};
         out.push_back(c + f.plane.normal / f.plane.offset);
     }
-    std::sort(out.begin(), out.end(), lexLess);
-    out.erase(std::unique(out.begin(), out.end()), out.end());
-    if (out.size() < 4)
-        return {};
-    return out;
+    return distinctCorners(std::move(out));
 }
 
 // Directions spread evenly over the sphere (a Fibonacci lattice): where a capped hull's support is compared.
