@@ -1,6 +1,5 @@
 #pragma once
-// Private to the persist module (and its tests): a mesh's per-corner attributes with each distinct corner
-// kept once (snapshot version 6).
+// Private to the persist module: a mesh's distinct corners, each once (snapshot version 6, docs/journal.md).
 
 #include <cstdint>
 #include <string>
@@ -10,9 +9,8 @@
 
 namespace rubble::persist {
 
-/// The distinct corners of a mesh (a vertex with its normal and texture coordinates, compared bit for bit) in
-/// the order the triangles first use them, and the triangles' corners as codes: (the largest corner used
-/// before, plus one) minus the corner, so that a corner used for the first time is 0.
+/// A mesh's distinct corners in first-use order, and its triangles' corners as codes (corners used so far −
+/// k).
 struct CornerTable {
     std::vector<std::uint32_t> vertex; ///< each corner's vertex
     std::vector<Vec3f> normals;        ///< each corner's normal (empty when the mesh has none)
@@ -23,8 +21,7 @@ struct CornerTable {
 /// The table of m with its normals and uvs where asked (each then one per triangle corner).
 CornerTable cornerTable(const Mesh& m, bool normals, bool uvs);
 
-/// What is wrong with a table: the index of the first bad code (or corner) and why; empty `what` when
-/// nothing.
+/// The first bad code or corner of a table and why (empty `what`: none).
 struct CornerError {
     std::size_t index = 0;
     std::string what;
@@ -33,10 +30,8 @@ struct CornerError {
 /// The first corner whose vertex is not below vertexCount.
 CornerError checkCornerVertices(const CornerTable& t, std::size_t vertexCount);
 
-/// Sets m's triangles, normals and uvs from t, whose corners' vertices are below vertexCount (checked).
-/// Fails, leaving m's triangles and attributes unspecified, at the first code that names no corner or makes a
-/// corner equal to one before it, or (index: the code count) when a corner is never used: the tables
-/// cornerTable makes are the only ones accepted, so a table read and written again gives the same bytes.
+/// Sets m's triangles and attributes from a table only cornerTable could have made, else fails
+/// (docs/journal.md).
 CornerError expandCorners(const CornerTable& t, std::size_t vertexCount, Mesh& m);
 
 } // namespace rubble::persist

@@ -212,8 +212,7 @@ void writeMesh(ByteWriter& w, const Mesh& m) {
         text(w, s);
 }
 
-// A part's corners in the order its faces first use them, bit-equal ones once (as fromFaces shares them), and
-// each face corner's index in that list: the same for a part and the part a load makes of it.
+// A part's bit-distinct corners in the order its faces first use them, and each face corner's index.
 struct PartCorners {
     std::vector<const Vec3*> corners;
     std::vector<std::uint32_t> index; // face after face
@@ -437,8 +436,7 @@ std::size_t repeatedCorner(const std::vector<Vec3>& corners) {
     return first;
 }
 
-// The convex parts (version 6: writeParts; before, each face with its corners' coordinates): the polytopes
-// fromFaces makes of the faces with their corners.
+// Reads the convex parts (version 6: writeParts; before, corners inline in each face).
 std::vector<ConvexPolytope> readParts(ByteReader& r, std::uint16_t version) {
     const bool shared = version >= 6;
     std::vector<ConvexPolytope> parts;

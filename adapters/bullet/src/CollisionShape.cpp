@@ -103,9 +103,7 @@ std::vector<Vec3> shiftedCorners(const ConvexPolytope& part, double margin) {
     return distinctCorners(std::move(out));
 }
 
-// The part's core as the polar of its moved-in planes' dual points about its centroid: each facet of their
-// hull is a corner of the core (docs/collision.md); empty when the centroid is not well inside every moved
-// plane or the hull fails.
+// The part's core corners from the polar of its moved-in planes about its centroid (docs/collision.md).
 std::vector<Vec3> polarCorners(const ConvexPolytope& part, double margin) {
     const Vec3 c = part.centroid();
     const double scale = std::max(1.0, part.bounds().diagonal());
