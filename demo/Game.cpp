@@ -123,7 +123,7 @@ void Game::clear(Renderer& renderer) {
     hitBy_.clear();
     sounds_.clear();
     lastKnock_.clear();
-    collapsesHeard_ = 0;
+    heard_ = {};
     blastBy_ = -1;
 }
 
@@ -326,44 +326,50 @@ void Game::onAdopted(const rubble::FractureOutcome& o, Renderer& renderer) {
         looks_[piece.id] = look;
         addVisual(b->id, piece.state->mesh, look, 1.0f, renderer);
     }
-    // one break sound at the pieces' centre, as loud as the impacts that caused it, as low as it is big
-    SoundEvent e{SoundKind::Break, look.timbre};
-    double volume = 0;
-    V3 centre{};
-    int counted = 0;
-    for (const rubble::AdoptedPiece& piece : o.pieces)
-        if (const BodyRecord* b = runtime_->bodyOf(piece.id)) {
-            volume += b->volume;
-            centre += toV3(binding_->rigid(b->id)->getCenterOfMassPosition());
-            ++counted;
-        }
-    for (const rubble::Impact& i : o.impacts)
-        e.impulse += static_cast<float>(i.impulse);
-    if (counted > 0) {
-        e.position = centre * (1.0f / static_cast<float>(counted));
-        e.size = static_cast<float>(std::cbrt(volume));
-        sound(e);
-    }
 }
 
-void Game::soundCollapses() {
-    // one rumble for the bodies that began to fall since the last call: their mass at 3 m/s, their volume
+void Game::effectsOfEvents() {
+    // one break sound per split: at its pieces' centre of mass, as loud as the impulse, as low as it is big
+    const auto& made = runtime_->createdPieces();
+    for (std::size_t i = heard_.pieces; i < made.size();) {
+        const rubble::PieceCreated& first = made[i];
+        SoundEvent e{SoundKind::Break, timbreOf(first.material)};
+        e.impulse = static_cast<float>(first.impulse);
+        double mass = 0, volume = 0;
+        rubble::Vec3 centre{};
+        for (; i < made.size() && made[i].parent == first.parent; ++i) {
+            mass += made[i].mass;
+            volume += made[i].volume;
+            centre = centre + made[i].position * made[i].mass;
+        }
+        if (mass > 0) {
+            e.position = toV3(centre * (1.0 / mass));
+            e.size = static_cast<float>(std::cbrt(volume));
+            sound(e);
+        }
+    }
+    heard_.pieces = made.size();
+    // a dust cloud where a bond broke, as wide as its section
+    const auto& broke = runtime_->structureBreaks();
+    for (std::size_t i = heard_.breaks; i < broke.size(); ++i)
+        particles_.debrisPuff(toV3(broke[i].position), V3{},
+                              0.5f * static_cast<float>(std::sqrt(broke[i].area)), burstSeed_++);
+    heard_.breaks = broke.size();
+    // one rumble for the bodies that began to fall: their mass at 3 m/s, their volume; dust where each let go
     const auto& falls = runtime_->structureCollapses();
-    if (collapsesHeard_ >= falls.size())
+    if (heard_.collapses >= falls.size())
         return;
-    SoundEvent e{SoundKind::Collapse, Timbre::Stone};
+    SoundEvent e{SoundKind::Collapse, timbreOf(falls[heard_.collapses].material)};
     double mass = 0, volume = 0;
     rubble::Vec3 centre{};
-    for (std::size_t i = collapsesHeard_; i < falls.size(); ++i) {
+    for (std::size_t i = heard_.collapses; i < falls.size(); ++i) {
         mass += falls[i].mass;
         volume += falls[i].volume;
         centre = centre + falls[i].position * falls[i].mass;
+        particles_.debrisPuff(toV3(falls[i].position), V3{}, static_cast<float>(std::cbrt(falls[i].volume)),
+                              burstSeed_++);
     }
-    const rubble::StructureCollapse& first = falls[collapsesHeard_];
-    if (const BodyRecord* b = runtime_->body(first.body); b && b->hasObject)
-        if (auto look = looks_.find(b->object); look != looks_.end())
-            e.timbre = look->second.timbre;
-    collapsesHeard_ = falls.size();
+    heard_.collapses = falls.size();
     if (!(mass > 0))
         return;
     e.position = toV3(centre * (1.0 / mass));
@@ -721,9 +727,9 @@ void Game::step(const ControlInput& input, float dt, Renderer& renderer) {
     const long long impactsBefore = runtime_->counters().impacts;
     const long long retiredBefore = runtime_->counters().piecesRetired;
     runtime_->setFocus({camera_.eye.x, camera_.eye.y, camera_.eye.z}); // distant tiny debris fades
-    collapsesHeard_ = 0; // the runtime's list restarts with the frame
+    heard_ = {}; // the runtime's event lists restart with the frame
     runtime_->stepFrame(dt);
-    soundCollapses();
+    effectsOfEvents();
     creditHits();
     checkCrash();
     emitEffects(impactsBefore, retiredBefore);
@@ -756,7 +762,7 @@ void Game::adoptReady(double waitMs) {
     const long long retiredBefore = runtime_->counters().piecesRetired;
     if (runtime_->adoptReady().piecesRetired > 0)
         emitEffects(impacts, retiredBefore); // dust for pieces retired while adopting (no new impacts)
-    soundCollapses();
+    effectsOfEvents();
     updateCounters();
 }
 

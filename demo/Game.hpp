@@ -233,7 +233,7 @@ private:
     void checkCrash();
     void emitEffects(long long impactsBefore, long long retiredBefore);
     void listenForDebris();
-    void soundCollapses();
+    void effectsOfEvents();
     void sound(const SoundEvent& e);
     void updateCounters();
 
@@ -287,7 +287,10 @@ private:
     std::map<rubble::ObjectId, int> hitBy_;            // object -> weapon whose impact will fracture it
     std::vector<SoundEvent> sounds_;                   // made since the last takeSounds()
     std::unordered_map<rubble::BodyId, std::uint64_t> lastKnock_; // body -> frame it last hit the ground
-    std::size_t collapsesHeard_ = 0; // of the runtime's structureCollapses(), those already sounded
+    struct EventsHeard { // of the runtime's event lists of this frame, those already sounded and shown
+        std::size_t pieces = 0, breaks = 0, collapses = 0;
+    };
+    EventsHeard heard_;
 };
 
 } // namespace demo

@@ -55,7 +55,7 @@ if [ -n "$loose" ]; then
 fi
 
 # The umbrella a game includes compiles alone and stays small: Rubble's own lines it pulls in, transitively.
-max_umbrella_lines=2780
+max_umbrella_lines=2800
 cxx=${CXX:-c++}
 if ! echo '#include "rubble/rubble.hpp"' | "$cxx" -std=c++20 -fsyntax-only -Iinclude -x c++ -; then
     echo "check-layering: rubble/rubble.hpp does not compile alone" >&2

@@ -124,6 +124,7 @@ struct DestructionRuntime::Impl {
     detail::StructureMonitor structure;
     std::vector<StructureBreak> breaks;            // the bonds this frame broke
     std::vector<StructureCollapse> collapses;      // the static bodies this frame let fall
+    std::vector<PieceCreated> created;             // the piece bodies this frame made
     std::map<ObjectId, const Material*> materials; // of objects (pieces inherit their parent's)
     std::map<ObjectId, std::uint64_t> solids;      // pieces: the scene object they were cut from
     detail::DebrisGovernor governor;
@@ -330,6 +331,9 @@ struct DestructionRuntime::Impl {
         dropBody(parent.id);
         ++stats.fractures;
         ++counters.fractures;
+        double impulse = 0;
+        for (const Impact& i : outcome.impacts)
+            impulse += i.impulse;
         for (std::size_t i = 0; i < plan.spawns.size(); ++i) {
             const detail::PieceSpawn& s = plan.spawns[i];
             const ObjectState& st = *outcome.pieces[i].state;
@@ -351,6 +355,9 @@ struct DestructionRuntime::Impl {
             }
             if (parentResting && !s.isStatic)
                 governor.wakeNear(boundsOf(made), config.support.tolerance);
+            created.push_back({counters.frames, made.id, s.object, outcome.parent,
+                               s.desc.transform.translation, s.desc.linearVelocity, s.volume, s.mass,
+                               std::cbrt(s.volume), impulse, s.isStatic, material.name});
             ++stats.piecesCreated;
             ++counters.piecesCreated;
         }
@@ -451,6 +458,7 @@ struct DestructionRuntime::Impl {
         contacts.clear();
         breaks.clear();
         collapses.clear();
+        created.clear();
         f.stats.substeps = binding.step(f.dt, contacts);
         f.stats.physicsMs = msSince(t0);
         f.afterPhysics = Clock::now();
@@ -865,6 +873,10 @@ const std::vector<StructureBreak>& DestructionRuntime::structureBreaks() const {
 
 const std::vector<StructureCollapse>& DestructionRuntime::structureCollapses() const {
     return impl_->collapses;
+}
+
+const std::vector<PieceCreated>& DestructionRuntime::createdPieces() const {
+    return impl_->created;
 }
 
 std::vector<BodyId> DestructionRuntime::supportNeighbours(BodyId id) const {

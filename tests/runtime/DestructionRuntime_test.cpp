@@ -388,6 +388,48 @@ TEST(DestructionRuntime, VolumeAccountingIsExactWithDustParticlesAndRetirement) 
     EXPECT_LT(std::abs(v.total() - start) / start, 1e-9);
 }
 
+// Each piece body a split makes is one record, with its body's place, motion, volume and mass and the impulse
+// that broke its parent; the pieces' and the dust's volumes add up to the parent's; records last one frame.
+TEST(DestructionRuntime, EachPieceMadeIsARecordOfItsBodyAndTheImpulseThatBrokeIt) {
+    DestructionRuntime::Config c = ToyRig::defaults();
+    c.world.minPieceVolume = 0.01;
+    ToyRig rig(c);
+    const ObjectId box = rig.addBox({1, 1, 1}, {0, 1, 0}, true, shatter(12, 1.5));
+    ASSERT_TRUE(rig.runtime.submitLocalImpact(box, Impact{{1, 0.5, 0}, {1, 0, 0}, 80}));
+    FrameStats stats;
+    for (int i = 0; i < 10 && rig.runtime.createdPieces().empty(); ++i)
+        stats = rig.runtime.stepFrame();
+    const std::vector<PieceCreated> made = rig.runtime.createdPieces();
+    ASSERT_GT(made.size(), 2u);
+    EXPECT_EQ(made.size(), static_cast<std::size_t>(stats.piecesCreated));
+    double volume = 0;
+    int statics = 0;
+    for (const PieceCreated& p : made) {
+        const BodyRecord* r = rig.runtime.body(p.body);
+        ASSERT_NE(r, nullptr);
+        EXPECT_EQ(r->role, BodyRole::Piece);
+        EXPECT_EQ(r->object, p.object);
+        EXPECT_EQ(p.parent, box);
+        EXPECT_EQ(p.frame, rig.runtime.counters().frames);
+        const BodyMotion m = rig.runtime.motion(p.body);
+        EXPECT_LT(length(m.transform.translation - p.position), 1e-9);
+        EXPECT_LT(length(m.linearVelocity - p.velocity), 1e-9);
+        EXPECT_DOUBLE_EQ(p.volume, r->volume);
+        EXPECT_NEAR(p.mass, 500 * p.volume, 1e-9);
+        EXPECT_NEAR(p.size * p.size * p.size, p.volume, 1e-12);
+        EXPECT_NEAR(p.impulse, 80, 1e-4);
+        EXPECT_EQ(p.material, "concrete");
+        statics += p.isStatic;
+        volume += p.volume;
+    }
+    EXPECT_GE(statics, 1) << "the kept part of the static box";
+    EXPECT_LT(statics, static_cast<int>(made.size())) << "and the thrown debris";
+    const VolumeLedger v = rig.runtime.volumes();
+    EXPECT_NEAR(volume + v.dust + v.dropped, 8, 1e-9);
+    rig.runtime.stepFrame();
+    EXPECT_TRUE(rig.runtime.createdPieces().empty());
+}
+
 TEST(DestructionRuntime, BlastHitsEveryObjectInRangeWithAnImpulseFallingOffToItsEdge) {
     ToyRig rig;
     std::vector<ObjectId> boxes;

@@ -266,6 +266,21 @@ struct RUBBLE_API ObjectPlacement {
 /// Structure keys of bodies without objects (ground, scenery) in StructureBondState: this bit | the body id.
 constexpr std::uint64_t kSceneryNodeKey = 1ull << 63;
 
+/// A piece body a fracture made, for effects (dust, debris sound): a self-contained record.
+struct RUBBLE_API PieceCreated {
+    std::uint64_t frame = 0;     ///< the frame it was adopted in (RuntimeCounters::frames)
+    BodyId body = 0;             ///< its body
+    ObjectId object = 0;         ///< its object
+    ObjectId parent = 0;         ///< the object it was cut from (gone once the split is committed)
+    Vec3 position;               ///< its centre of mass (world)
+    Vec3 velocity;               ///< its linear velocity when made (m/s, world)
+    double volume = 0, mass = 0; ///< m³, kg (mass also for a piece that stays static)
+    double size = 0;             ///< edge length of a cube of the same volume (m)
+    double impulse = 0;          ///< Σ impulse of the impacts that broke the parent (N·s)
+    bool isStatic = false;       ///< stays static (the kept part of a static object)
+    std::string material;        ///< its object's material (preset name)
+};
+
 /// The runtime. Call everything from one (main) thread; fracture jobs run on the DestructionWorld's workers.
 class RUBBLE_API DestructionRuntime {
 public:
@@ -381,6 +396,8 @@ public:
     const std::vector<StructureBreak>& structureBreaks() const;
     /// Static bodies that fell for want of support since the last stepFrame() began (adoptReady() too).
     const std::vector<StructureCollapse>& structureCollapses() const;
+    /// Piece bodies made since the last stepFrame() began (adoptReady() too), in the order they were made.
+    const std::vector<PieceCreated>& createdPieces() const;
     /// The point distant debris fades from (e.g. the camera).
     void setFocus(const Vec3& point);
 
