@@ -28,6 +28,7 @@
 #include "rubble/geometry/MeshCheck.hpp"
 #include "rubble/geometry/MeshRepair.hpp"
 #include "rubble/io/MeshIO.hpp"
+#include "rubble/runtime/Structure.hpp"
 #include "rubble/structure/Material.hpp"
 
 namespace py = pybind11;
@@ -390,6 +391,44 @@ py::list decomposeMesh(const rubble::Mesh& mesh, int maxParts, double concavity,
 
 } // namespace
 
+/// A structure's settings from Python keywords (ValueError for a negative or non-finite one).
+rubble::StructurePolicy structurePolicy(double bearingFriction, bool converged, double damageRadius,
+                                        double damagePerImpulse) {
+    for (const auto& [name, value] :
+         {std::pair{"bearing_friction", bearingFriction}, std::pair{"damage_radius", damageRadius},
+          std::pair{"damage_per_impulse", damagePerImpulse}})
+        if (!(value >= 0) || !std::isfinite(value))
+            throw py::value_error(std::string(name) + ": expected a finite number >= 0");
+    rubble::StructurePolicy p;
+    p.bearingFriction = bearingFriction;
+    p.damageRadius = damageRadius;
+    p.damagePerImpulse = damagePerImpulse;
+    p.stress.method = converged ? rubble::StressMethod::GaussSeidel : rubble::StressMethod::SweepBudget;
+    return p;
+}
+
+/// A length-3 vector of finite numbers, or ValueError naming `what`.
+rubble::Vec3 finiteVec3(const py::object& input, const char* what) {
+    const rubble::Vec3 v = toVec3(input, what);
+    if (!rubble::isFinite(v))
+        throw py::value_error(std::string(what) + ": expected finite numbers");
+    return v;
+}
+
+/// A placement from a position and an optional (3, 3) rotation.
+rubble::Frame placementOf(const py::object& position, const py::object& rotation) {
+    rubble::Frame f{rubble::Mat3::identity(), finiteVec3(position, "position")};
+    if (!rotation.is_none()) {
+        const DoubleArray r = doubleRows(rotation, 3, "rotation");
+        if (r.shape(0) != 3)
+            throw py::value_error("rotation: expected shape (3, 3)");
+        for (py::ssize_t i = 0; i < 3; ++i)
+            for (py::ssize_t j = 0; j < 3; ++j)
+                f.rotation.m[i][j] = r.at(i, j);
+    }
+    return f;
+}
+
 PYBIND11_MODULE(_rubble, m) {
     m.doc() =
         "Rubble: fracture closed meshes at an impact into pieces with mass properties and convex parts.";
@@ -464,6 +503,85 @@ PYBIND11_MODULE(_rubble, m) {
             return "<rubble.Piece " + std::to_string(p.triangleCount()) + " triangles, volume " +
                    std::to_string(p.mass.volume) + ", cell " + std::to_string(p.cell) + ">";
         });
+
+    py::class_<rubble::StructureBreak>(m, "StructureBreak")
+        .def_readonly("step", &rubble::StructureBreak::frame)
+        .def_readonly("a", &rubble::StructureBreak::a)
+        .def_readonly("b", &rubble::StructureBreak::b)
+        .def_property_readonly("position", [](const rubble::StructureBreak& k) { return vec3(k.position); })
+        .def_property_readonly("normal", [](const rubble::StructureBreak& k) { return vec3(k.normal); })
+        .def_readonly("area", &rubble::StructureBreak::area)
+        .def_property_readonly("force", [](const rubble::StructureBreak& k) { return vec3(k.force); })
+        .def_readonly("utilisation", &rubble::StructureBreak::utilisation)
+        .def_readonly("damaged", &rubble::StructureBreak::damaged)
+        .def_readonly("material_a", &rubble::StructureBreak::materialA)
+        .def_readonly("material_b", &rubble::StructureBreak::materialB)
+        .def("__repr__", [](const rubble::StructureBreak& k) {
+            return "<rubble.StructureBreak " + std::to_string(k.a) + "-" + std::to_string(k.b) + ", step " +
+                   std::to_string(k.frame) + (k.damaged ? ", damaged>" : ">");
+        });
+    py::class_<rubble::StructureCollapse>(m, "StructureCollapse")
+        .def_readonly("step", &rubble::StructureCollapse::frame)
+        .def_readonly("body", &rubble::StructureCollapse::body)
+        .def_property_readonly("position",
+                               [](const rubble::StructureCollapse& c) { return vec3(c.position); })
+        .def_readonly("volume", &rubble::StructureCollapse::volume)
+        .def_readonly("mass", &rubble::StructureCollapse::mass)
+        .def_readonly("material", &rubble::StructureCollapse::material)
+        .def("__repr__", [](const rubble::StructureCollapse& c) {
+            return "<rubble.StructureCollapse body " + std::to_string(c.body) + ", step " +
+                   std::to_string(c.frame) + ">";
+        });
+    py::class_<rubble::StructureStep>(m, "StructureStep")
+        .def_readonly("breaks", &rubble::StructureStep::breaks)
+        .def_readonly("collapses", &rubble::StructureStep::collapses)
+        .def_readonly("residual", &rubble::StructureStep::residual)
+        .def("__repr__", [](const rubble::StructureStep& s) {
+            return "<rubble.StructureStep " + std::to_string(s.breaks.size()) + " breaks, " +
+                   std::to_string(s.collapses.size()) + " collapses>";
+        });
+    py::class_<rubble::Structure>(m, "Structure")
+        .def(py::init([](double friction, bool converged, double radius, double perImpulse) {
+                 return rubble::Structure(structurePolicy(friction, converged, radius, perImpulse));
+             }),
+             py::kw_only(), py::arg("bearing_friction") = 0.6, py::arg("converged") = true,
+             py::arg("damage_radius") = 1.0, py::arg("damage_per_impulse") = 1e-4)
+        .def(
+            "add",
+            [](rubble::Structure& s, rubble::BodyId id, const rubble::Mesh& mesh, const std::string& material,
+               bool root, const py::object& position, const py::object& rotation) {
+                const rubble::Frame place = placementOf(position, rotation);
+                py::gil_scoped_release unlocked;
+                unwrap(s.add(id, mesh, place, material, root));
+            },
+            py::arg("id"), py::arg("mesh"), py::kw_only(), py::arg("material") = "", py::arg("root") = false,
+            py::arg("position") = py::make_tuple(0.0, 0.0, 0.0), py::arg("rotation") = py::none())
+        .def("remove", &rubble::Structure::remove, py::arg("id"))
+        .def("__contains__", &rubble::Structure::contains)
+        .def("__len__", &rubble::Structure::size)
+        .def_property_readonly("bond_count", [](const rubble::Structure& s) { return s.bonds().size(); })
+        .def(
+            "add_load",
+            [](rubble::Structure& s, rubble::BodyId id, const py::object& force, const py::object& point) {
+                if (!s.contains(id))
+                    throw py::value_error("id: no body " + std::to_string(id));
+                s.addLoad(id, finiteVec3(force, "force"), finiteVec3(point, "point"));
+            },
+            py::arg("id"), py::arg("force"), py::arg("point"))
+        .def(
+            "damage",
+            [](rubble::Structure& s, const py::object& point, const py::object& impulse) {
+                s.damage(checkedVector(point, "point"), checkedParam<double>(impulse, "impulse"));
+            },
+            py::arg("point"), py::arg("impulse"))
+        .def(
+            "step",
+            [](rubble::Structure& s, const py::object& gravity) {
+                const rubble::Vec3 g = finiteVec3(gravity, "gravity");
+                py::gil_scoped_release unlocked;
+                return s.step(g);
+            },
+            py::arg("gravity") = py::make_tuple(0.0, -9.81, 0.0));
 
     m.def(
         "read_mesh",

@@ -24,7 +24,7 @@ extern "C" {
 #endif
 
 /// Version of this C API; bumped when a struct or a function signature changes.
-#define RUBBLE_C_API_VERSION 3
+#define RUBBLE_C_API_VERSION 4
 
 /// What a call returned: RUBBLE_OK or why it failed (1-7 are the library's rubble::ErrorCode values).
 typedef RUBBLE_C_ENUM(rubble_status){
@@ -300,6 +300,83 @@ RUBBLE_C_API rubble_status rubble_world_copy_object_mesh(const rubble_world* wor
 /// The corner points of an object's convex part, as rubble_fracture_get_convex_part.
 RUBBLE_C_API rubble_status rubble_world_get_convex_part(const rubble_world* world, uint32_t id, size_t part,
                                                         double* points, size_t capacity, size_t* count);
+
+/// A structure without a physics engine (rubble/runtime/Structure.hpp): static bodies bonded where they touch,
+/// solved under gravity, loads and impact damage at every step; the bonds that break and the bodies that fall
+/// come back as records, for the caller's engine to let fall and for effects (dust, sound).
+typedef struct rubble_structure rubble_structure;
+
+/// Settings of a structure; rubble_structure_config_init sets the defaults.
+typedef struct rubble_structure_config {
+    double bearing_friction;   ///< > 0: bodies rest on each other with this friction coefficient; 0: welded
+    int converged;             ///< 1: every step solves to a relative residual of 1e-3; 0: a sweep budget
+    double damage_radius;      ///< impacts weaken the bonds within this distance (m) of the hit
+    double damage_per_impulse; ///< health a bond at the hit loses per N*s of impulse
+} rubble_structure_config;
+
+/// What one step did; its records stay readable until the next step.
+typedef struct rubble_structure_step_info {
+    size_t break_count;    ///< bonds broken
+    size_t collapse_count; ///< bodies that lost their support (they left the structure)
+    double residual;       ///< relative residual of the step's last solve
+} rubble_structure_step_info;
+
+/// A bond that broke.
+typedef struct rubble_structure_break {
+    uint64_t step;          ///< the step it broke in (1 for the first)
+    uint32_t a, b;          ///< the bodies it joined, a < b
+    double position[3];     ///< interface centroid (world)
+    double normal[3];       ///< interface normal, from a to b
+    double area;            ///< interface area (m^2)
+    double force[3];        ///< the force it carried the moment it broke, b on a (N)
+    double utilisation;     ///< its largest stress over its limit (> 1 when its load broke it)
+    int damaged;            ///< 1: impact damage broke it, not its load
+    const char* material_a; ///< a's material; valid until the next step
+    const char* material_b; ///< b's material; valid until the next step
+} rubble_structure_break;
+
+/// A body that lost its support.
+typedef struct rubble_structure_collapse {
+    uint64_t step;        ///< the step it fell in
+    uint32_t body;        ///< its id
+    double position[3];   ///< its centre of mass (world)
+    double volume, mass;  ///< m^3, kg
+    const char* material; ///< its material; valid until the next step
+} rubble_structure_collapse;
+
+/// The defaults: bearings with friction 0.6, converged solves, damage within 1 m at 1e-4 per N*s.
+RUBBLE_C_API rubble_status rubble_structure_config_init(rubble_structure_config* config);
+/// Creates a structure (NULL config means the defaults).
+RUBBLE_C_API rubble_status rubble_structure_create(const rubble_structure_config* config,
+                                                   rubble_structure** out);
+/// Destroys a structure (NULL is accepted and ignored).
+RUBBLE_C_API rubble_status rubble_structure_destroy(rubble_structure* structure);
+/// Adds a body (or replaces the one with this id, > 0): a closed mesh (its convex parts) placed by a rotation
+/// (row-major, NULL: none) and a translation, of a material preset (NULL or "": concrete); root = 1 holds it
+/// (the ground). RUBBLE_ERROR_INVALID_INPUT, changing nothing, for an unknown material or a bad mesh.
+RUBBLE_C_API rubble_status rubble_structure_add(rubble_structure* structure, uint32_t id, const rubble_mesh* mesh,
+                                                const double rotation[9], const double translation[3],
+                                                const char* material, int root);
+/// Removes a body and its bonds; RUBBLE_ERROR_INVALID_ARGUMENT when there is none with this id.
+RUBBLE_C_API rubble_status rubble_structure_remove(rubble_structure* structure, uint32_t id);
+/// A force (N) at a world point on a body for the next step (a contact, a weight).
+RUBBLE_C_API rubble_status rubble_structure_add_load(rubble_structure* structure, uint32_t id,
+                                                     const double force[3], const double point[3]);
+/// Weakens the bonds near a hit (world point, impulse in N*s) at the next step.
+RUBBLE_C_API rubble_status rubble_structure_damage(rubble_structure* structure, const double point[3],
+                                                   double impulse);
+/// Solves under gravity (m/s^2; NULL: 9.81 down y), breaks overstressed bonds and lets go of what they held.
+RUBBLE_C_API rubble_status rubble_structure_step(rubble_structure* structure, const double gravity[3],
+                                                 rubble_structure_step_info* info);
+/// Break `index` of the latest step.
+RUBBLE_C_API rubble_status rubble_structure_get_break(const rubble_structure* structure, size_t index,
+                                                      rubble_structure_break* out);
+/// Collapse `index` of the latest step.
+RUBBLE_C_API rubble_status rubble_structure_get_collapse(const rubble_structure* structure, size_t index,
+                                                         rubble_structure_collapse* out);
+/// Number of bodies and of intact bonds.
+RUBBLE_C_API rubble_status rubble_structure_count(const rubble_structure* structure, size_t* bodies,
+                                                  size_t* bonds);
 
 #ifdef __cplusplus
 }

@@ -12,6 +12,10 @@ __all__ = [
     "Mesh",
     "MeshReport",
     "Piece",
+    "Structure",
+    "StructureBreak",
+    "StructureCollapse",
+    "StructureStep",
     "box",
     "check",
     "decompose",
@@ -156,6 +160,118 @@ class Piece(Mesh):
     def concavity(self) -> float | None:
         """How far the convex parts stray from the piece's surface (one-sided Hausdorff distance, as a fraction
         of its bounding-box diagonal, as decompose's); None without convex_parts."""
+
+class StructureBreak:
+    """A bond that broke: where, how large, the force it carried and the two materials."""
+
+    @property
+    def step(self) -> int:
+        """The step it broke in (1 for the first)."""
+    @property
+    def a(self) -> int:
+        """The first body it joined (a < b)."""
+    @property
+    def b(self) -> int:
+        """The second body."""
+    @property
+    def position(self) -> Float64Array:
+        """Interface centroid (world)."""
+    @property
+    def normal(self) -> Float64Array:
+        """Interface normal, from a to b."""
+    @property
+    def area(self) -> float:
+        """Interface area (m^2)."""
+    @property
+    def force(self) -> Float64Array:
+        """The force it carried the moment it broke, b on a (N)."""
+    @property
+    def utilisation(self) -> float:
+        """Its largest stress over its limit (> 1 when its load broke it)."""
+    @property
+    def damaged(self) -> bool:
+        """Impact damage broke it (health 0), not its load."""
+    @property
+    def material_a(self) -> str:
+        """a's material preset."""
+    @property
+    def material_b(self) -> str:
+        """b's material preset."""
+
+class StructureCollapse:
+    """A body that lost its support (it left the structure; the caller lets it fall)."""
+
+    @property
+    def step(self) -> int:
+        """The step it fell in."""
+    @property
+    def body(self) -> int:
+        """Its id."""
+    @property
+    def position(self) -> Float64Array:
+        """Its centre of mass (world)."""
+    @property
+    def volume(self) -> float:
+        """m^3."""
+    @property
+    def mass(self) -> float:
+        """kg."""
+    @property
+    def material(self) -> str:
+        """Its material preset."""
+
+class StructureStep:
+    """What one Structure.step did."""
+
+    @property
+    def breaks(self) -> list[StructureBreak]:
+        """Bonds broken, in the order they broke."""
+    @property
+    def collapses(self) -> list[StructureCollapse]:
+        """Bodies no bond holds up any more, ascending id."""
+    @property
+    def residual(self) -> float:
+        """Relative residual of the step's last solve."""
+
+class Structure:
+    """Static bodies bonded where they touch, without a physics engine: each step solves them under gravity,
+    loads and impact damage and returns the bonds that broke and the bodies that fell (docs/structure.md)."""
+
+    def __init__(
+        self,
+        *,
+        bearing_friction: float = 0.6,
+        converged: bool = True,
+        damage_radius: float = 1.0,
+        damage_per_impulse: float = 1e-4,
+    ) -> None:
+        """bearing_friction > 0: bodies rest on each other with this friction, 0: welded; converged: solve to
+        a relative residual of 1e-3 (else a sweep budget). Raises ValueError for a negative setting."""
+    def add(
+        self,
+        id: int,
+        mesh: Mesh,
+        *,
+        material: str = "",
+        root: bool = False,
+        position: Vector3 = (0.0, 0.0, 0.0),
+        rotation: Float64Array | Sequence[Sequence[float]] | None = None,
+    ) -> None:
+        """Adds (or replaces) body id > 0: the mesh's convex parts placed at position and rotation, of a
+        material preset ("": concrete); a root is held. Raises Error ("invalid input") for an unknown
+        material, an open mesh or a rotation that is none, changing nothing."""
+    def remove(self, id: int) -> bool: ...
+    def __contains__(self, id: int) -> bool: ...
+    def __len__(self) -> int: ...
+    @property
+    def bond_count(self) -> int:
+        """Intact bonds."""
+    def add_load(self, id: int, force: Vector3, point: Vector3) -> None:
+        """A force (N) at a world point on a body for the next step."""
+    def damage(self, point: Vector3, impulse: float) -> None:
+        """Weakens the bonds near a hit (impulse in N s) at the next step."""
+    def step(self, gravity: Vector3 = (0.0, -9.81, 0.0)) -> StructureStep:
+        """Solves, breaks overstressed bonds and lets go of what they held."""
 
 def read_mesh(path: str | os.PathLike[str]) -> Mesh:
     """Reads .obj, .off, .stl, .ply, .3ds, .gltf or .glb; Error names the file and line."""

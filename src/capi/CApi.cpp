@@ -3,6 +3,8 @@
 // refused instead of used.
 #include "rubble/rubble.h"
 
+#include "capi/CApiSupport.hpp"
+
 #include <cstring>
 #include <exception>
 #include <memory>
@@ -33,22 +35,9 @@ static_assert(RUBBLE_ERROR_IO == static_cast<int>(rubble::ErrorCode::IoError) &&
                   RUBBLE_ERROR_CANCELLED == static_cast<int>(rubble::ErrorCode::Cancelled),
               "C status codes 1-7 are rubble::ErrorCode");
 
-namespace {
-
-constexpr std::uint32_t kMeshTag = 0x4d455348;     // "MESH"
-constexpr std::uint32_t kFractureTag = 0x46524143; // "FRAC"
-constexpr std::uint32_t kWorldTag = 0x574f524c;    // "WORL"
-
-} // namespace
-
-struct rubble_mesh {
-    std::uint32_t tag = kMeshTag;
-    bool ownedByFracture = false;
-    rubble::Mesh mesh;
-};
-
 struct rubble_fracture {
-    std::uint32_t tag = kFractureTag;
+    static constexpr std::uint32_t kTag = 0x46524143; // "FRAC"
+    std::uint32_t tag = kTag;
     rubble::FractureResult result;
     std::vector<std::unique_ptr<rubble_mesh>> meshes;                 // one per piece
     std::vector<std::vector<std::vector<rubble::Vec3>>> convexPoints; // [piece][part] corner points
@@ -56,84 +45,16 @@ struct rubble_fracture {
 };
 
 struct rubble_world {
-    std::uint32_t tag = kWorldTag;
+    static constexpr std::uint32_t kTag = 0x574f524c; // "WORL"
+    std::uint32_t tag = kTag;
     std::unique_ptr<rubble::DestructionWorld> world;
     std::vector<rubble::FractureOutcome> outcomes; // of the latest collect
 };
 
 namespace {
 
-thread_local std::string lastError;
-
-rubble_status fail(rubble_status status, std::string message) {
-    lastError = std::move(message);
-    return status;
-}
-
-rubble_status fail(const rubble::Error& error) {
-    return fail(static_cast<rubble_status>(error.code), error.message);
-}
-
-rubble_status invalid(const char* function, const char* what) {
-    return fail(RUBBLE_ERROR_INVALID_ARGUMENT, std::string(function) + ": " + what);
-}
-
-rubble_status ok() {
-    lastError.clear();
-    return RUBBLE_OK;
-}
-
-/// Runs body(function), turning exceptions into status codes.
-template <class Body>
-rubble_status guarded(const char* function, Body&& body) noexcept {
-    try {
-        return body(function);
-    } catch (const std::bad_alloc&) {
-        return fail(RUBBLE_ERROR_OUT_OF_MEMORY, std::string(function) + ": out of memory");
-    } catch (const std::exception& e) {
-        return fail(RUBBLE_ERROR_INTERNAL, std::string(function) + ": " + e.what());
-    } catch (...) {
-        return fail(RUBBLE_ERROR_INTERNAL, std::string(function) + ": unknown exception");
-    }
-}
-
-bool valid(const rubble_mesh* m) {
-    return m && m->tag == kMeshTag;
-}
-bool valid(const rubble_fracture* f) {
-    return f && f->tag == kFractureTag;
-}
-bool valid(const rubble_world* w) {
-    return w && w->tag == kWorldTag;
-}
-
-/// Deletes a handle of the right kind (null is fine), clearing its tag first.
-template <class Handle>
-rubble_status destroy(const char* function, Handle* handle, const char* what) {
-    if (!handle)
-        return ok();
-    if (!valid(handle))
-        return invalid(function, what);
-    handle->tag = 0;
-    delete handle;
-    return ok();
-}
-
-rubble::Vec3 vec(const double v[3]) {
-    return {v[0], v[1], v[2]};
-}
-
-void copy(const rubble::Vec3& v, double out[3]) {
-    out[0] = v.x;
-    out[1] = v.y;
-    out[2] = v.z;
-}
-
-void copy(const rubble::Mat3& m, double out[9]) {
-    for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c)
-            out[3 * r + c] = m.m[r][c];
-}
+using namespace rubble::capi;
+using rubble::capi::copy; // overloaded below for mass properties
 
 void copy(const rubble::MassProperties& mass, rubble_mass_properties& out) {
     out.volume = mass.volume;

@@ -10,6 +10,7 @@
 #include <string>
 #include <tuple>
 
+#include "core/Rotation.hpp"
 #include "geometry/MeshTopology.hpp"
 #include "rubble/structure/Material.hpp"
 #include "runtime/BodyTable.hpp"
@@ -23,22 +24,6 @@
 
 namespace rubble {
 namespace {
-
-// True when r is a rotation: orthonormal columns (to 1e-6) and determinant 1.
-bool isRotation(const Mat3& r) {
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) {
-            double d = 0;
-            for (int k = 0; k < 3; ++k)
-                d += r.m[k][i] * r.m[k][j];
-            if (!(std::abs(d - (i == j ? 1.0 : 0.0)) < 1e-6))
-                return false;
-        }
-    const double det = r.m[0][0] * (r.m[1][1] * r.m[2][2] - r.m[1][2] * r.m[2][1]) -
-                       r.m[0][1] * (r.m[1][0] * r.m[2][2] - r.m[1][2] * r.m[2][0]) +
-                       r.m[0][2] * (r.m[1][0] * r.m[2][1] - r.m[1][1] * r.m[2][0]);
-    return det > 0;
-}
 
 using Clock = std::chrono::steady_clock;
 
@@ -620,7 +605,7 @@ BodyId DestructionRuntime::addGround(const Vec3& center, const Vec3& halfExtents
 
 Result<ObjectId> DestructionRuntime::addObject(ObjectDesc desc, const Frame& placement, bool isStatic) {
     Impl& im = *impl_;
-    if (!isRotation(placement.rotation) || !isFinite(placement.translation))
+    if (!detail::isRotation(placement.rotation) || !isFinite(placement.translation))
         return Error{ErrorCode::InvalidInput,
                      "addObject: the placement is not a rigid motion (its rotation must "
                      "be orthonormal with determinant 1: Mat3{} is zero, "

@@ -632,6 +632,89 @@ static void test_parameter_table(const char* path) {
     CHECK(rows >= 15);
 }
 
+/* A structure without an engine: a cantilever welded to a held wall stands or breaks as its root bending
+ * stress 3 rho g L^2 / h says (concrete's tensile limit 2.9 MPa is passed between 2.5 and 3.5 m); the break and
+ * the collapse come back as records; bad bodies are refused and change nothing. */
+static int cantilever(double span, const char* material, rubble_structure** out) {
+    rubble_structure_config config;
+    rubble_mesh *wall = NULL, *slab = NULL;
+    const double wall_lo[3] = {-1, 0, -2}, wall_hi[3] = {0, 4, 2};
+    const double slab_lo[3] = {0, 2, -0.75}, slab_hi[3] = {span, 2.2, 0.75}, zero[3] = {0, 0, 0};
+    int ok = 1;
+    CHECK_OK(rubble_structure_config_init(&config));
+    config.bearing_friction = 0; /* welded */
+    ok &= rubble_structure_create(&config, out) == RUBBLE_OK;
+    ok &= rubble_mesh_create_box(wall_lo, wall_hi, 1, &wall) == RUBBLE_OK;
+    ok &= rubble_mesh_create_box(slab_lo, slab_hi, 1, &slab) == RUBBLE_OK;
+    ok &= rubble_structure_add(*out, 1, wall, NULL, zero, material, 1) == RUBBLE_OK;
+    ok &= rubble_structure_add(*out, 2, slab, NULL, zero, material, 0) == RUBBLE_OK;
+    CHECK_OK(rubble_mesh_destroy(wall));
+    CHECK_OK(rubble_mesh_destroy(slab));
+    CHECK(ok);
+    return ok;
+}
+
+static void test_structure(void) {
+    rubble_structure* s = NULL;
+    rubble_structure_step_info info;
+    rubble_structure_break k;
+    rubble_structure_collapse c;
+    size_t bodies = 0, bonds = 0;
+    const double zero[3] = {0, 0, 0}, lo[3] = {3, 0, 0}, hi[3] = {4, 1, 1};
+    const double skew[9] = {1, 0, 0, 0, 1, 0, 0, 0, 2}, down[3] = {0, -1, 0}, nan3[3] = {0, NAN, 0};
+    rubble_mesh* cube = NULL;
+    if (cantilever(2.5, "concrete", &s)) {
+        CHECK_OK(rubble_structure_count(s, &bodies, &bonds));
+        CHECK(bodies == 2 && bonds == 1);
+        CHECK_OK(rubble_structure_step(s, NULL, &info));
+        CHECK(info.break_count == 0 && info.collapse_count == 0 && info.residual <= 1e-3);
+        CHECK(rubble_structure_get_break(s, 0, &k) == RUBBLE_ERROR_INVALID_ARGUMENT);
+        /* bad bodies change nothing */
+        CHECK_OK(rubble_mesh_create_box(lo, hi, 1, &cube));
+        CHECK(rubble_structure_add(s, 3, cube, NULL, zero, "Wood", 0) == RUBBLE_ERROR_INVALID_INPUT);
+        CHECK(contains(rubble_last_error(), "unknown material 'Wood'"));
+        CHECK(rubble_structure_add(s, 3, cube, skew, zero, "wood", 0) == RUBBLE_ERROR_INVALID_INPUT);
+        CHECK(contains(rubble_last_error(), "not a rigid motion"));
+        CHECK(rubble_structure_add(s, 0, cube, NULL, zero, "wood", 0) == RUBBLE_ERROR_INVALID_INPUT);
+        CHECK(rubble_structure_add(s, 3, NULL, NULL, zero, "wood", 0) == RUBBLE_ERROR_INVALID_ARGUMENT);
+        CHECK(rubble_structure_add_load(s, 3, down, zero) == RUBBLE_ERROR_INVALID_ARGUMENT);
+        CHECK(rubble_structure_add_load(s, 2, nan3, zero) == RUBBLE_ERROR_INVALID_ARGUMENT);
+        CHECK(rubble_structure_damage(s, zero, -1) == RUBBLE_ERROR_INVALID_ARGUMENT);
+        CHECK(rubble_structure_remove(s, 3) == RUBBLE_ERROR_INVALID_ARGUMENT);
+        CHECK_OK(rubble_structure_count(s, &bodies, &bonds));
+        CHECK(bodies == 2 && bonds == 1);
+        CHECK(rubble_structure_destroy((rubble_structure*)(void*)cube) == RUBBLE_ERROR_INVALID_ARGUMENT);
+        CHECK(rubble_mesh_destroy((rubble_mesh*)(void*)s) == RUBBLE_ERROR_INVALID_ARGUMENT);
+        CHECK_OK(rubble_mesh_destroy(cube));
+        CHECK_OK(rubble_structure_destroy(s));
+    }
+    s = NULL;
+    if (cantilever(3.5, "concrete", &s)) {
+        CHECK_OK(rubble_structure_step(s, NULL, &info));
+        CHECK(info.break_count == 1 && info.collapse_count == 1);
+        CHECK_OK(rubble_structure_get_break(s, 0, &k));
+        CHECK(k.step == 1 && k.a == 1 && k.b == 2 && !k.damaged && k.utilisation > 1);
+        CHECK(fabs(k.position[0]) < 1e-9 && fabs(k.position[1] - 2.1) < 1e-9 && fabs(k.position[2]) < 1e-9);
+        CHECK(fabs(k.area - 0.3) < 1e-9);
+        CHECK(strcmp(k.material_a, "concrete") == 0 && strcmp(k.material_b, "concrete") == 0);
+        CHECK_OK(rubble_structure_get_collapse(s, 0, &c));
+        CHECK(c.step == 1 && c.body == 2 && strcmp(c.material, "concrete") == 0);
+        CHECK(fabs(c.volume - 3.5 * 1.5 * 0.2) < 1e-9 && fabs(c.mass - 2400 * c.volume) < 1e-6);
+        CHECK(fabs(c.position[0] - 1.75) < 1e-9 && fabs(c.position[1] - 2.1) < 1e-9);
+        CHECK(rubble_structure_get_collapse(s, 1, &c) == RUBBLE_ERROR_INVALID_ARGUMENT);
+        CHECK_OK(rubble_structure_count(s, &bodies, &bonds));
+        CHECK(bodies == 1 && bonds == 0);
+        CHECK_OK(rubble_structure_destroy(s));
+    }
+    s = NULL;
+    if (cantilever(3.5, "steel", &s)) { /* 14 MPa against 355 */
+        CHECK_OK(rubble_structure_step(s, NULL, &info));
+        CHECK(info.break_count == 0 && info.collapse_count == 0);
+        CHECK_OK(rubble_structure_destroy(s));
+    }
+    CHECK_OK(rubble_structure_destroy(NULL));
+}
+
 int main(int argc, char** argv) {
     const char* dir = argc > 1 ? argv[1] : ".";
     test_status_and_version();
@@ -640,6 +723,7 @@ int main(int argc, char** argv) {
     test_meshes(dir);
     test_fracture();
     test_world();
+    test_structure();
     test_log_callback();
     if (argc > 2)
         test_parameter_table(argv[2]);
