@@ -13,6 +13,7 @@
 #include <cstdlib>
 #include <limits>
 #include <map>
+#include <tuple>
 
 #include "rubble/geometry/MassProperties.hpp"
 
@@ -667,18 +668,22 @@ void StressSolver::route(std::vector<Route>& changes) {
         const NodeState& n = nodes_[i];
         below.clear();
         double area = 0;
-        for (std::size_t k : n.bonds) {
-            const BondState& b = bonds_[k];
-            if (b.broken || !b.solvable || !b.corners.empty())
-                continue;
-            const BondInterface& x = b.bond.section;
-            const std::uint32_t j = b.bond.other(i);
-            const double vertical = std::abs(dot(x.normal, down));
-            if (vertical <= 0.5 || dot(x.centroid - n.node.centroid, down) <= 0 ||
-                (movable(j) && height(j) >= key.first))
-                continue;
-            below.push_back({k, x.sectionArea * vertical});
-            area += below.back().second;
+        for (const bool steep : {false, true}) { // welds facing down first, else any weld to a lower node
+            for (std::size_t k : n.bonds) {
+                const BondState& b = bonds_[k];
+                if (b.broken || !b.solvable || !b.corners.empty())
+                    continue;
+                const BondInterface& x = b.bond.section;
+                const std::uint32_t j = b.bond.other(i);
+                const double vertical = std::abs(dot(x.normal, down));
+                if ((movable(j) && height(j) >= key.first) ||
+                    (!steep && (vertical <= 0.5 || dot(x.centroid - n.node.centroid, down) <= 0)))
+                    continue;
+                below.push_back({k, steep ? x.sectionArea : x.sectionArea * vertical});
+                area += below.back().second;
+            }
+            if (area > 0)
+                break;
         }
         if (area <= 0)
             continue;
@@ -717,6 +722,8 @@ void StressSolver::settleAmong(const std::vector<std::uint32_t>& group, double t
                 inside.push_back(k);
         }
     std::sort(inside.begin(), inside.end());
+    const bool welded =
+        std::all_of(inside.begin(), inside.end(), [&](std::size_t k) { return bonds_[k].corners.empty(); });
     auto worst = [&] {
         double m = 0;
         for (std::uint32_t n : group)
@@ -724,6 +731,41 @@ void StressSolver::settleAmong(const std::vector<std::uint32_t>& group, double t
                 m = std::max(m, nodeResidual(nodes_[n]));
         return m;
     };
+    if (welded) {
+        // The welds to what lies beneath the group (lower nodes, or held ones) carry its net load.
+        const double g = length(settings_.gravity);
+        const Vec3 down = g > 0 ? settings_.gravity / g : Vec3{};
+        auto height = [&](std::uint32_t i) { return -dot(nodes_[i].node.centroid, down); };
+        std::vector<std::size_t> welds = inside;
+        std::vector<std::uint32_t> below;
+        for (const bool steep : {false, true}) { // welds facing down first, else any weld to a lower node
+            for (std::uint32_t n : group)
+                for (std::size_t k : nodes_[n].bonds) {
+                    const BondState& b = bonds_[k];
+                    const std::uint32_t m = b.bond.other(n);
+                    const BondInterface& x = b.bond.section;
+                    if (b.broken || !b.solvable || !b.corners.empty() || !movable(n) ||
+                        std::binary_search(group.begin(), group.end(), m) ||
+                        (movable(m) && height(m) >= height(n)) ||
+                        (!steep && (std::abs(dot(x.normal, down)) <= 0.5 ||
+                                    dot(x.centroid - nodes_[n].node.centroid, down) <= 0)))
+                        continue;
+                    welds.push_back(k);
+                    if (movable(m))
+                        below.push_back(m);
+                }
+            if (welds.size() > inside.size())
+                break;
+        }
+        (void)balanceAmong(group, welds);
+        // The reactions on the nodes beneath go down to the ground.
+        std::sort(below.begin(), below.end());
+        below.erase(std::unique(below.begin(), below.end()), below.end());
+        std::vector<Route> rest;
+        for (std::uint32_t n : below)
+            rest.push_back({n, nodes_[n].v * nodes_[n].node.mass, nodes_[n].node.inertia * nodes_[n].w});
+        route(rest);
+    }
     double last = worst();
     for (int sweep = 1; sweep <= 400 && last > tolerance * tolerance; ++sweep) {
         for (std::size_t k : inside) {
@@ -739,6 +781,64 @@ void StressSolver::settleAmong(const std::vector<std::uint32_t>& group, double t
             last = now;
         }
     }
+}
+
+// The welds between these nodes take the smallest change of force that leaves every movable one of them at
+// rest, their other bonds held (one dense solve of the group's equilibrium; docs/structure.md). What no such
+// change can balance (the group's net imbalance) stays for the iteration. False when the group is too large.
+bool StressSolver::balanceAmong(const std::vector<std::uint32_t>& group,
+                                const std::vector<std::size_t>& welds) {
+    constexpr std::size_t kMostNodes = 48;
+    std::vector<int> local(group.size(), -1);
+    int n = 0;
+    for (std::size_t i = 0; i < group.size(); ++i)
+        if (movable(group[i]))
+            local[i] = n++;
+    if (n == 0 || welds.empty() || static_cast<std::size_t>(n) > kMostNodes)
+        return false;
+    auto indexOf = [&](std::uint32_t node) {
+        const auto it = std::lower_bound(group.begin(), group.end(), node);
+        return it != group.end() && *it == node ? local[static_cast<std::size_t>(it - group.begin())] : -1;
+    };
+    // Columns of J^T: a weld's (F, M) acts on a as (F, ra x F + M) and on b as the negative with rb.
+    const Eigen::Index rows = 6 * n, cols = 6 * static_cast<Eigen::Index>(welds.size());
+    Eigen::MatrixXd jt = Eigen::MatrixXd::Zero(rows, cols);
+    for (std::size_t k = 0; k < welds.size(); ++k) {
+        const BondState& b = bonds_[welds[k]];
+        for (const auto& [node, r, sign] :
+             {std::tuple{b.bond.a, b.ra, 1.0}, std::tuple{b.bond.b, b.rb, -1.0}}) {
+            const int i = indexOf(node);
+            if (i < 0)
+                continue;
+            auto block = jt.block<6, 6>(6 * i, 6 * static_cast<Eigen::Index>(k));
+            block.setIdentity();
+            const Eigen::Matrix3d skew{{0, -r.z, r.y}, {r.z, 0, -r.x}, {-r.y, r.x, 0}};
+            block.block<3, 3>(3, 0) = skew;
+            block *= sign;
+        }
+    }
+    // The generalised force that brings each node to rest: -(m v, I w).
+    Eigen::VectorXd f(rows);
+    for (std::size_t i = 0; i < group.size(); ++i) {
+        if (local[i] < 0)
+            continue;
+        const NodeState& s = nodes_[group[i]];
+        const Vec3 lin = s.v * -s.node.mass, ang = s.node.inertia * s.w * -1.0;
+        f.segment<6>(6 * local[i]) << lin.x, lin.y, lin.z, ang.x, ang.y, ang.z;
+    }
+    // The least change: the minimum-norm least-squares solution of J^T change = f.
+    const Eigen::VectorXd change = jt.completeOrthogonalDecomposition().solve(f);
+    if (!change.allFinite())
+        return false;
+    for (std::size_t k2 = 0; k2 < welds.size(); ++k2) {
+        const auto c = change.segment<6>(6 * static_cast<Eigen::Index>(k2));
+        BondState& b = bonds_[welds[k2]];
+        const Vec3 df{c[0], c[1], c[2]}, dm{c[3], c[4], c[5]};
+        b.force += df;
+        b.moment += dm;
+        apply(b, df, dm);
+    }
+    return true;
 }
 
 // The nodes a chain of intact bonds links to a root (kept until a bond or root changes).

@@ -239,6 +239,7 @@ private:
     };
     void route(std::vector<Route>& changes);
     void settleAmong(const std::vector<std::uint32_t>& group, double tolerance);
+    bool balanceAmong(const std::vector<std::uint32_t>& group, const std::vector<std::size_t>& welds);
     std::vector<Route> routes_;            // startSolve(): this solve's load changes
     std::vector<BondBreak> breaks_;        // since takeBreaks()
     std::vector<Orphan> orphans_;          // since the last solve
