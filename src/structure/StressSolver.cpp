@@ -13,6 +13,7 @@
 #include <cstdlib>
 #include <limits>
 #include <map>
+#include <queue>
 #include <tuple>
 
 #include "rubble/geometry/MassProperties.hpp"
@@ -253,6 +254,7 @@ void StressSolver::reset(std::vector<StructureNode> nodes, std::vector<Bond> bon
     direct_.reset();
     allDirty_ = true;
     reachValid_ = false;
+    reachFull_ = true;
     for (const StructureNode& n : nodes)
         (void)addNode(n);
     for (std::size_t i = 0; i < bonds.size(); ++i)
@@ -275,6 +277,8 @@ std::uint32_t StressSolver::addNode(const StructureNode& node) {
         freeNodes_.pop_back();
         nodes_[i] = std::move(s);
     }
+    if (i < reached_.size())
+        reached_[i] = 0;
     if (direct_)
         direct_->touch(i);
     return i;
@@ -299,6 +303,8 @@ void StressSolver::removeNode(std::uint32_t node) {
     n = NodeState{};
     n.removed = n.detached = true;
     reachValid_ = false;
+    if (node < reached_.size())
+        reached_[node] = 0;
     freeNodes_.insert(std::upper_bound(freeNodes_.begin(), freeNodes_.end(), node, std::greater<>()), node);
 }
 
@@ -325,6 +331,8 @@ std::size_t StressSolver::addBond(Bond bond, StrengthLimits limits) {
             direct_->touch(n);
     }
     reachValid_ = false;
+    reachGained_.push_back(bonds_[i].bond.a);
+    reachGained_.push_back(bonds_[i].bond.b);
     if (!orphans_.empty())
         fresh_.push_back(i);
     return i;
@@ -338,6 +346,7 @@ void StressSolver::removeBond(std::size_t i) {
         markDirty(n);
         if (direct_)
             direct_->touch(n);
+        reachLost_.push_back(n);
     }
     reachValid_ = false;
     if (direct_)
@@ -368,6 +377,7 @@ void StressSolver::setRoot(std::uint32_t node, bool root) {
         }
     }
     reachValid_ = false;
+    reachFull_ = true;
 }
 
 void StressSolver::markDirty(std::uint32_t node) {
@@ -541,7 +551,8 @@ void StressSolver::solve() {
     // Nodes that replace a removed one (a fracture's pieces): with routeLoads they first balance among
     // themselves, below.
     std::vector<std::uint32_t> newcomers;
-    if (settings_.routeLoads && settings_.method != StressMethod::SweepBudget && !allDirty_)
+    const bool routing = settings_.routeLoads && settings_.method != StressMethod::SweepBudget && !allDirty_;
+    if (routing)
         for (std::size_t k : fresh_)
             for (std::uint32_t n : {bonds_[k].bond.a, bonds_[k].bond.b})
                 if (!nodes_[n].solved && !nodes_[n].removed)
@@ -563,6 +574,8 @@ void StressSolver::solve() {
         route(routes_);
     if (!newcomers.empty() && settings_.method != StressMethod::Direct)
         settleAmong(newcomers, settings_.residual * scale);
+    if (routing && settings_.method != StressMethod::Direct) // what is still unbalanced goes down, if it can
+        routeUnbalanced(settings_.residual * scale);
     factorizations_ = blocksMade_ = 0;
     switch (settings_.method) {
     case StressMethod::SweepBudget:
@@ -708,6 +721,17 @@ void StressSolver::route(std::vector<Route>& changes) {
     }
 }
 
+// Every node still out of the tolerance passes its imbalance down its welds (route): exact where a chain of
+// welds leads down to what is held, left for the iteration elsewhere.
+void StressSolver::routeUnbalanced(double tolerance) {
+    std::vector<Route> rest;
+    for (std::uint32_t i = 0; i < nodes_.size(); ++i)
+        if (movable(i) && nodeResidual(nodes_[i]) > tolerance * tolerance)
+            rest.push_back({i, nodes_[i].v * nodes_[i].node.mass, nodes_[i].node.inertia * nodes_[i].w});
+    if (!rest.empty())
+        route(rest);
+}
+
 // Gauss-Seidel over the bonds between these nodes only (ascending), until they are at rest within the
 // tolerance or stop improving: the pieces that replaced a body carry its inherited load path among
 // themselves before the iteration spreads what is left to their neighbours.
@@ -843,8 +867,83 @@ bool StressSolver::balanceAmong(const std::vector<std::uint32_t>& group,
 
 // The nodes a chain of intact bonds links to a root (kept until a bond or root changes).
 void StressSolver::reach() {
-    reached_ = reachable();
+    if (reachFull_ || !reachAgain())
+        reached_ = reachable();
     reachValid_ = true;
+    reachFull_ = false;
+    reachLost_.clear();
+    reachGained_.clear();
+}
+
+// reached_ brought up to date from the bonds lost and gained since it was found: each end of a lost bond
+// searches for a root, lowest nodes first (what finds none is cut off, with everything it met); then the
+// reached ends of added bonds pass it on. The same result as reachable(); false when a search grows past a
+// share of the structure (then the whole is found again).
+bool StressSolver::reachAgain() {
+    reached_.resize(nodes_.size(), 0);
+    const std::size_t most = std::max<std::size_t>(512, nodes_.size() / 8);
+    const double g = length(settings_.gravity);
+    const Vec3 down = g > 0 ? settings_.gravity / g : Vec3{0, -1, 0};
+    std::vector<char> held(nodes_.size(), 0);          // proven linked to a root in this call
+    std::vector<std::uint32_t> seen(nodes_.size(), 0); // the search that met the node (1, 2, ...)
+    std::uint32_t search = 0;
+    std::vector<std::uint32_t> met;
+    using Open = std::pair<double, std::uint32_t>; // (height, node): lowest first
+    std::priority_queue<Open, std::vector<Open>, std::greater<>> open;
+    auto root = [&](std::uint32_t i) { return nodes_[i].node.root && !nodes_[i].detached; };
+    for (std::uint32_t start : reachLost_) {
+        if (start >= nodes_.size() || nodes_[start].removed || !reached_[start] || held[start])
+            continue;
+        met.assign(1, start);
+        open = {};
+        open.push({-dot(nodes_[start].node.centroid, down), start});
+        seen[start] = ++search;
+        bool linked = false;
+        while (!open.empty() && !linked) {
+            const std::uint32_t n = open.top().second;
+            open.pop();
+            if (root(n) || held[n]) {
+                linked = true;
+                break;
+            }
+            for (std::size_t k : nodes_[n].bonds) {
+                const BondState& b = bonds_[k];
+                const std::uint32_t m = b.bond.other(n);
+                if (b.broken || seen[m] == search)
+                    continue;
+                seen[m] = search;
+                met.push_back(m);
+                open.push({-dot(nodes_[m].node.centroid, down), m});
+            }
+            if (met.size() > most)
+                return false;
+        }
+        for (std::uint32_t m : met) {
+            if (linked)
+                held[m] = 1; // met on the way to a root: linked too (its component holds the root)
+            else
+                reached_[m] = 0;
+        }
+    }
+    std::vector<std::uint32_t> flood;
+    for (std::uint32_t start : reachGained_)
+        if (start < nodes_.size() && !nodes_[start].removed && (reached_[start] || root(start))) {
+            reached_[start] = 1;
+            flood.push_back(start);
+        }
+    while (!flood.empty()) {
+        const std::uint32_t n = flood.back();
+        flood.pop_back();
+        for (std::size_t k : nodes_[n].bonds) {
+            const BondState& b = bonds_[k];
+            const std::uint32_t m = b.bond.other(n);
+            if (!b.broken && !reached_[m]) {
+                reached_[m] = 1;
+                flood.push_back(m);
+            }
+        }
+    }
+    return true;
 }
 
 std::vector<char> StressSolver::reachable() const {
@@ -1863,6 +1962,8 @@ void StressSolver::breakBond(std::size_t i) {
         markDirty(bonds_[i].bond.a);
         markDirty(bonds_[i].bond.b);
         reachValid_ = false;
+        reachLost_.push_back(bonds_[i].bond.a);
+        reachLost_.push_back(bonds_[i].bond.b);
     }
     bonds_[i].broken = true;
     bonds_[i].force = bonds_[i].moment = Vec3{};
@@ -1872,6 +1973,7 @@ void StressSolver::detach(std::uint32_t node) {
     nodes_[node].detached = true;
     markDirty(node);
     reachValid_ = false;
+    reachFull_ = true;
     for (std::size_t i : nodes_[node].bonds)
         breakBond(i);
 }

@@ -1,4 +1,5 @@
-// A fracture changes the forces only where its load goes: a brick of a welded block replaced by its Voronoi
+// Which nodes a chain of bonds links to the ground is kept up to date from the bonds lost and gained, and a
+// fracture changes the forces only where its load goes: a brick of a welded block replaced by its Voronoi
 // pieces balances among them and its neighbours beneath, and what it no longer weighs goes down its column
 // to the ground, with no sweep over the rest of the block (docs/structure.md, "Local balance").
 #include <gtest/gtest.h>
@@ -131,4 +132,80 @@ TEST(StressLocality, AFracturedBrickBalancesAmongItsPiecesAndPassesWhatItLostDow
     // The column's foot carries what the brick lost less (to the residual the block was solved to, 1e-3).
     EXPECT_NEAR(std::abs(block.solver.bondForce(foot).y), std::abs(footBefore) - lost,
                 1e-3 * std::abs(footBefore));
+}
+
+// After any sequence of removed nodes, added nodes and broken bonds, the nodes the solver finds unsupported
+// (kept up to date from the changes) are those no chain of intact bonds links to the ground.
+TEST(StressLocality, WhatIsCutOffFromTheGroundIsFoundFromTheChangesAlone) {
+    BondGraph graph;
+    StressSolver solver;
+    solver.settings().method = StressMethod::SweepBudget;
+    solver.settings().iterations = 1;
+    auto add = [&](const std::vector<ConvexPolytope>& parts, bool root = false) {
+        const std::uint32_t slot = solver.addNode(structureNode(parts, kDensity, root));
+        for (Bond& b : graph.add(slot, parts))
+            (void)solver.addBond(std::move(b), {});
+        return slot;
+    };
+    (void)add(box({-1, -1, -1}, {7, 0, 7}), true);
+    // Sixteen columns of six bricks, apart, and slabs on top joining them in pairs: cycles through the top.
+    std::vector<std::vector<ConvexPolytope>> cells;
+    for (int z = 0; z < 4; ++z)
+        for (int x = 0; x < 4; ++x)
+            for (int y = 0; y < 6; ++y)
+                cells.push_back(box({1.5 * x, 0.5 * y, 1.5 * z}, {1.5 * x + 1, 0.5 * y + 0.5, 1.5 * z + 1}));
+    for (int z = 0; z < 4; ++z)
+        for (int x : {0, 2})
+            cells.push_back(box({1.5 * x, 3, 1.5 * z}, {1.5 * x + 2.5, 3.5, 1.5 * z + 1}));
+    std::vector<std::int64_t> slotOf(cells.size(), -1); // cell -> its node while present
+    for (std::size_t c = 0; c < cells.size(); ++c)
+        slotOf[c] = add(cells[c]);
+    std::uint64_t state = 12345;
+    auto next = [&](std::uint64_t n) {
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        return (state >> 33) % n;
+    };
+    int cutOff = 0;
+    for (int step = 0; step < 300; ++step) {
+        const int op = static_cast<int>(next(5));
+        const std::size_t c = next(cells.size());
+        if (op <= 1 && slotOf[c] >= 0) { // a brick goes
+            (void)graph.remove(static_cast<std::uint32_t>(slotOf[c]));
+            solver.removeNode(static_cast<std::uint32_t>(slotOf[c]));
+            slotOf[c] = -1;
+        } else if (op == 4 && slotOf[c] < 0) { // a brick comes back
+            slotOf[c] = add(cells[c]);
+        } else if ((op == 2 || op == 3) && slotOf[c] >= 0) { // one of its bonds breaks
+            const auto& bonds = solver.bondsOf(static_cast<std::uint32_t>(slotOf[c]));
+            if (!bonds.empty())
+                solver.breakBond(bonds[next(bonds.size())]);
+        }
+        solver.solve();
+        // The truth: a search from the ground over intact bonds.
+        std::vector<char> linked(solver.nodeCount(), 0);
+        std::vector<std::uint32_t> open;
+        for (std::uint32_t n = 0; n < solver.nodeCount(); ++n)
+            if (solver.present(n) && solver.root(n)) {
+                linked[n] = 1;
+                open.push_back(n);
+            }
+        while (!open.empty()) {
+            const std::uint32_t n = open.back();
+            open.pop_back();
+            for (std::size_t k : solver.bondsOf(n)) {
+                const std::uint32_t m = solver.bond(k).other(n);
+                if (!solver.broken(k) && !linked[m]) {
+                    linked[m] = 1;
+                    open.push_back(m);
+                }
+            }
+        }
+        std::vector<std::uint32_t> expected;
+        for (std::uint32_t n = 0; n < solver.nodeCount(); ++n)
+            if (solver.present(n) && !linked[n])
+                expected.push_back(n);
+        ASSERT_EQ(solver.unsupported(), expected) << "step " << step;
+        cutOff = std::max(cutOff, static_cast<int>(expected.size()));
+    }
+    EXPECT_GT(cutOff, 10) << "some bricks were cut off on the way";
 }
