@@ -1,0 +1,153 @@
+// Cascades on the toy engine of tests/support: a body the structure lets fall delivers its landing to what it
+// hits as shots do (an impact through the impact policy, damage to the bonds near the hit) and as a load on
+// the floor beneath, which fails only if its materials say so.
+#include <gtest/gtest.h>
+
+#include <optional>
+
+#include "StructureRig.hpp"
+#include "rubble/runtime/DestructionRuntime.hpp"
+
+namespace rubble {
+namespace {
+
+using Rig = test::StructureRig;
+
+// A 3.4 x 0.5 x 1 m block (density 500: 850 kg) on two props 3 m tall, over a 2 x 0.5 x 2 m destructible
+// concrete floor on the ground between them.
+struct Drop {
+    explicit Drop(const ImpactPolicy& policy) : rig(true, 1, false, 0.6) {
+        rig.runtime.setImpactPolicy(policy);
+        props = {rig.addBox({-1.7, 0, -0.2}, {-1.3, 3, 0.2}, "concrete"),
+                 rig.addBox({1.3, 0, -0.2}, {1.7, 3, 0.2}, "concrete")};
+        block = rig.addBox({-1.7, 3, -0.5}, {1.7, 3.5, 0.5}, "concrete");
+        floor = rig.addBox({-1, 0, -1}, {1, 0.5, 1}, "concrete", true);
+        for (int i = 0; i < 10; ++i)
+            rig.runtime.stepFrame();
+    }
+    // The health of the floor's bond to the ground.
+    double floorHealth() const {
+        const BodyRecord* f = rig.runtime.bodyOf(floor);
+        if (!f)
+            return -1;
+        for (const StructureBond& b : rig.runtime.structureBonds())
+            if (b.a == f->id || b.b == f->id)
+                return b.health;
+        return -1;
+    }
+    Rig rig;
+    std::vector<ObjectId> props;
+    ObjectId block = 0, floor = 0;
+};
+
+} // namespace
+
+// The props go, the block falls 2.5 m (7.0 m/s, 5.9 kN s on landing): above the impact policy's threshold its
+// landing is an impact on the floor, counted, marked, fracturing it and weakening its bond to the ground by
+// 5.9e3 N s * 1e-4 * (1 - 0.5 m / 1 m) = 0.30 in that frame; above the landing's impulse or approach speed,
+// none.
+TEST(Cascade, ACollapsingBodyHitsWhatItLandsOnThroughTheImpactPathAboveThePolicysThresholds) {
+    for (const int mode : {0, 1, 2}) { // thresholds below the landing, impulse above it, approach above it
+        SCOPED_TRACE(mode);
+        ImpactPolicy policy;
+        if (mode == 1)
+            policy.collisionImpulseThreshold = 1e4;
+        if (mode == 2)
+            policy.minApproachSpeed = 8;
+        Drop d(policy);
+        ASSERT_EQ(d.rig.motionOf(d.block), BodyMotionState::Static);
+        EXPECT_EQ(d.floorHealth(), 1);
+        for (ObjectId p : d.props)
+            d.rig.runtime.removeBody(d.rig.runtime.bodyOf(p)->id);
+        std::optional<double> healthAtImpact;
+        bool collapsed = false;
+        for (int i = 0; i < 90 && !healthAtImpact; ++i) {
+            d.rig.runtime.stepFrame();
+            for (const StructureCollapse& c : d.rig.runtime.structureCollapses())
+                collapsed = collapsed || c.body == d.rig.runtime.bodyOf(d.block)->id;
+            if (d.rig.runtime.counters().impacts > 0)
+                healthAtImpact = d.floorHealth();
+        }
+        for (int i = 0; i < 30; ++i)
+            d.rig.runtime.stepFrame();
+        EXPECT_TRUE(collapsed) << "the block fell for want of support";
+        const RuntimeCounters& c = d.rig.runtime.counters();
+        if (mode != 0) {
+            EXPECT_FALSE(healthAtImpact);
+            EXPECT_EQ(c.impacts, 0);
+            EXPECT_TRUE(d.rig.runtime.recentImpacts().empty());
+            EXPECT_EQ(c.fractures, 0);
+            EXPECT_EQ(d.floorHealth(), 1) << "no damage without an impact";
+            continue;
+        }
+        ASSERT_TRUE(healthAtImpact);
+        EXPECT_NEAR(*healthAtImpact, 1 - 850 * std::sqrt(2 * 9.81 * 2.5) * 1e-4 * 0.5, 0.02);
+        EXPECT_EQ(c.impacts, 1) << "the floor; the block is indestructible";
+        ASSERT_EQ(d.rig.runtime.recentImpacts().size(), 1u);
+        const ImpactMark& m = d.rig.runtime.recentImpacts().front();
+        EXPECT_NEAR(length(m.point - Vec3{0, 0.5, 0}), 0, 1e-9) << "on the floor's top, under the block";
+        EXPECT_GT(m.impulse, 5000);
+        EXPECT_EQ(c.fractures, 1);
+        EXPECT_EQ(d.rig.runtime.bodyOf(d.floor), nullptr) << "broken into pieces";
+    }
+}
+
+// A floor that collapses onto the one beneath: a 5.2 x 0.2 x 1.5 m slab (780 kg) on props outside the lower
+// floor falls 2.8 m onto a 4 m slab on two 0.1 x 0.1 m piers (bearings). The landing (780 kg at 7.4 m/s over
+// a 1/60 s frame, 346 kN, half on each pier) presses 17 MPa on each pier's 0.01 m^2 ends: brick (f_c 9 MPa)
+// crushes and the lower floor falls, steel (355 MPa) holds. Unloaded, the brick floor stands.
+TEST(Cascade, AFloorThatCollapsesOntoTheOneBelowBreaksItOnlyIfItsMaterialsSaySo) {
+    for (const char* material : {"brick", "steel"})
+        for (const bool drop : {true, false}) {
+            SCOPED_TRACE(std::string(material) + (drop ? ", dropped" : ", not dropped"));
+            Rig rig(true, 1, false, 0.6);
+            const ObjectId left = rig.addBox({-2, 0, -0.05}, {-1.9, 3, 0.05}, material);
+            const ObjectId right = rig.addBox({1.9, 0, -0.05}, {2, 3, 0.05}, material);
+            const ObjectId lower = rig.addBox({-2, 3, -0.75}, {2, 3.2, 0.75}, material);
+            const std::vector<ObjectId> props{rig.addBox({-2.6, 0, -0.2}, {-2.2, 6, 0.2}, "concrete"),
+                                              rig.addBox({2.2, 0, -0.2}, {2.6, 6, 0.2}, "concrete")};
+            const ObjectId upper = rig.addBox({-2.6, 6, -0.75}, {2.6, 6.2, 0.75}, "concrete");
+            for (int i = 0; i < 10; ++i)
+                rig.runtime.stepFrame();
+            ASSERT_EQ(rig.motionOf(lower), BodyMotionState::Static) << "it carries itself";
+            ASSERT_EQ(rig.runtime.counters().bondsBroken, 0);
+            if (drop)
+                for (ObjectId p : props)
+                    rig.runtime.removeBody(rig.runtime.bodyOf(p)->id);
+            std::vector<StructureBreak> breaks;
+            std::uint64_t upperFell = 0, lowerFell = 0;
+            for (int i = 0; i < 90; ++i) {
+                rig.runtime.stepFrame();
+                breaks.insert(breaks.end(), rig.runtime.structureBreaks().begin(),
+                              rig.runtime.structureBreaks().end());
+                for (const StructureCollapse& c : rig.runtime.structureCollapses()) {
+                    if (c.body == rig.runtime.bodyOf(upper)->id)
+                        upperFell = c.frame;
+                    if (c.body == rig.runtime.bodyOf(lower)->id)
+                        lowerFell = c.frame;
+                }
+            }
+            EXPECT_EQ(upperFell > 0, drop);
+            const bool fails = drop && std::string(material) == "brick";
+            EXPECT_EQ(rig.motionOf(lower), fails ? BodyMotionState::Dynamic : BodyMotionState::Static);
+            EXPECT_EQ(lowerFell > 0, fails);
+            EXPECT_EQ(rig.motionOf(left) != BodyMotionState::Static, fails);
+            EXPECT_EQ(rig.motionOf(right) != BodyMotionState::Static, fails);
+            if (!fails) {
+                EXPECT_TRUE(breaks.empty());
+                EXPECT_EQ(rig.runtime.counters().bondsBroken, 0);
+                continue;
+            }
+            EXPECT_GT(lowerFell, upperFell + 10)
+                << "the upper floor fell, landed, then the lower one gave way";
+            ASSERT_GE(breaks.size(), 2u) << "both piers' bearings";
+            for (const StructureBreak& b : breaks) {
+                EXPECT_FALSE(b.damaged) << "crushed by the load, not by impact damage";
+                EXPECT_GT(b.utilisation, 1);
+                EXPECT_TRUE(b.materialA == "brick" || b.materialB == "brick");
+            }
+            EXPECT_EQ(rig.runtime.counters().impacts, 0) << "nothing destructible: the load alone broke it";
+        }
+}
+
+} // namespace rubble
