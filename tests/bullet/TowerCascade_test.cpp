@@ -1,6 +1,4 @@
-// assets/scenes/tower.cfg brought down by one charge at its base, on the Bullet binding: the charge breaks
-// the ground floor, the storeys above drop onto it and break one after another, from the bottom up, by the
-// impacts of their landing (docs/structure.md, "A tower that falls because of its load").
+// tower.cfg brought down by one charge at its base, on Bullet (docs/structure.md, "A tower that falls").
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -28,10 +26,7 @@ struct TowerRun {
     long long impacts = 0, collapses = 0; // at the end
 };
 
-// The tower on Bullet as the demo runs it (stress solver on bearings, seed, dust limit), a second to settle,
-// then the charge (none when impulse is 0), then `frames` frames under the given impact policy (frame 0: the
-// charge's). With writeCsv, RUBBLE_TOWER_CSV names a file for each frame's slab heights
-// (bench/results/tower_cascade.csv).
+// The tower as the demo runs it, settled, charged (impulse > 0), stepped; RUBBLE_TOWER_CSV gets slab heights.
 TowerRun runTower(double impulse, const ImpactPolicy& afterCharge, int frames, bool writeCsv = false) {
     const Result<SceneConfig> scene = parseSceneConfig(test::sourceDir() / "assets/scenes/tower.cfg");
     EXPECT_TRUE(scene) << scene.error().message;
@@ -105,12 +100,7 @@ TowerRun runTower(double impulse, const ImpactPolicy& afterCharge, int frames, b
 
 } // namespace
 
-// One charge under the ground floor (at (0, -12, 0), 2 m below the ground's top, radius 4 m, 20,000 N s)
-// reaches the four ground-floor pillars and the first slab only. The storeys above lose their support at once
-// and drop as a stack; as each lands on the wreck below, its landing's impacts break it: storey 1 first, the
-// top one more than a second later, each in a later frame than the one beneath. With collisions no longer
-// impacts (the impact policy's threshold out of reach after the charge) they fall as far and none of them
-// breaks; unshot, the tower stands.
+// The charge breaks the ground floor; the storeys above fall at once and break bottom-up as they land.
 TEST(TowerCascade, OneChargeAtItsBaseBringsTheTowerDownStoreyByStoreyThroughLandingImpacts) {
     const int frames = 360;
     const TowerRun unshot = runTower(0, ImpactPolicy{}, frames);

@@ -1,6 +1,4 @@
-// Cascades on the toy engine of tests/support: a body the structure lets fall delivers its landing to what it
-// hits as shots do (an impact through the impact policy, damage to the bonds near the hit) and as a load on
-// the floor beneath, which fails only if its materials say so.
+// Cascades on the toy engine: what falls hits and loads what is beneath (docs/structure.md, "Cascades").
 #include <gtest/gtest.h>
 
 #include <map>
@@ -14,8 +12,7 @@ namespace {
 
 using Rig = test::StructureRig;
 
-// A 3.4 x 0.5 x 1 m block (density 500: 850 kg) on two props 3 m tall, over a 2 x 0.5 x 2 m destructible
-// concrete floor on the ground between them.
+// An 850 kg block on two 3 m props over a destructible concrete floor on the ground between them.
 struct Drop {
     explicit Drop(const ImpactPolicy& policy) : rig(true, 1, false, 0.6) {
         rig.runtime.setImpactPolicy(policy);
@@ -43,10 +40,7 @@ struct Drop {
 
 } // namespace
 
-// The props go, the block falls 2.5 m (7.0 m/s, 5.9 kN s on landing): above the impact policy's threshold its
-// landing is an impact on the floor, counted, marked, fracturing it and weakening its bond to the ground by
-// 5.9e3 N s * 1e-4 * (1 - 0.5 m / 1 m) = 0.30 in that frame; above the landing's impulse or approach speed,
-// none.
+// The block's 2.5 m fall is an impact on the floor (0.30 of its ground bond's health) only above the policy.
 TEST(Cascade, ACollapsingBodyHitsWhatItLandsOnThroughTheImpactPathAboveThePolicysThresholds) {
     for (const int mode : {0, 1, 2}) { // thresholds below the landing, impulse above it, approach above it
         SCOPED_TRACE(mode);
@@ -93,11 +87,7 @@ TEST(Cascade, ACollapsingBodyHitsWhatItLandsOnThroughTheImpactPathAboveThePolicy
     }
 }
 
-// A floor that collapses onto the one beneath: a 5.2 x 0.2 x 1.5 m slab (780 kg) on props outside the lower
-// floor falls 2.8 m onto a 4 m slab on two 0.1 x 0.1 m piers (bearings). Its landing (780 kg at up to 7.4 m/s
-// stopped in a 1/60 s frame) puts 127-136 kN on each pier's 0.01 m^2 ends, 13 MPa: brick (f_c 9 MPa) crushes
-// at both ends of both piers in the landing's frame and the lower floor falls; steel (355 MPa) holds.
-// Unloaded, the brick floor stands.
+// A 780 kg slab falls 2.8 m onto a slab on 0.1 m piers: brick bearings crush (13 MPa > 9), steel holds.
 TEST(Cascade, AFloorThatCollapsesOntoTheOneBelowBreaksItOnlyIfItsMaterialsSaySo) {
     for (const char* material : {"brick", "steel"})
         for (const bool drop : {true, false}) {
@@ -153,17 +143,7 @@ TEST(Cascade, AFloorThatCollapsesOntoTheOneBelowBreaksItOnlyIfItsMaterialsSaySo)
         }
 }
 
-} // namespace rubble
-
-namespace rubble {
-
-// Floors falling on floors, top down, one landing at a time: three brick storeys of 4 x 0.4 x 1.5 m slabs
-// (1,200 kg) on two piers each, 0.22, 0.16 and 0.1 m square from the bottom up, and a concrete slab (780 kg)
-// dropped 3 m onto the top. Its landing crushes the top piers' ends (about 200 kN each, 20 MPa against
-// brick's 9) and not the middle ones (7.8 MPa); the top slab falls 2.8 m onto the middle one, whose piers
-// crush in that landing's frame (about 290 kN, 11 MPa); the middle slab's landing leaves the bottom piers at
-// 6 MPa, and the bottom storey stands. With the two lower storeys of steel, the cascade stops at the top one.
-// (Converged solves: with the sweep budget the top slab, unloaded, is let go as unbalanced after 30 solves.)
+// Three brick storeys under a dropped slab: the top, then the middle one give way as each lands.
 TEST(Cascade, FloorsFallingOnFloorsBreakThemTopDownOneLandingAtATimeWhileTheirMaterialsGiveWay) {
     for (const char* below : {"brick", "steel"}) {
         SCOPED_TRACE(below);
