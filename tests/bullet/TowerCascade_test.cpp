@@ -133,5 +133,5 @@ TEST(TowerCascade, OneChargeAtItsBaseBringsTheTowerDownStoreyByStoreyThroughLand
     std::printf("storeys broke in frames");
     for (int s = 0; s < kStoreys; ++s)
         std::printf(" %d", run.broke[s]);
-    std::printf(" (fell in %d)\n", run.fell[1]);
+    std::printf(" (fell in %d), impacts %lld\n", run.fell[1], run.impacts);
 }
