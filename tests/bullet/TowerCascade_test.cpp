@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
+#include <memory>
+#include <vector>
 
 #include "TestSupport.hpp"
 #include "rubble/bullet/BulletBinding.hpp"
@@ -26,10 +28,13 @@ struct TowerRun {
     long long impacts = 0, collapses = 0; // at the end
 };
 
-// The tower as the demo runs it, settled, charged (impulse > 0), stepped; RUBBLE_TOWER_CSV gets slab heights.
+// The tower with the demo's runtime settings, settled, charged (impulse > 0), stepped; RUBBLE_TOWER_CSV:
+// heights.
 TowerRun runTower(double impulse, const ImpactPolicy& afterCharge, int frames, bool writeCsv = false) {
     const Result<SceneConfig> scene = parseSceneConfig(test::sourceDir() / "assets/scenes/tower.cfg");
     EXPECT_TRUE(scene) << scene.error().message;
+    if (!scene)
+        return {};
     DestructionRuntime::Config rc;
     rc.world.workers = 1;
     rc.world.deterministic = true;
@@ -109,6 +114,7 @@ TEST(TowerCascade, OneChargeAtItsBaseBringsTheTowerDownStoreyByStoreyThroughLand
     EXPECT_EQ(unshot.impacts, 0);
 
     const TowerRun run = runTower(20000, ImpactPolicy{}, frames, true);
+    ASSERT_EQ(run.broke.size(), static_cast<std::size_t>(kStoreys)) << "the scene loaded";
     EXPECT_EQ(run.accepted, 5) << "the ground floor's four pillars and the first slab";
     for (const ImpactMark& m : run.chargeMarks)
         EXPECT_LT(m.point.y, -6.5) << "below the first slab's top";
@@ -124,6 +130,7 @@ TEST(TowerCascade, OneChargeAtItsBaseBringsTheTowerDownStoreyByStoreyThroughLand
     ImpactPolicy noCollisions;
     noCollisions.collisionImpulseThreshold = std::numeric_limits<double>::infinity();
     const TowerRun off = runTower(20000, noCollisions, frames);
+    ASSERT_EQ(off.broke.size(), static_cast<std::size_t>(kStoreys));
     EXPECT_EQ(off.accepted, 5);
     EXPECT_EQ(off.impacts, 5) << "the charge's only";
     for (int s = 1; s < kStoreys; ++s) {
