@@ -6,6 +6,7 @@
 #include <imgui_impl_glfw.h>
 #include <imgui_impl_opengl3.h>
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -76,6 +77,7 @@ struct Options {
     std::vector<std::string> hits;     // "X,Y,Z,IMPULSE": impacts in the first frame
     bool holdFire = false;             // the autopilot flies without shooting
     std::string camera;                // "EX,EY,EZ,TX,TY,TZ": a fixed showcase camera
+    std::string charge;                // "X,Y,Z,RADIUS,IMPULSE,SECONDS": one demolition charge
     std::string record;                // journal file written at exit
     std::string replay;                // journal file replayed on the loaded scene instead of playing
     int host = 0;                      // port to host loopback multiplayer on
@@ -125,6 +127,7 @@ struct App {
     bool nextScene = false;                              // N pressed
     std::vector<std::pair<demo::V3, float>> hits;        // --hit: (point, impulse), after the first load
     std::optional<std::pair<demo::V3, demo::V3>> camera; // --camera: (eye, target), after every load
+    std::optional<std::array<float, 6>> charge;          // --charge: x, y, z, radius, impulse, seconds
     bool paused = false;
     bool quit = false;
     bool screenshotRequested = false;
@@ -330,6 +333,9 @@ int parseOptions(int argc, char** argv, Options& o) {
     cli.add_option(
         "--camera", o.camera,
         "EX,EY,EZ,TX,TY,TZ: a fixed camera at EX,EY,EZ looking at TX,TY,TZ (also in the --join window)");
+    cli.add_option("--charge", o.charge,
+                   "X,Y,Z,RADIUS,IMPULSE,SECONDS: one demolition charge blasts the objects within RADIUS of "
+                   "that point at that game time (IMPULSE N s at its centre, 40 % at its edge)");
     cli.add_flag("--bilinear", o.bilinear, "software quality: bilinear textures instead of nearest texels");
     cli.add_option("--record", o.record,
                    "write the destruction journal (every impact and removal, 48 bytes each) to FILE at exit");
@@ -458,6 +464,16 @@ int setUp(App& app, RunMode& mode) {
             return 2;
         }
         app.camera = {demo::V3{v[0], v[1], v[2]}, demo::V3{v[3], v[4], v[5]}};
+    }
+    if (!o.charge.empty()) {
+        std::array<float, 6> v{};
+        if (!parseNumbers(o.charge, 6, v.data()) || !(v[3] > 0) || !(v[4] > 0) || !(v[5] >= 0)) {
+            std::fprintf(stderr,
+                         "error: --charge %s: expected X,Y,Z,RADIUS,IMPULSE,SECONDS (RADIUS, IMPULSE > 0)\n",
+                         o.charge.c_str());
+            return 2;
+        }
+        app.charge = v;
     }
 
     const bool haveDisplay = std::getenv("DISPLAY") && *std::getenv("DISPLAY");
@@ -765,6 +781,12 @@ int frameLoop(App& app, const RunMode& mode) {
         if (o.demolish > 0 && !o.holdFire && static_cast<long>(app.game.counters().frame) >= nextDemolish) {
             app.game.blastNextTarget(); // --demolish: the next charge, on the next standing target
             nextDemolish = static_cast<long>(app.game.counters().frame) + std::lround(o.demolish * 60.0);
+        }
+        if (app.charge &&
+            static_cast<long>(app.game.counters().frame) >= std::lround((*app.charge)[5] * 60.0)) {
+            const auto& c = *app.charge; // --charge: once, at its game time
+            app.game.blast(demo::V3{c[0], c[1], c[2]}, c[3], c[4], static_cast<int>(demo::Weapon::Charge));
+            app.charge.reset();
         }
         if (o.fireRate > 0 && static_cast<long>(app.game.counters().frame) >= nextShot) {
             app.game.shootNextTarget(app.game.camera().eye); // --fire-rate: the next shell

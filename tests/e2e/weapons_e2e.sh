@@ -45,6 +45,24 @@ env -u DISPLAY timeout 60 "$demo" --headless --scene "$here/../../assets/scenes/
 grep -q "expected X,Y,Z,IMPULSE" "$work/bad.log" || fail "no message for a malformed --hit: $(cat "$work/bad.log")"
 echo "ok: --hit breaks each pane once, --hold-fire fires nothing, a malformed --hit is refused"
 
+# --charge: one charge under tower.cfg's ground floor; the storeys above break as they land (docs/structure.md).
+env -u DISPLAY timeout 300 "$demo" --headless --no-panel --mute --scene "$here/../../assets/scenes/tower.cfg" \
+    --autopilot 4 --hold-fire --deterministic --camera 16,-2,20,0,0,0 --charge 0,-12,0,4,20000,1 --width 320 \
+    --height 180 --out "$work/t" >"$work/t.log" 2>&1 || fail "tower: rubble-demo exited with $?"
+python3 - "$work/t/report.json" <<'PY' || fail "tower: $(cat "$work/t/report.json")"
+import json, sys
+r = json.load(open(sys.argv[1]))
+charge = r["weapons"]["demolition charge"]["fractures"]
+assert 1 <= charge <= 5, ("the charge breaks the ground floor only", charge)
+assert r["fractures"] >= charge + 10, ("the storeys above break as they land", r["fractures"], charge)
+assert r["bodies_collapsed"] >= 20, ("the tower did not come down", r["bodies_collapsed"])
+PY
+env -u DISPLAY timeout 60 "$demo" --headless --scene "$here/../../assets/scenes/tower.cfg" --autopilot 0.1 \
+    --charge=0,0,0,4 --out "$work/badcharge" >"$work/badcharge.log" 2>&1 && fail "a malformed --charge was accepted"
+grep -q "expected X,Y,Z,RADIUS,IMPULSE,SECONDS" "$work/badcharge.log" ||
+    fail "no message for a malformed --charge: $(cat "$work/badcharge.log")"
+echo "ok: one --charge under tower.cfg brings it down, the landings breaking more than the charge; a malformed --charge is refused"
+
 # The autopilot adopts deterministically: its journal replays to the geometry it ended with.
 env -u DISPLAY timeout 600 "$demo" --headless --no-panel --scene "$scene" --deterministic --replay "$work/w.rjournal" \
     >"$work/replay.log" 2>&1 || fail "replay exited with $?: $(tail -3 "$work/replay.log")"
