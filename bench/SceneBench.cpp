@@ -600,13 +600,14 @@ rubble::tools::Registrar registrar{
          app.add_option(
              "--structure-iterations", args->structureIterations,
              "with --structure: the old solver, Gauss-Seidel with this many sweeps a frame (default: the "
-             "library's, a sweep budget)");
+             "library's, converged: direct with bearings, else Gauss-Seidel)");
          app.add_flag(
              "--structure-converged", args->structureConverged,
              "with --structure: the converged Gauss-Seidel solve (relative residual 1e-3 every frame)");
          app.add_option("--structure-solver", args->structureSolver,
-                        "with --structure: the converged solve to use (relative residual 1e-3 every frame)")
-             ->check(CLI::IsMember({"gauss-seidel", "conjugate-gradient", "direct"}));
+                        "with --structure: the converged solve to use (relative residual 1e-3 every frame; "
+                        "auto, the default: direct with bearings, else gauss-seidel)")
+             ->check(CLI::IsMember({"auto", "gauss-seidel", "conjugate-gradient", "direct"}));
          app.add_option("--projectile-speed", args->projectileSpeed, "m/s");
          app.add_option("--projectile-mass", args->projectileMass, "kg");
          app.add_flag("--rough", args->rough,

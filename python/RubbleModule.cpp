@@ -403,7 +403,7 @@ rubble::StructurePolicy structurePolicy(double bearingFriction, bool converged, 
     p.bearingFriction = bearingFriction;
     p.damageRadius = damageRadius;
     p.damagePerImpulse = damagePerImpulse;
-    p.stress.method = converged ? rubble::StressMethod::GaussSeidel : rubble::StressMethod::SweepBudget;
+    p.stress.method = converged ? rubble::StressMethod::Auto : rubble::StressMethod::SweepBudget;
     return p;
 }
 

@@ -50,7 +50,7 @@ rubble_status rubble_structure_create(const rubble_structure_config* config, rub
         p.bearingFriction = c.bearing_friction;
         p.damageRadius = c.damage_radius;
         p.damagePerImpulse = c.damage_per_impulse;
-        p.stress.method = c.converged ? rubble::StressMethod::GaussSeidel : rubble::StressMethod::SweepBudget;
+        p.stress.method = c.converged ? rubble::StressMethod::Auto : rubble::StressMethod::SweepBudget;
         *out = new rubble_structure{rubble_structure::kTag, rubble::Structure(p), {}};
         return ok();
     });

@@ -255,6 +255,7 @@ void StressSolver::reset(std::vector<StructureNode> nodes, std::vector<Bond> bon
     allDirty_ = true;
     reachValid_ = false;
     reachFull_ = true;
+    bearingBonds_ = 0;
     for (const StructureNode& n : nodes)
         (void)addNode(n);
     for (std::size_t i = 0; i < bonds.size(); ++i)
@@ -279,6 +280,8 @@ std::uint32_t StressSolver::addNode(const StructureNode& node) {
     }
     if (i < reached_.size())
         reached_[i] = 0;
+    if (node.root)
+        reachGained_.push_back(i);
     if (direct_)
         direct_->touch(i);
     return i;
@@ -323,6 +326,7 @@ std::size_t StressSolver::addBond(Bond bond, StrengthLimits limits) {
     }
     if (direct_)
         direct_->forget(i);
+    bearingBonds_ += limits.friction > 0;
     for (std::uint32_t n : {bonds_[i].bond.a, bonds_[i].bond.b}) {
         std::vector<std::size_t>& list = nodes_[n].bonds;
         list.insert(std::upper_bound(list.begin(), list.end(), i), i);
@@ -340,6 +344,7 @@ std::size_t StressSolver::addBond(Bond bond, StrengthLimits limits) {
 
 void StressSolver::removeBond(std::size_t i) {
     BondState& b = bonds_[i];
+    bearingBonds_ -= b.limits.friction > 0;
     for (std::uint32_t n : {b.bond.a, b.bond.b}) {
         std::erase(nodes_[n].bonds, i);
         nodes_[n].bearings -= b.limits.friction > 0;
@@ -548,10 +553,13 @@ void StressSolver::coldStart() {
 }
 
 void StressSolver::solve() {
+    method_ = settings_.method != StressMethod::Auto ? settings_.method
+              : bearingBonds_ > 0                    ? StressMethod::Direct
+                                                     : StressMethod::GaussSeidel;
     // Nodes that replace a removed one (a fracture's pieces): with routeLoads they first balance among
     // themselves, below.
     std::vector<std::uint32_t> newcomers;
-    const bool routing = settings_.routeLoads && settings_.method != StressMethod::SweepBudget && !allDirty_;
+    const bool routing = settings_.routeLoads && method_ != StressMethod::SweepBudget && !allDirty_;
     if (routing)
         for (std::size_t k : fresh_)
             for (std::uint32_t n : {bonds_[k].bond.a, bonds_[k].bond.b})
@@ -562,7 +570,7 @@ void StressSolver::solve() {
     if (!orphans_.empty())
         inherit();
     fresh_.clear();
-    if (settings_.method != StressMethod::SweepBudget && settings_.deadLoadGuess && allDirty_) {
+    if (method_ != StressMethod::SweepBudget && settings_.deadLoadGuess && allDirty_) {
         if (!reachValid_)
             reach();
         coldStart();
@@ -570,14 +578,15 @@ void StressSolver::solve() {
     const double scale = startSolve();
     scale_ = scale;
     history_.clear();
-    if (!routes_.empty() && settings_.method != StressMethod::Direct)
+    if (!routes_.empty() && method_ != StressMethod::Direct)
         route(routes_);
-    if (!newcomers.empty() && settings_.method != StressMethod::Direct)
+    if (!newcomers.empty() && method_ != StressMethod::Direct)
         settleAmong(newcomers, settings_.residual * scale);
-    if (routing && settings_.method != StressMethod::Direct) // what is still unbalanced goes down, if it can
+    if (routing && method_ != StressMethod::Direct) // what is still unbalanced goes down, if it can
         routeUnbalanced(settings_.residual * scale);
     factorizations_ = blocksMade_ = 0;
-    switch (settings_.method) {
+    switch (method_) {
+    case StressMethod::Auto: // resolved above
     case StressMethod::SweepBudget:
         solveSweepBudget();
         break;
@@ -614,7 +623,7 @@ double StressSolver::startSolve() {
     gravity_ = settings_.gravity;
     if (!reachValid_)
         reach();
-    const bool routing = settings_.routeLoads && settings_.method != StressMethod::SweepBudget && !allDirty_;
+    const bool routing = settings_.routeLoads && method_ != StressMethod::SweepBudget && !allDirty_;
     routes_.clear();
     double scale2 = 0;
     for (std::uint32_t i = 0; i < nodes_.size(); ++i) {

@@ -180,8 +180,10 @@ TEST(StressLocality, WhatIsCutOffFromTheGroundIsFoundFromTheChangesAlone) {
             if (!bonds.empty())
                 solver.breakBond(bonds[next(bonds.size())]);
         }
+        if (step == 100) // a held block on its own (an anchor: a floating object's kept piece)
+            (void)add(box({20, 20, 20}, {21, 21, 21}), true);
         solver.solve();
-        // The truth: a search from the ground over intact bonds.
+        // The truth: a search from the held nodes over intact bonds.
         std::vector<char> linked(solver.nodeCount(), 0);
         std::vector<std::uint32_t> open;
         for (std::uint32_t n = 0; n < solver.nodeCount(); ++n)

@@ -98,12 +98,12 @@ struct RUBBLE_API SupportPolicy {
 /// weight and the contact forces of moving bodies on them; a bond over its material's limit breaks and what
 /// no chain of bonds holds up falls. Set at construction.
 struct RUBBLE_API StructurePolicy {
-    bool enabled = false;              ///< off: support is connectivity only (SupportPolicy)
-    BondSettings bonds{0.02, 1, 1e-4}; ///< what counts as a bond (gap as SupportPolicy::tolerance)
-    StressSettings stress{}; ///< the solver (a sweep budget by default; StressMethod::GaussSeidel converges
-                             ///< to a relative residual of 1e-3); gravity is the binding's. With
-                             ///< StressMethod::SweepBudget: at most `iterations` sweeps a frame (ten times
-                             ///< that in the first solve after objects are placed)
+    bool enabled = false;                      ///< off: support is connectivity only (SupportPolicy)
+    BondSettings bonds{0.02, 1, 1e-4};         ///< what counts as a bond (gap as SupportPolicy::tolerance)
+    StressSettings stress{StressMethod::Auto}; ///< the solver: converged to a relative residual of 1e-3
+                                               ///< every frame; gravity is the binding's. With SweepBudget:
+                                               ///< at most `iterations` sweeps a frame (ten times that in
+                                               ///< the first solve after objects are placed)
     int breakRounds = 8; ///< solves after bonds break in a frame, for the new load path (converged methods)
     double damageRadius = 1.0;      ///< impacts weaken bonds within this distance (m) of the hit
     double damagePerImpulse = 1e-4; ///< health a bond at the hit loses per N·s of impulse

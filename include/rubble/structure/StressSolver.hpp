@@ -222,18 +222,20 @@ private:
     double scale_ = 0; // the last solve's residual scale (m/s^2)
     std::vector<double> history_;
     std::vector<std::size_t> freeBonds_;
-    std::vector<std::uint32_t> dirty_;       // nodes whose v and w the next solve recomputes
-    bool allDirty_ = true;                   // every node's (gravity changed, or never solved)
-    Vec3 gravity_;                           // the gravity v and w hold
-    std::vector<char> reached_;              // a chain of intact bonds links the node to a root
-    bool reachValid_ = false;                // reached_ matches the bonds
-    bool reachFull_ = true;                  // reached_ must be found again from every root
-    std::vector<std::uint32_t> reachLost_;   // ends of bonds gone since: may have lost their chain
-    std::vector<std::uint32_t> reachGained_; // ends of bonds added since: may have gained one
-    struct Orphan {                          // the load a removed node's bond put on a neighbour
-        std::uint32_t node;                  // the neighbour
-        Vec3 force, moment;                  // on it, the moment about the section centroid
-        Vec3 centroid, normal;               // the section's
+    std::vector<std::uint32_t> dirty_;                // nodes whose v and w the next solve recomputes
+    bool allDirty_ = true;                            // every node's (gravity changed, or never solved)
+    Vec3 gravity_;                                    // the gravity v and w hold
+    std::vector<char> reached_;                       // a chain of intact bonds links the node to a root
+    bool reachValid_ = false;                         // reached_ matches the bonds
+    bool reachFull_ = true;                           // reached_ must be found again from every root
+    std::size_t bearingBonds_ = 0;                    // bonds with friction (bearings)
+    StressMethod method_ = StressMethod::SweepBudget; // the method of the solve in progress (Auto resolved)
+    std::vector<std::uint32_t> reachLost_;            // ends of bonds gone since: may have lost their chain
+    std::vector<std::uint32_t> reachGained_;          // ends of bonds added since: may have gained one
+    struct Orphan {                                   // the load a removed node's bond put on a neighbour
+        std::uint32_t node;                           // the neighbour
+        Vec3 force, moment;                           // on it, the moment about the section centroid
+        Vec3 centroid, normal;                        // the section's
     };
     void inherit();
     void coldStart();

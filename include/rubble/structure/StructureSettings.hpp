@@ -17,15 +17,20 @@ struct RUBBLE_API BondSettings {
 
 /// How StressSolver::solve() iterates (docs/structure.md, "Convergence").
 enum class StressMethod {
-    SweepBudget,       ///< Gauss-Seidel over every bond, at most `iterations` sweeps (the default)
-    GaussSeidel,       ///< Gauss-Seidel over the bonds of the nodes not at rest, until `residual` is met
+    SweepBudget, ///< Gauss-Seidel over every bond, at most `iterations` sweeps (StressSettings' default)
+    GaussSeidel, ///< Gauss-Seidel over the bonds of the nodes not at rest, until `residual` is met
     ConjugateGradient, ///< block-Jacobi preconditioned conjugate gradient on the welds, until `residual`
     Direct ///< sparse Cholesky of the regularised bond system with an active set for bearings, then
            ///< Gauss-Seidel until `residual` (friction limits, what bearings cannot hold)
+    ,
+    Auto ///< Direct while the structure has bearings, else GaussSeidel (the runtime's default)
 };
 
 /// Settings of the stress solver.
 struct RUBBLE_API StressSettings {
+    StressSettings() = default;
+    /// The defaults, iterating by `how`.
+    explicit StressSettings(StressMethod how) : method(how) {}
     int iterations = 25;       ///< Gauss-Seidel sweeps over all bonds per solve(), at most
     double tolerance = 0.01;   ///< m/s^2 (and rad/s^2), SweepBudget: fewer sweeps once every bonded node's
                                ///< acceleration is below it; 0: always `iterations`
