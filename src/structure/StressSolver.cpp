@@ -934,35 +934,18 @@ bool StressSolver::reachAgain() {
                 reached_[m] = 0;
         }
     }
-    std::vector<std::uint32_t> flood;
+    std::vector<std::uint32_t> gained;
     for (std::uint32_t start : reachGained_)
         if (start < nodes_.size() && !nodes_[start].removed && (reached_[start] || root(start))) {
             reached_[start] = 1;
-            flood.push_back(start);
+            gained.push_back(start);
         }
-    while (!flood.empty()) {
-        const std::uint32_t n = flood.back();
-        flood.pop_back();
-        for (std::size_t k : nodes_[n].bonds) {
-            const BondState& b = bonds_[k];
-            const std::uint32_t m = b.bond.other(n);
-            if (!b.broken && !reached_[m]) {
-                reached_[m] = 1;
-                flood.push_back(m);
-            }
-        }
-    }
+    spread(reached_, gained);
     return true;
 }
 
-std::vector<char> StressSolver::reachable() const {
-    std::vector<char> reached(nodes_.size(), 0);
-    std::vector<std::uint32_t> open;
-    for (std::uint32_t i = 0; i < nodes_.size(); ++i)
-        if (nodes_[i].node.root && !nodes_[i].detached) {
-            reached[i] = 1;
-            open.push_back(i);
-        }
+// Marks everything a chain of intact bonds links to the open (marked) nodes.
+void StressSolver::spread(std::vector<char>& reached, std::vector<std::uint32_t>& open) const {
     while (!open.empty()) {
         const std::uint32_t n = open.back();
         open.pop_back();
@@ -975,6 +958,17 @@ std::vector<char> StressSolver::reachable() const {
             }
         }
     }
+}
+
+std::vector<char> StressSolver::reachable() const {
+    std::vector<char> reached(nodes_.size(), 0);
+    std::vector<std::uint32_t> open;
+    for (std::uint32_t i = 0; i < nodes_.size(); ++i)
+        if (nodes_[i].node.root && !nodes_[i].detached) {
+            reached[i] = 1;
+            open.push_back(i);
+        }
+    spread(reached, open);
     return reached;
 }
 

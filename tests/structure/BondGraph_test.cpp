@@ -2,23 +2,20 @@
 
 #include <cmath>
 
+#include "BoxSolid.hpp"
 #include "rubble/structure/BondGraph.hpp"
 
 using namespace rubble;
 
 namespace {
-std::vector<ConvexPolytope> box(Vec3 lo, Vec3 hi) {
-    Aabb b;
-    b.extend(lo);
-    b.extend(hi);
-    return {ConvexPolytope::fromAabb(b)};
-}
+
+using test::boxSolid;
 } // namespace
 
 TEST(BondGraph, BoxOnBoxSharesTheOverlapRectangle) {
     // A 2 x 1 x 2 box on a 1 x 1 x 3 box, offset: overlap x in [0.5, 1], z in [0, 2].
-    const auto lower = box({0, 0, 0}, {1, 1, 3});
-    const auto upper = box({0.5, 1, -1}, {2.5, 2, 2});
+    const auto lower = boxSolid({0, 0, 0}, {1, 1, 3});
+    const auto upper = boxSolid({0.5, 1, -1}, {2.5, 2, 2});
     const BondInterface s = bondInterface(lower, upper, {});
     EXPECT_NEAR(s.area, 0.5 * 2, 1e-12);
     EXPECT_NEAR(s.sectionArea, s.area, 1e-12);
@@ -39,29 +36,29 @@ TEST(BondGraph, BoxOnBoxSharesTheOverlapRectangle) {
 }
 
 TEST(BondGraph, GapAndAngleDecideTouching) {
-    const auto lower = box({0, 0, 0}, {1, 1, 1});
-    EXPECT_NEAR(bondInterface(lower, box({0, 1.0005, 0}, {1, 2, 1}), {}).area, 1, 1e-12);
-    EXPECT_EQ(bondInterface(lower, box({0, 1.01, 0}, {1, 2, 1}), {}).area, 0);
+    const auto lower = boxSolid({0, 0, 0}, {1, 1, 1});
+    EXPECT_NEAR(bondInterface(lower, boxSolid({0, 1.0005, 0}, {1, 2, 1}), {}).area, 1, 1e-12);
+    EXPECT_EQ(bondInterface(lower, boxSolid({0, 1.01, 0}, {1, 2, 1}), {}).area, 0);
     // Edge-to-edge: boxes meeting only along a line share no area.
-    EXPECT_EQ(bondInterface(lower, box({1, 1, 0}, {2, 2, 1}), {}).area, 0);
+    EXPECT_EQ(bondInterface(lower, boxSolid({1, 1, 0}, {2, 2, 1}), {}).area, 0);
     // A box tilted 5 degrees about z resting on a corner: not coplanar.
     const double a = 5 * 3.14159265358979 / 180;
     Frame f;
     f.rotation = Mat3{{{std::cos(a), -std::sin(a), 0}, {std::sin(a), std::cos(a), 0}, {0, 0, 1}}};
     f.translation = {0.5, 1.5, 0.5};
     const auto tilted =
-        std::vector<ConvexPolytope>{box({-0.5, -0.5, -0.5}, {0.5, 0.5, 0.5})[0].transformed(f)};
+        std::vector<ConvexPolytope>{boxSolid({-0.5, -0.5, -0.5}, {0.5, 0.5, 0.5})[0].transformed(f)};
     EXPECT_EQ(bondInterface(lower, tilted, {}).area, 0);
 }
 
 TEST(BondGraph, SlabOnColumnsAndAWallMakesOneBondPerContact) {
     // Ground, two columns, a slab spanning them, and a box floating apart.
     const std::vector<std::vector<ConvexPolytope>> solids = {
-        box({-5, -1, -5}, {5, 0, 5}),       // 0 ground
-        box({-2, 0, -0.2}, {-1.6, 3, 0.2}), // 1 column
-        box({1.6, 0, -0.2}, {2, 3, 0.2}),   // 2 column
-        box({-2.5, 3, -1}, {2.5, 3.3, 1}),  // 3 slab
-        box({10, 0, 10}, {11, 1, 11}),      // 4 apart
+        boxSolid({-5, -1, -5}, {5, 0, 5}),       // 0 ground
+        boxSolid({-2, 0, -0.2}, {-1.6, 3, 0.2}), // 1 column
+        boxSolid({1.6, 0, -0.2}, {2, 3, 0.2}),   // 2 column
+        boxSolid({-2.5, 3, -1}, {2.5, 3.3, 1}),  // 3 slab
+        boxSolid({10, 0, 10}, {11, 1, 11}),      // 4 apart
     };
     const std::vector<Bond> bonds = buildBonds(solids, {});
     ASSERT_EQ(bonds.size(), 4u);
@@ -81,9 +78,9 @@ TEST(BondGraph, SlabOnColumnsAndAWallMakesOneBondPerContact) {
 
 TEST(BondGraph, MultiPartSolidsSumTheirPatches) {
     // An L-shaped solid of two parts standing on a plate: both feet touch.
-    auto l = box({0, 0, 0}, {1, 2, 1});
-    l.push_back(box({1, 0, 0}, {3, 1, 1})[0]);
-    const auto plate = box({-1, -0.5, -1}, {4, 0, 2});
+    auto l = boxSolid({0, 0, 0}, {1, 2, 1});
+    l.push_back(boxSolid({1, 0, 0}, {3, 1, 1})[0]);
+    const auto plate = boxSolid({-1, -0.5, -1}, {4, 0, 2});
     const BondInterface s = bondInterface(plate, l, {});
     EXPECT_NEAR(s.area, 3, 1e-12);
     EXPECT_NEAR(s.centroid.x, 1.5, 1e-12);
@@ -94,10 +91,10 @@ TEST(BondGraph, MultiPartSolidsSumTheirPatches) {
 TEST(BondGraph, AnInterfaceAroundACornerCountsEveryPatch) {
     // A unit cube nested in the corner of an L of three boxes: three faces touch, the section is their
     // projection on the mean normal (1, 1, 1) / sqrt 3.
-    const auto cube = box({0, 0, 0}, {1, 1, 1});
-    auto corner = box({-1, -1, -1}, {0, 1, 1});
-    corner.push_back(box({0, -1, -1}, {1, 0, 1})[0]);
-    corner.push_back(box({0, 0, -1}, {1, 1, 0})[0]);
+    const auto cube = boxSolid({0, 0, 0}, {1, 1, 1});
+    auto corner = boxSolid({-1, -1, -1}, {0, 1, 1});
+    corner.push_back(boxSolid({0, -1, -1}, {1, 0, 1})[0]);
+    corner.push_back(boxSolid({0, 0, -1}, {1, 1, 0})[0]);
     const BondInterface s = bondInterface(corner, cube, {});
     EXPECT_NEAR(s.area, 3, 1e-12);
     EXPECT_NEAR(s.normal.x, 1 / std::sqrt(3.0), 1e-12);

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <vector>
 
+#include "BoxSolid.hpp"
 #include "rubble/fracture/Fracture.hpp"
 #include "rubble/structure/BondGraph.hpp"
 #include "rubble/structure/StressSolver.hpp"
@@ -16,14 +17,9 @@ using namespace rubble;
 
 namespace {
 
-constexpr double kDensity = 1900;
+using test::boxSolid;
 
-std::vector<ConvexPolytope> box(Vec3 lo, Vec3 hi) {
-    Aabb b;
-    b.extend(lo);
-    b.extend(hi);
-    return {ConvexPolytope::fromAabb(b)};
-}
+constexpr double kDensity = 1900;
 
 // Voronoi pieces of a brick (12 cells from a hit on its top, clipped to it), each one solid.
 std::vector<std::vector<ConvexPolytope>> shatter(const Aabb& brick) {
@@ -62,11 +58,11 @@ struct Block {
         return 1 + static_cast<std::uint32_t>((y * 3 + z) * 3 + x);
     }
     Block() {
-        ground = add(box({-1, -1, -1}, {4, 0, 4}), true);
+        ground = add(boxSolid({-1, -1, -1}, {4, 0, 4}), true);
         for (int y = 0; y < 4; ++y)
             for (int z = 0; z < 3; ++z)
                 for (int x = 0; x < 3; ++x)
-                    add(box({double(x), 0.5 * y, double(z)}, {x + 1.0, 0.5 * y + 0.5, z + 1.0}));
+                    add(boxSolid({double(x), 0.5 * y, double(z)}, {x + 1.0, 0.5 * y + 0.5, z + 1.0}));
         solver.settings().method = StressMethod::GaussSeidel;
         solver.solve();
     }
@@ -147,16 +143,17 @@ TEST(StressLocality, WhatIsCutOffFromTheGroundIsFoundFromTheChangesAlone) {
             (void)solver.addBond(std::move(b), {});
         return slot;
     };
-    (void)add(box({-1, -1, -1}, {7, 0, 7}), true);
+    (void)add(boxSolid({-1, -1, -1}, {7, 0, 7}), true);
     // Sixteen columns of six bricks, apart, and slabs on top joining them in pairs: cycles through the top.
     std::vector<std::vector<ConvexPolytope>> cells;
     for (int z = 0; z < 4; ++z)
         for (int x = 0; x < 4; ++x)
             for (int y = 0; y < 6; ++y)
-                cells.push_back(box({1.5 * x, 0.5 * y, 1.5 * z}, {1.5 * x + 1, 0.5 * y + 0.5, 1.5 * z + 1}));
+                cells.push_back(
+                    boxSolid({1.5 * x, 0.5 * y, 1.5 * z}, {1.5 * x + 1, 0.5 * y + 0.5, 1.5 * z + 1}));
     for (int z = 0; z < 4; ++z)
         for (int x : {0, 2})
-            cells.push_back(box({1.5 * x, 3, 1.5 * z}, {1.5 * x + 2.5, 3.5, 1.5 * z + 1}));
+            cells.push_back(boxSolid({1.5 * x, 3, 1.5 * z}, {1.5 * x + 2.5, 3.5, 1.5 * z + 1}));
     std::vector<std::int64_t> slotOf(cells.size(), -1); // cell -> its node while present
     for (std::size_t c = 0; c < cells.size(); ++c)
         slotOf[c] = add(cells[c]);
@@ -181,7 +178,7 @@ TEST(StressLocality, WhatIsCutOffFromTheGroundIsFoundFromTheChangesAlone) {
                 solver.breakBond(bonds[next(bonds.size())]);
         }
         if (step == 100) // a held block on its own (an anchor: a floating object's kept piece)
-            (void)add(box({20, 20, 20}, {21, 21, 21}), true);
+            (void)add(boxSolid({20, 20, 20}, {21, 21, 21}), true);
         solver.solve();
         // The truth: a search from the held nodes over intact bonds.
         std::vector<char> linked(solver.nodeCount(), 0);

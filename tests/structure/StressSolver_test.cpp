@@ -4,19 +4,15 @@
 #include <cmath>
 
 #include "BondLookup.hpp"
+#include "BoxSolid.hpp"
 #include "rubble/structure/StressSolver.hpp"
 
 using namespace rubble;
 
 namespace {
-constexpr double kG = 9.81;
 
-std::vector<ConvexPolytope> box(Vec3 lo, Vec3 hi) {
-    Aabb b;
-    b.extend(lo);
-    b.extend(hi);
-    return {ConvexPolytope::fromAabb(b)};
-}
+using test::boxSolid;
+constexpr double kG = 9.81;
 
 // A structure of boxes: solids, their materials, and which are roots.
 struct Scene {
@@ -52,8 +48,8 @@ using test::bondBetween;
 } // namespace
 
 TEST(StressSolver, NodeMassAndInertiaFromTheParts) {
-    auto parts = box({0, 0, 0}, {2, 1, 1});
-    parts.push_back(box({2, 0, 0}, {4, 1, 1})[0]);
+    auto parts = boxSolid({0, 0, 0}, {2, 1, 1});
+    parts.push_back(boxSolid({2, 0, 0}, {4, 1, 1})[0]);
     const StructureNode n = structureNode(parts, 1000, false);
     EXPECT_NEAR(n.mass, 4000, 1e-9);
     EXPECT_NEAR(n.centroid.x, 2, 1e-12);
@@ -69,8 +65,8 @@ TEST(StressSolver, CantileverBreaksAtItsRootWhenBendingStressExceedsTheTensileLi
     int broke = 0, stood = 0;
     for (double span = 1.0; span <= 5.0; span += 0.25) {
         Scene scene;
-        scene.add(box({-1, 0, -2}, {0, 4, 2}), "concrete", true);
-        const std::uint32_t slab = scene.add(box({0, 2, -b / 2}, {span, 2 + h, b / 2}), "concrete");
+        scene.add(boxSolid({-1, 0, -2}, {0, 4, 2}), "concrete", true);
+        const std::uint32_t slab = scene.add(boxSolid({0, 2, -b / 2}, {span, 2 + h, b / 2}), "concrete");
         StressSolver s = scene.solver();
         s.solve();
         ASSERT_EQ(s.bondCount(), 1u);
@@ -95,9 +91,9 @@ TEST(StressSolver, CantileverBreaksAtItsRootWhenBendingStressExceedsTheTensileLi
 // A column carrying a slab and the load of the floors above: F / A at its foot; hits shrink the section.
 TEST(StressSolver, ColumnFailsInCompressionOnceHitsReduceItsSection) {
     Scene scene;
-    scene.add(box({-5, -1, -5}, {5, 0, 5}), "concrete", true);
-    const std::uint32_t column = scene.add(box({-0.2, 0, -0.2}, {0.2, 3, 0.2}), "concrete");
-    const std::uint32_t slab = scene.add(box({-2.5, 3, -1}, {2.5, 3.3, 1}), "concrete");
+    scene.add(boxSolid({-5, -1, -5}, {5, 0, 5}), "concrete", true);
+    const std::uint32_t column = scene.add(boxSolid({-0.2, 0, -0.2}, {0.2, 3, 0.2}), "concrete");
+    const std::uint32_t slab = scene.add(boxSolid({-2.5, 3, -1}, {2.5, 3.3, 1}), "concrete");
     StressSolver s = scene.solver();
     const double above = 3e6; // N, floors above, on the slab's centre
     const Material& concrete = *findMaterial("concrete");
@@ -137,11 +133,11 @@ struct Bridge {
     Scene scene;
     std::uint32_t pierA = 0, pierB = 0, left = 0, right = 0;
     explicit Bridge(const char* deck, double pier = 1) {
-        scene.add(box({-10, -1, -5}, {10, 0, 5}), "concrete", true);
-        pierA = scene.add(box({-5, 0, -1}, {-5 + pier, 4, 1}), "concrete");
-        pierB = scene.add(box({5 - pier, 0, -1}, {5, 4, 1}), "concrete");
-        left = scene.add(box({-5, 4, -1}, {0, 4.3, 1}), deck);
-        right = scene.add(box({0, 4, -1}, {5, 4.3, 1}), deck);
+        scene.add(boxSolid({-10, -1, -5}, {10, 0, 5}), "concrete", true);
+        pierA = scene.add(boxSolid({-5, 0, -1}, {-5 + pier, 4, 1}), "concrete");
+        pierB = scene.add(boxSolid({5 - pier, 0, -1}, {5, 4, 1}), "concrete");
+        left = scene.add(boxSolid({-5, 4, -1}, {0, 4.3, 1}), deck);
+        right = scene.add(boxSolid({0, 4, -1}, {5, 4.3, 1}), deck);
     }
 };
 
@@ -227,8 +223,9 @@ TEST(StressSolver, BearingSlabTipsExactlyWhenItsCentreOfMassLeavesTheContact) {
     int stood = 0, tipped = 0;
     for (double start = -1.9; start <= 0.9; start += 0.2) {
         Scene scene;
-        scene.add(box({0, 0, -1}, {1, 1, 1}), "concrete", true);
-        const std::uint32_t slab = scene.add(box({start, 1, -0.5}, {start + span, 1.2, 0.5}), "concrete");
+        scene.add(boxSolid({0, 0, -1}, {1, 1, 1}), "concrete", true);
+        const std::uint32_t slab =
+            scene.add(boxSolid({start, 1, -0.5}, {start + span, 1.2, 0.5}), "concrete");
         StressSolver s = scene.solver({}, 0.6);
         for (int i = 0; i < 40; ++i)
             s.solve();
@@ -253,8 +250,8 @@ namespace {
 constexpr std::uint32_t kSlab = 1;
 StressSolver loadedSlabOnPier(double friction, const Vec3& load, const Vec3& at) {
     Scene scene;
-    scene.add(box({-1, 0, -1}, {1, 1, 1}), "concrete", true);
-    scene.add(box({-1, 1, -1}, {1, 1.2, 1}), "concrete");
+    scene.add(boxSolid({-1, 0, -1}, {1, 1, 1}), "concrete", true);
+    scene.add(boxSolid({-1, 1, -1}, {1, 1.2, 1}), "concrete");
     StressSolver s = scene.solver({}, friction);
     for (int i = 0; i < 40; ++i) {
         s.addLoad(kSlab, load, at);
@@ -295,9 +292,9 @@ TEST(StressSolver, BearingSlidesWhenThePushExceedsFrictionTimesWeight) {
 // x2 in [3, 3.5], puts F2 between W / 2 and 2 W / 3.
 TEST(StressSolver, BearingSlabOnTwoPiersStandsWithTheLeverRuleForces) {
     Scene scene;
-    scene.add(box({0, 0, -0.5}, {0.5, 2, 0.5}), "concrete", true);
-    scene.add(box({3, 0, -0.5}, {3.5, 2, 0.5}), "concrete", true);
-    const std::uint32_t slab = scene.add(box({0, 2, -0.5}, {4, 2.3, 0.5}), "concrete");
+    scene.add(boxSolid({0, 0, -0.5}, {0.5, 2, 0.5}), "concrete", true);
+    scene.add(boxSolid({3, 0, -0.5}, {3.5, 2, 0.5}), "concrete", true);
+    const std::uint32_t slab = scene.add(boxSolid({0, 2, -0.5}, {4, 2.3, 0.5}), "concrete");
     StressSolver s = scene.solver({}, 0.6);
     for (int i = 0; i < 60; ++i)
         s.solve();

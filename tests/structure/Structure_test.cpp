@@ -5,19 +5,15 @@
 
 #include <gtest/gtest.h>
 
+#include "BoxSolid.hpp"
 #include <cmath>
 
 using namespace rubble;
 
 namespace {
-constexpr double kG = 9.81;
 
-std::vector<ConvexPolytope> box(Vec3 lo, Vec3 hi) {
-    Aabb b;
-    b.extend(lo);
-    b.extend(hi);
-    return {ConvexPolytope::fromAabb(b)};
-}
+using test::boxSolid;
+constexpr double kG = 9.81;
 
 // Welded joints, converged solves.
 StructurePolicy welded() {
@@ -34,8 +30,8 @@ constexpr double kH = 0.2, kB = 1.5; // the slab's depth and width
 // takes the weaker of its two materials' limits).
 Structure cantilever(double span, const char* material, const StructurePolicy& policy = welded()) {
     Structure s(policy);
-    EXPECT_TRUE(s.add(kWall, box({-1, 0, -2}, {0, 4, 2}), material, true));
-    EXPECT_TRUE(s.add(kSlab, box({0, 2, -kB / 2}, {span, 2 + kH, kB / 2}), material));
+    EXPECT_TRUE(s.add(kWall, boxSolid({-1, 0, -2}, {0, 4, 2}), material, true));
+    EXPECT_TRUE(s.add(kSlab, boxSolid({0, 2, -kB / 2}, {span, 2 + kH, kB / 2}), material));
     return s;
 }
 
@@ -127,13 +123,13 @@ TEST(Structure, HitsNearTheRootWeakenItUntilItBreaks) {
 // Bad input is refused with a message and changes nothing.
 TEST(Structure, BadBodiesAreRefusedAndChangeNothing) {
     Structure s = cantilever(2.5, "concrete");
-    const Status unknown = s.add(3, box({0, 0, 0}, {1, 1, 1}), "Wood");
+    const Status unknown = s.add(3, boxSolid({0, 0, 0}, {1, 1, 1}), "Wood");
     ASSERT_FALSE(unknown);
     EXPECT_EQ(unknown.error().code, ErrorCode::InvalidInput);
     EXPECT_NE(unknown.message().find("unknown material 'Wood'"), std::string::npos) << unknown.message();
-    EXPECT_FALSE(s.add(0, box({0, 0, 0}, {1, 1, 1})));
+    EXPECT_FALSE(s.add(0, boxSolid({0, 0, 0}, {1, 1, 1})));
     EXPECT_FALSE(s.add(3, {}));
-    EXPECT_FALSE(s.add(3, box({0, 0, 0}, {1, 0, 1})));
+    EXPECT_FALSE(s.add(3, boxSolid({0, 0, 0}, {1, 0, 1})));
     EXPECT_FALSE(s.contains(3));
     EXPECT_EQ(s.size(), 2u);
     EXPECT_EQ(s.bonds().size(), 1u);

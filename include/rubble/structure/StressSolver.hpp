@@ -197,6 +197,7 @@ private:
     double startSolve();
     void reach();
     bool reachAgain();
+    void spread(std::vector<char>& reached, std::vector<std::uint32_t>& open) const;
     std::vector<char> reachable() const;
     double nodeResidual(const NodeState& n) const;
     bool movable(std::uint32_t i) const;
