@@ -258,6 +258,7 @@ typedef struct rubble_outcome {
     uint32_t parent;       ///< the object that broke (no longer in the world)
     size_t piece_count;    ///< the new objects
     double dropped_volume; ///< volume of slivers and dust dropped
+    double impulse;        ///< summed impulse of the impacts that broke it (N*s; since version 4)
 } rubble_outcome;
 
 /// A new object of an outcome.

@@ -457,6 +457,7 @@ static void test_world(void) {
     CHECK(outcomes == 1);
     CHECK_OK(rubble_world_get_outcome(world, 0, &outcome));
     CHECK(outcome.parent == id && outcome.piece_count >= 2);
+    CHECK(fabs(outcome.impulse - impact.impulse) < 1e-3 * impact.impulse); /* the impact that broke it */
     CHECK(rubble_world_get_outcome(world, 1, &outcome) == RUBBLE_ERROR_INVALID_ARGUMENT);
     CHECK(rubble_world_get_object(world, id, &object) == RUBBLE_ERROR_INVALID_ARGUMENT); /* replaced */
     volume = outcome.dropped_volume;
