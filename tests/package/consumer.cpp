@@ -1,11 +1,12 @@
 // A game's first contact with an installed Rubble: fracture a mesh with the kernel (also as a request), then
-// let Bullet and the runtime break a cube hit by a projectile. Exits non-zero when volume is not conserved or
-// nothing breaks.
+// let Bullet and the runtime break a cube hit by a projectile, then ask the engine-free structure what
+// stands. Exits non-zero when volume is not conserved, nothing breaks or the wrong body falls.
 #include <cmath>
 #include <cstdio>
 
 #include "rubble/bullet/BulletBinding.hpp"
 #include "rubble/rubble.hpp"
+#include "rubble/runtime/Structure.hpp"
 
 namespace {
 
@@ -78,5 +79,19 @@ int main() {
     std::printf("runtime: %lld fractures after %d frames, %zu bodies, volume %.9f of %.9f\n",
                 static_cast<long long>(runtime.counters().fractures), frames, runtime.bodyCount(), after,
                 before);
-    return runtime.counters().fractures > 0 && near(after, before, 1e-6) ? 0 : 1;
+    if (runtime.counters().fractures == 0 || !near(after, before, 1e-6))
+        return 1;
+
+    // 3. The structure without an engine: a box on the held ground stands, a box in the air falls.
+    rubble::Structure structure;
+    const rubble::Frame here{rubble::Mat3::identity(), {}};
+    const bool added =
+        structure.add(1, rubble::makeSubdividedBox({-5, -1, -5}, {5, 0, 5}, 1), here, "", true) &&
+        structure.add(2, rubble::makeSubdividedBox({-1, 0, -1}, {1, 1, 1}, 1), here, "brick") &&
+        structure.add(3, rubble::makeSubdividedBox({-1, 3, -1}, {1, 4, 1}, 1), here, "brick");
+    const rubble::StructureStep step = structure.step();
+    std::printf("structure: %zu bodies, %zu collapsed, residual %.2g\n", structure.size(),
+                step.collapses.size(), step.residual);
+    return added && step.collapses.size() == 1 && step.collapses[0].body == 3 && structure.size() == 2 ? 0
+                                                                                                       : 1;
 }
