@@ -737,14 +737,43 @@ void StressSolver::routeUnbalanced(double tolerance) {
     for (std::uint32_t i = 0; i < nodes_.size(); ++i)
         if (movable(i) && nodeResidual(nodes_[i]) > tolerance * tolerance)
             rest.push_back({i, nodes_[i].v * nodes_[i].node.mass, nodes_[i].node.inertia * nodes_[i].w});
-    if (!rest.empty())
-        route(rest);
+    if (rest.empty())
+        return;
+    std::vector<std::uint32_t> routed;
+    for (const Route& r : rest)
+        routed.push_back(r.node);
+    route(rest);
+    // What routing could not pass down (no weld to a lower node) is balanced with its welded neighbours.
+    constexpr std::size_t kMostRings = 64;
+    std::size_t rings = 0;
+    for (const std::uint32_t n : routed) {
+        if (rings == kMostRings)
+            break;
+        // the node and its welded neighbours, one ring more while that leaves it unbalanced (three at most)
+        std::vector<std::uint32_t> ring{n};
+        for (int radius = 1; radius <= 3; ++radius) {
+            if (!movable(n) || nodeResidual(nodes_[n]) <= tolerance * tolerance)
+                break;
+            const std::size_t last = ring.size();
+            for (std::size_t i = 0; i < last; ++i)
+                for (std::size_t k : nodes_[ring[i]].bonds) {
+                    const BondState& b = bonds_[k];
+                    const std::uint32_t m = b.bond.other(ring[i]);
+                    if (!b.broken && b.solvable && b.corners.empty() && movable(m))
+                        ring.push_back(m);
+                }
+            std::sort(ring.begin(), ring.end());
+            ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
+            (void)balanceDown(ring);
+            ++rings;
+        }
+    }
 }
 
-// Gauss-Seidel over the bonds between these nodes only (ascending), until they are at rest within the
-// tolerance or stop improving: the pieces that replaced a body carry its inherited load path among
-// themselves before the iteration spreads what is left to their neighbours.
-void StressSolver::settleAmong(const std::vector<std::uint32_t>& group, double tolerance) {
+// The bonds among a group of nodes (ascending). When they are all welds, the group is balanced in one solve
+// (balanceAmong) over them and the welds beneath it (facing down first, else any to a lower or held node),
+// and the reactions on the nodes beneath are routed down to the ground.
+std::vector<std::size_t> StressSolver::balanceDown(const std::vector<std::uint32_t>& group) {
     std::vector<std::size_t> inside;
     for (std::uint32_t n : group)
         for (std::size_t k : nodes_[n].bonds) {
@@ -755,8 +784,48 @@ void StressSolver::settleAmong(const std::vector<std::uint32_t>& group, double t
                 inside.push_back(k);
         }
     std::sort(inside.begin(), inside.end());
-    const bool welded =
-        std::all_of(inside.begin(), inside.end(), [&](std::size_t k) { return bonds_[k].corners.empty(); });
+    if (!std::all_of(inside.begin(), inside.end(), [&](std::size_t k) { return bonds_[k].corners.empty(); }))
+        return inside;
+    const double g = length(settings_.gravity);
+    const Vec3 down = g > 0 ? settings_.gravity / g : Vec3{};
+    auto height = [&](std::uint32_t i) { return -dot(nodes_[i].node.centroid, down); };
+    std::vector<std::size_t> welds = inside;
+    std::vector<std::uint32_t> below;
+    for (const bool steep : {false, true}) { // welds facing down first, else any weld to a lower node
+        for (std::uint32_t n : group)
+            for (std::size_t k : nodes_[n].bonds) {
+                const BondState& b = bonds_[k];
+                const std::uint32_t m = b.bond.other(n);
+                const BondInterface& x = b.bond.section;
+                if (b.broken || !b.solvable || !b.corners.empty() || !movable(n) ||
+                    std::binary_search(group.begin(), group.end(), m) ||
+                    (movable(m) && height(m) >= height(n)) ||
+                    (!steep && (std::abs(dot(x.normal, down)) <= 0.5 ||
+                                dot(x.centroid - nodes_[n].node.centroid, down) <= 0)))
+                    continue;
+                welds.push_back(k);
+                if (movable(m))
+                    below.push_back(m);
+            }
+        if (welds.size() > inside.size())
+            break;
+    }
+    if (!balanceAmong(group, welds))
+        return inside;
+    std::sort(below.begin(), below.end());
+    below.erase(std::unique(below.begin(), below.end()), below.end());
+    std::vector<Route> rest;
+    for (std::uint32_t n : below)
+        rest.push_back({n, nodes_[n].v * nodes_[n].node.mass, nodes_[n].node.inertia * nodes_[n].w});
+    route(rest);
+    return inside;
+}
+
+// Gauss-Seidel over the bonds between these nodes only (ascending), until they are at rest within the
+// tolerance or stop improving: the pieces that replaced a body carry its inherited load path among
+// themselves before the iteration spreads what is left to their neighbours.
+void StressSolver::settleAmong(const std::vector<std::uint32_t>& group, double tolerance) {
+    const std::vector<std::size_t> inside = balanceDown(group);
     auto worst = [&] {
         double m = 0;
         for (std::uint32_t n : group)
@@ -764,41 +833,6 @@ void StressSolver::settleAmong(const std::vector<std::uint32_t>& group, double t
                 m = std::max(m, nodeResidual(nodes_[n]));
         return m;
     };
-    if (welded) {
-        // The welds to what lies beneath the group (lower nodes, or held ones) carry its net load.
-        const double g = length(settings_.gravity);
-        const Vec3 down = g > 0 ? settings_.gravity / g : Vec3{};
-        auto height = [&](std::uint32_t i) { return -dot(nodes_[i].node.centroid, down); };
-        std::vector<std::size_t> welds = inside;
-        std::vector<std::uint32_t> below;
-        for (const bool steep : {false, true}) { // welds facing down first, else any weld to a lower node
-            for (std::uint32_t n : group)
-                for (std::size_t k : nodes_[n].bonds) {
-                    const BondState& b = bonds_[k];
-                    const std::uint32_t m = b.bond.other(n);
-                    const BondInterface& x = b.bond.section;
-                    if (b.broken || !b.solvable || !b.corners.empty() || !movable(n) ||
-                        std::binary_search(group.begin(), group.end(), m) ||
-                        (movable(m) && height(m) >= height(n)) ||
-                        (!steep && (std::abs(dot(x.normal, down)) <= 0.5 ||
-                                    dot(x.centroid - nodes_[n].node.centroid, down) <= 0)))
-                        continue;
-                    welds.push_back(k);
-                    if (movable(m))
-                        below.push_back(m);
-                }
-            if (welds.size() > inside.size())
-                break;
-        }
-        (void)balanceAmong(group, welds);
-        // The reactions on the nodes beneath go down to the ground.
-        std::sort(below.begin(), below.end());
-        below.erase(std::unique(below.begin(), below.end()), below.end());
-        std::vector<Route> rest;
-        for (std::uint32_t n : below)
-            rest.push_back({n, nodes_[n].v * nodes_[n].node.mass, nodes_[n].node.inertia * nodes_[n].w});
-        route(rest);
-    }
     double last = worst();
     for (int sweep = 1; sweep <= 400 && last > tolerance * tolerance; ++sweep) {
         for (std::size_t k : inside) {

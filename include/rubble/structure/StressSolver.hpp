@@ -246,6 +246,7 @@ private:
     };
     void route(std::vector<Route>& changes);
     void settleAmong(const std::vector<std::uint32_t>& group, double tolerance);
+    std::vector<std::size_t> balanceDown(const std::vector<std::uint32_t>& group);
     void routeUnbalanced(double tolerance);
     bool balanceAmong(const std::vector<std::uint32_t>& group, const std::vector<std::size_t>& welds);
     std::vector<Route> routes_;            // startSolve(): this solve's load changes
