@@ -278,8 +278,6 @@ std::uint32_t StressSolver::addNode(const StructureNode& node) {
         freeNodes_.pop_back();
         nodes_[i] = std::move(s);
     }
-    if (i < reached_.size())
-        reached_[i] = 0;
     if (node.root)
         reachGained_.push_back(i);
     if (direct_)
@@ -692,16 +690,10 @@ void StressSolver::route(std::vector<Route>& changes) {
         double area = 0;
         for (const bool steep : {false, true}) { // welds facing down first, else any weld to a lower node
             for (std::size_t k : n.bonds) {
-                const BondState& b = bonds_[k];
-                if (b.broken || !b.solvable || !b.corners.empty())
+                if (!weldBeneath(k, i, down, steep))
                     continue;
-                const BondInterface& x = b.bond.section;
-                const std::uint32_t j = b.bond.other(i);
-                const double vertical = std::abs(dot(x.normal, down));
-                if ((movable(j) && height(j) >= key.first) ||
-                    (!steep && (vertical <= 0.5 || dot(x.centroid - n.node.centroid, down) <= 0)))
-                    continue;
-                below.push_back({k, steep ? x.sectionArea : x.sectionArea * vertical});
+                const BondInterface& x = bonds_[k].bond.section;
+                below.push_back({k, steep ? x.sectionArea : x.sectionArea * std::abs(dot(x.normal, down))});
                 area += below.back().second;
             }
             if (area > 0)
@@ -730,13 +722,33 @@ void StressSolver::route(std::vector<Route>& changes) {
     }
 }
 
+// True when bond k of node n is a weld to a lower or held node that faces down from below n's centroid (any
+// such weld when steep).
+bool StressSolver::weldBeneath(std::size_t k, std::uint32_t n, const Vec3& down, bool steep) const {
+    const BondState& b = bonds_[k];
+    if (b.broken || !b.solvable || !b.corners.empty())
+        return false;
+    const std::uint32_t m = b.bond.other(n);
+    const Vec3& c = nodes_[n].node.centroid;
+    if (movable(m) && -dot(nodes_[m].node.centroid, down) >= -dot(c, down)) // not lower
+        return false;
+    const BondInterface& x = b.bond.section;
+    return steep || (std::abs(dot(x.normal, down)) > 0.5 && dot(x.centroid - c, down) > 0);
+}
+
+// A node's imbalance as a load change to route: (m v, I w).
+StressSolver::Route StressSolver::unbalance(std::uint32_t n) const {
+    const NodeState& s = nodes_[n];
+    return {n, s.v * s.node.mass, s.node.inertia * s.w};
+}
+
 // Every node still out of the tolerance passes its imbalance down its welds (route): exact where a chain of
 // welds leads down to what is held, left for the iteration elsewhere.
 void StressSolver::routeUnbalanced(double tolerance) {
     std::vector<Route> rest;
     for (std::uint32_t i = 0; i < nodes_.size(); ++i)
         if (movable(i) && nodeResidual(nodes_[i]) > tolerance * tolerance)
-            rest.push_back({i, nodes_[i].v * nodes_[i].node.mass, nodes_[i].node.inertia * nodes_[i].w});
+            rest.push_back(unbalance(i));
     if (rest.empty())
         return;
     std::vector<std::uint32_t> routed;
@@ -788,20 +800,14 @@ std::vector<std::size_t> StressSolver::balanceDown(const std::vector<std::uint32
         return inside;
     const double g = length(settings_.gravity);
     const Vec3 down = g > 0 ? settings_.gravity / g : Vec3{};
-    auto height = [&](std::uint32_t i) { return -dot(nodes_[i].node.centroid, down); };
     std::vector<std::size_t> welds = inside;
     std::vector<std::uint32_t> below;
     for (const bool steep : {false, true}) { // welds facing down first, else any weld to a lower node
         for (std::uint32_t n : group)
             for (std::size_t k : nodes_[n].bonds) {
-                const BondState& b = bonds_[k];
-                const std::uint32_t m = b.bond.other(n);
-                const BondInterface& x = b.bond.section;
-                if (b.broken || !b.solvable || !b.corners.empty() || !movable(n) ||
-                    std::binary_search(group.begin(), group.end(), m) ||
-                    (movable(m) && height(m) >= height(n)) ||
-                    (!steep && (std::abs(dot(x.normal, down)) <= 0.5 ||
-                                dot(x.centroid - nodes_[n].node.centroid, down) <= 0)))
+                const std::uint32_t m = bonds_[k].bond.other(n);
+                if (!movable(n) || std::binary_search(group.begin(), group.end(), m) ||
+                    !weldBeneath(k, n, down, steep))
                     continue;
                 welds.push_back(k);
                 if (movable(m))
@@ -816,7 +822,7 @@ std::vector<std::size_t> StressSolver::balanceDown(const std::vector<std::uint32
     below.erase(std::unique(below.begin(), below.end()), below.end());
     std::vector<Route> rest;
     for (std::uint32_t n : below)
-        rest.push_back({n, nodes_[n].v * nodes_[n].node.mass, nodes_[n].node.inertia * nodes_[n].w});
+        rest.push_back(unbalance(n));
     route(rest);
     return inside;
 }

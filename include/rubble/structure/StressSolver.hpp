@@ -248,6 +248,8 @@ private:
     void settleAmong(const std::vector<std::uint32_t>& group, double tolerance);
     std::vector<std::size_t> balanceDown(const std::vector<std::uint32_t>& group);
     void routeUnbalanced(double tolerance);
+    bool weldBeneath(std::size_t k, std::uint32_t n, const Vec3& down, bool steep) const;
+    Route unbalance(std::uint32_t n) const;
     bool balanceAmong(const std::vector<std::uint32_t>& group, const std::vector<std::size_t>& welds);
     std::vector<Route> routes_;            // startSolve(): this solve's load changes
     std::vector<BondBreak> breaks_;        // since takeBreaks()
