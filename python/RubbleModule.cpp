@@ -565,7 +565,7 @@ PYBIND11_MODULE(_rubble, m) {
             [](rubble::Structure& s, rubble::BodyId id, const py::object& force, const py::object& point) {
                 if (!s.contains(id))
                     throw py::value_error("id: no body " + std::to_string(id));
-                s.addLoad(id, finiteVec3(force, "force"), finiteVec3(point, "point"));
+                s.addLoad(id, checkedVector(force, "force"), checkedVector(point, "point"));
             },
             py::arg("id"), py::arg("force"), py::arg("point"))
         .def(

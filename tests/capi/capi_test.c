@@ -663,6 +663,7 @@ static void test_structure(void) {
     size_t bodies = 0, bonds = 0;
     const double zero[3] = {0, 0, 0}, lo[3] = {3, 0, 0}, hi[3] = {4, 1, 1};
     const double skew[9] = {1, 0, 0, 0, 1, 0, 0, 0, 2}, down[3] = {0, -1, 0}, nan3[3] = {0, NAN, 0};
+    const double light[3] = {0, -5e5, 0}, heavy[3] = {0, -1.2e6, 0}, tip[3] = {3.5, 2.2, 0};
     rubble_mesh* cube = NULL;
     if (cantilever(2.5, "concrete", &s)) {
         CHECK_OK(rubble_structure_count(s, &bodies, &bonds));
@@ -711,6 +712,13 @@ static void test_structure(void) {
     if (cantilever(3.5, "steel", &s)) { /* 14 MPa against 355 */
         CHECK_OK(rubble_structure_step(s, NULL, &info));
         CHECK(info.break_count == 0 && info.collapse_count == 0);
+        /* a tip load: 350 Pa per N at the root beside the slab's own 14 MPa */
+        CHECK_OK(rubble_structure_add_load(s, 2, light, tip));
+        CHECK_OK(rubble_structure_step(s, NULL, &info));
+        CHECK(info.break_count == 0 && info.collapse_count == 0); /* 189 MPa */
+        CHECK_OK(rubble_structure_add_load(s, 2, heavy, tip));
+        CHECK_OK(rubble_structure_step(s, NULL, &info));
+        CHECK(info.break_count == 1 && info.collapse_count == 1); /* 434 MPa */
         CHECK_OK(rubble_structure_destroy(s));
     }
     CHECK_OK(rubble_structure_destroy(NULL));

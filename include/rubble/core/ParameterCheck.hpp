@@ -61,6 +61,7 @@ inline constexpr ParamRange kParamRanges[] = {
     {"octaves", ParamKind::Integer, 1, kMaxRoughOctaves},
     {"grain_stretch", ParamKind::Real, 1, 100},
     {"grain", ParamKind::Point},
+    {"force", ParamKind::Point}, // a load on a structure's body (N)
     {"max_triangles_per_piece", ParamKind::Integer, 64, 10'000'000},
 };
 
