@@ -722,8 +722,7 @@ void StressSolver::route(std::vector<Route>& changes) {
     }
 }
 
-// True when bond k of node n is a weld to a lower or held node that faces down from below n's centroid (any
-// such weld when steep).
+// Bond k of node n is a weld to a lower or held node, facing down from below n (any such weld when steep).
 bool StressSolver::weldBeneath(std::size_t k, std::uint32_t n, const Vec3& down, bool steep) const {
     const BondState& b = bonds_[k];
     if (b.broken || !b.solvable || !b.corners.empty())
@@ -742,8 +741,7 @@ StressSolver::Route StressSolver::unbalance(std::uint32_t n) const {
     return {n, s.v * s.node.mass, s.node.inertia * s.w};
 }
 
-// Every node still out of the tolerance passes its imbalance down its welds (route): exact where a chain of
-// welds leads down to what is held, left for the iteration elsewhere.
+// Passes every node still out of the tolerance down its welds, else balances it with rings of neighbours.
 void StressSolver::routeUnbalanced(double tolerance) {
     std::vector<Route> rest;
     for (std::uint32_t i = 0; i < nodes_.size(); ++i)
@@ -782,9 +780,7 @@ void StressSolver::routeUnbalanced(double tolerance) {
     }
 }
 
-// The bonds among a group of nodes (ascending). When they are all welds, the group is balanced in one solve
-// (balanceAmong) over them and the welds beneath it (facing down first, else any to a lower or held node),
-// and the reactions on the nodes beneath are routed down to the ground.
+// Balances a welded group over its welds and those beneath it, routing the reactions down; its inner bonds.
 std::vector<std::size_t> StressSolver::balanceDown(const std::vector<std::uint32_t>& group) {
     std::vector<std::size_t> inside;
     for (std::uint32_t n : group)
@@ -827,9 +823,7 @@ std::vector<std::size_t> StressSolver::balanceDown(const std::vector<std::uint32
     return inside;
 }
 
-// Gauss-Seidel over the bonds between these nodes only (ascending), until they are at rest within the
-// tolerance or stop improving: the pieces that replaced a body carry its inherited load path among
-// themselves before the iteration spreads what is left to their neighbours.
+// A fracture's pieces balanced down (balanceDown), then Gauss-Seidel among them for what that left.
 void StressSolver::settleAmong(const std::vector<std::uint32_t>& group, double tolerance) {
     const std::vector<std::size_t> inside = balanceDown(group);
     auto worst = [&] {
@@ -856,9 +850,7 @@ void StressSolver::settleAmong(const std::vector<std::uint32_t>& group, double t
     }
 }
 
-// The welds between these nodes take the smallest change of force that leaves every movable one of them at
-// rest, their other bonds held (one dense solve of the group's equilibrium; docs/structure.md). What no such
-// change can balance (the group's net imbalance) stays for the iteration. False when the group is too large.
+// The least change of these welds' forces that leaves the group at rest (docs/structure.md); false if none.
 bool StressSolver::balanceAmong(const std::vector<std::uint32_t>& group,
                                 const std::vector<std::size_t>& welds) {
     constexpr std::size_t kMostNodes = 48;
@@ -924,10 +916,7 @@ void StressSolver::reach() {
     reachGained_.clear();
 }
 
-// reached_ brought up to date from the bonds lost and gained since it was found: each end of a lost bond
-// searches for a root, lowest nodes first (what finds none is cut off, with everything it met); then the
-// reached ends of added bonds pass it on. The same result as reachable(); false when a search grows past a
-// share of the structure (then the whole is found again).
+// reached_ updated from the bonds lost and gained (docs/structure.md); false to find it again whole.
 bool StressSolver::reachAgain() {
     reached_.resize(nodes_.size(), 0);
     const std::size_t most = std::max<std::size_t>(512, nodes_.size() / 8);
