@@ -151,6 +151,7 @@ bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const Game
     rc.world.seed = 20260522;
     rc.world.minPieceVolume = settings.minPieceVolume;
     rc.impacts.collisionImpulseThreshold = settings.collisionImpulse;
+    rc.impacts.blastCutVolume = settings.blastCutVolume;
     rc.debris.maxAwakeBodies = settings.maxAwake;
     rc.debris.lightPerAwake = settings.lightPerAwake;
     rc.support.collapseUnsupported = settings.collapseUnsupported;
@@ -466,7 +467,7 @@ void Game::respawn() {
 
 void Game::blast(const V3& point, float radius, float impulse, int by) {
     blastBy_ = by;
-    runtime_->blast(rubble::Vec3{point.x, point.y, point.z}, radius, impulse);
+    counters_.blastThrown += runtime_->blast(rubble::Vec3{point.x, point.y, point.z}, radius, impulse).thrown;
     blastBy_ = -1;
     particles_.impactBurst(point, V3{0, 1, 0}, 3.0f, burstSeed_++);
     particles_.impactBurst(point, V3{0, 1, 0}, 2.0f, burstSeed_++);
@@ -483,7 +484,8 @@ bool Game::blastNextTarget() {
 }
 
 bool Game::hitAt(const V3& point, float impulse) {
-    return runtime_ && runtime_->blast(rubble::Vec3{point.x, point.y, point.z}, 0.01, impulse, 1.0) > 0;
+    return runtime_ &&
+           runtime_->blast(rubble::Vec3{point.x, point.y, point.z}, 0.01, impulse, 1.0).impacts > 0;
 }
 
 void Game::checkCrash() {
@@ -719,6 +721,7 @@ void Game::step(const ControlInput& input, float dt, Renderer& renderer) {
     runtime_->setDebrisBudget(debris);
     rubble::ImpactPolicy impacts = rc.impacts;
     impacts.collisionImpulseThreshold = settings_.collisionImpulse;
+    impacts.blastCutVolume = settings_.blastCutVolume;
     runtime_->setImpactPolicy(impacts);
     rubble::SupportPolicy support = rc.support;
     support.collapseUnsupported = settings_.collapseUnsupported;

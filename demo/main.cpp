@@ -67,6 +67,7 @@ struct Options {
     bool headless = false;
     bool window = false;
     int workers = -1;
+    double blastCutVolume = rubble::ImpactPolicy{}.blastCutVolume; // blasts throw moving bodies below this
     std::string pattern = "adaptive";
     int cells = 6;
     bool noPanel = false;
@@ -298,6 +299,9 @@ int parseOptions(int argc, char** argv, Options& o) {
     cli.add_flag("--headless", o.headless, "render offscreen with EGL (default when DISPLAY is unset)");
     cli.add_flag("--window", o.window, "open a window even for --autopilot");
     cli.add_option("--workers", o.workers, "fracture worker threads (-1 automatic)");
+    cli.add_option("--blast-cut-volume", o.blastCutVolume,
+                   "blasts throw moving pieces below this volume (m^3) instead of cutting them (0: cut all)")
+        ->check(CLI::NonNegativeNumber);
     cli.add_option("--pattern", o.pattern,
                    "fracture pattern: adaptive (weak hits chip, strong hits shatter), single or shatter")
         ->check(CLI::IsMember({"adaptive", "single", "shatter"}));
@@ -537,6 +541,7 @@ int setUp(App& app, RunMode& mode) {
 
     app.pending.workers = o.workers;
     app.pending.workerNice = o.workerNice;
+    app.pending.blastCutVolume = o.blastCutVolume;
     app.pending.deterministic = o.deterministic || (autopilot && !o.adoptReady);
     app.pending.fracture.pattern = o.pattern == "shatter"  ? rubble::CellPattern::Shatter
                                    : o.pattern == "single" ? rubble::CellPattern::SingleCell

@@ -246,6 +246,13 @@ struct DestructionRuntime::Impl {
         bodies.setMotion(*r, BodyMotionState::Dynamic);
     }
 
+    // A moving or frozen body given a velocity change (a blast's throw); a frozen one wakes first.
+    void throwBody(BodyId id, const Vec3& dv) {
+        makeDynamic(id);
+        const BodyMotion m = binding.motion(id);
+        binding.setVelocity(id, m.linearVelocity + dv, m.angularVelocity);
+    }
+
     void freeze(BodyId id) {
         BodyRecord* r = bodies.find(id);
         if (!r || r->motion != BodyMotionState::Dynamic)
@@ -739,14 +746,15 @@ void DestructionRuntime::setJournalSink(std::function<void(const JournalEvent&)>
     impl_->world.setJournalSink(std::move(sink));
 }
 
-int DestructionRuntime::blast(const Vec3& center, double radius, double impulse, double edgeShare) {
+BlastOutcome DestructionRuntime::blast(const Vec3& center, double radius, double impulse, double edgeShare) {
+    BlastOutcome out;
     if (!(radius > 0) || !(impulse > 0))
-        return 0;
-    int accepted = 0;
+        return out;
+    const ImpactPolicy& policy = impl_->config.impacts;
     // bodies() is a copy; an accepted impact changes no body before the next frame anyway
     for (BodyId id : bodies()) {
         const BodyRecord* b = body(id);
-        if (!b || !b->hasObject || b->volume < impl_->config.impacts.minFractureVolume)
+        if (!b || !b->hasObject)
             continue;
         const Vec3 c = motion(id).transform.translation;
         const Vec3 d = center - c;
@@ -754,11 +762,20 @@ int DestructionRuntime::blast(const Vec3& center, double radius, double impulse,
         if (dist > radius + b->radius)
             continue;
         const Vec3 n = dist > 1e-9 ? d * (1.0 / dist) : Vec3{0, 1, 0};
+        const double share = 1.0 - (1.0 - edgeShare) * std::clamp((dist - b->radius) / radius, 0.0, 1.0);
+        if (b->motion != BodyMotionState::Static && b->volume < policy.blastCutVolume) {
+            if (b->mass > 0)
+                impl_->throwBody(id,
+                                 n * -std::min(impulse * share / b->mass, policy.blastThrowSpeed * share));
+            ++out.thrown;
+            continue;
+        }
+        if (b->volume < policy.minFractureVolume)
+            continue;
         const Vec3 at = c + n * std::min(dist, 0.7 * b->radius); // a cell centred here cuts the object
-        const double t = std::clamp((dist - b->radius) / radius, 0.0, 1.0);
-        accepted += submitImpact(id, at, n, impulse * (1.0 - (1.0 - edgeShare) * t)) ? 1 : 0;
+        out.impacts += submitImpact(id, at, n, impulse * share) ? 1 : 0;
     }
-    return accepted;
+    return out;
 }
 
 FrameStats DestructionRuntime::stepFrame(double dt) {

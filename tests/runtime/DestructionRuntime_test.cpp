@@ -439,7 +439,8 @@ TEST(DestructionRuntime, BlastHitsEveryObjectInRangeWithAnImpulseFallingOffToIts
     std::vector<JournalEvent> hits;
     rig.runtime.setJournalSink([&](const JournalEvent& e) { hits.push_back(e); });
     const double radius = 7, impulse = 1000;
-    EXPECT_EQ(rig.runtime.blast({0, 0.5, 0}, radius, impulse), 3) << "the boxes within 7 m plus their radius";
+    EXPECT_EQ(rig.runtime.blast({0, 0.5, 0}, radius, impulse).impacts, 3)
+        << "the boxes within 7 m plus their radius";
     ASSERT_EQ(hits.size(), 3u);
     double last = 2 * impulse;
     for (std::size_t i = 0; i < hits.size(); ++i) {
@@ -455,7 +456,7 @@ TEST(DestructionRuntime, BlastHitsEveryObjectInRangeWithAnImpulseFallingOffToIts
             EXPECT_NEAR(hits[i].normal[0], -1, 1e-6);
         }
     }
-    EXPECT_EQ(rig.runtime.blast({0, 0.5, 0}, 0, impulse), 0) << "no radius, no blast";
+    EXPECT_EQ(rig.runtime.blast({0, 0.5, 0}, 0, impulse).impacts, 0) << "no radius, no blast";
     EXPECT_NE(rig.runtime.bodyOf(sturdy), nullptr);
 }
 
@@ -468,14 +469,57 @@ TEST(DestructionRuntime, BlastSkipsBodiesBelowTheMinimumFractureVolume) {
     rig.runtime.setImpactPolicy(policy);
     std::vector<JournalEvent> hits;
     rig.runtime.setJournalSink([&](const JournalEvent& e) { hits.push_back(e); });
-    EXPECT_EQ(rig.runtime.blast({0, 0.5, 0}, 8, 1000), 1) << "only the large box is hit";
+    EXPECT_EQ(rig.runtime.blast({0, 0.5, 0}, 8, 1000).impacts, 1) << "only the large box is hit";
     ASSERT_EQ(hits.size(), 1u);
     EXPECT_EQ(hits[0].object, large);
     policy.minFractureVolume = 0;
     rig.runtime.setImpactPolicy(policy);
-    EXPECT_EQ(rig.runtime.blast({0, 0.5, 0}, 8, 1000), 2) << "without the minimum both are";
+    EXPECT_EQ(rig.runtime.blast({0, 0.5, 0}, 8, 1000).impacts, 2) << "without the minimum both are";
     ASSERT_EQ(hits.size(), 3u);
     EXPECT_TRUE(hits[1].object == small || hits[2].object == small);
+}
+
+TEST(DestructionRuntime, BlastThrowsSmallMovingBodiesAndCutsTheRest) {
+    ToyRig rig;
+    // 0.001 m³ each: a moving box 2 m from the centre, one 4 m away that comes to rest and is frozen, and a
+    // static one; a moving 1 m³ box; blastCutVolume 0.05 m³.
+    const ObjectId moving = rig.addBox({0.05, 0.05, 0.05}, {2, 3, 0}, false);
+    const ObjectId resting = rig.addBox({0.05, 0.05, 0.05}, {-4, 0.05, 0}, false);
+    const ObjectId fixed = rig.addBox({0.05, 0.05, 0.05}, {0, 0.05, 2}, true);
+    const ObjectId large = rig.addBox({0.5, 0.5, 0.5}, {0, 3, -3}, false);
+    for (int i = 0; i < 240 && rig.motionOf(resting) != BodyMotionState::Frozen; ++i)
+        rig.runtime.stepFrame();
+    ASSERT_EQ(rig.motionOf(resting), BodyMotionState::Frozen);
+    ASSERT_EQ(rig.motionOf(moving), BodyMotionState::Dynamic);
+    std::vector<JournalEvent> hits;
+    rig.runtime.setJournalSink([&](const JournalEvent& e) { hits.push_back(e); });
+    const BodyId movingBody = rig.runtime.bodyOf(moving)->id, restingBody = rig.runtime.bodyOf(resting)->id;
+    const Vec3 center = rig.runtime.motion(movingBody).transform.translation - Vec3{2, 0, 0};
+    const Vec3 before = rig.runtime.motion(movingBody).linearVelocity;
+    const double impulse = 1000, mass = 500 * 0.001;
+    const BlastOutcome out = rig.runtime.blast(center, 8, impulse);
+    EXPECT_EQ(out.thrown, 2) << "the moving and the frozen small boxes";
+    EXPECT_EQ(out.impacts, 2) << "the static small box and the large one";
+    ASSERT_EQ(hits.size(), 2u);
+    EXPECT_TRUE((hits[0].object == fixed && hits[1].object == large) ||
+                (hits[0].object == large && hits[1].object == fixed));
+    EXPECT_EQ(rig.motionOf(resting), BodyMotionState::Dynamic) << "woken to be thrown";
+    const ImpactPolicy& policy = rig.runtime.config().impacts;
+    for (const BodyId id : {movingBody, restingBody}) {
+        const BodyMotion m = rig.runtime.motion(id);
+        const Vec3 dv = m.linearVelocity - (id == movingBody ? before : Vec3{});
+        const Vec3 away = m.transform.translation - center;
+        const double dist = length(away), r = rig.runtime.body(id)->radius;
+        const double share = 1 - 0.6 * std::clamp((dist - r) / 8, 0.0, 1.0);
+        EXPECT_NEAR(length(dv), std::min(impulse * share / mass, policy.blastThrowSpeed * share), 1e-9);
+        EXPECT_GT(dot(dv, away), 0.999 * length(dv) * dist) << "away from the centre";
+    }
+    // With blastCutVolume 0 the same blast cuts every destructible body in range.
+    ImpactPolicy cutAll = policy;
+    cutAll.blastCutVolume = 0;
+    rig.runtime.setImpactPolicy(cutAll);
+    EXPECT_EQ(rig.runtime.blast(center, 8, impulse).thrown, 0);
+    EXPECT_EQ(hits.size(), 6u);
 }
 
 TEST(DestructionRuntime, PhysicsTimeBudgetShrinksTheAwakeBudgetOutsideDeterministicMode) {

@@ -60,6 +60,12 @@ struct RUBBLE_API BodyRecord {
     }
 };
 
+/// What a blast did (DestructionRuntime::blast).
+struct RUBBLE_API BlastOutcome {
+    int impacts = 0; ///< impacts accepted: the bodies it cuts
+    int thrown = 0;  ///< moving bodies below ImpactPolicy::blastCutVolume it threw instead
+};
+
 /// When contacts become impacts (ImpactCollector).
 struct RUBBLE_API ImpactPolicy {
     double collisionImpulseThreshold = 2500; ///< non-projectile contacts fracture only above this total
@@ -68,6 +74,8 @@ struct RUBBLE_API ImpactPolicy {
     double minApproachSpeed = 2.0;           ///< non-projectile contacts also need this approach speed (m/s)
     int graceFrames = 30;             ///< new pieces ignore non-projectile contacts for this many frames
     double minFractureVolume = 0;     ///< impacts on bodies below this volume (m³) are ignored
+    double blastCutVolume = 0.05;     ///< a blast throws, not cuts, moving bodies below this volume (m³)
+    double blastThrowSpeed = 8;       ///< most speed (m/s) a blast gives a body it throws, at its centre
     double maxContactDistance = 0.05; ///< contacts farther apart than this (m) are not hits
     int maxImpactMarks = 64;          ///< recent impacts kept for debug drawing
 };
@@ -342,12 +350,11 @@ public:
     bool submitLocalImpact(ObjectId object, const Impact& impact);
     /// Called with every journal event of the world (DestructionWorld::setJournalSink).
     void setJournalSink(std::function<void(const JournalEvent&)> sink);
-    /// A blast: an impact on every destructible object whose bounding sphere meets the sphere of `radius`
-    /// around `center`, at the point of its bounding sphere nearest the centre (pushed in), its normal toward
-    /// the centre, the impulse falling off linearly from `impulse` to `edgeShare` of it across the radius.
-    /// Bodies below the impact policy's minFractureVolume are skipped, as their contacts are. Returns the
-    /// impacts accepted.
-    int blast(const Vec3& center, double radius, double impulse, double edgeShare = 0.4);
+    /// A blast on every destructible object whose bounding sphere meets the sphere of `radius` around
+    /// `center`, its impulse falling off linearly to `edgeShare` at the edge: a moving (or frozen) body below
+    /// ImpactPolicy::blastCutVolume is thrown (impulse over mass, at most blastThrowSpeed); any other is hit
+    /// at its bounding sphere's point nearest the centre, normal toward it, unless below minFractureVolume.
+    BlastOutcome blast(const Vec3& center, double radius, double impulse, double edgeShare = 0.4);
 
     /// One frame, a list of stages: physics step, contacts → impacts, anchors classified, splits adopted
     /// (bodies made, then each split committed), support settled (once a frame), the onAdopted callbacks,
