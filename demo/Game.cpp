@@ -611,10 +611,10 @@ void Game::launch(const btVector3& from, const btVector3& velocity, Weapon weapo
 }
 
 bool Game::shootNextTarget(const V3& from) {
-    const std::vector<V3> standing = targets();
-    if (standing.empty())
+    const std::vector<V3> all = shellTargets();
+    if (all.empty())
         return false;
-    const V3 target = standing[nextShot_++ % standing.size()];
+    const V3 target = all[nextShot_++ % all.size()];
     const V3 toward = from - target;
     const V3 dir = len(toward) > 1e-3f ? norm(toward) : V3{0, 0, 1};
     const V3 muzzle = target + dir * 40.0f;
@@ -910,6 +910,20 @@ std::vector<V3> Game::targets() const {
         if (standingDynamic || (b->motion == rubble::BodyMotionState::Static &&
                                 (b->role == BodyRole::Object ||
                                  (b->role == BodyRole::Piece && b->volume > 150 && c.y > groundTop_ + 15))))
+            out.push_back(toV3(c));
+    }
+    return out;
+}
+
+std::vector<V3> Game::shellTargets() const {
+    std::vector<V3> out;
+    if (!runtime_)
+        return out;
+    for (BodyId id : runtime_->bodies()) {
+        const BodyRecord* b = runtime_->body(id);
+        const rubble::Vec3 c = runtime_->motion(id).transform.translation;
+        if (b->role == BodyRole::Object ||
+            (b->role == BodyRole::Piece && b->volume >= 1.0 && c.y > groundTop_))
             out.push_back(toV3(c));
     }
     return out;

@@ -151,8 +151,8 @@ public:
     /// A demolition charge's blast on the next standing target (round robin over targets()), for --demolish;
     /// false when nothing stands.
     bool blastNextTarget();
-    /// A cannon shell at the next standing target (round robin over targets()), fired from 40 m off on the
-    /// side of `from` (the camera), for --fire-rate; false when nothing stands.
+    /// A cannon shell at the next of the scene's objects wherever they lie (round robin over shellTargets()),
+    /// fired from 40 m off on the side of `from` (the camera), for --fire-rate; false when none is left.
     bool shootNextTarget(const V3& from);
     /// One impact at a world point on the objects whose bounds reach it (no sparks); false when none took it.
     bool hitAt(const V3& point, float impulse);
@@ -175,6 +175,8 @@ public:
     const PriorityJobs* jobs() const { return jobs_.get(); }
     /// Centres of destructible objects still standing (for the autopilot).
     std::vector<V3> targets() const;
+    /// Centres of the scene's objects, standing or not, and of pieces of 1 m³ or more (--fire-rate).
+    std::vector<V3> shellTargets() const;
     /// Height of the ground surface.
     float groundY() const { return groundTop_; }
     /// True: fracture runs on Rubble's DestructionWorld runtime (kept for the panel and the run report).

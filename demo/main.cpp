@@ -97,7 +97,7 @@ struct Options {
     int rasterNice = 0;                // niceness of llvmpipe's rasteriser threads (0: unchanged)
     int rasterThreads = -1;            // LP_NUM_THREADS for llvmpipe (-1: unchanged)
     int workerNice = kWorkerNice;      // niceness of the fracture workers (0: unchanged)
-    double fireRate = 0;               // cannon shots per game second at the standing targets (0: none)
+    double fireRate = 0;               // cannon shots per game second at objects and large pieces (0: none)
     bool adoptReady = false;           // the autopilot adopts results when ready, not a fixed 2 frames later
     double adoptWaitMs = kAdoptWaitMs; // before drawing, wait this long for a fracture job in flight
     int rasterYield = 0;               // llvmpipe's niceness while fracture jobs run (0: unchanged)
@@ -414,7 +414,8 @@ int parseOptions(int argc, char** argv, Options& o) {
                        "CAP_SYS_NICE; report.json says what the system granted)")
         ->check(CLI::Range(-20, 19));
     cli.add_option("--fire-rate", o.fireRate,
-                   "cannon shots per game second at the standing objects, round robin, from 40 m on the "
+                   "cannon shots per game second at the objects and pieces of 1 m^3 or more, round robin, "
+                   "from 40 m on the "
                    "camera's side (a latency run's steady fractures; also with --hold-fire)")
         ->check(CLI::Range(0.0, 60.0));
     cli.add_option(

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Fracture latency while rendering: rubble-demo's autopilot on the thesis's world.cfg (the seed scene) at
-# 1280x720, headless EGL (llvmpipe), with --fire-rate cannon shells at the standing objects and results adopted
+# 1280x720, headless EGL (llvmpipe), with --fire-rate cannon shells at the objects and large pieces and results adopted
 # as soon as they are ready (--adopt-ready), so that report.json's latency_ms (impact -> adopted) measures the
 # workers, not the deterministic 2-frame delay; visible_ms adds the wait for the frame that shows the pieces.
 # Configurations alternate within each round: the demo's defaults (workers at niceness -5, hardware threads
