@@ -152,6 +152,7 @@ bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const Game
     rc.world.minPieceVolume = settings.minPieceVolume;
     rc.impacts.collisionImpulseThreshold = settings.collisionImpulse;
     rc.impacts.blastCutVolume = settings.blastCutVolume;
+    rc.impacts.collisionFracturesPerSecond = settings.collisionFractureRate;
     rc.debris.maxAwakeBodies = settings.maxAwake;
     rc.debris.lightPerAwake = settings.lightPerAwake;
     rc.support.collapseUnsupported = settings.collapseUnsupported;
@@ -722,6 +723,7 @@ void Game::step(const ControlInput& input, float dt, Renderer& renderer) {
     rubble::ImpactPolicy impacts = rc.impacts;
     impacts.collisionImpulseThreshold = settings_.collisionImpulse;
     impacts.blastCutVolume = settings_.blastCutVolume;
+    impacts.collisionFracturesPerSecond = settings_.collisionFractureRate;
     runtime_->setImpactPolicy(impacts);
     rubble::SupportPolicy support = rc.support;
     support.collapseUnsupported = settings_.collapseUnsupported;
@@ -785,6 +787,7 @@ void Game::updateCounters() {
     counters_.impacts = static_cast<int>(c.projectileHits);
     counters_.submitted = static_cast<int>(c.impacts);
     counters_.fractures = static_cast<int>(c.fractures);
+    counters_.collisionsOverBudget = static_cast<int>(c.collisionsOverBudget);
     counters_.piecesCreated = static_cast<int>(c.piecesCreated);
     counters_.retired = static_cast<int>(c.piecesRetired);
     counters_.retiredBy = {static_cast<int>(c.retired.dust), static_cast<int>(c.retired.awake),

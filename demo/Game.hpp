@@ -44,15 +44,16 @@ struct GameSettings {
     double impulseThreshold = 50;    ///< impacts below this impulse do not fracture
     double collisionImpulse = 2500;  ///< non-projectile contacts above this impulse fracture too
     double blastCutVolume = rubble::ImpactPolicy{}.blastCutVolume; ///< blasts throw moving bodies below this
-    int workers = -1;             ///< fracture worker threads (-1 automatic), applied on restart
-    int workerNice = 0;           ///< niceness of the fracture workers (0: unchanged), applied on restart
-    bool deterministic = false;   ///< adopt results a fixed number of frames after the impact
-    float timeScale = 1;          ///< slow motion factor
-    float projectileSpeed = 170;  ///< m/s
-    float projectileMass = 4;     ///< kg
-    float fireInterval = 0.14f;   ///< s between shots while Space is held
-    float minPieceVolume = 0.02f; ///< m^3: smaller pieces become debris particles (applied on restart)
-    int maxAwake = 400;           ///< awake debris budget: beyond it the smallest retire to particles
+    double collisionFractureRate = 0; ///< non-projectile contacts start at most this many fractures a second
+    int workers = -1;                 ///< fracture worker threads (-1 automatic), applied on restart
+    int workerNice = 0;               ///< niceness of the fracture workers (0: unchanged), applied on restart
+    bool deterministic = false;       ///< adopt results a fixed number of frames after the impact
+    float timeScale = 1;              ///< slow motion factor
+    float projectileSpeed = 170;      ///< m/s
+    float projectileMass = 4;         ///< kg
+    float fireInterval = 0.14f;       ///< s between shots while Space is held
+    float minPieceVolume = 0.02f;     ///< m^3: smaller pieces become debris particles (applied on restart)
+    int maxAwake = 400;               ///< awake debris budget: beyond it the smallest retire to particles
     double lightPerAwake =
         4; ///< moving pieces over the budget collide with static bodies only, up to this many
            ///< per budgeted awake body, before any retires (DebrisBudget::lightPerAwake)
@@ -89,6 +90,7 @@ struct GameCounters {
     int warnings = 0;               ///< scene warnings
     int crashes = 0;                ///< the jet hit the ground or an object
     int blastThrown = 0;            ///< moving pieces blasts threw instead of cutting
+    int collisionsOverBudget = 0;   ///< collision impacts over GameSettings::collisionFractureRate, dropped
     int respawns = 0;               ///< the jet came back (2 s after a crash, or R)
     int turnBacks = 0;              ///< times the world bounds started turning the jet back
     std::array<int, kWeaponCount> weaponShots{};     ///< shots fired, by weapon

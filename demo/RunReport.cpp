@@ -72,6 +72,7 @@ bool RunReport::write(const std::filesystem::path& dir, const std::string& scene
     j["fractures"] = last.fractures;
     j["pieces_created"] = last.piecesCreated;
     j["blast_thrown"] = last.blastThrown;
+    j["collisions_over_budget"] = last.collisionsOverBudget;
     j["pieces_live"] = last.pieces;
     j["pieces_awake"] = last.awake;
     j["pieces_frozen"] = last.frozen;

@@ -460,9 +460,10 @@ struct DestructionRuntime::Impl {
     void submitImpacts(FrameContext& f) {
         collector.gather(contacts, bodies, world, binding, counters.frames, config.debris.freezeSpeed,
                          governor.light());
-        f.impacts = collector.take();
+        f.impacts = collector.take(f.dt);
         f.stats.projectileHits = f.impacts.projectileHits;
         counters.projectileHits += f.impacts.projectileHits;
+        counters.collisionsOverBudget += f.impacts.collisionsOverBudget;
         for (const detail::PendingImpact& p : f.impacts.impacts)
             submit(p, f.stats);
         world.beginFrame();
@@ -751,28 +752,28 @@ BlastOutcome DestructionRuntime::blast(const Vec3& center, double radius, double
     if (!(radius > 0) || !(impulse > 0))
         return out;
     const ImpactPolicy& policy = impl_->config.impacts;
-    // bodies() is a copy; an accepted impact changes no body before the next frame anyway
-    for (BodyId id : bodies()) {
-        const BodyRecord* b = body(id);
-        if (!b || !b->hasObject)
-            continue;
+    // The bodies in range, nearest first, so that the nearest cuts are queued first.
+    std::vector<std::pair<double, BodyId>> inRange;
+    for (const auto& [id, b] : impl_->bodies.all()) {
+        const double dist = length(center - motion(id).transform.translation);
+        if (b.hasObject && dist <= radius + b.radius)
+            inRange.emplace_back(dist, id);
+    }
+    std::sort(inRange.begin(), inRange.end());
+    for (const auto& [dist, id] : inRange) {
+        const BodyRecord& b = *body(id);
         const Vec3 c = motion(id).transform.translation;
-        const Vec3 d = center - c;
-        const double dist = length(d);
-        if (dist > radius + b->radius)
-            continue;
-        const Vec3 n = dist > 1e-9 ? d * (1.0 / dist) : Vec3{0, 1, 0};
-        const double share = 1.0 - (1.0 - edgeShare) * std::clamp((dist - b->radius) / radius, 0.0, 1.0);
-        if (b->motion != BodyMotionState::Static && b->volume < policy.blastCutVolume) {
-            if (b->mass > 0)
-                impl_->throwBody(id,
-                                 n * -std::min(impulse * share / b->mass, policy.blastThrowSpeed * share));
+        const Vec3 n = dist > 1e-9 ? (center - c) * (1.0 / dist) : Vec3{0, 1, 0};
+        const double share = 1.0 - (1.0 - edgeShare) * std::clamp((dist - b.radius) / radius, 0.0, 1.0);
+        if (b.motion != BodyMotionState::Static && b.volume < policy.blastCutVolume) {
+            if (b.mass > 0)
+                impl_->throwBody(id, n * -std::min(impulse * share / b.mass, policy.blastThrowSpeed * share));
             ++out.thrown;
             continue;
         }
-        if (b->volume < policy.minFractureVolume)
+        if (b.volume < policy.minFractureVolume)
             continue;
-        const Vec3 at = c + n * std::min(dist, 0.7 * b->radius); // a cell centred here cuts the object
+        const Vec3 at = c + n * std::min(dist, 0.7 * b.radius); // a cell centred here cuts the object
         out.impacts += submitImpact(id, at, n, impulse * share) ? 1 : 0;
     }
     return out;

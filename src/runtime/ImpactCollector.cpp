@@ -1,6 +1,7 @@
 #include "runtime/ImpactCollector.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 namespace rubble::detail {
@@ -95,11 +96,29 @@ void ImpactCollector::gather(const std::vector<ContactReport>& contacts, BodyTab
     }
 }
 
-ImpactBatch ImpactCollector::take() {
+ImpactBatch ImpactCollector::take(double dt) {
     ImpactBatch out;
     out.impacts = std::move(projectileImpacts_);
-    for (auto& [id, p] : collisionImpacts_)
-        out.impacts.push_back(p);
+    std::vector<const PendingImpact*> collisions;
+    for (const auto& [id, p] : collisionImpacts_)
+        collisions.push_back(&p);
+    if (const double rate = policy_.collisionFracturesPerSecond; rate > 0) {
+        collisionBudget_ = std::min(collisionBudget_ + rate * dt, std::max(1.0, 0.25 * rate));
+        const auto allowed = static_cast<std::size_t>(std::max(0.0, std::floor(collisionBudget_)));
+        if (collisions.size() > allowed) {
+            std::stable_sort(collisions.begin(), collisions.end(),
+                             [](const PendingImpact* a, const PendingImpact* b) {
+                                 return a->impact.impulse > b->impact.impulse;
+                             });
+            out.collisionsOverBudget = static_cast<int>(collisions.size() - allowed);
+            collisions.resize(allowed);
+            std::sort(collisions.begin(), collisions.end(),
+                      [](const PendingImpact* a, const PendingImpact* b) { return a->object < b->object; });
+        }
+        collisionBudget_ -= static_cast<double>(collisions.size());
+    }
+    for (const PendingImpact* p : collisions)
+        out.impacts.push_back(*p);
     out.frozenHits = std::move(frozenHits_);
     out.projectileHits = projectileHits_;
     projectileImpacts_.clear();

@@ -1,6 +1,7 @@
 #pragma once
 // Turns the contacts of a physics step into impacts on objects (ImpactPolicy: thresholds and coalescing).
 
+#include <limits>
 #include <map>
 #include <set>
 #include <vector>
@@ -26,6 +27,7 @@ struct ImpactBatch {
     std::map<BodyId, double> frozenHits; ///< strongest impulse of a contact closing on each frozen body
                                          ///< (projectile hits: infinite)
     int projectileHits = 0;              ///< projectiles that hit anything
+    int collisionsOverBudget = 0;        ///< collision impacts dropped over collisionFracturesPerSecond
 };
 
 /// Applies the ImpactPolicy to contact reports: a projectile's first hit on a destructible object always
@@ -44,8 +46,9 @@ public:
     void gather(const std::vector<ContactReport>& contacts, BodyTable& bodies, const DestructionWorld& world,
                 const PhysicsBinding& binding, std::uint64_t frame, double wakeSpeed,
                 const std::set<BodyId>& light);
-    /// The frame's batch; starts a new one.
-    ImpactBatch take();
+    /// The frame's batch, its collision impacts within the policy's budget for a frame of dt seconds (the
+    /// strongest first; unspent budget carries over up to a quarter second's worth); starts a new one.
+    ImpactBatch take(double dt);
 
 private:
     const ImpactPolicy& policy_;
@@ -53,6 +56,7 @@ private:
     std::map<ObjectId, PendingImpact> collisionImpacts_;
     std::map<BodyId, double> frozenHits_;
     int projectileHits_ = 0;
+    double collisionBudget_ = std::numeric_limits<double>::infinity(); // fractures the budget allows now
 };
 
 } // namespace rubble::detail

@@ -433,8 +433,9 @@ TEST(DestructionRuntime, EachPieceMadeIsARecordOfItsBodyAndTheImpulseThatBrokeIt
 TEST(DestructionRuntime, BlastHitsEveryObjectInRangeWithAnImpulseFallingOffToItsEdge) {
     ToyRig rig;
     std::vector<ObjectId> boxes;
-    for (int i = 0; i < 5; ++i) // centres 0, 3, 6, 9, 12 m from the blast; bounding radius sqrt(0.75)
+    for (int i = 4; i >= 0; --i) // centres 12, 9, 6, 3, 0 m from the blast; bounding radius sqrt(0.75)
         boxes.push_back(rig.addBox({0.5, 0.5, 0.5}, {3.0 * i, 0.5, 0}, true));
+    std::reverse(boxes.begin(), boxes.end()); // boxes[i] at 3 i m, the nearest made last
     const ObjectId sturdy = rig.addBox({0.5, 0.5, 0.5}, {0, 0.5, 3}, true, {}, false); // not destructible
     std::vector<JournalEvent> hits;
     rig.runtime.setJournalSink([&](const JournalEvent& e) { hits.push_back(e); });
@@ -444,7 +445,7 @@ TEST(DestructionRuntime, BlastHitsEveryObjectInRangeWithAnImpulseFallingOffToIts
     ASSERT_EQ(hits.size(), 3u);
     double last = 2 * impulse;
     for (std::size_t i = 0; i < hits.size(); ++i) {
-        EXPECT_EQ(hits[i].object, boxes[i]);
+        EXPECT_EQ(hits[i].object, boxes[i]) << "nearest first";
         const double dist = 3.0 * static_cast<double>(i), r = std::sqrt(0.75);
         const double share = 1 - 0.6 * std::clamp((dist - r) / radius, 0.0, 1.0);
         EXPECT_NEAR(hits[i].impulse, impulse * share, 1e-6 * impulse); // the journal keeps floats
@@ -482,7 +483,7 @@ TEST(DestructionRuntime, BlastSkipsBodiesBelowTheMinimumFractureVolume) {
 TEST(DestructionRuntime, BlastThrowsSmallMovingBodiesAndCutsTheRest) {
     ToyRig rig;
     // 0.001 m³ each: a moving box 2 m from the centre, one 4 m away that comes to rest and is frozen, and a
-    // static one; a moving 1 m³ box; blastCutVolume 0.05 m³.
+    // static one; a moving 1 m³ box; blastCutVolume 0.25 m³.
     const ObjectId moving = rig.addBox({0.05, 0.05, 0.05}, {2, 3, 0}, false);
     const ObjectId resting = rig.addBox({0.05, 0.05, 0.05}, {-4, 0.05, 0}, false);
     const ObjectId fixed = rig.addBox({0.05, 0.05, 0.05}, {0, 0.05, 2}, true);

@@ -68,13 +68,12 @@ struct RUBBLE_API BlastOutcome {
 
 /// When contacts become impacts (ImpactCollector).
 struct RUBBLE_API ImpactPolicy {
-    double collisionImpulseThreshold = 2500; ///< non-projectile contacts fracture only above this total
-                                             ///< impulse per contact pair and step (and the object's own
-                                             ///< threshold)
+    double collisionImpulseThreshold = 2500; ///< non-projectile contacts fracture above this (N·s a step)
+    double collisionFracturesPerSecond = 0;  ///< they start at most this many fractures a second (0: no cap)
     double minApproachSpeed = 2.0;           ///< non-projectile contacts also need this approach speed (m/s)
     int graceFrames = 30;             ///< new pieces ignore non-projectile contacts for this many frames
     double minFractureVolume = 0;     ///< impacts on bodies below this volume (m³) are ignored
-    double blastCutVolume = 0.05;     ///< a blast throws, not cuts, moving bodies below this volume (m³)
+    double blastCutVolume = 0.25;     ///< a blast throws, not cuts, moving bodies below this volume (m³)
     double blastThrowSpeed = 8;       ///< most speed (m/s) a blast gives a body it throws, at its centre
     double maxContactDistance = 0.05; ///< contacts farther apart than this (m) are not hits
     int maxImpactMarks = 64;          ///< recent impacts kept for debug drawing
@@ -236,19 +235,20 @@ struct RUBBLE_API RetiredPieces {
 
 /// Totals since construction.
 struct RUBBLE_API RuntimeCounters {
-    std::uint64_t frames = 0;      ///< frames stepped
-    long long impacts = 0;         ///< impacts accepted by the DestructionWorld
-    long long projectileHits = 0;  ///< projectile hits on anything
-    long long fractures = 0;       ///< outcomes adopted
-    long long piecesCreated = 0;   ///< piece bodies created
-    long long piecesRetired = 0;   ///< bodies and dust turned into particles (retired.total())
-    RetiredPieces retired;         ///< the same, by reason
-    long long piecesCollapsed = 0; ///< static bodies that lost their support
-    long long bondsBroken = 0;     ///< structure bonds broken
-    long long piecesFrozen = 0;    ///< debris bodies frozen
-    long long piecesWoken = 0;     ///< frozen bodies woken
-    long long piecesLight = 0;     ///< moving pieces over the awake budget made light (DebrisBudget)
-    long long staleOutcomes = 0;   ///< outcomes whose parent had no body
+    std::uint64_t frames = 0;           ///< frames stepped
+    long long impacts = 0;              ///< impacts accepted by the DestructionWorld
+    long long projectileHits = 0;       ///< projectile hits on anything
+    long long fractures = 0;            ///< outcomes adopted
+    long long piecesCreated = 0;        ///< piece bodies created
+    long long piecesRetired = 0;        ///< bodies and dust turned into particles (retired.total())
+    RetiredPieces retired;              ///< the same, by reason
+    long long piecesCollapsed = 0;      ///< static bodies that lost their support
+    long long bondsBroken = 0;          ///< structure bonds broken
+    long long piecesFrozen = 0;         ///< debris bodies frozen
+    long long piecesWoken = 0;          ///< frozen bodies woken
+    long long piecesLight = 0;          ///< moving pieces over the awake budget made light (DebrisBudget)
+    long long staleOutcomes = 0;        ///< outcomes whose parent had no body
+    long long collisionsOverBudget = 0; ///< collision impacts over collisionFracturesPerSecond, dropped
 };
 
 /// Where the volume of the world went (m³); live + retired + dust + dropped stays constant.
