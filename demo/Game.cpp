@@ -153,6 +153,7 @@ bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const Game
     rc.impacts.collisionImpulseThreshold = settings.collisionImpulse;
     rc.impacts.blastCutVolume = settings.blastCutVolume;
     rc.impacts.collisionFracturesPerSecond = settings.collisionFractureRate;
+    rc.impacts.blastMaxCuts = settings.blastMaxCuts;
     rc.debris.maxAwakeBodies = settings.maxAwake;
     rc.debris.lightPerAwake = settings.lightPerAwake;
     rc.support.collapseUnsupported = settings.collapseUnsupported;
@@ -724,6 +725,7 @@ void Game::step(const ControlInput& input, float dt, Renderer& renderer) {
     impacts.collisionImpulseThreshold = settings_.collisionImpulse;
     impacts.blastCutVolume = settings_.blastCutVolume;
     impacts.collisionFracturesPerSecond = settings_.collisionFractureRate;
+    impacts.blastMaxCuts = settings_.blastMaxCuts;
     runtime_->setImpactPolicy(impacts);
     rubble::SupportPolicy support = rc.support;
     support.collapseUnsupported = settings_.collapseUnsupported;

@@ -69,6 +69,7 @@ struct Options {
     int workers = -1;
     double blastCutVolume = rubble::ImpactPolicy{}.blastCutVolume; // blasts throw moving bodies below this
     double collisionFractureRate = 0; // fractures non-projectile contacts may start a second (0: any)
+    int blastMaxCuts = 0;             // bodies a blast may cut, nearest first (0: any)
     std::string pattern = "adaptive";
     int cells = 6;
     bool noPanel = false;
@@ -302,6 +303,9 @@ int parseOptions(int argc, char** argv, Options& o) {
     cli.add_option("--workers", o.workers, "fracture worker threads (-1 automatic)");
     cli.add_option("--blast-cut-volume", o.blastCutVolume,
                    "blasts throw moving pieces below this volume (m^3) instead of cutting them (0: cut all)")
+        ->check(CLI::NonNegativeNumber);
+    cli.add_option("--blast-max-cuts", o.blastMaxCuts,
+                   "bodies a blast may cut, nearest first; moving ones past it are thrown (0: any)")
         ->check(CLI::NonNegativeNumber);
     cli.add_option("--collision-fracture-rate", o.collisionFractureRate,
                    "fractures a second that collisions (not shots) may start, the strongest first (0: any)")
@@ -548,6 +552,7 @@ int setUp(App& app, RunMode& mode) {
     app.pending.workerNice = o.workerNice;
     app.pending.blastCutVolume = o.blastCutVolume;
     app.pending.collisionFractureRate = o.collisionFractureRate;
+    app.pending.blastMaxCuts = o.blastMaxCuts;
     app.pending.deterministic = o.deterministic || (autopilot && !o.adoptReady);
     app.pending.fracture.pattern = o.pattern == "shatter"  ? rubble::CellPattern::Shatter
                                    : o.pattern == "single" ? rubble::CellPattern::SingleCell

@@ -458,6 +458,16 @@ TEST(DestructionRuntime, BlastHitsEveryObjectInRangeWithAnImpulseFallingOffToIts
         }
     }
     EXPECT_EQ(rig.runtime.blast({0, 0.5, 0}, 0, impulse).impacts, 0) << "no radius, no blast";
+    ImpactPolicy capped = rig.runtime.config().impacts;
+    capped.blastMaxCuts = 2;
+    rig.runtime.setImpactPolicy(capped);
+    hits.clear();
+    const BlastOutcome two = rig.runtime.blast({0, 0.5, 0}, radius, impulse);
+    EXPECT_EQ(two.impacts, 2) << "the nearest two; static bodies past the cap are left alone";
+    EXPECT_EQ(two.thrown, 0);
+    ASSERT_EQ(hits.size(), 2u);
+    EXPECT_EQ(hits[0].object, boxes[0]);
+    EXPECT_EQ(hits[1].object, boxes[1]);
     EXPECT_NE(rig.runtime.bodyOf(sturdy), nullptr);
 }
 

@@ -75,6 +75,7 @@ struct RUBBLE_API ImpactPolicy {
     double minFractureVolume = 0;     ///< impacts on bodies below this volume (m³) are ignored
     double blastCutVolume = 0.25;     ///< a blast throws, not cuts, moving bodies below this volume (m³)
     double blastThrowSpeed = 8;       ///< most speed (m/s) a blast gives a body it throws, at its centre
+    int blastMaxCuts = 0;             ///< a blast cuts at most this many bodies, nearest first (0: any)
     double maxContactDistance = 0.05; ///< contacts farther apart than this (m) are not hits
     int maxImpactMarks = 64;          ///< recent impacts kept for debug drawing
 };
@@ -350,10 +351,10 @@ public:
     bool submitLocalImpact(ObjectId object, const Impact& impact);
     /// Called with every journal event of the world (DestructionWorld::setJournalSink).
     void setJournalSink(std::function<void(const JournalEvent&)> sink);
-    /// A blast on every destructible object whose bounding sphere meets the sphere of `radius` around
-    /// `center`, its impulse falling off linearly to `edgeShare` at the edge: a moving (or frozen) body below
-    /// ImpactPolicy::blastCutVolume is thrown (impulse over mass, at most blastThrowSpeed); any other is hit
-    /// at its bounding sphere's point nearest the centre, normal toward it, unless below minFractureVolume.
+    /// A blast on the destructible objects whose bounding spheres meet `radius` around `center`, nearest
+    /// first, its impulse falling off linearly to `edgeShare` at the edge: moving bodies below blastCutVolume
+    /// or past blastMaxCuts (ImpactPolicy) are thrown, at most at blastThrowSpeed; others are hit on their
+    /// bounding sphere nearest the centre, normal toward it (unless below minFractureVolume).
     BlastOutcome blast(const Vec3& center, double radius, double impulse, double edgeShare = 0.4);
 
     /// One frame, a list of stages: physics step, contacts → impacts, anchors classified, splits adopted
