@@ -45,7 +45,7 @@ struct GameSettings {
     double collisionImpulse = 2500;  ///< non-projectile contacts above this impulse fracture too
     double blastCutVolume = rubble::ImpactPolicy{}.blastCutVolume; ///< blasts throw moving bodies below this
     double collisionFractureRate = 0; ///< non-projectile contacts start at most this many fractures a second
-    int blastMaxCuts = 0;             ///< a blast cuts at most this many bodies, nearest first (0: any)
+    int blastMaxCuts = 4;             ///< a blast cuts at most this many moving bodies, nearest first
     int workers = -1;                 ///< fracture worker threads (-1 automatic), applied on restart
     int workerNice = 0;               ///< niceness of the fracture workers (0: unchanged), applied on restart
     bool deterministic = false;       ///< adopt results a fixed number of frames after the impact

@@ -69,7 +69,7 @@ struct Options {
     int workers = -1;
     double blastCutVolume = rubble::ImpactPolicy{}.blastCutVolume; // blasts throw moving bodies below this
     double collisionFractureRate = 0; // fractures non-projectile contacts may start a second (0: any)
-    int blastMaxCuts = 0;             // bodies a blast may cut, nearest first (0: any)
+    int blastMaxCuts = 4;             // moving bodies a blast may cut, nearest first (0: any)
     std::string pattern = "adaptive";
     int cells = 6;
     bool noPanel = false;
@@ -305,7 +305,7 @@ int parseOptions(int argc, char** argv, Options& o) {
                    "blasts throw moving pieces below this volume (m^3) instead of cutting them (0: cut all)")
         ->check(CLI::NonNegativeNumber);
     cli.add_option("--blast-max-cuts", o.blastMaxCuts,
-                   "bodies a blast may cut, nearest first; moving ones past it are thrown (0: any)")
+                   "moving bodies a blast may cut, nearest first; the rest are thrown (0: any; default 4)")
         ->check(CLI::NonNegativeNumber);
     cli.add_option("--collision-fracture-rate", o.collisionFractureRate,
                    "fractures a second that collisions (not shots) may start, the strongest first (0: any)")

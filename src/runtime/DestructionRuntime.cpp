@@ -760,22 +760,27 @@ BlastOutcome DestructionRuntime::blast(const Vec3& center, double radius, double
             inRange.emplace_back(dist, id);
     }
     std::sort(inRange.begin(), inRange.end());
+    int movingCuts = 0;
     for (const auto& [dist, id] : inRange) {
         const BodyRecord& b = *body(id);
         const Vec3 c = motion(id).transform.translation;
         const Vec3 n = dist > 1e-9 ? (center - c) * (1.0 / dist) : Vec3{0, 1, 0};
         const double share = 1.0 - (1.0 - edgeShare) * std::clamp((dist - b.radius) / radius, 0.0, 1.0);
-        const bool capped = policy.blastMaxCuts > 0 && out.impacts >= policy.blastMaxCuts;
-        if (b.motion != BodyMotionState::Static && (b.volume < policy.blastCutVolume || capped)) {
+        const bool moving = b.motion != BodyMotionState::Static;
+        if (moving && (b.volume < policy.blastCutVolume ||
+                       (policy.blastMaxCuts > 0 && movingCuts >= policy.blastMaxCuts))) {
             if (b.mass > 0)
                 impl_->throwBody(id, n * -std::min(impulse * share / b.mass, policy.blastThrowSpeed * share));
             ++out.thrown;
             continue;
         }
-        if (capped || b.volume < policy.minFractureVolume)
+        if (b.volume < policy.minFractureVolume)
             continue;
         const Vec3 at = c + n * std::min(dist, 0.7 * b.radius); // a cell centred here cuts the object
-        out.impacts += submitImpact(id, at, n, impulse * share) ? 1 : 0;
+        if (submitImpact(id, at, n, impulse * share)) {
+            ++out.impacts;
+            movingCuts += moving ? 1 : 0;
+        }
     }
     return out;
 }

@@ -459,15 +459,11 @@ TEST(DestructionRuntime, BlastHitsEveryObjectInRangeWithAnImpulseFallingOffToIts
     }
     EXPECT_EQ(rig.runtime.blast({0, 0.5, 0}, 0, impulse).impacts, 0) << "no radius, no blast";
     ImpactPolicy capped = rig.runtime.config().impacts;
-    capped.blastMaxCuts = 2;
+    capped.blastMaxCuts = 1;
     rig.runtime.setImpactPolicy(capped);
     hits.clear();
-    const BlastOutcome two = rig.runtime.blast({0, 0.5, 0}, radius, impulse);
-    EXPECT_EQ(two.impacts, 2) << "the nearest two; static bodies past the cap are left alone";
-    EXPECT_EQ(two.thrown, 0);
-    ASSERT_EQ(hits.size(), 2u);
-    EXPECT_EQ(hits[0].object, boxes[0]);
-    EXPECT_EQ(hits[1].object, boxes[1]);
+    EXPECT_EQ(rig.runtime.blast({0, 0.5, 0}, radius, impulse).impacts, 3)
+        << "static bodies are cut past the cap";
     EXPECT_NE(rig.runtime.bodyOf(sturdy), nullptr);
 }
 
@@ -515,7 +511,7 @@ TEST(DestructionRuntime, BlastThrowsSmallMovingBodiesAndCutsTheRest) {
     EXPECT_TRUE((hits[0].object == fixed && hits[1].object == large) ||
                 (hits[0].object == large && hits[1].object == fixed));
     EXPECT_EQ(rig.motionOf(resting), BodyMotionState::Dynamic) << "woken to be thrown";
-    const ImpactPolicy& policy = rig.runtime.config().impacts;
+    const ImpactPolicy policy = rig.runtime.config().impacts;
     for (const BodyId id : {movingBody, restingBody}) {
         const BodyMotion m = rig.runtime.motion(id);
         const Vec3 dv = m.linearVelocity - (id == movingBody ? before : Vec3{});
@@ -525,12 +521,31 @@ TEST(DestructionRuntime, BlastThrowsSmallMovingBodiesAndCutsTheRest) {
         EXPECT_NEAR(length(dv), std::min(impulse * share / mass, policy.blastThrowSpeed * share), 1e-9);
         EXPECT_GT(dot(dv, away), 0.999 * length(dv) * dist) << "away from the centre";
     }
+    // With blastMaxCuts 1 it cuts the nearest moving body and throws the others.
+    ImpactPolicy oneCut = policy;
+    oneCut.blastMaxCuts = 1;
+    oneCut.blastCutVolume = 0;
+    rig.runtime.setImpactPolicy(oneCut);
+    hits.clear();
+    const BlastOutcome capped = rig.runtime.blast(center, 8, impulse);
+    EXPECT_EQ(capped.thrown, 2) << "the farther moving boxes";
+    ASSERT_EQ(hits.size(), 2u) << "the nearest moving box and the static one";
+    const double toMoving = length(rig.runtime.motion(movingBody).transform.translation - center);
+    const double toLarge =
+        length(rig.runtime.motion(rig.runtime.bodyOf(large)->id).transform.translation - center);
+    const double toResting = length(rig.runtime.motion(restingBody).transform.translation - center);
+    const ObjectId nearest = toMoving < std::min(toLarge, toResting) ? moving
+                             : toLarge < toResting                   ? large
+                                                                     : resting;
+    EXPECT_TRUE(hits[0].object == nearest || hits[1].object == nearest);
+    EXPECT_TRUE(hits[0].object == fixed || hits[1].object == fixed);
     // With blastCutVolume 0 the same blast cuts every destructible body in range.
     ImpactPolicy cutAll = policy;
     cutAll.blastCutVolume = 0;
     rig.runtime.setImpactPolicy(cutAll);
+    hits.clear();
     EXPECT_EQ(rig.runtime.blast(center, 8, impulse).thrown, 0);
-    EXPECT_EQ(hits.size(), 6u);
+    EXPECT_EQ(hits.size(), 4u);
 }
 
 TEST(DestructionRuntime, PhysicsTimeBudgetShrinksTheAwakeBudgetOutsideDeterministicMode) {

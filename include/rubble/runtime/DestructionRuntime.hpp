@@ -71,11 +71,11 @@ struct RUBBLE_API ImpactPolicy {
     double collisionImpulseThreshold = 2500; ///< non-projectile contacts fracture above this (N·s a step)
     double collisionFracturesPerSecond = 0;  ///< they start at most this many fractures a second (0: no cap)
     double minApproachSpeed = 2.0;           ///< non-projectile contacts also need this approach speed (m/s)
-    int graceFrames = 30;             ///< new pieces ignore non-projectile contacts for this many frames
-    double minFractureVolume = 0;     ///< impacts on bodies below this volume (m³) are ignored
-    double blastCutVolume = 0.25;     ///< a blast throws, not cuts, moving bodies below this volume (m³)
-    double blastThrowSpeed = 8;       ///< most speed (m/s) a blast gives a body it throws, at its centre
-    int blastMaxCuts = 0;             ///< a blast cuts at most this many bodies, nearest first (0: any)
+    int graceFrames = 30;         ///< new pieces ignore non-projectile contacts for this many frames
+    double minFractureVolume = 0; ///< impacts on bodies below this volume (m³) are ignored
+    double blastCutVolume = 0.25; ///< a blast throws, not cuts, moving bodies below this volume (m³)
+    double blastThrowSpeed = 8;   ///< most speed (m/s) a blast gives a body it throws, at its centre
+    int blastMaxCuts = 0;         ///< a blast cuts at most this many moving bodies, nearest first (0: any)
     double maxContactDistance = 0.05; ///< contacts farther apart than this (m) are not hits
     int maxImpactMarks = 64;          ///< recent impacts kept for debug drawing
 };
