@@ -54,7 +54,7 @@ TowerRun runTower(double impulse, const ImpactPolicy& afterCharge, int frames, b
     out.broke.assign(kStoreys, -1);
     out.fell.assign(kStoreys, -1);
     if (impulse > 0) {
-        out.accepted = runtime->blast({0, -12, 0}, 4, impulse);
+        out.accepted = runtime->blast({0, -12, 0}, 4, impulse).impacts;
         out.chargeMarks.assign(runtime->recentImpacts().begin(), runtime->recentImpacts().end());
     }
     runtime->setImpactPolicy(afterCharge);
