@@ -902,36 +902,35 @@ void Game::notePlacedDynamic() {
     }
 }
 
-std::vector<V3> Game::targets() const {
+std::vector<V3>
+Game::centresWhere(const std::function<bool(BodyId, const BodyRecord&, const rubble::Vec3&)>& keep) const {
     std::vector<V3> out;
     if (!runtime_)
         return out;
     for (BodyId id : runtime_->bodies()) {
-        const BodyRecord* b = runtime_->body(id);
         const rubble::Vec3 c = runtime_->motion(id).transform.translation;
-        const auto placed = placedDynamic_.find(id);
-        const bool standingDynamic =
-            placed != placedDynamic_.end() && rubble::length(c - placed->second) < 1.0;
-        if (standingDynamic || (b->motion == rubble::BodyMotionState::Static &&
-                                (b->role == BodyRole::Object ||
-                                 (b->role == BodyRole::Piece && b->volume > 150 && c.y > groundTop_ + 15))))
+        if (keep(id, *runtime_->body(id), c))
             out.push_back(toV3(c));
     }
     return out;
 }
 
+std::vector<V3> Game::targets() const {
+    return centresWhere([this](BodyId id, const BodyRecord& b, const rubble::Vec3& c) {
+        const auto placed = placedDynamic_.find(id);
+        const bool standingDynamic =
+            placed != placedDynamic_.end() && rubble::length(c - placed->second) < 1.0;
+        return standingDynamic || (b.motion == rubble::BodyMotionState::Static &&
+                                   (b.role == BodyRole::Object ||
+                                    (b.role == BodyRole::Piece && b.volume > 150 && c.y > groundTop_ + 15)));
+    });
+}
+
 std::vector<V3> Game::shellTargets() const {
-    std::vector<V3> out;
-    if (!runtime_)
-        return out;
-    for (BodyId id : runtime_->bodies()) {
-        const BodyRecord* b = runtime_->body(id);
-        const rubble::Vec3 c = runtime_->motion(id).transform.translation;
-        if (b->role == BodyRole::Object ||
-            (b->role == BodyRole::Piece && b->volume >= 1.0 && c.y > groundTop_))
-            out.push_back(toV3(c));
-    }
-    return out;
+    return centresWhere([this](BodyId, const BodyRecord& b, const rubble::Vec3& c) {
+        return b.role == BodyRole::Object ||
+               (b.role == BodyRole::Piece && b.volume >= 1.0 && c.y > groundTop_);
+    });
 }
 
 void Game::writeTimings(const std::string& path) const {

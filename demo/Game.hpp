@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -214,6 +215,9 @@ public:
     bool saveSnapshot(const std::string& path, std::string& message) const;
 
 private:
+    /// Centres of the bodies `keep` accepts (body id, record, centre).
+    std::vector<V3> centresWhere(const std::function<bool(rubble::BodyId, const rubble::BodyRecord&,
+                                                          const rubble::Vec3&)>& keep) const;
     /// How a body with a render mesh looks.
     struct Visual {
         int mesh = -1;    ///< renderer mesh (object coordinates)
