@@ -804,6 +804,7 @@ void Renderer::compact(Batch& b, int batchIndex) {
     b.dead = 0;
     b.dirty = true;
     b.gpuCapacity = 0;
+    b.uploaded = 0;
 }
 
 void Renderer::uploadBatch(Batch& b) {
@@ -812,8 +813,12 @@ void Renderer::uploadBatch(Batch& b) {
     if (bytes > b.gpuCapacity) {
         b.gpuCapacity = std::max(bytes * 3 / 2, static_cast<size_t>(1 << 16));
         glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(b.gpuCapacity), nullptr, GL_DYNAMIC_DRAW);
+        b.uploaded = 0;
     }
-    glBufferSubData(GL_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(bytes), b.cpu.data());
+    const size_t from = std::min(b.uploaded, b.cpu.size()) * sizeof(float);
+    glBufferSubData(GL_ARRAY_BUFFER, static_cast<GLintptr>(from), static_cast<GLsizeiptr>(bytes - from),
+                    b.cpu.data() + from / sizeof(float));
+    b.uploaded = b.cpu.size();
     b.dirty = false;
 }
 

@@ -122,6 +122,7 @@ private:
         bool interior = false; ///< cut faces: drawn with the interior texture
         std::vector<float> cpu;
         size_t gpuCapacity = 0;
+        size_t uploaded = 0; ///< floats of cpu already in the GPU buffer (appends upload only the rest)
         bool dirty = false;
         int dead = 0;
         std::vector<GLint> firsts;         ///< ranges drawn this frame (inside the view frustum)
