@@ -63,7 +63,7 @@ struct RUBBLE_API BodyRecord {
 /// What a blast did (DestructionRuntime::blast).
 struct RUBBLE_API BlastOutcome {
     int impacts = 0; ///< impacts accepted: the bodies it cuts
-    int thrown = 0;  ///< moving bodies below ImpactPolicy::blastCutVolume it threw instead
+    int thrown = 0;  ///< moving bodies it threw instead (below blastCutVolume, or past blastMaxCuts)
 };
 
 /// When contacts become impacts (ImpactCollector).
