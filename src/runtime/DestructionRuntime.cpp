@@ -17,6 +17,7 @@
 #include "runtime/DebrisGovernor.hpp"
 #include "runtime/DebrisPool.hpp"
 #include "runtime/ImpactCollector.hpp"
+#include "runtime/MaterialByName.hpp"
 #include "runtime/PieceAdopter.hpp"
 #include "runtime/StateAccess.hpp"
 #include "runtime/StructureMonitor.hpp"
@@ -618,10 +619,10 @@ Result<ObjectId> DestructionRuntime::addObject(ObjectDesc desc, const Frame& pla
                      "addObject: the placement is not a rigid motion (its rotation must "
                      "be orthonormal with determinant 1: Mat3{} is zero, "
                      "Mat3::identity() is no rotation)"};
-    const Material* material = desc.material.empty() ? &defaultMaterial() : findMaterial(desc.material);
-    if (!material)
-        return Error{ErrorCode::InvalidInput,
-                     "unknown material '" + desc.material + "'; expected one of " + materialNames()};
+    const Result<const Material*> named = detail::materialByName(desc.material);
+    if (!named)
+        return named.error();
+    const Material* material = named.value();
     Result<ObjectId> id = im.world.addObject(std::move(desc));
     if (!id)
         return id;

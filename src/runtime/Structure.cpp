@@ -6,6 +6,7 @@
 
 #include "core/Rotation.hpp"
 #include "rubble/collision/ConvexDecomposition.hpp"
+#include "runtime/MaterialByName.hpp"
 #include "runtime/StructureMonitor.hpp"
 
 namespace rubble {
@@ -32,10 +33,10 @@ Status Structure::add(BodyId id, const std::vector<ConvexPolytope>& worldParts, 
                       bool root) {
     if (id == 0)
         return Error{ErrorCode::InvalidInput, "Structure::add: body id 0 is reserved"};
-    const Material* m = material.empty() ? &defaultMaterial() : findMaterial(material);
-    if (!m)
-        return Error{ErrorCode::InvalidInput, "Structure::add: unknown material '" + std::string(material) +
-                                                  "'; expected one of " + materialNames()};
+    const Result<const Material*> named = detail::materialByName(material);
+    if (!named)
+        return Error{ErrorCode::InvalidInput, "Structure::add: " + named.error().message};
+    const Material* m = named.value();
     if (worldParts.empty())
         return Error{ErrorCode::InvalidInput, "Structure::add: body " + std::to_string(id) + " has no parts"};
     Impl::Body body{m, 0, {}};
