@@ -586,9 +586,7 @@ rubble_status rubble_world_get_outcome(const rubble_world* world, size_t index, 
         out->parent = o.parent;
         out->piece_count = o.pieces.size();
         out->dropped_volume = o.droppedVolume + o.dustVolume();
-        out->impulse = 0;
-        for (const rubble::Impact& i : o.impacts)
-            out->impulse += i.impulse;
+        out->impulse = o.impulse();
         return ok();
     });
 }

@@ -324,9 +324,7 @@ struct DestructionRuntime::Impl {
         dropBody(parent.id);
         ++stats.fractures;
         ++counters.fractures;
-        double impulse = 0;
-        for (const Impact& i : outcome.impacts)
-            impulse += i.impulse;
+        const double impulse = outcome.impulse();
         for (std::size_t i = 0; i < plan.spawns.size(); ++i) {
             const detail::PieceSpawn& s = plan.spawns[i];
             const ObjectState& st = *outcome.pieces[i].state;
@@ -753,18 +751,26 @@ BlastOutcome DestructionRuntime::blast(const Vec3& center, double radius, double
     if (!(radius > 0) || !(impulse > 0))
         return out;
     const ImpactPolicy& policy = impl_->config.impacts;
-    // The bodies in range, nearest first, so that the nearest cuts are queued first.
-    std::vector<std::pair<double, BodyId>> inRange;
+    struct InRange { // a body the blast reaches, its distance from the centre and its own centre
+        double dist;
+        BodyId id;
+        Vec3 c;
+    };
+    std::vector<InRange> inRange;
     for (const auto& [id, b] : impl_->bodies.all()) {
-        const double dist = length(center - motion(id).transform.translation);
-        if (b.hasObject && dist <= radius + b.radius)
-            inRange.emplace_back(dist, id);
-    }
-    std::sort(inRange.begin(), inRange.end());
-    int movingCuts = 0;
-    for (const auto& [dist, id] : inRange) {
-        const BodyRecord& b = *body(id);
+        if (!b.hasObject)
+            continue;
         const Vec3 c = motion(id).transform.translation;
+        if (const double dist = length(center - c); dist <= radius + b.radius)
+            inRange.push_back({dist, id, c});
+    }
+    // nearest first, so that the nearest cuts are queued first
+    std::sort(inRange.begin(), inRange.end(), [](const InRange& x, const InRange& y) {
+        return std::tie(x.dist, x.id) < std::tie(y.dist, y.id);
+    });
+    int movingCuts = 0;
+    for (const auto& [dist, id, c] : inRange) {
+        const BodyRecord& b = *body(id);
         const Vec3 n = dist > 1e-9 ? (center - c) * (1.0 / dist) : Vec3{0, 1, 0};
         const double share = 1.0 - (1.0 - edgeShare) * std::clamp((dist - b.radius) / radius, 0.0, 1.0);
         const bool moving = b.motion != BodyMotionState::Static;

@@ -299,6 +299,13 @@ double FractureOutcome::dustVolume() const {
     return v;
 }
 
+double FractureOutcome::impulse() const {
+    double sum = 0;
+    for (const Impact& i : impacts)
+        sum += i.impulse;
+    return sum;
+}
+
 struct DestructionWorld::Impl {
     Config config;
     Status configStatus; // checkConfig(config), decided once at construction

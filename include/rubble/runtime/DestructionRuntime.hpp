@@ -352,9 +352,8 @@ public:
     /// Called with every journal event of the world (DestructionWorld::setJournalSink).
     void setJournalSink(std::function<void(const JournalEvent&)> sink);
     /// A blast on the destructible objects whose bounding spheres meet `radius` around `center`, nearest
-    /// first, its impulse falling off linearly to `edgeShare` at the edge: moving bodies below blastCutVolume
-    /// or past blastMaxCuts (ImpactPolicy) are thrown, at most at blastThrowSpeed; others are hit on their
-    /// bounding sphere nearest the centre, normal toward it (unless below minFractureVolume).
+    /// first, impulse falling to `edgeShare` at the edge: moving bodies below blastCutVolume or past
+    /// blastMaxCuts are thrown (≤ blastThrowSpeed); others are hit at that sphere's point nearest the centre.
     BlastOutcome blast(const Vec3& center, double radius, double impulse, double edgeShare = 0.4);
 
     /// One frame, a list of stages: physics step, contacts → impacts, anchors classified, splits adopted

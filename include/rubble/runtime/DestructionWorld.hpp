@@ -122,6 +122,8 @@ struct RUBBLE_API FractureOutcome {
 
     /// Σ volume of dust.
     double dustVolume() const;
+    /// Σ impulse of the impacts (N·s).
+    double impulse() const;
 };
 
 /// The runtime. All member functions are called from one (main) thread; work runs on the JobSystem.
@@ -133,8 +135,7 @@ public:
         int workers = -1;           ///< worker count of the owned pool (-1 = automatic)
         bool deterministic = false; ///< adopt each result exactly delayFrames after its impact
         int delayFrames = 2;        ///< frame delay in deterministic mode
-        double adoptionBudgetMs =
-            1.0;                ///< main-thread time per frame for adoption (at least one result adopts)
+        double adoptionBudgetMs = 1.0; ///< main-thread ms a frame for adoption (at least one result adopts)
         std::uint64_t seed = 1; ///< world seed; each job's seed derives from it, the object and version
         DecompositionParams decomposition; ///< convex parts of pieces
         /// Every crater adds faces, so an object hit again and again would grow without bound. Once an
