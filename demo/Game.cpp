@@ -82,6 +82,14 @@ rubble::Mesh standInJet() {
     return jet;
 }
 
+/// The game's impact settings in the runtime's policy.
+void applyImpactSettings(rubble::ImpactPolicy& impacts, const GameSettings& settings) {
+    impacts.collisionImpulseThreshold = settings.collisionImpulse;
+    impacts.blastCutVolume = settings.blastCutVolume;
+    impacts.collisionFracturesPerSecond = settings.collisionFractureRate;
+    impacts.blastMaxCuts = settings.blastMaxCuts;
+}
+
 } // namespace
 
 Game::Game() = default;
@@ -150,10 +158,7 @@ bool Game::load(const rubble::SceneConfig& scene, Renderer& renderer, const Game
     rc.world.deterministic = settings.deterministic;
     rc.world.seed = 20260522;
     rc.world.minPieceVolume = settings.minPieceVolume;
-    rc.impacts.collisionImpulseThreshold = settings.collisionImpulse;
-    rc.impacts.blastCutVolume = settings.blastCutVolume;
-    rc.impacts.collisionFracturesPerSecond = settings.collisionFractureRate;
-    rc.impacts.blastMaxCuts = settings.blastMaxCuts;
+    applyImpactSettings(rc.impacts, settings);
     rc.debris.maxAwakeBodies = settings.maxAwake;
     rc.debris.lightPerAwake = settings.lightPerAwake;
     rc.support.collapseUnsupported = settings.collapseUnsupported;
@@ -722,10 +727,7 @@ void Game::step(const ControlInput& input, float dt, Renderer& renderer) {
     debris.maxAwakeBodies = settings_.maxAwake;
     runtime_->setDebrisBudget(debris);
     rubble::ImpactPolicy impacts = rc.impacts;
-    impacts.collisionImpulseThreshold = settings_.collisionImpulse;
-    impacts.blastCutVolume = settings_.blastCutVolume;
-    impacts.collisionFracturesPerSecond = settings_.collisionFractureRate;
-    impacts.blastMaxCuts = settings_.blastMaxCuts;
+    applyImpactSettings(impacts, settings_);
     runtime_->setImpactPolicy(impacts);
     rubble::SupportPolicy support = rc.support;
     support.collapseUnsupported = settings_.collapseUnsupported;

@@ -737,7 +737,6 @@ int Renderer::addMesh(const rubble::Mesh& mesh, int texture, float r, float g, f
             }
         }
         rec.count[range] = static_cast<int>(batch.cpu.size() / kFloatsPerVertex) - rec.first[range];
-        batch.dirty = batch.dirty || rec.count[range] > 0;
     }
     {
         const rubble::Aabb box = mesh.bounds();
@@ -802,7 +801,6 @@ void Renderer::compact(Batch& b, int batchIndex) {
         }
     b.cpu.swap(fresh);
     b.dead = 0;
-    b.dirty = true;
     b.gpuCapacity = 0;
     b.uploaded = 0;
 }
@@ -815,11 +813,10 @@ void Renderer::uploadBatch(Batch& b) {
         glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(b.gpuCapacity), nullptr, GL_DYNAMIC_DRAW);
         b.uploaded = 0;
     }
-    const size_t from = std::min(b.uploaded, b.cpu.size()) * sizeof(float);
+    const size_t from = b.uploaded * sizeof(float);
     glBufferSubData(GL_ARRAY_BUFFER, static_cast<GLintptr>(from), static_cast<GLsizeiptr>(bytes - from),
                     b.cpu.data() + from / sizeof(float));
     b.uploaded = b.cpu.size();
-    b.dirty = false;
 }
 
 void Renderer::beginFrame() {
@@ -1002,7 +999,7 @@ void Renderer::render(const FrameView& fv) {
     drawCalls_ = 0;
     triangles_ = 0;
     for (auto& b : batches_)
-        if (b.dirty)
+        if (b.uploaded < b.cpu.size())
             uploadBatch(b);
     cullAndBatch(fv.proj * fv.view, fv.proj.m[5] * 0.5f * static_cast<float>(fv.height),
                  skip.find("lod") == std::string::npos);

@@ -123,7 +123,6 @@ private:
         std::vector<float> cpu;
         size_t gpuCapacity = 0;
         size_t uploaded = 0; ///< floats of cpu already in the GPU buffer (appends upload only the rest)
-        bool dirty = false;
         int dead = 0;
         std::vector<GLint> firsts;         ///< ranges drawn this frame (inside the view frustum)
         std::vector<GLsizei> counts;       ///< their vertex counts

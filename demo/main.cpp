@@ -67,9 +67,9 @@ struct Options {
     bool headless = false;
     bool window = false;
     int workers = -1;
-    double blastCutVolume = rubble::ImpactPolicy{}.blastCutVolume; // blasts throw moving bodies below this
-    double collisionFractureRate = 0; // fractures non-projectile contacts may start a second (0: any)
-    int blastMaxCuts = 4;             // moving bodies a blast may cut, nearest first (0: any)
+    double blastCutVolume = demo::GameSettings{}.blastCutVolume;               // --blast-cut-volume
+    double collisionFractureRate = demo::GameSettings{}.collisionFractureRate; // --collision-fracture-rate
+    int blastMaxCuts = demo::GameSettings{}.blastMaxCuts;                      // --blast-max-cuts
     std::string pattern = "adaptive";
     int cells = 6;
     bool noPanel = false;
@@ -305,8 +305,9 @@ int parseOptions(int argc, char** argv, Options& o) {
                    "blasts throw moving pieces below this volume (m^3) instead of cutting them (0: cut all)")
         ->check(CLI::NonNegativeNumber);
     cli.add_option("--blast-max-cuts", o.blastMaxCuts,
-                   "moving bodies a blast may cut, nearest first; the rest are thrown (0: any; default 4)")
-        ->check(CLI::NonNegativeNumber);
+                   "moving bodies a blast may cut, nearest first; the rest are thrown (0: any)")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
     cli.add_option("--collision-fracture-rate", o.collisionFractureRate,
                    "fractures a second that collisions (not shots) may start, the strongest first (0: any)")
         ->check(CLI::NonNegativeNumber);
@@ -423,8 +424,7 @@ int parseOptions(int argc, char** argv, Options& o) {
         ->check(CLI::Range(-20, 19));
     cli.add_option("--fire-rate", o.fireRate,
                    "cannon shots per game second at the objects and pieces of 1 m^3 or more, round robin, "
-                   "from 40 m on the "
-                   "camera's side (a latency run's steady fractures; also with --hold-fire)")
+                   "from 40 m on the camera's side (a latency run's steady fractures; also with --hold-fire)")
         ->check(CLI::Range(0.0, 60.0));
     cli.add_option(
            "--adopt-wait", o.adoptWaitMs,
