@@ -3,6 +3,7 @@
 #include "geometry/ClosestPoint.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -129,53 +130,117 @@ void Mesh::removeUnreferencedVertices() {
 }
 
 namespace {
-// FNV-1a over raw bytes; doubles are hashed by their bit pattern with -0.0 folded into 0.0.
-struct Hasher {
-    std::uint64_t h = 1469598103934665603ull;
-    void bytes(const void* p, std::size_t n) {
-        const auto* c = static_cast<const unsigned char*>(p);
-        for (std::size_t i = 0; i < n; ++i) {
-            h ^= c[i];
-            h *= 1099511628211ull;
+/// A 64-bit hash of a stream of 64-bit words in four interleaved lanes (xxHash64's round, merge and
+/// avalanche).
+class WordHasher {
+public:
+    void word(std::uint64_t w) {
+        buffer_[held_++] = w;
+        if (held_ == kBuffer)
+            flush();
+    }
+    /// A double by its bits, with -0.0 folded into 0.0.
+    void real(double d) { word(std::bit_cast<std::uint64_t>(d + 0.0)); }
+    /// A 32-bit value: two make a word.
+    void half(std::uint32_t v) {
+        if (halfHeld_) {
+            word(low_ | std::uint64_t{v} << 32);
+            halfHeld_ = false;
+        } else {
+            low_ = v;
+            halfHeld_ = true;
         }
     }
-    void real(double d) {
-        if (d == 0)
-            d = 0;
-        std::uint64_t bits;
-        std::memcpy(&bits, &d, sizeof bits);
-        bytes(&bits, sizeof bits);
+    /// A float by its bits, with -0.0 folded into 0.0.
+    void real(float f) { half(std::bit_cast<std::uint32_t>(f + 0.0f)); }
+    /// Ends a run of halves (an odd one out becomes a word).
+    void endHalves() {
+        if (halfHeld_)
+            word(low_);
+        halfHeld_ = false;
     }
-    void u64(std::uint64_t v) { bytes(&v, sizeof v); }
+    std::uint64_t finish() {
+        const std::size_t whole = held_ & ~std::size_t{3};
+        const std::size_t tail = held_ - whole;
+        held_ = whole;
+        flush();
+        std::uint64_t h = rotl(lanes_[0], 1) + rotl(lanes_[1], 7) + rotl(lanes_[2], 12) + rotl(lanes_[3], 18);
+        for (std::uint64_t lane : lanes_)
+            h = (h ^ round(0, lane)) * kPrime1 + kPrime4;
+        for (std::size_t i = 0; i < tail; ++i)
+            h = rotl(h ^ round(0, buffer_[whole + i]), 27) * kPrime1 + kPrime4;
+        h += words_ + tail;
+        h ^= h >> 33;
+        h *= kPrime2;
+        h ^= h >> 29;
+        h *= kPrime3;
+        h ^= h >> 32;
+        return h;
+    }
+
+private:
+    static constexpr std::uint64_t kPrime1 = 0x9E3779B185EBCA87ull, kPrime2 = 0xC2B2AE3D27D4EB4Full,
+                                   kPrime3 = 0x165667B19E3779F9ull, kPrime4 = 0x85EBCA77C2B2AE63ull;
+    static constexpr std::size_t kBuffer = 64;
+    static std::uint64_t rotl(std::uint64_t x, int r) { return (x << r) | (x >> (64 - r)); }
+    static std::uint64_t round(std::uint64_t acc, std::uint64_t w) {
+        return rotl(acc + w * kPrime2, 31) * kPrime1;
+    }
+    void flush() {
+        std::uint64_t a = lanes_[0], b = lanes_[1], c = lanes_[2], d = lanes_[3];
+        for (std::size_t i = 0; i < held_; i += 4) {
+            a = round(a, buffer_[i]);
+            b = round(b, buffer_[i + 1]);
+            c = round(c, buffer_[i + 2]);
+            d = round(d, buffer_[i + 3]);
+        }
+        lanes_[0] = a;
+        lanes_[1] = b;
+        lanes_[2] = c;
+        lanes_[3] = d;
+        words_ += held_;
+        held_ = 0;
+    }
+    std::uint64_t lanes_[4] = {kPrime1 + kPrime2, kPrime2, 0, 0 - kPrime1};
+    std::uint64_t buffer_[kBuffer] = {};
+    std::size_t held_ = 0;
+    std::uint64_t words_ = 0;
+    std::uint64_t low_ = 0;
+    bool halfHeld_ = false;
 };
 } // namespace
 
 std::uint64_t Mesh::hash() const {
-    Hasher h;
-    h.u64(positions.size());
+    WordHasher h;
+    h.word(positions.size());
     for (const Vec3& p : positions) {
         h.real(p.x);
         h.real(p.y);
         h.real(p.z);
     }
-    h.u64(triangles.size());
+    h.word(triangles.size());
     for (const Triangle& t : triangles)
-        h.bytes(t.data(), sizeof(t));
-    h.u64(normals.size());
-    for (const Vec3f& n : normals) { // hashed widened to double
+        for (std::uint32_t v : t)
+            h.half(v);
+    h.endHalves();
+    h.word(normals.size());
+    for (const Vec3f& n : normals) {
         h.real(n.x);
         h.real(n.y);
         h.real(n.z);
     }
-    h.u64(uvs.size());
+    h.endHalves();
+    h.word(uvs.size());
     for (const Vec2f& u : uvs) {
         h.real(u.x);
         h.real(u.y);
     }
-    h.u64(materials.size());
-    if (!materials.empty())
-        h.bytes(materials.data(), materials.size() * sizeof(materials[0]));
-    return h.h;
+    h.endHalves();
+    h.word(materials.size());
+    for (std::uint32_t m : materials)
+        h.half(m);
+    h.endHalves();
+    return h.finish();
 }
 
 double windingNumber(const Mesh& mesh, const Vec3& p) {

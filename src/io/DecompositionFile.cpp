@@ -70,7 +70,7 @@ std::filesystem::path decompositionPathFor(const std::filesystem::path& meshPath
 Status writeDecompositionFile(const std::filesystem::path& path, const DecompositionFile& file) {
     json j;
     j["format"] = "rubble-decomposition";
-    j["version"] = 1;
+    j["version"] = 2;
     j["mesh_hash"] = hex(file.meshHash);
     j["mesh_volume"] = file.meshVolume;
     json parts = json::array();
@@ -106,8 +106,8 @@ Result<DecompositionFile> readDecompositionFile(const std::filesystem::path& pat
         return r.fail("(top level)", "expected an object");
     if (!j.contains("format") || j["format"] != "rubble-decomposition")
         return r.fail("format", "expected \"rubble-decomposition\"");
-    if (!j.contains("version") || j["version"] != 1)
-        return r.fail("version", "expected 1");
+    if (!j.contains("version") || !(j["version"] == 1 || j["version"] == 2))
+        return r.fail("version", "expected 1 or 2");
     DecompositionFile out;
     Error err;
     if (!j.contains("mesh_hash") || !j["mesh_hash"].is_string())

@@ -91,8 +91,9 @@ void checkFinite(ByteReader& r, const std::vector<T>& v, std::size_t start, cons
 }
 
 // 2: decomposition settings, each object's mesh hash, the volume ledger. 3: the structure. 4: roughness.
-// 5: normals and texture coordinates in float. 6: mesh corners and part corners each once (read: 2 to 6).
-constexpr std::uint16_t kVersion = 6;
+// 5: normals and texture coordinates in float. 6: mesh corners and part corners each once. 7: Mesh::hash in
+// 64-bit words (read: 2 to 7; older files' mesh hashes are computed again).
+constexpr std::uint16_t kVersion = 7;
 constexpr std::uint16_t kOldestVersion = 2;
 
 void vec(ByteWriter& w, const Vec3& v) {
@@ -542,8 +543,6 @@ void readMeshBefore6(ByteReader& r, const std::uint8_t* data, std::uint16_t vers
         narrow(r, wide, m.uvs, start, "mesh.uvs");
     }
     readMaterials(r, data, m);
-    if (!floats && r.ok() && (m.hasNormals() || m.hasUvs()))
-        o.meshHash = m.hash(); // the saved hash was of the attributes in double
 }
 
 ObjectState readObject(ByteReader& r, const std::uint8_t* data, std::uint16_t version) {
@@ -604,6 +603,8 @@ ObjectState readObject(ByteReader& r, const std::uint8_t* data, std::uint16_t ve
         readMesh(r, data, o.mesh);
     else
         readMeshBefore6(r, data, version, o);
+    if (version < 7 && r.ok())
+        o.meshHash = o.mesh.hash(); // the saved hash is Mesh::hash's former one
     o.convexParts = readParts(r, version);
     o.warning = text(r, data, "warning.length", "warning");
     return o;

@@ -9,6 +9,8 @@
 #include "rubble/io/MeshIO.hpp"
 #include "rubble/structure/Material.hpp"
 
+#include "geometry/FormerMeshHash.hpp"
+
 namespace rubble {
 namespace {
 
@@ -50,7 +52,7 @@ Model modelOrStandIn(const SceneConfig& scene, const SceneObject& o, std::vector
                 if (!file)
                     warnings.push_back(where(scene, o) + ": " + file.error().message +
                                        "; decomposing at load");
-                else if (file->meshHash != mesh->hash())
+                else if (file->meshHash != mesh->hash() && file->meshHash != detail::formerMeshHash(*mesh))
                     warnings.push_back(where(scene, o) + ": " + cached.string() +
                                        " was made for another mesh; decomposing at load");
                 else

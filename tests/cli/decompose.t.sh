@@ -68,7 +68,7 @@ python3 -c "import json,sys; d=json.load(open(sys.argv[1])); assert d['parts']>=
 python3 - "$tmp/l.parts.json" <<'PY' || fail "parts file: $(head -c 300 "$tmp/l.parts.json")"
 import json, sys
 d = json.load(open(sys.argv[1]))
-assert d["format"] == "rubble-decomposition" and d["version"] == 1 and len(d["mesh_hash"]) == 16, d.keys()
+assert d["format"] == "rubble-decomposition" and d["version"] == 2 and len(d["mesh_hash"]) == 16, d.keys()
 assert len(d["parts"]) >= 2 and all(len(p["faces"]) >= 4 for p in d["parts"]), d["parts"]
 PY
 set +e

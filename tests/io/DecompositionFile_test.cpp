@@ -49,7 +49,7 @@ TEST(DecompositionFile, ErrorsNameTheFileAndTheField) {
     const std::vector<Case> cases = {
         {"{\"format\":", "byte"},
         {R"({"format":"other","version":1})", "format"},
-        {R"({"format":"rubble-decomposition","version":2})", "version"},
+        {R"({"format":"rubble-decomposition","version":3})", "version"},
         {R"({"format":"rubble-decomposition","version":1,"mesh_hash":"xyz"})", "mesh_hash"},
         {head + R"("mesh_volume":"big","parts":[]})", "mesh_volume"},
         {head + R"("mesh_volume":1,"parts":[{"faces":[{"normal":[1,0],"offset":0,"corners":[]}]}]})",

@@ -5,17 +5,21 @@
 
 #include "JournalScene.hpp"
 #include "WorldSteps.hpp"
+#include "geometry/FormerMeshHash.hpp"
 #include "persist/Bytes.hpp"
+#include "rubble/core/Random.hpp"
 #include "rubble/persist/JournalFile.hpp"
 #include "rubble/runtime/JournalPlayer.hpp"
 
 namespace rubble {
 namespace {
 
-constexpr std::uint64_t kExpectedGeometryHash = 0x8EA90FB6A15C2F45ull;
+constexpr std::uint64_t kExpectedGeometryHash = 0x929A860E7BF0E5A2ull;
+/// The same geometry hashed by Mesh::hash's former FNV-1a: pinned before Mesh::hash changed, unchanged since.
+constexpr std::uint64_t kExpectedFormerGeometryHash = 0x8EA90FB6A15C2F45ull;
 constexpr std::uint32_t kExpectedJournalCrc = 0x2144DF1Cu;
 /// The same scene and journal with rough cut faces (the concrete preset; docs/roughness.md).
-constexpr std::uint64_t kExpectedRoughGeometryHash = 0x5DC9A636AC38BF00ull;
+constexpr std::uint64_t kExpectedRoughGeometryHash = 0xCEDCE36FA2F7967Eull;
 
 DestructionWorld::Config goldenConfig(int workers) {
     DestructionWorld::Config c;
@@ -73,7 +77,18 @@ std::vector<JournalEvent> recordGoldenJournal(const Roughness& roughness = {}) {
     return events;
 }
 
-std::uint64_t replay(const JournalFile& journal, int workers, const Roughness& roughness = {}) {
+/// DestructionWorld::geometryHash with each mesh hashed by the former Mesh::hash.
+std::uint64_t formerGeometryHash(const DestructionWorld& world) {
+    std::uint64_t sum = 0;
+    for (ObjectId id : world.objects()) {
+        const ObjectState& o = *world.object(id);
+        sum += mixSeed(mixSeed(o.id, o.version), detail::formerMeshHash(o.mesh));
+    }
+    return mixSeed(sum, world.objects().size());
+}
+
+std::uint64_t replay(const JournalFile& journal, int workers, const Roughness& roughness = {},
+                     std::uint64_t* former = nullptr) {
     DestructionWorld world(goldenConfig(workers));
     EXPECT_TRUE(checkJournalHeader(journal.header, goldenConfig(workers)));
     addScene(world, roughness);
@@ -81,6 +96,8 @@ std::uint64_t replay(const JournalFile& journal, int workers, const Roughness& r
     for (const JournalEvent& e : journal.events)
         EXPECT_TRUE(player.receive(e));
     EXPECT_TRUE(player.drain());
+    if (former)
+        *former = formerGeometryHash(world);
     return world.geometryHash();
 }
 
@@ -91,13 +108,15 @@ TEST(GoldenHash, FixedJournalOnFixedSceneGivesThePinnedGeometry) {
     const std::uint32_t crc = persist::crc32(bytes.data(), bytes.size());
     Result<JournalFile> decoded = decodeJournal(bytes.data(), bytes.size(), "golden");
     ASSERT_TRUE(decoded) << decoded.error().message;
-    const std::uint64_t one = replay(*decoded, 1);
+    std::uint64_t former = 0;
+    const std::uint64_t one = replay(*decoded, 1, {}, &former);
     const std::uint64_t two = replay(*decoded, 2);
     EXPECT_EQ(one, two);
     std::printf("golden: journal crc 0x%08X, geometry hash 0x%016llX\n", crc,
                 static_cast<unsigned long long>(one));
     EXPECT_EQ(crc, kExpectedJournalCrc) << "the journal's encoding or its recorded values changed";
     EXPECT_EQ(one, kExpectedGeometryHash) << "the geometry differs from the pinned one";
+    EXPECT_EQ(former, kExpectedFormerGeometryHash) << "the geometry or the former mesh hash changed";
 }
 
 // Rough scenes have a pinned geometry of their own, the same on 1 and 2 workers; the flat one above is not

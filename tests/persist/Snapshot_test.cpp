@@ -114,7 +114,7 @@ TEST(Snapshot, KeepsNormalsAndTextureCoordinatesExactly) {
 }
 
 // A version-4 file (attributes in double, saved by the build before float attributes) still loads: its
-// attributes rounded to float, its mesh hash that of the rounded mesh; saving it again writes version 6.
+// attributes rounded to float, its mesh hash that of the rounded mesh; saving it again writes version 7.
 TEST(Snapshot, AVersion4FileLoadsWithItsAttributesRoundedToFloat) {
     const std::filesystem::path v4 = test::sourceDir() / "tests/data/snapshot/v4-box-attributes.rsnap";
     Result<Snapshot> r = loadSnapshot(v4);
@@ -128,7 +128,7 @@ TEST(Snapshot, AVersion4FileLoadsWithItsAttributesRoundedToFloat) {
     EXPECT_EQ(o.mesh.materials, want.materials);
     EXPECT_EQ(o.meshHash, want.hash());
     const std::vector<std::uint8_t> again = encodeSnapshot(*r);
-    EXPECT_EQ(again[4] | again[5] << 8, 6);
+    EXPECT_EQ(again[4] | again[5] << 8, 7);
     Result<Snapshot> reloaded = decodeSnapshot(again.data(), again.size(), "again.rsnap");
     ASSERT_TRUE(reloaded) << reloaded.error().message;
     EXPECT_EQ(reloaded->world.objects[0].mesh, o.mesh);
@@ -465,8 +465,8 @@ TEST(Snapshot, DamagedFilesAreRefusedNamingOffsetAndFieldAndTheWorldStaysAsItWas
     refused(b, "field crc32: checksum mismatch");
     // Another version, another format.
     b = bytes;
-    b[4] = 7;
-    refused(b, "offset 4, field version: version 7 is not supported");
+    b[4] = 8;
+    refused(b, "offset 4, field version: version 8 is not supported");
     b = bytes;
     b[0] = 'X';
     refused(b, "offset 0, field magic");

@@ -2,8 +2,12 @@
 // decomposing at load: scaled with the model, and only when it was made for that very mesh.
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <sstream>
+
 #include "TestSupport.hpp"
 #include "ToyPhysics.hpp"
+#include "geometry/FormerMeshHash.hpp"
 #include "rubble/io/DecompositionFile.hpp"
 #include "rubble/io/MeshIO.hpp"
 #include "rubble/io/SceneConfig.hpp"
@@ -62,6 +66,38 @@ TEST(SceneDecompositionFile, PartsBesideTheModelAreLoadedScaledInsteadOfDecompos
     for (const std::string& w : warnings)
         warned = warned || w.find("another mesh") != std::string::npos;
     EXPECT_TRUE(warned) << test::joinLines(warnings);
+}
+
+// A version-1 file names its mesh by Mesh::hash's former FNV-1a: still loaded, and still refused for
+// another mesh.
+TEST(SceneDecompositionFile, AVersionOneFileIsCheckedByTheFormerHash) {
+    const auto dir = test::tempDir("scene_parts_file_v1");
+    const Mesh block = makeBox({-0.5, -0.5, -0.5}, {0.5, 0.5, 0.5});
+    ASSERT_TRUE(writeObj(dir / "block.obj", block));
+    const Mesh read = readMesh(dir / "block.obj").value();
+    ASSERT_NE(detail::formerMeshHash(read), read.hash());
+    const auto path = decompositionPathFor(dir / "block.obj");
+    auto writeVersionOne = [&](std::uint64_t hash) {
+        DecompositionFile file{hash,
+                               1.0,
+                               {ConvexPolytope::fromAabb({{-0.5, -0.5, -0.5}, {0, 0.5, 0.5}}),
+                                ConvexPolytope::fromAabb({{0, -0.5, -0.5}, {0.5, 0.5, 0.5}})}};
+        ASSERT_TRUE(writeDecompositionFile(path, file));
+        std::stringstream text;
+        text << std::ifstream(path).rdbuf();
+        std::string json = text.str();
+        const auto at = json.find("\"version\":2");
+        ASSERT_NE(at, std::string::npos) << json;
+        json.replace(at, 11, "\"version\":1");
+        test::writeFile(path, json);
+    };
+    writeVersionOne(detail::formerMeshHash(read));
+    std::vector<std::string> warnings;
+    EXPECT_EQ(loadedParts(dir, warnings).size(), 2u) << test::joinLines(warnings);
+    EXPECT_FALSE(test::mentions(warnings, "parts.json")) << test::joinLines(warnings);
+    writeVersionOne(detail::formerMeshHash(read) ^ 1);
+    EXPECT_EQ(loadedParts(dir, warnings).size(), 1u);
+    EXPECT_TRUE(test::mentions(warnings, "another mesh")) << test::joinLines(warnings);
 }
 
 } // namespace

@@ -8,11 +8,11 @@
 
 namespace rubble::test {
 
-/// A hash of a fracture's pieces' meshes, in order (same seed → same bytes).
-inline std::uint64_t hashPieces(const FractureResult& r) {
+/// A hash of a fracture's pieces' meshes, in order (same seed → same bytes), each hashed by meshHash.
+inline std::uint64_t hashPieces(const FractureResult& r, std::uint64_t (*meshHash)(const Mesh&) = nullptr) {
     std::uint64_t h = 1469598103934665603ull;
     for (const Piece& p : r.pieces)
-        h = mixSeed(h, p.mesh.hash());
+        h = mixSeed(h, meshHash ? meshHash(p.mesh) : p.mesh.hash());
     return h;
 }
 

@@ -15,7 +15,7 @@ namespace rubble {
 
 /// The contents of a decomposition file: the parts and the mesh they were made for.
 struct RUBBLE_API DecompositionFile {
-    std::uint64_t meshHash = 0;        ///< Mesh::hash() of the mesh as read from its file
+    std::uint64_t meshHash = 0;        ///< Mesh::hash() of the mesh as read (version 1: its former hash)
     double meshVolume = 0;             ///< volume of that mesh
     std::vector<ConvexPolytope> parts; ///< convex parts in the mesh's coordinates
 };
@@ -23,7 +23,7 @@ struct RUBBLE_API DecompositionFile {
 /// The file beside a mesh asset: "arch.obj" -> "arch.parts.json".
 RUBBLE_API std::filesystem::path decompositionPathFor(const std::filesystem::path& meshPath);
 
-/// Writes {"format": "rubble-decomposition", "version": 1, "mesh_hash", "mesh_volume", "parts": [{"faces":
+/// Writes {"format": "rubble-decomposition", "version": 2, "mesh_hash", "mesh_volume", "parts": [{"faces":
 /// [{"normal", "offset", "corners"}]}]} with shortest round-trip numbers, atomically (staging file + rename).
 RUBBLE_API Status writeDecompositionFile(const std::filesystem::path& path, const DecompositionFile& file);
 
