@@ -9,6 +9,7 @@
 
 #include "collision/HullWitness.hpp"
 #include "collision/MeshRegion.hpp"
+#include "collision/SmallHull.hpp"
 #include "rubble/collision/CollisionTolerance.hpp"
 #include "rubble/collision/ConvexDecomposition.hpp"
 #include "rubble/fracture/Fracture.hpp"
@@ -428,7 +429,7 @@ void collapseSiblings(std::vector<ConvexPolytope>& parts, std::vector<std::uint3
                 const auto v = parts[i].vertices();
                 pts.insert(pts.end(), v.begin(), v.end());
             }
-            auto h = convexHull(pts);
+            auto h = detail::hullOfFew(pts);
             const Overlaps covered = h && guard ? guard->overlaps(*h) : Overlaps{};
             if (h && (!guard || guard->excess(covered) <= 0)) {
                 if (guard)
@@ -593,7 +594,7 @@ void mergeToBudget(std::vector<ConvexPolytope>& parts, std::vector<std::uint32_t
                 corners[k] = parts[k].vertices();
         std::vector<Vec3> pts = corners[c.i];
         pts.insert(pts.end(), corners[c.j].begin(), corners[c.j].end());
-        auto h = convexHull(pts);
+        auto h = detail::hullOfFew(pts);
         if (!h)
             return nullptr;
         const double cost = h->volume() - volumes[c.i] - volumes[c.j];
@@ -950,11 +951,12 @@ void fitPiece(std::size_t i, Assignment& a, const PieceSet& pieces,
         // The hull of the extremes in 26 directions lies inside the full hull: when it is already larger
         // than the parts together, they do not fill their hull (and the full hull is not computed).
         const double fillTol = highPoly ? kHighPolyFillTolerance : 1e-6;
-        if (auto quick = convexHull(extremePoints(pts)); quick && quick->volume() > sum * (1 + fillTol)) {
+        if (auto quick = detail::hullOfFew(extremePoints(pts));
+            quick && quick->volume() > sum * (1 + fillTol)) {
             mergeToBudget(parts, a.origins[i], params.maxParts, g);
             return;
         }
-        auto h = convexHull(pts);
+        auto h = detail::hullOfFew(pts);
         if (h && h->volume() <= sum * (1 + fillTol) && (!g || g->excess(g->overlaps(*h)) <= 0)) {
             parts.clear();
             parts.push_back(std::move(h.value()));

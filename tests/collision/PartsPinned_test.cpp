@@ -15,7 +15,7 @@
 namespace rubble {
 namespace {
 
-constexpr std::uint64_t kExpectedPartsHash = 0x6C0967BA85A06349ull;
+constexpr std::uint64_t kExpectedPartsHash = 0x202F62372B1D2F63ull;
 
 std::uint64_t mixParts(std::uint64_t h, const std::vector<ConvexPolytope>& parts) {
     h = mixSeed(h, parts.size());
