@@ -243,7 +243,10 @@ private:
                 continue;
             for (int k = 0; k < 3; ++k) {
                 const std::uint32_t a = t.v[k], b = t.v[(k + 1) % 3];
-                const auto g = static_cast<std::uint32_t>(edge(b, a));
+                const std::int32_t twin = edge(b, a);
+                if (twin < 0)
+                    return std::nullopt;
+                const auto g = static_cast<std::uint32_t>(twin);
                 if (g <= f)
                     continue;
                 const Tri& u = tris_[g];
@@ -284,7 +287,10 @@ private:
                 const Tri& t = tris_[f];
                 for (int k = 0; k < 3; ++k) {
                     const std::uint32_t a = t.v[k], b = t.v[(k + 1) % 3];
-                    if (faceOf[static_cast<std::size_t>(edge(b, a))] != static_cast<std::int32_t>(i))
+                    const std::int32_t twin = edge(b, a);
+                    if (twin < 0)
+                        return std::nullopt;
+                    if (faceOf[static_cast<std::size_t>(twin)] != static_cast<std::int32_t>(i))
                         boundary.emplace_back(a, b);
                 }
             }
