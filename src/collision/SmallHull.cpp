@@ -177,7 +177,9 @@ private:
                 }
             }
         }
-        if (!oneLoop(horizon))
+        const bool loop = oneLoop(horizon);
+        clearLoop(horizon);
+        if (!loop)
             return false;
         for (std::int32_t f : visible) {
             Tri& t = tris_[static_cast<std::size_t>(f)];
@@ -191,34 +193,32 @@ private:
         return true;
     }
 
-    // True when the directed edges form one simple loop.
+    // True when the directed edges form one simple loop; leaves each edge's end in next_ (clearLoop empties
+    // it).
     bool oneLoop(const std::vector<std::pair<std::uint32_t, std::uint32_t>>& edges) {
-        if (edges.size() < 3)
-            return false;
-        bool ok = true;
+        bool ok = edges.size() >= 3;
         for (const auto& [a, b] : edges) {
             ok = ok && next_[a] < 0;
             next_[a] = static_cast<std::int32_t>(b);
         }
-        if (ok) {
-            std::uint32_t v = edges.front().first;
-            for (std::size_t k = 0; k < edges.size() && ok; ++k) {
-                ok = next_[v] >= 0;
-                if (ok)
-                    v = static_cast<std::uint32_t>(next_[v]);
-            }
-            ok = ok && v == edges.front().first;
-            ++stamp_;
-            std::uint32_t u = edges.front().first;
-            for (std::size_t k = 0; k < edges.size() && ok; ++k) {
-                ok = seen_[u] != stamp_;
-                seen_[u] = stamp_;
-                u = static_cast<std::uint32_t>(next_[u]);
-            }
+        if (!ok)
+            return false;
+        ++stamp_;
+        const std::uint32_t start = edges.front().first;
+        std::uint32_t v = start;
+        for (std::size_t k = 0; k < edges.size() && ok; ++k) {
+            ok = next_[v] >= 0 && seen_[v] != stamp_;
+            seen_[v] = stamp_;
+            if (ok)
+                v = static_cast<std::uint32_t>(next_[v]);
         }
+        return ok && v == start;
+    }
+
+    // Empties next_ at the edges' starts.
+    void clearLoop(const std::vector<std::pair<std::uint32_t, std::uint32_t>>& edges) {
         for (const auto& e : edges)
             next_[e.first] = -1;
-        return ok;
     }
 
     // Live triangles in one plane (each one's far corner within rounding of the other's plane) merged into
@@ -294,10 +294,10 @@ private:
                         boundary.emplace_back(a, b);
                 }
             }
-            if (!oneLoop(boundary))
+            if (!oneLoop(boundary)) {
+                clearLoop(boundary);
                 return std::nullopt;
-            for (const auto& [a, b] : boundary)
-                next_[a] = static_cast<std::int32_t>(b);
+            }
             const std::uint32_t first = std::min_element(boundary.begin(), boundary.end())->first;
             std::uint32_t v = first;
             double lo = 1e300, hi = -1e300;
@@ -309,8 +309,7 @@ private:
                 hi = std::max(hi, d);
                 v = static_cast<std::uint32_t>(next_[v]);
             } while (v != first);
-            for (const auto& e : boundary)
-                next_[e.first] = -1;
+            clearLoop(boundary);
             if (!(hi - lo <= 4 * eps_))
                 return std::nullopt;
             face.plane.offset = hi;
