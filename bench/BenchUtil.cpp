@@ -165,6 +165,25 @@ bool writeCsv(const fs::path& path, const Table& table) {
     return true;
 }
 
+std::vector<std::vector<std::string>> rowsOfOtherLabels(const std::filesystem::path& path,
+                                                        const std::string& label, std::size_t columns) {
+    std::vector<std::vector<std::string>> rows;
+    std::ifstream in(path);
+    std::string line;
+    std::getline(in, line); // header
+    while (std::getline(in, line)) {
+        std::vector<std::string> cells;
+        std::stringstream ss(line);
+        for (std::string c; std::getline(ss, c, ',');)
+            cells.push_back(c);
+        if (!line.empty() && line.back() == ',') // an empty last cell
+            cells.emplace_back();
+        if (cells.size() == columns && cells[0] != label)
+            rows.push_back(std::move(cells));
+    }
+    return rows;
+}
+
 bool makeResultsDir(const fs::path& dir) {
     std::error_code ec;
     if (fs::exists(dir, ec) && !fs::is_directory(dir, ec)) {

@@ -81,6 +81,11 @@ void printTable(const Table& table);
 /// Returns false (after printing why) when the file cannot be written.
 bool writeCsv(const std::filesystem::path& path, const Table& table);
 
+/// The rows of an earlier CSV at path with `columns` cells whose first cell (the label) is not `label`, so
+/// that a before and an after run share one file.
+std::vector<std::vector<std::string>> rowsOfOtherLabels(const std::filesystem::path& path,
+                                                        const std::string& label, std::size_t columns);
+
 /// Creates the results folder dir; false (after printing why on stderr) when it cannot be, e.g. when dir
 /// names a file.
 bool makeResultsDir(const std::filesystem::path& dir);

@@ -5,7 +5,6 @@
 // coordinates, as the pieces of a game carry them. The two are timed alternately, R runs each; medians.
 // Table on stdout, mesh_hash.csv (rows of other labels kept) and mesh_hash.png in DIR.
 #include <algorithm>
-#include <fstream>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -27,35 +26,6 @@ struct BenchArgs {
     std::string out = rubble::bench::resultsDir();
 };
 
-/// The mesh with flat per-corner normals and texture coordinates from its positions.
-rubble::Mesh withAttributes(rubble::Mesh mesh) {
-    mesh.computeFlatNormals();
-    mesh.uvs.resize(3 * mesh.triangles.size());
-    for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
-        for (int c = 0; c < 3; ++c) {
-            const rubble::Vec3& p = mesh.positions[mesh.triangles[t][c]];
-            mesh.uvs[3 * t + c] = rubble::Vec2f{static_cast<float>(p.x), static_cast<float>(p.z)};
-        }
-    return mesh;
-}
-
-/// The rows of an earlier mesh_hash.csv whose label differs from this run's.
-std::vector<std::vector<std::string>> keptRows(const std::filesystem::path& path, const std::string& label) {
-    std::vector<std::vector<std::string>> rows;
-    std::ifstream in(path);
-    std::string line;
-    std::getline(in, line); // header
-    while (std::getline(in, line)) {
-        std::vector<std::string> cells;
-        std::stringstream ss(line);
-        for (std::string cell; std::getline(ss, cell, ',');)
-            cells.push_back(cell);
-        if (!cells.empty() && cells[0] != label)
-            rows.push_back(cells);
-    }
-    return rows;
-}
-
 int runBench(BenchArgs args) {
     if (args.quick) {
         args.sizes = {2000};
@@ -64,9 +34,10 @@ int runBench(BenchArgs args) {
     rubble::bench::Table table{
         {"label", "triangles", "mbytes", "former_fnv1a_ms", "words_ms", "speedup", "other_cpu_cores"}, {}};
     const std::filesystem::path csvPath = std::filesystem::path(args.out) / "mesh_hash.csv";
-    table.rows = keptRows(csvPath, args.label);
+    table.rows = rubble::bench::rowsOfOtherLabels(csvPath, args.label, table.header.size());
     for (std::size_t size : args.sizes) {
-        const rubble::Mesh mesh = withAttributes(rubble::bench::megaMesh("geosphere", size));
+        const rubble::Mesh mesh =
+            rubble::bench::withFlatAttributes(rubble::bench::megaMesh("geosphere", size));
         const double bytes = static_cast<double>(
             mesh.positions.size() * sizeof(rubble::Vec3) + mesh.triangles.size() * sizeof(rubble::Triangle) +
             mesh.normals.size() * sizeof(rubble::Vec3f) + mesh.uvs.size() * sizeof(rubble::Vec2f));

@@ -65,6 +65,15 @@ Mesh subdivideTriangles(const Mesh& mesh, int n) {
     return out;
 }
 
+Mesh withFlatAttributes(Mesh m) {
+    m.computeFlatNormals();
+    m.uvs.reserve(3 * m.triangles.size());
+    for (const Triangle& t : m.triangles)
+        for (std::uint32_t v : t)
+            m.uvs.push_back({m.positions[v].x, m.positions[v].z});
+    return m;
+}
+
 Mesh megaMesh(const std::string& kind, std::size_t triangles) {
     const double t = static_cast<double>(triangles);
     if (kind == "sphere") { // 2 · slices · (stacks − 1) triangles, slices = 2 · stacks

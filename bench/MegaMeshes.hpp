@@ -22,6 +22,9 @@ Mesh subdivideTriangles(const Mesh& mesh, int n);
 /// body with seven limbs) and "bumpy" (a potato) are the geodesic sphere displaced along its radius.
 Mesh megaMesh(const std::string& kind, std::size_t triangles);
 
+/// The mesh with flat per-corner normals and texture coordinates from its positions' x and z.
+Mesh withFlatAttributes(Mesh mesh);
+
 /// The kinds of megaMesh.
 inline const std::vector<std::string> kMegaKinds = {"sphere", "geosphere", "torus", "arch"};
 /// The organic kinds of megaMesh.

@@ -17,7 +17,6 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -253,18 +252,9 @@ Row piecesRow(const Templates& t, int n) {
 }
 
 // The mesh with per-corner flat normals and planar texture coordinates, as an OBJ asset brings them.
-Mesh withAttributes(Mesh m) {
-    m.computeFlatNormals();
-    m.uvs.reserve(3 * m.triangles.size());
-    for (const Triangle& t : m.triangles)
-        for (std::uint32_t v : t)
-            m.uvs.push_back({m.positions[v].x, m.positions[v].z});
-    return m;
-}
-
 Row largeRow(const std::string& kind, std::size_t triangles, bool attributes) {
     Row row;
-    const Mesh mesh = attributes ? withAttributes(rubble::bench::megaMesh(kind, triangles))
+    const Mesh mesh = attributes ? rubble::bench::withFlatAttributes(rubble::bench::megaMesh(kind, triangles))
                                  : rubble::bench::megaMesh(kind, triangles);
     row.name = kind + "_" + std::to_string(mesh.triangles.size()) + (attributes ? "_attributes" : "");
     row.count = mesh.triangles.size();
@@ -369,18 +359,7 @@ int runBench(const BenchArgs& args) {
                              {}};
     // rows of other labels already in the file stay (a before and an after run side by side)
     const fs::path csvPath = fs::path(args.out) / "memory.csv";
-    if (std::ifstream in(csvPath); in) {
-        std::string line;
-        std::getline(in, line);
-        while (std::getline(in, line)) {
-            std::vector<std::string> cells;
-            std::stringstream ss(line);
-            for (std::string c; std::getline(ss, c, ',');)
-                cells.push_back(c);
-            if (cells.size() == csv.header.size() && cells[0] != args.label)
-                csv.rows.push_back(cells);
-        }
-    }
+    csv.rows = rubble::bench::rowsOfOtherLabels(csvPath, args.label, csv.header.size());
     for (const Row& r : rows)
         csv.rows.push_back(csvRow(args.label, r, otherCpu));
     rubble::bench::Table table{{"label", "case", "count", "B/unit", "world alone", "scratch", "tri/piece",
