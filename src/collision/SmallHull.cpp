@@ -134,8 +134,7 @@ private:
         return true;
     }
 
-    // Adds point i: the triangles it sees (reached from the one it sees most) go, and a fan from i to their
-    // horizon comes. False when the horizon is not one loop or a new triangle has no area.
+    // Replaces the triangles point i sees by a fan from i to their horizon; false where that cannot close.
     bool insert(std::uint32_t i) {
         const Vec3& p = p_[i];
         std::int32_t best = -1;
@@ -193,8 +192,7 @@ private:
         return true;
     }
 
-    // True when the directed edges form one simple loop; leaves each edge's end in next_ (clearLoop empties
-    // it).
+    // True when the directed edges form one simple loop; each edge's end stays in next_ until clearLoop.
     bool oneLoop(const std::vector<std::pair<std::uint32_t, std::uint32_t>>& edges) {
         bool ok = edges.size() >= 3;
         for (const auto& [a, b] : edges) {
@@ -221,8 +219,7 @@ private:
             next_[e.first] = -1;
     }
 
-    // Live triangles in one plane (each one's far corner within rounding of the other's plane) merged into
-    // faces; corners on fewer than three faces (inside an edge) dropped.
+    // The polytope of the live triangles, those in one plane merged into one face (docs/collision.md).
     std::optional<ConvexPolytope> faces() {
         std::vector<std::uint32_t> root(tris_.size());
         std::iota(root.begin(), root.end(), 0u);

@@ -1,6 +1,5 @@
 #pragma once
-// Private helper of the geometry module (inline, so that the bench can time it): Mesh::hash as it was before
-// decomposition files' version 2.
+// Private helper of the geometry module: Mesh::hash as it was before (inline: the bench times it too).
 
 #include <bit>
 #include <cstddef>
@@ -10,8 +9,7 @@
 
 namespace rubble::detail {
 
-/// FNV-1a over the mesh's bytes (attributes widened to double, -0.0 folded into 0.0): what a version-1
-/// decomposition file names its mesh by.
+/// FNV-1a over the mesh's bytes, which a version-1 decomposition file names its mesh by.
 inline std::uint64_t formerMeshHash(const Mesh& mesh) {
     std::uint64_t h = 1469598103934665603ull;
     auto bytes = [&h](const void* p, std::size_t n) {

@@ -130,8 +130,7 @@ void Mesh::removeUnreferencedVertices() {
 }
 
 namespace {
-/// A 64-bit hash of a stream of 64-bit words in four interleaved lanes (xxHash64's round, merge and
-/// avalanche).
+/// A 64-bit hash of 64-bit words in four interleaved lanes (xxHash64's round and avalanche).
 class WordHasher {
 public:
     void word(std::uint64_t w) {
