@@ -725,7 +725,7 @@ void StressSolver::route(std::vector<Route>& changes) {
 // Bond k of node n is a weld to a lower or held node, facing down from below n (any such weld when steep).
 bool StressSolver::weldBeneath(std::size_t k, std::uint32_t n, const Vec3& down, bool steep) const {
     const BondState& b = bonds_[k];
-    if (b.broken || !b.solvable || !b.corners.empty())
+    if (!b.intactWeld())
         return false;
     const std::uint32_t m = b.bond.other(n);
     const Vec3& c = nodes_[n].node.centroid;
@@ -769,7 +769,7 @@ void StressSolver::routeUnbalanced(double tolerance) {
                 for (std::size_t k : nodes_[ring[i]].bonds) {
                     const BondState& b = bonds_[k];
                     const std::uint32_t m = b.bond.other(ring[i]);
-                    if (!b.broken && b.solvable && b.corners.empty() && movable(m))
+                    if (b.intactWeld() && movable(m))
                         ring.push_back(m);
                 }
             std::sort(ring.begin(), ring.end());

@@ -185,6 +185,8 @@ private:
         bool broken = false;
         bool removed = false;               // a free slot
         std::vector<BearingCorner> corners; // bearing: contact points at the patch's hull corners
+        /// A weld (no bearing corners) that holds and can be solved.
+        bool intactWeld() const { return !broken && solvable && corners.empty(); }
     };
     void prepare(BondState& b);
     void removeBond(std::size_t i);
