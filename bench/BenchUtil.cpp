@@ -9,12 +9,16 @@
 #include <sstream>
 #include <thread>
 
+namespace rubble::generated {
+extern const char* const sourceDir; // rubble_paths_unit
+} // namespace rubble::generated
+
 namespace rubble::bench {
 
 namespace fs = std::filesystem;
 
 fs::path sourceDir() {
-    return RUBBLE_SOURCE_DIR;
+    return generated::sourceDir;
 }
 
 std::string resultsDir() {

@@ -34,6 +34,10 @@
 #include "Weapons.hpp"
 #include "rubble/rubble.hpp"
 
+namespace rubble::generated {
+extern const char* const sourceDir; // rubble_paths_unit
+} // namespace rubble::generated
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -231,7 +235,7 @@ bool prepareRenderer(App& a, std::string& error) {
     // Interior material of cut faces: interior.png next to the scene, in ../textures, or in assets/textures.
     for (const auto& candidate :
          {a.scene.baseDir / "interior.png", a.scene.baseDir / "../textures/interior.png",
-          std::filesystem::path(RUBBLE_SOURCE_DIR) / "assets/textures/interior.png"})
+          std::filesystem::path(rubble::generated::sourceDir) / "assets/textures/interior.png"})
         if (std::filesystem::exists(candidate) && a.renderer.setInteriorTexture(candidate))
             break;
     bool skyOk = true;
@@ -504,7 +508,8 @@ int setUp(App& app, RunMode& mode) {
     }
 
     // Scene.
-    const std::filesystem::path assets = std::filesystem::path(RUBBLE_SOURCE_DIR) / "assets/scenes";
+    const std::filesystem::path assets =
+        std::filesystem::path(rubble::generated::sourceDir) / "assets/scenes";
     std::filesystem::path scenePath =
         o.scene.empty() ? assets / "demolition.cfg" : std::filesystem::path(o.scene);
     if (o.scene.empty() && !std::filesystem::exists(scenePath))
@@ -513,7 +518,7 @@ int setUp(App& app, RunMode& mode) {
         std::fprintf(stderr, "warning: %s not found; using the built-in fallback scene\n",
                      scenePath.string().c_str());
         auto r = rubble::parseSceneConfigText(kFallbackScene, "builtin.cfg",
-                                              std::filesystem::path(RUBBLE_SOURCE_DIR) / "assets");
+                                              std::filesystem::path(rubble::generated::sourceDir) / "assets");
         if (!r) {
             std::fprintf(stderr, "error: %s\n", r.error().message.c_str());
             return 1;
@@ -534,7 +539,7 @@ int setUp(App& app, RunMode& mode) {
         const char* seedEnv = std::getenv("RUBBLE_SEED_MEDIA");
         const std::filesystem::path seed =
             seedEnv ? std::filesystem::path(seedEnv)
-                    : std::filesystem::path(RUBBLE_SOURCE_DIR) / "../shared/seed/media";
+                    : std::filesystem::path(rubble::generated::sourceDir) / "../shared/seed/media";
         for (const auto& p : {assets / "demolition.cfg", seed / "world.cfg", seed / "performance_test.cfg",
                               seed / "cube_test.cfg", assets / "world.cfg"}) {
             std::error_code ec;

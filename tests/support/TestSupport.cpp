@@ -11,14 +11,19 @@
 #include "rubble/geometry/MassProperties.hpp"
 #include "rubble/geometry/MeshCheck.hpp"
 
+namespace rubble::generated {
+extern const char* const sourceDir; // rubble_paths_unit
+extern const char* const binaryDir;
+} // namespace rubble::generated
+
 namespace rubble::test {
 
 std::filesystem::path sourceDir() {
-    return RUBBLE_SOURCE_DIR;
+    return generated::sourceDir;
 }
 
 std::filesystem::path tempDir(const std::string& name) {
-    const auto dir = std::filesystem::path(RUBBLE_BINARY_DIR) / "test-tmp" / name;
+    const auto dir = std::filesystem::path(generated::binaryDir) / "test-tmp" / name;
     std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
     return dir;
