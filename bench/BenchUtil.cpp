@@ -9,9 +9,7 @@
 #include <sstream>
 #include <thread>
 
-namespace rubble::generated {
-extern const char* const sourceDir; // rubble_paths_unit
-} // namespace rubble::generated
+#include "RubblePaths.hpp"
 
 namespace rubble::bench {
 

@@ -29,14 +29,11 @@
 #include "RasterThreads.hpp"
 #include "RenderBench.hpp"
 #include "Renderer.hpp"
+#include "RubblePaths.hpp"
 #include "RunReport.hpp"
 #include "ScaledTarget.hpp"
 #include "Weapons.hpp"
 #include "rubble/rubble.hpp"
-
-namespace rubble::generated {
-extern const char* const sourceDir; // rubble_paths_unit
-} // namespace rubble::generated
 
 namespace {
 

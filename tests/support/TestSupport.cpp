@@ -8,13 +8,9 @@
 #include <fstream>
 #include <map>
 
+#include "RubblePaths.hpp"
 #include "rubble/geometry/MassProperties.hpp"
 #include "rubble/geometry/MeshCheck.hpp"
-
-namespace rubble::generated {
-extern const char* const sourceDir; // rubble_paths_unit
-extern const char* const binaryDir;
-} // namespace rubble::generated
 
 namespace rubble::test {
 
